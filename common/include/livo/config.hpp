@@ -1,0 +1,124 @@
+// YAML configuration with strict checking: a missing required key, a value of the wrong type or
+// a key nobody reads is an error naming the file and the full key path.
+//
+//   livo::Config cfg = livo::Config::load("config/sim/room.yaml");
+//   livo::Config lio = cfg.section("lio");
+//   lio.read("max_iterations", opts.max_iterations);          // required
+//   lio.readOptional("voxel_size", opts.voxel_size);           // keeps the struct's default
+//   lio.checkAllUsed();                                        // unknown keys under lio.*
+#pragma once
+
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <yaml-cpp/yaml.h>
+
+namespace livo {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Config {
+ public:
+  /// Parses a YAML file; throws ConfigError if it is missing or malformed.
+  static Config load(const std::string& file);
+  /// Parses YAML text (tests, embedded defaults); `name` stands for the file in messages.
+  static Config fromString(const std::string& yaml, const std::string& name = "<string>");
+
+  /// A required nested map.
+  Config section(const std::string& key) const;
+  /// An optional nested map; an empty (null) config if absent.
+  Config optionalSection(const std::string& key) const;
+  bool has(const std::string& key) const;
+  bool isNull() const { return !node_ || node_.IsNull(); }
+  /// Keys of this map in file order.
+  std::vector<std::string> keys() const;
+
+  template <class T>
+  void read(const std::string& key, T& value) const {
+    value = convert<T>(child(key, true), key);
+  }
+  template <class T>
+  bool readOptional(const std::string& key, T& value) const {
+    YAML::Node n = child(key, false);
+    if (!n) return false;
+    value = convert<T>(n, key);
+    return true;
+  }
+  template <class T>
+  T get(const std::string& key) const {
+    T v{};
+    read(key, v);
+    return v;
+  }
+
+  /// Marks a key (and everything under it) as handled without reading it.
+  void ignore(const std::string& key) const;
+  /// Throws ConfigError listing every key under this section that was never read.
+  void checkAllUsed() const;
+  /// Throws ConfigError if this map has a top-level key outside `allowed`.
+  void checkKeysIn(const std::vector<std::string>& allowed) const;
+
+  const std::string& file() const { return state_->file; }
+  /// Dotted path of this section ("" for the root).
+  const std::string& path() const { return path_; }
+  std::string keyPath(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  /// "file: key.path: what" for error messages.
+  std::string where(const std::string& key) const;
+
+ private:
+  struct State {
+    std::string file;
+    std::set<std::string> used;   // full key paths read or ignored
+    std::set<std::string> opened; // sections opened with section()/optionalSection()
+    std::set<std::string> asked;  // every key path asked for, present or not (for suggestions)
+  };
+  Config(YAML::Node node, std::shared_ptr<State> state, std::string path)
+      : node_(std::move(node)), state_(std::move(state)), path_(std::move(path)) {}
+
+  YAML::Node child(const std::string& key, bool required) const;
+  template <class T>
+  T convert(const YAML::Node& n, const std::string& key) const;
+  void collectUnused(const YAML::Node& n, const std::string& path, std::vector<std::string>* out) const;
+
+  YAML::Node node_;
+  std::shared_ptr<State> state_;
+  std::string path_;
+};
+
+
+// Explicit specialisations of Config::convert, defined in config.cpp.
+#define LIVO_CONFIG_TYPE(T) template <> T Config::convert<T>(const YAML::Node&, const std::string&) const;
+LIVO_CONFIG_TYPE(bool)
+LIVO_CONFIG_TYPE(int)
+LIVO_CONFIG_TYPE(int64_t)
+LIVO_CONFIG_TYPE(double)
+LIVO_CONFIG_TYPE(float)
+LIVO_CONFIG_TYPE(std::string)
+LIVO_CONFIG_TYPE(std::vector<double>)
+LIVO_CONFIG_TYPE(std::vector<int>)
+LIVO_CONFIG_TYPE(std::vector<std::string>)
+LIVO_CONFIG_TYPE(Eigen::Vector3d)
+LIVO_CONFIG_TYPE(Eigen::Matrix3d)
+LIVO_CONFIG_TYPE(Eigen::Matrix4d)
+LIVO_CONFIG_TYPE(Eigen::Quaterniond)
+LIVO_CONFIG_TYPE(Eigen::Isometry3d)
+#undef LIVO_CONFIG_TYPE
+
+// Supported value types (defined in config.cpp): bool, int, int64_t, double, float,
+// std::string, std::vector<double|int|std::string>, Eigen::Vector3d, Eigen::Matrix3d (9 numbers,
+// row-major), Eigen::Matrix4d (16 numbers, row-major), Eigen::Quaterniond ([w, x, y, z]),
+// Eigen::Isometry3d ({translation: [x, y, z], rotation: [w, x, y, z]} or
+// {translation: [...], rpy_deg: [roll, pitch, yaw]} or a 16-number row-major matrix).
+
+/// Top-level sections a project config file may hold; each process reads those it needs.
+extern const std::vector<std::string> kConfigSections;
+
+}  // namespace livo

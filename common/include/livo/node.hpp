@@ -1,0 +1,144 @@
+// The node framework every process is built on: typed subscriptions that count decode failures
+// instead of dying, per-channel processing-time statistics, PROGRESS for lockstep replay, HEALTH,
+// and a spin loop with clean shutdown on SIGINT/SIGTERM.
+//
+// A process is a node class holding a livo::Node; main() parses the command line, builds the
+// node on an lcm::LCM (udpm:// on a bus, memq:// in tests) and calls livo::spin().
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <iosfwd>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "livo/channel_stats_t.hpp"
+#include "livo/latency_stats.hpp"
+
+namespace livo {
+
+struct NodeOptions {
+  std::string name;                      // unique on the bus; PROGRESS and HEALTH carry it
+  std::string progress_channel = "PROGRESS";
+  std::string health_channel = "HEALTH";
+  double health_period_s = 1.0;          // wall-clock period of HEALTH messages; 0 disables
+  bool publish_progress = true;          // a PROGRESS message after every handled input
+  bool quiet = false;                    // no summary on stderr at shutdown
+};
+
+class Node {
+ public:
+  Node(lcm::LCM& lcm, NodeOptions options);
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+  ~Node();
+
+  /// Subscribes with a typed handler. A message that fails to decode is counted and reported,
+  /// never passed on; an exception from the handler is counted as a rejected message.
+  template <class Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> handler) {
+    subscribeRaw(channel, [this, channel, handler = std::move(handler)](const void* data, int size) {
+      Msg msg;
+      if (msg.decode(data, 0, size) != size) {
+        decodeFailed(channel, Msg::getTypeName(), size);
+        return;
+      }
+      if constexpr (hasUtime<Msg>(0)) noteSensorTime(msg.utime);
+      handler(msg);
+    });
+  }
+
+  /// Subscribes to raw bytes; processing time and PROGRESS are still accounted.
+  void subscribeRaw(const std::string& channel, std::function<void(const void*, int)> handler);
+
+  template <class Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    lcm_.publish(channel, &msg);
+    ++published_[channel];
+  }
+  void publishRaw(const std::string& channel, const void* data, int size);
+  /// Declares an output channel so that PROGRESS lists it (with 0) before its first message.
+  void declareOutput(const std::string& channel) { published_.emplace(channel, 0); }
+
+  /// The current message on `channel` was refused (bad stamp, NaN, ...): counted, and reported
+  /// on stderr and HEALTH (each distinct reason at most once per second of wall time).
+  void reject(const std::string& channel, const std::string& why);
+  void info(const std::string& message);
+  void warn(const std::string& message);
+  void error(const std::string& message);
+
+  /// Publishes HEALTH if its period elapsed; spin() calls it.
+  void tick();
+  /// Final PROGRESS (finished = 1) and HEALTH, and the summary on stderr. Idempotent.
+  void finish();
+
+  std::vector<channel_stats_t> channelStats() const;
+  void printSummary(std::ostream& os) const;
+  int64_t handled(const std::string& channel) const;
+  int64_t published(const std::string& channel) const;
+  int64_t decodeFailures() const;
+  int64_t lastSensorTime() const { return last_utime_; }
+  void noteSensorTime(int64_t utime) { last_utime_ = utime; }
+  const std::string& name() const { return options_.name; }
+  lcm::LCM& lcm() { return lcm_; }
+
+ private:
+  struct Subscription {
+    Node* node;
+    std::string channel;
+    std::function<void(const void*, int)> handler;
+    LatencyStats latency;
+    int64_t handled = 0;
+    int64_t decode_failures = 0;
+    int64_t rejected = 0;
+  };
+  static void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
+  template <class M>
+  static constexpr auto hasUtime(int) -> decltype(std::declval<M>().utime, bool()) { return true; }
+  template <class M>
+  static constexpr bool hasUtime(...) { return false; }
+
+  void decodeFailed(const std::string& channel, const char* type, int size);
+  void report(int8_t level, const std::string& message);
+  bool rateLimited(const std::string& key);
+  void publishProgress(bool finished);
+  void publishHealth();
+  Subscription* find(const std::string& channel) const;
+
+  lcm::LCM& lcm_;
+  NodeOptions options_;
+  std::deque<Subscription> subs_;  // stable addresses for LCM's callbacks
+  std::vector<lcm::Subscription*> lcm_subs_;
+  std::map<std::string, int64_t> published_;
+  int64_t progress_sequence_ = 0;
+  int64_t last_utime_ = 0;
+  int8_t level_ = 0;
+  std::string last_event_;
+  std::map<std::string, std::chrono::steady_clock::time_point> last_report_;
+  std::chrono::steady_clock::time_point last_health_;
+  bool finished_ = false;
+  Subscription* current_ = nullptr;  // subscription whose handler is running
+};
+
+/// Sets the shutdown flag on SIGINT/SIGTERM (idempotent).
+void installSignalHandlers();
+void requestShutdown();
+bool shutdownRequested();
+
+/// Handles messages until shutdown is requested or `done()` returns true, calling node.tick()
+/// between messages; then calls `on_shutdown` (flush outputs) and node.finish().
+/// Returns 0, or 1 if the LCM provider failed.
+int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown = {},
+         const std::function<bool()>& done = {});
+
+/// Creates an LCM instance on `url` (empty: LCM_DEFAULT_URL or LCM's default) or throws.
+std::unique_ptr<lcm::LCM> makeLcm(const std::string& url);
+
+}  // namespace livo

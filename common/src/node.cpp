@@ -1,0 +1,227 @@
+#include "livo/node.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "livo/health_t.hpp"
+#include "livo/progress_t.hpp"
+
+namespace livo {
+
+namespace {
+std::atomic<bool> g_shutdown{false};
+extern "C" void onSignal(int) { g_shutdown.store(true); }
+}  // namespace
+
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+void requestShutdown() { g_shutdown.store(true); }
+bool shutdownRequested() { return g_shutdown.load(); }
+
+Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
+  if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
+  last_health_ = std::chrono::steady_clock::now();
+}
+
+Node::~Node() {
+  // Subscriptions point into subs_: unsubscribe before it goes away (the LCM may outlive us).
+  for (auto* s : lcm_subs_) lcm_.unsubscribe(s);
+}
+
+void Node::subscribeRaw(const std::string& channel, std::function<void(const void*, int)> handler) {
+  subs_.push_back(Subscription{this, channel, std::move(handler), {}, 0, 0, 0});
+  Subscription* sub = &subs_.back();
+  lcm_subs_.push_back(lcm_.subscribeFunction(channel, &Node::dispatch, sub));
+}
+
+void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
+  Node& node = *sub->node;
+  node.current_ = sub;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    sub->handler(rbuf->data, static_cast<int>(rbuf->data_size));
+  } catch (const std::exception& e) {
+    node.reject(sub->channel, std::string("handler failed: ") + e.what());
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  sub->latency.add(std::chrono::duration<double>(t1 - t0).count());
+  ++sub->handled;
+  node.current_ = nullptr;
+  if (node.options_.publish_progress) node.publishProgress(false);
+}
+
+void Node::publishRaw(const std::string& channel, const void* data, int size) {
+  lcm_.publish(channel, data, static_cast<unsigned int>(size));
+  ++published_[channel];
+}
+
+Node::Subscription* Node::find(const std::string& channel) const {
+  for (const auto& s : subs_)
+    if (s.channel == channel) return const_cast<Subscription*>(&s);
+  return nullptr;
+}
+
+void Node::decodeFailed(const std::string& channel, const char* type, int size) {
+  if (Subscription* s = find(channel)) ++s->decode_failures;
+  std::ostringstream os;
+  os << "message on " << channel << " (" << size << " bytes) does not decode as " << type << "; dropped";
+  if (!rateLimited("decode:" + channel)) report(health_t::LEVEL_WARN, os.str());
+}
+
+void Node::reject(const std::string& channel, const std::string& why) {
+  if (Subscription* s = find(channel)) ++s->rejected;
+  if (!rateLimited("reject:" + channel + why)) report(health_t::LEVEL_WARN, channel + ": " + why);
+}
+
+void Node::info(const std::string& message) {
+  if (!options_.quiet) std::cerr << "[" << options_.name << "] " << message << std::endl;
+}
+void Node::warn(const std::string& message) { report(health_t::LEVEL_WARN, message); }
+void Node::error(const std::string& message) { report(health_t::LEVEL_ERROR, message); }
+
+bool Node::rateLimited(const std::string& key) {
+  const auto now = std::chrono::steady_clock::now();
+  auto it = last_report_.find(key);
+  if (it != last_report_.end() && now - it->second < std::chrono::seconds(1)) return true;
+  last_report_[key] = now;
+  return false;
+}
+
+void Node::report(int8_t level, const std::string& message) {
+  std::cerr << "[" << options_.name << "] " << (level == health_t::LEVEL_ERROR ? "error: " : "warning: ") << message
+            << std::endl;
+  level_ = std::max(level_, level);
+  last_event_ = message;
+}
+
+void Node::publishProgress(bool finished) {
+  progress_t p;
+  p.utime = last_utime_;
+  p.node = options_.name;
+  p.sequence = progress_sequence_++;
+  p.finished = finished ? 1 : 0;
+  for (const auto& s : subs_) {
+    p.input_channel.push_back(s.channel);
+    p.handled.push_back(s.handled);
+  }
+  p.num_inputs = static_cast<int32_t>(p.input_channel.size());
+  for (const auto& [ch, n] : published_) {
+    p.output_channel.push_back(ch);
+    p.published.push_back(n);
+  }
+  p.num_outputs = static_cast<int32_t>(p.output_channel.size());
+  lcm_.publish(options_.progress_channel, &p);
+}
+
+std::vector<channel_stats_t> Node::channelStats() const {
+  std::vector<channel_stats_t> out;
+  for (const auto& s : subs_) {
+    channel_stats_t c;
+    c.channel = s.channel;
+    c.messages = s.handled;
+    c.decode_failures = s.decode_failures;
+    c.rejected = s.rejected;
+    c.median_ms = s.latency.medianMs();
+    c.p90_ms = s.latency.p90Ms();
+    c.max_ms = s.latency.maxMs();
+    out.push_back(c);
+  }
+  return out;
+}
+
+void Node::publishHealth() {
+  health_t h;
+  h.utime = last_utime_;
+  h.node = options_.name;
+  h.level = level_;
+  h.message = last_event_;
+  h.peak_rss_mb = peakRssMb();
+  h.channels = channelStats();
+  h.num_channels = static_cast<int32_t>(h.channels.size());
+  lcm_.publish(options_.health_channel, &h);
+  level_ = health_t::LEVEL_OK;
+  last_event_.clear();
+}
+
+void Node::tick() {
+  if (options_.health_period_s <= 0.0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_health_).count() >= options_.health_period_s) {
+    last_health_ = now;
+    publishHealth();
+  }
+}
+
+void Node::finish() {
+  if (finished_) return;
+  finished_ = true;
+  publishProgress(true);
+  publishHealth();
+  if (!options_.quiet) printSummary(std::cerr);
+}
+
+int64_t Node::handled(const std::string& channel) const {
+  const Subscription* s = find(channel);
+  return s ? s->handled : 0;
+}
+int64_t Node::published(const std::string& channel) const {
+  auto it = published_.find(channel);
+  return it == published_.end() ? 0 : it->second;
+}
+int64_t Node::decodeFailures() const {
+  int64_t n = 0;
+  for (const auto& s : subs_) n += s.decode_failures;
+  return n;
+}
+
+void Node::printSummary(std::ostream& os) const {
+  os << "[" << options_.name << "] processing time per message (peak RSS " << std::fixed << std::setprecision(1)
+     << peakRssMb() << " MB):\n";
+  os << "  " << std::left << std::setw(22) << "channel" << std::right << std::setw(9) << "messages" << std::setw(11)
+     << "median ms" << std::setw(9) << "p90 ms" << std::setw(9) << "max ms" << std::setw(9) << "decode!" << std::setw(10)
+     << "rejected" << "\n";
+  for (const auto& c : channelStats()) {
+    os << "  " << std::left << std::setw(22) << c.channel << std::right << std::setw(9) << c.messages
+       << std::setprecision(3) << std::setw(11) << c.median_ms << std::setw(9) << c.p90_ms << std::setw(9) << c.max_ms
+       << std::setw(9) << c.decode_failures << std::setw(10) << c.rejected << "\n";
+  }
+  for (const auto& [ch, n] : published_) os << "  published " << ch << ": " << n << "\n";
+  os.flush();
+}
+
+int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, const std::function<bool()>& done) {
+  installSignalHandlers();
+  int rc = 0;
+  while (!shutdownRequested() && !(done && done())) {
+    const int r = lcm.handleTimeout(100);
+    if (r < 0) {
+      node.error("LCM provider failed; shutting down");
+      rc = 1;
+      break;
+    }
+    node.tick();
+  }
+  if (on_shutdown) on_shutdown();
+  node.finish();
+  return rc;
+}
+
+std::unique_ptr<lcm::LCM> makeLcm(const std::string& url) {
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    throw std::runtime_error("cannot open the LCM bus '" + (url.empty() ? std::string("$LCM_DEFAULT_URL") : url) +
+                             "' (on a machine without multicast routing use scripts/private_bus.sh)");
+  }
+  return lcm;
+}
+
+}  // namespace livo

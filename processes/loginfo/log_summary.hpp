@@ -1,0 +1,37 @@
+// Summary of an LCM log file, per channel: type, count, rate, bytes (like `rosbag info`).
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <map>
+#include <string>
+
+namespace livo {
+
+struct ChannelSummary {
+  std::string type;            // project type name, "unknown (0x…)" or "mixed"
+  int64_t count = 0;
+  int64_t bytes = 0;
+  int64_t first_utime = 0;     // event timestamps (log time)
+  int64_t last_utime = 0;
+  int64_t out_of_order = 0;    // events stamped earlier than the previous one on this channel
+  double rateHz() const;
+};
+
+struct LogSummary {
+  std::string path;
+  int64_t file_bytes = 0;
+  int64_t events = 0;
+  int64_t first_utime = 0;
+  int64_t last_utime = 0;
+  int64_t trailing_bytes = 0;  // bytes after the last readable event (truncated or corrupt tail)
+  std::map<std::string, ChannelSummary> channels;
+  double durationS() const { return events ? (last_utime - first_utime) * 1e-6 : 0.0; }
+};
+
+/// Reads the whole log; throws std::runtime_error if it cannot be opened.
+LogSummary summarizeLog(const std::string& path);
+
+void printLogSummary(const LogSummary& s, std::ostream& os);
+
+}  // namespace livo

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs every build, run and test dependency of livo-lcm from Debian 12 packages (apt only).
+# Idempotent: does nothing (and prints nothing) when everything is already installed.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config git
+  # middleware: LCM C/C++ library, lcm-gen / lcm-logger / lcm-logplayer, Java bindings for lcm-spy
+  liblcm-dev libglib2.0-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
+  # math, geometry, vision, mapping, optimisation
+  libeigen3-dev libpcl-dev libopencv-dev liboctomap-dev libceres-dev libflann-dev
+  libnanoflann-dev libyaml-cpp-dev liblz4-dev libbz2-dev zlib1g-dev
+  # tests and benchmarks
+  googletest libgtest-dev libgmock-dev libbenchmark-dev python3
+  # private bus (network namespaces) and process tools
+  iproute2 util-linux procps
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps.sh: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  SUDO="sudo"
+fi
+echo "install_deps.sh: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+log=$(mktemp /tmp/livo-install-deps.XXXXXX.log)
+if ! { $SUDO apt-get update -qq && $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+  echo "install_deps.sh: apt failed; last lines of $log:" >&2
+  tail -n 30 "$log" >&2
+  exit 1
+fi
+rm -f "$log"
