@@ -12,6 +12,9 @@ PACKAGES=(
   libnanoflann-dev libyaml-cpp-dev liblz4-dev libbz2-dev zlib1g-dev
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev python3
+  # livo-import: Ouster metadata JSON; ROS 1 bags written by the real ROS library in its tests
+  nlohmann-json3-dev python3-rosbag python3-roslz4 python3-sensor-msgs python3-geometry-msgs
+  python3-nav-msgs
   # private bus (network namespaces) and process tools
   iproute2 util-linux procps
 )
