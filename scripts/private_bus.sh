@@ -19,8 +19,10 @@ if [ "${LIVO_PRIVATE_BUS:-}" = "1" ]; then
 fi
 
 # ttl=0: never leaves the host even if routed; a large receive buffer for 1 MB point clouds
-# (the kernel caps it at 2 x net.core.rmem_max).
-url="${LIVO_LCM_URL:-udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216}"
+# Ask for what the kernel grants (2 x net.core.rmem_max), up to 16 MB, so LCM does not warn.
+rmem_max=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 8388608)
+buf=$((2 * rmem_max)); [ "$buf" -gt 16777216 ] && buf=16777216
+url="${LIVO_LCM_URL:-udpm://239.255.76.67:7667?ttl=0&recv_buf_size=$buf}"
 
 command -v unshare >/dev/null || { echo "private_bus.sh: 'unshare' (util-linux) is not installed" >&2; exit 1; }
 command -v ip >/dev/null || { echo "private_bus.sh: 'ip' (iproute2) is not installed" >&2; exit 1; }

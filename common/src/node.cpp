@@ -158,7 +158,12 @@ void Node::tick() {
   if (std::chrono::duration<double>(now - last_health_).count() >= options_.health_period_s) {
     last_health_ = now;
     publishHealth();
+    if (options_.publish_progress) publishProgress(false);  // heartbeat: lockstep sees we are alive
   }
+}
+
+void Node::announce() {
+  if (options_.publish_progress) publishProgress(false);
 }
 
 void Node::finish() {
@@ -200,9 +205,11 @@ void Node::printSummary(std::ostream& os) const {
 
 int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, const std::function<bool()>& done) {
   installSignalHandlers();
+  node.announce();
   int rc = 0;
   while (!shutdownRequested() && !(done && done())) {
     const int r = lcm.handleTimeout(100);
+    if (r < 0 && shutdownRequested()) break;  // a signal interrupted the wait
     if (r < 0) {
       node.error("LCM provider failed; shutting down");
       rc = 1;

@@ -15,6 +15,7 @@ struct ChannelSummary {
   int64_t first_utime = 0;     // event timestamps (log time)
   int64_t last_utime = 0;
   int64_t out_of_order = 0;    // events stamped earlier than the previous one on this channel
+  uint64_t digest = 0;         // FNV-1a over the payloads in log order (determinism checks)
   double rateHz() const;
 };
 
@@ -32,6 +33,7 @@ struct LogSummary {
 /// Reads the whole log; throws std::runtime_error if it cannot be opened.
 LogSummary summarizeLog(const std::string& path);
 
-void printLogSummary(const LogSummary& s, std::ostream& os);
+/// `with_digest` adds a column with each channel's payload digest.
+void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest = false);
 
 }  // namespace livo

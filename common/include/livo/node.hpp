@@ -74,7 +74,10 @@ class Node {
   void warn(const std::string& message);
   void error(const std::string& message);
 
-  /// Publishes HEALTH if its period elapsed; spin() calls it.
+  /// Publishes a PROGRESS with zero counts so lockstep playback knows the node is up and
+  /// subscribed; spin() calls it first.
+  void announce();
+  /// Publishes HEALTH (and a heartbeat PROGRESS) if its period elapsed; spin() calls it.
   void tick();
   /// Final PROGRESS (finished = 1) and HEALTH, and the summary on stderr. Idempotent.
   void finish();
