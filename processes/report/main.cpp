@@ -1,0 +1,138 @@
+// livo-report: turns a pipeline run's recorded outputs into the files the user gets back.
+//   livo-report extract OUTPUTS.lcmlog --dir DIR     odometry.tum, trajectory.tum, timing.json
+//   livo-report markdown --dir DIR [...]             report.md from those and livo-evaluate's JSON
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "livo/command_line.hpp"
+#include "pipeline_outputs.hpp"
+#include "run_report.hpp"
+
+namespace {
+
+std::vector<std::string> splitList(const std::string& s, char sep = ',') {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, sep))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+int extract(int argc, char** argv) {
+  livo::CommandLine cli("livo-report extract", "Writes odometry.tum, trajectory.tum and timing.json from a run's outputs log.");
+  cli.positional("OUTPUTS", "LCM log recorded during the run (lcm-logger)")
+      .option("--dir", "DIR", "where to write the files", ".")
+      .option("--odometry-channel", "CH", "online estimate", "ODOMETRY")
+      .option("--keyframe-channel", "CH", "keyframes", "KEYFRAME")
+      .option("--loop-channel", "CH", "loop corrections", "LOOP_CORRECTION")
+      .option("--health-channel", "CH", "node health", "HEALTH");
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  livo::PipelineChannels ch;
+  ch.odometry = cli.get("--odometry-channel");
+  ch.keyframe = cli.get("--keyframe-channel");
+  ch.loop_correction = cli.get("--loop-channel");
+  ch.health = cli.get("--health-channel");
+  const livo::PipelineOutputs out = livo::readPipelineOutputs(cli.get("OUTPUTS"), ch);
+  const std::string dir = cli.get("--dir");
+  livo::writeTum(dir + "/odometry.tum", out.odometry);
+  livo::writeTum(dir + "/trajectory.tum", livo::loopCorrectedTrajectory(out));
+  writeText(dir + "/timing.json", livo::timingJson(out.final_health).dump(2) + "\n");
+  std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
+            << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes\n";
+  if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
+  if (out.non_finite) std::cerr << "livo-report: warning: " << out.non_finite << " odometry poses were not finite\n";
+  if (out.odometry.empty()) {
+    std::cerr << "livo-report: no " << ch.odometry << " messages in " << cli.get("OUTPUTS") << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+int markdown(int argc, char** argv) {
+  livo::CommandLine cli("livo-report markdown", "Writes DIR/report.md from DIR/timing.json, evaluations and figures.");
+  cli.option("--dir", "DIR", "the run's output folder", ".")
+      .option("--log", "LOG", "the replayed log")
+      .option("--config", "FILE", "the pipeline config")
+      .option("--processes", "A,B", "processes that ran")
+      .option("--mode", "M", "lockstep or real time", "lockstep")
+      .option("--log-seconds", "S", "replayed span of the log", "0")
+      .option("--wall-seconds", "S", "wall time of the replay", "0")
+      .option("--evaluation", "TITLE=FILE;...", "livo-evaluate JSON files with their titles")
+      .option("--figure", "CAPTION=FILE;...", "figures (paths relative to DIR)")
+      .option("--warning", "TEXT;...", "warnings to list");
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  const std::string dir = cli.get("--dir");
+  livo::ReportInputs in;
+  in.run.log = cli.get("--log");
+  in.run.config = cli.get("--config");
+  in.run.processes = splitList(cli.get("--processes"));
+  in.run.mode = cli.get("--mode");
+  in.run.log_seconds = cli.getDouble("--log-seconds");
+  in.run.wall_seconds = cli.getDouble("--wall-seconds");
+  {
+    std::ifstream t(dir + "/timing.json");
+    if (!t) throw std::runtime_error(dir + "/timing.json: missing (run livo-report extract first)");
+    in.timing = nlohmann::json::parse(t);
+  }
+  for (const auto& item : splitList(cli.get("--evaluation"), ';')) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--evaluation: expected TITLE=FILE, got " + item);
+    std::ifstream f(item.substr(eq + 1));
+    if (!f) {
+      in.warnings.push_back("evaluation " + item.substr(eq + 1) + " is missing");
+      continue;
+    }
+    in.evaluations.emplace_back(item.substr(0, eq), nlohmann::json::parse(f));
+  }
+  for (const auto& item : splitList(cli.get("--figure"), ';')) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("--figure: expected CAPTION=FILE, got " + item);
+    in.figures.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+  }
+  for (const auto& w : splitList(cli.get("--warning"), ';')) in.warnings.push_back(w);
+  for (const auto& [node, p] : in.timing.items()) {
+    for (const auto& [channel, c] : p["channels"].items()) {
+      if (c.value("decode_failures", 0) > 0)
+        in.warnings.push_back(node + ": " + std::to_string(c.value("decode_failures", 0)) + " messages on " + channel +
+                              " did not decode");
+      if (c.value("rejected", 0) > 0)
+        in.warnings.push_back(node + ": " + std::to_string(c.value("rejected", 0)) + " messages on " + channel +
+                              " were rejected (see its log)");
+    }
+  }
+  writeText(dir + "/report.md", livo::reportMarkdown(in));
+  std::cout << dir << "/report.md\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string usage = "usage: livo-report extract OUTPUTS.lcmlog --dir DIR | livo-report markdown --dir DIR [...]\n";
+  if (argc < 2) {
+    std::cerr << usage;
+    return 2;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "extract") return extract(argc - 1, argv + 1);
+    if (cmd == "markdown") return markdown(argc - 1, argv + 1);
+    if (cmd == "--help") {
+      std::cout << usage;
+      return 0;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "livo-report: " << e.what() << "\n";
+    return 1;
+  }
+  std::cerr << "livo-report: unknown command '" << cmd << "'\n" << usage;
+  return 2;
+}
