@@ -91,11 +91,11 @@ Trajectory readKittiPoses(const std::string& path, const std::string& times_path
   Trajectory t;
   readNumericRows(path, [&](int ln, const std::vector<double>& v) {
     if (v.size() != 12) throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 12 numbers (KITTI 3x4 pose), got " + std::to_string(v.size()));
-    Eigen::Matrix3d R;
-    R << v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10];
+    // Kept as written: KITTI rotations carry ~7 digits and are off SO(3) by ~1e-7; evaluation
+    // tools (evo, the devkit) use them as they are, and so do we.
     Pose3 T = Pose3::Identity();
-    T.linear() = Quat(R).normalized().toRotationMatrix();
-    T.translation() = Vec3(v[3], v[7], v[11]);
+    T.matrix().topRows<3>() = Eigen::Map<const Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>(v.data());
+    if (!T.matrix().allFinite()) throw TrajectoryError(path + ":" + std::to_string(ln) + ": pose is not finite");
     t.push_back({static_cast<double>(t.size()), T});
   });
   if (!times_path.empty()) {

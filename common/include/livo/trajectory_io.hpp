@@ -27,7 +27,8 @@ class TrajectoryError : public std::runtime_error {
 
 Trajectory readTum(const std::string& path);
 void writeTum(const std::string& path, const Trajectory& trajectory);
-/// KITTI poses; `times_path` (KITTI times.txt) gives stamps, else stamp = line index.
+/// KITTI poses, matrices kept exactly as written (not re-orthonormalised); `times_path` (KITTI
+/// times.txt) gives stamps, else stamp = line index.
 Trajectory readKittiPoses(const std::string& path, const std::string& times_path = "");
 /// EuRoC/ASL ground-truth csv (nanosecond stamps, position, quaternion w x y z; extra columns ignored).
 Trajectory readEurocCsv(const std::string& path);

@@ -1,0 +1,192 @@
+// livo-evaluate end to end: the table, JSON, SVG and Markdown outputs, EuRoC csv input, and exit
+// codes with clear messages on bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "evaluate_command.hpp"
+#include "livo/trajectory_io.hpp"
+#include "synthetic_trajectory.hpp"
+
+using namespace livo;
+
+namespace {
+
+const std::string kTrajectories = std::string(LIVO_SHARED_DATA) + "/trajectories/";
+
+struct CommandResult {
+  int code;
+  std::string out, err;
+};
+
+CommandResult run(std::vector<std::string> args) {
+  args.insert(args.begin(), "livo-evaluate");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  std::ostringstream out, err;
+  const int code = evaluation::runEvaluateCommand(static_cast<int>(argv.size()), argv.data(), out, err);
+  return {code, out.str(), err.str()};
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+size_t count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(EvaluateCommand, WritesTableJsonSvgAndReport) {
+  const std::string dir = ::testing::TempDir();
+  const CommandResult r = run({"--est", kTrajectories + "freiburg1_xyz-rgbdslam.txt", "--gt",
+                     kTrajectories + "freiburg1_xyz-groundtruth.txt", "--align", "sim3", "--json", dir + "/fr1.json",
+                     "--plot", dir + "/fr1.svg", "--report", dir + "/fr1.md"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ATE translation (m)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0.0133894"), std::string::npos) << r.out;  // evo_ape tum ... -as: rmse 0.013389...
+  EXPECT_NE(r.out.find("KITTI drift: no segment"), std::string::npos) << r.out;
+
+  const auto j = nlohmann::json::parse(readFile(dir + "/fr1.json"));
+  // evo_ape tum freiburg1_xyz-groundtruth.txt freiburg1_xyz-rgbdslam.txt -as (see test_evo_agreement.cpp)
+  EXPECT_NEAR(j["ate"]["rmse"].get<double>(), 0.013389384904168198, 1e-6 * 0.0134);
+  for (const char* key : {"rmse", "mean", "median", "max", "coverage"}) EXPECT_TRUE(j["ate"][key].is_number()) << key;
+  // The estimate starts 3.49 s into the 30.09 s of ground truth: at most 88.4 % coverage.
+  EXPECT_GT(j["ate"]["coverage"].get<double>(), 0.85);
+  EXPECT_LT(j["ate"]["coverage"].get<double>(), 0.884);
+  for (const char* key : {"rmse", "mean", "median", "max"}) {
+    EXPECT_TRUE(j["rpe"]["translation"][key].is_number()) << key;
+    EXPECT_TRUE(j["rpe"]["rotation"][key].is_number()) << key;
+  }
+  EXPECT_EQ(j["rpe"]["rotation_unit"], "deg");
+  EXPECT_EQ(j["association"]["method"], "time");
+  EXPECT_EQ(j["association"]["pairs"], 785);
+  EXPECT_EQ(j["alignment"]["mode"], "sim3");
+  EXPECT_TRUE(j["drift"]["translation_percent"].is_null());  // a 2 m path has no 100 m segment
+  EXPECT_EQ(j["drift"]["segments"], 0);
+
+  const std::string svg = readFile(dir + "/fr1.svg");
+  EXPECT_EQ(svg.rfind("<?xml", 0), 0u);
+  EXPECT_NE(svg.find("<svg xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  EXPECT_GT(count(svg, "<polyline"), 5u);  // ground truth, coloured estimate runs, three series
+  EXPECT_EQ(count(svg, "<svg"), 1u);
+  EXPECT_EQ(count(svg, "nan"), 0u);
+  EXPECT_EQ(count(svg, "inf"), 0u);
+  for (const char* label : {"ATE (m)", "RPE (m)", "RPE (deg)", "x (m)", "y (m)", "ground truth"})
+    EXPECT_NE(svg.find(label), std::string::npos) << label;
+
+  const std::string md = readFile(dir + "/fr1.md");
+  EXPECT_NE(md.find("| ATE translation (m) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("](fr1.svg)"), std::string::npos) << md;
+}
+
+TEST(EvaluateCommand, EurocCsvGroundTruthGivesTheTumNumbers) {
+  // V101_gt.txt rewritten as an EuRoC csv (nanosecond stamps, w x y z quaternion order).
+  const Trajectory gt = readTum(kTrajectories + "V101_gt.txt");
+  const std::string csv = ::testing::TempDir() + "/V101_gt.csv";
+  {
+    std::ofstream out(csv);
+    out << "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
+    out << std::setprecision(17);
+    for (const auto& s : gt) {
+      const Quat q(s.pose.linear());
+      const Vec3 p = s.pose.translation();
+      out << std::llround(s.stamp * 1e9) << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << ","
+          << q.x() << "," << q.y() << "," << q.z() << "\n";
+    }
+  }
+  const std::string dir = ::testing::TempDir();
+  const std::string est = kTrajectories + "V101_openvins.txt";
+  ASSERT_EQ(run({"--est", est, "--gt", csv, "--json", dir + "/csv.json", "--quiet"}).code, 0);
+  ASSERT_EQ(run({"--est", est, "--gt", kTrajectories + "V101_gt.txt", "--json", dir + "/tum.json", "--quiet"}).code, 0);
+  const auto a = nlohmann::json::parse(readFile(dir + "/csv.json"));
+  const auto b = nlohmann::json::parse(readFile(dir + "/tum.json"));
+  EXPECT_EQ(a["ground_truth"]["format"], "euroc-csv");
+  EXPECT_EQ(a["association"]["pairs"], b["association"]["pairs"]);
+  EXPECT_NEAR(a["ate"]["rmse"].get<double>(), b["ate"]["rmse"].get<double>(), 1e-12);
+  EXPECT_NEAR(a["rpe"]["rotation"]["rmse"].get<double>(), b["rpe"]["rotation"]["rmse"].get<double>(), 1e-9);
+  // evo_ape tum V101_gt.txt V101_openvins.txt -a (see test_evo_agreement.cpp)
+  EXPECT_NEAR(b["ate"]["rmse"].get<double>(), 0.052101965251271695, 1e-6 * 0.0521);
+}
+
+TEST(EvaluateCommand, KittiDriftOnKitti00) {
+  // Reference: an independent numpy implementation of the KITTI devkit's segment loop
+  // (evaluate_odometry.cpp: segments of 100..800 m from every 10th pose, error pose
+  // (P_i^-1 P_j)^-1 (Q_i^-1 Q_j), translation / length and acos((trace - 1) / 2) / length averaged),
+  // in double precision, on the unaligned ORB estimate: 3283 segments.
+  const std::string json = ::testing::TempDir() + "/kitti.json";
+  const CommandResult r = run({"--est", kTrajectories + "KITTI_00_ORB.txt", "--gt", kTrajectories + "KITTI_00_gt.txt",
+                               "--align", "none", "--json", json});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(readFile(json));
+  EXPECT_EQ(j["association"]["method"], "index");
+  EXPECT_EQ(j["drift"]["per_length"].size(), 8u);
+  EXPECT_EQ(j["drift"]["segments"], 3283);
+  EXPECT_NEAR(j["drift"]["translation_percent"].get<double>(), 0.6997289189481147, 1e-9 * 0.7);
+  EXPECT_NEAR(j["drift"]["rotation_deg_per_m"].get<double>(), 0.0025356001677448938, 1e-9 * 0.0025);
+  EXPECT_NE(r.out.find("KITTI drift (segments from every 10 poses)"), std::string::npos) << r.out;
+}
+
+TEST(EvaluateCommand, FailsClearlyOnBadInput) {
+  const std::string dir = ::testing::TempDir();
+  // Nothing associates: the estimate is on another time base.
+  Trajectory shifted = readTum(kTrajectories + "freiburg1_xyz-rgbdslam.txt");
+  for (auto& s : shifted) s.stamp -= 1.0e9;
+  writeTum(dir + "/shifted.tum", shifted);
+  CommandResult r = run({"--est", dir + "/shifted.tum", "--gt", kTrajectories + "freiburg1_xyz-groundtruth.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("no estimated pose lies within 0.01 s of a ground-truth pose"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+
+  // A malformed line.
+  {
+    std::ofstream bad(dir + "/bad.tum");
+    bad << "# t x y z qx qy qz qw\n1 0 0 0 0 0 0 1\n2 0 0 zero 0 0 0 1\n";
+  }
+  r = run({"--est", dir + "/bad.tum", "--gt", kTrajectories + "freiburg1_xyz-groundtruth.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("bad.tum:3: 'zero' is not a number"), std::string::npos) << r.err;
+
+  // KITTI poses of different lengths cannot be paired by index.
+  {
+    std::ofstream k(dir + "/short_kitti.txt");
+    k << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n";
+  }
+  r = run({"--est", dir + "/short_kitti.txt", "--gt", kTrajectories + "KITTI_00_gt.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("cannot pair poses by index: the estimate has 2 poses, the ground truth 4541"), std::string::npos)
+      << r.err;
+  {
+    std::ofstream k(dir + "/bad_kitti.txt");
+    k << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1\n";
+  }
+  r = run({"--est", dir + "/bad_kitti.txt", "--gt", kTrajectories + "KITTI_00_gt.txt"});
+  EXPECT_NE(r.err.find("bad_kitti.txt:2: expected 12 numbers"), std::string::npos) << r.err;
+
+  r = run({"--est", dir + "/missing.tum", "--gt", kTrajectories + "V101_gt.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("missing.tum: no such file"), std::string::npos) << r.err;
+
+  // Usage errors.
+  r = run({"--est", kTrajectories + "V101_openvins.txt", "--gt", kTrajectories + "V101_gt.txt", "--align", "affine"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--align: expected se3, sim3 or none"), std::string::npos) << r.err;
+  r = run({"--est", kTrajectories + "V101_openvins.txt", "--gt", kTrajectories + "V101_gt.txt", "--gt-offset", "1,2"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--gt-offset: expected x,y,z"), std::string::npos) << r.err;
+  r = run({"--gt", kTrajectories + "V101_gt.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("--est and --gt are both required"), std::string::npos) << r.err;
+}

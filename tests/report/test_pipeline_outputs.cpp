@@ -1,0 +1,135 @@
+// Reading a run's outputs, the loop-corrected trajectory against known corrections, timing.json.
+#include <gtest/gtest.h>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "livo/keyframe_t.hpp"
+#include "livo/messages.hpp"
+#include "livo/odometry_t.hpp"
+#include "pipeline_outputs.hpp"
+#include "run_report.hpp"
+
+using namespace livo;
+
+namespace {
+
+template <class T>
+void write(lcm::LogFile& log, const std::string& ch, int64_t t, const T& m) {
+  std::vector<uint8_t> buf(m.getEncodedSize());
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  lcm::LogEvent ev;
+  ev.timestamp = t;
+  ev.channel = ch;
+  ev.datalen = static_cast<int32_t>(buf.size());
+  ev.data = buf.data();
+  log.writeEvent(&ev);
+}
+
+Pose3 poseAt(int i) {
+  Vec6 xi;
+  xi << 0.0, 0.0, 0.05 * i, 1.0 * i, 0.2 * i, 0.0;
+  return se3::boxplus(Pose3::Identity(), xi);
+}
+
+// 20 scans, keyframes at scans 0, 5, 10, 15; a loop correction for keyframes 0..2.
+std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2, bool with_loop, bool with_nan) {
+  const std::string path = ::testing::TempDir() + "/outputs_" + std::to_string(with_loop) + std::to_string(with_nan) + ".lcmlog";
+  lcm::LogFile log(path, "w");
+  for (int i = 0; i < 20; ++i) {
+    const int64_t t = 1000000 + i * 100000;
+    odometry_t o{};
+    o.utime = t;
+    poseTo(poseAt(i), o.position, o.orientation);
+    if (with_nan && i == 7) o.position[1] = std::nan("");
+    write(log, "ODOMETRY", t, o);
+    if (i % 5 == 0) {
+      keyframe_t k{};
+      k.id = i / 5;
+      k.utime = t;
+      poseTo(poseAt(i), k.position, k.orientation);
+      k.cloud.frame = "I";
+      write(log, "KEYFRAME", t, k);
+    }
+  }
+  if (with_loop) {
+    loop_correction_t lc{};
+    lc.utime = 2000000;
+    lc.num_keyframes = 3;
+    const Pose3 corr[3] = {Pose3::Identity(), correction_kf1, correction_kf2};
+    for (int k = 0; k < 3; ++k) {
+      lc.keyframe_id.push_back(k);
+      std::array<double, 3> p;
+      std::array<double, 4> q;
+      poseTo(corr[k] * poseAt(5 * k), p.data(), q.data());
+      lc.position.push_back({p[0], p[1], p[2]});
+      lc.orientation.push_back({q[0], q[1], q[2], q[3]});
+    }
+    poseTo(correction_kf2, lc.correction_position, lc.correction_orientation);
+    write(log, "LOOP_CORRECTION", 2000000, lc);
+  }
+  health_t h{};
+  h.node = "lio";
+  h.peak_rss_mb = 42.0;
+  channel_stats_t imu{}, lidar{};
+  imu.channel = "IMU";
+  imu.messages = 400;
+  imu.median_ms = 0.01;
+  imu.p90_ms = 0.02;
+  imu.max_ms = 0.1;
+  lidar.channel = "LIDAR";
+  lidar.messages = 20;
+  lidar.median_ms = 5.0;
+  lidar.p90_ms = 7.0;
+  lidar.max_ms = 9.0;
+  lidar.rejected = 1;
+  h.channels = {imu, lidar};
+  h.num_channels = 2;
+  write(log, "HEALTH", 3000000, h);
+  return path;
+}
+
+}  // namespace
+
+TEST(PipelineOutputs, NoLoopMeansTrajectoryEqualsOdometry) {
+  const PipelineOutputs out = readPipelineOutputs(makeOutputs(Pose3::Identity(), Pose3::Identity(), false, true));
+  EXPECT_EQ(out.odometry.size(), 19u);  // the NaN pose is dropped and counted
+  EXPECT_EQ(out.non_finite, 1);
+  EXPECT_EQ(out.keyframes.size(), 4u);
+  EXPECT_FALSE(out.last_loop.has_value());
+  const Trajectory t = loopCorrectedTrajectory(out);
+  ASSERT_EQ(t.size(), out.odometry.size());
+  for (size_t i = 0; i < t.size(); ++i) EXPECT_TRUE(t[i].pose.isApprox(out.odometry[i].pose, 1e-12));
+}
+
+TEST(PipelineOutputs, LoopCorrectionMovesEachSpanByItsKeyframe) {
+  Vec6 a, b;
+  a << 0.0, 0.0, 0.02, 0.3, -0.1, 0.0;
+  b << 0.0, 0.0, -0.03, -0.5, 0.4, 0.1;
+  const Pose3 c1 = se3::Exp(a), c2 = se3::Exp(b);
+  const PipelineOutputs out = readPipelineOutputs(makeOutputs(c1, c2, true, false));
+  ASSERT_TRUE(out.last_loop.has_value());
+  const Trajectory t = loopCorrectedTrajectory(out);
+  ASSERT_EQ(t.size(), 20u);
+  for (int i = 0; i < 20; ++i) {
+    // scans 0-4 follow keyframe 0 (no correction), 5-9 keyframe 1 (c1), 10-19 keyframe 2 and the
+    // newer keyframe 3, which the correction does not list: the overall correction c2
+    const Pose3 c = i < 5 ? Pose3::Identity() : i < 10 ? c1 : c2;
+    const Pose3 expected = c * poseAt(i);
+    EXPECT_NEAR((t[i].pose.matrix() - expected.matrix()).norm(), 0.0, 1e-9) << i;
+  }
+}
+
+TEST(PipelineOutputs, TimingJsonHeadlinesTheBusiestInput) {
+  const PipelineOutputs out = readPipelineOutputs(makeOutputs(Pose3::Identity(), Pose3::Identity(), false, false));
+  const nlohmann::json j = timingJson(out.final_health);
+  ASSERT_TRUE(j.contains("lio"));
+  EXPECT_EQ(j["lio"]["busiest_channel"], "LIDAR");  // 20 x 5 ms outweighs 400 x 0.01 ms
+  EXPECT_EQ(j["lio"]["messages"], 20);
+  EXPECT_DOUBLE_EQ(j["lio"]["median_ms"].get<double>(), 5.0);
+  EXPECT_DOUBLE_EQ(j["lio"]["p90_ms"].get<double>(), 7.0);
+  EXPECT_DOUBLE_EQ(j["lio"]["max_ms"].get<double>(), 9.0);
+  EXPECT_DOUBLE_EQ(j["lio"]["peak_rss_mb"].get<double>(), 42.0);
+  EXPECT_EQ(j["lio"]["channels"]["LIDAR"]["rejected"], 1);
+  EXPECT_EQ(j["lio"]["messages_all_channels"], 420);
+  EXPECT_THROW(readPipelineOutputs("/nonexistent.lcmlog"), std::runtime_error);
+}
