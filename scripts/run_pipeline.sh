@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs a recorded log through the pipeline on a private LCM bus and writes, into --out:
-#   outputs.lcmlog   every output channel, recorded by lcm-logger (and GROUND_TRUTH)
+#   outputs.lcmlog   every output channel (and GROUND_TRUTH), recorded by livo-record, which takes
+#                    part in lockstep so nothing is missed (lcm-logger cannot say it is ready)
 #   odometry.tum     the online estimate (body pose at every scan)
 #   trajectory.tum   the final estimate (loop-corrected when loop closure ran)
 #   timing.json      per process: messages, median/p90/max ms, peak RSS
@@ -8,7 +9,7 @@
 #   report.md        all of it for a person; logs/<process>.log: what each process printed
 #
 #   scripts/run_pipeline.sh --log LOG --config FILE --out DIR [--realtime] [--without P,...]
-#                           [--swap P=EXE] [--processes P,...] [--record REGEX]
+#                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,7 +20,7 @@ usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0
-record='ODOMETRY|REGISTERED_SCAN|KEYFRAME|LOOP_CORRECTION|COLORED_CLOUD|OCTOMAP|STATE_PRIOR|STATE_POSTERIOR|HEALTH|GROUND_TRUTH'
+record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -43,7 +44,7 @@ log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
 config="$(cd "$(dirname "$config")" && pwd)/$(basename "$config")"
 mkdir -p "$out/logs"
 out="$(cd "$out" && pwd)"
-for tool in livo-playback livo-report; do
+for tool in livo-playback livo-record livo-report; do
   [ -x "$bin/$tool" ] || die "$bin/$tool missing: run scripts/build.sh"
 done
 
@@ -113,7 +114,7 @@ fi
 
 # ---- inside the private bus --------------------------------------------------------------------
 exec 3>"$out/logs/run.txt"
-lcm-logger --quiet -f -c "$record" "$out/outputs.lcmlog" &
+"$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
 logger=$!
 declare -A pids=()
 for p in "${selected[@]}"; do
@@ -128,9 +129,9 @@ trap cleanup INT TERM
 
 start=$(date +%s%N)
 if [ "$realtime" = 1 ]; then
-  replay=(--speed 1)
+  replay=(--speed 1 --consumers "$(IFS=,; echo "${selected[*]}"),record" --startup-timeout 60)
 else
-  replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}")" --stall-timeout 120 --startup-timeout 60)
+  replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 120 --startup-timeout 60)
 fi
 rc=0
 "$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
@@ -153,7 +154,7 @@ ms=$(( (end - start) / 1000000 ))
 printf "%s %d.%03d\n" "${log_s:-0}" $((ms / 1000)) $((ms % 1000)) > "$out/logs/replay_times.txt"
 [ "$rc" = 0 ] || echo "playback failed: $(tail -n 1 "$out/logs/playback.log")" >&3
 
-# Stop the processes (they flush and send a final HEALTH), then the logger.
+# Stop the processes (they flush and send a final HEALTH), then the recorder.
 failed=0
 for p in "${selected[@]}"; do
   if ! kill -0 "${pids[$p]}" 2>/dev/null; then

@@ -34,17 +34,6 @@ double fractionOf(const std::string& s, const std::string& text) {
   return f;
 }
 
-// Types whose first encoded field is `int64_t utime`.
-bool leadsWithUtime(const std::string& type) {
-  static const char* kTypes[] = {"livo.imu_t",     "livo.point_cloud_t",   "livo.image_t",      "livo.wheel_odometry_t",
-                                 "livo.pose_t",    "livo.odometry_t",      "livo.filter_state_t", "livo.registered_scan_t",
-                                 "livo.loop_correction_t", "livo.colored_cloud_t", "livo.octomap_t", "livo.progress_t",
-                                 "livo.health_t"};
-  for (const char* t : kTypes)
-    if (type == t) return true;
-  return false;
-}
-
 }  // namespace
 
 Fault parseFault(const std::string& text) {
@@ -104,13 +93,9 @@ std::string describe(const Fault& f) {
 }
 
 bool shiftMessageUtime(std::vector<uint8_t>& data, int64_t delta_us) {
-  const MessageType* t = identifyMessage(data.data(), static_cast<int>(data.size()));
-  if (!t || !leadsWithUtime(t->name) || data.size() < 16) return false;
-  uint64_t u = 0;
-  for (int i = 8; i < 16; ++i) u = (u << 8) | data[i];
-  u = static_cast<uint64_t>(static_cast<int64_t>(u) + delta_us);
-  for (int i = 15; i >= 8; --i, u >>= 8) data[i] = static_cast<uint8_t>(u & 0xff);
-  return true;
+  int64_t utime = 0;
+  const int size = static_cast<int>(data.size());
+  return messageUtime(data.data(), size, &utime) && setMessageUtime(data.data(), size, utime + delta_us);
 }
 
 FaultInjector::FaultInjector(std::vector<Fault> faults, uint64_t seed) : faults_(std::move(faults)), rng_(seed) {}

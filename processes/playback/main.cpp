@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
   cli.positional("LOG", "LCM log to replay")
       .option("--speed", "X", "real-time factor; 0 = as fast as possible (ignored with --lockstep)", "1.0")
       .flag("--lockstep", "publish each message only after every consumer reported it handled the previous one")
-      .option("--consumers", "A,B,...", "node names lockstep waits for (their --name)")
+      .option("--consumers", "A,B,...", "node names to wait for (their --name): at the start, and with --lockstep after every message")
       .option("--channels", "REGEX", "replay only channels matching this regular expression", ".*")
       .option("--start", "S", "skip the first S seconds of the log", "0")
       .option("--duration", "S", "replay only S seconds (0: to the end)", "0")

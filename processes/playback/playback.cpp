@@ -84,8 +84,10 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
     LockstepGate* gate;
     Clock::time_point* last;
   } ctx{&gate, &last_progress};
+  // Consumers are waited for at the start in any mode; lockstep also waits after every message.
+  const bool watch_progress = !sink.toFile() && !options.consumers.empty();
   lcm::Subscription* sub = nullptr;
-  if (lockstep) {
+  if (watch_progress) {
     sub = lcm->subscribeFunction(
         options.progress_channel,
         +[](const lcm::ReceiveBuffer* rbuf, const std::string&, ProgressContext* c) {
@@ -107,7 +109,7 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
     return result;
   };
 
-  if (lockstep) {
+  if (watch_progress) {
     const auto t0 = Clock::now();
     while (!gate.allPresent()) {
       if (shutdownRequested()) return fail("interrupted");
@@ -121,10 +123,11 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
   }
 
   ProgressLine progress(options.quiet);
+  const auto pace_start = Clock::now();  // real-time pacing starts once the consumers are up
   int64_t first = -1;
   auto publishOne = [&](const LogEvent& e) -> std::string {
     if (!lockstep && !sink.toFile() && options.speed > 0.0) {
-      const auto target = wall_start + std::chrono::microseconds(static_cast<int64_t>((e.utime - first) / options.speed));
+      const auto target = pace_start + std::chrono::microseconds(static_cast<int64_t>((e.utime - first) / options.speed));
       std::this_thread::sleep_until(target);
     }
     sink.emit(e);

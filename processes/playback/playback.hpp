@@ -20,7 +20,7 @@ struct PlaybackOptions {
   LogSourceOptions source;
   double speed = 1.0;                   // real-time factor; 0 = as fast as possible
   bool lockstep = false;
-  std::vector<std::string> consumers;   // node names lockstep waits for
+  std::vector<std::string> consumers;   // nodes to wait for at the start (and, lockstep, always)
   std::string progress_channel = "PROGRESS";
   double stall_timeout_s = 30.0;        // lockstep: no progress for this long = a stalled consumer
   double startup_timeout_s = 30.0;      // lockstep: time for every consumer to report once

@@ -12,6 +12,7 @@
 #include "evaluate_command.hpp"
 #include "livo/trajectory_io.hpp"
 #include "synthetic_trajectory.hpp"
+#include "temp_path.hpp"
 
 using namespace livo;
 
@@ -49,7 +50,7 @@ size_t count(const std::string& text, const std::string& what) {
 }  // namespace
 
 TEST(EvaluateCommand, WritesTableJsonSvgAndReport) {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = livo_test::tempDir();
   const CommandResult r = run({"--est", kTrajectories + "freiburg1_xyz-rgbdslam.txt", "--gt",
                      kTrajectories + "freiburg1_xyz-groundtruth.txt", "--align", "sim3", "--json", dir + "/fr1.json",
                      "--plot", dir + "/fr1.svg", "--report", dir + "/fr1.md"});
@@ -95,7 +96,7 @@ TEST(EvaluateCommand, WritesTableJsonSvgAndReport) {
 TEST(EvaluateCommand, EurocCsvGroundTruthGivesTheTumNumbers) {
   // V101_gt.txt rewritten as an EuRoC csv (nanosecond stamps, w x y z quaternion order).
   const Trajectory gt = readTum(kTrajectories + "V101_gt.txt");
-  const std::string csv = ::testing::TempDir() + "/V101_gt.csv";
+  const std::string csv = livo_test::tempPath("V101_gt.csv");
   {
     std::ofstream out(csv);
     out << "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
@@ -107,7 +108,7 @@ TEST(EvaluateCommand, EurocCsvGroundTruthGivesTheTumNumbers) {
           << q.x() << "," << q.y() << "," << q.z() << "\n";
     }
   }
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = livo_test::tempDir();
   const std::string est = kTrajectories + "V101_openvins.txt";
   ASSERT_EQ(run({"--est", est, "--gt", csv, "--json", dir + "/csv.json", "--quiet"}).code, 0);
   ASSERT_EQ(run({"--est", est, "--gt", kTrajectories + "V101_gt.txt", "--json", dir + "/tum.json", "--quiet"}).code, 0);
@@ -126,7 +127,7 @@ TEST(EvaluateCommand, KittiDriftOnKitti00) {
   // (evaluate_odometry.cpp: segments of 100..800 m from every 10th pose, error pose
   // (P_i^-1 P_j)^-1 (Q_i^-1 Q_j), translation / length and acos((trace - 1) / 2) / length averaged),
   // in double precision, on the unaligned ORB estimate: 3283 segments.
-  const std::string json = ::testing::TempDir() + "/kitti.json";
+  const std::string json = livo_test::tempPath("kitti.json");
   const CommandResult r = run({"--est", kTrajectories + "KITTI_00_ORB.txt", "--gt", kTrajectories + "KITTI_00_gt.txt",
                                "--align", "none", "--json", json});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -140,7 +141,7 @@ TEST(EvaluateCommand, KittiDriftOnKitti00) {
 }
 
 TEST(EvaluateCommand, FailsClearlyOnBadInput) {
-  const std::string dir = ::testing::TempDir();
+  const std::string dir = livo_test::tempDir();
   // Nothing associates: the estimate is on another time base.
   Trajectory shifted = readTum(kTrajectories + "freiburg1_xyz-rgbdslam.txt");
   for (auto& s : shifted) s.stamp -= 1.0e9;

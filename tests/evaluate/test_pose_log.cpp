@@ -12,6 +12,7 @@
 #include "livo/pose_t.hpp"
 #include "pose_log.hpp"
 #include "synthetic_trajectory.hpp"
+#include "temp_path.hpp"
 
 using namespace livo;
 using namespace livo::evaluation;
@@ -41,7 +42,7 @@ int64_t utimeOf(double seconds) { return static_cast<int64_t>(std::llround(secon
 /// GROUND_TRUTH (pose_t, 20 Hz), ODOMETRY (odometry_t, 10 Hz, the truth moved by a known
 /// transform), ODOM_B (odometry_t) with two messages swapped, and IMU.
 std::string makeLog(const Trajectory& gt, const Pose3& world_change) {
-  const std::string path = ::testing::TempDir() + "/evaluate_poses.lcmlog";
+  const std::string path = livo_test::tempPath("evaluate_poses.lcmlog");
   lcm::LogFile log(path, "w");
   EXPECT_TRUE(log.good());
   for (size_t i = 0; i < gt.size(); ++i) {
@@ -123,7 +124,7 @@ TEST(PoseLog, ErrorsNameTheFileTheEventAndTheChannels) {
   EXPECT_NE(m.find("is not an LCM log"), std::string::npos) << m;
 
   // Garbage, a truncated message, a NaN pose and a zero quaternion on the channel.
-  const std::string bad = ::testing::TempDir() + "/evaluate_bad.lcmlog";
+  const std::string bad = livo_test::tempPath("evaluate_bad.lcmlog");
   auto writeBad = [&](const std::function<void(lcm::LogFile&)>& last) {
     lcm::LogFile f(bad, "w");
     fixtures::writeMessage(f, "ODOMETRY", 1, odometryMessage(1000000, Pose3::Identity()));

@@ -2,12 +2,14 @@
 #pragma once
 
 #include <string>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "temp_path.hpp"
 
 namespace playback_test {
 
@@ -39,7 +41,8 @@ inline livo::point_cloud_t cloudAt(int64_t utime, int n) {
 
 /// `seconds` of IMU (100 Hz) and LIDAR (10 Hz, 200 points); returns the path.
 inline std::string makeLog(const std::string& name, double seconds) {
-  const std::string path = ::testing::TempDir() + "/" + name + ".lcmlog";
+  // ctest runs the tests of one executable as parallel processes: one file per process.
+  const std::string path = livo_test::tempPath(name + ".lcmlog");
   lcm::LogFile log(path, "w");
   const int n = static_cast<int>(seconds * 100);
   for (int i = 0; i < n; ++i) {

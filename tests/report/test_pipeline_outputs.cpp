@@ -8,6 +8,7 @@
 #include "livo/odometry_t.hpp"
 #include "pipeline_outputs.hpp"
 #include "run_report.hpp"
+#include "temp_path.hpp"
 
 using namespace livo;
 
@@ -33,7 +34,7 @@ Pose3 poseAt(int i) {
 
 // 20 scans, keyframes at scans 0, 5, 10, 15; a loop correction for keyframes 0..2.
 std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2, bool with_loop, bool with_nan) {
-  const std::string path = ::testing::TempDir() + "/outputs_" + std::to_string(with_loop) + std::to_string(with_nan) + ".lcmlog";
+  const std::string path = livo_test::tempPath("outputs_") + std::to_string(with_loop) + std::to_string(with_nan) + ".lcmlog";
   lcm::LogFile log(path, "w");
   for (int i = 0; i < 20; ++i) {
     const int64_t t = 1000000 + i * 100000;

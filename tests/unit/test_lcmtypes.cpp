@@ -255,3 +255,24 @@ TEST(LcmTypes, RegistryHasEveryTypeOnce) {
   EXPECT_EQ(identifyMessage(junk, 8), nullptr);
   EXPECT_EQ(identifyMessage(junk, 4), nullptr);
 }
+
+TEST(LcmTypes, LeadingUtimeReadAndWrittenInPlace) {
+  imu_t m{};
+  m.utime = 1700000000123456;
+  auto buf = encode(m);
+  int64_t t = 0;
+  ASSERT_TRUE(messageUtime(buf.data(), static_cast<int>(buf.size()), &t));
+  EXPECT_EQ(t, 1700000000123456);
+  ASSERT_TRUE(setMessageUtime(buf.data(), static_cast<int>(buf.size()), -42));
+  imu_t d;
+  ASSERT_EQ(d.decode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  EXPECT_EQ(d.utime, -42);
+  // keyframe_t starts with its id, channel_stats_t has no utime
+  keyframe_t k{};
+  k.utime = 5;
+  const auto kb = encode(k);
+  EXPECT_FALSE(messageUtime(kb.data(), static_cast<int>(kb.size()), &t));
+  int with_utime = 0;
+  for (const auto& type : messageTypes()) with_utime += type.leading_utime;
+  EXPECT_EQ(with_utime, 13);  // all but keyframe_t and channel_stats_t
+}

@@ -9,6 +9,7 @@
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "log_summary.hpp"
+#include "temp_path.hpp"
 
 namespace {
 template <class T>
@@ -24,7 +25,7 @@ void write(lcm::LogFile& log, const std::string& channel, int64_t t, const T& m)
 }
 
 std::string makeLog() {
-  const std::string path = ::testing::TempDir() + "/loginfo_test.lcmlog";
+  const std::string path = livo_test::tempPath("loginfo_test.lcmlog");
   lcm::LogFile log(path, "w");
   EXPECT_TRUE(log.good());
   for (int i = 0; i <= 200; ++i) {  // 2 s of IMU at 100 Hz
@@ -76,7 +77,7 @@ TEST(LogInfo, TruncatedLogKeepsWhatIsReadable) {
   const std::string path = makeLog();
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string cut = ::testing::TempDir() + "/loginfo_cut.lcmlog";
+  const std::string cut = livo_test::tempPath("loginfo_cut.lcmlog");
   std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   const livo::LogSummary s = livo::summarizeLog(cut);
   EXPECT_GT(s.events, 50);

@@ -5,6 +5,7 @@
 
 #include "livo/asl_dataset.hpp"
 #include "livo/trajectory_io.hpp"
+#include "temp_path.hpp"
 
 using namespace livo;
 
@@ -33,7 +34,7 @@ TEST(TrajectoryIo, ReadsTumKittiAndDetectsFormats) {
 
 TEST(TrajectoryIo, TumRoundTripAndErrors) {
   const Trajectory gt = readTum(kData + "/trajectories/freiburg1_xyz-groundtruth.txt");
-  const std::string out = ::testing::TempDir() + "/rt.tum";
+  const std::string out = livo_test::tempPath("rt.tum");
   writeTum(out, gt);
   const Trajectory back = readTum(out);
   ASSERT_EQ(back.size(), gt.size());
@@ -41,7 +42,7 @@ TEST(TrajectoryIo, TumRoundTripAndErrors) {
     EXPECT_NEAR(back[i].stamp, gt[i].stamp, 1e-9);
     EXPECT_NEAR((back[i].pose.matrix() - gt[i].pose.matrix()).norm(), 0.0, 1e-8);
   }
-  const std::string bad = ::testing::TempDir() + "/bad.tum";
+  const std::string bad = livo_test::tempPath("bad.tum");
   std::ofstream(bad) << "1 0 0 0 0 0 0 1\n2 0 0 x 0 0 0 1\n";
   try {
     readTum(bad);

@@ -10,6 +10,7 @@ namespace livo {
 struct MessageType {
   std::string name;      // package-qualified, e.g. "livo.point_cloud_t"
   int64_t fingerprint;   // the 8 bytes every encoded message starts with
+  bool leading_utime;    // its first field is `int64_t utime` (bytes 8..15, big-endian)
 };
 
 /// All project types.
@@ -17,5 +18,10 @@ const std::vector<MessageType>& messageTypes();
 
 /// The type whose fingerprint starts `data`, or nullptr.
 const MessageType* identifyMessage(const void* data, int size);
+
+/// The utime of an encoded project message whose first field is utime; false for other types.
+bool messageUtime(const void* data, int size, int64_t* utime);
+/// Rewrites that utime in place; false (and nothing changed) for other types.
+bool setMessageUtime(void* data, int size, int64_t utime);
 
 }  // namespace livo

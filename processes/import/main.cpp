@@ -1,0 +1,134 @@
+// livo-import FORMAT INPUT --out LOG [--preset NAME]: dataset formats -> the project's LCM log.
+#include <iostream>
+
+#include "file_utils.hpp"
+#include "import_job.hpp"
+#include "livo/command_line.hpp"
+#include "rosbag_presets.hpp"
+
+namespace {
+
+livo::LidarStampConvention stampConvention(const std::string& s) {
+  if (s == "start") return livo::LidarStampConvention::kStart;
+  if (s == "end") return livo::LidarStampConvention::kEnd;
+  throw std::invalid_argument("--lidar-stamp: expected start or end, got '" + s + "'");
+}
+
+livo::KittiPointFields pointFields(const std::string& s) {
+  if (s == "auto") return livo::KittiPointFields::kAuto;
+  if (s == "xyzi") return livo::KittiPointFields::kXyzi;
+  if (s == "xyz") return livo::KittiPointFields::kXyz;
+  throw std::invalid_argument("--point-fields: expected auto, xyzi or xyz, got '" + s + "'");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  livo::CommandLine cli("livo-import",
+                        "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
+                        "GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
+  cli.positional("FORMAT", "rosbag (ROS 1 bag), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
+                           "ouster (pcap + metadata JSON)");
+  cli.positional("INPUT", "the bag, folder or pcap file");
+  cli.option("--out", "LOG", "output LCM log (required unless --list-topics)")
+      .option("--preset", "NAME", "rosbag topic map and conventions: ntu_viral, m2dgr (--list-presets)")
+      .option("--imu", "TOPIC", "rosbag: IMU topic (sensor_msgs/Imu)")
+      .option("--lidar", "TOPIC", "rosbag: LiDAR topic (sensor_msgs/PointCloud2)")
+      .option("--camera", "TOPIC", "rosbag: camera topic (sensor_msgs/Image or CompressedImage)")
+      .option("--camera-right", "TOPIC", "rosbag: second camera topic")
+      .option("--ground-truth", "TOPIC|FILE",
+              "rosbag: ground-truth topic (Odometry, PoseStamped, PoseWithCovarianceStamped, TransformStamped, "
+              "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
+      .flag("--no-auto-topics", "rosbag: do not pick the only IMU / PointCloud2 / image topic when none is given")
+      .flag("--list-topics", "rosbag: print the bag's topics, types and counts, then exit")
+      .flag("--list-presets", "print the presets, then exit")
+      .option("--imu-channel", "NAME", "IMU channel", "IMU")
+      .option("--lidar-channel", "NAME", "LiDAR channel", "LIDAR")
+      .option("--camera-channel", "NAME", "camera channel", "CAMERA")
+      .option("--camera-right-channel", "NAME", "second camera channel", "CAMERA_RIGHT")
+      .option("--ground-truth-channel", "NAME", "ground-truth channel", "GROUND_TRUTH")
+      .option("--lidar-stamp", "start|end", "rosbag: what a cloud's header stamp marks (preset or start)")
+      .option("--sweep-duration", "S", "sweep length in seconds (rosbag, kitti; default 0.1)")
+      .option("--lidar-rings", "N", "rosbag: beams of the LiDAR (default: from the cloud)")
+      .option("--lidar-time-field", "NAME", "rosbag: per-point time field (default: time, t, offset_time, timestamp)")
+      .option("--lidar-time-unit", "s|ms|us|ns", "rosbag: unit of the time field (default: ns if integer, s if float)")
+      .option("--imu-accel-unit", "auto|m/s2|g", "rosbag: acceleration unit", "auto")
+      .option("--imu-gyro-unit", "rad/s|deg/s", "rosbag: angular rate unit", "rad/s")
+      .flag("--use-bag-time", "rosbag: stamp messages with the bag's receive time instead of header.stamp")
+      .flag("--decode-png", "euroc: decode PNG images to GRAY8 instead of keeping them compressed")
+      .option("--metadata", "FILE", "ouster: sensor metadata JSON (default: beside the pcap)")
+      .flag("--drop-partial-sweeps", "ouster: drop sweeps that miss packets")
+      .option("--poses", "FILE", "kitti: odometry poses file (default: ../../poses/<seq>.txt)")
+      .option("--times", "FILE", "kitti: odometry times.txt (default: beside velodyne/)")
+      .option("--lidar-rate", "HZ", "kitti: scan rate of a folder without timestamps", "10")
+      .option("--point-fields", "auto|xyzi|xyz", "kitti: floats per point in .bin scans", "auto")
+      .option("--max-buffer-mb", "MB", "memory for sorting before spilling to temporary files", "512")
+      .flag("--quiet", "no progress line and no warnings on stderr (the summary still prints)");
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+
+  if (cli.has("--list-presets")) {
+    for (const livo::RosbagPreset& p : livo::rosbagPresets()) std::cout << p.name << ": " << p.description << "\n";
+    return 0;
+  }
+  livo::ImportJob job;
+  try {
+    job.format = cli.get("FORMAT");
+    job.input = cli.get("INPUT");
+    if (cli.has("--list-topics")) {
+      if (job.format != "rosbag") throw std::invalid_argument("--list-topics is for the rosbag format");
+      for (const livo::BagTopic& t : livo::listBagTopics(job.input))
+        std::cout << t.topic << "  " << t.type << "  " << t.messages << "\n";
+      return 0;
+    }
+    if (!cli.has("--out")) throw std::invalid_argument("--out LOG is required");
+    job.out = cli.get("--out");
+    job.preset = cli.get("--preset");
+    job.channels.imu = cli.get("--imu-channel");
+    job.channels.lidar = cli.get("--lidar-channel");
+    job.channels.camera = cli.get("--camera-channel");
+    job.channels.camera_right = cli.get("--camera-right-channel");
+    job.channels.ground_truth = cli.get("--ground-truth-channel");
+    job.max_buffer_mb = cli.getInt("--max-buffer-mb");
+    job.quiet = cli.has("--quiet");
+
+    livo::RosbagImportOptions& r = job.rosbag;
+    r.imu_topic = cli.get("--imu");
+    r.lidar_topic = cli.get("--lidar");
+    r.camera_topic = cli.get("--camera");
+    r.camera_right_topic = cli.get("--camera-right");
+    if (cli.has("--ground-truth")) {
+      const std::string gt = cli.get("--ground-truth");
+      if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::isFile(gt))
+        r.ground_truth_topic = gt;
+      else
+        r.ground_truth_file = gt;
+      job.euroc.ground_truth_file = gt;
+    }
+    r.auto_map = !cli.has("--no-auto-topics");
+    r.use_bag_time = cli.has("--use-bag-time");
+    r.imu_units.accel = cli.get("--imu-accel-unit");
+    r.imu_units.gyro = cli.get("--imu-gyro-unit");
+    applyPreset(job);  // fills what the flags left empty
+    if (cli.has("--lidar-stamp")) r.lidar.stamp = stampConvention(cli.get("--lidar-stamp"));
+    if (cli.has("--sweep-duration")) {
+      r.lidar.sweep_duration = cli.getDouble("--sweep-duration");
+      job.kitti.sweep_duration = r.lidar.sweep_duration;
+    }
+    if (cli.has("--lidar-rings")) r.lidar.num_rings = static_cast<int>(cli.getInt("--lidar-rings"));
+    r.lidar.time_field = cli.get("--lidar-time-field");
+    r.lidar.time_unit = cli.get("--lidar-time-unit");
+
+    job.euroc.decode_png = cli.has("--decode-png");
+    job.ouster.metadata_file = cli.get("--metadata");
+    job.ouster.keep_partial_sweeps = !cli.has("--drop-partial-sweeps");
+    job.kitti.poses_file = cli.get("--poses");
+    job.kitti.times_file = cli.get("--times");
+    job.kitti.lidar_rate_hz = cli.getDouble("--lidar-rate");
+    job.kitti.point_fields = pointFields(cli.get("--point-fields"));
+  } catch (const std::exception& e) {
+    std::cerr << "livo-import: " << e.what() << "\n";
+    return 2;
+  }
+  const livo::ImportOutcome outcome = livo::runImport(job, &std::cout);
+  return outcome.ok() ? 0 : 1;
+}
