@@ -1,0 +1,83 @@
+// The sensor rig as mounted (the `rig:` section of a project config): rates, noise, extrinsics,
+// intrinsics and channel names. Shared by the simulator and every estimator.
+//
+//   livo::SensorRig rig = livo::readSensorRig(livo::Config::load(file).section("rig"));
+#pragma once
+
+#include <array>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "livo/config.hpp"
+#include "livo/so3.hpp"
+
+namespace livo {
+
+struct RigChannels {
+  std::string imu = "IMU";
+  std::string lidar = "LIDAR";
+  std::string camera = "CAMERA";
+  std::string wheel = "WHEEL";
+  std::string ground_truth = "GROUND_TRUTH";
+};
+
+/// Body frame I == IMU frame. Noise parameters are continuous-time densities.
+struct ImuRig {
+  double rate_hz = 200.0;
+  double gyro_noise_density = 1.7e-4;   // rad/s/sqrt(Hz)
+  double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
+  double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
+  double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
+  double gravity = 9.81;                // m/s^2, world z up
+};
+
+struct LidarRig {
+  std::string model = "VLP-16";  // one of kLidarModels
+  double rate_hz = 10.0;
+  double min_range = 0.5;
+  double max_range = 100.0;
+  double range_noise_std = 0.01;      // m
+  double dropout_probability = 0.0;
+  Pose3 T_I_L = Pose3::Identity();    // p_I = T_I_L * p_L
+};
+
+/// Pinhole camera with radial-tangential distortion, z forward, x right, y down.
+struct CameraRig {
+  int width = 640;
+  int height = 480;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  std::array<double, 4> distortion{{0.0, 0.0, 0.0, 0.0}};  // k1 k2 p1 p2
+  double rate_hz = 20.0;
+  bool color = false;                 // RGB8 if true, else GRAY8
+  Pose3 T_I_C = Pose3::Identity();    // p_I = T_I_C * p_C
+};
+
+/// Differential-drive wheel encoder; base frame B: x forward, z up.
+struct WheelRig {
+  double rate_hz = 50.0;
+  double track_width = 0.5;           // m
+  double speed_noise_std = 0.02;      // m/s per wheel
+  Pose3 T_I_B = Pose3::Identity();
+};
+
+struct SensorRig {
+  RigChannels channels;
+  ImuRig imu;
+  std::optional<LidarRig> lidar;      // absent: no LiDAR
+  std::optional<CameraRig> camera;    // absent: no camera
+  std::optional<WheelRig> wheel;      // absent: no wheel encoder
+};
+
+/// LiDAR models the rig may name.
+extern const std::vector<std::string> kLidarModels;
+
+/// Reads and validates a `rig:` section (every key under it must be known); throws ConfigError
+/// naming the file and key.
+SensorRig readSensorRig(const Config& rig);
+
+/// Human-readable summary (for start-up output).
+void printSensorRig(const SensorRig& rig, std::ostream& os);
+
+}  // namespace livo

@@ -1,0 +1,65 @@
+#include "lidar_scanner.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace livo {
+namespace sim {
+
+LidarScanner::LidarScanner(const LidarRig& rig, const LidarPatternOptions& pattern_options)
+    : rig_(rig), pattern_(rig.model, rig.rate_hz, pattern_options) {}
+
+LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajectory, double t0, int64_t utime,
+                              double sensor_time0, Random rng) const {
+  LidarSweep sweep;
+  sweep.utime = utime;
+  sweep.duration = pattern_.sweepDuration();
+  sweep.solid_state = pattern_.solidState();
+  sweep.num_rings = pattern_.beams();
+  const size_t expected = static_cast<size_t>(pattern_.columns()) * pattern_.beams();
+  for (auto* v : {&sweep.x, &sweep.y, &sweep.z, &sweep.intensity, &sweep.time_offset}) v->reserve(expected);
+  sweep.ring.reserve(expected);
+
+  const Mat3 R_IL = rig_.T_I_L.linear();
+  const Vec3 t_IL = rig_.T_I_L.translation();
+  for (int c = 0; c < pattern_.columns(); ++c) {
+    const double column_time = c * pattern_.columnPeriod();
+    const BodyState s = trajectory.at(t0 + column_time);
+    const Mat3 R_WI = s.T_W_I.linear();
+    const Vec3 p_WI = s.T_W_I.translation();
+    for (int b = 0; b < pattern_.beams(); ++b) {
+      const double dt = pattern_.firingTime(c, b) - column_time;  // microseconds at most
+      // sensor pose at the beam's firing time (constant-rate step over dt, exact for dt = 0)
+      const Mat3 R = dt == 0.0 ? R_WI : Mat3(R_WI * so3::Exp(s.angular_velocity * dt));
+      const Vec3 p = p_WI + s.velocity * dt + 0.5 * s.acceleration * dt * dt;
+      const Mat3 R_WL = R * R_IL;
+      const double time_offset = column_time + dt;
+      const Vec3 d_L = pattern_.direction(b, time_offset, sensor_time0 + time_offset);
+      Ray ray;
+      ray.origin = p + R * t_IL;
+      ray.direction = R_WL * d_L;
+      // draw the noise for every beam so each beam's noise does not depend on other beams' hits
+      const double noise = rng.normal();
+      const double drop = rng.uniform();
+      const RayHit hit = scene.cast(ray, 1e-6, rig_.max_range);
+      if (!hit.valid() || hit.t < rig_.min_range) continue;
+      if (drop < rig_.dropout_probability) continue;
+      const double range = hit.t + rig_.range_noise_std * noise;
+      if (range < rig_.min_range || range > rig_.max_range) continue;
+      const SurfacePoint sp = scene.surface(ray, hit);
+      const double cos_incidence = std::abs(sp.normal.dot(ray.direction));
+      const double intensity = 255.0 * scene.material(hit.object).reflectivity * cos_incidence;
+      const Vec3 q = d_L * range;
+      sweep.x.push_back(static_cast<float>(q.x()));
+      sweep.y.push_back(static_cast<float>(q.y()));
+      sweep.z.push_back(static_cast<float>(q.z()));
+      sweep.intensity.push_back(static_cast<float>(std::min(255.0, intensity)));
+      sweep.time_offset.push_back(static_cast<float>(time_offset));
+      sweep.ring.push_back(static_cast<int16_t>(pattern_.ring(b)));
+    }
+  }
+  return sweep;
+}
+
+}  // namespace sim
+}  // namespace livo

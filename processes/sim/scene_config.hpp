@@ -1,0 +1,17 @@
+// Reads a scene description (YAML, see README.md: sky, light, textures, objects) into a Scene.
+#pragma once
+
+#include <memory>
+
+#include "livo/config.hpp"
+#include "scene.hpp"
+
+namespace livo {
+namespace sim {
+
+/// Builds (and build()s) the scene described by `scene`; every key must be known. Errors are
+/// ConfigErrors naming the file and key.
+std::unique_ptr<Scene> readScene(const Config& scene);
+
+}  // namespace sim
+}  // namespace livo

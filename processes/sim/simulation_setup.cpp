@@ -1,0 +1,177 @@
+#include "simulation_setup.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <ostream>
+
+#include "scene_config.hpp"
+#include "trajectory_config.hpp"
+
+namespace livo {
+namespace sim {
+
+namespace {
+
+std::string dirOf(const std::string& file) {
+  const size_t slash = file.rfind('/');
+  return slash == std::string::npos ? "." : file.substr(0, slash);
+}
+
+std::string resolve(const std::string& base_dir, const std::string& path) {
+  if (path.empty() || path[0] == '/' || base_dir.empty()) return path;
+  return base_dir + "/" + path;
+}
+
+void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
+  sim.readOptional("start_time_s", o->start_time_s);
+  sim.readOptional("duration_s", o->duration_s);
+  sim.readOptional("ground_truth_rate_hz", o->ground_truth_rate_hz);
+  int64_t seed = static_cast<int64_t>(o->seed);
+  if (sim.readOptional("seed", seed)) {
+    if (seed < 0) throw ConfigError(sim.where("seed") + ": must be >= 0");
+    o->seed = static_cast<uint64_t>(seed);
+  }
+  sim.readOptional("threads", o->threads);
+  if (!(o->start_time_s >= 0.0)) throw ConfigError(sim.where("start_time_s") + ": must be >= 0");
+  if (!(o->duration_s > 0.0)) throw ConfigError(sim.where("duration_s") + ": must be > 0");
+  if (!(o->ground_truth_rate_hz > 0.0)) throw ConfigError(sim.where("ground_truth_rate_hz") + ": must be > 0");
+  if (o->threads < 1 || o->threads > 256) throw ConfigError(sim.where("threads") + ": must be in 1..256");
+
+  const Config imu = sim.optionalSection("imu");
+  imu.readOptional("initial_gyro_bias", o->initial_gyro_bias);
+  imu.readOptional("initial_accel_bias", o->initial_accel_bias);
+  imu.checkAllUsed();
+
+  const Config lidar = sim.optionalSection("lidar");
+  if (!lidar.isNull() && !rig.lidar) throw ConfigError(sim.where("lidar") + ": the rig has no lidar");
+  lidar.readOptional("columns", o->lidar.columns);
+  lidar.readOptional("start_azimuth_deg", o->lidar.start_azimuth_deg);
+  if (o->lidar.columns < 0 || o->lidar.columns > 100000) throw ConfigError(lidar.where("columns") + ": must be in 0..100000");
+  lidar.checkAllUsed();
+
+  const Config cam = sim.optionalSection("camera");
+  if (!cam.isNull() && !rig.camera) throw ConfigError(sim.where("camera") + ": the rig has no camera");
+  CameraEffects& e = o->camera;
+  cam.readOptional("exposure_time", e.exposure_time);
+  cam.readOptional("exposure_variation", e.exposure_variation);
+  cam.readOptional("exposure_period_s", e.exposure_period_s);
+  cam.readOptional("motion_blur_samples", e.motion_blur_samples);
+  cam.readOptional("noise_std", e.noise_std);
+  cam.readOptional("brightness", e.brightness);
+  cam.readOptional("vignetting", e.vignetting);
+  if (!(e.exposure_time > 0.0)) throw ConfigError(cam.where("exposure_time") + ": must be > 0");
+  if (!(e.exposure_variation >= 0.0 && e.exposure_variation < 1.0))
+    throw ConfigError(cam.where("exposure_variation") + ": must be in [0, 1)");
+  if (!(e.exposure_period_s > 0.0)) throw ConfigError(cam.where("exposure_period_s") + ": must be > 0");
+  if (e.motion_blur_samples < 1 || e.motion_blur_samples > 64)
+    throw ConfigError(cam.where("motion_blur_samples") + ": must be in 1..64");
+  if (!(e.noise_std >= 0.0)) throw ConfigError(cam.where("noise_std") + ": must be >= 0");
+  if (!(e.brightness > 0.0)) throw ConfigError(cam.where("brightness") + ": must be > 0");
+  if (!(e.vignetting >= 0.0 && e.vignetting <= 1.0)) throw ConfigError(cam.where("vignetting") + ": must be in [0, 1]");
+  cam.checkAllUsed();
+
+  const Config wheel = sim.optionalSection("wheel");
+  if (!wheel.isNull() && !rig.wheel) throw ConfigError(sim.where("wheel") + ": the rig has no wheel encoder");
+  wheel.readOptional("left_scale", o->wheel_left_scale);
+  wheel.readOptional("right_scale", o->wheel_right_scale);
+  if (!(o->wheel_left_scale > 0.0)) throw ConfigError(wheel.where("left_scale") + ": must be > 0");
+  if (!(o->wheel_right_scale > 0.0)) throw ConfigError(wheel.where("right_scale") + ": must be > 0");
+  wheel.checkAllUsed();
+}
+
+}  // namespace
+
+SimulationSetup loadSimulation(const std::string& file, const SimOverrides& overrides) {
+  SimulationSetup s = loadSimulation(Config::load(file), dirOf(file), overrides);
+  s.config_file = file;
+  return s;
+}
+
+SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, const SimOverrides& overrides) {
+  root.checkKeysIn(kConfigSections);
+  SimulationSetup s;
+  s.config_file = root.file();
+  s.rig = readSensorRig(root.section("rig"));
+  const Config sim = root.section("sim");
+  readSimOptions(sim, s.rig, &s.options);
+
+  if (sim.has("scene") == sim.has("scene_file"))
+    throw ConfigError(sim.where("scene") + ": give exactly one of scene (a map) or scene_file (a path)");
+  if (sim.has("scene")) {
+    s.scene = readScene(sim.section("scene"));
+    s.scene_source = "inline";
+  } else {
+    const std::string path = resolve(base_dir, sim.get<std::string>("scene_file"));
+    Config scene_cfg = Config::fromString("", path);
+    try {
+      scene_cfg = Config::load(path);
+    } catch (const ConfigError& e) {
+      throw ConfigError(sim.where("scene_file") + ": " + e.what());
+    }
+    s.scene = readScene(scene_cfg);
+    s.scene_source = path;
+  }
+
+  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir);
+  s.trajectory = std::move(traj.trajectory);
+  s.trajectory_description = traj.description;
+  s.recorded = traj.recorded;
+  s.recorded_imu = std::move(traj.recorded_imu);
+
+  if (overrides.seed) s.options.seed = *overrides.seed;
+  if (overrides.threads) s.options.threads = *overrides.threads;
+  if (overrides.duration_s) {
+    if (!(*overrides.duration_s > 0.0)) throw ConfigError("--duration: must be > 0");
+    s.options.duration_s = *overrides.duration_s;
+  }
+
+  if (s.recorded) {
+    if (sim.has("start_time_s"))
+      throw ConfigError(sim.where("start_time_s") + ": a recorded trajectory takes its start time from the recording");
+    // the span covered by both the ground truth and the IMU
+    const double gt0 = traj.recorded_start_stamp, gt1 = gt0 + s.trajectory->duration();
+    const double imu0 = s.recorded_imu.front().stamp_ns * 1e-9, imu1 = s.recorded_imu.back().stamp_ns * 1e-9;
+    const double t0 = std::max(gt0, imu0), t1 = std::min(gt1, imu1);
+    if (!(t1 > t0)) throw ConfigError(sim.where("trajectory") + ": the ground truth and the IMU do not overlap in time");
+    s.start_utime = static_cast<int64_t>(std::ceil(t0 * 1e6));
+    s.trajectory_time_offset = static_cast<double>(s.start_utime) * 1e-6 - gt0;
+    const double available = std::floor((t1 * 1e6 - static_cast<double>(s.start_utime))) * 1e-6;
+    if (!sim.has("duration_s") && !overrides.duration_s) s.options.duration_s = available;
+    s.options.duration_s = std::min(s.options.duration_s, available);
+  } else {
+    s.start_utime = static_cast<int64_t>(std::llround(s.options.start_time_s * 1e6));
+  }
+  sim.checkAllUsed();
+  return s;
+}
+
+void printSimulation(const SimulationSetup& s, std::ostream& os) {
+  const SimOptions& o = s.options;
+  os << "config:     " << s.config_file << "\n";
+  printSensorRig(s.rig, os);
+  os << "sim:\n  start " << std::fixed << std::setprecision(6) << s.start_utime * 1e-6 << " s, duration "
+     << std::setprecision(3) << o.duration_s << " s";
+  os.unsetf(std::ios::floatfield);
+  os << std::setprecision(6) << ", ground truth at " << o.ground_truth_rate_hz << " Hz, seed " << o.seed << ", "
+     << o.threads << " threads\n";
+  os << "  scene: " << s.scene_source << ": " << s.scene->objectCount() << " objects, " << s.scene->textureCount()
+     << " textures\n";
+  os << "  trajectory: " << s.trajectory_description << "\n";
+  if (s.recorded) os << "  IMU: the recording's own samples, unchanged\n";
+  else
+    os << "  IMU initial bias: gyro [" << o.initial_gyro_bias.transpose() << "] rad/s, accel ["
+       << o.initial_accel_bias.transpose() << "] m/s^2\n";
+  if (s.rig.lidar)
+    os << "  lidar: columns " << (o.lidar.columns ? std::to_string(o.lidar.columns) : std::string("model default"))
+       << ", start azimuth " << o.lidar.start_azimuth_deg << " deg\n";
+  if (s.rig.camera)
+    os << "  camera: exposure " << o.camera.exposure_time * 1e3 << " ms +-" << o.camera.exposure_variation * 100
+       << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples
+       << ", noise " << o.camera.noise_std << " DN, brightness " << o.camera.brightness << ", vignetting "
+       << o.camera.vignetting << "\n";
+  if (s.rig.wheel)
+    os << "  wheel: scale errors left " << o.wheel_left_scale << ", right " << o.wheel_right_scale << "\n";
+}
+
+}  // namespace sim
+}  // namespace livo

@@ -1,0 +1,27 @@
+// Reads `sim.trajectory` (handheld | car | uav | recorded) into a BodyTrajectory.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "livo/asl_dataset.hpp"
+#include "livo/config.hpp"
+#include "trajectory.hpp"
+
+namespace livo {
+namespace sim {
+
+struct TrajectoryConfig {
+  std::unique_ptr<BodyTrajectory> trajectory;
+  std::string description;
+  bool recorded = false;
+  double recorded_start_stamp = 0.0;      // s, first ground-truth stamp
+  std::vector<ImuSample> recorded_imu;    // recorded: the real IMU samples
+};
+
+/// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths.
+TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir);
+
+}  // namespace sim
+}  // namespace livo

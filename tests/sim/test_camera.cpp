@@ -1,0 +1,188 @@
+// Camera: the pinhole + radial-tangential model against OpenCV, a rendered checkerboard plane
+// landing on the pixels the model predicts, exposure changes and motion blur.
+#include <gtest/gtest.h>
+
+#include "camera_renderer.hpp"
+#include "random.hpp"
+#include "sim_test_support.hpp"
+
+#ifdef LIVO_HAVE_OPENCV
+#include <opencv2/calib3d.hpp>
+#endif
+
+using namespace livo;
+using namespace livo::sim;
+
+namespace {
+
+CameraRig testCamera() {
+  CameraRig c;
+  c.width = 320;
+  c.height = 240;
+  c.fx = 210.0;
+  c.fy = 205.0;
+  c.cx = 161.3;
+  c.cy = 118.7;
+  c.distortion = {-0.28, 0.07, 0.0002, 1.8e-5};  // EuRoC cam0-like
+  c.rate_hz = 20;
+  c.T_I_C.linear() = so3::Exp(Vec3(0.02, 0.01, -0.03));
+  c.T_I_C.translation() = Vec3(0.05, 0.0, 0.0);
+  return c;
+}
+
+CameraEffects plainEffects() {
+  CameraEffects e;
+  e.exposure_variation = 0.0;
+  e.noise_std = 0.0;
+  e.vignetting = 0.0;
+  return e;
+}
+
+// Checkerboard plane z = 4 (normal towards the camera), squares of 0.25 m, lit uniformly.
+constexpr double kPlaneZ = 4.0, kSquare = 0.25;
+const Vec3 kPlaneCenter(0.2, -0.1, kPlaneZ);
+
+Scene checkerScene() {
+  Scene scene;
+  scene.lighting.ambient = 1.0;
+  scene.lighting.diffuse = 0.0;
+  TextureOptions t;
+  t.pattern = TexturePattern::kChecker;
+  t.scale = kSquare;
+  t.color_a = Eigen::Vector3d::Constant(0.9);
+  t.color_b = Eigen::Vector3d::Constant(0.1);
+  t.grain = 0.0;
+  t.variation = 0.0;
+  scene.addTexture(t);
+  Shape plane;
+  plane.type = ShapeType::kPlane;
+  plane.center = kPlaneCenter;
+  plane.half_size = Vec3(3.0, 3.0, 0.0);
+  scene.addShape("board", plane, Material{});
+  scene.build();
+  return scene;
+}
+
+Pose3 bodyPose() {
+  Pose3 T = Pose3::Identity();
+  T.linear() = so3::Exp(Vec3(0.05, -0.04, 0.1));
+  T.translation() = Vec3(0.1, 0.2, 0.0);
+  return T;
+}
+
+}  // namespace
+
+#ifdef LIVO_HAVE_OPENCV
+TEST(PinholeCamera, MatchesOpenCvProjectPoints) {
+  const CameraRig rig = testCamera();
+  PinholeCamera cam(rig);
+  Random rng(4, 4);
+  std::vector<cv::Point3d> pts;
+  for (int i = 0; i < 200; ++i) pts.emplace_back(rng.uniform(-1.5, 1.5), rng.uniform(-1.0, 1.0), rng.uniform(1.0, 4.0));
+  const cv::Matx33d K(rig.fx, 0, rig.cx, 0, rig.fy, rig.cy, 0, 0, 1);
+  const std::vector<double> dist(rig.distortion.begin(), rig.distortion.end());
+  std::vector<cv::Point2d> px;
+  cv::projectPoints(pts, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, dist, px);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    Eigen::Vector2d uv;
+    ASSERT_TRUE(cam.project(Vec3(pts[i].x, pts[i].y, pts[i].z), &uv));
+    EXPECT_NEAR(uv.x(), px[i].x, 1e-9);
+    EXPECT_NEAR(uv.y(), px[i].y, 1e-9);
+  }
+}
+#endif
+
+TEST(PinholeCamera, PixelRaysProjectBackToTheirPixels) {
+  PinholeCamera cam(testCamera());
+  for (int v = 0; v < 240; v += 13)
+    for (int u = 0; u < 320; u += 17) {
+      const Vec3 ray = cam.pixelRay(Eigen::Vector2d(u, v));
+      EXPECT_NEAR(ray.norm(), 1.0, 1e-12);
+      Eigen::Vector2d back;
+      ASSERT_TRUE(cam.project(3.0 * ray, &back));
+      EXPECT_NEAR(back.x(), u, 1e-7);
+      EXPECT_NEAR(back.y(), v, 1e-7);
+    }
+  Eigen::Vector2d uv;
+  EXPECT_FALSE(cam.project(Vec3(0, 0, -1), &uv));
+}
+
+TEST(CameraRenderer, CheckerboardLandsOnThePredictedPixels) {
+  const CameraRig rig = testCamera();
+  const Scene scene = checkerScene();
+  CameraRenderer renderer(rig, plainEffects());
+  test::ConstantMotion still(bodyPose());
+  const CameraImage img = renderer.render(scene, still, 0.0, 42, Random(1, 4));
+  ASSERT_EQ(img.width, 320);
+  ASSERT_EQ(img.data.size(), 320u * 240u);
+  EXPECT_EQ(img.utime, 42);
+  const Pose3 T_W_C = bodyPose() * rig.T_I_C;
+  int checked = 0, white = 0;
+  for (int v = 0; v < rig.height; ++v)
+    for (int u = 0; u < rig.width; ++u) {
+      // where this pixel looks on the plane, from the camera model alone
+      const Vec3 d = T_W_C.linear() * renderer.camera().pixelRay(Eigen::Vector2d(u, v));
+      const double t = (kPlaneZ - T_W_C.translation().z()) / d.z();
+      const Vec3 p = T_W_C.translation() + t * d - kPlaneCenter;
+      if (std::abs(p.x()) > 2.9 || std::abs(p.y()) > 2.9) continue;
+      const double fu = p.x() / kSquare - std::floor(p.x() / kSquare), fv = p.y() / kSquare - std::floor(p.y() / kSquare);
+      const double margin = 0.03 / kSquare;  // stay 3 cm (a few pixels) off the square edges
+      if (fu < margin || fu > 1 - margin || fv < margin || fv > 1 - margin) continue;
+      const int64_t a = static_cast<int64_t>(std::floor(p.x() / kSquare)), b = static_cast<int64_t>(std::floor(p.y() / kSquare));
+      const bool is_white = ((a + b) % 2 + 2) % 2 == 0;
+      const int expected = is_white ? 230 : 26;  // 255 * 0.9, 255 * 0.1
+      ASSERT_NEAR(img.data[static_cast<size_t>(v) * rig.width + u], expected, 1) << "pixel " << u << ", " << v;
+      ++checked;
+      white += is_white;
+    }
+  EXPECT_GT(checked, 320 * 240 * 2 / 5);  // most of the image sees the board
+  EXPECT_GT(white, checked / 3);
+  EXPECT_LT(white, 2 * checked / 3);
+}
+
+TEST(CameraRenderer, ExposureChangesScaleTheImage) {
+  CameraRig rig = testCamera();
+  rig.color = true;
+  const Scene scene = checkerScene();
+  CameraEffects e = plainEffects();
+  e.exposure_variation = 0.3;
+  e.brightness = 0.8;
+  CameraRenderer renderer(rig, e);
+  test::ConstantMotion still(bodyPose());
+  // two times with clearly different exposures
+  double ta = 0.0, tb = 0.0;
+  for (double t = 0.0; t < 8.0; t += 0.05) {
+    if (renderer.exposureAt(t) > renderer.exposureAt(ta)) ta = t;
+    if (renderer.exposureAt(t) < renderer.exposureAt(tb)) tb = t;
+  }
+  const CameraImage a = renderer.render(scene, still, ta, 0, Random(1, 4, 0));
+  const CameraImage b = renderer.render(scene, still, tb, 0, Random(1, 4, 1));
+  ASSERT_EQ(a.data.size(), 320u * 240u * 3u);
+  EXPECT_FLOAT_EQ(a.exposure_time, static_cast<float>(renderer.exposureAt(ta)));
+  double sa = 0, sb = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) sa += a.data[i], sb += b.data[i];
+  const double ratio = renderer.exposureAt(ta) / renderer.exposureAt(tb);
+  EXPECT_GT(ratio, 1.3);
+  EXPECT_NEAR(sa / sb, ratio, 0.01 * ratio);
+}
+
+TEST(CameraRenderer, MotionBlurSmoothsAMovingView) {
+  const CameraRig rig = testCamera();
+  const Scene scene = checkerScene();
+  CameraEffects sharp = plainEffects(), blurred = plainEffects();
+  sharp.exposure_time = blurred.exposure_time = 0.02;
+  blurred.motion_blur_samples = 8;
+  test::ConstantMotion pan(bodyPose(), Vec3(2.0, 0, 0), Vec3(0, 1.5, 0));
+  const CameraImage a = CameraRenderer(rig, sharp).render(scene, pan, 0.5, 0, Random(1, 4));
+  const CameraImage b = CameraRenderer(rig, blurred).render(scene, pan, 0.5, 0, Random(1, 4));
+  auto gradient = [&](const CameraImage& im) {  // energy of horizontal gradients
+    double g = 0;
+    for (int v = 0; v < im.height; ++v)
+      for (int u = 1; u < im.width; ++u) {
+        const double d = im.data[v * im.width + u] - im.data[v * im.width + u - 1];
+        g += d * d;
+      }
+    return g;
+  };
+  EXPECT_LT(gradient(b), 0.7 * gradient(a));
+}

@@ -1,0 +1,212 @@
+// The whole simulator: shipped configs make logs with the configured channels and rates, the log
+// is ordered and reproducible byte for byte, the EuRoC re-simulation keeps the real IMU stream,
+// and configuration mistakes are reported with the file and key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "livo/asl_dataset.hpp"
+#include "livo/image_t.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/point_cloud_t.hpp"
+#include "livo/pose_t.hpp"
+#include "livo/trajectory_io.hpp"
+#include "livo/wheel_odometry_t.hpp"
+#include "log_writer.hpp"
+#include "sim_test_support.hpp"
+#include "simulation_setup.hpp"
+#include "simulator.hpp"
+#include "temp_path.hpp"
+
+using namespace livo;
+using namespace livo::sim;
+
+namespace {
+
+std::string configPath(const std::string& name) { return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml"; }
+
+std::string simulateToLog(const std::string& config, double duration, uint64_t seed, int threads, const std::string& tag) {
+  SimOverrides o;
+  o.duration_s = duration;
+  o.seed = seed;
+  o.threads = threads;
+  const SimulationSetup setup = loadSimulation(configPath(config), o);
+  const std::string path = livo_test::tempPath("sim_") + config + "_" + tag + ".lcmlog";
+  {
+    LogWriter writer(path, setup.rig.channels);
+    Simulator(setup).run(writer);
+  }
+  return path;
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+template <class Msg>
+int64_t utimeOf(const lcm::LogEvent* ev) {
+  Msg m;
+  EXPECT_EQ(m.decode(ev->data, 0, ev->datalen), ev->datalen) << ev->channel;
+  return m.utime;
+}
+
+struct ChannelCount {
+  int64_t count = 0, first = 0, last = 0;
+};
+
+/// Reads a log, checks order, tie order and that each event's stamp is its message's utime.
+std::map<std::string, ChannelCount> checkLog(const std::string& path, const RigChannels& ch) {
+  const std::map<std::string, int> rank = {
+      {ch.imu, 0}, {ch.wheel, 1}, {ch.ground_truth, 2}, {ch.lidar, 3}, {ch.camera, 4}};
+  lcm::LogFile log(path, "r");
+  EXPECT_TRUE(log.good());
+  std::map<std::string, ChannelCount> out;
+  int64_t prev_t = -1;
+  int prev_rank = -1;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    int64_t u = -1;
+    if (ev->channel == ch.imu) u = utimeOf<imu_t>(ev);
+    else if (ev->channel == ch.ground_truth) u = utimeOf<pose_t>(ev);
+    else if (ev->channel == ch.wheel) u = utimeOf<wheel_odometry_t>(ev);
+    else if (ev->channel == ch.lidar) u = utimeOf<point_cloud_t>(ev);
+    else if (ev->channel == ch.camera) u = utimeOf<image_t>(ev);
+    else ADD_FAILURE() << "unexpected channel " << ev->channel;
+    EXPECT_EQ(u, ev->timestamp) << ev->channel;
+    EXPECT_GE(ev->timestamp, prev_t);
+    if (ev->timestamp == prev_t) {
+      EXPECT_GE(rank.at(ev->channel), prev_rank) << "tie order at " << ev->timestamp;
+    }
+    prev_t = ev->timestamp;
+    prev_rank = rank.at(ev->channel);
+    ChannelCount& c = out[ev->channel];
+    if (c.count++ == 0) c.first = ev->timestamp;
+    c.last = ev->timestamp;
+  }
+  return out;
+}
+
+void expectRate(const std::map<std::string, ChannelCount>& counts, const std::string& channel, double rate_hz,
+                double duration, double phase = 0.0) {
+  ASSERT_TRUE(counts.count(channel)) << channel;
+  const ChannelCount& c = counts.at(channel);
+  EXPECT_NEAR(static_cast<double>(c.count), std::floor(duration * rate_hz - phase + 1e-9) + 1.0, 1.0) << channel;
+  if (c.count > 1) {
+    EXPECT_NEAR((c.count - 1) / ((c.last - c.first) * 1e-6), rate_hz, 0.01 * rate_hz) << channel;
+  }
+}
+
+std::string configError(const std::string& yaml) {
+  try {
+    loadSimulation(Config::fromString(yaml, "bad.yaml"), "");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Simulation, SameSeedGivesAByteIdenticalLogWhateverTheThreads) {
+  const std::string a = readBytes(simulateToLog("room", 0.6, 7, 2, "a"));
+  const std::string b = readBytes(simulateToLog("room", 0.6, 7, 2, "b"));
+  const std::string c = readBytes(simulateToLog("room", 0.6, 7, 1, "c"));
+  const std::string d = readBytes(simulateToLog("room", 0.6, 8, 2, "d"));
+  ASSERT_GT(a.size(), 1000000u);
+  EXPECT_TRUE(a == b);
+  EXPECT_TRUE(a == c);
+  EXPECT_FALSE(a == d);  // other noise (and other LiDAR dropouts)
+}
+
+TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
+  for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking"}) {
+    SCOPED_TRACE(name);
+    const double duration = 0.5;
+    const SimulationSetup setup = loadSimulation(configPath(name));
+    const std::string log = simulateToLog(name, duration, 1, 2, "rates");
+    const auto counts = checkLog(log, setup.rig.channels);
+    const RigChannels& ch = setup.rig.channels;
+    expectRate(counts, ch.imu, setup.rig.imu.rate_hz, duration);
+    expectRate(counts, ch.ground_truth, setup.options.ground_truth_rate_hz, duration);
+    if (setup.rig.wheel) expectRate(counts, ch.wheel, setup.rig.wheel->rate_hz, duration);
+    if (setup.rig.camera) expectRate(counts, ch.camera, setup.rig.camera->rate_hz, duration, 0.5);
+    if (setup.rig.lidar) {
+      ASSERT_TRUE(counts.count(ch.lidar));
+      EXPECT_EQ(counts.at(ch.lidar).count, static_cast<int64_t>(std::floor(duration * setup.rig.lidar->rate_hz)));
+    }
+    EXPECT_EQ(counts.begin()->second.first >= setup.start_utime, true);
+  }
+}
+
+TEST(Simulation, EurocResimulationKeepsTheRealImuStream) {
+  SimOverrides o;
+  o.duration_s = 0.6;
+  const SimulationSetup setup = loadSimulation(configPath("euroc_v1_01"), o);
+  ASSERT_TRUE(setup.recorded);
+  test::CollectingSink sink;
+  Simulator(setup).run(sink);
+  const auto real = readAslImuCsv(std::string(LIVO_SHARED_DATA) + "/euroc_v1_01/mav0/imu0/data.csv");
+  ASSERT_GE(sink.imu.size(), 110u);  // 200 Hz
+  size_t k = 0;
+  while (real[k].stamp_ns < setup.start_utime * 1000) ++k;
+  for (size_t i = 0; i < sink.imu.size(); ++i, ++k) {
+    EXPECT_EQ(sink.imu[i].utime, (real[k].stamp_ns + 500) / 1000);
+    EXPECT_EQ(sink.imu[i].angular_velocity, real[k].gyro);          // bit for bit
+    EXPECT_EQ(sink.imu[i].linear_acceleration, real[k].accel);
+  }
+  // the ray-cast sensors and the ground truth follow the recorded motion
+  ASSERT_FALSE(sink.sweeps.empty());
+  ASSERT_FALSE(sink.images.empty());
+  EXPECT_EQ(sink.images.front().width, 752);
+  const livo::Trajectory gt = readTrajectory(std::string(LIVO_SHARED_DATA) + "/euroc_v1_01/groundtruth.tum");
+  EXPECT_NEAR(sink.poses.front().utime * 1e-6, gt.front().stamp, 1e-5);
+  EXPECT_LT((sink.poses.front().T_W_I.translation() - gt.front().pose.translation()).norm(), 1e-4);
+  // the drone stays inside the modelled room: every LiDAR sweep is nearly complete
+  for (const auto& s : sink.sweeps) EXPECT_GT(s.size(), 0.9 * 16 * 1024);
+}
+
+TEST(SimulationConfig, ErrorsNameTheFileAndKey) {
+  const std::string rig = test::noiseFreeImuRig();
+  const std::string good_traj = "  trajectory: {type: handheld, waypoints: [0,0,1, 2,0,1, 2,2,1]}\n";
+  // the valid baseline
+  EXPECT_EQ(configError(rig + "sim:\n" + test::boxRoomScene() + good_traj), "");
+
+  EXPECT_NE(configError("rig:\n  imu: {gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
+                        "accel_random_walk: 0}\nsim:\n" + test::boxRoomScene() + good_traj)
+                .find("bad.yaml: rig.imu.rate_hz: missing required key"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n  duraton_s: 3\n" + test::boxRoomScene() + good_traj)
+                .find("sim.duraton_s (did you mean sim.duration_s?)"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "  lidar: {model: VLP-32, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
+                              "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
+                        test::boxRoomScene() + good_traj)
+                .find("rig.lidar.model: unknown LiDAR model 'VLP-32'"),
+            std::string::npos);
+  std::string bad_texture = test::boxRoomScene();
+  bad_texture.replace(bad_texture.find("texture: grey"), 13, "texture: gray");
+  EXPECT_NE(configError(rig + "sim:\n" + bad_texture + good_traj).find("sim.scene.objects.room.texture: unknown texture 'gray'"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n" + test::boxRoomScene() + "  trajectory: {type: bicycle}\n")
+                .find("sim.trajectory.type: unknown trajectory type 'bicycle'"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n  scene_file: /nonexistent/scene.yaml\n" + good_traj)
+                .find("sim.scene_file: /nonexistent/scene.yaml: cannot open"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n" + test::boxRoomScene() +
+                        "  trajectory: {type: recorded, ground_truth: /nonexistent/gt.tum, imu: /nonexistent/imu.csv}\n")
+                .find("sim.trajectory.ground_truth: /nonexistent/gt.tum"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n  camera: {noise_std: 1}\n" + test::boxRoomScene() + good_traj)
+                .find("sim.camera: the rig has no camera"),
+            std::string::npos);
+  EXPECT_NE(configError(rig + "vio: {}\nsimulation: {}\n").find("simulation: unknown section"), std::string::npos);
+  EXPECT_NE(configError(rig + "sim:\n  duration_s: -1\n" + test::boxRoomScene() + good_traj).find("sim.duration_s: must be > 0"),
+            std::string::npos);
+  EXPECT_THROW(loadSimulation("/nonexistent/config.yaml"), ConfigError);
+}
