@@ -138,7 +138,7 @@ std::vector<channel_stats_t> Node::channelStats() const {
   return out;
 }
 
-void Node::publishHealth() {
+health_t Node::healthMessage() const {
   health_t h;
   h.utime = last_utime_;
   h.node = options_.name;
@@ -147,6 +147,11 @@ void Node::publishHealth() {
   h.peak_rss_mb = peakRssMb();
   h.channels = channelStats();
   h.num_channels = static_cast<int32_t>(h.channels.size());
+  return h;
+}
+
+void Node::publishHealth() {
+  const health_t h = healthMessage();
   lcm_.publish(options_.health_channel, &h);
   level_ = health_t::LEVEL_OK;
   last_event_.clear();

@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
     o.quiet = true;
     livo::Node node(*lcm, o);
     livo::Recorder recorder(node, cli.get("--out"), channels);
-    const int rc = livo::spin(*lcm, node, [&] { recorder.flush(); });
+    const int rc = livo::spin(*lcm, node, [&] { recorder.finish(o.health_channel); });
     std::cerr << "[" << o.name << "] wrote " << recorder.written() << " messages to " << cli.get("--out") << std::endl;
     return rc;
   } catch (const std::exception& e) {

@@ -35,6 +35,19 @@ void Recorder::write(const std::string& channel, const void* data, int size) {
   ++written_;
 }
 
+void Recorder::finish(const std::string& health_channel) {
+  const health_t h = node_.healthMessage();
+  std::vector<uint8_t> buf(h.getEncodedSize());
+  h.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  lcm::LogEvent ev;
+  ev.timestamp = last_utime_;
+  ev.channel = health_channel;
+  ev.datalen = static_cast<int32_t>(buf.size());
+  ev.data = buf.data();
+  log_->writeEvent(&ev);
+  flush();
+}
+
 void Recorder::flush() {
   if (log_) std::fflush(log_->getFilePtr());
 }

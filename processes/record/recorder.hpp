@@ -22,6 +22,9 @@ class Recorder {
   /// Throws std::runtime_error naming the file if it cannot be written.
   Recorder(Node& node, const std::string& out_path, const std::vector<std::string>& channels);
   ~Recorder();
+  /// Writes the recorder's own final HEALTH into the log (it cannot receive its own message), then
+  /// flushes. Call once at shutdown.
+  void finish(const std::string& health_channel = "HEALTH");
   void flush();
   int64_t written() const { return written_; }
 

@@ -20,6 +20,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "livo/channel_stats_t.hpp"
+#include "livo/health_t.hpp"
 #include "livo/latency_stats.hpp"
 
 namespace livo {
@@ -83,6 +84,8 @@ class Node {
   void finish();
 
   std::vector<channel_stats_t> channelStats() const;
+  /// The HEALTH message this node would publish now.
+  health_t healthMessage() const;
   void printSummary(std::ostream& os) const;
   int64_t handled(const std::string& channel) const;
   int64_t published(const std::string& channel) const;
