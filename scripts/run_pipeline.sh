@@ -7,6 +7,7 @@
 #   timing.json      per process: messages, median/p90/max ms, peak RSS
 #   evaluation_*.json, *.svg   accuracy against GROUND_TRUTH, if the log has it
 #   report.md        all of it for a person; logs/<process>.log: what each process printed
+#   maps and other files the processes write (they run in DIR)
 #
 #   scripts/run_pipeline.sh --log LOG --config FILE --out DIR [--realtime] [--without P,...]
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
@@ -118,7 +119,8 @@ exec 3>"$out/logs/run.txt"
 logger=$!
 declare -A pids=()
 for p in "${selected[@]}"; do
-  "$(exe_of "$p")" --config "$config" --name "$p" >"$out/logs/$p.log" 2>&1 &
+  # in the output folder, so the files a process writes (maps, loops.json) land there
+  (cd "$out" && exec "$(exe_of "$p")" --config "$config" --name "$p") >"$out/logs/$p.log" 2>&1 &
   pids[$p]=$!
 done
 cleanup() {

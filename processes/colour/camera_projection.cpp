@@ -1,0 +1,48 @@
+#include "camera_projection.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace livo {
+namespace colour {
+
+CameraProjection::CameraProjection(const CameraRig& rig) : rig_(rig) {
+  // The valid field: the undistorted image corners (fixed-point inversion), with a margin.
+  double r2 = 0.0;
+  const double corners[4][2] = {{0, 0}, {double(rig.width - 1), 0}, {0, double(rig.height - 1)},
+                                {double(rig.width - 1), double(rig.height - 1)}};
+  for (const auto& c : corners) {
+    const Eigen::Vector2d d((c[0] - rig.cx) / rig.fx, (c[1] - rig.cy) / rig.fy);
+    Eigen::Vector2d u = d;
+    for (int it = 0; it < 50; ++it) u += d - distort(u);
+    r2 = std::max(r2, u.squaredNorm());
+  }
+  max_r2_ = 1.5 * r2;
+}
+
+Eigen::Vector2d CameraProjection::distort(const Eigen::Vector2d& xy) const {
+  const double k1 = rig_.distortion[0], k2 = rig_.distortion[1], p1 = rig_.distortion[2], p2 = rig_.distortion[3];
+  const double x = xy.x(), y = xy.y(), r2 = x * x + y * y;
+  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x), y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
+bool CameraProjection::project(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel, double border) const {
+  if (!(p_C.z() > 1e-6)) return false;
+  const Eigen::Vector2d xy(p_C.x() / p_C.z(), p_C.y() / p_C.z());
+  if (xy.squaredNorm() > max_r2_) return false;
+  const Eigen::Vector2d d = distort(xy);
+  *pixel = Eigen::Vector2d(rig_.fx * d.x() + rig_.cx, rig_.fy * d.y() + rig_.cy);
+  return pixel->x() >= border && pixel->y() >= border && pixel->x() <= rig_.width - 1 - border &&
+         pixel->y() <= rig_.height - 1 - border;
+}
+
+double CameraProjection::vignette(const Eigen::Vector2d& pixel, double v) const {
+  if (v <= 0.0) return 1.0;
+  const double half_diag2 = 0.25 * (double(rig_.width) * rig_.width + double(rig_.height) * rig_.height);
+  const double dx = pixel.x() - rig_.cx, dy = pixel.y() - rig_.cy;
+  return 1.0 - v * std::min(1.0, (dx * dx + dy * dy) / half_diag2);
+}
+
+}  // namespace colour
+}  // namespace livo

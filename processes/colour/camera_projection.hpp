@@ -1,0 +1,32 @@
+// Pinhole projection with radial-tangential (k1 k2 p1 p2) distortion, OpenCV convention (pixel
+// (i, j) has its centre at (i, j)); camera frame z forward, x right, y down.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "livo/sensor_rig.hpp"
+
+namespace livo {
+namespace colour {
+
+class CameraProjection {
+ public:
+  explicit CameraProjection(const CameraRig& rig);
+
+  /// Pixel of p_C; false if behind the camera, outside the distortion model's valid field, or
+  /// outside the image shrunk by `border` pixels.
+  bool project(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel, double border = 0.0) const;
+  Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
+
+  /// Vignetting gain at a pixel for fall-off v (the simulator's and a common calibration model).
+  double vignette(const Eigen::Vector2d& pixel, double v) const;
+
+  const CameraRig& rig() const { return rig_; }
+
+ private:
+  CameraRig rig_;
+  double max_r2_ = 1e9;  // normalised radius^2 beyond which the polynomial is not trusted
+};
+
+}  // namespace colour
+}  // namespace livo

@@ -1,0 +1,54 @@
+#include "colour_config.hpp"
+
+namespace livo {
+namespace colour {
+
+ColourNodeOptions readColourOptions(const Config& c) {
+  ColourNodeOptions n;
+  ColourOptions& o = n.core;
+  if (!c.isNull()) {
+    c.readOptional("voxel_size", o.voxel_size);
+    c.readOptional("max_time_difference", o.max_time_difference);
+    c.readOptional("max_depth", o.max_depth);
+    c.readOptional("min_depth", o.min_depth);
+    c.readOptional("border_px", o.border_px);
+    c.readOptional("depth_cell_px", o.depth_cell_px);
+    c.readOptional("occluder_radius", o.occluder_radius);
+    c.readOptional("max_splat_cells", o.max_splat_cells);
+    c.readOptional("depth_tolerance", o.depth_tolerance);
+    c.readOptional("depth_tolerance_rel", o.depth_tolerance_rel);
+    c.readOptional("vignetting", o.vignetting);
+    c.readOptional("use_exposure_time", o.use_exposure_time);
+    c.readOptional("reference_exposure_s", o.reference_exposure_s);
+    c.readOptional("estimate_gain", o.estimate_gain);
+    c.readOptional("gain_min_pairs", o.gain_min_pairs);
+    c.readOptional("gain_min", o.gain_min);
+    c.readOptional("gain_max", o.gain_max);
+    c.readOptional("outlier_threshold", o.outlier_threshold);
+    c.readOptional("outlier_min_count", o.outlier_min_count);
+    c.readOptional("max_count", o.max_count);
+    c.readOptional("scan_channel", n.scan_channel);
+    c.readOptional("odometry_channel", n.odometry_channel);
+    c.readOptional("image_channel", n.image_channel);
+    c.readOptional("keyframe_channel", n.keyframe_channel);
+    c.readOptional("correction_channel", n.correction_channel);
+    c.readOptional("output_channel", n.output_channel);
+    c.readOptional("save_channel", n.save_channel);
+    c.readOptional("map_name", n.map_name);
+    c.checkAllUsed();
+  }
+  auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
+  if (!(o.voxel_size > 0.0)) fail("voxel_size", "must be > 0");
+  if (!(o.max_time_difference >= 0.0)) fail("max_time_difference", "must be >= 0");
+  if (!(o.min_depth > 0.0 && o.max_depth > o.min_depth)) fail("max_depth", "need 0 < min_depth < max_depth");
+  if (o.depth_cell_px < 1) fail("depth_cell_px", "must be >= 1");
+  if (o.occluder_radius < 0.0) fail("occluder_radius", "must be >= 0");
+  if (!(o.vignetting >= 0.0 && o.vignetting < 1.0)) fail("vignetting", "must be in [0, 1)");
+  if (!(o.gain_min > 0.0 && o.gain_max > o.gain_min)) fail("gain_max", "need 0 < gain_min < gain_max");
+  if (o.max_count < 1) fail("max_count", "must be >= 1");
+  if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");
+  return n;
+}
+
+}  // namespace colour
+}  // namespace livo

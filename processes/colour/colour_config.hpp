@@ -1,0 +1,28 @@
+// Reads the `colour:` section of a project config into ColourOptions and node settings (strict:
+// unknown keys are errors).
+#pragma once
+
+#include <string>
+
+#include "colour_options.hpp"
+#include "livo/config.hpp"
+
+namespace livo {
+namespace colour {
+
+struct ColourNodeOptions {
+  ColourOptions core;
+  std::string scan_channel = "REGISTERED_SCAN";
+  std::string odometry_channel = "ODOMETRY";
+  std::string image_channel;  // default: the rig's camera channel
+  std::string keyframe_channel = "KEYFRAME";
+  std::string correction_channel = "LOOP_CORRECTION";
+  std::string output_channel = "COLORED_CLOUD";
+  std::string save_channel = "COLOUR_SAVE";  // any message here writes the map files now
+  std::string map_name = "colour_map";       // files <output_dir>/<map_name>.ply / .pcd
+};
+
+ColourNodeOptions readColourOptions(const Config& section);
+
+}  // namespace colour
+}  // namespace livo

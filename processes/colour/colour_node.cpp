@@ -1,0 +1,175 @@
+#include "colour_node.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include "livo/colored_cloud_t.hpp"
+#include "livo/image_t.hpp"
+#include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/messages.hpp"
+#include "livo/odometry_t.hpp"
+#include "livo/registered_scan_t.hpp"
+#include "map_files.hpp"
+
+namespace livo {
+namespace colour {
+
+namespace {
+const CameraRig& requireCamera(const SensorRig& rig) {
+  if (!rig.camera) throw ConfigError("livo-colour: the rig has no camera (rig.camera)");
+  return *rig.camera;
+}
+}  // namespace
+
+ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const ColourNodeOptions& options,
+                       const SensorRig& rig, std::string output_dir)
+    : node_(lcm, node_options),
+      options_(options),
+      pipeline_(options.core, requireCamera(rig)),
+      output_dir_(std::move(output_dir)) {
+  if (options_.image_channel.empty()) options_.image_channel = rig.channels.camera;
+  node_.declareOutput(options_.output_channel);
+
+  node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
+    const point_cloud_t& c = m.cloud;
+    if (c.num_points <= 0) {
+      node_.reject(options_.scan_channel, "empty cloud");
+      return;
+    }
+    if (static_cast<int>(c.x.size()) != c.num_points || static_cast<int>(c.time_offset.size()) != c.num_points) {
+      node_.reject(options_.scan_channel, "cloud arrays disagree with num_points");
+      return;
+    }
+    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+      node_.reject(options_.scan_channel, "pose is not finite");
+      return;
+    }
+    if (!c.frame.empty() && c.frame != "W") {
+      node_.reject(options_.scan_channel, "cloud frame is '" + c.frame + "', expected W");
+      return;
+    }
+    ScanView v;
+    v.utime = m.utime;
+    v.cloud_utime = c.utime;
+    v.T_W_I = poseFrom(m.position, m.orientation);
+    v.num_points = c.num_points;
+    v.x = c.x.data();
+    v.y = c.y.data();
+    v.z = c.z.data();
+    v.time_offset = c.time_offset.data();
+    std::string error;
+    if (!pipeline_.addScan(v, &error)) {
+      node_.reject(options_.scan_channel, error);
+      return;
+    }
+    publishRecoloured(m.utime);
+  });
+  node_.subscribe<odometry_t>(options_.odometry_channel, [this](const odometry_t& m) {
+    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+      node_.reject(options_.odometry_channel, "pose is not finite");
+      return;
+    }
+    pipeline_.addPose(m.utime, poseFrom(m.position, m.orientation));
+  });
+  node_.subscribe<image_t>(options_.image_channel, [this](const image_t& m) {
+    RawImage raw;
+    raw.utime = m.utime;
+    raw.width = m.width;
+    raw.height = m.height;
+    raw.row_stride = m.row_stride;
+    raw.encoding = m.encoding;
+    raw.exposure_time = m.exposure_time;
+    raw.data = m.data.data();
+    raw.size = std::min<size_t>(m.data.size(), m.size > 0 ? static_cast<size_t>(m.size) : 0);
+    ColourImage img;
+    std::string error;
+    if (!decodeImage(raw, &img, &error) || !pipeline_.addImage(std::move(img), &error)) {
+      node_.reject(options_.image_channel, error);
+      return;
+    }
+    publishRecoloured(m.utime);
+  });
+  node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
+    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+      node_.reject(options_.keyframe_channel, "pose is not finite");
+      return;
+    }
+    pipeline_.addKeyframe(m.id, m.utime, poseFrom(m.position, m.orientation));
+  });
+  node_.subscribe<loop_correction_t>(options_.correction_channel, [this](const loop_correction_t& m) {
+    std::map<int64_t, Pose3> corrected;
+    for (int i = 0; i < m.num_keyframes && i < static_cast<int>(m.keyframe_id.size()); ++i) {
+      if (!allFinite(m.position[i].data(), 3) || !allFinite(m.orientation[i].data(), 4)) {
+        node_.reject(options_.correction_channel, "corrected pose is not finite");
+        return;
+      }
+      corrected[m.keyframe_id[i]] = poseFrom(m.position[i].data(), m.orientation[i].data());
+    }
+    const int moved = pipeline_.applyCorrection(corrected);
+    std::ostringstream s;
+    s << "loop correction: " << moved << " keyframes moved the map";
+    node_.info(s.str());
+    publishRecoloured(m.utime);
+  });
+  node_.subscribeRaw(options_.save_channel, [this](const void*, int) { saveMap(); });
+}
+
+void ColourNode::publishRecoloured(int64_t utime) {
+  const std::vector<uint32_t> ids = pipeline_.takeRecoloured();
+  if (ids.empty()) return;
+  colored_cloud_t out;
+  out.utime = utime;
+  out.frame = "W";
+  out.num_points = static_cast<int32_t>(ids.size());
+  out.x.resize(ids.size());
+  out.y.resize(ids.size());
+  out.z.resize(ids.size());
+  out.r.resize(ids.size());
+  out.g.resize(ids.size());
+  out.b.resize(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const MapPoint& p = pipeline_.map().point(ids[i]);
+    out.x[i] = p.position.x();
+    out.y[i] = p.position.y();
+    out.z[i] = p.position.z();
+    out.r[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[0], 0.0f, 255.0f)));
+    out.g[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[1], 0.0f, 255.0f)));
+    out.b[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[2], 0.0f, 255.0f)));
+  }
+  node_.publish(options_.output_channel, out);
+}
+
+std::string ColourNode::plyPath() const { return output_dir_ + "/" + options_.map_name + ".ply"; }
+std::string ColourNode::pcdPath() const { return output_dir_ + "/" + options_.map_name + ".pcd"; }
+
+bool ColourNode::saveMap() {
+  ColouredPoints pts;
+  for (const MapPoint& p : pipeline_.map().points()) {
+    if (!p.coloured()) continue;
+    pts.position.push_back(p.position);
+    std::array<uint8_t, 3> c;
+    for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[k], 0.0f, 255.0f)));
+    pts.rgb.push_back(c);
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(output_dir_, ec);
+  std::string error;
+  if (!writePly(plyPath(), pts, &error) || !writePcd(pcdPath(), pts, &error)) {
+    node_.error(error);
+    return false;
+  }
+  node_.info("wrote " + std::to_string(pts.size()) + " coloured points to " + plyPath() + " and " + pcdPath());
+  return true;
+}
+
+void ColourNode::finish() {
+  if (finished_) return;
+  finished_ = true;
+  pipeline_.flush();
+  publishRecoloured(node_.lastSensorTime());
+  saveMap();
+}
+
+}  // namespace colour
+}  // namespace livo

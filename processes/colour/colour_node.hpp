@@ -1,0 +1,44 @@
+// livo-colour's node: REGISTERED_SCAN, ODOMETRY, CAMERA, KEYFRAME and LOOP_CORRECTION in;
+// COLORED_CLOUD out (the points coloured or recoloured since the previous message, after every
+// scan); the map written as PLY and PCD on exit and whenever a message arrives on COLOUR_SAVE.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "colour_config.hpp"
+#include "colouring_pipeline.hpp"
+#include "livo/node.hpp"
+#include "livo/sensor_rig.hpp"
+
+namespace livo {
+namespace colour {
+
+class ColourNode {
+ public:
+  /// Throws ConfigError if the rig has no camera.
+  ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const ColourNodeOptions& options, const SensorRig& rig,
+             std::string output_dir);
+
+  /// Processes the images still queued, publishes what they coloured, writes the map files.
+  void finish();
+  /// Writes <output_dir>/<map_name>.ply and .pcd (coloured points only); false on failure.
+  bool saveMap();
+
+  Node& node() { return node_; }
+  const ColouringPipeline& pipeline() const { return pipeline_; }
+  std::string plyPath() const;
+  std::string pcdPath() const;
+
+ private:
+  void publishRecoloured(int64_t utime);
+
+  Node node_;
+  ColourNodeOptions options_;
+  ColouringPipeline pipeline_;
+  std::string output_dir_;
+  bool finished_ = false;
+};
+
+}  // namespace colour
+}  // namespace livo

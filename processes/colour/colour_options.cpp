@@ -1,0 +1,23 @@
+#include "colour_options.hpp"
+
+#include <ostream>
+
+namespace livo {
+namespace colour {
+
+void printColourOptions(const ColourOptions& o, std::ostream& os) {
+  os << "colour: voxel_size " << o.voxel_size << " m, max_time_difference " << o.max_time_difference
+     << " s, depth " << o.min_depth << ".." << o.max_depth << " m, border " << o.border_px << " px\n"
+     << "  occlusion: cell " << o.depth_cell_px << " px, occluder_radius " << o.occluder_radius
+     << " m (max " << o.max_splat_cells << " cells), tolerance " << o.depth_tolerance << " m + "
+     << o.depth_tolerance_rel << " z\n"
+     << "  photometry: vignetting " << o.vignetting << ", use_exposure_time " << (o.use_exposure_time ? "yes" : "no")
+     << ", reference_exposure " << o.reference_exposure_s << " s, estimate_gain "
+     << (o.estimate_gain ? "yes" : "no") << " (min " << o.gain_min_pairs << " pairs, " << o.gain_min << ".."
+     << o.gain_max << ")\n"
+     << "  accumulation: outlier_threshold " << o.outlier_threshold << " after " << o.outlier_min_count
+     << " observations, max_count " << o.max_count << "\n";
+}
+
+}  // namespace colour
+}  // namespace livo

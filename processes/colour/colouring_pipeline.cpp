@@ -1,0 +1,244 @@
+#include "colouring_pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "exposure_gain.hpp"
+
+namespace livo {
+namespace colour {
+
+namespace {
+DepthBufferOptions depthOptions(const ColourOptions& o) {
+  DepthBufferOptions d;
+  d.cell_px = o.depth_cell_px;
+  d.occluder_radius = o.occluder_radius;
+  d.max_splat_cells = o.max_splat_cells;
+  d.tolerance = o.depth_tolerance;
+  d.tolerance_rel = o.depth_tolerance_rel;
+  return d;
+}
+}  // namespace
+
+ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraRig& camera)
+    : options_(options),
+      camera_(camera),
+      depth_(camera.width, camera.height, std::max(camera.fx, camera.fy), depthOptions(options)),
+      map_(options.voxel_size),
+      reference_exposure_(options.reference_exposure_s) {}
+
+void ColouringPipeline::addPose(int64_t utime, const Pose3& T_W_I) { poses_.add(utime, T_W_I); }
+
+bool ColouringPipeline::addScan(const ScanView& scan, std::string* error) {
+  if (scan.utime <= last_scan_utime_) {
+    *error = "scan stamp not after the previous scan";
+    return false;
+  }
+  if (!scan.T_W_I.matrix().allFinite()) {
+    *error = "scan pose is not finite";
+    return false;
+  }
+  last_scan_utime_ = scan.utime;
+  newest_scan_end_ = scan.utime;
+  poses_.add(scan.utime, scan.T_W_I);
+  ++stats_.scans;
+  const int64_t anchor = keyframes_.empty() ? -1 : keyframes_.rbegin()->first;
+  ActiveScan active{INT64_MAX, INT64_MIN, {}};
+  active.points.reserve(scan.num_points);
+  for (int j = 0; j < scan.num_points; ++j) {
+    const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
+    const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
+    if (!p.allFinite() || !std::isfinite(dt) || p.cwiseAbs().maxCoeff() > 1e5f) {
+      ++stats_.points_rejected;
+      continue;
+    }
+    const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));
+    const uint32_t id = map_.addPoint(p, anchor);
+    active.points.emplace_back(id, t);
+    active.t_min = std::min(active.t_min, t);
+    active.t_max = std::max(active.t_max, t);
+  }
+  stats_.points_in += static_cast<int64_t>(active.points.size());
+  if (!active.points.empty()) active_.push_back(std::move(active));
+  // keep the scans an image still to come may need (a generous second beyond the window)
+  const int64_t keep_from = newest_scan_end_ - 2 * windowUs() - 1000000;
+  while (!active_.empty() && active_.front().t_max < keep_from) active_.pop_front();
+  poses_.dropBefore(keep_from);
+  processReady(false);
+  return true;
+}
+
+bool ColouringPipeline::addImage(ColourImage image, std::string* error) {
+  if (image.utime <= last_image_utime_) {
+    *error = "image stamp not after the previous image";
+    return false;
+  }
+  if (image.pixels.cols != camera_.rig().width || image.pixels.rows != camera_.rig().height) {
+    *error = "image size " + std::to_string(image.pixels.cols) + "x" + std::to_string(image.pixels.rows) +
+             " differs from the rig's camera";
+    return false;
+  }
+  last_image_utime_ = image.utime;
+  images_.push_back(std::move(image));
+  processReady(false);
+  return true;
+}
+
+void ColouringPipeline::flush() { processReady(true); }
+
+void ColouringPipeline::processReady(bool flushing) {
+  while (!images_.empty()) {
+    const ColourImage& image = images_.front();
+    const bool scans_in = newest_scan_end_ != INT64_MIN && newest_scan_end_ >= image.utime + windowUs();
+    if (!scans_in && !flushing) return;
+    if (!processImage(image)) {
+      // no pose yet: wait for one unless the poses have moved past it or the stream ended
+      if (!flushing && poses_.newest() < image.utime) return;
+      ++stats_.images_without_pose;
+    }
+    images_.pop_front();
+  }
+}
+
+bool ColouringPipeline::processImage(const ColourImage& image) {
+  Pose3 T_W_I;
+  if (!poses_.at(image.utime, &T_W_I)) return false;
+  ++stats_.images;
+  const Pose3 T_W_C = T_W_I * camera_.rig().T_I_C;
+  const Pose3 T_C_W = T_W_C.inverse();
+  const int64_t t0 = image.utime - windowUs(), t1 = image.utime + windowUs();
+
+  struct Candidate {
+    uint32_t id;
+    Eigen::Vector2d pixel;
+    double z;
+  };
+  std::vector<Candidate> candidates;
+  ++visit_;
+  for (const ActiveScan& scan : active_) {
+    if (scan.t_max < t0 || scan.t_min > t1) continue;
+    for (const auto& [id, t] : scan.points) {
+      if (t < t0 || t > t1) continue;
+      MapPoint& mp = map_.point(id);
+      if (mp.visit == visit_) continue;
+      mp.visit = visit_;
+      const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
+      if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
+      Eigen::Vector2d px;
+      if (!camera_.project(p_C, &px, 0.0)) continue;
+      candidates.push_back({id, px, p_C.z()});
+    }
+  }
+  stats_.projected += static_cast<int64_t>(candidates.size());
+
+  depth_.clear();
+  for (const Candidate& c : candidates) depth_.splat(c.pixel, c.z);
+
+  double exposure_scale = 1.0;
+  if (options_.use_exposure_time && image.exposure_time > 0) {
+    if (reference_exposure_ <= 0.0) reference_exposure_ = image.exposure_time;
+    exposure_scale = reference_exposure_ / image.exposure_time;
+  }
+  const double b = options_.border_px, w = camera_.rig().width - 1 - b, h = camera_.rig().height - 1 - b;
+  std::vector<uint32_t> ids;
+  std::vector<Eigen::Vector3f> observed, mapped;
+  for (const Candidate& c : candidates) {
+    if (c.pixel.x() < b || c.pixel.y() < b || c.pixel.x() > w || c.pixel.y() > h) continue;
+    if (!depth_.visible(c.pixel, c.z)) {
+      ++stats_.occluded;
+      continue;
+    }
+    const double scale = exposure_scale / camera_.vignette(c.pixel, options_.vignetting);
+    ids.push_back(c.id);
+    observed.push_back(image.sample(c.pixel) * static_cast<float>(scale));
+  }
+  double gain = 1.0;
+  if (options_.estimate_gain) {
+    std::vector<Eigen::Vector3f> obs_known;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const MapPoint& mp = map_.point(ids[i]);
+      if (mp.count >= 2) {
+        obs_known.push_back(observed[i]);
+        mapped.push_back(mp.colour);
+      }
+    }
+    const GainEstimate g = estimateGain(obs_known, mapped, options_.gain_min_pairs, options_.gain_min, options_.gain_max);
+    if (g.valid) {
+      gain = g.gain;
+      ++stats_.gain_estimates;
+    }
+  }
+  stats_.last_gain = gain;
+  AccumulationOptions acc{options_.outlier_threshold, options_.outlier_min_count, options_.max_count};
+  if (recoloured_flag_.size() < map_.size()) recoloured_flag_.resize(map_.size(), 0);
+  size_t k = 0;
+  for (const Candidate& c : candidates) {
+    if (k >= ids.size() || ids[k] != c.id) continue;
+    const Eigen::Vector3f col = (observed[k] / static_cast<float>(gain)).cwiseMin(255.0f);
+    ++k;
+    if (!map_.accumulate(c.id, col, acc)) {
+      ++stats_.outliers;
+      continue;
+    }
+    ++stats_.accepted;
+    if (!recoloured_flag_[c.id]) {
+      recoloured_flag_[c.id] = 1;
+      recoloured_.push_back(c.id);
+    }
+    if (observer_) observer_({c.id, image.utime, c.pixel, T_W_C.translation(), col});
+  }
+  return true;
+}
+
+std::vector<uint32_t> ColouringPipeline::takeRecoloured() {
+  std::vector<uint32_t> out;
+  out.swap(recoloured_);
+  for (uint32_t id : out) recoloured_flag_[id] = 0;
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void ColouringPipeline::addKeyframe(int64_t id, int64_t utime, const Pose3& T_W_I) {
+  if (!T_W_I.matrix().allFinite()) return;
+  keyframes_.emplace(id, std::make_pair(utime, T_W_I));
+}
+
+int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
+  std::map<int64_t, Pose3> delta;
+  for (const auto& [id, pose] : corrected) {
+    auto it = keyframes_.find(id);
+    if (it == keyframes_.end() || !pose.matrix().allFinite()) continue;
+    const Pose3 d = pose * it->second.second.inverse();
+    if ((d.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-12) continue;
+    delta[id] = d;
+    it->second.second = pose;
+  }
+  if (delta.empty()) return 0;
+  map_.transform([&](int64_t anchor, Pose3* T) {
+    auto it = delta.find(anchor);
+    if (it == delta.end()) return false;
+    *T = it->second;
+    return true;
+  });
+  const auto& remap = map_.lastRemap();
+  for (ActiveScan& s : active_)
+    for (auto& pt : s.points) pt.first = remap[pt.first];
+  std::vector<uint32_t> rec;
+  for (uint32_t id : recoloured_) rec.push_back(remap[id]);
+  std::sort(rec.begin(), rec.end());
+  rec.erase(std::unique(rec.begin(), rec.end()), rec.end());
+  // every point that moved is "recoloured" (its published position changed)
+  recoloured_flag_.assign(map_.size(), 0);
+  recoloured_.clear();
+  for (uint32_t id = 0; id < map_.size(); ++id) {
+    const MapPoint& mp = map_.point(id);
+    if (mp.coloured() && (delta.count(mp.anchor) || std::binary_search(rec.begin(), rec.end(), id))) {
+      recoloured_flag_[id] = 1;
+      recoloured_.push_back(id);
+    }
+  }
+  return static_cast<int>(delta.size());
+}
+
+}  // namespace colour
+}  // namespace livo

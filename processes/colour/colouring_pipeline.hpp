@@ -1,0 +1,118 @@
+// The colouring core: registered scans grow the map, each image colours the map points measured
+// near its time that it sees unoccluded, and loop corrections move the map.
+//
+// Timing. A registered scan is a world-frame cloud; a world point needs only the camera pose at
+// the image time t_img (body pose interpolated from ODOMETRY / scan poses, times T_I_C). The
+// point's own measurement time t_p = cloud.utime + time_offset decides which images it may take
+// colour from: only those with |t_img - t_p| <= max_time_difference. That keeps pose drift and
+// moving objects from smearing colours across long gaps, and the same window defines the set of
+// points that build the depth buffer, so an object in front of the camera at t_img was measured
+// near t_img and hides what is behind it. An image is processed once a scan ending at or after
+// t_img + max_time_difference has arrived (every point that may take its colour is in) and the
+// poses bracket t_img, or at flush(); so the result depends on the stamps, not on arrival order.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "camera_projection.hpp"
+#include "colour_image.hpp"
+#include "colour_map.hpp"
+#include "colour_options.hpp"
+#include "depth_buffer.hpp"
+#include "pose_history.hpp"
+
+namespace livo {
+namespace colour {
+
+/// A registered scan (world frame), as plain arrays.
+struct ScanView {
+  int64_t utime = 0;        // sweep end: the pose's time
+  int64_t cloud_utime = 0;  // point j measured at cloud_utime + time_offset[j]
+  Pose3 T_W_I = Pose3::Identity();
+  int num_points = 0;
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  const float* time_offset = nullptr;  // may be null (all at cloud_utime)
+};
+
+/// One colour sample accepted into the map (for diagnostics and the bars).
+struct Observation {
+  uint32_t point = 0;
+  int64_t image_utime = 0;
+  Eigen::Vector2d pixel;
+  Eigen::Vector3d camera_center;
+  Eigen::Vector3f colour;  // normalised, as accumulated
+};
+
+struct ColouringStats {
+  int64_t scans = 0, points_in = 0, points_rejected = 0;
+  int64_t images = 0, images_without_pose = 0;
+  int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
+  int64_t gain_estimates = 0;
+  double last_gain = 1.0;
+};
+
+class ColouringPipeline {
+ public:
+  ColouringPipeline(const ColourOptions& options, const CameraRig& camera);
+
+  /// Body pose samples (ODOMETRY, REGISTERED_SCAN).
+  void addPose(int64_t utime, const Pose3& T_W_I);
+  /// Adds a scan's points to the map (non-finite points are skipped and counted) and processes
+  /// the images it makes ready. False (and nothing changes) for a scan older than the last one.
+  bool addScan(const ScanView& scan, std::string* error);
+  /// Queues an image; processes it at once if it is ready. False if older than the last image.
+  bool addImage(ColourImage image, std::string* error);
+  /// Processes every queued image that has a pose (end of stream).
+  void flush();
+
+  /// A keyframe: later scans' points are anchored to it until the next one.
+  void addKeyframe(int64_t id, int64_t utime, const Pose3& T_W_I);
+  /// Corrected keyframe poses: points anchored to each keyframe move by corrected * current^-1.
+  /// Returns the number of keyframes that moved.
+  int applyCorrection(const std::map<int64_t, Pose3>& corrected);
+
+  /// Ids of points coloured or recoloured since the last call (ascending).
+  std::vector<uint32_t> takeRecoloured();
+  void setObserver(std::function<void(const Observation&)> observer) { observer_ = std::move(observer); }
+
+  const ColourMap& map() const { return map_; }
+  const ColouringStats& stats() const { return stats_; }
+  const ColourOptions& options() const { return options_; }
+  size_t pendingImages() const { return images_.size(); }
+
+ private:
+  struct ActiveScan {
+    int64_t t_min, t_max;
+    std::vector<std::pair<uint32_t, int64_t>> points;  // map point, measurement time
+  };
+  void processReady(bool flushing);
+  bool processImage(const ColourImage& image);
+  int64_t windowUs() const { return static_cast<int64_t>(options_.max_time_difference * 1e6); }
+
+  ColourOptions options_;
+  CameraProjection camera_;
+  DepthBuffer depth_;
+  ColourMap map_;
+  PoseHistory poses_;
+  std::deque<ActiveScan> active_;
+  std::deque<ColourImage> images_;  // time order
+  std::map<int64_t, std::pair<int64_t, Pose3>> keyframes_;  // id -> (utime, pose the map is in)
+  int64_t last_scan_utime_ = INT64_MIN, last_image_utime_ = INT64_MIN;
+  int64_t newest_scan_end_ = INT64_MIN;
+  double reference_exposure_ = 0.0;
+  uint32_t visit_ = 0;
+  std::vector<uint8_t> recoloured_flag_;
+  std::vector<uint32_t> recoloured_;
+  std::function<void(const Observation&)> observer_;
+  ColouringStats stats_;
+};
+
+}  // namespace colour
+}  // namespace livo

@@ -1,0 +1,162 @@
+#include "map_files.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace livo {
+namespace colour {
+
+namespace {
+
+bool writeAtomically(const std::string& path, const std::string& header, const std::vector<char>& body,
+                     std::string* error) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      *error = "cannot write " + tmp;
+      return false;
+    }
+    out.write(header.data(), static_cast<std::streamsize>(header.size()));
+    out.write(body.data(), static_cast<std::streamsize>(body.size()));
+    if (!out) {
+      *error = "write failed: " + tmp;
+      return false;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    *error = "cannot rename " + tmp + " to " + path + ": " + ec.message();
+    return false;
+  }
+  return true;
+}
+
+template <class T>
+void put(std::vector<char>* out, const T& v) {
+  const char* p = reinterpret_cast<const char*>(&v);
+  out->insert(out->end(), p, p + sizeof(T));
+}
+
+bool readHeader(std::ifstream& in, const std::string& end_marker, std::vector<std::string>* lines) {
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines->push_back(line);
+    if (line.rfind(end_marker, 0) == 0) return true;
+    if (lines->size() > 200) return false;
+  }
+  return false;
+}
+
+uint32_t packRgb(const std::array<uint8_t, 3>& c) {
+  return (uint32_t(c[0]) << 16) | (uint32_t(c[1]) << 8) | uint32_t(c[2]);
+}
+
+}  // namespace
+
+bool writePly(const std::string& path, const ColouredPoints& pts, std::string* error) {
+  std::ostringstream h;
+  h << "ply\nformat binary_little_endian 1.0\ncomment livo-colour map, world frame W, metres\n"
+    << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+    << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  std::vector<char> body;
+  body.reserve(pts.size() * 15);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
+    for (int k = 0; k < 3; ++k) put(&body, pts.rgb[i][k]);
+  }
+  return writeAtomically(path, h.str(), body, error);
+}
+
+bool writePcd(const std::string& path, const ColouredPoints& pts, std::string* error) {
+  std::ostringstream h;
+  h << "# .PCD v0.7 - livo-colour map, world frame W\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
+    << "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
+    << pts.size() << "\nDATA binary\n";
+  std::vector<char> body;
+  body.reserve(pts.size() * 16);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
+    put(&body, packRgb(pts.rgb[i]));  // the bits of PCL's packed float rgb
+  }
+  return writeAtomically(path, h.str(), body, error);
+}
+
+bool readPly(const std::string& path, ColouredPoints* pts, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> header;
+  if (!in || !readHeader(in, "end_header", &header) || header.empty() || header[0] != "ply") {
+    *error = path + ": not a PLY file";
+    return false;
+  }
+  size_t n = 0;
+  std::string props;
+  bool binary = false;
+  for (const std::string& l : header) {
+    std::istringstream s(l);
+    std::string w, a, b;
+    s >> w;
+    if (w == "format") binary = (l.find("binary_little_endian") != std::string::npos);
+    if (w == "element" && (s >> a >> n) && a != "vertex") n = 0;
+    if (w == "property" && (s >> a >> b)) props += a + ":" + b + " ";
+  }
+  if (!binary || props != "float:x float:y float:z uchar:red uchar:green uchar:blue ") {
+    *error = path + ": unsupported PLY layout (" + props + ")";
+    return false;
+  }
+  pts->position.resize(n);
+  pts->rgb.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    in.read(reinterpret_cast<char*>(pts->position[i].data()), 12);
+    in.read(reinterpret_cast<char*>(pts->rgb[i].data()), 3);
+  }
+  if (!in) {
+    *error = path + ": truncated";
+    return false;
+  }
+  return true;
+}
+
+bool readPcd(const std::string& path, ColouredPoints* pts, std::string* error) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> header;
+  if (!in || !readHeader(in, "DATA", &header)) {
+    *error = path + ": not a PCD file";
+    return false;
+  }
+  size_t n = 0;
+  std::string fields, data;
+  for (const std::string& l : header) {
+    std::istringstream s(l);
+    std::string w;
+    s >> w;
+    if (w == "FIELDS") fields = l;
+    if (w == "POINTS") s >> n;
+    if (w == "DATA") s >> data;
+  }
+  if (fields != "FIELDS x y z rgb" || data != "binary") {
+    *error = path + ": unsupported PCD layout";
+    return false;
+  }
+  pts->position.resize(n);
+  pts->rgb.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t c = 0;
+    in.read(reinterpret_cast<char*>(pts->position[i].data()), 12);
+    in.read(reinterpret_cast<char*>(&c), 4);
+    pts->rgb[i] = {uint8_t(c >> 16), uint8_t(c >> 8), uint8_t(c)};
+  }
+  if (!in) {
+    *error = path + ": truncated";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace colour
+}  // namespace livo

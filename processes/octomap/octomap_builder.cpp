@@ -1,0 +1,77 @@
+#include "octomap_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace livo {
+namespace octomap_export {
+
+OctomapBuilder::OctomapBuilder(const OctomapOptions& options, const Pose3& T_I_L)
+    : options_(options), T_I_L_(T_I_L), map_(options) {}
+
+bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error) {
+  if (have_previous_ && scan.utime <= previous_utime_) {
+    *error = "scan stamp not after the previous scan";
+    return false;
+  }
+  if (!scan.T_W_I.matrix().allFinite()) {
+    *error = "scan pose is not finite";
+    return false;
+  }
+  // the previous sweep's end pose is this sweep's start pose if the sweeps are contiguous
+  const int64_t span = std::max<int64_t>(1, scan.utime - scan.cloud_utime);
+  const bool interpolate = have_previous_ && std::llabs(previous_utime_ - scan.cloud_utime) <= span / 2 + 1000;
+  const int segments = interpolate ? std::max(1, options_.origin_segments) : 1;
+  std::vector<std::vector<Eigen::Vector3f>> slices(segments);
+  for (int j = 0; j < scan.num_points; ++j) {
+    const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
+    if (!p.allFinite()) continue;
+    int s = segments - 1;
+    if (segments > 1 && scan.time_offset && std::isfinite(scan.time_offset[j])) {
+      const double a = (scan.cloud_utime + scan.time_offset[j] * 1e6 - previous_utime_) / double(scan.utime - previous_utime_);
+      s = std::clamp(static_cast<int>(a * segments), 0, segments - 1);
+    }
+    slices[s].push_back(p);
+  }
+  for (int s = 0; s < segments; ++s) {
+    if (slices[s].empty()) continue;
+    const Pose3 T = segments > 1 ? se3::interpolate(previous_pose_, scan.T_W_I, (s + 0.5) / segments) : scan.T_W_I;
+    map_.insertRays(slices[s], (T * T_I_L_).translation());
+  }
+  have_previous_ = true;
+  previous_utime_ = scan.utime;
+  previous_pose_ = scan.T_W_I;
+  ++scans_;
+  return true;
+}
+
+void OctomapBuilder::addKeyframe(int64_t id, Keyframe keyframe) { keyframes_[id] = std::move(keyframe); }
+
+int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
+  int moved = 0;
+  for (const auto& [id, pose] : corrected) {
+    auto it = keyframes_.find(id);
+    if (it == keyframes_.end() || !pose.matrix().allFinite()) continue;
+    if ((pose.matrix() - it->second.T_W_I.matrix()).cwiseAbs().maxCoeff() < 1e-12) continue;
+    it->second.T_W_I = pose;
+    ++moved;
+  }
+  if (moved) rebuild();
+  // the next scan comes in the corrected frame: do not interpolate across the jump
+  have_previous_ = false;
+  return moved;
+}
+
+void OctomapBuilder::rebuild() {
+  map_.clear();
+  for (const auto& [id, kf] : keyframes_) {
+    std::vector<Eigen::Vector3f> world;
+    world.reserve(kf.points.size());
+    for (const Eigen::Vector3f& p : kf.points) world.push_back((kf.T_W_I * p.cast<double>()).cast<float>());
+    map_.insertRays(world, (kf.T_W_I * T_I_L_).translation());
+  }
+  ++rebuilds_;
+}
+
+}  // namespace octomap_export
+}  // namespace livo

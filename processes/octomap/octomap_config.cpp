@@ -1,0 +1,46 @@
+#include "octomap_config.hpp"
+
+namespace livo {
+namespace octomap_export {
+
+OctomapNodeOptions readOctomapOptions(const Config& c) {
+  OctomapNodeOptions n;
+  OctomapOptions& o = n.core;
+  if (!c.isNull()) {
+    c.readOptional("resolution", o.resolution);
+    c.readOptional("max_range", o.max_range);
+    c.readOptional("min_range", o.min_range);
+    c.readOptional("prob_hit", o.prob_hit);
+    c.readOptional("prob_miss", o.prob_miss);
+    c.readOptional("clamping_min", o.clamping_min);
+    c.readOptional("clamping_max", o.clamping_max);
+    c.readOptional("occupancy_threshold", o.occupancy_threshold);
+    c.readOptional("colour", o.colour);
+    c.readOptional("origin_segments", o.origin_segments);
+    c.readOptional("scan_channel", n.scan_channel);
+    c.readOptional("colour_channel", n.colour_channel);
+    c.readOptional("keyframe_channel", n.keyframe_channel);
+    c.readOptional("correction_channel", n.correction_channel);
+    c.readOptional("output_channel", n.output_channel);
+    c.readOptional("publish_period_s", n.publish_period_s);
+    c.readOptional("write_period_s", n.write_period_s);
+    c.readOptional("map_name", n.map_name);
+    c.checkAllUsed();
+  }
+  auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
+  if (!(o.resolution >= 0.005 && o.resolution <= 10.0)) fail("resolution", "must be in [0.005, 10] m");
+  if (!(o.max_range > o.min_range && o.min_range >= 0.0)) fail("max_range", "need 0 <= min_range < max_range");
+  if (!(o.prob_hit > 0.5 && o.prob_hit < 1.0)) fail("prob_hit", "must be in (0.5, 1)");
+  if (!(o.prob_miss > 0.0 && o.prob_miss < 0.5)) fail("prob_miss", "must be in (0, 0.5)");
+  if (!(o.clamping_min > 0.0 && o.clamping_min < o.clamping_max && o.clamping_max < 1.0))
+    fail("clamping_max", "need 0 < clamping_min < clamping_max < 1");
+  if (!(o.occupancy_threshold > 0.0 && o.occupancy_threshold < 1.0)) fail("occupancy_threshold", "must be in (0, 1)");
+  if (o.origin_segments < 1) fail("origin_segments", "must be >= 1");
+  if (n.publish_period_s < 0.0) fail("publish_period_s", "must be >= 0");
+  if (n.write_period_s < 0.0) fail("write_period_s", "must be >= 0");
+  if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");
+  return n;
+}
+
+}  // namespace octomap_export
+}  // namespace livo

@@ -1,0 +1,42 @@
+// livo-octomap's node: REGISTERED_SCAN (and COLORED_CLOUD for a ColorOcTree), KEYFRAME and
+// LOOP_CORRECTION in; OCTOMAP out every publish_period_s of sensor time; <map_name>.bt / .ot
+// written every write_period_s of sensor time and on exit.
+#pragma once
+
+#include <string>
+
+#include "livo/node.hpp"
+#include "livo/sensor_rig.hpp"
+#include "octomap_builder.hpp"
+#include "octomap_config.hpp"
+
+namespace livo {
+namespace octomap_export {
+
+class OctomapNode {
+ public:
+  OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const OctomapNodeOptions& options, const SensorRig& rig,
+              std::string output_dir);
+
+  void finish();
+  bool writeFiles();
+  void publishTree(int64_t utime);
+
+  Node& node() { return node_; }
+  const OctomapBuilder& builder() const { return builder_; }
+  std::string btPath() const { return output_dir_ + "/" + options_.map_name + ".bt"; }
+  std::string otPath() const { return output_dir_ + "/" + options_.map_name + ".ot"; }
+
+ private:
+  void periodic(int64_t utime);
+
+  Node node_;
+  OctomapNodeOptions options_;
+  OctomapBuilder builder_;
+  std::string output_dir_;
+  int64_t last_publish_ = INT64_MIN, last_write_ = INT64_MIN;
+  bool finished_ = false;
+};
+
+}  // namespace octomap_export
+}  // namespace livo

@@ -1,0 +1,16 @@
+#include "octomap_options.hpp"
+
+#include <ostream>
+
+namespace livo {
+namespace octomap_export {
+
+void printOctomapOptions(const OctomapOptions& o, std::ostream& os) {
+  os << "octomap: resolution " << o.resolution << " m, range " << o.min_range << ".." << o.max_range
+     << " m, prob_hit " << o.prob_hit << ", prob_miss " << o.prob_miss << ", clamping " << o.clamping_min << ".."
+     << o.clamping_max << ", threshold " << o.occupancy_threshold << ", " << (o.colour ? "ColorOcTree" : "OcTree")
+     << ", origin_segments " << o.origin_segments << "\n";
+}
+
+}  // namespace octomap_export
+}  // namespace livo

@@ -1,0 +1,26 @@
+// Options of the OctoMap core (livo_octomap), with their defaults.
+#pragma once
+
+#include <iosfwd>
+
+namespace livo {
+namespace octomap_export {
+
+struct OctomapOptions {
+  double resolution = 0.1;        // m, leaf size
+  double max_range = 30.0;        // m: longer rays only clear space up to here
+  double min_range = 0.3;         // m: nearer points are dropped (sensor body)
+  double prob_hit = 0.7;
+  double prob_miss = 0.4;
+  double clamping_min = 0.12;
+  double clamping_max = 0.97;
+  double occupancy_threshold = 0.5;
+  bool colour = false;            // ColorOcTree with colours from COLORED_CLOUD
+  int origin_segments = 8;        // a sweep is cut into this many time slices, each cast from the
+                                  // LiDAR position at its time (spinning sensors move during a sweep)
+};
+
+void printOctomapOptions(const OctomapOptions& o, std::ostream& os);
+
+}  // namespace octomap_export
+}  // namespace livo

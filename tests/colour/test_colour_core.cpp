@@ -1,0 +1,335 @@
+// The colouring core without LCM: projection against OpenCV, occlusion on a constructed scene,
+// the time window, accumulation and exposure normalisation, loop corrections, image decoding and
+// the PLY/PCD files.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "camera_projection.hpp"
+#include "colour_map.hpp"
+#include "colouring_pipeline.hpp"
+#include "exposure_gain.hpp"
+#include "map_files.hpp"
+#include "scene_fixtures.hpp"
+#include "temp_path.hpp"
+
+using namespace livo;
+using namespace livo::colour;
+using livo_test::WallAndBox;
+
+namespace {
+
+ScanView viewOf(int64_t utime, const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
+                const std::vector<float>& dt, const Pose3& T = Pose3::Identity()) {
+  ScanView v;
+  v.utime = utime;
+  v.cloud_utime = utime - 100000;
+  v.T_W_I = T;
+  v.num_points = static_cast<int>(x.size());
+  v.x = x.data();
+  v.y = y.data();
+  v.z = z.data();
+  v.time_offset = dt.data();
+  return v;
+}
+
+}  // namespace
+
+TEST(CameraProjection, AgreesWithOpenCvProjectPointsWithDistortion) {
+  const CameraRig rig = livo_test::testCamera(true);
+  CameraProjection cam(rig);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<cv::Point3d> object;
+  for (int i = 0; i < 500; ++i) object.emplace_back(0.7 * u(rng), 0.5 * u(rng), 1.0 + std::abs(2.0 * u(rng)));
+  const cv::Mat K = (cv::Mat_<double>(3, 3) << rig.fx, 0, rig.cx, 0, rig.fy, rig.cy, 0, 0, 1);
+  const cv::Mat D = (cv::Mat_<double>(1, 4) << rig.distortion[0], rig.distortion[1], rig.distortion[2], rig.distortion[3]);
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(object, cv::Mat::zeros(3, 1, CV_64F), cv::Mat::zeros(3, 1, CV_64F), K, D, expected);
+  int inside = 0;
+  for (size_t i = 0; i < object.size(); ++i) {
+    Eigen::Vector2d px;
+    if (!cam.project(Eigen::Vector3d(object[i].x, object[i].y, object[i].z), &px)) continue;
+    ++inside;
+    EXPECT_NEAR(px.x(), expected[i].x, 1e-9);
+    EXPECT_NEAR(px.y(), expected[i].y, 1e-9);
+  }
+  EXPECT_GT(inside, 100);
+  Eigen::Vector2d px;
+  EXPECT_FALSE(cam.project(Eigen::Vector3d(0, 0, -1), &px));  // behind
+  EXPECT_FALSE(cam.project(Eigen::Vector3d(10, 0, 1), &px));  // far outside the field
+}
+
+TEST(ColouringPipeline, ColoursFromTheCameraPoseAtTheImageTimeWithExtrinsics) {
+  // body moves along x; the camera is mounted 0.1 m to the body's right and looks along body z.
+  CameraRig rig = livo_test::testCamera(false);
+  rig.T_I_C = Pose3::Identity();
+  rig.T_I_C.translation() = Vec3(0.1, 0.0, 0.0);
+  ColourOptions o;
+  o.estimate_gain = false;
+  o.max_time_difference = 0.2;
+  ColouringPipeline pipe(o, rig);
+  // at t_img the camera sits at the world origin: body at x = -0.1; poses at 0 and 0.2 s bracket it
+  const int64_t t0 = 1000000, t_img = t0 + 100000, t1 = t0 + 200000;
+  Pose3 A = Pose3::Identity(), B = Pose3::Identity();
+  A.translation() = Vec3(-0.2, 0, 0);
+  B.translation() = Vec3(0.0, 0, 0);
+  pipe.addPose(t0, A);
+  std::vector<float> x, y, z;
+  WallAndBox::points(0.05, 0.1, &x, &y, &z);
+  std::vector<float> dt(x.size(), 0.05f);  // measured at t1 - 0.05 s: inside the window
+  std::string error;
+  ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, t_img), &error)) << error;
+  EXPECT_EQ(pipe.pendingImages(), 1u);  // the scan that closes the window has not come yet
+  ASSERT_TRUE(pipe.addScan(viewOf(t1, x, y, z, dt, B), &error)) << error;
+  ASSERT_TRUE(pipe.addScan(viewOf(t1 + 200000, {}, {}, {}, {}, B), &error)) << error;
+  EXPECT_EQ(pipe.pendingImages(), 0u);
+  EXPECT_EQ(pipe.stats().images, 1);
+  int checked = 0;
+  for (const MapPoint& p : pipe.map().points()) {
+    if (!p.coloured()) continue;
+    const double truth = WallAndBox::inBox(p.position.x(), p.position.y()) && p.position.z() < 3
+                             ? WallAndBox::kBoxGrey
+                             : WallAndBox::wallGrey(p.position.x(), p.position.y());
+    if (p.position.z() > 3 && WallAndBox::inBox(p.position.x() * 0.4, p.position.y() * 0.4)) continue;
+    EXPECT_NEAR(p.colour[0], truth, 3.0) << p.position.transpose();
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+TEST(ColouringPipeline, OcclusionKeepsForegroundColourOffTheBackground) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColourOptions o;
+  o.estimate_gain = false;
+  ColouringPipeline pipe(o, rig);
+  std::vector<float> x, y, z;
+  WallAndBox::points(0.03, 0.12, &x, &y, &z);  // sparse rows, as a LiDAR gives
+  std::vector<float> dt(x.size(), 0.0f);
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));
+  ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 1000000), &error));
+  pipe.flush();
+  int hidden = 0, hidden_coloured = 0, visible_wall = 0, box = 0;
+  for (const MapPoint& p : pipe.map().points()) {
+    const double px = p.position.x(), py = p.position.y();
+    if (p.position.z() < 3) {
+      ++box;
+      ASSERT_TRUE(p.coloured());
+      EXPECT_NEAR(p.colour[0], WallAndBox::kBoxGrey, 3.0) << p.position.transpose();
+      continue;
+    }
+    // the box's shadow on the wall (scaled by 5/2), minus a 5 cm margin for the edge
+    const double sx = px * WallAndBox::kBoxZ / WallAndBox::kWallZ, sy = py * WallAndBox::kBoxZ / WallAndBox::kWallZ;
+    const bool shadow = std::abs(sx) < WallAndBox::kBoxHalfX - 0.02 && std::abs(sy) < WallAndBox::kBoxHalfY - 0.02;
+    const bool clear = std::abs(sx) > WallAndBox::kBoxHalfX + 0.02 || std::abs(sy) > WallAndBox::kBoxHalfY + 0.02;
+    if (shadow) {
+      ++hidden;
+      if (p.coloured()) ++hidden_coloured;
+    } else if (clear && p.coloured()) {
+      ++visible_wall;
+      EXPECT_NEAR(p.colour[0], WallAndBox::wallGrey(px, py), 3.0);
+    }
+  }
+  EXPECT_GT(box, 100);
+  EXPECT_GT(hidden, 100);
+  EXPECT_EQ(hidden_coloured, 0);
+  EXPECT_GT(visible_wall, 2000);
+  EXPECT_GT(pipe.stats().occluded, hidden);
+}
+
+TEST(ColouringPipeline, PointsFarFromTheImageTimeTakeNoColour) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColourOptions o;
+  o.max_time_difference = 0.1;
+  ColouringPipeline pipe(o, rig);
+  std::vector<float> x, y, z;
+  WallAndBox::points(0.05, 0.1, &x, &y, &z);
+  std::vector<float> dt(x.size(), 0.0f);
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));  // measured at 0.9 s
+  ASSERT_TRUE(pipe.addScan(viewOf(1400000, x, y, z, dt), &error));  // and again at 1.3 s
+  ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 1150000), &error));  // >= 0.15 s from both
+  pipe.flush();
+  EXPECT_EQ(pipe.stats().images, 1);
+  EXPECT_EQ(pipe.map().colouredCount(), 0u);
+  EXPECT_EQ(pipe.stats().projected, 0);
+}
+
+TEST(ColourMap, RobustRunningMeanRejectsOutliersAndSaturates) {
+  ColourMap map(0.1);
+  bool created = false;
+  const uint32_t id = map.addPoint(Eigen::Vector3f(0.01f, 0.02f, 0.03f), -1, &created);
+  EXPECT_TRUE(created);
+  EXPECT_EQ(map.addPoint(Eigen::Vector3f(0.09f, 0.05f, 0.01f), -1, &created), id);  // same voxel
+  EXPECT_FALSE(created);
+  AccumulationOptions o;
+  o.outlier_threshold = 30;
+  o.outlier_min_count = 3;
+  o.max_count = 4;
+  for (float v : {100.f, 110.f, 90.f}) EXPECT_TRUE(map.accumulate(id, Eigen::Vector3f::Constant(v), o));
+  EXPECT_NEAR(map.point(id).colour[0], 100.0f, 1e-4);
+  EXPECT_FALSE(map.accumulate(id, Eigen::Vector3f(100, 100, 250), o));  // an occluder's colour
+  EXPECT_EQ(map.point(id).rejected, 1);
+  EXPECT_TRUE(map.accumulate(id, Eigen::Vector3f::Constant(120), o));
+  EXPECT_NEAR(map.point(id).colour[0], 105.0f, 1e-4);
+  EXPECT_TRUE(map.accumulate(id, Eigen::Vector3f::Constant(125), o));  // count saturates at 4
+  EXPECT_NEAR(map.point(id).colour[0], 110.0f, 1e-4);
+  EXPECT_EQ(map.point(id).count, 4);
+}
+
+TEST(ExposureGain, MedianRatioIgnoresDarkSaturatedAndOutliers) {
+  std::vector<Eigen::Vector3f> obs, map;
+  for (int i = 0; i < 100; ++i) {
+    const float m = 40.0f + i;
+    map.push_back(Eigen::Vector3f::Constant(m));
+    obs.push_back(Eigen::Vector3f::Constant(i % 10 == 0 ? 0.4f * m : 1.3f * m));  // 10 % outliers
+  }
+  map.push_back(Eigen::Vector3f::Constant(2.0f));
+  obs.push_back(Eigen::Vector3f::Constant(9.0f));
+  const GainEstimate g = estimateGain(obs, map, 50, 0.5, 2.0);
+  ASSERT_TRUE(g.valid);
+  EXPECT_EQ(g.pairs, 100);
+  EXPECT_NEAR(g.gain, 1.3, 1e-5);
+  EXPECT_FALSE(estimateGain(obs, map, 200, 0.5, 2.0).valid);
+}
+
+TEST(ColouringPipeline, ExposureNormalisationKeepsColoursAcrossBrightnessChanges) {
+  const CameraRig rig = livo_test::testCamera(false);
+  std::vector<float> x, y, z;
+  WallAndBox::points(0.05, 0.1, &x, &y, &z);
+  std::vector<float> dt(x.size(), 0.0f);
+  for (bool known_exposure : {true, false}) {
+    ColourOptions o;
+    o.max_time_difference = 0.5;
+    o.use_exposure_time = known_exposure;
+    o.estimate_gain = !known_exposure;
+    ColouringPipeline pipe(o, rig);
+    std::string error;
+    pipe.addPose(800000, Pose3::Identity());
+    pipe.addPose(1200000, Pose3::Identity());
+    ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));
+    // the image brightens by 30 % (auto-exposure); stamps say so only when known_exposure
+    const double gains[4] = {1.0, 1.0, 1.3, 1.3};
+    for (int k = 0; k < 4; ++k)
+      ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 900000 + 50000 * k, gains[k], known_exposure ? float(0.005 * gains[k]) : 0.0f), &error));
+    pipe.flush();
+    EXPECT_EQ(pipe.stats().images, 4);
+    if (!known_exposure) {
+      EXPECT_NEAR(pipe.stats().last_gain, 1.3, 0.02);
+    }
+    double err = 0;
+    int n = 0;
+    for (const MapPoint& p : pipe.map().points()) {
+      if (!p.coloured() || p.position.z() < 3 || WallAndBox::inBox(p.position.x() * 0.4, p.position.y() * 0.4)) continue;
+      if (WallAndBox::wallGrey(p.position.x(), p.position.y()) * 1.3 > 250) continue;
+      err += std::abs(p.colour[0] - WallAndBox::wallGrey(p.position.x(), p.position.y()));
+      ++n;
+    }
+    ASSERT_GT(n, 1000);
+    EXPECT_LT(err / n, 1.5) << (known_exposure ? "exposure time" : "estimated gain");
+  }
+}
+
+TEST(ColouringPipeline, LoopCorrectionMovesPointsWithTheirKeyframe) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColouringPipeline pipe(ColourOptions{}, rig);
+  pipe.addKeyframe(0, 1000000, Pose3::Identity());
+  std::vector<float> x{0.f, 1.f}, y{0.f, 0.f}, z{5.f, 5.f}, dt{0.f, 0.f};
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));
+  pipe.addKeyframe(1, 2000000, Pose3::Identity());
+  std::vector<float> x2{3.f}, y2{0.f}, z2{5.f}, dt2{0.f};
+  ASSERT_TRUE(pipe.addScan(viewOf(2000000, x2, y2, z2, dt2), &error));
+  Pose3 corrected = Pose3::Identity();
+  corrected.translation() = Vec3(0.0, 0.5, 0.0);
+  EXPECT_EQ(pipe.applyCorrection({{1, corrected}}), 1);
+  ASSERT_EQ(pipe.map().size(), 3u);
+  EXPECT_NEAR(pipe.map().point(0).position.y(), 0.0, 1e-6);  // anchored to keyframe 0: stays
+  EXPECT_NEAR(pipe.map().point(2).position.y(), 0.5, 1e-6);  // anchored to keyframe 1: moves
+  EXPECT_EQ(pipe.applyCorrection({{1, corrected}}), 0);      // already there
+}
+
+TEST(ColouringPipeline, RefusesStaleStampsAndSkipsNonFinitePoints) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColouringPipeline pipe(ColourOptions{}, rig);
+  std::vector<float> x{0.f, NAN, 1.f}, y{0.f, 0.f, INFINITY}, z{5.f, 5.f, 5.f}, dt{0.f, 0.f, 0.f};
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(2000000, x, y, z, dt), &error));
+  EXPECT_EQ(pipe.stats().points_rejected, 2);
+  EXPECT_FALSE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));
+  ColourImage img = WallAndBox::render(rig, 2000000);
+  EXPECT_TRUE(pipe.addImage(img, &error));
+  EXPECT_FALSE(pipe.addImage(img, &error));
+  ColourImage small;
+  small.utime = 3000000;
+  small.pixels = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  EXPECT_FALSE(pipe.addImage(small, &error));
+}
+
+TEST(ColourImage, DecodesRawAndCompressedAndRefusesGarbage) {
+  cv::Mat rgb(4, 5, CV_8UC3);
+  for (int v = 0; v < 4; ++v)
+    for (int u = 0; u < 5; ++u) rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(10 * u, 20 * v, 7);
+  std::vector<uint8_t> raw(rgb.datastart, rgb.dataend);
+  RawImage r;
+  r.width = 5;
+  r.height = 4;
+  r.encoding = 1;
+  r.data = raw.data();
+  r.size = raw.size();
+  ColourImage out;
+  std::string error;
+  ASSERT_TRUE(decodeImage(r, &out, &error)) << error;
+  EXPECT_NEAR(out.sample(Eigen::Vector2d(2.5, 1.0))[0], 25.0f, 1e-4);
+  EXPECT_NEAR(out.sample(Eigen::Vector2d(2.0, 1.5))[1], 30.0f, 1e-4);
+  r.encoding = 2;  // BGR: channels swap
+  ASSERT_TRUE(decodeImage(r, &out, &error));
+  EXPECT_NEAR(out.sample(Eigen::Vector2d(2.0, 1.0))[2], 20.0f, 1e-4);
+  // PNG (lossless) of a BGR Mat decodes back to the same RGB
+  std::vector<uint8_t> png;
+  cv::imencode(".png", rgb, png);
+  RawImage p;
+  p.encoding = 11;
+  p.data = png.data();
+  p.size = png.size();
+  ASSERT_TRUE(decodeImage(p, &out, &error)) << error;
+  EXPECT_NEAR(out.sample(Eigen::Vector2d(3.0, 2.0))[2], 30.0f, 1e-4);  // B = the Mat's first channel
+  // short raw data, garbage JPEG, unknown encoding
+  r.size = 10;
+  EXPECT_FALSE(decodeImage(r, &out, &error));
+  std::vector<uint8_t> junk(100, 0xAB);
+  p.encoding = 10;
+  p.data = junk.data();
+  p.size = junk.size();
+  EXPECT_FALSE(decodeImage(p, &out, &error));
+  r.size = raw.size();
+  r.encoding = 42;
+  EXPECT_FALSE(decodeImage(r, &out, &error));
+}
+
+TEST(MapFiles, PlyAndPcdLoadBack) {
+  ColouredPoints pts;
+  for (int i = 0; i < 1000; ++i) {
+    pts.position.emplace_back(0.1f * i, -0.5f * i, 3.25f);
+    pts.rgb.push_back({uint8_t(i), uint8_t(255 - i % 256), uint8_t(i * 7)});
+  }
+  for (const bool ply : {true, false}) {
+    const std::string path = livo_test::tempPath(ply ? "map.ply" : "map.pcd");
+    std::string error;
+    ASSERT_TRUE(ply ? writePly(path, pts, &error) : writePcd(path, pts, &error)) << error;
+    ColouredPoints back;
+    ASSERT_TRUE(ply ? readPly(path, &back, &error) : readPcd(path, &back, &error)) << error;
+    ASSERT_EQ(back.size(), pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) {
+      EXPECT_EQ(back.position[i], pts.position[i]);
+      EXPECT_EQ(back.rgb[i], pts.rgb[i]);
+    }
+  }
+  std::string error;
+  ColouredPoints none;
+  EXPECT_FALSE(readPly(livo_test::tempPath("missing.ply"), &none, &error));
+}

@@ -1,0 +1,167 @@
+// The OctoMap core without LCM: free/occupied/unknown on a box scene, .bt/.ot load back with
+// octomap's own readers, colours, and the rebuild from corrected keyframes.
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
+#include "octomap_builder.hpp"
+#include "octomap_config.hpp"
+#include "temp_path.hpp"
+
+using namespace livo;
+using namespace livo::octomap_export;
+
+namespace {
+
+/// Rays from `origin` in all directions into a closed box room [-2.05, 2.05]^2 x [0.05, 2.45] with
+/// a solid crate [0.85, 1.25] x [-0.25, 0.25] x [0, 1.25]: the first surface each ray hits (world frame).
+std::vector<Eigen::Vector3f> boxRoomHits(const Eigen::Vector3d& origin) {
+  std::vector<Eigen::Vector3f> pts;
+  // surfaces mid-voxel (a surface on a voxel boundary would put its hits on either side at random)
+  const Eigen::Vector3d lo(-2.05, -2.05, 0.05), hi(2.05, 2.05, 2.45), clo(0.85, -0.25, 0), chi(1.25, 0.25, 1.25);
+  for (int i = 0; i < 360; ++i) {
+    for (int j = -60; j <= 80; ++j) {
+      const double az = i * M_PI / 180.0, el = j * 0.75 * M_PI / 180.0;
+      const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      double t_exit = 1e9;
+      for (int k = 0; k < 3; ++k) {
+        if (d[k] > 1e-12) t_exit = std::min(t_exit, (hi[k] - origin[k]) / d[k]);
+        if (d[k] < -1e-12) t_exit = std::min(t_exit, (lo[k] - origin[k]) / d[k]);
+      }
+      double t0 = 0, t1 = 1e9;  // slab test against the crate
+      bool crate = true;
+      for (int k = 0; k < 3 && crate; ++k) {
+        if (std::abs(d[k]) < 1e-12) {
+          crate = origin[k] >= clo[k] && origin[k] <= chi[k];
+          continue;
+        }
+        double a = (clo[k] - origin[k]) / d[k], b = (chi[k] - origin[k]) / d[k];
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a), t1 = std::min(t1, b);
+        crate = t0 <= t1;
+      }
+      const double t = crate ? std::min(t0, t_exit) : t_exit;
+      pts.push_back((origin + t * d).cast<float>());
+    }
+  }
+  return pts;
+}
+
+OctomapOptions options(bool colour) {
+  OctomapOptions o;
+  o.resolution = 0.1;
+  o.colour = colour;
+  return o;
+}
+
+}  // namespace
+
+TEST(OccupancyMap, ClassifiesFreeOccupiedAndUnknownInABoxRoom) {
+  OccupancyMap map(options(false));
+  const Eigen::Vector3d origin(-0.5, 0.3, 1.2);
+  for (int k = 0; k < 3; ++k) EXPECT_GT(map.insertRays(boxRoomHits(origin), origin), 40000u);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(-2.05, 0.0, 1.0)), 1);   // west wall
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 2.05, 1.0)), 1);    // north wall
+  EXPECT_EQ(map.classify(Eigen::Vector3d(-1.85, 0.35, 0.05)), 1);  // floor (within the 45° down-looking beams)
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.85, 0.0, 0.6)), 1);    // crate face towards the sensor
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 0.0, 1.2)), 0);     // open room
+  EXPECT_EQ(map.classify(Eigen::Vector3d(-1.0, -1.0, 2.0)), 0);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(1.6, 0.0, 0.5)), -1);    // in the crate's shadow
+  EXPECT_EQ(map.classify(Eigen::Vector3d(1.05, 0.0, 0.6)), -1);   // inside the crate
+  EXPECT_EQ(map.classify(Eigen::Vector3d(3.0, 0.0, 1.0)), -1);    // outside the room
+  // occupied voxels lie on the surfaces, not in the room's free middle
+  const auto occupied = map.occupiedVoxels();
+  EXPECT_GT(occupied.size(), 1000u);
+  for (const Eigen::Vector3d& c : occupied) {
+    const bool on_wall = std::abs(c.x()) > 1.95 || std::abs(c.y()) > 1.95 || c.z() < 0.15 || c.z() > 2.35;
+    const bool on_crate = c.x() > 0.75 && c.x() < 1.35 && std::abs(c.y()) < 0.35 && c.z() < 1.35;
+    EXPECT_TRUE(on_wall || on_crate) << c.transpose();
+  }
+}
+
+TEST(OccupancyMap, MaxRangeOnlyClearsAndNonFinitePointsAreSkipped) {
+  OctomapOptions o = options(false);
+  o.max_range = 1.0;
+  OccupancyMap map(o);
+  std::vector<Eigen::Vector3f> pts{{3.0f, 0.05f, 0.05f}, {NAN, 0.f, 0.f}, {0.05f, 0.05f, 0.1f}};
+  EXPECT_EQ(map.insertRays(pts, Eigen::Vector3d::Zero()), 1u);  // the too-near one is dropped too
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.55, 0.05, 0.05)), 0);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(2.95, 0.05, 0.05)), -1);
+}
+
+TEST(OccupancyMap, BtAndOtFilesLoadBackWithOctomapsReaders) {
+  for (const bool colour : {false, true}) {
+    OccupancyMap map(options(colour));
+    const Eigen::Vector3d origin(0.0, 0.0, 1.0);
+    map.insertRays(boxRoomHits(origin), origin);
+    if (colour) {
+      std::vector<Eigen::Vector3f> p{{-2.05f, 0.05f, 1.05f}};
+      EXPECT_EQ(map.setColours(p, {{{200, 10, 30}}}), 1u);
+    }
+    const std::string bt = livo_test::tempPath(colour ? "c.bt" : "p.bt"), ot = livo_test::tempPath(colour ? "c.ot" : "p.ot");
+    ASSERT_TRUE(map.writeBinary(bt));
+    ASSERT_TRUE(map.writeFull(ot));
+    const size_t occupied = map.occupiedVoxels().size();
+
+    octomap::OcTree from_bt(0.1);
+    ASSERT_TRUE(from_bt.readBinary(bt));
+    EXPECT_DOUBLE_EQ(from_bt.getResolution(), 0.1);
+    size_t bt_occupied = 0;
+    for (auto it = from_bt.begin_leafs(); it != from_bt.end_leafs(); ++it)
+      if (from_bt.isNodeOccupied(*it)) bt_occupied += static_cast<size_t>(std::lround(std::pow(it.getSize() / 0.1, 3)));
+    EXPECT_EQ(bt_occupied, occupied);
+    ASSERT_NE(from_bt.search(-2.05, 0.0, 1.0), nullptr);
+    EXPECT_TRUE(from_bt.isNodeOccupied(from_bt.search(-2.05, 0.0, 1.0)));
+
+    std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(ot));
+    ASSERT_NE(any, nullptr);
+    EXPECT_EQ(any->getTreeType(), colour ? "ColorOcTree" : "OcTree");
+    if (colour) {
+      auto* t = dynamic_cast<octomap::ColorOcTree*>(any.get());
+      ASSERT_NE(t, nullptr);
+      const octomap::ColorOcTreeNode* n = t->search(-2.05, 0.05, 1.05);
+      ASSERT_NE(n, nullptr);
+      EXPECT_EQ(n->getColor().r, 200);
+      EXPECT_EQ(n->getColor().g, 10);
+      EXPECT_EQ(n->getColor().b, 30);
+    }
+  }
+}
+
+TEST(OctomapBuilder, RebuildsFromCorrectedKeyframes) {
+  OctomapBuilder builder(options(false), Pose3::Identity());
+  Keyframe k;
+  k.utime = 1000000;
+  k.T_W_I = Pose3::Identity();
+  for (int i = -5; i <= 5; ++i)
+    for (int j = 0; j <= 10; ++j) k.points.emplace_back(3.05f, 0.1f * i + 0.05f, 0.1f * j + 0.05f);  // a wall 3 m ahead
+  std::vector<float> x, y, z, dt;
+  for (const auto& p : k.points) x.push_back(p.x()), y.push_back(p.y()), z.push_back(p.z()), dt.push_back(0.f);
+  RegisteredScanView v;
+  v.utime = 1100000;
+  v.cloud_utime = 1000000;
+  v.num_points = static_cast<int>(x.size());
+  v.x = x.data(), v.y = y.data(), v.z = z.data(), v.time_offset = dt.data();
+  std::string error;
+  ASSERT_TRUE(builder.addScan(v, &error)) << error;
+  EXPECT_FALSE(builder.addScan(v, &error));  // stale
+  builder.addKeyframe(0, k);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 0.55)), 1);
+  Pose3 corrected = Pose3::Identity();
+  corrected.translation() = Vec3(0.0, 0.0, 2.0);
+  EXPECT_EQ(builder.applyCorrection({{0, corrected}, {7, corrected}}), 1);
+  EXPECT_EQ(builder.rebuilds(), 1);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 0.55)), -1);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 2.55)), 1);
+}
+
+TEST(OctomapConfig, ReadsKeysStrictly) {
+  const auto o = readOctomapOptions(Config::fromString("octomap: {resolution: 0.2, colour: true}").section("octomap"));
+  EXPECT_DOUBLE_EQ(o.core.resolution, 0.2);
+  EXPECT_TRUE(o.core.colour);
+  EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {resolutoin: 0.2}").section("octomap")), ConfigError);
+  EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {prob_hit: 0.3}").section("octomap")), ConfigError);
+}
