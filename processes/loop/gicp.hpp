@@ -1,0 +1,48 @@
+// Nano-GICP (Koide et al.'s fast_gicp, as used by FAST-LIO-SAM-QN): generalized ICP with
+// per-point covariances from kNN neighbourhoods, Gauss-Newton on SE(3).
+#pragma once
+
+#include <memory>
+
+#include "local_geometry.hpp"
+#include "point_types.hpp"
+
+namespace livo::loop {
+
+/// A cloud ready for GICP: points, their covariances and a kd-tree over the points.
+/// The points live on the heap so the tree's reference survives moves and copies.
+struct GicpCloud {
+  std::shared_ptr<const Points> cloud;
+  Covariances covariances;
+  std::shared_ptr<const PointTree> tree;
+  const Points& points() const { return *cloud; }
+  size_t size() const { return cloud ? cloud->size() : 0; }
+  /// Computes covariances and the tree for `points` (moved in).
+  static GicpCloud build(Points points, int num_neighbors = 10, double plane_epsilon = 1e-3);
+  /// Uses given covariances (e.g. cached per keyframe and merged), builds only the tree.
+  static GicpCloud fromParts(Points points, Covariances covariances);
+};
+
+struct GicpOptions {
+  double max_correspondence_distance = 1.0;  // m
+  int max_iterations = 30;
+  double rotation_epsilon = 2e-4;            // rad: converged when the update is smaller
+  double translation_epsilon = 1e-4;         // m
+  double overlap_distance = 0.5;             // m, a source point "overlaps" within this
+};
+
+struct GicpResult {
+  Pose3 T_target_source = Pose3::Identity();
+  bool converged = false;
+  int iterations = 0;
+  double fitness = 0.0;        // mean squared distance of correspondences within max distance, m^2
+  double overlap = 0.0;        // fraction of source points with a target point within overlap_distance
+  int num_correspondences = 0;
+  Mat6 information = Mat6::Zero();   // Gauss-Newton Hessian at the solution, [rotation; translation]
+  double min_translation_eigenvalue = 0.0;  // of the Hessian's translation block per correspondence
+};
+
+GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const Pose3& initial,
+                        const GicpOptions& options);
+
+}  // namespace livo::loop

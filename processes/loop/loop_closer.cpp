@@ -1,0 +1,118 @@
+#include "loop_closer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "voxel_grid.hpp"
+
+namespace livo::loop {
+
+namespace {
+// Rotation that levels the body frame: R_rp with W_R_I = Rz(yaw) * R_rp.
+Mat3 rollPitch(const Mat3& W_R_I) {
+  const Vec3 x = W_R_I.col(0);
+  const double yaw = std::atan2(x.y(), x.x());
+  return Eigen::AngleAxisd(-yaw, Vec3::UnitZ()).toRotationMatrix() * W_R_I;
+}
+Pose3 rotationOnly(const Mat3& R) {
+  Pose3 T = Pose3::Identity();
+  T.linear() = R;
+  return T;
+}
+}  // namespace
+
+Pose3 LoopCloser::correction() const {
+  if (keyframes_.empty()) return Pose3::Identity();
+  const auto& [id, kf] = *keyframes_.rbegin();
+  return graph_.pose(id) * kf.odometry.inverse();
+}
+
+std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
+  const Keyframe& cur = keyframes_.at(id);
+  const Vec3 p = graph_.pose(id).translation();
+  const double r2 = options_.candidates.search_radius * options_.candidates.search_radius;
+  const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+  std::vector<std::pair<double, int64_t>> near;
+  for (const auto& [other, kf] : keyframes_) {
+    if (other >= id || cur.utime - kf.utime < recent || kf.coarse.points.empty()) continue;
+    const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
+    if (d2 <= r2) near.push_back({d2, other});
+  }
+  std::sort(near.begin(), near.end());
+  std::vector<int64_t> out;
+  for (size_t i = 0; i < near.size() && static_cast<int>(i) < options_.candidates.max_candidates; ++i)
+    out.push_back(near[i].second);
+  return out;
+}
+
+AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
+  if (!keyframes_.empty() && input.id <= keyframes_.rbegin()->first)
+    throw std::invalid_argument("keyframe id " + std::to_string(input.id) + " is not after " +
+                                std::to_string(keyframes_.rbegin()->first));
+  Keyframe kf;
+  kf.utime = input.utime;
+  kf.odometry = input.pose;
+  kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
+  kf.G_R_I = rollPitch(input.pose.linear());
+  const Points levelled = transformed(input.cloud, rotationOnly(kf.G_R_I));
+  kf.coarse = computeCoarseFeatures(levelled, options_.coarse);
+  kf.fine = GicpCloud::build(voxelDownsample(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
+  kf.map_cloud = voxelDownsample(input.cloud, options_.map_voxel_size);
+
+  // Initial estimate: the previous keyframe's corrected pose composed with the odometry increment.
+  Pose3 initial = input.pose;
+  if (!keyframes_.empty()) {
+    const auto& [prev_id, prev] = *keyframes_.rbegin();
+    initial = graph_.pose(prev_id) * (prev.odometry.inverse() * input.pose);
+    graph_.addNode(input.id, initial);
+    PoseEdge e;
+    e.from = prev_id;
+    e.to = input.id;
+    e.T_from_to = prev.odometry.inverse() * input.pose;
+    e.information = relativeInformation(prev.covariance, kf.covariance, options_.odometry_rotation_floor,
+                                        options_.odometry_translation_floor);
+    keyframes_.emplace(input.id, std::move(kf));
+    graph_.addEdge(e);
+  } else {
+    graph_.addNode(input.id, initial);
+    keyframes_.emplace(input.id, std::move(kf));
+  }
+
+  AddResult result;
+  if (++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes) return result;
+  const Keyframe& cur = keyframes_.at(input.id);
+  if (cur.coarse.points.empty()) return result;
+  for (int64_t cand : candidates(input.id)) {
+    const Keyframe& target = keyframes_.at(cand);
+    LoopRegistrationResult r = registerLoop(cur.coarse, target.coarse, cur.fine, target.fine, options_.registration);
+    result.attempts.push_back(r);
+    if (!r.accepted) continue;
+    AcceptedLoop loop;
+    loop.from_id = input.id;
+    loop.to_id = cand;
+    loop.from_utime = cur.utime;
+    loop.to_utime = target.utime;
+    loop.T_to_from = rotationOnly(target.G_R_I).inverse() * r.T_target_source * rotationOnly(cur.G_R_I);
+    loop.coarse_inliers = r.coarse.num_inliers;
+    loop.fitness = r.fine.fitness;
+    loop.overlap = r.fine.overlap;
+    PoseEdge e;
+    e.from = cand;
+    e.to = input.id;
+    e.T_from_to = loop.T_to_from;
+    e.is_loop = true;
+    Vec6 sigma;
+    sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
+    e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
+    graph_.addEdge(e);
+    graph_.optimize();
+    loops_.push_back(loop);
+    result.loop = loop;
+    keyframes_since_loop_ = 0;
+    break;
+  }
+  return result;
+}
+
+}  // namespace livo::loop

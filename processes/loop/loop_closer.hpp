@@ -1,0 +1,97 @@
+// The loop-closure core without middleware: a keyframe store (gravity-aligned clouds with cached
+// coarse features and GICP covariances), radius candidates, coarse-to-fine registration and the
+// pose graph, optimised only when a loop is accepted.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "coarse_features.hpp"
+#include "gicp.hpp"
+#include "loop_registration.hpp"
+#include "pose_graph.hpp"
+
+namespace livo::loop {
+
+struct CandidateOptions {
+  double search_radius = 12.0;      // m, around the current (corrected) keyframe position
+  double exclude_recent_s = 30.0;   // keyframes this recent are not loop candidates
+  int max_candidates = 2;           // nearest first
+  int cooldown_keyframes = 3;       // after an accepted loop, skip this many keyframes
+};
+
+struct LoopCloserOptions {
+  CoarseFeatureOptions coarse;
+  double fine_voxel_size = 0.4;     // m
+  int covariance_neighbors = 10;
+  double map_voxel_size = 0.2;      // m, clouds kept for the global map
+  CandidateOptions candidates;
+  LoopRegistrationOptions registration;
+  PoseGraphOptions graph;
+  double odometry_rotation_floor = 2e-3;     // rad, added to the relative odometry covariance
+  double odometry_translation_floor = 2e-2;  // m
+  double loop_rotation_sigma = 5e-3;         // rad
+  double loop_translation_sigma = 5e-2;      // m
+};
+
+struct KeyframeInput {
+  int64_t id = 0;
+  int64_t utime = 0;
+  Pose3 pose = Pose3::Identity();    // odometry W_T_I
+  Mat6 covariance = Mat6::Zero();    // [rotation; position]
+  Points cloud;                      // body frame I
+};
+
+struct AcceptedLoop {
+  int64_t from_id = 0;   // the new keyframe (source)
+  int64_t to_id = 0;     // the earlier keyframe (target)
+  int64_t from_utime = 0, to_utime = 0;
+  Pose3 T_to_from = Pose3::Identity();  // I_to <- I_from
+  int coarse_inliers = 0;
+  double fitness = 0.0, overlap = 0.0;
+};
+
+struct AddResult {
+  std::vector<LoopRegistrationResult> attempts;
+  std::optional<AcceptedLoop> loop;  // set if a loop was accepted and the graph optimised
+};
+
+class LoopCloser {
+ public:
+  explicit LoopCloser(LoopCloserOptions options = {}) : options_(std::move(options)), graph_(options_.graph) {}
+
+  /// Adds a keyframe (ids must increase; throws std::invalid_argument otherwise) and searches
+  /// for a loop.
+  AddResult addKeyframe(const KeyframeInput& input);
+
+  const PoseGraph& graph() const { return graph_; }
+  const std::vector<AcceptedLoop>& loops() const { return loops_; }
+  /// T_corrected_odom for the newest keyframe (identity before the first loop).
+  Pose3 correction() const;
+  int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
+  const Points& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
+  size_t size() const { return keyframes_.size(); }
+
+ private:
+  struct Keyframe {
+    int64_t utime = 0;
+    Pose3 odometry = Pose3::Identity();
+    Mat6 covariance = Mat6::Zero();
+    Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
+    CoarseFeatures coarse;              // in G
+    GicpCloud fine;                     // in G
+    Points map_cloud;                   // in I
+  };
+  std::vector<int64_t> candidates(int64_t id) const;
+
+  LoopCloserOptions options_;
+  PoseGraph graph_;
+  std::map<int64_t, Keyframe> keyframes_;
+  std::vector<AcceptedLoop> loops_;
+  int64_t keyframes_since_loop_ = 1000000;
+};
+
+}  // namespace livo::loop

@@ -1,0 +1,129 @@
+#include "loop_node.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "livo/loop_correction_t.hpp"
+#include "livo/messages.hpp"
+#include "loop_outputs.hpp"
+
+namespace livo::loop {
+
+LoopNodeOptions readLoopNodeOptions(const Config& root) {
+  LoopNodeOptions o;
+  const Config s = root.optionalSection("loop");
+  if (s.isNull()) return o;
+  s.readOptional("keyframe_channel", o.keyframe_channel);
+  s.readOptional("loop_correction_channel", o.loop_correction_channel);
+  s.readOptional("output_dir", o.output_dir);
+  s.readOptional("global_map_voxel", o.global_map_voxel);
+  LoopCloserOptions& c = o.closer;
+  s.readOptional("coarse_voxel", c.coarse.voxel_size);
+  s.readOptional("fpfh_normal_radius", c.coarse.normal_radius);
+  s.readOptional("fpfh_radius", c.coarse.feature_radius);
+  s.readOptional("fine_voxel", c.fine_voxel_size);
+  s.readOptional("search_radius", c.candidates.search_radius);
+  s.readOptional("exclude_recent_s", c.candidates.exclude_recent_s);
+  s.readOptional("max_candidates", c.candidates.max_candidates);
+  s.readOptional("cooldown_keyframes", c.candidates.cooldown_keyframes);
+  s.readOptional("noise_bound", c.registration.quatro.noise_bound);
+  s.readOptional("quasi_so3", c.registration.quatro.quasi_so3);
+  s.readOptional("max_correspondence_distance", c.registration.gicp.max_correspondence_distance);
+  s.readOptional("min_coarse_inliers", c.registration.acceptance.min_coarse_inliers);
+  s.readOptional("max_fitness", c.registration.acceptance.max_fitness);
+  s.readOptional("min_overlap", c.registration.acceptance.min_overlap);
+  s.readOptional("min_translation_eigenvalue", c.registration.acceptance.min_translation_eigenvalue);
+  s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
+  s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
+  s.checkAllUsed();
+  if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
+      c.registration.quatro.noise_bound <= 0)
+    throw ConfigError(s.where("coarse_voxel") + ": voxel sizes, search_radius and noise_bound must be > 0");
+  return o;
+}
+
+LoopNode::LoopNode(lcm::LCM& lcm, NodeOptions node_options, LoopNodeOptions options)
+    : node_(lcm, std::move(node_options)), options_(std::move(options)), closer_(options_.closer) {
+  node_.declareOutput(options_.loop_correction_channel);
+  node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) { onKeyframe(m); });
+}
+
+void LoopNode::onKeyframe(const keyframe_t& m) {
+  const std::string& ch = options_.keyframe_channel;
+  if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+    node_.reject(ch, "keyframe " + std::to_string(m.id) + " has a non-finite pose");
+    return;
+  }
+  const double qn = std::sqrt(m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
+                              m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3]);
+  if (qn < 1e-6) {
+    node_.reject(ch, "keyframe " + std::to_string(m.id) + " has a zero quaternion");
+    return;
+  }
+  if (closer_.size() > 0 && m.id <= closer_.graph().poses().rbegin()->first) {
+    node_.reject(ch, "keyframe " + std::to_string(m.id) + " is not after keyframe " +
+                         std::to_string(closer_.graph().poses().rbegin()->first) + " (out of order or repeated)");
+    return;
+  }
+  const point_cloud_t& c = m.cloud;
+  if (c.num_points < 0 || static_cast<size_t>(c.num_points) != c.x.size() || c.x.size() != c.y.size() ||
+      c.x.size() != c.z.size()) {
+    node_.reject(ch, "keyframe " + std::to_string(m.id) + " has inconsistent cloud arrays");
+    return;
+  }
+  if (!c.frame.empty() && c.frame != "I")
+    node_.warn("keyframe " + std::to_string(m.id) + " cloud is in frame '" + c.frame + "', expected 'I'; used as I");
+  KeyframeInput in;
+  in.id = m.id;
+  in.utime = m.utime;
+  in.pose = poseFrom(m.position, m.orientation);
+  in.covariance = matrixFrom<6>(m.pose_covariance);
+  in.cloud.reserve(c.x.size());
+  size_t non_finite = 0;
+  for (size_t i = 0; i < c.x.size(); ++i) {
+    const Vec3 p(c.x[i], c.y[i], c.z[i]);
+    if (p.allFinite()) in.cloud.push_back(p);
+    else ++non_finite;
+  }
+  if (non_finite > 0)
+    node_.warn("keyframe " + std::to_string(m.id) + ": dropped " + std::to_string(non_finite) + " non-finite points");
+  if (in.cloud.empty())
+    node_.warn("keyframe " + std::to_string(m.id) + " has no points: kept in the graph, not used for loops");
+  const AddResult r = closer_.addKeyframe(in);
+  if (r.loop) {
+    std::ostringstream s;
+    s << "loop " << r.loop->from_id << " -> " << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
+      << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << ")";
+    node_.info(s.str());
+    publishCorrection(*r.loop, m.utime);
+  }
+}
+
+void LoopNode::publishCorrection(const AcceptedLoop& loop, int64_t utime) {
+  loop_correction_t msg;
+  msg.utime = utime;
+  msg.loop_from_id = loop.from_id;
+  msg.loop_to_id = loop.to_id;
+  msg.loop_fitness = loop.fitness;
+  poseTo(closer_.correction(), msg.correction_position, msg.correction_orientation);
+  const auto& poses = closer_.graph().poses();
+  msg.num_keyframes = static_cast<int32_t>(poses.size());
+  msg.keyframe_id.reserve(poses.size());
+  for (const auto& [id, T] : poses) {
+    msg.keyframe_id.push_back(id);
+    std::vector<double> p(3), q(4);
+    poseTo(T, p.data(), q.data());
+    msg.position.push_back(p);
+    msg.orientation.push_back(q);
+  }
+  node_.publish(options_.loop_correction_channel, msg);
+}
+
+void LoopNode::writeOutputs() {
+  if (options_.output_dir.empty()) return;
+  writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
+  node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
+             std::to_string(closer_.loops().size()) + " loops)");
+}
+
+}  // namespace livo::loop

@@ -1,0 +1,62 @@
+#include "loop_outputs.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "livo/time.hpp"
+#include "livo/trajectory_io.hpp"
+#include "voxel_grid.hpp"
+
+namespace livo::loop {
+
+void writeKeyframeTrajectory(const std::string& path, const LoopCloser& closer) {
+  Trajectory t;
+  for (const auto& [id, pose] : closer.graph().poses()) t.push_back({toSeconds(closer.utime(id)), pose});
+  writeTum(path, t);
+}
+
+void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
+  nlohmann::json loops = nlohmann::json::array();
+  for (const AcceptedLoop& l : closer.loops()) {
+    const Quat q(l.T_to_from.linear());
+    const Vec3 t = l.T_to_from.translation();
+    loops.push_back({{"from_id", l.from_id},
+                     {"to_id", l.to_id},
+                     {"from_time", toSeconds(l.from_utime)},
+                     {"to_time", toSeconds(l.to_utime)},
+                     {"T_to_from", {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
+                     {"coarse_inliers", l.coarse_inliers},
+                     {"fitness", l.fitness},
+                     {"overlap", l.overlap}});
+  }
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out << nlohmann::json{{"num_keyframes", closer.size()}, {"loops", loops}}.dump(2) << "\n";
+}
+
+void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {
+  Points all;
+  for (const auto& [id, pose] : closer.graph().poses())
+    for (const Vec3& p : closer.mapCloud(id)) all.push_back(pose * p);
+  const Points map = voxelDownsample(all, voxel_size);
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + path);
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << map.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const Vec3& p : map) {
+    const float xyz[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+  }
+}
+
+void writeLoopOutputs(const std::string& dir, const LoopCloser& closer, double map_voxel_size) {
+  std::filesystem::create_directories(dir);
+  writeKeyframeTrajectory(dir + "/keyframes.tum", closer);
+  writeLoopsJson(dir + "/loops.json", closer);
+  writeGlobalMapPly(dir + "/global_map.ply", closer, map_voxel_size);
+}
+
+}  // namespace livo::loop

@@ -1,0 +1,51 @@
+#include "voxel_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <tuple>
+
+namespace livo::loop {
+
+Points transformed(const Points& points, const Pose3& T) {
+  Points out;
+  out.reserve(points.size());
+  for (const Vec3& p : points) out.push_back(T * p);
+  return out;
+}
+
+Points voxelDownsample(const Points& points, double voxel_size) {
+  Points finite;
+  finite.reserve(points.size());
+  for (const Vec3& p : points)
+    if (p.allFinite()) finite.push_back(p);
+  if (voxel_size <= 0.0 || finite.empty()) return finite;
+
+  struct Keyed {
+    int64_t x, y, z;
+    uint32_t index;
+  };
+  std::vector<Keyed> keyed;
+  keyed.reserve(finite.size());
+  const double inv = 1.0 / voxel_size;
+  for (size_t i = 0; i < finite.size(); ++i) {
+    const Vec3& p = finite[i];
+    keyed.push_back({static_cast<int64_t>(std::floor(p.x() * inv)), static_cast<int64_t>(std::floor(p.y() * inv)),
+                     static_cast<int64_t>(std::floor(p.z() * inv)), static_cast<uint32_t>(i)});
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    return std::tie(a.x, a.y, a.z, a.index) < std::tie(b.x, b.y, b.z, b.index);
+  });
+  Points out;
+  for (size_t i = 0; i < keyed.size();) {
+    size_t j = i;
+    Vec3 sum = Vec3::Zero();
+    while (j < keyed.size() && keyed[j].x == keyed[i].x && keyed[j].y == keyed[i].y && keyed[j].z == keyed[i].z)
+      sum += finite[keyed[j++].index];
+    out.push_back(sum / static_cast<double>(j - i));
+    i = j;
+  }
+  return out;
+}
+
+}  // namespace livo::loop

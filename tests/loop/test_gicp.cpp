@@ -1,0 +1,42 @@
+#include <gtest/gtest.h>
+
+#include "gicp.hpp"
+#include "synthetic_scenes.hpp"
+#include "voxel_grid.hpp"
+
+namespace livo::loop {
+namespace {
+using namespace livo::loop::testing;
+
+// The fine stage converges from a coarse-stage-sized error (2 degrees, 0.4 m) on partially
+// overlapping noisy views.
+TEST(Gicp, ConvergesFromCoarseResult) {
+  const Points scene = makeScene(31);
+  const Pose3 W_T_t = yawPose(0.1, Vec3(0, 0, 1.8));
+  const Pose3 W_T_s = yawPose(0.9, Vec3(4.0, 1.5, 1.8));
+  const GicpCloud target = GicpCloud::build(voxelDownsample(viewFrom(scene, W_T_t.translation(), 0.1, 25, 0.01, 1), 0.3));
+  const GicpCloud source = GicpCloud::build(voxelDownsample(viewFrom(scene, W_T_s.translation(), 0.9, 25, 0.01, 2), 0.3));
+  const Pose3 truth = W_T_t.inverse() * W_T_s;
+  for (const Vec3& dr : {Vec3(0, 0, 0.035), Vec3(0.01, -0.01, -0.035)}) {
+    Pose3 init = truth;
+    init.linear() = so3::Exp(dr) * init.linear();
+    init.translation() += Vec3(0.3, -0.25, 0.1);
+    GicpOptions o;
+    const GicpResult r = gicpRegister(source, target, init, o);
+    EXPECT_TRUE(r.converged);
+    EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 0.1);
+    EXPECT_LT(translationError(r.T_target_source, truth), 0.03);
+    EXPECT_GT(r.overlap, 0.5);
+    EXPECT_LT(r.fitness, 0.02);
+  }
+}
+
+TEST(Gicp, EmptyCloudsDoNotConverge) {
+  const GicpCloud empty = GicpCloud::build({});
+  const GicpCloud some = GicpCloud::build(voxelDownsample(makeScene(3), 1.0));
+  EXPECT_FALSE(gicpRegister(empty, some, Pose3::Identity(), {}).converged);
+  EXPECT_FALSE(gicpRegister(some, empty, Pose3::Identity(), {}).converged);
+}
+
+}  // namespace
+}  // namespace livo::loop

@@ -1,0 +1,33 @@
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "voxel_grid.hpp"
+
+namespace livo::loop {
+namespace {
+
+TEST(VoxelGrid, CentroidPerVoxelAndNonFiniteDropped) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Points in{{0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {1.2, 0.0, 0.0}, {nan, 0, 0}, {0, std::numeric_limits<double>::infinity(), 0}};
+  const Points out = voxelDownsample(in, 1.0);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_TRUE(out[0].isApprox(Vec3(0.2, 0.2, 0.2)));
+  EXPECT_TRUE(out[1].isApprox(Vec3(1.2, 0.0, 0.0)));
+}
+
+TEST(VoxelGrid, OutputIndependentOfInputOrder) {
+  Points a;
+  for (int i = 0; i < 500; ++i) a.push_back(Vec3(std::sin(i * 1.3) * 5, std::cos(i * 0.7) * 5, i * 0.01));
+  Points b(a.rbegin(), a.rend());
+  const Points oa = voxelDownsample(a, 0.5), ob = voxelDownsample(b, 0.5);
+  ASSERT_EQ(oa.size(), ob.size());
+  for (size_t i = 0; i < oa.size(); ++i) EXPECT_LT((oa[i] - ob[i]).norm(), 1e-12);
+  EXPECT_LT(oa.size(), a.size());
+}
+
+TEST(VoxelGrid, EmptyInput) { EXPECT_TRUE(voxelDownsample({}, 0.5).empty()); }
+
+}  // namespace
+}  // namespace livo::loop
