@@ -14,7 +14,7 @@
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bin="${LIVO_BUILD_DIR:-$root/build}/bin"
+bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio loop colour octomap)
 
 usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }

@@ -1,0 +1,48 @@
+// The iterated ESIKF update (paper eqs. 11-18) in the information form of FAST-LIO:
+//   K = (H^T R^-1 H + P^-1)^-1 H^T R^-1,  P = J^-1 P̂ J^-T  (J: the ⊟ Jacobian of eq. 12),
+//   x̌ ← x̌ ⊞ (-K z - (I - K H) J^-1 (x̌ ⊟ x̂)),  P̂ ← (I - K H) P,
+// for measurements that touch only the pose (the first 6 error states), so H^T R^-1 H is a 6x6
+// block and no 18x18 matrix is ever inverted:
+//   (P^-1 + E S E^T)^-1 = P - P E (I + S P_66)^-1 S E^T P,  E = [I_6; 0].
+#pragma once
+
+#include <functional>
+
+#include "livo/filter_state.hpp"
+
+namespace livo::lio {
+
+/// Sufficient statistics of a pose measurement at the current iterate: S = H^T R^-1 H (6x6),
+/// g = H^T R^-1 z (6), with the residual z = h(x̌) - measurement and H = ∂z/∂[δr δp].
+struct PoseInformation {
+  Mat6 HtRinvH = Mat6::Zero();
+  Vec6 HtRinvz = Vec6::Zero();
+  int count = 0;               // scalar residuals
+  Mat6 geometry = Mat6::Zero();// scale-free information for the degeneracy test (see Degeneracy)
+};
+
+/// Evaluates the measurement at the iterate x (iteration 0 is the prior); false: no usable data.
+using PoseMeasurement = std::function<bool(const FilterState& x, int iteration, PoseInformation* info)>;
+
+struct EsikfOptions {
+  int max_iterations = 4;
+  double convergence_rot = 1e-4;  // rad: stop when the step is below this ...
+  double convergence_pos = 1e-4;  // m: ... and this
+};
+
+struct EsikfResult {
+  bool valid = false;  // false: no measurement, state and covariance left unchanged
+  int iterations = 0;
+  bool converged = false;
+  PoseInformation info;  // of the last iterate
+};
+
+/// One information-form step: the Gauss-Newton increment and the updated covariance at iterate x.
+void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
+                     const Vec6& g, Vec18* delta, Mat18* P_post);
+
+/// Iterates from the prior until the step is small or max_iterations; writes the posterior.
+EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
+                           const EsikfOptions& options, FilterState* post, Mat18* P_post);
+
+}  // namespace livo::lio

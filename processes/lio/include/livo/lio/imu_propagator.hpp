@@ -1,0 +1,91 @@
+// IMU forward propagation of the ESIKF (paper eqs. 3-8): the state x_{i+1} = x_i ⊞ (Δt f(x_i, u_i, 0))
+// on SO(3) x R^15 with gravity in the state, and the covariance P_{i+1} = F_x P F_x^T + F_w Q F_w^T
+// for the right-perturbation error state [rot pos vel bg ba g] (FilterState's order).
+// The input u_i of a step is the mean of the two IMU samples that bound it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "livo/filter_state.hpp"
+
+namespace livo::lio {
+
+using Mat18x12 = Eigen::Matrix<double, 18, 12>;
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+
+/// One IMU sample in the body frame I: angular rate (rad/s) and specific force (m/s^2).
+struct ImuSample {
+  int64_t utime = 0;
+  Vec3 gyro = Vec3::Zero();
+  Vec3 accel = Vec3::Zero();
+};
+
+/// Continuous-time noise densities of the IMU (the rig's imu section).
+struct ImuNoise {
+  double gyro_noise_density = 1.7e-4;   // rad/s/sqrt(Hz)
+  double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
+  double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
+  double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
+};
+
+/// Eq. (5): x ⊞ (dt f(x, u, 0)) with f of eq. (4).
+FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt);
+
+/// F_x = ∂δx_{i+1}/∂δx_i and F_w = ∂δx_{i+1}/∂w_i (eq. 8), w = [n_w n_a n_bw n_ba].
+void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx,
+                          Mat18x12* Fw);
+
+/// Covariance of the discrete noise w_i over a step of dt: density^2 / dt per axis.
+Mat12 discreteNoiseCovariance(const ImuNoise& noise, double dt);
+
+/// The IMU-rate trajectory over one step: state at `utime` and the constant input until the next.
+struct ImuSegment {
+  int64_t utime = 0;
+  Mat3 rot = Mat3::Identity();
+  Vec3 pos = Vec3::Zero();
+  Vec3 vel = Vec3::Zero();
+  Vec3 omega = Vec3::Zero();      // bias-corrected angular rate, frame I
+  Vec3 acc_world = Vec3::Zero();  // R (a - b_a) + g, frame W
+};
+
+/// Holds the filter's state and covariance at time utime() and propagates them through IMU samples.
+class ImuPropagator {
+ public:
+  explicit ImuPropagator(ImuNoise noise = {}) : noise_(noise) {}
+
+  /// Sets the state at `last.utime`; `last` is the IMU sample at that instant (first input half).
+  void reset(const FilterState& x, const Mat18& P, const ImuSample& last);
+  /// Replaces state and covariance at the current time (after an update).
+  void setState(const FilterState& x, const Mat18& P);
+
+  /// Propagates through one sample later than utime() (eq. 5-6 with u = mean of the bounding
+  /// samples). Samples at or before utime() are ignored (returns false).
+  bool addSample(const ImuSample& s);
+  /// Propagates to `utime` (>= utime()) inside the interval ending at `next`, interpolating the
+  /// sample at `utime` between the last one and `next`. If next.utime <= utime the last
+  /// sample is held.
+  void propagateTo(int64_t utime, const ImuSample& next);
+
+  const FilterState& state() const { return x_; }
+  const Mat18& covariance() const { return P_; }
+  int64_t utime() const { return last_.utime; }
+  const ImuSample& lastSample() const { return last_; }
+  const ImuNoise& noise() const { return noise_; }
+
+  /// Steps taken since clearSegments(), in time order (for undistortion), and the final state's
+  /// time as the end of the last one.
+  const std::vector<ImuSegment>& segments() const { return segments_; }
+  void clearSegments() { segments_.clear(); }
+
+ private:
+  void step(const ImuSample& next);
+
+  ImuNoise noise_;
+  FilterState x_;
+  Mat18 P_ = Mat18::Identity();
+  ImuSample last_;
+  std::vector<ImuSegment> segments_;
+};
+
+}  // namespace livo::lio

@@ -1,0 +1,44 @@
+// Options of the livo-lio node, read from a project config: the rig section (channels, IMU noise,
+// LiDAR extrinsic and range limits, optional wheel) and the optional lio section (every key
+// optional, unknown keys are errors).
+#pragma once
+
+#include <iosfwd>
+#include <string>
+
+#include "livo/config.hpp"
+#include "livo/lio/lio_options.hpp"
+
+namespace livo::lio {
+
+struct LioNodeOptions {
+  std::string name = "lio";
+  // inputs (rig.channels)
+  std::string imu_channel = "IMU";
+  std::string lidar_channel = "LIDAR";
+  std::string wheel_channel = "WHEEL";
+  std::string state_posterior_channel = "STATE_POSTERIOR";
+  std::string loop_correction_channel = "LOOP_CORRECTION";
+  // outputs
+  std::string odometry_channel = "ODOMETRY";
+  std::string registered_scan_channel = "REGISTERED_SCAN";
+  std::string keyframe_channel = "KEYFRAME";
+  std::string state_prior_channel = "STATE_PRIOR";
+  bool publish_registered_scan = true;
+
+  double imu_reorder_window_s = 0.02;  // IMU is handed to the filter this far behind the newest
+  double wheel_max_wait_s = 0.2;       // a sweep waits for wheel data past its end at most this long
+  double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
+  int max_pending_scans = 50;          // sweeps waiting for IMU; older ones are dropped beyond this
+
+  LioOptions lio;
+};
+
+/// Reads rig.* (the keys of the rig schema) and lio.* (all optional) into options.
+/// Throws ConfigError on malformed values or unknown keys under lio.
+LioNodeOptions readLioNodeOptions(const Config& root);
+
+/// Human-readable summary (printed at start-up).
+void printOptions(const LioNodeOptions& o, std::ostream& os);
+
+}  // namespace livo::lio

@@ -1,0 +1,137 @@
+// LioEstimator: the LiDAR-inertial odometry as one object (KISS-ICP's pipeline facade for the
+// ESIKF). Feed IMU samples and wheel readings in time order with addImu()/addWheel(), then each
+// sweep with addScan() once IMU data past its end has been added; every sweep returns the
+// posterior state, its covariance, the undistorted points in the world frame, the degeneracy
+// analysis and, when one is due, a keyframe. No middleware: the LCM node wraps it.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "livo/lio/degeneracy.hpp"
+#include "livo/lio/imu_propagator.hpp"
+#include "livo/lio/lio_options.hpp"
+
+namespace livo::lio {
+
+struct Keyframe {
+  int64_t id = 0;
+  int64_t utime = 0;                  // IMU clock
+  Pose3 pose = Pose3::Identity();     // W_T_I
+  Mat6 pose_covariance = Mat6::Zero();// [rotation; position]
+  std::vector<Vec3> cloud;            // body frame I, downsampled
+};
+
+struct ScanResult {
+  enum class Status {
+    kInitializing,    // IMU not initialised yet: no output
+    kRejected,        // the sweep was not used (see message): no output
+    kMapInitialized,  // first sweep: the map was seeded at the initial pose
+    kTracked,         // registered against the map
+    kPredicted,       // no usable LiDAR update (too few points or matches): IMU prediction only
+  };
+  Status status = Status::kRejected;
+  std::string message;  // what went wrong or was worked around (empty if nothing)
+
+  int64_t utime = 0;  // end of the sweep, IMU clock: the time of state and points
+  FilterState state;
+  Mat18 covariance = Mat18::Zero();
+  Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
+
+  int num_points = 0;       // valid points of the sweep
+  int num_registered = 0;   // after downsampling
+  int num_residuals = 0;    // point-to-plane residuals of the last iterate
+  int iterations = 0;
+  bool converged = false;
+  DegeneracyReport degeneracy;
+  double min_information_eigenvalue = 0.0;  // of H^T R^-1 H (6x6)
+
+  std::vector<Vec3> world_points;  // undistorted to utime, world frame
+  std::vector<float> intensity;    // one per world point
+  std::vector<uint32_t> point_index;  // index of each world point in the input sweep
+
+  bool is_keyframe = false;
+  Keyframe keyframe;
+
+  bool hasOutput() const {
+    return status == Status::kMapInitialized || status == Status::kTracked || status == Status::kPredicted;
+  }
+};
+
+const char* toString(ScanResult::Status s);
+
+class LioEstimator {
+ public:
+  explicit LioEstimator(LioOptions options = {});
+
+  /// Adds an IMU sample (IMU clock). False (with the reason) for non-finite values or a sample
+  /// not later than the previous one.
+  bool addImu(const ImuSample& s, std::string* why = nullptr);
+  /// Adds a wheel reading (IMU clock); used only if options.wheel.enabled.
+  bool addWheel(const WheelSample& s, std::string* why = nullptr);
+  /// Processes a sweep; IMU samples up to its end should have been added (see scanEndUtime).
+  ScanResult addScan(const LidarScan& scan);
+
+  /// End of the sweep in the IMU clock (the watermark the IMU must pass before addScan).
+  int64_t scanEndUtime(const LidarScan& scan) const;
+
+  bool initialized() const { return initialized_; }
+  /// Time of the filter state (IMU clock).
+  int64_t utime() const { return prop_.utime(); }
+  const FilterState& state() const { return prop_.state(); }
+  const Mat18& covariance() const { return prop_.covariance(); }
+  const VoxelMap& map() const { return map_; }
+  const std::deque<Keyframe>& keyframes() const { return keyframes_; }
+  const LioOptions& options() const { return opts_; }
+
+  /// Camera hand-off: propagates the filter with the added IMU samples to `utime` (STATE_PRIOR).
+  bool propagateTo(int64_t utime, std::string* why = nullptr);
+  /// Adopts an external update of the state at the filter's current time (STATE_POSTERIOR).
+  bool adoptPosterior(int64_t utime, const FilterState& x, const Mat18& P, std::string* why = nullptr);
+
+  struct KeyframePose {
+    int64_t id;
+    Pose3 pose;  // corrected W_T_I
+  };
+  /// Loop correction: moves the state by T_corrected_odom, replaces the poses of the listed
+  /// keyframes (the others move with T_corrected_odom) and rebuilds the local map from them.
+  void applyLoopCorrection(const Pose3& T_corrected_odom, const std::vector<KeyframePose>& corrected);
+
+  /// Forgets everything (state, map, keyframes, buffers): the next IMU samples re-initialise.
+  void reset();
+
+ private:
+  double scanEndOffset(const LidarScan& scan) const;
+  void tryInitialize(std::string* note);
+  bool propagateThrough(int64_t t_end, std::string* note);
+  void softReset(const ImuSample& s, double gap_s, std::string* note);
+  void widenForGap(double gap_s);
+  bool wheelSpeedAt(int64_t utime, double* speed) const;
+  void insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
+  void pruneMap(const Vec3& position);
+
+  LioOptions opts_;
+  ImuPropagator prop_;
+  VoxelMap map_;
+  KeyframeSelector keyframe_selector_;
+  bool initialized_ = false;
+  std::vector<ImuSample> init_window_;
+  std::deque<ImuSample> imu_;
+  std::deque<WheelSample> wheel_;
+  int64_t last_imu_utime_ = 0;
+  bool has_imu_ = false;
+  int64_t last_wheel_utime_ = 0;
+  bool has_wheel_ = false;
+  Vec3 last_prune_position_ = Vec3::Zero();
+  std::deque<Keyframe> keyframes_;
+  int64_t next_keyframe_id_ = 0;
+  std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
+  int consecutive_failures_ = 0;
+  Vec3 last_post_pos_ = Vec3::Zero(), prev_post_pos_ = Vec3::Zero();  // registered positions ...
+  int64_t last_post_utime_ = 0, prev_post_utime_ = 0;                 // ... of the last two sweeps
+  bool has_last_post_ = false, has_prev_post_ = false;
+};
+
+}  // namespace livo::lio

@@ -1,0 +1,39 @@
+// Conversions between the LCM messages and the LIO core's types.
+#pragma once
+
+#include <string>
+
+#include "livo/filter_state_t.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/keyframe_t.hpp"
+#include "livo/lio/lio_estimator.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/odometry_t.hpp"
+#include "livo/point_cloud_t.hpp"
+#include "livo/registered_scan_t.hpp"
+#include "livo/wheel_odometry_t.hpp"
+
+namespace livo::lio {
+
+ImuSample fromMessage(const imu_t& m);
+WheelSample fromMessage(const wheel_odometry_t& m);
+/// A sweep in frame "L" (or "I": then the points are taken as already in the body frame by the
+/// caller). False with the reason for inconsistent array sizes, an unknown frame or a pattern
+/// without time offsets.
+bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why);
+
+odometry_t toOdometry(const ScanResult& r);
+/// The undistorted sweep in frame "W"; ring and intensity from the input, time offsets zero.
+registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& input);
+keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings);
+
+filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P, int64_t request_id,
+                             const std::string& source);
+/// False for a message with non-finite numbers.
+bool fromFilterState(const filter_state_t& m, FilterState* x, Mat18* P);
+
+/// The loop correction as T_corrected_odom and the corrected keyframe poses.
+bool fromMessage(const loop_correction_t& m, Pose3* T_corr, std::vector<LioEstimator::KeyframePose>* poses,
+                 std::string* why);
+
+}  // namespace livo::lio

@@ -1,0 +1,49 @@
+// Every option of the LiDAR-inertial odometry, with defaults (filled from YAML by the node).
+#pragma once
+
+#include <cstddef>
+
+#include "livo/lio/esikf_update.hpp"
+#include "livo/lio/imu_initializer.hpp"
+#include "livo/lio/keyframe_selector.hpp"
+#include "livo/lio/lidar_scan.hpp"
+#include "livo/lio/scan_to_map.hpp"
+#include "livo/lio/voxel_map.hpp"
+#include "livo/lio/wheel_update.hpp"
+
+namespace livo::lio {
+
+struct LioOptions {
+  ImuNoise imu_noise;
+  ImuInitOptions init;
+  LidarExtrinsics extrinsics;
+
+  // scan preprocessing
+  double min_range = 0.5;        // m
+  double max_range = 100.0;      // m
+  int point_stride = 1;          // keep every n-th valid point for registration (1: all)
+  double scan_voxel_size = 0.5;  // m, downsampling of the scan for registration
+  int min_points = 100;          // fewer valid points: no update (prediction only)
+
+  // map and registration
+  VoxelMapOptions map;
+  double map_radius = 100.0;           // m, local window kept around the body
+  double map_prune_distance = 10.0;    // m travelled between window prunings
+  ScanToMapOptions matching;
+  EsikfOptions esikf;
+  int min_residuals = 30;              // fewer: the update is skipped and flagged degenerate
+
+  // robustness
+  double max_imu_gap_s = 0.05;         // larger gaps are bridged and reported
+  double reset_imu_gap_s = 1.0;        // larger gaps reset the velocity (soft re-initialisation)
+  double gap_rate_std = 1.0;           // rad/s: rotation uncertainty added per second of such a gap
+                                       // (the position gets init.moving_vel_std per second)
+  double max_position_jump = 5.0;      // m per scan: a larger update step re-initialises
+
+  KeyframeOptions keyframe;
+  size_t max_stored_keyframes = 300;   // keyframe clouds kept for map rebuilds (bounded memory)
+
+  WheelOptions wheel;
+};
+
+}  // namespace livo::lio

@@ -1,0 +1,69 @@
+// The LiDAR measurement of the ESIKF: point-to-plane residuals of a scan (undistorted, body frame)
+// against the voxel map at each iterate, reduced to the 6x6 information H^T R^-1 H and the
+// vector H^T R^-1 z of the pose. Planes are re-fitted only for points whose world image moved
+// more than `research_distance` since their last neighbour search (usually once or twice a scan).
+#pragma once
+
+#include <limits>
+#include <vector>
+
+#include "livo/lio/degeneracy.hpp"
+#include "livo/lio/esikf_update.hpp"
+#include "livo/lio/point_to_plane.hpp"
+#include "livo/lio/voxel_map.hpp"
+
+namespace livo::lio {
+
+struct ScanToMapOptions {
+  PlaneFitOptions plane;
+  double point_noise_std = 0.03;        // m, standard deviation of one residual
+  double residual_range_factor = 0.11;  // gate: |r| <= factor * sqrt(range) (FAST-LIO's test)
+  double research_distance = 0.1;       // m, see above
+  double robust_scale = 0.05;           // m, Cauchy kernel scale near the optimum (weight
+                                        // 1 / (1 + (r/c)^2)); it damps residuals on planes
+                                        // fitted across two surfaces (corners); 0: off
+  double degeneracy_lever_arm = 1.0;    // m, L of the degeneracy test (degeneracy.hpp)
+  double degeneracy_threshold = 0.01;   // eigenvalue of G below which a direction is degenerate
+  bool remove_degenerate = true;        // drop the information of degenerate directions
+};
+
+class ScanToMap {
+ public:
+  /// `map` must outlive this object and stay unchanged while it is used.
+  ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options);
+
+  /// PoseMeasurement for iteratedUpdate.
+  bool evaluate(const FilterState& x, int iteration, PoseInformation* info);
+
+  /// Residuals accepted at the last evaluate().
+  int numResiduals() const { return last_count_; }
+  /// Points that have a fitted plane (after the last evaluate()).
+  int numMatched() const;
+  /// Degeneracy of the last evaluate().
+  const DegeneracyReport& degeneracy() const { return degeneracy_; }
+  /// Smallest eigenvalue of H^T R^-1 H at the last evaluate(), before any removal.
+  double minInformationEigenvalue() const { return min_information_eigenvalue_; }
+
+ private:
+  struct Match {
+    Plane plane;
+    Vec3 searched_at = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    bool has_plane = false;
+  };
+  struct Row {
+    Row6 h;
+    double r;
+  };
+  const VoxelMap& map_;
+  const std::vector<Vec3>& points_;
+  ScanToMapOptions opts_;
+  std::vector<Match> matches_;
+  std::vector<double> gate_;  // per point: max |r|
+  std::vector<Row> rows_;     // accepted residuals of the current iterate
+  std::vector<double> abs_r_;
+  DegeneracyReport degeneracy_;
+  double min_information_eigenvalue_ = 0.0;
+  int last_count_ = 0;
+};
+
+}  // namespace livo::lio

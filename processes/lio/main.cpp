@@ -1,0 +1,33 @@
+// livo-lio --config FILE: the ESIKF LiDAR-inertial odometry as an LCM process.
+#include <iostream>
+
+#include "livo/command_line.hpp"
+#include "livo/lio/lio_node.hpp"
+
+int main(int argc, char** argv) {
+  livo::CommandLine cli("livo-lio", "ESIKF LiDAR-inertial odometry: IMU + LIDAR (+ WHEEL) in, ODOMETRY, "
+                                    "REGISTERED_SCAN and KEYFRAME out.");
+  cli.option("--config", "FILE", "project config with rig: and (optional) lio: sections")
+      .option("--name", "NAME", "node name on the bus (overrides lio.name)")
+      .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
+      .flag("--quiet", "no start-up options and no summary at shutdown");
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  if (!cli.has("--config")) {
+    std::cerr << "livo-lio: --config FILE is required\n" << cli.usage();
+    return 2;
+  }
+  try {
+    const livo::Config cfg = livo::Config::load(cli.get("--config"));
+    livo::lio::LioNodeOptions opts = livo::lio::readLioNodeOptions(cfg);
+    if (cli.has("--name")) opts.name = cli.get("--name");
+    const bool quiet = cli.has("--quiet");
+    if (!quiet) livo::lio::printOptions(opts, std::cerr);
+    auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
+    livo::lio::LioNode node(*lcm, opts, quiet);
+    livo::installSignalHandlers();
+    return livo::spin(*lcm, node.node());
+  } catch (const std::exception& e) {
+    std::cerr << "livo-lio: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,64 @@
+#include "livo/lio/esikf_update.hpp"
+
+#include <Eigen/LU>
+
+namespace livo::lio {
+
+void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
+                     const Vec6& g, Vec18* delta, Mat18* P_post) {
+  using S18 = FilterState;
+  // J^-1 of eq. (12): the right Jacobian on the rotation block, identity elsewhere.
+  const Vec18 e0 = x.boxminus(prior);
+  const Mat3 Jr = so3::rightJacobian(e0.segment<3>(S18::kRot));
+  Mat18 P = P_prior;
+  // P = J^-1 P̂ J^-T touching only the rotation rows and columns
+  P.topRows<3>() = Jr * P.topRows<3>();
+  P.leftCols<3>() = P.leftCols<3>() * Jr.transpose();
+  Vec18 Jinv_e0 = e0;
+  Jinv_e0.head<3>() = Jr * e0.head<3>();
+
+  // Pn = (P^-1 + E S E^T)^-1 = P - P E (I + S P66)^-1 S E^T P
+  const Eigen::Matrix<double, 18, 6> PE = P.leftCols<6>();
+  const Mat6 M = (Mat6::Identity() + S * P.topLeftCorner<6, 6>()).lu().solve(S);  // (I + S P66)^-1 S
+  Mat18 Pn = P - PE * M * PE.transpose();
+  Pn = 0.5 * (Pn + Pn.transpose());
+  // K z = Pn E g;  K H = Pn E S E^T (nonzero in the first 6 columns only)
+  const Eigen::Matrix<double, 18, 6> KH6 = Pn.leftCols<6>() * S;
+  Vec18 d = -Pn.leftCols<6>() * g - Jinv_e0;
+  d += KH6 * Jinv_e0.head<6>();
+  *delta = d;
+  *P_post = Pn;
+}
+
+EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
+                           const EsikfOptions& opts, FilterState* post, Mat18* P_post) {
+  EsikfResult res;
+  FilterState x = prior;
+  Mat18 P = P_prior;
+  for (int it = 0; it < opts.max_iterations; ++it) {
+    PoseInformation info;
+    if (!measure(x, it, &info) || info.count == 0) {
+      if (it == 0) return res;  // nothing to update with
+      break;                    // keep the last good iterate
+    }
+    Vec18 delta;
+    informationStep(x, prior, P_prior, info.HtRinvH, info.HtRinvz, &delta, &P);
+    if (!delta.allFinite() || !P.allFinite()) {
+      res.valid = false;
+      return res;
+    }
+    x = x.boxplus(delta);
+    res.iterations = it + 1;
+    res.info = info;
+    res.valid = true;
+    if (delta.segment<3>(0).norm() < opts.convergence_rot && delta.segment<3>(3).norm() < opts.convergence_pos) {
+      res.converged = true;
+      break;
+    }
+  }
+  *post = x;
+  *P_post = P;
+  return res;
+}
+
+}  // namespace livo::lio

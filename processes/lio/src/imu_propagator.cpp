@@ -1,0 +1,105 @@
+#include "livo/lio/imu_propagator.hpp"
+
+namespace livo::lio {
+
+FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt) {
+  // f(x, u, 0) of eq. (4), applied with ⊞ as eq. (3)/(5).
+  Vec18 f = Vec18::Zero();
+  f.segment<3>(FilterState::kRot) = gyro - x.gyro_bias;
+  f.segment<3>(FilterState::kPos) = x.vel;
+  f.segment<3>(FilterState::kVel) = x.rot * (accel - x.accel_bias) + x.gravity;
+  return x.boxplus(f * dt);
+}
+
+void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx,
+                          Mat18x12* Fw) {
+  using S = FilterState;
+  const Vec3 w = gyro - x.gyro_bias;
+  const Vec3 a = accel - x.accel_bias;
+  const Vec3 wdt = w * dt;
+  const Mat3 JrDt = so3::rightJacobian(wdt) * dt;
+
+  Fx->setIdentity();
+  Fx->block<3, 3>(S::kRot, S::kRot) = so3::Exp(-wdt);
+  Fx->block<3, 3>(S::kRot, S::kGyroBias) = -JrDt;
+  Fx->block<3, 3>(S::kPos, S::kVel) = Mat3::Identity() * dt;
+  Fx->block<3, 3>(S::kVel, S::kRot) = -x.rot * so3::hat(a) * dt;
+  Fx->block<3, 3>(S::kVel, S::kAccelBias) = -x.rot * dt;
+  Fx->block<3, 3>(S::kVel, S::kGravity) = Mat3::Identity() * dt;
+
+  Fw->setZero();
+  Fw->block<3, 3>(S::kRot, 0) = -JrDt;
+  Fw->block<3, 3>(S::kVel, 3) = -x.rot * dt;
+  Fw->block<3, 3>(S::kGyroBias, 6) = Mat3::Identity() * dt;
+  Fw->block<3, 3>(S::kAccelBias, 9) = Mat3::Identity() * dt;
+}
+
+Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt) {
+  Mat12 Q = Mat12::Zero();
+  const double inv = 1.0 / dt;
+  Q.diagonal().segment<3>(0).setConstant(n.gyro_noise_density * n.gyro_noise_density * inv);
+  Q.diagonal().segment<3>(3).setConstant(n.accel_noise_density * n.accel_noise_density * inv);
+  Q.diagonal().segment<3>(6).setConstant(n.gyro_random_walk * n.gyro_random_walk * inv);
+  Q.diagonal().segment<3>(9).setConstant(n.accel_random_walk * n.accel_random_walk * inv);
+  return Q;
+}
+
+void ImuPropagator::reset(const FilterState& x, const Mat18& P, const ImuSample& last) {
+  x_ = x;
+  P_ = P;
+  last_ = last;
+  segments_.clear();
+}
+
+void ImuPropagator::setState(const FilterState& x, const Mat18& P) {
+  x_ = x;
+  P_ = P;
+}
+
+void ImuPropagator::step(const ImuSample& next) {
+  const double dt = static_cast<double>(next.utime - last_.utime) * 1e-6;
+  const Vec3 gyro = 0.5 * (last_.gyro + next.gyro);
+  const Vec3 accel = 0.5 * (last_.accel + next.accel);
+
+  ImuSegment seg;
+  seg.utime = last_.utime;
+  seg.rot = x_.rot;
+  seg.pos = x_.pos;
+  seg.vel = x_.vel;
+  seg.omega = gyro - x_.gyro_bias;
+  seg.acc_world = x_.rot * (accel - x_.accel_bias) + x_.gravity;
+  segments_.push_back(seg);
+
+  if (dt > 0.0) {
+    Mat18 Fx;
+    Mat18x12 Fw;
+    propagationJacobians(x_, gyro, accel, dt, &Fx, &Fw);
+    x_ = propagateState(x_, gyro, accel, dt);
+    P_ = Fx * P_ * Fx.transpose() + Fw * discreteNoiseCovariance(noise_, dt) * Fw.transpose();
+    P_ = 0.5 * (P_ + P_.transpose());
+  }
+  last_ = next;
+}
+
+bool ImuPropagator::addSample(const ImuSample& s) {
+  if (s.utime <= last_.utime) return false;
+  step(s);
+  return true;
+}
+
+void ImuPropagator::propagateTo(int64_t utime, const ImuSample& next) {
+  if (utime <= last_.utime) return;
+  ImuSample at;
+  at.utime = utime;
+  if (next.utime > last_.utime && next.utime >= utime) {
+    const double alpha = static_cast<double>(utime - last_.utime) / static_cast<double>(next.utime - last_.utime);
+    at.gyro = (1.0 - alpha) * last_.gyro + alpha * next.gyro;
+    at.accel = (1.0 - alpha) * last_.accel + alpha * next.accel;
+  } else {
+    at.gyro = last_.gyro;
+    at.accel = last_.accel;
+  }
+  step(at);
+}
+
+}  // namespace livo::lio

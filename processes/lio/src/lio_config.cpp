@@ -1,0 +1,171 @@
+#include "livo/lio/lio_config.hpp"
+
+#include <ostream>
+
+namespace livo::lio {
+
+namespace {
+void readRig(const Config& rig, LioNodeOptions* o) {
+  LioOptions& l = o->lio;
+  const Config ch = rig.optionalSection("channels");
+  ch.readOptional("imu", o->imu_channel);
+  ch.readOptional("lidar", o->lidar_channel);
+  ch.readOptional("wheel", o->wheel_channel);
+  ch.ignore("camera");
+  ch.ignore("ground_truth");
+
+  const Config imu = rig.section("imu");
+  imu.ignore("rate_hz");
+  imu.read("gyro_noise_density", l.imu_noise.gyro_noise_density);
+  imu.read("gyro_random_walk", l.imu_noise.gyro_random_walk);
+  imu.read("accel_noise_density", l.imu_noise.accel_noise_density);
+  imu.read("accel_random_walk", l.imu_noise.accel_random_walk);
+  imu.readOptional("gravity", l.init.gravity);
+
+  const Config lidar = rig.section("lidar");
+  lidar.ignore("model");
+  lidar.ignore("rate_hz");
+  lidar.ignore("dropout_probability");
+  lidar.readOptional("min_range", l.min_range);
+  lidar.readOptional("max_range", l.max_range);
+  double range_noise = 0.0;
+  if (lidar.readOptional("range_noise_std", range_noise) && range_noise > 0.0)
+    l.matching.point_noise_std = std::max(l.matching.point_noise_std, 3.0 * range_noise);
+  lidar.read("T_I_L", l.extrinsics.T_I_L);
+
+  rig.ignore("camera");
+  const Config wheel = rig.optionalSection("wheel");
+  if (!wheel.isNull()) {
+    l.wheel.enabled = true;
+    wheel.ignore("rate_hz");
+    wheel.readOptional("track_width", l.wheel.track_width);
+    wheel.readOptional("speed_noise_std", l.wheel.speed_noise_std);
+    wheel.readOptional("T_I_B", l.wheel.T_I_B);
+  }
+}
+
+void readLio(const Config& c, LioNodeOptions* o) {
+  LioOptions& l = o->lio;
+  c.readOptional("name", o->name);
+  c.readOptional("publish_registered_scan", o->publish_registered_scan);
+  c.readOptional("imu_reorder_window_s", o->imu_reorder_window_s);
+  c.readOptional("wheel_max_wait_s", o->wheel_max_wait_s);
+  c.readOptional("clock_reset_s", o->clock_reset_s);
+  c.readOptional("max_pending_scans", o->max_pending_scans);
+
+  const Config out = c.optionalSection("channels");
+  out.readOptional("state_posterior", o->state_posterior_channel);
+  out.readOptional("loop_correction", o->loop_correction_channel);
+  out.readOptional("odometry", o->odometry_channel);
+  out.readOptional("registered_scan", o->registered_scan_channel);
+  out.readOptional("keyframe", o->keyframe_channel);
+  out.readOptional("state_prior", o->state_prior_channel);
+
+  const Config init = c.optionalSection("init");
+  std::string mode;
+  if (init.readOptional("mode", mode)) {
+    if (mode == "auto") l.init.mode = ImuInitOptions::Mode::kAuto;
+    else if (mode == "static") l.init.mode = ImuInitOptions::Mode::kStatic;
+    else if (mode == "moving") l.init.mode = ImuInitOptions::Mode::kMoving;
+    else throw ConfigError(init.where("mode") + ": expected auto, static or moving, got '" + mode + "'");
+  }
+  init.readOptional("window_s", l.init.window_s);
+  init.readOptional("max_gyro_std", l.init.max_gyro_std);
+  init.readOptional("max_accel_std", l.init.max_accel_std);
+  init.readOptional("moving_vel_std", l.init.moving_vel_std);
+
+  c.readOptional("lidar_time_offset_s", l.extrinsics.time_offset_s);
+  c.readOptional("point_stride", l.point_stride);
+  c.readOptional("scan_voxel_size", l.scan_voxel_size);
+  c.readOptional("min_points", l.min_points);
+  c.readOptional("min_residuals", l.min_residuals);
+  c.readOptional("max_imu_gap_s", l.max_imu_gap_s);
+  c.readOptional("reset_imu_gap_s", l.reset_imu_gap_s);
+  c.readOptional("gap_rate_std", l.gap_rate_std);
+  c.readOptional("max_position_jump", l.max_position_jump);
+
+  const Config map = c.optionalSection("map");
+  map.readOptional("voxel_size", l.map.voxel_size);
+  map.readOptional("max_points_per_voxel", l.map.max_points_per_voxel);
+  map.readOptional("min_point_distance", l.map.min_point_distance);
+  map.readOptional("radius", l.map_radius);
+  map.readOptional("prune_distance", l.map_prune_distance);
+
+  const Config m = c.optionalSection("matching");
+  m.readOptional("num_neighbors", l.matching.plane.num_neighbors);
+  m.readOptional("max_neighbor_distance", l.matching.plane.max_neighbor_distance);
+  m.readOptional("max_plane_thickness", l.matching.plane.max_plane_thickness);
+  m.readOptional("min_planarity", l.matching.plane.min_planarity);
+  m.readOptional("point_noise_std", l.matching.point_noise_std);
+  m.readOptional("residual_range_factor", l.matching.residual_range_factor);
+  m.readOptional("research_distance", l.matching.research_distance);
+  m.readOptional("robust_scale", l.matching.robust_scale);
+  m.readOptional("degeneracy_threshold", l.matching.degeneracy_threshold);
+  m.readOptional("degeneracy_lever_arm", l.matching.degeneracy_lever_arm);
+  m.readOptional("remove_degenerate", l.matching.remove_degenerate);
+
+  const Config e = c.optionalSection("esikf");
+  e.readOptional("max_iterations", l.esikf.max_iterations);
+  e.readOptional("convergence_rot", l.esikf.convergence_rot);
+  e.readOptional("convergence_pos", l.esikf.convergence_pos);
+
+  const Config k = c.optionalSection("keyframe");
+  k.readOptional("min_distance", l.keyframe.min_distance);
+  k.readOptional("min_angle_deg", l.keyframe.min_angle_deg);
+  k.readOptional("cloud_voxel", l.keyframe.cloud_voxel);
+  int max_stored = static_cast<int>(l.max_stored_keyframes);
+  k.readOptional("max_stored", max_stored);
+  l.max_stored_keyframes = static_cast<size_t>(std::max(1, max_stored));
+
+  const Config w = c.optionalSection("wheel");
+  w.readOptional("enabled", l.wheel.enabled);
+  w.readOptional("lateral_noise_std", l.wheel.lateral_noise_std);
+  w.readOptional("vertical_noise_std", l.wheel.vertical_noise_std);
+  w.readOptional("max_sample_gap_s", l.wheel.max_sample_gap_s);
+  w.readOptional("gate_chi2", l.wheel.gate_chi2);
+
+  auto positive = [&](bool ok, const char* key) {
+    if (!ok) throw ConfigError(c.where(key) + ": must be positive");
+  };
+  positive(l.map.voxel_size > 0 && l.map.max_points_per_voxel > 0, "map");
+  positive(l.scan_voxel_size > 0 && l.point_stride > 0, "scan_voxel_size");
+  positive(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors");
+  positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
+  positive(l.init.window_s > 0, "init.window_s");
+}
+}  // namespace
+
+LioNodeOptions readLioNodeOptions(const Config& root) {
+  LioNodeOptions o;
+  readRig(root.section("rig"), &o);
+  const Config lio = root.optionalSection("lio");
+  if (!lio.isNull()) {
+    readLio(lio, &o);
+    lio.checkAllUsed();
+  }
+  return o;
+}
+
+void printOptions(const LioNodeOptions& o, std::ostream& os) {
+  const LioOptions& l = o.lio;
+  const Vec3 t = l.extrinsics.T_I_L.translation();
+  os << "[" << o.name << "] inputs " << o.imu_channel << ", " << o.lidar_channel
+     << (l.wheel.enabled ? ", " + o.wheel_channel : std::string()) << ", " << o.state_posterior_channel << ", "
+     << o.loop_correction_channel << "; outputs " << o.odometry_channel << ", " << o.registered_scan_channel << ", "
+     << o.keyframe_channel << "\n"
+     << "  imu noise: gyro " << l.imu_noise.gyro_noise_density << " / " << l.imu_noise.gyro_random_walk << ", accel "
+     << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gravity " << l.init.gravity
+     << ", init window " << l.init.window_s << " s\n"
+     << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["
+     << l.min_range << ", " << l.max_range << "] m\n"
+     << "  scan voxel " << l.scan_voxel_size << " m, stride " << l.point_stride << "; map voxel " << l.map.voxel_size
+     << " m x " << l.map.max_points_per_voxel << " points, spacing " << l.map.min_point_distance << " m, radius "
+     << l.map_radius << " m\n"
+     << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
+     << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
+     << "; degeneracy threshold " << l.matching.degeneracy_threshold << "\n"
+     << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
+     << (l.wheel.enabled ? "on" : "off") << std::endl;
+}
+
+}  // namespace livo::lio

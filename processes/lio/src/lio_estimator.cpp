@@ -1,0 +1,461 @@
+#include "livo/lio/lio_estimator.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "livo/lio/scan_to_map.hpp"
+#include "livo/time.hpp"
+#include "livo/lio/undistorter.hpp"
+
+namespace livo::lio {
+
+namespace {
+constexpr double kMaxSweepS = 1.0;  // offsets beyond this are garbage
+
+void appendNote(std::string* note, const std::string& what) {
+  if (!note) return;
+  if (!note->empty()) *note += "; ";
+  *note += what;
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+const char* toString(ScanResult::Status s) {
+  switch (s) {
+    case ScanResult::Status::kInitializing: return "initializing";
+    case ScanResult::Status::kRejected: return "rejected";
+    case ScanResult::Status::kMapInitialized: return "map initialized";
+    case ScanResult::Status::kTracked: return "tracked";
+    case ScanResult::Status::kPredicted: return "predicted";
+  }
+  return "?";
+}
+
+LioEstimator::LioEstimator(LioOptions options)
+    : opts_(options), prop_(options.imu_noise), map_(options.map), keyframe_selector_(options.keyframe) {}
+
+void LioEstimator::reset() {
+  prop_ = ImuPropagator(opts_.imu_noise);
+  map_.clear();
+  keyframe_selector_.reset();
+  initialized_ = false;
+  init_window_.clear();
+  imu_.clear();
+  wheel_.clear();
+  has_imu_ = has_wheel_ = false;
+  keyframes_.clear();
+  last_registered_body_.clear();
+  has_last_post_ = has_prev_post_ = false;
+  consecutive_failures_ = 0;
+}
+
+bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
+  if (!s.gyro.allFinite() || !s.accel.allFinite()) {
+    if (why) *why = "non-finite IMU sample";
+    return false;
+  }
+  if (has_imu_ && s.utime <= last_imu_utime_) {
+    if (why) *why = "IMU sample not later than the previous one";
+    return false;
+  }
+  has_imu_ = true;
+  last_imu_utime_ = s.utime;
+  if (initialized_) {
+    imu_.push_back(s);
+  } else {
+    init_window_.push_back(s);
+    tryInitialize(nullptr);
+  }
+  return true;
+}
+
+bool LioEstimator::addWheel(const WheelSample& s, std::string* why) {
+  if (!std::isfinite(s.left_speed) || !std::isfinite(s.right_speed)) {
+    if (why) *why = "non-finite wheel speed";
+    return false;
+  }
+  if (has_wheel_ && s.utime <= last_wheel_utime_) {
+    if (why) *why = "wheel reading not later than the previous one";
+    return false;
+  }
+  has_wheel_ = true;
+  last_wheel_utime_ = s.utime;
+  wheel_.push_back(s);
+  return true;
+}
+
+void LioEstimator::tryInitialize(std::string* note) {
+  if (init_window_.size() < 2) return;
+  const int64_t span = init_window_.back().utime - init_window_.front().utime;
+  // a gap inside the window restarts it
+  const int64_t last_gap = init_window_.back().utime - init_window_[init_window_.size() - 2].utime;
+  if (static_cast<double>(last_gap) * 1e-6 > opts_.max_imu_gap_s) {
+    init_window_.erase(init_window_.begin(), init_window_.end() - 1);
+    return;
+  }
+  if (static_cast<double>(span) * 1e-6 < opts_.init.window_s) return;
+  const ImuInitResult r = initializeImu(init_window_, opts_.init);
+  if (!r.ok) {
+    appendNote(note, "IMU initialisation: " + r.message);
+    // slide the window by half its length
+    const int64_t cut = init_window_.back().utime - toUtime(0.5 * opts_.init.window_s);
+    init_window_.erase(init_window_.begin(),
+                       std::find_if(init_window_.begin(), init_window_.end(), [&](const ImuSample& s) { return s.utime >= cut; }));
+    return;
+  }
+  prop_.reset(r.state, r.covariance, r.last);
+  initialized_ = true;
+  init_window_.clear();
+  imu_.clear();
+  last_prune_position_ = r.state.pos;
+}
+
+double LioEstimator::scanEndOffset(const LidarScan& scan) const {
+  double end = (std::isfinite(scan.sweep_duration) && scan.sweep_duration > 0.0 && scan.sweep_duration <= kMaxSweepS)
+                   ? scan.sweep_duration
+                   : 0.0;
+  for (float t : scan.time_offset)
+    if (std::isfinite(t) && t >= 0.0f && t <= kMaxSweepS) end = std::max(end, static_cast<double>(t));
+  return end;
+}
+
+int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const {
+  return scan.utime + toUtime(opts_.extrinsics.time_offset_s + scanEndOffset(scan));
+}
+
+void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note) {
+  // Nothing is known about the motion over the gap: keep pose and biases, widen the pose by what
+  // the body may have done meanwhile, forget the velocity, and restart at s.
+  const double skipped = std::max(0.0, static_cast<double>(s.utime - prop_.utime()) * 1e-6);
+  FilterState x = prop_.state();
+  // the velocity the LiDAR saw between the last two registered sweeps, if recent
+  if (has_prev_post_ && prop_.utime() - prev_post_utime_ > 0 && prop_.utime() - prev_post_utime_ < 500'000)
+    x.vel = (x.pos - prev_post_pos_) / (static_cast<double>(prop_.utime() - prev_post_utime_) * 1e-6);
+  Mat18 P = prop_.covariance();
+  P.middleRows<3>(FilterState::kVel).setZero();
+  P.middleCols<3>(FilterState::kVel).setZero();
+  const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
+  P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
+  P.block<3, 3>(FilterState::kPos, FilterState::kPos) += Mat3::Identity() * v2 * skipped * skipped;
+  const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * skipped);
+  P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
+  prop_.reset(x, P, s);
+  appendNote(note, "IMU gap of " + fmt(gap_s) + " s: velocity re-initialised");
+}
+
+void LioEstimator::widenForGap(double gap_s) {
+  // a bridged gap: the interpolated IMU says little about the motion, so widen the pose and the
+  // velocity by what the body may have done meanwhile
+  Mat18 P = prop_.covariance();
+  const double v = opts_.init.moving_vel_std;
+  const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * gap_s);
+  P.block<3, 3>(FilterState::kPos, FilterState::kPos) += Mat3::Identity() * v * v * gap_s * gap_s;
+  P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
+  P.block<3, 3>(FilterState::kVel, FilterState::kVel) += Mat3::Identity() * v * v * std::min(1.0, gap_s);
+  prop_.setState(prop_.state(), P);
+}
+
+bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
+  const double max_gap = opts_.max_imu_gap_s, reset_gap = opts_.reset_imu_gap_s;
+  double worst_gap = 0.0;
+  while (!imu_.empty() && imu_.front().utime <= t_end) {
+    const ImuSample s = imu_.front();
+    imu_.pop_front();
+    if (s.utime <= prop_.utime()) continue;
+    const double gap = static_cast<double>(s.utime - prop_.utime()) * 1e-6;
+    if (gap > reset_gap) {
+      softReset(s, gap, note);
+      continue;
+    }
+    prop_.addSample(s);
+    if (gap > max_gap) widenForGap(gap);
+    worst_gap = std::max(worst_gap, gap);
+  }
+  if (prop_.utime() < t_end) {
+    const bool has_next = !imu_.empty();
+    const ImuSample next = has_next ? imu_.front() : prop_.lastSample();
+    const double gap = static_cast<double>((has_next ? next.utime : t_end) - prop_.utime()) * 1e-6;
+    const double step = static_cast<double>(t_end - prop_.utime()) * 1e-6;
+    if (!has_next) appendNote(note, "IMU data ends " + fmt(gap) + " s before the sweep end: last sample held");
+    if (gap > reset_gap) {
+      ImuSample at = next;
+      at.utime = t_end;
+      softReset(at, gap, note);
+    } else {
+      prop_.propagateTo(t_end, next);
+      if (gap > max_gap) widenForGap(step);
+      worst_gap = std::max(worst_gap, gap);
+    }
+  }
+  if (worst_gap > max_gap) appendNote(note, "IMU gap of " + fmt(worst_gap) + " s bridged");
+  return prop_.state().rot.allFinite() && prop_.state().pos.allFinite() && prop_.state().vel.allFinite() &&
+         prop_.covariance().allFinite();
+}
+
+bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed) const {
+  for (size_t i = 1; i < wheel_.size(); ++i) {
+    const WheelSample& a = wheel_[i - 1];
+    const WheelSample& b = wheel_[i];
+    if (a.utime <= utime && utime <= b.utime) {
+      if (static_cast<double>(b.utime - a.utime) * 1e-6 > opts_.wheel.max_sample_gap_s) return false;
+      const double alpha = b.utime > a.utime ? static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime) : 0.0;
+      *speed = 0.5 * ((1.0 - alpha) * (a.left_speed + a.right_speed) + alpha * (b.left_speed + b.right_speed));
+      return true;
+    }
+  }
+  return false;
+}
+
+void LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterState& x) {
+  for (const auto& p : body) map_.insert(Vec3(x.rot * p + x.pos));
+}
+
+void LioEstimator::pruneMap(const Vec3& position) {
+  if ((position - last_prune_position_).norm() < opts_.map_prune_distance) return;
+  map_.removeFarFrom(position, opts_.map_radius);
+  last_prune_position_ = position;
+}
+
+ScanResult LioEstimator::addScan(const LidarScan& scan) {
+  ScanResult res;
+  std::string* note = &res.message;
+  if (!initialized_) {
+    res.status = ScanResult::Status::kInitializing;
+    res.message = "waiting for the IMU initialisation";
+    return res;
+  }
+  const double end_offset = scanEndOffset(scan);
+  const int64_t t_end = scanEndUtime(scan);
+  const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
+  if (t_end <= prop_.utime()) {
+    // before the first output this is a sweep recorded during the IMU initialisation window
+    res.status = map_.empty() ? ScanResult::Status::kInitializing : ScanResult::Status::kRejected;
+    res.message = map_.empty() ? "sweep ends before the IMU initialisation" : "sweep ends before the filter time";
+    return res;
+  }
+
+  // 1. propagation to the sweep end (eqs. 5-6)
+  if (!propagateThrough(t_end, note)) {
+    appendNote(note, "propagation produced a non-finite state: re-initialising");
+    reset();
+    res.status = ScanResult::Status::kRejected;
+    return res;
+  }
+  const FilterState prior = prop_.state();
+  const Mat18 P_prior = prop_.covariance();
+
+  // 2. valid points, undistorted into the body frame at the end
+  std::vector<size_t> valid;
+  valid.reserve(scan.points.size());
+  const size_t n = std::min(scan.points.size(), scan.time_offset.size());
+  const double min_r2 = opts_.min_range * opts_.min_range, max_r2 = opts_.max_range * opts_.max_range;
+  for (size_t j = 0; j < n; ++j) {
+    const Vec3& p = scan.points[j];
+    const float t = scan.time_offset[j];
+    if (!p.allFinite() || !std::isfinite(t) || t < 0.0f || t > end_offset) continue;
+    const double r2 = p.squaredNorm();
+    if (r2 < min_r2 || r2 > max_r2) continue;
+    valid.push_back(j);
+  }
+  if (scan.points.size() != scan.time_offset.size()) appendNote(note, "points and time offsets differ in number");
+  res.num_points = static_cast<int>(valid.size());
+  std::vector<Vec3> body;
+  if (!prop_.segments().empty()) {
+    const Undistorter und(prop_.segments(), prior.rot, prior.pos, t_end, opts_.extrinsics.T_I_L);
+    und.undistort(scan, t_first, valid, &body);
+  } else {
+    body.reserve(valid.size());
+    for (size_t j : valid) body.push_back(opts_.extrinsics.T_I_L * scan.points[j]);
+  }
+  prop_.clearSegments();
+
+  // 3. registration subset: stride, then voxel downsampling
+  std::vector<size_t> subset;
+  const size_t stride = static_cast<size_t>(std::max(1, opts_.point_stride));
+  for (size_t i = 0; i < body.size(); i += stride) subset.push_back(i);
+  subset = voxelDownsample(body, subset, opts_.scan_voxel_size);
+  std::vector<Vec3> reg;
+  reg.reserve(subset.size());
+  for (size_t i : subset) reg.push_back(body[i]);
+  res.num_registered = static_cast<int>(reg.size());
+
+  FilterState x = prior;
+  Mat18 P = P_prior;
+
+  // 4. wheel velocity (before the LiDAR update)
+  if (opts_.wheel.enabled) {
+    double speed = 0.0;
+    if (wheelSpeedAt(t_end, &speed)) {
+      const WheelUpdateResult w = wheelVelocityUpdate(&x, &P, prop_.lastSample().gyro, speed, opts_.wheel);
+      if (!w.applied) appendNote(note, "wheel speed rejected (chi2 " + fmt(w.chi2) + ")");
+    } else {
+      appendNote(note, "no wheel reading around the sweep end");
+    }
+    while (wheel_.size() > 2 && wheel_[1].utime <= t_end) wheel_.pop_front();
+  }
+
+  // 5. LiDAR update or map seeding
+  if (map_.empty()) {
+    if (static_cast<int>(valid.size()) < opts_.min_points) {
+      res.status = ScanResult::Status::kPredicted;
+      appendNote(note, "too few valid points to seed the map (" + std::to_string(valid.size()) + ")");
+    } else {
+      res.status = ScanResult::Status::kMapInitialized;
+    }
+  } else if (static_cast<int>(valid.size()) < opts_.min_points) {
+    res.status = ScanResult::Status::kPredicted;
+    appendNote(note, "too few valid points (" + std::to_string(valid.size()) + "): prediction only");
+  } else {
+    ScanToMap s2m(map_, reg, opts_.matching);
+    FilterState post;
+    Mat18 P_post;
+    const EsikfResult er = iteratedUpdate(
+        x, P, [&](const FilterState& xi, int it, PoseInformation* info) { return s2m.evaluate(xi, it, info); },
+        opts_.esikf, &post, &P_post);
+    res.num_residuals = er.info.count;
+    res.iterations = er.iterations;
+    res.converged = er.converged;
+    res.degeneracy = s2m.degeneracy();
+    res.min_information_eigenvalue = s2m.minInformationEigenvalue();
+    const bool enough = er.valid && er.info.count >= opts_.min_residuals;
+    const bool sane = enough && post.rot.allFinite() && post.pos.allFinite() && P_post.allFinite() &&
+                      (post.pos - x.pos).norm() <= opts_.max_position_jump;
+    if (sane) {
+      x = post;
+      P = P_post;
+      res.status = ScanResult::Status::kTracked;
+      consecutive_failures_ = 0;
+    } else {
+      res.status = ScanResult::Status::kPredicted;
+      res.degeneracy.degenerate = true;
+      appendNote(note, enough ? "update rejected (diverged)"
+                              : "too few point-to-plane matches (" + std::to_string(er.info.count) + ")");
+      if (++consecutive_failures_ >= 10 && enough) {
+        appendNote(note, "registration failed 10 times in a row: re-initialising");
+        reset();
+        res.status = ScanResult::Status::kRejected;
+        return res;
+      }
+    }
+  }
+  if (res.status == ScanResult::Status::kTracked) {
+    // remember the previous registered position (velocity after IMU gaps)
+    if (has_last_post_) {
+      prev_post_pos_ = last_post_pos_;
+      prev_post_utime_ = last_post_utime_;
+      has_prev_post_ = true;
+    }
+    last_post_pos_ = x.pos;
+    last_post_utime_ = t_end;
+    has_last_post_ = true;
+  }
+  prop_.setState(x, P);
+
+  // 6. map insertion and the local window
+  if (res.status != ScanResult::Status::kPredicted) {
+    insertIntoMap(reg, x);
+    last_registered_body_ = reg;
+    pruneMap(x.pos);
+  }
+
+  // 7. outputs
+  res.utime = t_end;
+  res.state = x;
+  res.covariance = P;
+  res.angular_velocity = prop_.lastSample().gyro - x.gyro_bias;
+  res.world_points.resize(body.size());
+  res.intensity.resize(body.size());
+  res.point_index.resize(body.size());
+  for (size_t i = 0; i < body.size(); ++i) {
+    res.point_index[i] = static_cast<uint32_t>(valid[i]);
+    res.world_points[i] = x.rot * body[i] + x.pos;
+    res.intensity[i] = scan.intensity.size() == scan.points.size() ? scan.intensity[valid[i]] : 0.0f;
+  }
+  if (res.status != ScanResult::Status::kPredicted && keyframe_selector_.check(x.pose())) {
+    Keyframe kf;
+    kf.id = next_keyframe_id_++;
+    kf.utime = t_end;
+    kf.pose = x.pose();
+    kf.pose_covariance = P.topLeftCorner<6, 6>();
+    for (size_t i : voxelDownsample(body, opts_.keyframe.cloud_voxel)) kf.cloud.push_back(body[i]);
+    keyframes_.push_back(kf);
+    while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+    res.is_keyframe = true;
+    res.keyframe = kf;
+  }
+  return res;
+}
+
+bool LioEstimator::propagateTo(int64_t utime, std::string* why) {
+  if (!initialized_) {
+    if (why) *why = "not initialised";
+    return false;
+  }
+  if (utime < prop_.utime()) {
+    if (why) *why = "time before the filter time";
+    return false;
+  }
+  std::string note;
+  const bool ok = propagateThrough(utime, &note);
+  if (why) *why = note;
+  return ok;
+}
+
+bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat18& P, std::string* why) {
+  auto fail = [&](const char* w) {
+    if (why) *why = w;
+    return false;
+  };
+  if (!initialized_) return fail("not initialised");
+  if (utime != prop_.utime()) return fail("posterior time differs from the filter time");
+  if (!x.rot.allFinite() || !x.pos.allFinite() || !x.vel.allFinite() || !x.gyro_bias.allFinite() ||
+      !x.accel_bias.allFinite() || !x.gravity.allFinite() || !P.allFinite())
+    return fail("non-finite posterior");
+  if ((x.rot.transpose() * x.rot - Mat3::Identity()).norm() > 1e-6) return fail("posterior rotation not orthonormal");
+  if (Eigen::LLT<Mat18>(0.5 * (P + P.transpose())).info() != Eigen::Success)
+    return fail("posterior covariance not positive definite");
+  prop_.setState(x, 0.5 * (P + P.transpose()));
+  return true;
+}
+
+void LioEstimator::applyLoopCorrection(const Pose3& T, const std::vector<KeyframePose>& corrected) {
+  const Mat3 Rc = T.linear();
+  // keyframes: corrected poses where given, the rigid correction elsewhere
+  for (auto& kf : keyframes_) {
+    auto it = std::find_if(corrected.begin(), corrected.end(), [&](const KeyframePose& k) { return k.id == kf.id; });
+    kf.pose = it != corrected.end() ? it->pose : T * kf.pose;
+  }
+  if (initialized_) {
+    FilterState x = prop_.state();
+    x.rot = so3::normalize(Rc * x.rot);
+    x.pos = Rc * x.pos + T.translation();
+    x.vel = Rc * x.vel;
+    x.gravity = Rc * x.gravity;
+    Mat18 Tm = Mat18::Identity();
+    Tm.block<3, 3>(FilterState::kPos, FilterState::kPos) = Rc;
+    Tm.block<3, 3>(FilterState::kVel, FilterState::kVel) = Rc;
+    Tm.block<3, 3>(FilterState::kGravity, FilterState::kGravity) = Rc;
+    prop_.setState(x, Tm * prop_.covariance() * Tm.transpose());
+    keyframe_selector_.setReference(x.pose());
+  }
+  // rebuild the local map from the corrected keyframes around the new position
+  map_.clear();
+  const Vec3 here = initialized_ ? prop_.state().pos : T.translation();
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
+    if ((it->pose.translation() - here).norm() > opts_.map_radius) continue;
+    for (const auto& p : it->cloud) map_.insert(Vec3(it->pose * p));
+  }
+  if (initialized_) insertIntoMap(last_registered_body_, prop_.state());
+  last_prune_position_ = here;
+}
+
+}  // namespace livo::lio

@@ -1,0 +1,173 @@
+#include "livo/lio/lio_messages.hpp"
+
+#include <cmath>
+
+#include "livo/messages.hpp"
+
+namespace livo::lio {
+
+ImuSample fromMessage(const imu_t& m) {
+  ImuSample s;
+  s.utime = m.utime;
+  s.gyro = vec3From(m.angular_velocity);
+  s.accel = vec3From(m.linear_acceleration);
+  return s;
+}
+
+WheelSample fromMessage(const wheel_odometry_t& m) { return WheelSample{m.utime, m.left_speed, m.right_speed}; }
+
+bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why) {
+  const size_t n = static_cast<size_t>(std::max(0, m.num_points));
+  if (m.x.size() != n || m.y.size() != n || m.z.size() != n || m.time_offset.size() != n ||
+      (!m.intensity.empty() && m.intensity.size() != n)) {
+    *why = "point cloud arrays differ from num_points";
+    return false;
+  }
+  if (m.frame != "L") {
+    *why = "point cloud in frame '" + m.frame + "', expected 'L'";
+    return false;
+  }
+  scan->utime = m.utime;
+  scan->sweep_duration = m.sweep_duration;
+  scan->points.resize(n);
+  scan->time_offset.assign(m.time_offset.begin(), m.time_offset.end());
+  scan->intensity.assign(m.intensity.begin(), m.intensity.end());
+  for (size_t i = 0; i < n; ++i) scan->points[i] = Vec3(m.x[i], m.y[i], m.z[i]);
+  return true;
+}
+
+odometry_t toOdometry(const ScanResult& r) {
+  odometry_t o;
+  o.utime = r.utime;
+  o.parent_frame = "W";
+  o.child_frame = "I";
+  poseTo(r.state.pose(), o.position, o.orientation);
+  vec3To(r.state.vel, o.velocity);
+  vec3To(r.angular_velocity, o.angular_velocity);
+  matrixTo<6>(Mat6(r.covariance.topLeftCorner<6, 6>()), o.pose_covariance);
+  matrixTo<3>(Mat3(r.covariance.block<3, 3>(FilterState::kVel, FilterState::kVel)), o.velocity_covariance);
+  o.num_residuals = r.num_residuals;
+  o.degenerate = r.degeneracy.degenerate ? 1 : 0;
+  o.min_information_eigenvalue = r.min_information_eigenvalue;
+  return o;
+}
+
+registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in) {
+  registered_scan_t m;
+  m.utime = r.utime;
+  poseTo(r.state.pose(), m.position, m.orientation);
+  point_cloud_t& c = m.cloud;
+  c.utime = r.utime;
+  c.frame = "W";
+  c.pattern = in.pattern;
+  c.num_rings = in.num_rings;
+  c.sweep_duration = 0.0f;
+  const size_t n = r.world_points.size();
+  c.num_points = static_cast<int32_t>(n);
+  c.x.resize(n);
+  c.y.resize(n);
+  c.z.resize(n);
+  c.intensity.resize(n);
+  c.time_offset.assign(n, 0.0f);
+  c.ring.resize(n);
+  const bool has_ring = in.ring.size() == static_cast<size_t>(in.num_points);
+  for (size_t i = 0; i < n; ++i) {
+    c.x[i] = static_cast<float>(r.world_points[i].x());
+    c.y[i] = static_cast<float>(r.world_points[i].y());
+    c.z[i] = static_cast<float>(r.world_points[i].z());
+    c.intensity[i] = r.intensity[i];
+    c.ring[i] = has_ring ? in.ring[r.point_index[i]] : int16_t{-1};
+  }
+  return m;
+}
+
+keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings) {
+  keyframe_t m;
+  m.id = k.id;
+  m.utime = k.utime;
+  poseTo(k.pose, m.position, m.orientation);
+  matrixTo<6>(k.pose_covariance, m.pose_covariance);
+  point_cloud_t& c = m.cloud;
+  c.utime = k.utime;
+  c.frame = "I";
+  c.pattern = point_cloud_t::PATTERN_SPINNING;
+  c.num_rings = num_rings;
+  c.sweep_duration = 0.0f;
+  const size_t n = k.cloud.size();
+  c.num_points = static_cast<int32_t>(n);
+  c.x.resize(n);
+  c.y.resize(n);
+  c.z.resize(n);
+  c.intensity.assign(n, 0.0f);
+  c.time_offset.assign(n, 0.0f);
+  c.ring.assign(n, -1);
+  for (size_t i = 0; i < n; ++i) {
+    c.x[i] = static_cast<float>(k.cloud[i].x());
+    c.y[i] = static_cast<float>(k.cloud[i].y());
+    c.z[i] = static_cast<float>(k.cloud[i].z());
+  }
+  return m;
+}
+
+filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P, int64_t request_id,
+                             const std::string& source) {
+  filter_state_t m;
+  m.utime = utime;
+  m.request_id = request_id;
+  m.source = source;
+  quatToWxyz(Quat(x.rot), m.orientation);
+  vec3To(x.pos, m.position);
+  vec3To(x.vel, m.velocity);
+  vec3To(x.gyro_bias, m.gyro_bias);
+  vec3To(x.accel_bias, m.accel_bias);
+  vec3To(x.gravity, m.gravity);
+  matrixTo<18>(P, m.covariance);
+  m.valid = 1;
+  m.iterations = 0;
+  m.num_measurements = 0;
+  return m;
+}
+
+bool fromFilterState(const filter_state_t& m, FilterState* x, Mat18* P) {
+  if (!allFinite(m.orientation, 4) || !allFinite(m.position, 3) || !allFinite(m.velocity, 3) ||
+      !allFinite(m.gyro_bias, 3) || !allFinite(m.accel_bias, 3) || !allFinite(m.gravity, 3) ||
+      !allFinite(m.covariance, 324))
+    return false;
+  const double qn = std::sqrt(m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
+                              m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3]);
+  if (!(qn > 0.5 && qn < 2.0)) return false;
+  x->rot = quatFromWxyz(m.orientation).toRotationMatrix();
+  x->pos = vec3From(m.position);
+  x->vel = vec3From(m.velocity);
+  x->gyro_bias = vec3From(m.gyro_bias);
+  x->accel_bias = vec3From(m.accel_bias);
+  x->gravity = vec3From(m.gravity);
+  *P = matrixFrom<18>(m.covariance);
+  return true;
+}
+
+bool fromMessage(const loop_correction_t& m, Pose3* T, std::vector<LioEstimator::KeyframePose>* poses,
+                 std::string* why) {
+  const size_t n = static_cast<size_t>(std::max(0, m.num_keyframes));
+  if (m.keyframe_id.size() != n || m.position.size() != n || m.orientation.size() != n) {
+    *why = "loop correction arrays differ from num_keyframes";
+    return false;
+  }
+  if (!allFinite(m.correction_position, 3) || !allFinite(m.correction_orientation, 4)) {
+    *why = "non-finite loop correction";
+    return false;
+  }
+  *T = poseFrom(m.correction_position, m.correction_orientation);
+  poses->clear();
+  for (size_t i = 0; i < n; ++i) {
+    if (m.position[i].size() != 3 || m.orientation[i].size() != 4 || !allFinite(m.position[i].data(), 3) ||
+        !allFinite(m.orientation[i].data(), 4)) {
+      *why = "malformed corrected keyframe pose";
+      return false;
+    }
+    poses->push_back({m.keyframe_id[i], poseFrom(m.position[i].data(), m.orientation[i].data())});
+  }
+  return true;
+}
+
+}  // namespace livo::lio

@@ -1,0 +1,79 @@
+#include "livo/lio/scan_to_map.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace livo::lio {
+
+ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options)
+    : map_(map), points_(body_points), opts_(options), matches_(body_points.size()), gate_(body_points.size()) {
+  for (size_t i = 0; i < points_.size(); ++i)
+    gate_[i] = opts_.residual_range_factor * std::sqrt(points_[i].norm());
+}
+
+int ScanToMap::numMatched() const {
+  int n = 0;
+  for (const auto& m : matches_) n += m.has_plane ? 1 : 0;
+  return n;
+}
+
+bool ScanToMap::evaluate(const FilterState& x, int iteration, PoseInformation* info) {
+  const int k = opts_.plane.num_neighbors;
+  Vec3 nb[32];
+  double d2[32];
+  const double research2 = opts_.research_distance * opts_.research_distance;
+  const double w = 1.0 / (opts_.point_noise_std * opts_.point_noise_std);
+  const double inv_lever = 1.0 / opts_.degeneracy_lever_arm;
+  rows_.clear();
+  for (size_t i = 0; i < points_.size(); ++i) {
+    const Vec3 pw = x.rot * points_[i] + x.pos;
+    Match& m = matches_[i];
+    if (iteration == 0 || !((pw - m.searched_at).squaredNorm() <= research2)) {
+      m.searched_at = pw;
+      m.has_plane = map_.knn(pw, k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
+                    fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity);
+    }
+    if (!m.has_plane) continue;
+    const double r = m.plane.distance(pw);
+    if (!(std::abs(r) <= gate_[i])) continue;
+    rows_.push_back(Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x.rot), r});
+  }
+  const int count = static_cast<int>(rows_.size());
+  last_count_ = count;
+  info->count = count;
+  if (count == 0) return false;
+
+  // Cauchy weights with a scale that follows the residuals while the iterate is still far off
+  // (3 robust standard deviations) and settles at robust_scale near the optimum.
+  double c2 = 0.0;
+  if (opts_.robust_scale > 0.0) {
+    abs_r_.resize(rows_.size());
+    for (size_t i = 0; i < rows_.size(); ++i) abs_r_[i] = std::abs(rows_[i].r);
+    auto mid = abs_r_.begin() + static_cast<std::ptrdiff_t>(abs_r_.size() / 2);
+    std::nth_element(abs_r_.begin(), mid, abs_r_.end());
+    const double c = std::max(opts_.robust_scale, 3.0 * 1.4826 * *mid);
+    c2 = c * c;
+  }
+  Mat6 S = Mat6::Zero(), G = Mat6::Zero();
+  Vec6 g = Vec6::Zero();
+  for (const Row& row : rows_) {
+    const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
+    S.noalias() += rw * row.h.transpose() * row.h;
+    g.noalias() += rw * row.h.transpose() * row.r;
+    Row6 hs = row.h;
+    hs.head<3>() *= inv_lever;
+    G.noalias() += hs.transpose() * hs;
+  }
+  S *= w;
+  g *= w;
+  info->geometry = G / static_cast<double>(count);
+  min_information_eigenvalue_ = Eigen::SelfAdjointEigenSolver<Mat6>(S, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  degeneracy_ = analyzeDegeneracy(info->geometry, opts_.degeneracy_threshold);
+  if (opts_.remove_degenerate) removeDegenerateInformation(degeneracy_, &S, &g);
+  info->HtRinvH = S;
+  info->HtRinvz = g;
+  return true;
+}
+
+}  // namespace livo::lio

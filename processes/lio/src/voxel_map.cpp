@@ -1,0 +1,188 @@
+#include "livo/lio/voxel_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace livo::lio {
+
+VoxelMap::VoxelMap(VoxelMapOptions options) : opts_(options) {
+  if (!(opts_.voxel_size > 0.0) || opts_.max_points_per_voxel < 1)
+    throw std::invalid_argument("VoxelMap: voxel_size > 0 and max_points_per_voxel >= 1 required");
+  inv_size_ = 1.0 / opts_.voxel_size;
+  stride_ = 3 * static_cast<size_t>(opts_.max_points_per_voxel);
+}
+
+bool VoxelMap::insert(const Vec3& p) {
+  if (!p.allFinite()) return false;
+  const int64_t cx = static_cast<int64_t>(std::floor(p.x() * inv_size_));
+  const int64_t cy = static_cast<int64_t>(std::floor(p.y() * inv_size_));
+  const int64_t cz = static_cast<int64_t>(std::floor(p.z() * inv_size_));
+  const VoxelKey key = packVoxel(cx, cy, cz);
+  const int32_t next = static_cast<int32_t>(voxels_.size());
+  const int32_t v = index_.insert(key, next);
+  if (v == next) {
+    voxels_.push_back(Voxel{key, 0, static_cast<int32_t>(cx), static_cast<int32_t>(cy), static_cast<int32_t>(cz)});
+    pool_.resize(pool_.size() + stride_);
+  }
+  Voxel& vox = voxels_[static_cast<size_t>(v)];
+  if (vox.count >= opts_.max_points_per_voxel) return false;
+  float* pts = voxelPoints(v);
+  const double min_d2 = opts_.min_point_distance * opts_.min_point_distance;
+  for (int i = 0; i < vox.count; ++i) {
+    const double dx = pts[3 * i] - p.x(), dy = pts[3 * i + 1] - p.y(), dz = pts[3 * i + 2] - p.z();
+    if (dx * dx + dy * dy + dz * dz < min_d2) return false;
+  }
+  pts[3 * vox.count] = static_cast<float>(p.x());
+  pts[3 * vox.count + 1] = static_cast<float>(p.y());
+  pts[3 * vox.count + 2] = static_cast<float>(p.z());
+  ++vox.count;
+  return true;
+}
+
+size_t VoxelMap::insert(const std::vector<Vec3>& points) {
+  size_t n = 0;
+  for (const auto& p : points) n += insert(p) ? 1 : 0;
+  return n;
+}
+
+int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, double* out_sq_dist) const {
+  if (k <= 0 || k > 32 || voxels_.empty() || !q.allFinite()) return 0;
+  const double r = max_distance;
+  const double r2 = r * r;
+  const double vs = opts_.voxel_size;
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = static_cast<int64_t>(std::floor((q[a] - r) * inv_size_));
+    hi[a] = static_cast<int64_t>(std::floor((q[a] + r) * inv_size_));
+  }
+  // Candidate voxels intersecting the ball, visited nearest first and looked up
+  // lazily, so the search usually stops after the few nearest voxels.
+  struct Cand {
+    double d2;
+    int64_t x, y, z;
+  };
+  Cand small[64];
+  std::vector<Cand> large;
+  const int64_t ncand = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+  Cand* cands = small;
+  if (ncand > 64) {
+    large.resize(static_cast<size_t>(ncand));
+    cands = large.data();
+  }
+  int nc = 0;
+  for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+    const double dx = std::max({0.0, x * vs - q.x(), q.x() - (x + 1) * vs});
+    for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+      const double dy = std::max({0.0, y * vs - q.y(), q.y() - (y + 1) * vs});
+      const double dxy = dx * dx + dy * dy;
+      if (dxy > r2) continue;
+      for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+        const double dz = std::max({0.0, z * vs - q.z(), q.z() - (z + 1) * vs});
+        const double d2 = dxy + dz * dz;
+        if (d2 > r2) continue;
+        int i = nc++;
+        while (i > 0 && cands[i - 1].d2 > d2) {
+          cands[i] = cands[i - 1];
+          --i;
+        }
+        cands[i] = Cand{d2, x, y, z};
+      }
+    }
+  }
+
+  int found = 0;
+  double worst = r2;  // admit points with d2 <= worst
+  for (int c = 0; c < nc; ++c) {
+    if (cands[c].d2 > worst) break;
+    const int32_t v = index_.find(packVoxel(cands[c].x, cands[c].y, cands[c].z));
+    if (v < 0) continue;
+    const float* pts = voxelPoints(v);
+    const int cnt = voxels_[static_cast<size_t>(v)].count;
+    for (int i = 0; i < cnt; ++i) {
+      const double dx = pts[3 * i] - q.x(), dy = pts[3 * i + 1] - q.y(), dz = pts[3 * i + 2] - q.z();
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      if (d2 > worst) continue;
+      if (found == k && d2 >= out_sq_dist[k - 1]) continue;
+      int j = found < k ? found++ : k - 1;
+      while (j > 0 && out_sq_dist[j - 1] > d2) {
+        out_sq_dist[j] = out_sq_dist[j - 1];
+        out_points[j] = out_points[j - 1];
+        --j;
+      }
+      out_sq_dist[j] = d2;
+      out_points[j] = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+      if (found == k) worst = out_sq_dist[k - 1];
+    }
+  }
+  return found;
+}
+
+size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
+  const double r2 = radius * radius;
+  const double vs = opts_.voxel_size;
+  size_t kept = 0;
+  for (size_t v = 0; v < voxels_.size(); ++v) {
+    const Voxel& vox = voxels_[v];
+    const Vec3 c((vox.cx + 0.5) * vs, (vox.cy + 0.5) * vs, (vox.cz + 0.5) * vs);
+    if ((c - centre).squaredNorm() > r2) continue;
+    if (kept != v) {
+      voxels_[kept] = vox;
+      std::copy_n(&pool_[v * stride_], stride_, &pool_[kept * stride_]);
+    }
+    ++kept;
+  }
+  const size_t removed = voxels_.size() - kept;
+  if (removed == 0) return 0;
+  voxels_.resize(kept);
+  pool_.resize(kept * stride_);
+  voxels_.shrink_to_fit();
+  pool_.shrink_to_fit();
+  index_.resetFor(kept);
+  for (size_t v = 0; v < kept; ++v) index_.insert(voxels_[v].key, static_cast<int32_t>(v));
+  return removed;
+}
+
+void VoxelMap::clear() {
+  voxels_.clear();
+  pool_.clear();
+  index_.resetFor(0);
+}
+
+size_t VoxelMap::numPoints() const {
+  size_t n = 0;
+  for (const auto& v : voxels_) n += static_cast<size_t>(v.count);
+  return n;
+}
+
+std::vector<Vec3> VoxelMap::points() const {
+  std::vector<Vec3> out;
+  out.reserve(numPoints());
+  for (size_t v = 0; v < voxels_.size(); ++v) {
+    const float* pts = voxelPoints(static_cast<int32_t>(v));
+    for (int i = 0; i < voxels_[v].count; ++i) out.emplace_back(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+  }
+  return out;
+}
+
+std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
+                                    double voxel_size) {
+  const double inv = 1.0 / voxel_size;
+  FlatKeyIndex seen(subset.size());
+  std::vector<size_t> out;
+  out.reserve(subset.size() / 4 + 16);
+  for (size_t j : subset) {
+    const VoxelKey key = voxelKeyOf(points[j], inv);
+    const int32_t next = static_cast<int32_t>(out.size());
+    if (seen.insert(key, next) == next) out.push_back(j);
+  }
+  return out;
+}
+
+std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, double voxel_size) {
+  std::vector<size_t> all(points.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return voxelDownsample(points, all, voxel_size);
+}
+
+}  // namespace livo::lio

@@ -1,0 +1,62 @@
+// Plane fitting and the point-to-plane residual's Jacobian.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "livo/lio/point_to_plane.hpp"
+
+using namespace livo;
+using namespace livo::lio;
+
+TEST(PointToPlane, FitRecoversAPlane) {
+  const Vec3 n = Vec3(0.3, -0.2, 0.9).normalized();
+  const double d = -1.7;
+  // points on n.x + d = 0
+  const Vec3 c = -d * n;
+  const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
+  std::vector<Vec3> pts;
+  const double uv[5][2] = {{0, 0}, {0.4, 0.1}, {-0.3, 0.5}, {0.2, -0.6}, {-0.5, -0.2}};
+  for (const auto& q : uv) pts.push_back(c + q[0] * u + q[1] * v);
+  Plane p;
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.01, &p));
+  EXPECT_NEAR(std::abs(p.normal.dot(n)), 1.0, 1e-12);
+  for (const auto& x : pts) EXPECT_NEAR(p.distance(x), 0.0, 1e-12);
+  // a point 0.5 m off the plane on the normal's side
+  EXPECT_NEAR(std::abs(p.distance(c + 0.5 * n)), 0.5, 1e-12);
+
+  // thickness check: one point 20 cm off; the fit leans towards it, but it stays > 5 cm away
+  pts[2] += 0.2 * n;
+  EXPECT_FALSE(fitPlane(pts.data(), 5, 0.05, &p));
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.2, &p));
+  double worst = 0.0;
+  for (const auto& x : pts) worst = std::max(worst, std::abs(p.distance(x)));
+  EXPECT_GT(worst, 0.05);
+  EXPECT_LT(worst, 0.2);
+}
+
+TEST(PointToPlane, RejectsCollinearAndTooFewPoints) {
+  std::vector<Vec3> line;
+  for (int i = 0; i < 5; ++i) line.emplace_back(0.1 * i, 0.2 * i, 0.0);
+  Plane p;
+  EXPECT_FALSE(fitPlane(line.data(), 5, 0.1, &p));
+  EXPECT_FALSE(fitPlane(line.data(), 2, 0.1, &p));
+}
+
+TEST(PointToPlane, JacobianMatchesNumericDifferentiation) {
+  PointToPlaneResidual r;
+  r.p_body = Vec3(3.0, -1.0, 0.5);
+  r.plane.normal = Vec3(0.2, 0.9, -0.3).normalized();
+  r.plane.offset = 0.7;
+  const Mat3 R = so3::Exp(Vec3(0.4, -0.2, 1.1));
+  const Vec3 t(1.0, 2.0, -0.5);
+  const Row6 J = r.jacobian(R);
+  const double h = 1e-6;
+  for (int i = 0; i < 6; ++i) {
+    Vec6 d = Vec6::Zero();
+    d[i] = h;
+    const Pose3 Tp = se3::boxplus(se3::fromRotationTranslation(R, t), d);
+    const Pose3 Tm = se3::boxplus(se3::fromRotationTranslation(R, t), -d);
+    const double num = (r.value(Tp.linear(), Tp.translation()) - r.value(Tm.linear(), Tm.translation())) / (2 * h);
+    EXPECT_NEAR(J[i], num, 1e-8) << i;
+  }
+}
