@@ -11,6 +11,7 @@
 #
 #   scripts/run_pipeline.sh --log LOG --config FILE --out DIR [--realtime] [--without P,...]
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
+#                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -20,7 +21,7 @@ all_processes=(lio vio loop colour octomap)
 usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -32,6 +33,8 @@ while [ $# -gt 0 ]; do
     --without) without="$2"; shift 2 ;;
     --processes) processes="$2"; shift 2 ;;
     --record) record="$2"; shift 2 ;;
+    --faults) faults="$2"; shift 2 ;;
+    --seed) seed="$2"; shift 2 ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"; swap["${2%%=*}"]="${2#*=}"; shift 2 ;;
     --inside-bus) inside=1; shift ;;
     -h|--help) usage 0 ;;
@@ -75,6 +78,7 @@ if [ "$inside" = 0 ]; then
   rc=0
   "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
+    --faults "$faults" --seed "$seed" \
     $([ "$realtime" = 1 ] && echo --realtime) || rc=$?
 
   # Files for the user, whatever happened above (outputs so far are kept).
@@ -135,6 +139,7 @@ if [ "$realtime" = 1 ]; then
 else
   replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 120 --startup-timeout 60)
 fi
+[ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")
 rc=0
 "$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
 playback=$!
