@@ -122,8 +122,21 @@ void Node::publishProgress(bool finished) {
   lcm_.publish(options_.progress_channel, &p);
 }
 
+void Node::recordWork(const std::string& what, double seconds) { work_["work:" + what].add(seconds); }
+
 std::vector<channel_stats_t> Node::channelStats() const {
   std::vector<channel_stats_t> out;
+  for (const auto& [name, stats] : work_) {
+    channel_stats_t c;
+    c.channel = name;
+    c.messages = stats.count();
+    c.decode_failures = 0;
+    c.rejected = 0;
+    c.median_ms = stats.medianMs();
+    c.p90_ms = stats.p90Ms();
+    c.max_ms = stats.maxMs();
+    out.push_back(c);
+  }
   for (const auto& s : subs_) {
     channel_stats_t c;
     c.channel = s.channel;

@@ -85,6 +85,7 @@ GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const 
   if (L.count > 0) {
     Eigen::SelfAdjointEigenSolver<Mat3> es(L.H.bottomRightCorner<3, 3>() / L.count);
     r.min_translation_eigenvalue = es.eigenvalues()[0];
+    if (es.eigenvalues()[2] > 0.0) r.translation_eigenvalue_ratio = es.eigenvalues()[0] / es.eigenvalues()[2];
   }
   const double od2 = options.overlap_distance * options.overlap_distance;
   int overlapping = 0;

@@ -40,6 +40,9 @@ struct GicpResult {
   int num_correspondences = 0;
   Mat6 information = Mat6::Zero();   // Gauss-Newton Hessian at the solution, [rotation; translation]
   double min_translation_eigenvalue = 0.0;  // of the Hessian's translation block per correspondence
+  /// Smallest over largest eigenvalue of that block: near 0 when one direction is constrained only
+  /// by the weak in-plane terms (a corridor along its axis), whatever the point count.
+  double translation_eigenvalue_ratio = 0.0;
 };
 
 GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const Pose3& initial,

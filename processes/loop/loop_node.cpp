@@ -33,6 +33,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("max_fitness", c.registration.acceptance.max_fitness);
   s.readOptional("min_overlap", c.registration.acceptance.min_overlap);
   s.readOptional("min_translation_eigenvalue", c.registration.acceptance.min_translation_eigenvalue);
+  s.readOptional("min_translation_eigenvalue_ratio", c.registration.acceptance.min_translation_eigenvalue_ratio);
   s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
   s.checkAllUsed();
@@ -90,6 +91,14 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   if (in.cloud.empty())
     node_.warn("keyframe " + std::to_string(m.id) + " has no points: kept in the graph, not used for loops");
   const AddResult r = closer_.addKeyframe(in);
+  for (const LoopRegistrationResult& a : r.attempts) {
+    if (a.fine.iterations == 0) continue;  // stopped at the coarse stage
+    std::ostringstream s;
+    s << "keyframe " << m.id << ": candidate fitness " << a.fine.fitness << ", overlap " << a.fine.overlap
+      << ", translation eigenvalue " << a.fine.min_translation_eigenvalue << " (ratio "
+      << a.fine.translation_eigenvalue_ratio << "): " << (a.accepted ? "accepted" : a.reason);
+    node_.info(s.str());
+  }
   if (r.loop) {
     std::ostringstream s;
     s << "loop " << r.loop->from_id << " -> " << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers

@@ -41,6 +41,9 @@ LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const C
     why << "coarse and fine disagree by " << drot << " deg, " << dtrans << " m";
   else if (r.fine.min_translation_eigenvalue < a.min_translation_eigenvalue)
     why << "degenerate (translation eigenvalue " << r.fine.min_translation_eigenvalue << ")";
+  else if (r.fine.translation_eigenvalue_ratio < a.min_translation_eigenvalue_ratio)
+    why << "degenerate (translation eigenvalue ratio " << r.fine.translation_eigenvalue_ratio << " < "
+        << a.min_translation_eigenvalue_ratio << ")";
   r.reason = why.str();
   r.accepted = r.reason.empty();
   return r;

@@ -1,5 +1,6 @@
 #include "occupancy_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -21,7 +22,115 @@ void configure(Tree* t, const OctomapOptions& o) {
 }
 }  // namespace
 
-OccupancyMap::OccupancyMap(const OctomapOptions& options) : options_(options) { clear(); }
+// Open-addressing set of packed voxel keys (3 x 16 bits), reused across sweeps: the ray casting's
+// inner loop, several times faster than octomap's KeySet (an unordered_set).
+class FlatKeySet {
+ public:
+  void clear() {
+    if (size_ == 0) return;
+    std::fill(slots_.begin(), slots_.end(), 0);
+    size_ = 0;
+    order_.clear();
+  }
+  // true if newly inserted
+  bool insert(uint64_t packed) {
+    if ((size_ + 1) * 2 > slots_.size()) grow();
+    const uint64_t v = packed + 1;
+    size_t i = hash(v) & (slots_.size() - 1);
+    while (slots_[i]) {
+      if (slots_[i] == v) return false;
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    slots_[i] = v;
+    ++size_;
+    order_.push_back(packed);
+    return true;
+  }
+  bool contains(uint64_t packed) const {
+    if (slots_.empty()) return false;
+    const uint64_t v = packed + 1;
+    size_t i = hash(v) & (slots_.size() - 1);
+    while (slots_[i]) {
+      if (slots_[i] == v) return true;
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    return false;
+  }
+  const std::vector<uint64_t>& keys() const { return order_; }  // insertion order
+
+ private:
+  static size_t hash(uint64_t v) { return static_cast<size_t>((v * 0x9E3779B97F4A7C15ull) >> 20); }
+  void grow() {
+    std::vector<uint64_t> old = std::move(order_);
+    slots_.assign(std::max<size_t>(1 << 14, slots_.size() * 2), 0);
+    size_ = 0;
+    order_.clear();
+    order_.reserve(slots_.size() / 2);
+    for (uint64_t k : old) insert(k);
+  }
+  std::vector<uint64_t> slots_;
+  std::vector<uint64_t> order_;
+  size_t size_ = 0;
+};
+
+struct OccupancyMap::Scratch {
+  FlatKeySet free, hit, endpoints;
+  octomap::KeyRay ray;
+};
+
+namespace {
+uint64_t pack(const octomap::OcTreeKey& k) { return (uint64_t(k[0]) << 32) | (uint64_t(k[1]) << 16) | uint64_t(k[2]); }
+octomap::OcTreeKey unpack(uint64_t v) {
+  return octomap::OcTreeKey(uint16_t(v >> 32), uint16_t(v >> 16), uint16_t(v));
+}
+
+template <class Tree>
+size_t integrate(Tree& t, const std::vector<OccupancyMap::Slice>& slices, const OctomapOptions& o,
+                 OccupancyMap::Scratch& s) {
+  s.free.clear();
+  s.hit.clear();
+  const double min2 = o.min_range * o.min_range;
+  size_t rays = 0;
+  for (const OccupancyMap::Slice& slice : slices) {
+    if (!slice.points || !slice.origin.allFinite()) continue;
+    const octomap::point3d origin(slice.origin.x(), slice.origin.y(), slice.origin.z());
+    s.endpoints.clear();
+    for (const Eigen::Vector3f& p : *slice.points) {
+      if (!p.allFinite()) continue;
+      const Eigen::Vector3d d = p.cast<double>() - slice.origin;
+      const double r2 = d.squaredNorm();
+      if (r2 < min2) continue;
+      octomap::OcTreeKey key;
+      if (!t.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+      ++rays;
+      if (!s.endpoints.insert(pack(key))) continue;  // one ray per endpoint voxel and slice
+      // discretised: the ray ends at the endpoint voxel's centre
+      octomap::point3d end = t.keyToCoord(key);
+      bool hit = true;
+      const double r = std::sqrt(r2);
+      if (o.max_range > 0.0 && r > o.max_range) {
+        end = origin + (end - origin).normalized() * float(o.max_range);
+        hit = false;
+      } else if (o.free_margin > 0.0) {
+        // clear only up to free_margin before the endpoint (nothing if the ray is shorter)
+        const double length = (end - origin).norm();
+        end = origin + (end - origin) * float(std::max(0.0, length - o.free_margin) / std::max(length, 1e-9));
+      }
+      if (hit) s.hit.insert(pack(key));
+      if (t.computeRayKeys(origin, end, s.ray))
+        for (const octomap::OcTreeKey& k : s.ray) s.free.insert(pack(k));
+    }
+  }
+  for (uint64_t k : s.free.keys())
+    if (!s.hit.contains(k)) t.updateNode(unpack(k), false, true);
+  for (uint64_t k : s.hit.keys()) t.updateNode(unpack(k), true, true);
+  return rays;
+}
+}  // namespace
+
+OccupancyMap::OccupancyMap(const OctomapOptions& options) : options_(options), scratch_(std::make_unique<Scratch>()) {
+  clear();
+}
 OccupancyMap::~OccupancyMap() = default;
 
 void OccupancyMap::clear() {
@@ -50,22 +159,17 @@ void OccupancyMap::refreshInner() const {
 }
 
 size_t OccupancyMap::insertRays(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& origin) {
-  if (!origin.allFinite()) return 0;
-  octomap::Pointcloud cloud;
-  cloud.reserve(points.size());
-  const double min2 = options_.min_range * options_.min_range;
-  for (const Eigen::Vector3f& p : points) {
-    if (!p.allFinite()) continue;
-    if ((p.cast<double>() - origin).squaredNorm() < min2) continue;
-    cloud.push_back(p.x(), p.y(), p.z());
-  }
-  if (cloud.size() == 0) return 0;
-  const octomap::point3d o(origin.x(), origin.y(), origin.z());
-  // lazy: inner nodes are refreshed once before any read; discretize: one ray per endpoint voxel
-  if (colour_) colour_->insertPointCloud(cloud, o, options_.max_range, true, true);
-  else plain_->insertPointCloud(cloud, o, options_.max_range, true, true);
-  inner_dirty_ = true;
-  return cloud.size();
+  Slice s;
+  s.origin = origin;
+  s.points = &points;
+  return insertSweep({s});
+}
+
+size_t OccupancyMap::insertSweep(const std::vector<Slice>& slices) {
+  // lazy: inner nodes are refreshed once before any read
+  const size_t n = colour_ ? integrate(*colour_, slices, options_, *scratch_) : integrate(*plain_, slices, options_, *scratch_);
+  if (n) inner_dirty_ = true;
+  return n;
 }
 
 size_t OccupancyMap::setColours(const std::vector<Eigen::Vector3f>& points, const std::vector<std::array<uint8_t, 3>>& rgb) {

@@ -30,6 +30,17 @@ class OccupancyMap {
   /// Casts a ray from `origin` to every point (world frame); non-finite points and points within
   /// min_range are skipped. Returns the number of rays inserted.
   size_t insertRays(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& origin);
+  /// One sweep cast from several origins (time slices) as a single update: each slice casts one
+  /// ray per endpoint voxel (to its centre); every voxel crossed by any ray of the sweep gets one
+  /// miss unless it holds an endpoint of the sweep, and every endpoint voxel one hit, after the
+  /// misses (octomap's insertPointCloud with discretize, merged over the slices). Returns the
+  /// number of points taken (finite, in the tree's bounds, beyond min_range).
+  struct Slice {
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    const std::vector<Eigen::Vector3f>* points = nullptr;
+  };
+  size_t insertSweep(const std::vector<Slice>& slices);
+  struct Scratch;  // defined in the .cpp
   /// Colours occupied leaves (ColorOcTree only; otherwise a no-op returning 0).
   size_t setColours(const std::vector<Eigen::Vector3f>& points, const std::vector<std::array<uint8_t, 3>>& rgb);
   void clear();
@@ -55,6 +66,7 @@ class OccupancyMap {
   void refreshInner() const;
 
   OctomapOptions options_;
+  std::unique_ptr<Scratch> scratch_;  // key sets reused across sweeps
   std::unique_ptr<octomap::OcTree> plain_;
   std::unique_ptr<octomap::ColorOcTree> colour_;
   mutable bool inner_dirty_ = false;

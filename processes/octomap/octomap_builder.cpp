@@ -33,11 +33,16 @@ bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error)
     }
     slices[s].push_back(p);
   }
+  std::vector<OccupancyMap::Slice> cast;
   for (int s = 0; s < segments; ++s) {
     if (slices[s].empty()) continue;
     const Pose3 T = segments > 1 ? se3::interpolate(previous_pose_, scan.T_W_I, (s + 0.5) / segments) : scan.T_W_I;
-    map_.insertRays(slices[s], (T * T_I_L_).translation());
+    OccupancyMap::Slice slice;
+    slice.origin = (T * T_I_L_).translation();
+    slice.points = &slices[s];
+    cast.push_back(slice);
   }
+  map_.insertSweep(cast);
   have_previous_ = true;
   previous_utime_ = scan.utime;
   previous_pose_ = scan.T_W_I;

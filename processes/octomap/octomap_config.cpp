@@ -17,6 +17,7 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
     c.readOptional("occupancy_threshold", o.occupancy_threshold);
     c.readOptional("colour", o.colour);
     c.readOptional("origin_segments", o.origin_segments);
+    c.readOptional("free_margin", o.free_margin);
     c.readOptional("scan_channel", n.scan_channel);
     c.readOptional("colour_channel", n.colour_channel);
     c.readOptional("keyframe_channel", n.keyframe_channel);
@@ -35,6 +36,7 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
   if (!(o.clamping_min > 0.0 && o.clamping_min < o.clamping_max && o.clamping_max < 1.0))
     fail("clamping_max", "need 0 < clamping_min < clamping_max < 1");
   if (!(o.occupancy_threshold > 0.0 && o.occupancy_threshold < 1.0)) fail("occupancy_threshold", "must be in (0, 1)");
+  if (!(o.free_margin >= 0.0 && o.free_margin < o.max_range)) fail("free_margin", "must be in [0, max_range)");
   if (o.origin_segments < 1) fail("origin_segments", "must be >= 1");
   if (n.publish_period_s < 0.0) fail("publish_period_s", "must be >= 0");
   if (n.write_period_s < 0.0) fail("write_period_s", "must be >= 0");

@@ -16,6 +16,8 @@ struct OctomapOptions {
   double clamping_max = 0.97;
   double occupancy_threshold = 0.5;
   bool colour = false;            // ColorOcTree with colours from COLORED_CLOUD
+  double free_margin = 0.2;       // m: a ray clears space only up to this far before its endpoint
+                                  // (grazing rays then spare the surface they are about to hit)
   int origin_segments = 8;        // a sweep is cut into this many time slices, each cast from the
                                   // LiDAR position at its time (spinning sensors move during a sweep)
 };

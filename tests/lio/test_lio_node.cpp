@@ -3,6 +3,7 @@
 // refusal of bad messages without stopping.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "livo/lio/lio_node.hpp"
@@ -157,6 +158,50 @@ TEST(LioNode, PublishesOdometryScansAndKeyframes) {
   EXPECT_EQ(out.scans.back().utime, out.odometry.back().utime);
   EXPECT_EQ(out.keyframes.front().cloud.frame, "I");
   EXPECT_EQ(out.keyframes.front().id, 0);
+}
+
+// REGISTERED_SCAN keeps each point's capture time (cloud.utime = sweep start, the input offsets)
+// for the colouring process; KEYFRAME clouds carry the input intensities.
+TEST(LioNode, RegisteredScansKeepPointTimesAndKeyframesIntensity) {
+  const std::vector<Message> in = syntheticRun();
+  std::vector<int64_t> sweep_starts;
+  for (const auto& m : in)
+    if (m.channel == "LIDAR") {
+      point_cloud_t c;
+      c.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size()));
+      sweep_starts.push_back(c.utime);
+    }
+  const Outputs out = runNode(in);
+  ASSERT_FALSE(out.scans.empty());
+  for (const auto& s : out.scans) {
+    const point_cloud_t& c = s.cloud;
+    ASSERT_EQ(c.time_offset.size(), static_cast<size_t>(c.num_points));
+    EXPECT_NE(std::find(sweep_starts.begin(), sweep_starts.end(), c.utime), sweep_starts.end());
+    EXPECT_GT(s.utime, c.utime);
+    EXPECT_GT(c.sweep_duration, 0.0f);
+    float lo = 1e9f, hi = -1e9f;
+    for (float t : c.time_offset) {
+      lo = std::min(lo, t);
+      hi = std::max(hi, t);
+    }
+    EXPECT_GE(lo, 0.0f);
+    EXPECT_LE(hi, c.sweep_duration + 1e-6f);
+    EXPECT_GT(hi, 0.5f * c.sweep_duration);  // the offsets are not all zero
+    // the state time is the sweep end: start + sweep duration
+    EXPECT_NEAR(static_cast<double>(s.utime - c.utime), 1e6 * static_cast<double>(c.sweep_duration), 2.0);
+  }
+  ASSERT_FALSE(out.keyframes.empty());
+  for (const auto& k : out.keyframes) {
+    const point_cloud_t& c = k.cloud;
+    ASSERT_EQ(c.intensity.size(), static_cast<size_t>(c.num_points));
+    float hi = 0.0f;
+    for (float v : c.intensity) {
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 15.0f);  // the synthetic intensity is the ring index
+      hi = std::max(hi, v);
+    }
+    EXPECT_GT(hi, 0.0f);
+  }
 }
 
 TEST(LioNode, OutputDoesNotDependOnChannelInterleaving) {

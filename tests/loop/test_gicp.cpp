@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "gicp.hpp"
+#include "loop_registration.hpp"
 #include "synthetic_scenes.hpp"
 #include "voxel_grid.hpp"
 
@@ -29,6 +32,43 @@ TEST(Gicp, ConvergesFromCoarseResult) {
     EXPECT_GT(r.overlap, 0.5);
     EXPECT_LT(r.fitness, 0.02);
   }
+}
+
+// A straight corridor (floor, ceiling, two walls, 3 x 3 m) seen from x = 0 and x = 5: GICP fits
+// it perfectly at any offset along the axis, as the two false loops on config/sim/corridor.yaml
+// did (fitness 0.05-0.07, overlap 0.87-0.91, absolute translation eigenvalue 0.8-1.8, above its
+// 0.05 bound). The eigenvalue ratio tells it from a well-conditioned scene.
+Points corridorView(double x0, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 0.01);
+  Points out;
+  for (double x = -15.0; x <= 15.0; x += 0.1)
+    for (double u = -1.5; u <= 1.5; u += 0.1) {
+      out.push_back(Vec3(x, u, -1.5 + n(rng)));
+      out.push_back(Vec3(x, u, 1.5 + n(rng)));
+      out.push_back(Vec3(x, -1.5 + n(rng), u));
+      out.push_back(Vec3(x, 1.5 + n(rng), u));
+    }
+  for (Vec3& p : out) p.x() -= x0;
+  return out;
+}
+
+TEST(Gicp, CorridorIsDegenerateByEigenvalueRatio) {
+  const GicpCloud target = GicpCloud::build(voxelDownsample(corridorView(0.0, 1), 0.4));
+  const GicpCloud source = GicpCloud::build(voxelDownsample(corridorView(5.0, 2), 0.4));
+  const GicpResult r = gicpRegister(source, target, Pose3::Identity(), {});  // truth: 5 m along x
+  EXPECT_TRUE(r.converged);
+  EXPECT_GT(r.overlap, 0.5);      // a perfect-looking fit ...
+  EXPECT_LT(r.fitness, 0.15);
+  EXPECT_GT(r.min_translation_eigenvalue, AcceptanceOptions{}.min_translation_eigenvalue);  // ... the old check passes
+  EXPECT_LT(r.translation_eigenvalue_ratio, AcceptanceOptions{}.min_translation_eigenvalue_ratio);
+
+  const Points scene = makeScene(31);
+  const GicpCloud t2 = GicpCloud::build(voxelDownsample(viewFrom(scene, Vec3(0, 0, 1.8), 0.1, 25, 0.01, 1), 0.4));
+  const GicpCloud s2 = GicpCloud::build(voxelDownsample(viewFrom(scene, Vec3(4.0, 1.5, 1.8), 0.9, 25, 0.01, 2), 0.4));
+  const Pose3 truth = yawPose(0.1, Vec3(0, 0, 1.8)).inverse() * yawPose(0.9, Vec3(4.0, 1.5, 1.8));
+  const GicpResult ok = gicpRegister(s2, t2, truth, {});
+  EXPECT_GT(ok.translation_eigenvalue_ratio, 5 * AcceptanceOptions{}.min_translation_eigenvalue_ratio);
 }
 
 TEST(Gicp, EmptyCloudsDoNotConverge) {

@@ -30,11 +30,11 @@ LoopRegistrationResult registerPair(const Prepared& source, const Prepared& targ
 }
 
 void report(const std::string& what, const LoopRegistrationResult& r, const Pose3& truth) {
-  std::printf("[real-scan] %-22s coarse %.3f deg %.3f m | fine %.3f deg %.3f m | inliers %d fitness %.4f overlap %.2f %s\n",
+  std::printf("[real-scan] %-22s coarse %.3f deg %.3f m | fine %.3f deg %.3f m | inliers %d fitness %.4f overlap %.2f ratio %.3f %s\n",
               what.c_str(), rotationErrorDeg(r.coarse.T_target_source, truth),
               translationError(r.coarse.T_target_source, truth), rotationErrorDeg(r.T_target_source, truth),
               translationError(r.T_target_source, truth), r.coarse.num_inliers, r.fine.fitness, r.fine.overlap,
-              r.accepted ? "accepted" : r.reason.c_str());
+              r.fine.translation_eigenvalue_ratio, r.accepted ? "accepted" : r.reason.c_str());
 }
 
 TEST(RealScans, KittiSevenKeyframesRegisterToGraphPoses) {

@@ -2,6 +2,8 @@
 // octomap's own readers, colours, and the rebuild from corrected keyframes.
 #include <cmath>
 #include <fstream>
+#include <memory>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <octomap/ColorOcTree.h>
@@ -164,4 +166,62 @@ TEST(OctomapConfig, ReadsKeysStrictly) {
   EXPECT_TRUE(o.core.colour);
   EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {resolutoin: 0.2}").section("octomap")), ConfigError);
   EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {prob_hit: 0.3}").section("octomap")), ConfigError);
+}
+
+namespace {
+// floor hits on the line y = 0.05, z = 0.05 (mid-voxel) for x in [x0, x1)
+std::vector<Eigen::Vector3f> floorLine(double x0, double x1) {
+  std::vector<Eigen::Vector3f> pts;
+  for (double x = x0; x < x1; x += 0.02) pts.emplace_back(float(x), 0.05f, 0.05f);
+  return pts;
+}
+}  // namespace
+
+// Grazing rays to farther floor points pass through the floor voxels just before their own
+// endpoints: without free_margin they clear the floor seen before; with it they do not, and the
+// space above stays free.
+TEST(OccupancyMap, FreeMarginKeepsGrazingRaysFromClearingTheSurface) {
+  const Eigen::Vector3d origin(0.0, 0.05, 0.5);
+  const Eigen::Vector3d seen(3.95, 0.05, 0.05), above(1.05, 0.05, 0.35);
+  for (const double margin : {0.0, 0.2}) {
+    OctomapOptions o = options(false);
+    o.free_margin = margin;
+    OccupancyMap map(o);
+    map.insertRays(floorLine(1.0, 4.0), origin);
+    EXPECT_EQ(map.classify(seen), 1);
+    for (int k = 0; k < 3; ++k) map.insertRays(floorLine(4.12, 4.18), origin);
+    EXPECT_EQ(map.classify(seen), margin > 0 ? 1 : 0) << "free_margin " << margin;
+    EXPECT_EQ(map.classify(above), 0) << "free_margin " << margin;
+  }
+}
+
+// A sweep cast from several origins is one update: a voxel crossed by rays of several slices
+// takes one miss, and an endpoint of one slice is not cleared by another slice's rays.
+TEST(OccupancyMap, SweepSlicesAreOneUpdate) {
+  OctomapOptions o = options(false);
+  o.free_margin = 0.0;
+  OccupancyMap map(o);
+  const std::vector<Eigen::Vector3f> near{{1.05f, 0.05f, 0.05f}}, far{{3.05f, 0.05f, 0.05f}};
+  std::vector<OccupancyMap::Slice> slices(2);
+  slices[0].origin = slices[1].origin = Eigen::Vector3d(0.05, 0.05, 0.05);
+  slices[0].points = &near;  // its endpoint lies on the other slice's ray
+  slices[1].points = &far;
+  EXPECT_EQ(map.insertSweep(slices), 2u);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(1.05, 0.05, 0.05)), 1);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(3.05, 0.05, 0.05)), 1);
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.55, 0.05, 0.05)), 0);
+  // one miss per sweep: the log-odds of a voxel both rays crossed is that of a single miss
+  const float one_miss = octomap::logodds(o.prob_miss);
+  std::istringstream in(map.fullBytes());
+  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(in));
+  auto* tree = dynamic_cast<octomap::OcTree*>(read.get());
+  ASSERT_NE(tree, nullptr);
+  const octomap::OcTreeNode* n = tree->search(0.55, 0.05, 0.05);
+  ASSERT_NE(n, nullptr);
+  EXPECT_NEAR(n->getLogOdds(), one_miss, 1e-4);
+}
+
+TEST(OctomapConfig, FreeMarginIsReadAndChecked) {
+  EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("free_margin: 0.3")).core.free_margin, 0.3);
+  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("free_margin: -0.1")), livo::ConfigError);
 }

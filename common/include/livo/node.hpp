@@ -68,6 +68,11 @@ class Node {
   /// Declares an output channel so that PROGRESS lists it (with 0) before its first message.
   void declareOutput(const std::string& channel) { published_.emplace(channel, 0); }
 
+  /// Records the duration of a unit of work that is not one message's handler, e.g. a LiDAR sweep
+  /// processed when the IMU watermark passes it. It is reported (HEALTH, timing.json) as the
+  /// pseudo-channel "work:<what>", not in PROGRESS.
+  void recordWork(const std::string& what, double seconds);
+
   /// The current message on `channel` was refused (bad stamp, NaN, ...): counted, and reported
   /// on stderr and HEALTH (each distinct reason at most once per second of wall time).
   void reject(const std::string& channel, const std::string& why);
@@ -123,6 +128,7 @@ class Node {
   std::deque<Subscription> subs_;  // stable addresses for LCM's callbacks
   std::vector<lcm::Subscription*> lcm_subs_;
   std::map<std::string, int64_t> published_;
+  std::map<std::string, LatencyStats> work_;
   int64_t progress_sequence_ = 0;
   int64_t last_utime_ = 0;
   int8_t level_ = 0;

@@ -369,16 +369,19 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
 
   // 7. outputs
   res.utime = t_end;
+  res.sweep_start_utime = t_first;
   res.state = x;
   res.covariance = P;
   res.angular_velocity = prop_.lastSample().gyro - x.gyro_bias;
   res.world_points.resize(body.size());
   res.intensity.resize(body.size());
   res.point_index.resize(body.size());
+  res.time_offset.resize(body.size());
   for (size_t i = 0; i < body.size(); ++i) {
     res.point_index[i] = static_cast<uint32_t>(valid[i]);
     res.world_points[i] = x.rot * body[i] + x.pos;
     res.intensity[i] = scan.intensity.size() == scan.points.size() ? scan.intensity[valid[i]] : 0.0f;
+    res.time_offset[i] = scan.time_offset[valid[i]];
   }
   if (res.status != ScanResult::Status::kPredicted && keyframe_selector_.check(x.pose())) {
     Keyframe kf;
@@ -386,7 +389,10 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     kf.utime = t_end;
     kf.pose = x.pose();
     kf.pose_covariance = P.topLeftCorner<6, 6>();
-    for (size_t i : voxelDownsample(body, opts_.keyframe.cloud_voxel)) kf.cloud.push_back(body[i]);
+    for (size_t i : voxelDownsample(body, opts_.keyframe.cloud_voxel)) {
+      kf.cloud.push_back(body[i]);
+      kf.intensity.push_back(res.intensity[i]);
+    }
     keyframes_.push_back(kf);
     while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
     res.is_keyframe = true;

@@ -57,18 +57,20 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in)
   m.utime = r.utime;
   poseTo(r.state.pose(), m.position, m.orientation);
   point_cloud_t& c = m.cloud;
-  c.utime = r.utime;
+  // points undistorted to r.utime (sweep end); cloud.utime is the sweep start so that
+  // cloud.utime + time_offset is each point's capture time (IMU clock), as in the input sweep
+  c.utime = r.sweep_start_utime;
   c.frame = "W";
   c.pattern = in.pattern;
   c.num_rings = in.num_rings;
-  c.sweep_duration = 0.0f;
+  c.sweep_duration = in.sweep_duration;
   const size_t n = r.world_points.size();
   c.num_points = static_cast<int32_t>(n);
   c.x.resize(n);
   c.y.resize(n);
   c.z.resize(n);
   c.intensity.resize(n);
-  c.time_offset.assign(n, 0.0f);
+  c.time_offset.resize(n);
   c.ring.resize(n);
   const bool has_ring = in.ring.size() == static_cast<size_t>(in.num_points);
   for (size_t i = 0; i < n; ++i) {
@@ -76,6 +78,7 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in)
     c.y[i] = static_cast<float>(r.world_points[i].y());
     c.z[i] = static_cast<float>(r.world_points[i].z());
     c.intensity[i] = r.intensity[i];
+    c.time_offset[i] = r.time_offset[i];
     c.ring[i] = has_ring ? in.ring[r.point_index[i]] : int16_t{-1};
   }
   return m;
@@ -98,13 +101,14 @@ keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings) {
   c.x.resize(n);
   c.y.resize(n);
   c.z.resize(n);
-  c.intensity.assign(n, 0.0f);
+  c.intensity.resize(n);
   c.time_offset.assign(n, 0.0f);
   c.ring.assign(n, -1);
   for (size_t i = 0; i < n; ++i) {
     c.x[i] = static_cast<float>(k.cloud[i].x());
     c.y[i] = static_cast<float>(k.cloud[i].y());
     c.z[i] = static_cast<float>(k.cloud[i].z());
+    c.intensity[i] = i < k.intensity.size() ? k.intensity[i] : 0.0f;
   }
   return m;
 }

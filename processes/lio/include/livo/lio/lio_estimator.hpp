@@ -22,6 +22,7 @@ struct Keyframe {
   Pose3 pose = Pose3::Identity();     // W_T_I
   Mat6 pose_covariance = Mat6::Zero();// [rotation; position]
   std::vector<Vec3> cloud;            // body frame I, downsampled
+  std::vector<float> intensity;       // one per cloud point, from the input sweep (0 if it had none)
 };
 
 struct ScanResult {
@@ -36,6 +37,7 @@ struct ScanResult {
   std::string message;  // what went wrong or was worked around (empty if nothing)
 
   int64_t utime = 0;  // end of the sweep, IMU clock: the time of state and points
+  int64_t sweep_start_utime = 0;  // start of the sweep, IMU clock (input utime + extrinsic time offset)
   FilterState state;
   Mat18 covariance = Mat18::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
@@ -51,6 +53,7 @@ struct ScanResult {
   std::vector<Vec3> world_points;  // undistorted to utime, world frame
   std::vector<float> intensity;    // one per world point
   std::vector<uint32_t> point_index;  // index of each world point in the input sweep
+  std::vector<float> time_offset;  // per world point: its input time offset, s after sweep_start_utime
 
   bool is_keyframe = false;
   Keyframe keyframe;

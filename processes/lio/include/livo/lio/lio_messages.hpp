@@ -23,8 +23,14 @@ WheelSample fromMessage(const wheel_odometry_t& m);
 bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why);
 
 odometry_t toOdometry(const ScanResult& r);
-/// The undistorted sweep in frame "W"; ring and intensity from the input, time offsets zero.
+/// The undistorted sweep in frame "W": every point is expressed at the sweep end (the
+/// message's utime, the odometry time), while cloud.utime is the sweep start in the IMU clock
+/// (input utime + LiDAR time offset) and each point keeps its input time_offset, so
+/// cloud.utime + time_offset is the point's capture time (what the colouring process uses to pick
+/// images). cloud.sweep_duration, ring and intensity come from the input.
 registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& input);
+/// The keyframe's downsampled body-frame cloud with the input intensities; time offsets zero
+/// (the cloud is undistorted to the keyframe's utime).
 keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings);
 
 filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P, int64_t request_id,

@@ -1,0 +1,98 @@
+#!/usr/bin/env python3
+"""Checks a run's loops.json against the log's GROUND_TRUTH (pure Python, no LCM bindings).
+
+    tests/loop/check_loops.py --log SIM.lcmlog --loops RUN/loops.json [--max-trans 0.5] [--max-rot-deg 2]
+
+A loop is false if its T_to_from disagrees with the ground-truth relative body pose of the two
+keyframes (interpolated at their stamps) by more than the bounds. Exit status 1 if any is false.
+"""
+import argparse, bisect, json, math, struct, sys
+
+
+def read_ground_truth(path, channel="GROUND_TRUTH"):
+    out = []
+    with open(path, "rb") as f:
+        data = f.read()
+    i = 0
+    while i + 28 <= len(data):
+        sync, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
+        if sync != 0xEDA1DA01:
+            raise SystemExit("bad sync at %d" % i)
+        i += 28
+        ch = data[i:i + clen].decode()
+        i += clen
+        payload = data[i:i + dlen]
+        i += dlen
+        if ch != channel:
+            continue
+        o = 8  # fingerprint
+        utime, = struct.unpack_from(">q", payload, o); o += 8
+        for _ in range(2):
+            n, = struct.unpack_from(">i", payload, o); o += 4 + n
+        p = struct.unpack_from(">3d", payload, o); o += 24
+        q = struct.unpack_from(">4d", payload, o)
+        out.append((utime * 1e-6, p, q))
+    return out
+
+
+def qmul(a, b):
+    w1, x1, y1, z1 = a; w2, x2, y2, z2 = b
+    return (w1*w2 - x1*x2 - y1*y2 - z1*z2, w1*x2 + x1*w2 + y1*z2 - z1*y2,
+            w1*y2 - x1*z2 + y1*w2 + z1*x2, w1*z2 + x1*y2 - y1*x2 + z1*w2)
+
+
+def qconj(q):
+    return (q[0], -q[1], -q[2], -q[3])
+
+
+def qrot(q, v):
+    r = qmul(qmul(q, (0.0,) + tuple(v)), qconj(q))
+    return r[1:]
+
+
+def interp(gt, times, t):
+    k = bisect.bisect_left(times, t)
+    k = min(max(k, 1), len(gt) - 1)
+    (t0, p0, q0), (t1, p1, q1) = gt[k - 1], gt[k]
+    a = 0.0 if t1 == t0 else min(max((t - t0) / (t1 - t0), 0.0), 1.0)
+    p = tuple(p0[i] + a * (p1[i] - p0[i]) for i in range(3))
+    if sum(x*y for x, y in zip(q0, q1)) < 0: q1 = tuple(-x for x in q1)
+    q = tuple(q0[i] + a * (q1[i] - q0[i]) for i in range(4))
+    n = math.sqrt(sum(x*x for x in q))
+    return p, tuple(x / n for x in q), abs(t - (t0 if a < 0.5 else t1))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--log", required=True)
+    ap.add_argument("--loops", required=True)
+    ap.add_argument("--max-trans", type=float, default=0.5)
+    ap.add_argument("--max-rot-deg", type=float, default=2.0)
+    a = ap.parse_args()
+    gt = read_ground_truth(a.log)
+    times = [g[0] for g in gt]
+    loops = json.load(open(a.loops))
+    false = 0
+    print("keyframes %d, loops %d" % (loops["num_keyframes"], len(loops["loops"])))
+    for l in loops["loops"]:
+        pf, qf, _ = interp(gt, times, l["from_time"])
+        pt, qt, _ = interp(gt, times, l["to_time"])
+        # ground truth T_to_from = T_W_to^-1 T_W_from
+        qtf = qmul(qconj(qt), qf)
+        ttf = qrot(qconj(qt), tuple(pf[i] - pt[i] for i in range(3)))
+        e = l["T_to_from"]
+        qe = tuple(e["rotation_wxyz"]); te = e["translation"]
+        dq = qmul(qconj(qtf), qe)
+        rot = 2 * math.degrees(math.acos(min(1.0, abs(dq[0]))))
+        tr = math.sqrt(sum((te[i] - ttf[i]) ** 2 for i in range(3)))
+        bad = tr > a.max_trans or rot > a.max_rot_deg
+        false += bad
+        print("%5d -> %5d  t %.1f -> %.1f  gt |t| %.2f m  err %.3f m %.3f deg  inl %d fit %.3f ov %.2f %s" % (
+            l["from_id"], l["to_id"], l["from_time"], l["to_time"], math.sqrt(sum(x*x for x in ttf)), tr, rot,
+            l["coarse_inliers"], l["fitness"], l["overlap"], "FALSE" if bad else "ok"))
+    print("false loops: %d of %d" % (false, len(loops["loops"])))
+    return 1 if false else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
