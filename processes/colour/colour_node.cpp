@@ -7,6 +7,7 @@
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
+#include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
@@ -33,20 +34,8 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
 
   node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
     const point_cloud_t& c = m.cloud;
-    if (c.num_points <= 0) {
-      node_.reject(options_.scan_channel, "empty cloud");
-      return;
-    }
-    if (static_cast<int>(c.x.size()) != c.num_points || static_cast<int>(c.time_offset.size()) != c.num_points) {
-      node_.reject(options_.scan_channel, "cloud arrays disagree with num_points");
-      return;
-    }
-    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
-      node_.reject(options_.scan_channel, "pose is not finite");
-      return;
-    }
-    if (!c.frame.empty() && c.frame != "W") {
-      node_.reject(options_.scan_channel, "cloud frame is '" + c.frame + "', expected W");
+    if (const std::string why = registeredScanProblem(m); !why.empty()) {
+      node_.reject(options_.scan_channel, why);
       return;
     }
     ScanView v;

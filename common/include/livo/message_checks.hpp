@@ -1,0 +1,14 @@
+// Validation of incoming messages shared by every process that consumes them.
+#pragma once
+
+#include <string>
+
+#include "livo/registered_scan_t.hpp"
+
+namespace livo {
+
+/// Why a REGISTERED_SCAN cannot be used (empty cloud, arrays that disagree with num_points, a
+/// non-finite pose, a cloud not in the world frame), or "" if it can.
+std::string registeredScanProblem(const registered_scan_t& m);
+
+}  // namespace livo
