@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "camera_projection.hpp"
+#include "livo/camera_projection.hpp"
 #include "colour_image.hpp"
 #include "colour_map.hpp"
 #include "colour_options.hpp"

@@ -8,7 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "camera_projection.hpp"
+#include "livo/camera_projection.hpp"
 #include "colour_map.hpp"
 #include "colouring_pipeline.hpp"
 #include "exposure_gain.hpp"

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "livo/lio/degeneracy.hpp"
-#include "livo/lio/esikf_update.hpp"
+#include "livo/esikf_update.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "synthetic_world.hpp"
 

@@ -3,7 +3,7 @@
 
 #include <cstddef>
 
-#include "livo/lio/esikf_update.hpp"
+#include "livo/esikf_update.hpp"
 #include "livo/lio/imu_initializer.hpp"
 #include "livo/lio/keyframe_selector.hpp"
 #include "livo/lio/lidar_scan.hpp"

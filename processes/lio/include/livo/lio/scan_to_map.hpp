@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "livo/lio/degeneracy.hpp"
-#include "livo/lio/esikf_update.hpp"
+#include "livo/esikf_update.hpp"
 #include "livo/lio/point_to_plane.hpp"
 #include "livo/lio/voxel_map.hpp"
 

@@ -10,7 +10,7 @@
 
 #include "livo/filter_state.hpp"
 
-namespace livo::lio {
+namespace livo {
 
 /// Sufficient statistics of a pose measurement at the current iterate: S = H^T R^-1 H (6x6),
 /// g = H^T R^-1 z (6), with the residual z = h(x̌) - measurement and H = ∂z/∂[δr δp].
@@ -45,4 +45,4 @@ void informationStep(const FilterState& x, const FilterState& prior, const Mat18
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
                            const EsikfOptions& options, FilterState* post, Mat18* P_post);
 
-}  // namespace livo::lio
+}  // namespace livo

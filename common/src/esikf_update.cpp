@@ -1,8 +1,8 @@
-#include "livo/lio/esikf_update.hpp"
+#include "livo/esikf_update.hpp"
 
 #include <Eigen/LU>
 
-namespace livo::lio {
+namespace livo {
 
 void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
                      const Vec6& g, Vec18* delta, Mat18* P_post) {
@@ -61,4 +61,4 @@ EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const
   return res;
 }
 
-}  // namespace livo::lio
+}  // namespace livo

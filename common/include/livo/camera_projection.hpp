@@ -7,7 +7,6 @@
 #include "livo/sensor_rig.hpp"
 
 namespace livo {
-namespace colour {
 
 class CameraProjection {
  public:
@@ -28,5 +27,4 @@ class CameraProjection {
   double max_r2_ = 1e9;  // normalised radius^2 beyond which the polynomial is not trusted
 };
 
-}  // namespace colour
 }  // namespace livo

@@ -1,10 +1,9 @@
-#include "camera_projection.hpp"
+#include "livo/camera_projection.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace livo {
-namespace colour {
 
 CameraProjection::CameraProjection(const CameraRig& rig) : rig_(rig) {
   // The valid field: the undistorted image corners (fixed-point inversion), with a margin.
@@ -44,5 +43,4 @@ double CameraProjection::vignette(const Eigen::Vector2d& pixel, double v) const 
   return 1.0 - v * std::min(1.0, (dx * dx + dy * dy) / half_diag2);
 }
 
-}  // namespace colour
 }  // namespace livo
