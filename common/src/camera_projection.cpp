@@ -36,6 +36,34 @@ bool CameraProjection::project(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixe
          pixel->y() <= rig_.height - 1 - border;
 }
 
+Eigen::Matrix2d CameraProjection::distortJacobian(const Eigen::Vector2d& xy) const {
+  const double k1 = rig_.distortion[0], k2 = rig_.distortion[1], p1 = rig_.distortion[2], p2 = rig_.distortion[3];
+  const double x = xy.x(), y = xy.y(), r2 = x * x + y * y;
+  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+  const double dradial_dr2 = k1 + 2.0 * k2 * r2;  // d radial / d x = 2 x dradial_dr2
+  Eigen::Matrix2d J;
+  J(0, 0) = radial + 2.0 * x * x * dradial_dr2 + 2.0 * p1 * y + 6.0 * p2 * x;
+  J(0, 1) = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
+  J(1, 0) = J(0, 1);
+  J(1, 1) = radial + 2.0 * y * y * dradial_dr2 + 6.0 * p1 * y + 2.0 * p2 * x;
+  return J;
+}
+
+bool CameraProjection::projectWithJacobian(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel,
+                                           Eigen::Matrix<double, 2, 3>* J, double border) const {
+  if (!project(p_C, pixel, border)) return false;
+  const double iz = 1.0 / p_C.z();
+  const Eigen::Vector2d xy(p_C.x() * iz, p_C.y() * iz);
+  Eigen::Matrix<double, 2, 3> dxy;  // d (x/z, y/z) / d p_C
+  dxy << iz, 0.0, -xy.x() * iz, 0.0, iz, -xy.y() * iz;
+  const Eigen::Matrix2d D = distortJacobian(xy);
+  Eigen::Matrix2d K_D;
+  K_D.row(0) = rig_.fx * D.row(0);
+  K_D.row(1) = rig_.fy * D.row(1);
+  *J = K_D * dxy;
+  return true;
+}
+
 double CameraProjection::vignette(const Eigen::Vector2d& pixel, double v) const {
   if (v <= 0.0) return 1.0;
   const double half_diag2 = 0.25 * (double(rig_.width) * rig_.width + double(rig_.height) * rig_.height);

@@ -86,9 +86,11 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     sweep_us = static_cast<int64_t>(std::llround(scanner->pattern().sweepDuration() * 1e6));
   }
   std::unique_ptr<CameraRenderer> renderer;
+  int64_t camera_offset_us = 0;
   if (rig.camera) {
     stats.messages[rig.channels.camera] = 0;
     renderer = std::make_unique<CameraRenderer>(*rig.camera, o.camera);
+    camera_offset_us = static_cast<int64_t>(std::llround(rig.camera->time_offset_s * 1e6));
   }
 
   int64_t imu_k = 0, gt_k = 0, wheel_k = 0, sweep_k = 0, frame_k = 0;
@@ -156,7 +158,8 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
         const size_t slot = images.size() - 1;
         const int64_t k = frame_k;
         jobs.push_back([&, slot, k, u] {
-          images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u), u,
+          // rendered at IMU time u, stamped on the camera's clock (rig camera time_offset_s)
+          images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u), u - camera_offset_us,
                                           Random(o.seed, kCameraStream, static_cast<uint64_t>(k)));
         });
       }

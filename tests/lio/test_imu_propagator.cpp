@@ -189,3 +189,31 @@ TEST(ImuPropagator, CovarianceMatchesMonteCarlo) {
   for (int i : {0, 1, 3, 4})
     for (int j : {6, 7, 8}) EXPECT_NEAR(corr(C, i, j), corr(P, i, j), 0.1) << i << "," << j;
 }
+
+// An external update (the camera hand-off) moves the state; the sweep's recorded trajectory moves
+// rigidly with it, so undistortion relative to the new state is unchanged.
+TEST(ImuPropagator, TransformSegmentsKeepsTheTrajectoryRelativeToTheState) {
+  const auto traj = synth::roomTrajectory(0.0);
+  std::mt19937 rng(2);
+  const auto imu = synth::simulateImu(traj, 2.0, 2.1, 200.0, 0, synth::ImuErrorModel::exact(), &rng);
+  ImuPropagator p;
+  p.reset(traj.state(2.0), Mat18::Identity() * 1e-6, imu[0]);
+  for (size_t i = 1; i < imu.size(); ++i) p.addSample(imu[i]);
+  const std::vector<ImuSegment> before = p.segments();
+  const FilterState x0 = p.state();
+  const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.01, -0.02, 0.03)), Vec3(0.05, -0.04, 0.02));
+  p.transformSegments(T);
+  ASSERT_EQ(p.segments().size(), before.size());
+  const Mat3 R_new = T.linear() * x0.rot;
+  const Vec3 p_new = T.linear() * x0.pos + T.translation();
+  for (size_t i = 0; i < before.size(); ++i) {
+    const ImuSegment& a = before[i];
+    const ImuSegment& b = p.segments()[i];
+    // relative pose to the (moved) state is what it was
+    EXPECT_LT(so3::Log(Mat3((x0.rot.transpose() * a.rot).transpose() * (R_new.transpose() * b.rot))).norm(), 1e-12);
+    EXPECT_LT((x0.rot.transpose() * (a.pos - x0.pos) - R_new.transpose() * (b.pos - p_new)).norm(), 1e-12);
+    EXPECT_LT((x0.rot.transpose() * a.vel - R_new.transpose() * b.vel).norm(), 1e-12);
+    EXPECT_LT((x0.rot.transpose() * a.acc_world - R_new.transpose() * b.acc_world).norm(), 1e-12);
+    EXPECT_EQ(a.omega, b.omega);
+  }
+}

@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 
+#include "livo/image_t.hpp"
 #include "livo/lio/lio_node.hpp"
 #include "livo/messages.hpp"
 #include "synthetic_world.hpp"
@@ -78,13 +81,22 @@ void drain(lcm::LCM& lcm) {
   }
 }
 
-Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullptr) {
+struct RunSetup {
+  std::string config = kConfig;
+  /// Called with the observer node before the run (e.g. to answer STATE_PRIOR like a VIO).
+  std::function<void(Node& observer)> attach;
+  LioNode::HandoffCounts* handoff = nullptr;  // filled after the run
+  int64_t* rejected_posteriors = nullptr;     // filled after the run
+};
+
+Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullptr, const RunSetup& setup = {}) {
   lcm::LCM lcm("memq://");
   EXPECT_TRUE(lcm.good());
-  LioNodeOptions opts = readLioNodeOptions(Config::fromString(kConfig));
+  LioNodeOptions opts = readLioNodeOptions(Config::fromString(setup.config));
   LioNode node(lcm, opts, true);
   Outputs out;
   Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true});
+  if (setup.attach) setup.attach(observer);
   observer.subscribeRaw("ODOMETRY", [&](const void* data, int size) {
     const auto* b = static_cast<const uint8_t*>(data);
     out.odometry_bytes.emplace_back(b, b + size);
@@ -102,18 +114,28 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
     *rejected = 0;
     for (const auto& c : node.node().channelStats()) *rejected += c.rejected + c.decode_failures;
   }
+  if (setup.handoff) *setup.handoff = node.handoffCounts();
+  if (setup.rejected_posteriors) {
+    *setup.rejected_posteriors = 0;
+    for (const auto& c : node.node().channelStats())
+      if (c.channel == "STATE_POSTERIOR") *setup.rejected_posteriors = c.rejected;
+  }
   return out;
 }
 
 // 3 s in the room: IMU at 200 Hz and 30 sweeps, each message keyed by its arrival in "sensor
 // order" (a sweep arrives at its end, an IMU sample at its stamp).
-std::vector<Message> syntheticRun() {
+synth::SyntheticSequence syntheticSequence() {
   synth::SequenceSpec spec;
   spec.duration = 3.0;
   spec.imu_error = synth::realisticImu();
   spec.lidar.range_noise_std = 0.01;
   spec.T_I_L = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, M_PI / 2)), Vec3(0.05, 0.0, 0.1));
-  const synth::SyntheticSequence seq(spec);
+  return synth::SyntheticSequence(spec);
+}
+
+std::vector<Message> syntheticRun() {
+  const synth::SyntheticSequence seq = syntheticSequence();
   std::vector<Message> msgs;
   for (const auto& s : seq.imu()) msgs.push_back(encode(s.utime, "IMU", toImuMsg(s)));
   for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", toCloudMsg(seq.scan(k))));
@@ -245,4 +267,177 @@ TEST(LioNode, RefusesBadInputAndKeepsGoing) {
   EXPECT_EQ(rejected, 3);
   EXPECT_GE(out.odometry.size(), 24u);
   for (const auto& o : out.odometry) EXPECT_TRUE(allFinite(o.position, 3));
+}
+
+namespace {
+// The synthetic run with 20 Hz image times on CAMERA (tiny grey images: lio reads only the time).
+constexpr int64_t kBase = 1'000'000'000;
+std::vector<Message> withImages(std::vector<Message> msgs, int64_t* first_image, int64_t* last_image) {
+  image_t img;
+  img.frame = "C";
+  img.width = img.height = img.row_stride = 2;
+  img.encoding = image_t::ENCODING_GRAY8;
+  img.data = {10, 20, 30, 40};
+  img.size = 4;
+  *first_image = kBase + 25'000;
+  for (int64_t t = *first_image; t < kBase + 2'950'000; t += 50'000) {
+    img.utime = t;
+    msgs.push_back(encode(t, "CAMERA", img));
+    *last_image = t;
+  }
+  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  return msgs;
+}
+
+std::string handoffConfig() {
+  std::string c = kConfig;
+  c += "  camera_handoff: true\n";
+  return c;
+}
+
+Pose3 poseOf(const double* position, const double* orientation) {
+  Pose3 T = Pose3::Identity();
+  T.linear() = Eigen::Quaterniond(orientation[0], orientation[1], orientation[2], orientation[3]).toRotationMatrix();
+  T.translation() = Vec3(position[0], position[1], position[2]);
+  return T;
+}
+
+/// Position RMSE of the odometry against the truth after the best rigid alignment.
+double alignedError(const Outputs& out, const synth::SyntheticSequence& seq) {
+  std::vector<Vec3> est, gt;
+  for (const auto& o : out.odometry) {
+    est.emplace_back(o.position[0], o.position[1], o.position[2]);
+    gt.push_back(seq.truth(o.utime).translation());
+  }
+  return synth::alignedRmse(est, gt);
+}
+
+}  // namespace
+
+// At every image time after the map is seeded lio publishes the propagated filter on STATE_PRIOR
+// and waits for the answer; a VIO that answers with the true pose and a tight covariance pulls the
+// state onto the truth, and every sweep still gets its ODOMETRY.
+TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
+  const synth::SyntheticSequence seq = syntheticSequence();
+  int64_t first_image = 0, last_image = 0;
+  const std::vector<Message> in = withImages(syntheticRun(), &first_image, &last_image);
+  std::vector<filter_state_t> priors;
+  // lio's world frame is its own (gravity-aligned, started at the origin): the fake VIO maps the
+  // truth into it with the transform the first prior defines (that prior is a few mm off)
+  Pose3 T_lio_truth = Pose3::Identity();
+  RunSetup setup;
+  setup.config = handoffConfig();
+  LioNode::HandoffCounts counts;
+  setup.handoff = &counts;
+  setup.attach = [&](Node& vio) {
+    vio.subscribe<filter_state_t>("STATE_PRIOR", [&](const filter_state_t& prior) {
+      if (priors.empty()) T_lio_truth = poseOf(prior.position, prior.orientation) * seq.truth(prior.utime).inverse();
+      priors.push_back(prior);
+      // a pose measurement of the truth (1 mm, 1 mrad) through the same iterated ESIKF update
+      FilterState x, x_post;
+      Mat18 P, P_post;
+      ASSERT_TRUE(fromFilterState(prior, &x, &P));
+      const Pose3 T = T_lio_truth * seq.truth(prior.utime);
+      const PoseMeasurement measure = [&](const FilterState& xi, int, PoseInformation* info) {
+        Vec6 z;
+        z.head<3>() = so3::Log(Mat3(T.linear().transpose() * xi.rot));
+        z.tail<3>() = xi.pos - T.translation();
+        Mat6 H = Mat6::Identity();
+        H.topLeftCorner<3, 3>() = so3::rightJacobianInverse(z.head<3>());
+        info->HtRinvH = H.transpose() * H / 1e-6;
+        info->HtRinvz = H.transpose() * z / 1e-6;
+        info->count = 6;
+        return true;
+      };
+      const EsikfResult r = iteratedUpdate(x, P, measure, EsikfOptions{}, &x_post, &P_post);
+      ASSERT_TRUE(r.valid);
+      filter_state_t post = toFilterState(prior.utime, x_post, P_post, prior.request_id, "fake_vio");
+      post.valid = 1;
+      post.iterations = r.iterations;
+      post.num_measurements = r.info.count;
+      vio.publish("STATE_POSTERIOR", post);
+    });
+  };
+  const Outputs out = runNode(in, nullptr, setup);
+  const Outputs lidar_only = runNode(syntheticRun());
+
+  ASSERT_GE(priors.size(), 40u);  // 58 images, the first ~0.5 s before the map exists
+  EXPECT_EQ(counts.priors, static_cast<int64_t>(priors.size()));
+  EXPECT_EQ(counts.adopted, counts.priors);
+  EXPECT_EQ(counts.missing, 0);
+  EXPECT_EQ(counts.kept_prior, 0);
+  EXPECT_EQ(counts.priors + counts.images_skipped, (last_image - first_image) / 50'000 + 1);
+  for (size_t i = 0; i < priors.size(); ++i) {
+    EXPECT_EQ(priors[i].request_id, static_cast<int64_t>(i + 1));
+    EXPECT_EQ((priors[i].utime - first_image) % 50'000, 0);  // exactly the image times
+    EXPECT_EQ(priors[i].source, "lio");
+    EXPECT_TRUE(allFinite(priors[i].covariance, 324));
+    // the prior is the tracked state propagated by the IMU: close to the truth already
+    const Vec3 p(priors[i].position[0], priors[i].position[1], priors[i].position[2]);
+    EXPECT_LT((p - (T_lio_truth * seq.truth(priors[i].utime)).translation()).norm(), 0.02) << "prior " << i;
+  }
+  // every sweep still produces its odometry, and exact posteriors keep it on the truth
+  ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
+  for (size_t i = 0; i < out.odometry.size(); ++i) {
+    EXPECT_EQ(out.odometry[i].utime, lidar_only.odometry[i].utime);
+    const Pose3 truth = T_lio_truth * seq.truth(out.odometry[i].utime);
+    if (out.odometry[i].utime > priors.front().utime) {
+      EXPECT_LT((poseOf(out.odometry[i].position, out.odometry[i].orientation).translation() - truth.translation()).norm(), 0.01)
+          << "sweep " << i;
+    }
+  }
+  std::printf("aligned position RMSE: with exact posteriors %.4f m, LiDAR-only %.4f m\n", alignedError(out, seq),
+              alignedError(lidar_only, seq));
+  EXPECT_LT(alignedError(out, seq), 0.002);
+  EXPECT_LT(alignedError(out, seq), alignedError(lidar_only, seq));
+}
+
+// Without a VIO on the bus lio waits posterior_max_wait_s of IMU time per image, then goes on
+// LiDAR-only and counts it; a "kept the prior" answer and a foreign posterior are handled too.
+TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
+  int64_t first_image = 0, last_image = 0;
+  const std::vector<Message> in = withImages(syntheticRun(), &first_image, &last_image);
+  const synth::SyntheticSequence seq = syntheticSequence();
+  {
+    RunSetup setup;
+    setup.config = handoffConfig();
+    LioNode::HandoffCounts counts;
+    setup.handoff = &counts;
+    const Outputs out = runNode(in, nullptr, setup);
+    const Outputs lidar_only = runNode(syntheticRun());
+    EXPECT_GE(counts.priors, 40);
+    EXPECT_EQ(counts.missing, counts.priors);
+    EXPECT_EQ(counts.adopted, 0);
+    ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
+    EXPECT_LT(alignedError(out, seq), 0.02);
+  }
+  {
+    // a VIO that keeps every prior (valid = 0) and also sends a posterior nobody asked for
+    RunSetup setup;
+    setup.config = handoffConfig();
+    LioNode::HandoffCounts counts;
+    setup.handoff = &counts;
+    int64_t rejected_posteriors = 0;
+    setup.rejected_posteriors = &rejected_posteriors;
+    setup.attach = [&](Node& vio) {
+      vio.subscribe<filter_state_t>("STATE_PRIOR", [&vio](const filter_state_t& prior) {
+        filter_state_t post = prior;
+        post.valid = 0;
+        vio.publish("STATE_POSTERIOR", post);
+        if (prior.request_id == 3) {
+          filter_state_t foreign = prior;
+          foreign.request_id = 999;
+          foreign.valid = 1;
+          vio.publish("STATE_POSTERIOR", foreign);
+        }
+      });
+    };
+    const Outputs out = runNode(in, nullptr, setup);
+    EXPECT_GE(counts.priors, 40);
+    EXPECT_EQ(counts.kept_prior, counts.priors);
+    EXPECT_EQ(counts.missing, 0);
+    EXPECT_EQ(rejected_posteriors, 1);
+    ASSERT_GE(out.odometry.size(), 24u);
+    EXPECT_LT(alignedError(out, seq), 0.02);
+  }
 }

@@ -15,7 +15,12 @@ class CameraProjection {
   /// Pixel of p_C; false if behind the camera, outside the distortion model's valid field, or
   /// outside the image shrunk by `border` pixels.
   bool project(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel, double border = 0.0) const;
+  /// project() with the Jacobian d pixel / d p_C (2x3, distortion included); same validity.
+  bool projectWithJacobian(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel, Eigen::Matrix<double, 2, 3>* J,
+                           double border = 0.0) const;
   Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
+  /// d distort(xy) / d xy.
+  Eigen::Matrix2d distortJacobian(const Eigen::Vector2d& xy) const;
 
   /// Vignetting gain at a pixel for fall-off v (the simulator's and a common calibration model).
   double vignette(const Eigen::Vector2d& pixel, double v) const;

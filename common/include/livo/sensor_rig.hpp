@@ -52,6 +52,7 @@ struct CameraRig {
   double rate_hz = 20.0;
   bool color = false;                 // RGB8 if true, else GRAY8
   Pose3 T_I_C = Pose3::Identity();    // p_I = T_I_C * p_C
+  double time_offset_s = 0.0;         // image utime + time_offset_s = the same instant on the IMU clock
 };
 
 /// Differential-drive wheel encoder; base frame B: x forward, z up.

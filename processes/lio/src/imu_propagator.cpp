@@ -102,4 +102,14 @@ void ImuPropagator::propagateTo(int64_t utime, const ImuSample& next) {
   step(at);
 }
 
+void ImuPropagator::transformSegments(const Pose3& T) {
+  const Mat3 R = T.linear();
+  for (ImuSegment& g : segments_) {
+    g.rot = so3::normalize(R * g.rot);
+    g.pos = R * g.pos + T.translation();
+    g.vel = R * g.vel;
+    g.acc_world = R * g.acc_world;
+  }
+}
+
 }  // namespace livo::lio

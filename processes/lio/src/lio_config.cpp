@@ -11,7 +11,7 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   ch.readOptional("imu", o->imu_channel);
   ch.readOptional("lidar", o->lidar_channel);
   ch.readOptional("wheel", o->wheel_channel);
-  ch.ignore("camera");
+  ch.readOptional("camera", o->camera_channel);
   ch.ignore("ground_truth");
 
   const Config imu = rig.section("imu");
@@ -33,7 +33,12 @@ void readRig(const Config& rig, LioNodeOptions* o) {
     l.matching.point_noise_std = std::max(l.matching.point_noise_std, 3.0 * range_noise);
   lidar.read("T_I_L", l.extrinsics.T_I_L);
 
-  rig.ignore("camera");
+  const Config cam = rig.optionalSection("camera");
+  if (!cam.isNull()) {
+    for (const std::string& key : cam.keys())
+      if (key != "time_offset_s") cam.ignore(key);  // the VIO and colouring read the camera model
+    cam.readOptional("time_offset_s", o->camera_time_offset_s);
+  }
   const Config wheel = rig.optionalSection("wheel");
   if (!wheel.isNull()) {
     l.wheel.enabled = true;
@@ -52,6 +57,8 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("wheel_max_wait_s", o->wheel_max_wait_s);
   c.readOptional("clock_reset_s", o->clock_reset_s);
   c.readOptional("max_pending_scans", o->max_pending_scans);
+  c.readOptional("camera_handoff", o->camera_handoff);
+  c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
 
   const Config out = c.optionalSection("channels");
   out.readOptional("state_posterior", o->state_posterior_channel);
@@ -132,6 +139,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   positive(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors");
   positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
   positive(l.init.window_s > 0, "init.window_s");
+  positive(o->posterior_max_wait_s > 0, "posterior_max_wait_s");
 }
 }  // namespace
 
@@ -164,6 +172,8 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
      << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "\n"
+     << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
+     << "\n"
      << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
      << (l.wheel.enabled ? "on" : "off") << std::endl;
 }

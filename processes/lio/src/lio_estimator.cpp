@@ -429,6 +429,12 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat
   if ((x.rot.transpose() * x.rot - Mat3::Identity()).norm() > 1e-6) return fail("posterior rotation not orthonormal");
   if (Eigen::LLT<Mat18>(0.5 * (P + P.transpose())).info() != Eigen::Success)
     return fail("posterior covariance not positive definite");
+  // the sweep in progress is undistorted along the recorded segments: move them with the state
+  const FilterState& prior = prop_.state();
+  Pose3 T = Pose3::Identity();
+  T.linear() = x.rot * prior.rot.transpose();
+  T.translation() = x.pos - T.linear() * prior.pos;
+  prop_.transformSegments(T);
   prop_.setState(x, 0.5 * (P + P.transpose()));
   return true;
 }

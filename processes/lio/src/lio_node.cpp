@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "livo/lio/lio_messages.hpp"
+#include "livo/message_registry.hpp"
 #include "livo/messages.hpp"
 
 namespace livo::lio {
@@ -32,6 +33,10 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
   node_.subscribe<point_cloud_t>(opts_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
   if (opts_.lio.wheel.enabled)
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
+  if (opts_.camera_handoff) {
+    node_.declareOutput(opts_.state_prior_channel);
+    node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
+  }
   node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
@@ -43,6 +48,8 @@ void LioNode::resetAll(const std::string& why) {
   imu_.clear();
   wheel_.clear();
   scans_.clear();
+  images_.clear();
+  pending_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
 }
 
@@ -88,6 +95,28 @@ void LioNode::onLidar(const point_cloud_t& m) {
   advance();
 }
 
+void LioNode::onCamera(const void* data, int size) {
+  // only the image time matters here: read the leading utime without decoding the pixels
+  const MessageType* type = identifyMessage(data, size);
+  int64_t utime = 0;
+  if (!type || type->name != "livo.image_t" || !messageUtime(data, size, &utime)) {
+    node_.reject(opts_.camera_channel, "not a livo.image_t message");
+    return;
+  }
+  node_.noteSensorTime(utime);
+  const int64_t t = utime + toUtime(opts_.camera_time_offset_s);
+  if ((lio_.initialized() && t <= lio_.utime()) || (pending_ && t <= pending_->utime)) {
+    ++handoff_.images_skipped;  // the filter is already past it
+    return;
+  }
+  images_.insert(t, true);
+  while (static_cast<int>(images_.size()) > opts_.max_pending_scans) {
+    ++handoff_.images_skipped;  // no IMU past them: the oldest are dropped like sweeps are
+    images_.popUntil(images_.front().utime, [](const auto&) {});
+  }
+  advance();
+}
+
 void LioNode::onWheel(const wheel_odometry_t& m) {
   const WheelSample w = fromMessage(m);
   if (!std::isfinite(w.left_speed) || !std::isfinite(w.right_speed)) {
@@ -112,7 +141,24 @@ void LioNode::advance() {
       fed_any_imu_ = true;
     });
   }
-  while (!scans_.empty() && fed_any_imu_) {
+  while (fed_any_imu_) {
+    if (pending_) {
+      // waiting for the posterior of an image: nothing later may be processed meanwhile
+      if (fed_imu_ <= pending_->utime + toUtime(opts_.posterior_max_wait_s)) break;
+      ++handoff_.missing;
+      node_.warn("no STATE_POSTERIOR for the image at " + std::to_string(pending_->utime) +
+                 ": going on LiDAR-only (" + std::to_string(handoff_.missing) + " so far)");
+      pending_.reset();
+    }
+    // the earlier of the next image time and the next sweep end
+    if (!images_.empty() && (scans_.empty() || images_.front().utime <= scans_.front().utime)) {
+      const int64_t t_image = images_.front().utime;
+      if (fed_imu_ <= t_image) break;  // no IMU past the image yet
+      images_.popUntil(t_image, [](const auto&) {});
+      handOff(t_image);
+      continue;
+    }
+    if (scans_.empty()) break;
     const int64_t t_end = scans_.front().utime;
     if (fed_imu_ <= t_end) break;  // no IMU past the sweep end yet
     if (opts_.lio.wheel.enabled) {
@@ -164,16 +210,44 @@ void LioNode::process(const PendingScan& p) {
   if (r.is_keyframe) node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings));
 }
 
-void LioNode::onPosterior(const filter_state_t& m) {
-  FilterState x;
-  Mat18 P;
-  if (!m.valid) return;  // the VIO kept the prior
-  if (!fromFilterState(m, &x, &P)) {
-    node_.reject(opts_.state_posterior_channel, "non-finite or malformed posterior");
+void LioNode::handOff(int64_t utime) {
+  if (!lio_.tracking() || utime <= lio_.utime()) {
+    ++handoff_.images_skipped;
     return;
   }
+  std::string note;
+  if (!lio_.propagateTo(utime, &note)) {
+    resetAll("propagation to the image time failed" + (note.empty() ? std::string() : " (" + note + ")"));
+    return;
+  }
+  if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
+  const int64_t id = next_request_id_++;
+  node_.publish(opts_.state_prior_channel, toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name));
+  ++handoff_.priors;
+  pending_ = PendingPrior{id, utime};
+}
+
+void LioNode::onPosterior(const filter_state_t& m) {
+  if (!pending_ || m.request_id != pending_->request_id || m.utime != pending_->utime) {
+    node_.reject(opts_.state_posterior_channel, "posterior answers no waiting prior (late, duplicate or foreign)");
+    return;
+  }
+  pending_.reset();
+  FilterState x;
+  Mat18 P;
   std::string why;
-  if (!lio_.adoptPosterior(m.utime, x, P, &why)) node_.reject(opts_.state_posterior_channel, why);
+  if (!m.valid) {
+    ++handoff_.kept_prior;  // the VIO kept the prior (it says why on its own HEALTH)
+  } else if (!fromFilterState(m, &x, &P)) {
+    ++handoff_.kept_prior;
+    node_.reject(opts_.state_posterior_channel, "non-finite or malformed posterior: prior kept");
+  } else if (!lio_.adoptPosterior(m.utime, x, P, &why)) {
+    ++handoff_.kept_prior;
+    node_.reject(opts_.state_posterior_channel, why + ": prior kept");
+  } else {
+    ++handoff_.adopted;
+  }
+  advance();
 }
 
 void LioNode::onLoopCorrection(const loop_correction_t& m) {
@@ -184,8 +258,14 @@ void LioNode::onLoopCorrection(const loop_correction_t& m) {
     node_.reject(opts_.loop_correction_channel, why);
     return;
   }
+  if (pending_) {
+    node_.warn("loop correction while an image prior is out: its posterior will be ignored");
+    ++handoff_.missing;
+    pending_.reset();
+  }
   lio_.applyLoopCorrection(T, poses);
   node_.info("loop correction applied (" + std::to_string(poses.size()) + " keyframes)");
+  advance();
 }
 
 }  // namespace livo::lio

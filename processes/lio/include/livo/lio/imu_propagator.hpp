@@ -77,6 +77,9 @@ class ImuPropagator {
   /// time as the end of the last one.
   const std::vector<ImuSegment>& segments() const { return segments_; }
   void clearSegments() { segments_.clear(); }
+  /// Moves the recorded segments rigidly by T (world frame: p -> R p + t), so that the trajectory
+  /// stays continuous when an external update moves the current state by T.
+  void transformSegments(const Pose3& T);
 
  private:
   void step(const ImuSample& next);

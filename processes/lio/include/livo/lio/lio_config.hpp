@@ -17,6 +17,7 @@ struct LioNodeOptions {
   std::string imu_channel = "IMU";
   std::string lidar_channel = "LIDAR";
   std::string wheel_channel = "WHEEL";
+  std::string camera_channel = "CAMERA";  // image times only (camera hand-off)
   std::string state_posterior_channel = "STATE_POSTERIOR";
   std::string loop_correction_channel = "LOOP_CORRECTION";
   // outputs
@@ -30,6 +31,12 @@ struct LioNodeOptions {
   double wheel_max_wait_s = 0.2;       // a sweep waits for wheel data past its end at most this long
   double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
   int max_pending_scans = 50;          // sweeps waiting for IMU; older ones are dropped beyond this
+
+  // Camera hand-off (design.md): at each image time publish STATE_PRIOR and adopt the
+  // STATE_POSTERIOR that answers it; nothing later than the image is processed meanwhile.
+  bool camera_handoff = false;
+  double camera_time_offset_s = 0.0;   // rig.camera.time_offset_s: image utime + offset = IMU time
+  double posterior_max_wait_s = 0.1;   // IMU time past an image after which lio goes on without its posterior
 
   LioOptions lio;
 };

@@ -81,6 +81,8 @@ class LioEstimator {
   int64_t scanEndUtime(const LidarScan& scan) const;
 
   bool initialized() const { return initialized_; }
+  /// Initialised and the map seeded: the state is worth handing to the camera.
+  bool tracking() const { return initialized_ && !map_.empty(); }
   /// Time of the filter state (IMU clock).
   int64_t utime() const { return prop_.utime(); }
   const FilterState& state() const { return prop_.state(); }

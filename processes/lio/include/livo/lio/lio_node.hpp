@@ -5,12 +5,19 @@
 // on the messages' contents and stamps, never on the interleaving of channels. IMU samples reach
 // the filter imu_reorder_window_s behind the newest one; a sweep is processed once the filter has
 // an IMU sample past its end (and, with wheels, a wheel reading past its end or wheel_max_wait_s
-// of IMU beyond it). The camera hand-off (STATE_PRIOR at camera times) belongs to the VIO issue;
-// STATE_POSTERIOR is adopted when it refers to the filter's current time.
+// of IMU beyond it).
+//
+// Camera hand-off (options.camera_handoff): image times from CAMERA are events like sweep ends.
+// When the IMU passes one, the filter is propagated to it and published on STATE_PRIOR; nothing
+// later is processed until the STATE_POSTERIOR with that request id has been adopted (valid = 0:
+// the prior is kept), or the IMU has run posterior_max_wait_s past the image: then lio goes on
+// LiDAR-only and counts the missing answer. Under lockstep replay the answer always arrives first
+// (playback waits for the whole pipeline to be quiescent), so replays stay identical.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
+#include <optional>
 
 #include "livo/lio/lio_config.hpp"
 #include "livo/lio/lio_messages.hpp"
@@ -28,6 +35,16 @@ class LioNode {
   const LioEstimator& estimator() const { return lio_; }
   int64_t sweepsProcessed() const { return sweeps_; }
 
+  /// What became of the camera hand-off's priors.
+  struct HandoffCounts {
+    int64_t priors = 0;          // STATE_PRIOR published
+    int64_t adopted = 0;         // posteriors adopted
+    int64_t kept_prior = 0;      // answered valid = 0 (or unusable): the prior was kept
+    int64_t missing = 0;         // no answer within posterior_max_wait_s: went on LiDAR-only
+    int64_t images_skipped = 0;  // image times not handed off (filter not tracking yet, or already past them)
+  };
+  const HandoffCounts& handoffCounts() const { return handoff_; }
+
  private:
   struct PendingScan {
     point_cloud_t msg;
@@ -36,11 +53,14 @@ class LioNode {
   void onImu(const imu_t& m);
   void onLidar(const point_cloud_t& m);
   void onWheel(const wheel_odometry_t& m);
+  void onCamera(const void* data, int size);
   void onPosterior(const filter_state_t& m);
   void onLoopCorrection(const loop_correction_t& m);
   /// Hands IMU (and wheel) to the filter up to the watermarks and processes every ready sweep.
   void advance();
   void process(const PendingScan& p);
+  /// Propagates to an image time and publishes the prior (sets pending_).
+  void handOff(int64_t utime);
   void resetAll(const std::string& why);
 
   LioNodeOptions opts_;
@@ -56,6 +76,15 @@ class LioNode {
   int64_t fed_wheel_ = 0;
   bool fed_any_wheel_ = false;
   int64_t sweeps_ = 0;
+
+  struct PendingPrior {
+    int64_t request_id;
+    int64_t utime;
+  };
+  TimeBuffer<bool> images_;             // image times (IMU clock) not yet handed off
+  std::optional<PendingPrior> pending_;  // prior waiting for its posterior
+  int64_t next_request_id_ = 1;
+  HandoffCounts handoff_;
 };
 
 }  // namespace livo::lio
