@@ -116,6 +116,7 @@ CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& tra
   }
   CameraImage img;
   img.utime = utime;
+  img.log_utime = utime;
   img.width = rig_.width;
   img.height = rig_.height;
   img.color = rig_.color;

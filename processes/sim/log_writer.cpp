@@ -89,7 +89,7 @@ void LogWriter::write(const CameraImage& m) {
   msg.exposure_time = m.exposure_time;
   msg.size = static_cast<int32_t>(m.data.size());
   msg.data = m.data;
-  writeEvent(channels_.camera, m.utime, msg);
+  writeEvent(channels_.camera, m.log_utime, msg);
 }
 
 }  // namespace sim

@@ -38,7 +38,8 @@ struct LidarSweep {
 };
 
 struct CameraImage {
-  int64_t utime = 0;            // mid-exposure
+  int64_t utime = 0;            // mid-exposure, on the camera's clock
+  int64_t log_utime = 0;        // the same instant on the IMU clock: the log event's time
   int width = 0, height = 0;
   bool color = false;           // RGB8 if true, GRAY8 otherwise
   float exposure_time = 0.0f;   // s

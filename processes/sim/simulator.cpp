@@ -161,6 +161,7 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
           // rendered at IMU time u, stamped on the camera's clock (rig camera time_offset_s)
           images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u), u - camera_offset_us,
                                           Random(o.seed, kCameraStream, static_cast<uint64_t>(k)));
+          images[slot].log_utime = u;
         });
       }
     }

@@ -123,6 +123,43 @@ TEST(Simulation, SameSeedGivesAByteIdenticalLogWhateverTheThreads) {
   EXPECT_FALSE(a == d);  // other noise (and other LiDAR dropouts)
 }
 
+// rig.camera.time_offset_s: images carry the camera's clock (IMU time - offset), are rendered at
+// the IMU time and logged there, so the log stays in time order.
+TEST(Simulation, CameraTimeOffsetStampsImagesOnTheCameraClock) {
+  std::ifstream in(configPath("room"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string key = "    T_I_C:";
+  const size_t at = yaml.find(key);
+  ASSERT_NE(at, std::string::npos);
+  yaml.insert(at, "    time_offset_s: 0.0042\n");
+  SimOverrides o;
+  o.duration_s = 0.3;
+  const SimulationSetup shifted = loadSimulation(Config::fromString(yaml, "room_offset.yaml"),
+                                                 std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+  const SimulationSetup plain = loadSimulation(configPath("room"), o);
+  ASSERT_TRUE(shifted.rig.camera);
+  EXPECT_DOUBLE_EQ(shifted.rig.camera->time_offset_s, 0.0042);
+  struct Images : SensorDataSink {
+    std::vector<CameraImage> images;
+    void write(const ImuReading&) override {}
+    void write(const PoseReading&) override {}
+    void write(const WheelReading&) override {}
+    void write(const LidarSweep&) override {}
+    void write(const CameraImage& m) override { images.push_back(m); }
+  } a, b;
+  Simulator(shifted).run(a);
+  Simulator(plain).run(b);
+  ASSERT_EQ(a.images.size(), b.images.size());
+  ASSERT_GE(a.images.size(), 5u);
+  for (size_t i = 0; i < a.images.size(); ++i) {
+    EXPECT_EQ(a.images[i].log_utime, b.images[i].utime);       // logged at the IMU time
+    EXPECT_EQ(a.images[i].utime, b.images[i].utime - 4200);    // stamped on the camera clock
+    EXPECT_EQ(a.images[i].data, b.images[i].data);             // the same view
+  }
+}
+
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
   for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking"}) {
     SCOPED_TRACE(name);
