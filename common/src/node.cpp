@@ -1,5 +1,6 @@
 #include "livo/node.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <iomanip>
@@ -35,6 +36,36 @@ Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(o
 Node::~Node() {
   // Subscriptions point into subs_: unsubscribe before it goes away (the LCM may outlive us).
   for (auto* s : lcm_subs_) lcm_.unsubscribe(s);
+  if (peer_sub_) lcm_.unsubscribe(peer_sub_);
+}
+
+void Node::watchConsumers(const std::string& channel, double stale_s) {
+  watched_[channel].stale_s = stale_s;
+  if (!peer_sub_) peer_sub_ = lcm_.subscribeFunction(options_.progress_channel, &Node::onPeerProgress, this);
+}
+
+void Node::onPeerProgress(const lcm::ReceiveBuffer* rbuf, const std::string&, Node* node) {
+  progress_t p;
+  if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size)) return;
+  if (p.node == node->options_.name) return;
+  const auto now = std::chrono::steady_clock::now();
+  for (auto& [channel, watch] : node->watched_) {
+    const bool consumes = std::find(p.input_channel.begin(), p.input_channel.end(), channel) != p.input_channel.end();
+    if (consumes && !p.finished) {
+      watch.consumers[p.node] = now;
+    } else {
+      watch.consumers.erase(p.node);
+    }
+  }
+}
+
+bool Node::hasConsumers(const std::string& channel) const {
+  auto it = watched_.find(channel);
+  if (it == watched_.end()) return false;
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& [name, heard] : it->second.consumers)
+    if (std::chrono::duration<double>(now - heard).count() <= it->second.stale_s) return true;
+  return false;
 }
 
 void Node::subscribeRaw(const std::string& channel, std::function<void(const void*, int)> handler) {

@@ -83,7 +83,7 @@ void drain(lcm::LCM& lcm) {
 
 struct RunSetup {
   std::string config = kConfig;
-  /// Called with the observer node before the run (e.g. to answer STATE_PRIOR like a VIO).
+  /// Called with a stand-in VIO node before the run (e.g. to answer STATE_PRIOR).
   std::function<void(Node& observer)> attach;
   LioNode::HandoffCounts* handoff = nullptr;  // filled after the run
   int64_t* rejected_posteriors = nullptr;     // filled after the run
@@ -96,7 +96,9 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
   LioNode node(lcm, opts, true);
   Outputs out;
   Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true});
-  if (setup.attach) setup.attach(observer);
+  // a stand-in VIO on the real PROGRESS channel, so lio sees its subscriptions
+  Node vio(lcm, NodeOptions{"fake_vio", "PROGRESS", "HEALTH_VIO", 0.0, true, true});
+  if (setup.attach) setup.attach(vio);
   observer.subscribeRaw("ODOMETRY", [&](const void* data, int size) {
     const auto* b = static_cast<const uint8_t*>(data);
     out.odometry_bytes.emplace_back(b, b + size);
@@ -357,6 +359,7 @@ TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
       post.num_measurements = r.info.count;
       vio.publish("STATE_POSTERIOR", post);
     });
+    vio.announce();  // lio hands off only while a STATE_PRIOR subscriber is alive
   };
   const Outputs out = runNode(in, nullptr, setup);
   const Outputs lidar_only = runNode(syntheticRun());
@@ -392,24 +395,40 @@ TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
   EXPECT_LT(alignedError(out, seq), alignedError(lidar_only, seq));
 }
 
-// Without a VIO on the bus lio waits posterior_max_wait_s of IMU time per image, then goes on
-// LiDAR-only and counts it; a "kept the prior" answer and a foreign posterior are handled too.
+// Without a VIO on the bus nothing is handed off and the odometry is byte for byte LiDAR-only; a
+// VIO that never answers costs posterior_max_wait_s of IMU time per image and is counted; a "kept
+// the prior" answer and a foreign posterior are handled too.
 TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
   int64_t first_image = 0, last_image = 0;
   const std::vector<Message> in = withImages(syntheticRun(), &first_image, &last_image);
   const synth::SyntheticSequence seq = syntheticSequence();
+  const Outputs lidar_only = runNode(syntheticRun());
   {
     RunSetup setup;
     setup.config = handoffConfig();
     LioNode::HandoffCounts counts;
     setup.handoff = &counts;
     const Outputs out = runNode(in, nullptr, setup);
-    const Outputs lidar_only = runNode(syntheticRun());
+    EXPECT_EQ(counts.priors, 0);
+    EXPECT_GE(counts.no_vio, 40);
+    EXPECT_EQ(out.odometry_bytes, lidar_only.odometry_bytes);
+  }
+  {
+    // subscribed (announced) but silent: every prior times out
+    RunSetup setup;
+    setup.config = handoffConfig();
+    LioNode::HandoffCounts counts;
+    setup.handoff = &counts;
+    setup.attach = [](Node& vio) {
+      vio.subscribe<filter_state_t>("STATE_PRIOR", [](const filter_state_t&) {});
+      vio.announce();
+    };
+    const Outputs out = runNode(in, nullptr, setup);
     EXPECT_GE(counts.priors, 40);
     EXPECT_EQ(counts.missing, counts.priors);
     EXPECT_EQ(counts.adopted, 0);
     ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
-    EXPECT_LT(alignedError(out, seq), 0.02);
+    EXPECT_LT(alignedError(out, seq), 0.002);
   }
   {
     // a VIO that keeps every prior (valid = 0) and also sends a posterior nobody asked for
@@ -431,13 +450,14 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
           vio.publish("STATE_POSTERIOR", foreign);
         }
       });
+      vio.announce();
     };
     const Outputs out = runNode(in, nullptr, setup);
     EXPECT_GE(counts.priors, 40);
     EXPECT_EQ(counts.kept_prior, counts.priors);
     EXPECT_EQ(counts.missing, 0);
     EXPECT_EQ(rejected_posteriors, 1);
-    ASSERT_GE(out.odometry.size(), 24u);
-    EXPECT_LT(alignedError(out, seq), 0.02);
+    ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
+    EXPECT_LT(alignedError(out, seq), 0.002);
   }
 }

@@ -106,3 +106,38 @@ TEST(Node, RejectsEmptyName) {
   lcm::LCM lcm("memq://");
   EXPECT_THROW(Node(lcm, NodeOptions{}), std::invalid_argument);
 }
+
+// watchConsumers: a node learns from the others' PROGRESS whether anyone subscribes to a channel;
+// its own subscriptions do not count, a finished node stops counting, watching adds no input.
+TEST(Node, WatchesConsumersOfAChannel) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Node producer(lcm, NodeOptions{"producer", "PROGRESS", "HEALTH", 0.0, true, true});
+  producer.subscribe<imu_t>("STATE_PRIOR", [](const imu_t&) {});  // its own subscription
+  producer.watchConsumers("STATE_PRIOR");
+  producer.watchConsumers("OTHER");
+  producer.announce();
+  drain(lcm);
+  EXPECT_FALSE(producer.hasConsumers("STATE_PRIOR"));
+  EXPECT_FALSE(producer.hasConsumers("UNWATCHED"));
+  {
+    Node consumer(lcm, NodeOptions{"consumer", "PROGRESS", "HEALTH", 0.0, true, true});
+    consumer.subscribe<imu_t>("STATE_PRIOR", [](const imu_t&) {});
+    consumer.announce();
+    drain(lcm);
+    EXPECT_TRUE(producer.hasConsumers("STATE_PRIOR"));
+    EXPECT_FALSE(producer.hasConsumers("OTHER"));
+    consumer.finish();
+    drain(lcm);
+    EXPECT_FALSE(producer.hasConsumers("STATE_PRIOR"));
+  }
+  // watching is not an input: the producer's PROGRESS lists only its own subscription
+  std::vector<std::string> inputs;
+  Node listener(lcm, NodeOptions{"listener", "PROGRESS_L", "HEALTH_L", 0.0, false, true});
+  listener.subscribe<progress_t>("PROGRESS", [&](const progress_t& p) {
+    if (p.node == "producer") inputs = p.input_channel;
+  });
+  producer.announce();
+  drain(lcm);
+  EXPECT_EQ(inputs, std::vector<std::string>{"STATE_PRIOR"});
+}

@@ -80,6 +80,14 @@ class Node {
   void warn(const std::string& message);
   void error(const std::string& message);
 
+  /// Watches the other nodes' PROGRESS for subscribers of `channel` (e.g. is a VIO there to answer
+  /// STATE_PRIOR?). A node counts from its first PROGRESS (spin() announces at start) until it
+  /// finishes or has not been heard for stale_s of wall time (a dead process). Watching does not
+  /// count as an input: it adds nothing to this node's PROGRESS.
+  void watchConsumers(const std::string& channel, double stale_s = 3.0);
+  /// Whether a live node other than this one subscribes to a watched channel.
+  bool hasConsumers(const std::string& channel) const;
+
   /// Publishes a PROGRESS with zero counts so lockstep playback knows the node is up and
   /// subscribed; spin() calls it first.
   void announce();
@@ -111,6 +119,7 @@ class Node {
     int64_t rejected = 0;
   };
   static void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
+  static void onPeerProgress(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Node* node);
   template <class M>
   static constexpr auto hasUtime(int) -> decltype(std::declval<M>().utime, bool()) { return true; }
   template <class M>
@@ -137,6 +146,12 @@ class Node {
   std::chrono::steady_clock::time_point last_health_;
   bool finished_ = false;
   Subscription* current_ = nullptr;  // subscription whose handler is running
+  struct Watch {
+    double stale_s;
+    std::map<std::string, std::chrono::steady_clock::time_point> consumers;  // node -> last heard
+  };
+  std::map<std::string, Watch> watched_;  // channel -> its consumers
+  lcm::Subscription* peer_sub_ = nullptr;
 };
 
 /// Sets the shutdown flag on SIGINT/SIGTERM (idempotent).

@@ -35,6 +35,7 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   if (opts_.camera_handoff) {
     node_.declareOutput(opts_.state_prior_channel);
+    node_.watchConsumers(opts_.state_prior_channel);
     node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
   }
   node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
@@ -144,7 +145,8 @@ void LioNode::advance() {
   while (fed_any_imu_) {
     if (pending_) {
       // waiting for the posterior of an image: nothing later may be processed meanwhile
-      if (fed_imu_ <= pending_->utime + toUtime(opts_.posterior_max_wait_s)) break;
+      const bool vio_gone = !node_.hasConsumers(opts_.state_prior_channel);
+      if (!vio_gone && fed_imu_ <= pending_->utime + toUtime(opts_.posterior_max_wait_s)) break;
       ++handoff_.missing;
       node_.warn("no STATE_POSTERIOR for the image at " + std::to_string(pending_->utime) +
                  ": going on LiDAR-only (" + std::to_string(handoff_.missing) + " so far)");
@@ -213,6 +215,10 @@ void LioNode::process(const PendingScan& p) {
 void LioNode::handOff(int64_t utime) {
   if (!lio_.tracking() || utime <= lio_.utime()) {
     ++handoff_.images_skipped;
+    return;
+  }
+  if (!node_.hasConsumers(opts_.state_prior_channel)) {
+    ++handoff_.no_vio;  // nobody would answer: LiDAR-only, exactly as without the hand-off
     return;
   }
   std::string note;

@@ -11,8 +11,10 @@
 // When the IMU passes one, the filter is propagated to it and published on STATE_PRIOR; nothing
 // later is processed until the STATE_POSTERIOR with that request id has been adopted (valid = 0:
 // the prior is kept), or the IMU has run posterior_max_wait_s past the image: then lio goes on
-// LiDAR-only and counts the missing answer. Under lockstep replay the answer always arrives first
-// (playback waits for the whole pipeline to be quiescent), so replays stay identical.
+// LiDAR-only and counts the missing answer. While no live node subscribes to STATE_PRIOR (seen
+// from their PROGRESS) nothing is handed off and the output is exactly LiDAR-only. Under lockstep
+// replay the answer always arrives first (playback waits for the whole pipeline to be quiescent),
+// so replays stay identical.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
@@ -42,6 +44,7 @@ class LioNode {
     int64_t kept_prior = 0;      // answered valid = 0 (or unusable): the prior was kept
     int64_t missing = 0;         // no answer within posterior_max_wait_s: went on LiDAR-only
     int64_t images_skipped = 0;  // image times not handed off (filter not tracking yet, or already past them)
+    int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
 
