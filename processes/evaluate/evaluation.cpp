@@ -126,6 +126,12 @@ Evaluation evaluate(const TrajectoryInput& est_in, const TrajectoryInput& gt_in,
   ev.rpe_translation_m = summarizeErrors(ev.rpe.translation_m);
   ev.rpe_rotation_deg = summarizeErrors(ev.rpe.rotation_deg);
   ev.drift = kittiDrift(ev.gt, ev.est, options.drift);
+
+  const Pose3 anchor = ev.gt.front() * est[ev.pairs.est.front()].pose.inverse();
+  const Pose3 end_error = ev.gt.back().inverse() * (anchor * est[ev.pairs.est.back()].pose);
+  ev.end_point.translation_m = end_error.translation().norm();
+  ev.end_point.rotation_deg = rotationAngle(end_error.linear()) * 180.0 / M_PI;
+  for (size_t k = 1; k < n; ++k) ev.end_point.path_length_m += (gt_positions[k] - gt_positions[k - 1]).norm();
   return ev;
 }
 

@@ -50,6 +50,15 @@ struct Coverage {
 };
 Coverage groundTruthCoverage(std::vector<double> pair_gt_stamps, double gt_first, double gt_last, double gap);
 
+/// Drift at the end: the estimate anchored on the ground truth at the first pair (rigidly, no
+/// fit), its error at the last pair, and the ground-truth path length between them.
+struct EndPointDrift {
+  double translation_m = 0.0;
+  double rotation_deg = 0.0;
+  double path_length_m = 0.0;
+  double percent() const { return path_length_m > 0.0 ? 100.0 * translation_m / path_length_m : 0.0; }
+};
+
 struct Evaluation {
   size_t est_poses = 0;  // as read
   size_t gt_poses = 0;
@@ -67,6 +76,7 @@ struct Evaluation {
   ErrorStatistics rpe_translation_m;
   ErrorStatistics rpe_rotation_deg;
   KittiDrift drift;
+  EndPointDrift end_point;
 };
 
 /// Pairs by time stamp when both sides have stamps, else by index. Throws EvaluationError when no

@@ -68,6 +68,10 @@ json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const Traj
                 {"translation_percent", ev.drift.segments ? json(ev.drift.translation_percent) : json(nullptr)},
                 {"rotation_deg_per_m", ev.drift.segments ? json(ev.drift.rotation_deg_per_m) : json(nullptr)},
                 {"per_length", per_length}};
+  j["end_point"] = {{"translation_m", ev.end_point.translation_m},
+                    {"rotation_deg", ev.end_point.rotation_deg},
+                    {"path_length_m", ev.end_point.path_length_m},
+                    {"percent", ev.end_point.percent()}};
   return j;
 }
 

@@ -119,6 +119,14 @@ Table inputTable(const Evaluation& ev, const TrajectoryInput& est, const Traject
   return t;
 }
 
+std::string endPointLine(const Evaluation& ev) {
+  std::ostringstream os;
+  os << "End-point drift (anchored at the first pose): " << fixed(ev.end_point.translation_m, 4) << " m, "
+     << fixed(ev.end_point.rotation_deg, 3) << " deg over " << fixed(ev.end_point.path_length_m, 1) << " m ("
+     << fixed(ev.end_point.percent(), 3) << " %)";
+  return os.str();
+}
+
 }  // namespace
 
 void printSummary(std::ostream& os, const Evaluation& ev, const TrajectoryInput& est, const TrajectoryInput& gt,
@@ -126,7 +134,7 @@ void printSummary(std::ostream& os, const Evaluation& ev, const TrajectoryInput&
   inputTable(ev, est, gt, options).text(os, false);
   os << "\n";
   errorTable(ev).text(os);
-  os << "\n";
+  os << "\n" << endPointLine(ev) << "\n";
   if (ev.drift.segments == 0) {
     os << "KITTI drift: no segment (the ground-truth path, " << fixed(ev.drift.path_length_m, 1)
        << " m, is shorter than the shortest segment length)\n";
@@ -146,6 +154,7 @@ void writeMarkdownReport(const std::string& path, const Evaluation& ev, const Tr
       << " alignment; RPE of the relative pose over " << options.rpe.delta << " frame"
       << (options.rpe.delta == 1 ? "" : "s") << ".\n\n";
   errorTable(ev).markdown(out);
+  out << "\n" << endPointLine(ev) << "\n";
   out << "\n## KITTI drift\n\n";
   if (ev.drift.segments == 0) {
     out << "No segment: the ground-truth path (" << fixed(ev.drift.path_length_m, 1)

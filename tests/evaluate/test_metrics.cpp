@@ -250,3 +250,31 @@ TEST(Evaluate, ClearErrorsWhenNothingPairsOrAlignmentIsImpossible) {
   EXPECT_THROW(evaluate(timed(gt), timed(gt), bad), std::invalid_argument);
   EXPECT_THROW(parseAlignment("affine"), std::invalid_argument);
 }
+
+// End-point drift: anchored at the first pose, so a change of world frame costs nothing, while a
+// heading error at the start grows into a known end error; the path length is the truth's.
+TEST(Evaluate, EndPointDriftAnchorsAtTheFirstPose) {
+  const Trajectory gt = fixtures::wigglyTrajectory(600);
+  EvaluationOptions options;
+  Evaluation ev = evaluate(timed(fixtures::transformed(gt, fixtures::somePose())), timed(gt), options);
+  EXPECT_LT(ev.end_point.translation_m, 1e-9);
+  EXPECT_LT(ev.end_point.rotation_deg, 1e-9);
+  double length = 0.0;
+  for (size_t i = 1; i < gt.size(); ++i) length += (gt[i].pose.translation() - gt[i - 1].pose.translation()).norm();
+  EXPECT_NEAR(ev.end_point.path_length_m, length, 1e-9);
+
+  // every estimated pose after the first rotated by 1 degree of yaw about the first position
+  Trajectory est = gt;
+  const Vec3 p0 = gt.front().pose.translation();
+  Pose3 yaw = Pose3::Identity();
+  yaw.linear() = Eigen::AngleAxisd(M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
+  yaw.translation() = p0 - yaw.linear() * p0;
+  for (size_t i = 1; i < est.size(); ++i) est[i].pose = yaw * est[i].pose;
+  ev = evaluate(timed(est), timed(gt), options);
+  const Vec3 pn = gt.back().pose.translation();
+  const Vec3 d = pn - p0;
+  const double expected = 2.0 * std::sin(M_PI / 360.0) * std::hypot(d.x(), d.y());
+  EXPECT_NEAR(ev.end_point.translation_m, expected, 1e-9);
+  EXPECT_NEAR(ev.end_point.rotation_deg, 1.0, 1e-9);
+  EXPECT_NEAR(ev.end_point.percent(), 100.0 * expected / length, 1e-9);
+}
