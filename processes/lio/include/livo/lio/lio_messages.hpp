@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "livo/filter_state_t.hpp"
+#include "livo/filter_state_message.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/lio/lio_estimator.hpp"
@@ -32,11 +32,6 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& inp
 /// The keyframe's downsampled body-frame cloud with the input intensities; time offsets zero
 /// (the cloud is undistorted to the keyframe's utime).
 keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings);
-
-filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P, int64_t request_id,
-                             const std::string& source);
-/// False for a message with non-finite numbers.
-bool fromFilterState(const filter_state_t& m, FilterState* x, Mat18* P);
 
 /// The loop correction as T_corrected_odom and the corrected keyframe poses.
 bool fromMessage(const loop_correction_t& m, Pose3* T_corr, std::vector<LioEstimator::KeyframePose>* poses,

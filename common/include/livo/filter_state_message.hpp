@@ -1,0 +1,18 @@
+// The filter hand-off message (filter_state_t: STATE_PRIOR / STATE_POSTERIOR) and FilterState.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "livo/filter_state.hpp"
+#include "livo/filter_state_t.hpp"
+
+namespace livo {
+
+/// State and covariance at utime as a message (valid = 1, no iterations or measurements).
+filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P, int64_t request_id,
+                             const std::string& source);
+/// False for a message with non-finite numbers or a quaternion far from unit length.
+bool fromFilterState(const filter_state_t& m, FilterState* x, Mat18* P);
+
+}  // namespace livo
