@@ -12,6 +12,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
     c.readOptional("max_depth", o.max_depth);
     c.readOptional("min_depth", o.min_depth);
     c.readOptional("border_px", o.border_px);
+    c.readOptional("max_pending_images", o.max_pending_images);
     c.readOptional("depth_cell_px", o.depth_cell_px);
     c.readOptional("occluder_radius", o.occluder_radius);
     c.readOptional("max_splat_cells", o.max_splat_cells);
@@ -42,6 +43,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
   if (!(o.max_time_difference >= 0.0)) fail("max_time_difference", "must be >= 0");
   if (!(o.min_depth > 0.0 && o.max_depth > o.min_depth)) fail("max_depth", "need 0 < min_depth < max_depth");
   if (o.depth_cell_px < 1) fail("depth_cell_px", "must be >= 1");
+  if (o.max_pending_images < 1) fail("max_pending_images", "must be >= 1");
   if (o.occluder_radius < 0.0) fail("occluder_radius", "must be >= 0");
   if (!(o.vignetting >= 0.0 && o.vignetting < 1.0)) fail("vignetting", "must be in [0, 1)");
   if (!(o.gain_min > 0.0 && o.gain_max > o.gain_min)) fail("gain_max", "need 0 < gain_min < gain_max");

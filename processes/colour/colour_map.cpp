@@ -6,7 +6,41 @@
 namespace livo {
 namespace colour {
 
-ColourMap::ColourMap(double voxel_size) : voxel_(voxel_size > 0 ? voxel_size : 0.05) {}
+uint32_t ColourMap::VoxelIndex::findOrInsert(uint64_t key, uint32_t id, bool* inserted) {
+  if (2 * (size_ + 1) > slots_.size()) grow();
+  for (size_t i = home(key);; i = (i + 1) & (slots_.size() - 1)) {
+    Slot& s = slots_[i];
+    if (s.key == key) {
+      *inserted = false;
+      return s.id;
+    }
+    if (s.key == kEmpty) {
+      s.key = key;
+      s.id = id;
+      ++size_;
+      *inserted = true;
+      return id;
+    }
+  }
+}
+
+void ColourMap::VoxelIndex::reset(size_t expected) {
+  size_t n = 1024;
+  while (n < 2 * expected + 2) n *= 2;
+  slots_.assign(n, Slot{});
+  size_ = 0;
+}
+
+void ColourMap::VoxelIndex::grow() {
+  std::vector<Slot> old;
+  old.swap(slots_);
+  reset(old.size() / 2);  // twice the slots
+  bool inserted = false;
+  for (const Slot& s : old)
+    if (s.key != kEmpty) findOrInsert(s.key, s.id, &inserted);
+}
+
+ColourMap::ColourMap(double voxel_size) : voxel_(voxel_size > 0 ? voxel_size : 0.05) { index_.reset(0); }
 
 uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
   auto k = [this](float v) {
@@ -16,7 +50,8 @@ uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
 }
 
 uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created) {
-  auto [it, inserted] = index_.emplace(key(p), static_cast<uint32_t>(points_.size()));
+  bool inserted = false;
+  const uint32_t id = index_.findOrInsert(key(p), static_cast<uint32_t>(points_.size()), &inserted);
   if (inserted) {
     MapPoint mp;
     mp.position = p;
@@ -24,7 +59,7 @@ uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* cre
     points_.push_back(mp);
   }
   if (created) *created = inserted;
-  return it->second;
+  return id;
 }
 
 bool ColourMap::accumulate(uint32_t id, const Eigen::Vector3f& c, const AccumulationOptions& o) {
@@ -57,20 +92,21 @@ void ColourMap::transform(const std::function<bool(int64_t, Pose3*)>& delta) {
   std::vector<MapPoint> kept;
   kept.reserve(points_.size());
   remap_.assign(points_.size(), 0);
-  index_.clear();
+  index_.reset(points_.size());
   for (size_t i = 0; i < points_.size(); ++i) {
     const MapPoint& p = points_[i];
-    auto [it, inserted] = index_.emplace(key(p.position), static_cast<uint32_t>(kept.size()));
+    bool inserted = false;
+    const uint32_t id = index_.findOrInsert(key(p.position), static_cast<uint32_t>(kept.size()), &inserted);
     if (inserted) {
       kept.push_back(p);
     } else {
-      MapPoint& q = kept[it->second];
+      MapPoint& q = kept[id];
       const int n = q.count + p.count;
       if (n > 0) q.colour = (q.colour * float(q.count) + p.colour * float(p.count)) / float(n);
       q.count = n;
       q.rejected += p.rejected;
     }
-    remap_[i] = it->second;
+    remap_[i] = id;
   }
   points_.swap(kept);
 }

@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,7 +20,6 @@ struct MapPoint {
   int32_t count = 0;           // accepted observations
   int32_t rejected = 0;        // observations refused as outliers
   int64_t anchor = -1;         // keyframe id it moves with (-1: none)
-  uint32_t visit = 0;          // scratch marker (which image last looked at it)
   bool coloured() const { return count > 0; }
 };
 
@@ -54,10 +52,31 @@ class ColourMap {
   const std::vector<uint32_t>& lastRemap() const { return remap_; }
 
  private:
+  /// Voxel key -> point id, open addressing with linear probing, grown at 50 % load: one lookup
+  /// per scan point, several times faster than std::unordered_map at a few 100k points.
+  class VoxelIndex {
+   public:
+    /// The id stored for key, after storing `id` for it if it had none (*inserted tells which).
+    uint32_t findOrInsert(uint64_t key, uint32_t id, bool* inserted);
+    /// Empties the index, sized for `expected` keys.
+    void reset(size_t expected);
+
+   private:
+    static constexpr uint64_t kEmpty = ~uint64_t{0};  // voxel keys use 63 bits
+    struct Slot {
+      uint64_t key = kEmpty;
+      uint32_t id = 0;
+    };
+    size_t home(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 17) & (slots_.size() - 1); }
+    void grow();
+    std::vector<Slot> slots_;
+    size_t size_ = 0;
+  };
+
   uint64_t key(const Eigen::Vector3f& p) const;
   double voxel_;
   std::vector<MapPoint> points_;
-  std::unordered_map<uint64_t, uint32_t> index_;
+  VoxelIndex index_;
   std::vector<uint32_t> remap_;
 };
 

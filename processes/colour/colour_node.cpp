@@ -7,7 +7,7 @@
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
-#include "livo/message_checks.hpp"
+#include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
@@ -33,20 +33,11 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
   node_.declareOutput(options_.output_channel);
 
   node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
-    const point_cloud_t& c = m.cloud;
-    if (const std::string why = registeredScanProblem(m); !why.empty()) {
+    RegisteredScanView v;
+    if (const std::string why = viewRegisteredScan(m, &v); !why.empty()) {
       node_.reject(options_.scan_channel, why);
       return;
     }
-    ScanView v;
-    v.utime = m.utime;
-    v.cloud_utime = c.utime;
-    v.T_W_I = poseFrom(m.position, m.orientation);
-    v.num_points = c.num_points;
-    v.x = c.x.data();
-    v.y = c.y.data();
-    v.z = c.z.data();
-    v.time_offset = c.time_offset.data();
     std::string error;
     if (!pipeline_.addScan(v, &error)) {
       node_.reject(options_.scan_channel, error);
@@ -55,8 +46,8 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
     publishRecoloured(m.utime);
   });
   node_.subscribe<odometry_t>(options_.odometry_channel, [this](const odometry_t& m) {
-    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
-      node_.reject(options_.odometry_channel, "pose is not finite");
+    if (const std::string why = poseProblem(m.position, m.orientation); !why.empty()) {
+      node_.reject(options_.odometry_channel, why);
       return;
     }
     pipeline_.addPose(m.utime, poseFrom(m.position, m.orientation));
@@ -73,27 +64,28 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
     raw.size = std::min<size_t>(m.data.size(), m.size > 0 ? static_cast<size_t>(m.size) : 0);
     ColourImage img;
     std::string error;
+    const int64_t dropped = pipeline_.stats().images_dropped;
     if (!decodeImage(raw, &img, &error) || !pipeline_.addImage(std::move(img), &error)) {
       node_.reject(options_.image_channel, error);
       return;
     }
+    if (pipeline_.stats().images_dropped > dropped)
+      node_.warn("more than " + std::to_string(options_.core.max_pending_images) +
+                 " images wait for registered scans: the oldest is dropped");
     publishRecoloured(m.utime);
   });
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
-    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
-      node_.reject(options_.keyframe_channel, "pose is not finite");
+    if (const std::string why = poseProblem(m.position, m.orientation); !why.empty()) {  // the cloud is not used
+      node_.reject(options_.keyframe_channel, why);
       return;
     }
     pipeline_.addKeyframe(m.id, m.utime, poseFrom(m.position, m.orientation));
   });
   node_.subscribe<loop_correction_t>(options_.correction_channel, [this](const loop_correction_t& m) {
     std::map<int64_t, Pose3> corrected;
-    for (int i = 0; i < m.num_keyframes && i < static_cast<int>(m.keyframe_id.size()); ++i) {
-      if (!allFinite(m.position[i].data(), 3) || !allFinite(m.orientation[i].data(), 4)) {
-        node_.reject(options_.correction_channel, "corrected pose is not finite");
-        return;
-      }
-      corrected[m.keyframe_id[i]] = poseFrom(m.position[i].data(), m.orientation[i].data());
+    if (const std::string why = correctedKeyframePoses(m, &corrected); !why.empty()) {
+      node_.reject(options_.correction_channel, why);
+      return;
     }
     const int moved = pipeline_.applyCorrection(corrected);
     std::ostringstream s;

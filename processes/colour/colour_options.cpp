@@ -7,7 +7,8 @@ namespace colour {
 
 void printColourOptions(const ColourOptions& o, std::ostream& os) {
   os << "colour: voxel_size " << o.voxel_size << " m, max_time_difference " << o.max_time_difference
-     << " s, depth " << o.min_depth << ".." << o.max_depth << " m, border " << o.border_px << " px\n"
+     << " s, depth " << o.min_depth << ".." << o.max_depth << " m, border " << o.border_px << " px, at most "
+     << o.max_pending_images << " images waiting\n"
      << "  occlusion: cell " << o.depth_cell_px << " px, occluder_radius " << o.occluder_radius
      << " m (max " << o.max_splat_cells << " cells), tolerance " << o.depth_tolerance << " m + "
      << o.depth_tolerance_rel << " z\n"

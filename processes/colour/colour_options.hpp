@@ -15,6 +15,8 @@ struct ColourOptions {
   double max_depth = 30.0;             // m in front of the camera
   double min_depth = 0.2;              // m
   int border_px = 2;                   // ignore pixels this close to the image border
+  int max_pending_images = 50;         // images waiting for scans (no LIO output): the oldest is
+                                       // dropped beyond this, so memory stays bounded
   // Occlusion test (depth buffer over the image)
   int depth_cell_px = 4;               // depth-buffer cell size in pixels
   double occluder_radius = 0.06;       // m: each point covers a disc of this radius in the buffer

@@ -29,7 +29,7 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
 
 void ColouringPipeline::addPose(int64_t utime, const Pose3& T_W_I) { poses_.add(utime, T_W_I); }
 
-bool ColouringPipeline::addScan(const ScanView& scan, std::string* error) {
+bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* error) {
   if (scan.utime <= last_scan_utime_) {
     *error = "scan stamp not after the previous scan";
     return false;
@@ -81,6 +81,10 @@ bool ColouringPipeline::addImage(ColourImage image, std::string* error) {
   last_image_utime_ = image.utime;
   images_.push_back(std::move(image));
   processReady(false);
+  while (images_.size() > static_cast<size_t>(std::max(1, options_.max_pending_images))) {
+    images_.pop_front();
+    ++stats_.images_dropped;
+  }
   return true;
 }
 
@@ -114,14 +118,18 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
     double z;
   };
   std::vector<Candidate> candidates;
-  ++visit_;
+  // stamps older than this visit never equal it, whatever point they belonged to before a merge
+  visited_.resize(map_.size(), 0);
+  if (++visit_ == 0) {  // wrapped
+    std::fill(visited_.begin(), visited_.end(), 0);
+    visit_ = 1;
+  }
   for (const ActiveScan& scan : active_) {
     if (scan.t_max < t0 || scan.t_min > t1) continue;
     for (const auto& [id, t] : scan.points) {
-      if (t < t0 || t > t1) continue;
-      MapPoint& mp = map_.point(id);
-      if (mp.visit == visit_) continue;
-      mp.visit = visit_;
+      if (t < t0 || t > t1 || visited_[id] == visit_) continue;
+      visited_[id] = visit_;
+      const MapPoint& mp = map_.point(id);
       const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
       if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
       Eigen::Vector2d px;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "livo/camera_projection.hpp"
+#include "livo/map_inputs.hpp"
 #include "colour_image.hpp"
 #include "colour_map.hpp"
 #include "colour_options.hpp"
@@ -28,18 +29,6 @@
 
 namespace livo {
 namespace colour {
-
-/// A registered scan (world frame), as plain arrays.
-struct ScanView {
-  int64_t utime = 0;        // sweep end: the pose's time
-  int64_t cloud_utime = 0;  // point j measured at cloud_utime + time_offset[j]
-  Pose3 T_W_I = Pose3::Identity();
-  int num_points = 0;
-  const float* x = nullptr;
-  const float* y = nullptr;
-  const float* z = nullptr;
-  const float* time_offset = nullptr;  // may be null (all at cloud_utime)
-};
 
 /// One colour sample accepted into the map (for diagnostics and the bars).
 struct Observation {
@@ -52,7 +41,7 @@ struct Observation {
 
 struct ColouringStats {
   int64_t scans = 0, points_in = 0, points_rejected = 0;
-  int64_t images = 0, images_without_pose = 0;
+  int64_t images = 0, images_without_pose = 0, images_dropped = 0;  // dropped: waited beyond max_pending_images
   int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
   int64_t gain_estimates = 0;
   double last_gain = 1.0;
@@ -66,7 +55,7 @@ class ColouringPipeline {
   void addPose(int64_t utime, const Pose3& T_W_I);
   /// Adds a scan's points to the map (non-finite points are skipped and counted) and processes
   /// the images it makes ready. False (and nothing changes) for a scan older than the last one.
-  bool addScan(const ScanView& scan, std::string* error);
+  bool addScan(const RegisteredScanView& scan, std::string* error);
   /// Queues an image; processes it at once if it is ready. False if older than the last image.
   bool addImage(ColourImage image, std::string* error);
   /// Processes every queued image that has a pose (end of stream).
@@ -108,6 +97,7 @@ class ColouringPipeline {
   int64_t newest_scan_end_ = INT64_MIN;
   double reference_exposure_ = 0.0;
   uint32_t visit_ = 0;
+  std::vector<uint32_t> visited_;  // per map point: the last visit_ that looked at it (dense: cache-friendly)
   std::vector<uint8_t> recoloured_flag_;
   std::vector<uint32_t> recoloured_;
   std::function<void(const Observation&)> observer_;

@@ -2,39 +2,16 @@
 
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
+
+#include "livo/file_output.hpp"
 
 namespace livo {
 namespace colour {
 
 namespace {
-
-bool writeAtomically(const std::string& path, const std::string& header, const std::vector<char>& body,
-                     std::string* error) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      *error = "cannot write " + tmp;
-      return false;
-    }
-    out.write(header.data(), static_cast<std::streamsize>(header.size()));
-    out.write(body.data(), static_cast<std::streamsize>(body.size()));
-    if (!out) {
-      *error = "write failed: " + tmp;
-      return false;
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    *error = "cannot rename " + tmp + " to " + path + ": " + ec.message();
-    return false;
-  }
-  return true;
-}
 
 template <class T>
 void put(std::vector<char>* out, const T& v) {
@@ -70,7 +47,7 @@ bool writePly(const std::string& path, const ColouredPoints& pts, std::string* e
     for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
     for (int k = 0; k < 3; ++k) put(&body, pts.rgb[i][k]);
   }
-  return writeAtomically(path, h.str(), body, error);
+  return writeFileAtomically(path, {h.str(), std::string_view(body.data(), body.size())}, error);
 }
 
 bool writePcd(const std::string& path, const ColouredPoints& pts, std::string* error) {
@@ -84,7 +61,7 @@ bool writePcd(const std::string& path, const ColouredPoints& pts, std::string* e
     for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
     put(&body, packRgb(pts.rgb[i]));  // the bits of PCL's packed float rgb
   }
-  return writeAtomically(path, h.str(), body, error);
+  return writeFileAtomically(path, {h.str(), std::string_view(body.data(), body.size())}, error);
 }
 
 bool readPly(const std::string& path, ColouredPoints* pts, std::string* error) {

@@ -50,18 +50,38 @@ bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error)
   return true;
 }
 
-void OctomapBuilder::addKeyframe(int64_t id, Keyframe keyframe) { keyframes_[id] = std::move(keyframe); }
+bool OctomapBuilder::addKeyframe(int64_t id, Keyframe keyframe) {
+  if (!keyframe.T_W_I.matrix().allFinite()) return false;
+  StoredKeyframe& k = keyframes_[id];
+  // the keyframe's sweep went into the tree (as a registered scan) at the keyframe's pose
+  k.in_tree = keyframe.T_W_I;
+  k.reach = T_I_L_.translation().norm();
+  for (const Eigen::Vector3f& p : keyframe.points) k.reach = std::max(k.reach, double(p.norm()));
+  k.keyframe = std::move(keyframe);
+  return true;
+}
 
 int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
   int moved = 0;
   for (const auto& [id, pose] : corrected) {
     auto it = keyframes_.find(id);
     if (it == keyframes_.end() || !pose.matrix().allFinite()) continue;
-    if ((pose.matrix() - it->second.T_W_I.matrix()).cwiseAbs().maxCoeff() < 1e-12) continue;
-    it->second.T_W_I = pose;
+    Keyframe& k = it->second.keyframe;
+    if ((pose.matrix() - k.T_W_I.matrix()).cwiseAbs().maxCoeff() < 1e-12) continue;
+    k.T_W_I = pose;
     ++moved;
   }
-  if (moved) rebuild();
+  // how far the tree's contents are from the corrected keyframes: a point p of the body frame
+  // moves by |(R1 - R0) p + t1 - t0| <= |t1 - t0| + 2 sin(angle / 2) |p|
+  last_shift_ = 0.0;
+  for (const auto& [id, k] : keyframes_) {
+    const Pose3& a = k.in_tree;
+    const Pose3& b = k.keyframe.T_W_I;
+    const double angle = so3::Log(Mat3(a.linear().transpose() * b.linear())).norm();
+    last_shift_ = std::max(last_shift_, (b.translation() - a.translation()).norm() + 2.0 * std::sin(0.5 * angle) * k.reach);
+  }
+  last_rebuilt_ = moved > 0 && last_shift_ > options_.rebuild_tolerance;
+  if (last_rebuilt_) rebuild();
   // the next scan comes in the corrected frame: do not interpolate across the jump
   have_previous_ = false;
   return moved;
@@ -69,11 +89,14 @@ int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
 
 void OctomapBuilder::rebuild() {
   map_.clear();
-  for (const auto& [id, kf] : keyframes_) {
-    std::vector<Eigen::Vector3f> world;
+  std::vector<Eigen::Vector3f> world;
+  for (auto& [id, stored] : keyframes_) {
+    const Keyframe& kf = stored.keyframe;
+    world.clear();
     world.reserve(kf.points.size());
     for (const Eigen::Vector3f& p : kf.points) world.push_back((kf.T_W_I * p.cast<double>()).cast<float>());
     map_.insertRays(world, (kf.T_W_I * T_I_L_).translation());
+    stored.in_tree = kf.T_W_I;
   }
   ++rebuilds_;
 }

@@ -1,7 +1,10 @@
 // Builds the OctoMap from registered scans: each sweep is cut into time slices cast from the
 // LiDAR position at the slice's time (interpolated between the previous sweep's end pose and
 // this one's), and keeps the keyframes (body-frame clouds) so that after a loop correction the
-// map is rebuilt from the corrected keyframe poses.
+// map is rebuilt from the corrected keyframe poses, each cloud cast from its LiDAR origin
+// T_W_I * T_I_L. A correction that moves no keyframe point by more than rebuild_tolerance from
+// where the tree has it leaves the tree as it is (the shifts are measured against the poses of
+// the last rebuild, so small corrections cannot add up unnoticed).
 #pragma once
 
 #include <cstdint>
@@ -9,22 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "livo/map_inputs.hpp"
 #include "livo/so3.hpp"
 #include "occupancy_map.hpp"
 
 namespace livo {
 namespace octomap_export {
-
-struct RegisteredScanView {
-  int64_t utime = 0;        // sweep end, the pose's time
-  int64_t cloud_utime = 0;  // sweep start
-  Pose3 T_W_I = Pose3::Identity();
-  int num_points = 0;
-  const float* x = nullptr;
-  const float* y = nullptr;
-  const float* z = nullptr;
-  const float* time_offset = nullptr;  // may be null
-};
 
 struct Keyframe {
   int64_t utime = 0;
@@ -38,10 +31,17 @@ class OctomapBuilder {
 
   /// False with `error` for a stale or malformed scan (nothing is inserted).
   bool addScan(const RegisteredScanView& scan, std::string* error);
-  void addKeyframe(int64_t id, Keyframe keyframe);
-  /// Moves the listed keyframes and, if any moved, rebuilds the map from every keyframe.
-  /// Returns the number that moved.
+  /// Keeps a keyframe for rebuilds (a later one with the same id replaces it); false (and nothing
+  /// kept) for a non-finite pose.
+  bool addKeyframe(int64_t id, Keyframe keyframe);
+  /// Moves the listed keyframes (unknown ids are ignored) and rebuilds the map from every
+  /// keyframe if a keyframe point now lies more than rebuild_tolerance from where the tree has it.
+  /// Returns the number of keyframes that moved.
   int applyCorrection(const std::map<int64_t, Pose3>& corrected);
+  /// After applyCorrection: the largest shift of a keyframe point (or LiDAR origin) from where the
+  /// tree has it, m (an upper bound: |dt| + 2 sin(angle / 2) * reach), and whether it rebuilt.
+  double lastCorrectionShift() const { return last_shift_; }
+  bool lastCorrectionRebuilt() const { return last_rebuilt_; }
 
   OccupancyMap& map() { return map_; }
   const OccupancyMap& map() const { return map_; }
@@ -50,11 +50,18 @@ class OctomapBuilder {
   size_t keyframes() const { return keyframes_.size(); }
 
  private:
+  struct StoredKeyframe {
+    Keyframe keyframe;
+    Pose3 in_tree = Pose3::Identity();  // the pose the tree has this keyframe's data at
+    double reach = 0.0;                 // farthest point (or the LiDAR origin) from the body origin, m
+  };
   void rebuild();
   OctomapOptions options_;
   Pose3 T_I_L_;
   OccupancyMap map_;
-  std::map<int64_t, Keyframe> keyframes_;
+  std::map<int64_t, StoredKeyframe> keyframes_;
+  double last_shift_ = 0.0;
+  bool last_rebuilt_ = false;
   bool have_previous_ = false;
   int64_t previous_utime_ = 0;
   Pose3 previous_pose_ = Pose3::Identity();

@@ -18,6 +18,7 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
     c.readOptional("colour", o.colour);
     c.readOptional("origin_segments", o.origin_segments);
     c.readOptional("free_margin", o.free_margin);
+    c.readOptional("rebuild_tolerance", o.rebuild_tolerance);
     c.readOptional("scan_channel", n.scan_channel);
     c.readOptional("colour_channel", n.colour_channel);
     c.readOptional("keyframe_channel", n.keyframe_channel);
@@ -38,6 +39,7 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
   if (!(o.occupancy_threshold > 0.0 && o.occupancy_threshold < 1.0)) fail("occupancy_threshold", "must be in (0, 1)");
   if (!(o.free_margin >= 0.0 && o.free_margin < o.max_range)) fail("free_margin", "must be in [0, max_range)");
   if (o.origin_segments < 1) fail("origin_segments", "must be >= 1");
+  if (!(o.rebuild_tolerance >= 0.0)) fail("rebuild_tolerance", "must be >= 0");
   if (n.publish_period_s < 0.0) fail("publish_period_s", "must be >= 0");
   if (n.write_period_s < 0.0) fail("write_period_s", "must be >= 0");
   if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");

@@ -1,11 +1,12 @@
 #include "octomap_node.hpp"
 
 #include <filesystem>
+#include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
-#include "livo/message_checks.hpp"
+#include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
 #include "livo/octomap_t.hpp"
 #include "livo/registered_scan_t.hpp"
@@ -21,20 +22,11 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       output_dir_(std::move(output_dir)) {
   if (options_.publish_period_s > 0) node_.declareOutput(options_.output_channel);
   node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
-    const point_cloud_t& c = m.cloud;
-    if (const std::string why = registeredScanProblem(m); !why.empty()) {
+    RegisteredScanView v;
+    if (const std::string why = viewRegisteredScan(m, &v); !why.empty()) {
       node_.reject(options_.scan_channel, why);
       return;
     }
-    RegisteredScanView v;
-    v.utime = m.utime;
-    v.cloud_utime = c.utime;
-    v.T_W_I = poseFrom(m.position, m.orientation);
-    v.num_points = c.num_points;
-    v.x = c.x.data();
-    v.y = c.y.data();
-    v.z = c.z.data();
-    v.time_offset = c.time_offset.data();
     std::string error;
     if (!builder_.addScan(v, &error)) {
       node_.reject(options_.scan_channel, error);
@@ -59,16 +51,11 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
     });
   }
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
-    if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
-      node_.reject(options_.keyframe_channel, "pose is not finite");
+    if (const std::string why = keyframeProblem(m); !why.empty()) {
+      node_.reject(options_.keyframe_channel, why);
       return;
     }
     const point_cloud_t& c = m.cloud;
-    if (static_cast<int>(c.x.size()) != c.num_points || static_cast<int>(c.y.size()) != c.num_points ||
-        static_cast<int>(c.z.size()) != c.num_points) {
-      node_.reject(options_.keyframe_channel, "cloud arrays disagree with num_points");
-      return;
-    }
     Keyframe k;
     k.utime = m.utime;
     k.T_W_I = poseFrom(m.position, m.orientation);
@@ -76,21 +63,22 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       const Eigen::Vector3f p(c.x[i], c.y[i], c.z[i]);
       if (p.allFinite()) k.points.push_back(p);
     }
-    builder_.addKeyframe(m.id, std::move(k));
+    if (!builder_.addKeyframe(m.id, std::move(k))) node_.reject(options_.keyframe_channel, "pose is not finite");
   });
   node_.subscribe<loop_correction_t>(options_.correction_channel, [this](const loop_correction_t& m) {
     std::map<int64_t, Pose3> corrected;
-    for (int i = 0; i < m.num_keyframes && i < static_cast<int>(m.keyframe_id.size()); ++i) {
-      if (!allFinite(m.position[i].data(), 3) || !allFinite(m.orientation[i].data(), 4)) {
-        node_.reject(options_.correction_channel, "corrected pose is not finite");
-        return;
-      }
-      corrected[m.keyframe_id[i]] = poseFrom(m.position[i].data(), m.orientation[i].data());
+    if (const std::string why = correctedKeyframePoses(m, &corrected); !why.empty()) {
+      node_.reject(options_.correction_channel, why);
+      return;
     }
     const int moved = builder_.applyCorrection(corrected);
-    node_.info("loop correction: " + std::to_string(moved) + " keyframes moved; rebuilt from " +
-               std::to_string(builder_.keyframes()) + " keyframes");
-    if (moved) publishTree(m.utime);
+    std::ostringstream s;
+    s << "loop correction: " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
+      << " m; ";
+    if (builder_.lastCorrectionRebuilt()) s << "rebuilt from " << builder_.keyframes() << " keyframes";
+    else s << "tree kept (rebuild_tolerance " << options_.core.rebuild_tolerance << " m)";
+    node_.info(s.str());
+    if (builder_.lastCorrectionRebuilt()) publishTree(m.utime);
   });
 }
 

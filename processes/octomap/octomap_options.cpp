@@ -9,7 +9,8 @@ void printOctomapOptions(const OctomapOptions& o, std::ostream& os) {
   os << "octomap: resolution " << o.resolution << " m, range " << o.min_range << ".." << o.max_range
      << " m, prob_hit " << o.prob_hit << ", prob_miss " << o.prob_miss << ", clamping " << o.clamping_min << ".."
      << o.clamping_max << ", threshold " << o.occupancy_threshold << ", " << (o.colour ? "ColorOcTree" : "OcTree")
-     << ", free_margin " << o.free_margin << " m, origin_segments " << o.origin_segments << "\n";
+     << ", free_margin " << o.free_margin << " m, origin_segments " << o.origin_segments << ", rebuild_tolerance "
+     << o.rebuild_tolerance << " m\n";
 }
 
 }  // namespace octomap_export

@@ -20,6 +20,9 @@ struct OctomapOptions {
                                   // (grazing rays then spare the surface they are about to hit)
   int origin_segments = 8;        // a sweep is cut into this many time slices, each cast from the
                                   // LiDAR position at its time (spinning sensors move during a sweep)
+  double rebuild_tolerance = 0.05;  // m: a loop correction rebuilds the tree from the keyframes only
+                                    // if it moves some keyframe point farther than this from where
+                                    // the tree has it (0: after any change)
 };
 
 void printOctomapOptions(const OctomapOptions& o, std::ostream& os);

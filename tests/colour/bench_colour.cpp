@@ -39,7 +39,7 @@ void events(benchmark::State& state, int timed_kind, bool with_images) {
       pipe->addPose(rec.poses[e.second].utime, rec.poses[e.second].T_W_I);
     } else if (e.first == 1) {
       const livo_bench::WorldSweep& s = rec.sweeps[e.second];
-      livo::colour::ScanView v;
+      livo::RegisteredScanView v;
       v.utime = s.utime, v.cloud_utime = s.cloud_utime, v.T_W_I = s.T_W_I;
       v.num_points = static_cast<int>(s.x.size());
       v.x = s.x.data(), v.y = s.y.data(), v.z = s.z.data(), v.time_offset = s.time_offset.data();

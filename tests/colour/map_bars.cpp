@@ -89,7 +89,7 @@ class BarSink : public sim::SensorDataSink {
       if (hit.valid()) truth_voxels_.insert(voxelKey(ray.origin + hit.t * ray.direction, res_));
     }
     const Pose3 T_end = setup_.trajectory->at(setup_.trajectoryTime(end)).T_W_I;
-    colour::ScanView cv;
+    RegisteredScanView cv;
     cv.utime = end;
     cv.cloud_utime = s.utime;
     cv.T_W_I = T_end;
@@ -105,14 +105,8 @@ class BarSink : public sim::SensorDataSink {
       auto it = origin_of.find(bitsOf(p));
       if (it != origin_of.end()) truth_[id] = trueColour(it->second, p.cast<double>());
     }
-    octomap_export::RegisteredScanView ov;
-    ov.utime = end;
-    ov.cloud_utime = s.utime;
-    ov.T_W_I = T_end;
-    ov.num_points = cv.num_points;
-    ov.x = x.data(), ov.y = y.data(), ov.z = z.data(), ov.time_offset = s.time_offset.data();
     c0 = cpuSeconds();
-    octo_.addScan(ov, &error);
+    octo_.addScan(cv, &error);  // the same view
     octo_cpu_ += cpuSeconds() - c0;
     ++scans_;
   }

@@ -22,9 +22,9 @@ using livo_test::WallAndBox;
 
 namespace {
 
-ScanView viewOf(int64_t utime, const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
+RegisteredScanView viewOf(int64_t utime, const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
                 const std::vector<float>& dt, const Pose3& T = Pose3::Identity()) {
-  ScanView v;
+  RegisteredScanView v;
   v.utime = utime;
   v.cloud_utime = utime - 100000;
   v.T_W_I = T;
@@ -268,6 +268,38 @@ TEST(ColouringPipeline, RefusesStaleStampsAndSkipsNonFinitePoints) {
   small.utime = 3000000;
   small.pixels = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
   EXPECT_FALSE(pipe.addImage(small, &error));
+}
+
+// Without registered scans (no LIO output) images cannot be processed: at most max_pending_images
+// wait, the oldest are dropped and counted, and the ones kept are coloured once scans come.
+TEST(ColouringPipeline, PendingImagesAreBoundedWhileNoScansCome) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColourOptions o;
+  o.max_pending_images = 4;
+  o.max_time_difference = 0.1;
+  ColouringPipeline pipe(o, rig);
+  std::string error;
+  const ColourImage frame = WallAndBox::render(rig, 0);
+  for (int k = 0; k < 10; ++k) {
+    ColourImage img = frame;
+    img.utime = 1000000 + 50000 * k;
+    ASSERT_TRUE(pipe.addImage(img, &error)) << error;
+    EXPECT_LE(pipe.pendingImages(), 4u);
+  }
+  EXPECT_EQ(pipe.pendingImages(), 4u);
+  EXPECT_EQ(pipe.stats().images_dropped, 6);
+  // the kept ones (1.30 .. 1.45 s) are coloured when scans and poses cover them
+  pipe.addPose(1200000, Pose3::Identity());
+  std::vector<float> x, y, z;
+  WallAndBox::points(0.05, 0.1, &x, &y, &z);
+  for (int64_t t = 1300000; t <= 1700000; t += 100000) {
+    const std::vector<float> at(x.size(), 0.05f);
+    ASSERT_TRUE(pipe.addScan(viewOf(t, x, y, z, at), &error)) << error;
+  }
+  EXPECT_EQ(pipe.pendingImages(), 0u);
+  EXPECT_EQ(pipe.stats().images, 4);
+  EXPECT_EQ(pipe.stats().images_without_pose, 0);
+  EXPECT_GT(pipe.map().colouredCount(), 1000u);
 }
 
 TEST(ColourImage, DecodesRawAndCompressedAndRefusesGarbage) {

@@ -1,7 +1,9 @@
 // livo-colour's node on LCM's in-process memq:// provider: scans, odometry and images in,
 // COLORED_CLOUD out, map files on finish, bad input refused without a crash.
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
@@ -9,6 +11,8 @@
 #include "colour_node.hpp"
 #include "livo/colored_cloud_t.hpp"
 #include "livo/image_t.hpp"
+#include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_t.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "map_files.hpp"
@@ -55,41 +59,62 @@ image_t makeImage(const CameraRig& rig, int64_t utime) {
   return m;
 }
 
+/// A colour node on `lcm` with the test camera, a 0.1 s time window, quiet, no HEALTH.
+struct TestNode {
+  SensorRig rig;
+  colour::ColourNode node;
+  TestNode(lcm::LCM& lcm, const std::string& dir) : rig(withCamera()), node(lcm, quiet(), options(), rig, dir) {}
+  static SensorRig withCamera() {
+    SensorRig r;
+    r.camera = livo_test::testCamera(false);
+    return r;
+  }
+  static colour::ColourNodeOptions options() {
+    colour::ColourNodeOptions o;
+    o.core.max_time_difference = 0.1;
+    return o;
+  }
+  static NodeOptions quiet() {
+    NodeOptions n;
+    n.name = "colour";
+    n.quiet = true;
+    n.health_period_s = 0;
+    return n;
+  }
+};
+
+/// The body at the origin, at 0.9 .. 1.2 s.
+void publishStillOdometry(lcm::LCM& lcm) {
+  odometry_t odo{};
+  odo.orientation[0] = 1.0;
+  for (int64_t utime : {900000, 1000000, 1100000, 1200000}) {
+    odo.utime = utime;
+    lcm.publish("ODOMETRY", &odo);
+  }
+}
+
+/// Every COLORED_CLOUD message, appended to `out`.
+void collect(lcm::LCM& lcm, std::vector<colored_cloud_t>* out) {
+  lcm.subscribeFunction<colored_cloud_t, std::vector<colored_cloud_t>*>(
+      "COLORED_CLOUD",
+      [](const lcm::ReceiveBuffer*, const std::string&, const colored_cloud_t* m, std::vector<colored_cloud_t>* o) {
+        o->push_back(*m);
+      },
+      out);
+}
+
 }  // namespace
 
 TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  SensorRig rig;
-  rig.camera = livo_test::testCamera(false);
-  colour::ColourNodeOptions options;
-  options.core.max_time_difference = 0.1;
-  NodeOptions node_options;
-  node_options.name = "colour";
-  node_options.quiet = true;
-  node_options.health_period_s = 0;
-  const std::string dir = livo_test::tempPath("colour_out");
-  colour::ColourNode node(lcm, node_options, options, rig, dir);
+  TestNode t(lcm, livo_test::tempPath("colour_out"));
+  colour::ColourNode& node = t.node;
+  const SensorRig& rig = t.rig;
+  std::vector<colored_cloud_t> received;
+  collect(lcm, &received);
 
-  int64_t published_points = 0, messages = 0;
-  auto* sub = lcm.subscribeFunction<colored_cloud_t, int64_t*>(
-      "COLORED_CLOUD",
-      [](const lcm::ReceiveBuffer*, const std::string&, const colored_cloud_t* m, int64_t* n) {
-        *n += m->num_points;
-      },
-      &published_points);
-  (void)sub;
-  auto* sub2 = lcm.subscribeFunction<colored_cloud_t, int64_t*>(
-      "COLORED_CLOUD", [](const lcm::ReceiveBuffer*, const std::string&, const colored_cloud_t*, int64_t* n) { ++*n; },
-      &messages);
-  (void)sub2;
-
-  odometry_t odo{};
-  odo.orientation[0] = 1.0;
-  for (int64_t t : {900000, 1000000, 1100000, 1200000}) {
-    odo.utime = t;
-    lcm.publish("ODOMETRY", &odo);
-  }
+  publishStillOdometry(lcm);
   const image_t img = makeImage(*rig.camera, 1050000);
   lcm.publish("CAMERA", &img);
   const registered_scan_t scan = makeScan(1100000);
@@ -100,7 +125,9 @@ TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
   lcm.publish("REGISTERED_SCAN", &next);
   drain(lcm);
   EXPECT_EQ(node.pipeline().stats().images, 1);
-  EXPECT_GT(messages, 0);
+  ASSERT_GT(received.size(), 0u);
+  int64_t published_points = 0;
+  for (const colored_cloud_t& m : received) published_points += m.num_points;
   EXPECT_GT(published_points, 2000);
 
   // bad input: empty cloud, NaN pose, stale scan, undecodable JPEG, wrong frame
@@ -134,6 +161,69 @@ TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
   EXPECT_EQ(back.size(), node.pipeline().map().colouredCount());
 }
 
+// KEYFRAME and LOOP_CORRECTION over the bus: the points anchored to a corrected keyframe move with
+// it and are published again on COLORED_CLOUD at their new positions; a malformed correction is
+// refused and moves nothing.
+TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  TestNode t(lcm, livo_test::tempPath("colour_loop"));
+  colour::ColourNode& node = t.node;
+  std::vector<colored_cloud_t> received;
+  collect(lcm, &received);
+
+  keyframe_t kf{};
+  kf.id = 0;
+  kf.utime = 1000000;
+  kf.orientation[0] = 1.0;
+  kf.cloud.frame = "I";
+  lcm.publish("KEYFRAME", &kf);
+  publishStillOdometry(lcm);
+  const image_t img = makeImage(*t.rig.camera, 1050000);
+  lcm.publish("CAMERA", &img);
+  for (int64_t utime : {1100000, 1200000}) {
+    const registered_scan_t scan = makeScan(utime);
+    lcm.publish("REGISTERED_SCAN", &scan);
+  }
+  drain(lcm);
+  const size_t coloured = node.pipeline().map().colouredCount();
+  ASSERT_GT(coloured, 1000u);
+  std::vector<Eigen::Vector3f> before;
+  for (const auto& p : node.pipeline().map().points()) before.push_back(p.position);
+  const size_t messages = received.size();
+
+  loop_correction_t bad{};
+  bad.utime = 1300000;
+  bad.correction_orientation[0] = 1.0;
+  bad.num_keyframes = 1;
+  bad.keyframe_id = {0};
+  bad.position = {{0.5, 0.0, 0.0}};
+  bad.orientation = {{NAN, 0.0, 0.0, 0.0}};
+  lcm.publish("LOOP_CORRECTION", &bad);
+  drain(lcm);
+  EXPECT_EQ(received.size(), messages);
+  EXPECT_EQ(node.pipeline().map().points()[0].position, before[0]);
+
+  loop_correction_t good = bad;
+  good.orientation = {{1.0, 0.0, 0.0, 0.0}};  // keyframe 0 was 0.5 m further along x
+  lcm.publish("LOOP_CORRECTION", &good);
+  drain(lcm);
+  ASSERT_EQ(received.size(), messages + 1);
+  const colored_cloud_t& moved = received.back();
+  EXPECT_EQ(moved.utime, 1300000);
+  EXPECT_EQ(static_cast<size_t>(moved.num_points), node.pipeline().map().colouredCount());
+  EXPECT_GT(static_cast<size_t>(moved.num_points), coloured / 2);  // a few merge into shared voxels
+  // each published point is a point of the map before the correction, moved by +0.5 m in x
+  auto cell = [](const Eigen::Vector3f& p) {
+    return std::array<long, 3>{std::lround(p.x() * 100), std::lround(p.y() * 100), std::lround(p.z() * 100)};
+  };
+  std::set<std::array<long, 3>> shifted;
+  for (const Eigen::Vector3f& b : before) shifted.insert(cell(b + Eigen::Vector3f(0.5f, 0.f, 0.f)));
+  int found = 0;
+  for (int i = 0; i < moved.num_points; ++i) found += shifted.count(cell({moved.x[i], moved.y[i], moved.z[i]})) ? 1 : 0;
+  EXPECT_EQ(found, moved.num_points);
+}
+
 TEST(ColourNode, RefusesARigWithoutCamera) {
   lcm::LCM lcm("memq://");
   SensorRig rig;
@@ -151,4 +241,9 @@ TEST(ColourConfig, ReadsKeysStrictly) {
   EXPECT_EQ(o.map_name, "room");
   EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {voxel_sise: 0.1}").section("colour")), ConfigError);
   EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {voxel_size: -1}").section("colour")), ConfigError);
+  EXPECT_EQ(colour::readColourOptions(Config::fromString("colour: {max_pending_images: 8}").section("colour"))
+                .core.max_pending_images,
+            8);
+  EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {max_pending_images: 0}").section("colour")),
+               ConfigError);
 }

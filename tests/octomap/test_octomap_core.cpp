@@ -160,6 +160,111 @@ TEST(OctomapBuilder, RebuildsFromCorrectedKeyframes) {
   EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 2.55)), 1);
 }
 
+// After a loop correction the tree holds exactly the keyframes' clouds at their corrected poses,
+// each ray-cast from that keyframe's LiDAR origin T_W_I * T_I_L (not the body origin): a keyframe
+// whose pose changed moves its wall and its free space, an unchanged one stays, and the sweeps
+// registered before the correction are gone.
+TEST(OctomapBuilder, RebuildCastsEachCorrectedKeyframeFromItsLidarOrigin) {
+  Pose3 T_I_L = Pose3::Identity();
+  T_I_L.linear() = so3::Exp(Vec3(0.0, 0.0, 30.0 * M_PI / 180.0));  // must not touch the body-frame points
+  T_I_L.translation() = Vec3(0.5, 0.0, 1.0);
+  OctomapBuilder builder(options(false), T_I_L);
+
+  // keyframe 0: a wall 2.55 m ahead of the body; keyframe 1: a wall 2.55 m behind it
+  Pose3 odom = Pose3::Identity();
+  odom.translation() = Vec3(0.0, 0.05, 0.0);
+  Keyframe ahead, behind;
+  ahead.utime = 1000000;
+  behind.utime = 2000000;
+  ahead.T_W_I = behind.T_W_I = odom;
+  for (int k = -9; k <= 9; ++k)
+    for (int j = 0; j < 20; ++j) {
+      ahead.points.emplace_back(2.55f, 0.1f * k, 0.05f + 0.1f * j);
+      behind.points.emplace_back(-2.55f, 0.1f * k, 0.05f + 0.1f * j);
+    }
+  // the sweep registered at keyframe 0 (world frame = odometry frame)
+  std::vector<float> x, y, z, dt;
+  for (const Eigen::Vector3f& p : ahead.points) {
+    const Eigen::Vector3f w = (odom * p.cast<double>()).cast<float>();
+    x.push_back(w.x()), y.push_back(w.y()), z.push_back(w.z()), dt.push_back(0.f);
+  }
+  RegisteredScanView v;
+  v.utime = 1000000;
+  v.cloud_utime = 900000;
+  v.T_W_I = odom;
+  v.num_points = static_cast<int>(x.size());
+  v.x = x.data(), v.y = y.data(), v.z = z.data(), v.time_offset = dt.data();
+  std::string error;
+  ASSERT_TRUE(builder.addScan(v, &error)) << error;
+  builder.addKeyframe(0, ahead);
+  builder.addKeyframe(1, behind);
+  const Eigen::Vector3d old_wall(2.55, 0.05, 0.55), new_wall(0.95, 2.55, 0.55), back_wall(-2.55, 0.05, 0.55);
+  EXPECT_EQ(builder.map().classify(old_wall), 1);
+  EXPECT_EQ(builder.map().classify(back_wall), -1);  // keyframes alone do not enter the tree
+
+  // keyframe 0 turns out to have been 1.05 m further along x and turned left by 90 degrees
+  Pose3 corrected = Pose3::Identity();
+  corrected.linear() = so3::Exp(Vec3(0.0, 0.0, M_PI / 2));
+  corrected.translation() = Vec3(1.05, 0.0, 0.0);
+  EXPECT_EQ(builder.applyCorrection({{0, corrected}, {1, odom}, {9, corrected}}), 1);  // 1 unchanged, 9 unknown
+  EXPECT_EQ(builder.rebuilds(), 1);
+  EXPECT_EQ(builder.map().classify(new_wall), 1);    // keyframe 0's wall at its corrected pose
+  EXPECT_EQ(builder.map().classify(back_wall), 1);   // keyframe 1 at its (unchanged) pose
+  EXPECT_EQ(builder.map().classify(old_wall), -1);   // the old sweep and the old pose are gone
+  // free space from keyframe 0's LiDAR origin, (1.05, 0.5, 1.0) in the world, to its wall ...
+  const Eigen::Vector3d lidar = (corrected * T_I_L).translation();
+  EXPECT_NEAR((lidar - Eigen::Vector3d(1.05, 0.5, 1.0)).norm(), 0.0, 1e-9);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(1.05, 1.5, 1.02)), 0);
+  // ... and none at the body's height under it: a ray cast from the body origin would clear it
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(1.05, 0.95, 0.05)), -1);
+  // every occupied voxel is on one of the two walls
+  for (const Eigen::Vector3d& c : builder.map().occupiedVoxels())
+    EXPECT_TRUE(std::abs(c.y() - 2.55) < 0.06 || std::abs(c.x() + 2.55) < 0.06) << c.transpose();
+
+  // a correction that moves nothing does not rebuild
+  EXPECT_EQ(builder.applyCorrection({{0, corrected}}), 0);
+  EXPECT_EQ(builder.rebuilds(), 1);
+}
+
+// A correction that moves the keyframes' points by less than rebuild_tolerance keeps the tree; the
+// shift is measured from the poses the tree has, so small corrections that add up do rebuild, and
+// a small turn of a keyframe with far points counts with the distance it moves them.
+TEST(OctomapBuilder, RebuildsOnlyWhenPointsMoveBeyondTheTolerance) {
+  OctomapOptions o = options(false);
+  ASSERT_DOUBLE_EQ(o.rebuild_tolerance, 0.05);
+  OctomapBuilder builder(o, Pose3::Identity());
+  Keyframe k;
+  k.utime = 1000000;
+  for (int i = -5; i <= 5; ++i) k.points.emplace_back(10.05f, 0.1f * i + 0.05f, 0.55f);  // a wall 10 m ahead
+  ASSERT_TRUE(builder.addKeyframe(0, k));
+  auto shifted = [](double x, double yaw_deg) {
+    Pose3 T = Pose3::Identity();
+    T.linear() = so3::Exp(Vec3(0.0, 0.0, yaw_deg * M_PI / 180.0));
+    T.translation() = Vec3(x, 0.0, 0.0);
+    return T;
+  };
+  EXPECT_EQ(builder.applyCorrection({{0, shifted(0.02, 0.0)}}), 1);
+  EXPECT_NEAR(builder.lastCorrectionShift(), 0.02, 1e-9);
+  EXPECT_FALSE(builder.lastCorrectionRebuilt());
+  EXPECT_EQ(builder.rebuilds(), 0);
+  EXPECT_EQ(builder.applyCorrection({{0, shifted(0.04, 0.0)}}), 1);  // 0.04 from the tree's pose
+  EXPECT_EQ(builder.rebuilds(), 0);
+  EXPECT_EQ(builder.applyCorrection({{0, shifted(0.06, 0.0)}}), 1);  // 0.06: beyond
+  EXPECT_TRUE(builder.lastCorrectionRebuilt());
+  EXPECT_EQ(builder.rebuilds(), 1);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(10.15, 0.05, 0.55)), 1);  // the wall at x + 0.06
+  // 0.4 degrees move the wall's points (up to 10.06 m away) by about 7 cm
+  EXPECT_EQ(builder.applyCorrection({{0, shifted(0.06, 0.4)}}), 1);
+  EXPECT_NEAR(builder.lastCorrectionShift(), 2.0 * std::sin(0.2 * M_PI / 180.0) * std::sqrt(10.05 * 10.05 + 2 * 0.55 * 0.55), 1e-6);
+  EXPECT_EQ(builder.rebuilds(), 2);
+  // with no tolerance any change rebuilds
+  o.rebuild_tolerance = 0.0;
+  OctomapBuilder strict(o, Pose3::Identity());
+  ASSERT_TRUE(strict.addKeyframe(0, k));
+  EXPECT_EQ(strict.applyCorrection({{0, shifted(0.001, 0.0)}}), 1);
+  EXPECT_EQ(strict.rebuilds(), 1);
+}
+
 TEST(OctomapConfig, ReadsKeysStrictly) {
   const auto o = readOctomapOptions(Config::fromString("octomap: {resolution: 0.2, colour: true}").section("octomap"));
   EXPECT_DOUBLE_EQ(o.core.resolution, 0.2);
@@ -221,7 +326,9 @@ TEST(OccupancyMap, SweepSlicesAreOneUpdate) {
   EXPECT_NEAR(n->getLogOdds(), one_miss, 1e-4);
 }
 
-TEST(OctomapConfig, FreeMarginIsReadAndChecked) {
+TEST(OctomapConfig, FreeMarginAndRebuildToleranceAreReadAndChecked) {
   EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("free_margin: 0.3")).core.free_margin, 0.3);
   EXPECT_THROW(readOctomapOptions(livo::Config::fromString("free_margin: -0.1")), livo::ConfigError);
+  EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("rebuild_tolerance: 0")).core.rebuild_tolerance, 0.0);
+  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("rebuild_tolerance: -0.01")), livo::ConfigError);
 }

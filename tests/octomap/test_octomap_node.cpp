@@ -1,5 +1,5 @@
 // livo-octomap's node on memq://: scans in, OCTOMAP out at the publish period, files on finish,
-// bad input refused.
+// bad input refused; keyframes and loop corrections rebuild the tree.
 #include <cmath>
 #include <sstream>
 
@@ -7,6 +7,9 @@
 #include <lcm/lcm-cpp.hpp>
 #include <octomap/OcTree.h>
 
+#include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/messages.hpp"
 #include "livo/octomap_t.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "octomap_node.hpp"
@@ -33,6 +36,27 @@ registered_scan_t wallScan(int64_t utime) {
   s.cloud.ring.assign(s.cloud.x.size(), -1);
   return s;
 }
+NodeOptions quiet() {
+  NodeOptions n;
+  n.name = "octomap";
+  n.quiet = true;
+  n.health_period_s = 0;
+  return n;
+}
+
+/// Every OCTOMAP message, appended to `out`.
+void collect(lcm::LCM& lcm, std::vector<octomap_t>* out) {
+  lcm.subscribeFunction<octomap_t, std::vector<octomap_t>*>(
+      "OCTOMAP", [](const lcm::ReceiveBuffer*, const std::string&, const octomap_t* m, std::vector<octomap_t>* o) {
+        o->push_back(*m);
+      },
+      out);
+}
+
+void drain(lcm::LCM& lcm) {
+  while (lcm.handleTimeout(0) > 0) {
+  }
+}
 }  // namespace
 
 TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
@@ -41,17 +65,9 @@ TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
   octomap_export::OctomapNodeOptions options;
   options.publish_period_s = 0.5;
   options.write_period_s = 0;
-  NodeOptions node_options;
-  node_options.name = "octomap";
-  node_options.quiet = true;
-  node_options.health_period_s = 0;
-  octomap_export::OctomapNode node(lcm, node_options, options, SensorRig{}, livo_test::tempPath("octo"));
+  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo"));
   std::vector<octomap_t> received;
-  lcm.subscribeFunction<octomap_t, std::vector<octomap_t>*>(
-      "OCTOMAP", [](const lcm::ReceiveBuffer*, const std::string&, const octomap_t* m, std::vector<octomap_t>* out) {
-        out->push_back(*m);
-      },
-      &received);
+  collect(lcm, &received);
   for (int k = 0; k < 10; ++k) {
     const registered_scan_t s = wallScan(1000000 + 100000 * k);
     lcm.publish("REGISTERED_SCAN", &s);
@@ -63,8 +79,7 @@ TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
   empty.cloud.num_points = 0;
   empty.cloud.x.clear();
   lcm.publish("REGISTERED_SCAN", &empty);
-  while (lcm.handleTimeout(0) > 0) {
-  }
+  drain(lcm);
   EXPECT_EQ(node.builder().scans(), 10);
   ASSERT_EQ(received.size(), 2u);  // at 1.0 s and 1.5 s
   std::istringstream in(std::string(received.back().data.begin(), received.back().data.end()));
@@ -78,4 +93,93 @@ TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
   EXPECT_TRUE(from_file.readBinary(node.btPath()));
   std::unique_ptr<octomap::AbstractOcTree> ot(octomap::AbstractOcTree::read(node.otPath()));
   EXPECT_NE(ot, nullptr);
+}
+
+namespace {
+keyframe_t wallKeyframe(int64_t id, int64_t utime) {
+  const registered_scan_t s = wallScan(utime);
+  keyframe_t k{};
+  k.id = id;
+  k.utime = utime;
+  k.orientation[0] = 1.0;  // identity pose: body frame = world frame
+  k.cloud = s.cloud;
+  k.cloud.frame = "I";
+  return k;
+}
+
+loop_correction_t correction(int64_t utime, const std::vector<std::pair<int64_t, Pose3>>& poses) {
+  loop_correction_t m{};
+  m.utime = utime;
+  m.correction_orientation[0] = 1.0;
+  m.num_keyframes = static_cast<int32_t>(poses.size());
+  for (const auto& [id, T] : poses) {
+    m.keyframe_id.push_back(id);
+    std::vector<double> p(3), q(4);
+    poseTo(T, p.data(), q.data());
+    m.position.push_back(p);
+    m.orientation.push_back(q);
+  }
+  return m;
+}
+
+bool occupiedIn(const octomap_t& m, double x, double y, double z) {
+  std::istringstream in(std::string(m.data.begin(), m.data.end()));
+  octomap::OcTree tree(0.1);
+  if (!tree.readBinary(in)) return false;
+  const octomap::OcTreeNode* n = tree.search(x, y, z);
+  return n && tree.isNodeOccupied(n);
+}
+}  // namespace
+
+// KEYFRAME and LOOP_CORRECTION over the bus: the tree is rebuilt from the keyframes at their
+// corrected poses and published at once; a malformed correction or keyframe is refused.
+TEST(OctomapNode, RebuildsFromCorrectedKeyframesAndPublishes) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  octomap_export::OctomapNodeOptions options;
+  options.publish_period_s = 100.0;  // the first scan's tree, then only after corrections
+  options.write_period_s = 0;
+  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo_loop"));
+  std::vector<octomap_t> received;
+  collect(lcm, &received);
+  const registered_scan_t scan = wallScan(1000000);
+  lcm.publish("REGISTERED_SCAN", &scan);
+  const keyframe_t kf0 = wallKeyframe(0, 1000000);
+  lcm.publish("KEYFRAME", &kf0);
+  keyframe_t broken = wallKeyframe(1, 1100000);
+  broken.position[1] = NAN;
+  lcm.publish("KEYFRAME", &broken);
+  keyframe_t world_frame = wallKeyframe(2, 1100000);
+  world_frame.cloud.frame = "W";
+  lcm.publish("KEYFRAME", &world_frame);
+  keyframe_t no_rotation = wallKeyframe(3, 1100000);
+  no_rotation.orientation[0] = 0.0;  // a zero quaternion (poseFrom would make it the identity)
+  lcm.publish("KEYFRAME", &no_rotation);
+  drain(lcm);
+  ASSERT_EQ(received.size(), 1u);
+  EXPECT_TRUE(occupiedIn(received.back(), 2.05, 0.05, 0.05));
+  EXPECT_EQ(node.builder().keyframes(), 1u);
+
+  Pose3 up = Pose3::Identity();
+  up.translation() = Vec3(0.0, 0.0, 2.0);
+  loop_correction_t bad = correction(1200000, {{0, up}});
+  bad.position[0][2] = NAN;
+  lcm.publish("LOOP_CORRECTION", &bad);
+  drain(lcm);
+  EXPECT_EQ(node.builder().rebuilds(), 0);
+  EXPECT_EQ(received.size(), 1u);
+
+  const loop_correction_t good = correction(1200000, {{0, up}, {1, up}, {2, up}, {3, up}});  // 1-3 were refused
+  lcm.publish("LOOP_CORRECTION", &good);
+  drain(lcm);
+  EXPECT_EQ(node.builder().rebuilds(), 1);
+  ASSERT_EQ(received.size(), 2u);
+  EXPECT_EQ(received.back().utime, 1200000);
+  EXPECT_TRUE(occupiedIn(received.back(), 2.05, 0.05, 2.05));   // the wall 2 m up
+  EXPECT_FALSE(occupiedIn(received.back(), 2.05, 0.05, 0.05));  // and no longer where it was
+
+  lcm.publish("LOOP_CORRECTION", &good);  // the same poses again: nothing moves, nothing published
+  drain(lcm);
+  EXPECT_EQ(node.builder().rebuilds(), 1);
+  EXPECT_EQ(received.size(), 2u);
 }

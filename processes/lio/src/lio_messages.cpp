@@ -1,7 +1,9 @@
 #include "livo/lio/lio_messages.hpp"
 
 #include <cmath>
+#include <map>
 
+#include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
 
 namespace livo::lio {
@@ -115,25 +117,18 @@ keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings) {
 
 bool fromMessage(const loop_correction_t& m, Pose3* T, std::vector<LioEstimator::KeyframePose>* poses,
                  std::string* why) {
-  const size_t n = static_cast<size_t>(std::max(0, m.num_keyframes));
-  if (m.keyframe_id.size() != n || m.position.size() != n || m.orientation.size() != n) {
-    *why = "loop correction arrays differ from num_keyframes";
+  std::map<int64_t, Pose3> corrected;
+  if (std::string problem = correctedKeyframePoses(m, &corrected); !problem.empty()) {
+    *why = "loop correction: " + problem;
     return false;
   }
-  if (!allFinite(m.correction_position, 3) || !allFinite(m.correction_orientation, 4)) {
-    *why = "non-finite loop correction";
+  if (std::string problem = poseProblem(m.correction_position, m.correction_orientation); !problem.empty()) {
+    *why = "loop correction transform: " + problem;
     return false;
   }
   *T = poseFrom(m.correction_position, m.correction_orientation);
   poses->clear();
-  for (size_t i = 0; i < n; ++i) {
-    if (m.position[i].size() != 3 || m.orientation[i].size() != 4 || !allFinite(m.position[i].data(), 3) ||
-        !allFinite(m.orientation[i].data(), 4)) {
-      *why = "malformed corrected keyframe pose";
-      return false;
-    }
-    poses->push_back({m.keyframe_id[i], poseFrom(m.position[i].data(), m.orientation[i].data())});
-  }
+  for (const auto& [id, pose] : corrected) poses->push_back({id, pose});
   return true;
 }
 

@@ -1,0 +1,46 @@
+// What the map builders (livo-colour, livo-octomap) take from the LIO and the loop closure, checked
+// the same way for every consumer: a registered scan as plain arrays with its pose, a keyframe, and
+// a loop correction's corrected keyframe poses. RegisteredScanView is LCM-free, so the map cores
+// take it without knowing the messages; the functions (in livo_node) read the messages.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "livo/so3.hpp"
+
+namespace livo {
+
+class registered_scan_t;
+class keyframe_t;
+class loop_correction_t;
+
+/// A registered scan (world frame) as views into the message's arrays: valid while it lives.
+struct RegisteredScanView {
+  int64_t utime = 0;        // sweep end: the pose's time
+  int64_t cloud_utime = 0;  // point j was measured at cloud_utime + time_offset[j]
+  Pose3 T_W_I = Pose3::Identity();
+  int num_points = 0;
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  const float* time_offset = nullptr;  // may be null: every point at cloud_utime
+};
+
+/// The view of `m`, or why it cannot be used (registeredScanProblem()); "" when `view` was filled.
+std::string viewRegisteredScan(const registered_scan_t& m, RegisteredScanView* view);
+
+/// Why a message pose cannot be used: non-finite numbers, or a quaternion (w, x, y, z) whose norm
+/// is not within [0.5, 2] (poseFrom() normalises it); "" if it can.
+std::string poseProblem(const double position[3], const double orientation_wxyz[4]);
+
+/// Why a KEYFRAME cannot be used for map rebuilds: a bad pose, cloud arrays that disagree with
+/// num_points, a cloud not in the body frame "I"; "" if it can.
+std::string keyframeProblem(const keyframe_t& m);
+
+/// The corrected keyframe poses of a LOOP_CORRECTION (id -> W_T_I), or why it cannot be used
+/// (arrays that disagree with num_keyframes, a bad pose); "" when `poses` was filled.
+std::string correctedKeyframePoses(const loop_correction_t& m, std::map<int64_t, Pose3>* poses);
+
+}  // namespace livo

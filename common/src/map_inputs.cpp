@@ -1,0 +1,59 @@
+#include "livo/map_inputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/message_checks.hpp"
+#include "livo/messages.hpp"
+#include "livo/registered_scan_t.hpp"
+
+namespace livo {
+
+std::string viewRegisteredScan(const registered_scan_t& m, RegisteredScanView* v) {
+  if (std::string why = registeredScanProblem(m); !why.empty()) return why;
+  const point_cloud_t& c = m.cloud;
+  v->utime = m.utime;
+  v->cloud_utime = c.utime;
+  v->T_W_I = poseFrom(m.position, m.orientation);
+  v->num_points = c.num_points;
+  v->x = c.x.data();
+  v->y = c.y.data();
+  v->z = c.z.data();
+  v->time_offset = c.time_offset.data();
+  return "";
+}
+
+std::string poseProblem(const double position[3], const double q[4]) {
+  if (!allFinite(position, 3) || !allFinite(q, 4)) return "pose is not finite";
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(norm >= 0.5 && norm <= 2.0)) return "orientation is not a unit quaternion";
+  return "";
+}
+
+std::string keyframeProblem(const keyframe_t& m) {
+  if (std::string why = poseProblem(m.position, m.orientation); !why.empty()) return why;
+  const point_cloud_t& c = m.cloud;
+  const size_t n = static_cast<size_t>(std::max(0, c.num_points));
+  if (c.x.size() != n || c.y.size() != n || c.z.size() != n) return "cloud arrays disagree with num_points";
+  if (c.frame != "I") return "cloud frame is '" + c.frame + "', expected I";
+  return "";
+}
+
+std::string correctedKeyframePoses(const loop_correction_t& m, std::map<int64_t, Pose3>* poses) {
+  const size_t n = static_cast<size_t>(std::max(0, m.num_keyframes));
+  if (m.keyframe_id.size() != n || m.position.size() != n || m.orientation.size() != n)
+    return "arrays disagree with num_keyframes";
+  std::map<int64_t, Pose3> out;
+  for (size_t i = 0; i < n; ++i) {
+    if (m.position[i].size() != 3 || m.orientation[i].size() != 4) return "malformed corrected pose";
+    if (std::string why = poseProblem(m.position[i].data(), m.orientation[i].data()); !why.empty())
+      return "corrected " + why;
+    out[m.keyframe_id[i]] = poseFrom(m.position[i].data(), m.orientation[i].data());
+  }
+  *poses = std::move(out);
+  return "";
+}
+
+}  // namespace livo

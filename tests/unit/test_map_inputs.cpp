@@ -1,0 +1,105 @@
+// The map builders' inputs (livo/map_inputs.hpp): registered-scan views, keyframe and loop
+// correction checks, shared by livo-colour and livo-octomap.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/map_inputs.hpp"
+#include "livo/messages.hpp"
+#include "livo/registered_scan_t.hpp"
+
+using namespace livo;
+
+namespace {
+Pose3 pose(double x, double yaw) {
+  Pose3 T = Pose3::Identity();
+  T.linear() = so3::Exp(Vec3(0.0, 0.0, yaw));
+  T.translation() = Vec3(x, 0.5, -1.0);
+  return T;
+}
+
+loop_correction_t correction(const std::vector<std::pair<int64_t, Pose3>>& poses) {
+  loop_correction_t m{};
+  m.correction_orientation[0] = 1.0;
+  m.num_keyframes = static_cast<int32_t>(poses.size());
+  for (const auto& [id, T] : poses) {
+    m.keyframe_id.push_back(id);
+    std::vector<double> p(3), q(4);
+    poseTo(T, p.data(), q.data());
+    m.position.push_back(p);
+    m.orientation.push_back(q);
+  }
+  return m;
+}
+}  // namespace
+
+TEST(MapInputs, RegisteredScanViewPointsIntoTheMessage) {
+  registered_scan_t m{};
+  m.utime = 2000000;
+  poseTo(pose(3.0, 0.4), m.position, m.orientation);
+  m.cloud.utime = 1900000;
+  m.cloud.frame = "W";
+  m.cloud.num_points = 2;
+  m.cloud.x = {1, 2};
+  m.cloud.y = {3, 4};
+  m.cloud.z = {5, 6};
+  m.cloud.time_offset = {0.f, 0.05f};
+  RegisteredScanView v;
+  ASSERT_EQ(viewRegisteredScan(m, &v), "");
+  EXPECT_EQ(v.utime, 2000000);
+  EXPECT_EQ(v.cloud_utime, 1900000);
+  EXPECT_EQ(v.num_points, 2);
+  EXPECT_EQ(v.x, m.cloud.x.data());
+  EXPECT_EQ(v.time_offset, m.cloud.time_offset.data());
+  EXPECT_TRUE(v.T_W_I.isApprox(pose(3.0, 0.4), 1e-12));
+  m.cloud.frame = "I";
+  EXPECT_EQ(viewRegisteredScan(m, &v), "cloud frame is 'I', expected W");
+}
+
+TEST(MapInputs, PoseAndKeyframeProblems) {
+  double p[3] = {1, 2, 3}, q[4] = {1, 0, 0, 0};
+  EXPECT_EQ(poseProblem(p, q), "");
+  q[0] = 0.0;  // poseFrom() would silently make this the identity
+  EXPECT_EQ(poseProblem(p, q), "orientation is not a unit quaternion");
+  q[0] = 1.0;
+  p[2] = NAN;
+  EXPECT_EQ(poseProblem(p, q), "pose is not finite");
+
+  keyframe_t k{};
+  k.orientation[0] = 1.0;
+  k.cloud.frame = "I";
+  k.cloud.num_points = 1;
+  k.cloud.x = {1}, k.cloud.y = {2}, k.cloud.z = {3};
+  EXPECT_EQ(keyframeProblem(k), "");
+  k.cloud.frame = "W";
+  EXPECT_EQ(keyframeProblem(k), "cloud frame is 'W', expected I");
+  k.cloud.frame = "I";
+  k.cloud.z.clear();
+  EXPECT_EQ(keyframeProblem(k), "cloud arrays disagree with num_points");
+  k.cloud.z = {3};
+  k.orientation[0] = NAN;
+  EXPECT_EQ(keyframeProblem(k), "pose is not finite");
+}
+
+TEST(MapInputs, CorrectedKeyframePoses) {
+  std::map<int64_t, Pose3> poses;
+  ASSERT_EQ(correctedKeyframePoses(correction({{4, pose(1.0, 0.1)}, {9, pose(2.0, -0.3)}}), &poses), "");
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_TRUE(poses.at(4).isApprox(pose(1.0, 0.1), 1e-12));
+  EXPECT_TRUE(poses.at(9).isApprox(pose(2.0, -0.3), 1e-12));
+
+  loop_correction_t bad = correction({{4, pose(1.0, 0.1)}, {9, pose(2.0, -0.3)}});
+  bad.orientation[1][2] = INFINITY;
+  EXPECT_EQ(correctedKeyframePoses(bad, &poses), "corrected pose is not finite");
+  EXPECT_EQ(poses.size(), 2u);  // untouched on failure
+  bad = correction({{4, pose(1.0, 0.1)}});
+  bad.num_keyframes = 2;
+  EXPECT_EQ(correctedKeyframePoses(bad, &poses), "arrays disagree with num_keyframes");
+  bad = correction({{4, pose(1.0, 0.1)}});
+  bad.position[0].pop_back();
+  EXPECT_EQ(correctedKeyframePoses(bad, &poses), "malformed corrected pose");
+  EXPECT_EQ(correctedKeyframePoses(correction({}), &poses), "");
+  EXPECT_TRUE(poses.empty());
+}
