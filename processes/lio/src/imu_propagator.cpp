@@ -112,4 +112,11 @@ void ImuPropagator::transformSegments(const Pose3& T) {
   }
 }
 
+void ImuPropagator::dropSegmentsBefore(int64_t utime) {
+  // segment k lasts until segment k + 1 starts (the last one until utime())
+  size_t keep = 0;
+  while (keep + 1 < segments_.size() && segments_[keep + 1].utime <= utime) ++keep;
+  segments_.erase(segments_.begin(), segments_.begin() + static_cast<std::ptrdiff_t>(keep));
+}
+
 }  // namespace livo::lio

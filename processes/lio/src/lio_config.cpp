@@ -90,6 +90,8 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("reset_imu_gap_s", l.reset_imu_gap_s);
   c.readOptional("gap_rate_std", l.gap_rate_std);
   c.readOptional("max_position_jump", l.max_position_jump);
+  c.readOptional("max_imu_backlog_s", l.max_imu_backlog_s);
+  c.readOptional("reseed_after_s", l.reseed_after_s);
 
   const Config map = c.optionalSection("map");
   map.readOptional("voxel_size", l.map.voxel_size);
@@ -140,6 +142,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
   positive(l.init.window_s > 0, "init.window_s");
   positive(o->posterior_max_wait_s > 0, "posterior_max_wait_s");
+  positive(l.max_imu_backlog_s > 0 && l.reseed_after_s > 0, "max_imu_backlog_s");
 }
 }  // namespace
 

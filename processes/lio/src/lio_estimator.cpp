@@ -55,7 +55,7 @@ void LioEstimator::reset() {
   keyframes_.clear();
   last_registered_body_.clear();
   has_last_post_ = has_prev_post_ = false;
-  consecutive_failures_ = 0;
+  has_registered_ = false;
 }
 
 bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
@@ -71,6 +71,9 @@ bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
   last_imu_utime_ = s.utime;
   if (initialized_) {
     imu_.push_back(s);
+    // no sweep has come for a while: propagate the backlog now, keeping half of it for a late
+    // sweep, and forget the undistortion segments no sweep can need any more
+    if (imu_.front().utime < s.utime - toUtime(opts_.max_imu_backlog_s)) drainBacklog(s.utime);
   } else {
     init_window_.push_back(s);
     tryInitialize(nullptr);
@@ -79,6 +82,10 @@ bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
 }
 
 bool LioEstimator::addWheel(const WheelSample& s, std::string* why) {
+  if (!opts_.wheel.enabled) {
+    if (why) *why = "wheel fusion is disabled";
+    return false;
+  }
   if (!std::isfinite(s.left_speed) || !std::isfinite(s.right_speed)) {
     if (why) *why = "non-finite wheel speed";
     return false;
@@ -164,21 +171,38 @@ void LioEstimator::widenForGap(double gap_s) {
   prop_.setState(prop_.state(), P);
 }
 
+void LioEstimator::stepTo(const ImuSample& s, double* worst_gap, std::string* note) {
+  if (s.utime <= prop_.utime()) return;
+  const double gap = static_cast<double>(s.utime - prop_.utime()) * 1e-6;
+  if (gap > opts_.reset_imu_gap_s) {
+    softReset(s, gap, note);
+    return;
+  }
+  prop_.addSample(s);
+  if (gap > opts_.max_imu_gap_s) widenForGap(gap);
+  *worst_gap = std::max(*worst_gap, gap);
+}
+
+void LioEstimator::drainBacklog(int64_t newest) {
+  const int64_t backlog = toUtime(opts_.max_imu_backlog_s);
+  double worst_gap = 0.0;
+  while (!imu_.empty() && imu_.front().utime < newest - backlog / 2) {
+    const ImuSample s = imu_.front();
+    // a sweep may still come for an IMU gap that ended less than a backlog ago: leave it to addScan
+    if (static_cast<double>(s.utime - prop_.utime()) * 1e-6 > opts_.reset_imu_gap_s && newest - s.utime < backlog) break;
+    imu_.pop_front();
+    stepTo(s, &worst_gap, nullptr);
+  }
+  prop_.dropSegmentsBefore(prop_.utime() - toUtime(kMaxSweepS));
+}
+
 bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
   const double max_gap = opts_.max_imu_gap_s, reset_gap = opts_.reset_imu_gap_s;
   double worst_gap = 0.0;
   while (!imu_.empty() && imu_.front().utime <= t_end) {
     const ImuSample s = imu_.front();
     imu_.pop_front();
-    if (s.utime <= prop_.utime()) continue;
-    const double gap = static_cast<double>(s.utime - prop_.utime()) * 1e-6;
-    if (gap > reset_gap) {
-      softReset(s, gap, note);
-      continue;
-    }
-    prop_.addSample(s);
-    if (gap > max_gap) widenForGap(gap);
-    worst_gap = std::max(worst_gap, gap);
+    stepTo(s, &worst_gap, note);
   }
   if (prop_.utime() < t_end) {
     const bool has_next = !imu_.empty();
@@ -303,7 +327,21 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     while (wheel_.size() > 2 && wheel_[1].utime <= t_end) wheel_.pop_front();
   }
 
-  // 5. LiDAR update or map seeding
+  // 5. LiDAR update or map seeding. After reseed_after_s without a registration (a LiDAR outage,
+  // lost track) the map no longer fits the predicted pose: a new one is seeded there, so the
+  // trajectory goes on from the prediction instead of restarting at the origin.
+  if (!map_.empty() && has_registered_ &&
+      static_cast<double>(t_end - last_registered_utime_) * 1e-6 > opts_.reseed_after_s) {
+    const double lost_s = static_cast<double>(t_end - last_registered_utime_) * 1e-6;
+    map_.clear();
+    // the IMU-only velocity of a long outage is worthless: keep it only after a short one
+    if (lost_s > 3.0 * opts_.reseed_after_s) x.vel.setZero();
+    const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
+    P.middleRows<3>(FilterState::kVel).setZero();
+    P.middleCols<3>(FilterState::kVel).setZero();
+    P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
+    appendNote(note, "no registration for " + fmt(lost_s) + " s: map re-seeded at the predicted pose");
+  }
   if (map_.empty()) {
     if (static_cast<int>(valid.size()) < opts_.min_points) {
       res.status = ScanResult::Status::kPredicted;
@@ -333,19 +371,16 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
       x = post;
       P = P_post;
       res.status = ScanResult::Status::kTracked;
-      consecutive_failures_ = 0;
     } else {
       res.status = ScanResult::Status::kPredicted;
       res.degeneracy.degenerate = true;
       appendNote(note, enough ? "update rejected (diverged)"
                               : "too few point-to-plane matches (" + std::to_string(er.info.count) + ")");
-      if (++consecutive_failures_ >= 10 && enough) {
-        appendNote(note, "registration failed 10 times in a row: re-initialising");
-        reset();
-        res.status = ScanResult::Status::kRejected;
-        return res;
-      }
     }
+  }
+  if (res.status == ScanResult::Status::kTracked || res.status == ScanResult::Status::kMapInitialized) {
+    last_registered_utime_ = t_end;
+    has_registered_ = true;
   }
   if (res.status == ScanResult::Status::kTracked) {
     // remember the previous registered position (velocity after IMU gaps)

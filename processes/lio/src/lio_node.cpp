@@ -142,6 +142,8 @@ void LioNode::advance() {
       fed_any_imu_ = true;
     });
   }
+  // wheel readings no pending sweep can need (a LiDAR outage must not grow the buffer)
+  if (fed_any_imu_) wheel_.dropBefore(fed_imu_ - toUtime(opts_.wheel_max_wait_s + 1.0));
   while (fed_any_imu_) {
     if (pending_) {
       // waiting for the posterior of an image: nothing later may be processed meanwhile

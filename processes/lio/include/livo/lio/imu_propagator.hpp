@@ -77,6 +77,8 @@ class ImuPropagator {
   /// time as the end of the last one.
   const std::vector<ImuSegment>& segments() const { return segments_; }
   void clearSegments() { segments_.clear(); }
+  /// Forgets segments that ended before `utime` (bounded memory while no sweep consumes them).
+  void dropSegmentsBefore(int64_t utime);
   /// Moves the recorded segments rigidly by T (world frame: p -> R p + t), so that the trajectory
   /// stays continuous when an external update moves the current state by T.
   void transformSegments(const Pose3& T);

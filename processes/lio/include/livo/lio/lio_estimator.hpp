@@ -90,6 +90,9 @@ class LioEstimator {
   const VoxelMap& map() const { return map_; }
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
   const LioOptions& options() const { return opts_; }
+  /// IMU samples waiting for a sweep and IMU steps kept for undistortion (bounded; diagnostics).
+  size_t imuBacklog() const { return imu_.size(); }
+  size_t undistortionSegments() const { return prop_.segments().size(); }
 
   /// Camera hand-off: propagates the filter with the added IMU samples to `utime` (STATE_PRIOR).
   bool propagateTo(int64_t utime, std::string* why = nullptr);
@@ -111,6 +114,10 @@ class LioEstimator {
   double scanEndOffset(const LidarScan& scan) const;
   void tryInitialize(std::string* note);
   bool propagateThrough(int64_t t_end, std::string* note);
+  /// One IMU sample into the propagation (gaps bridged or soft-reset).
+  void stepTo(const ImuSample& s, double* worst_gap, std::string* note);
+  /// Propagates IMU that no sweep has claimed for max_imu_backlog_s (bounded memory in outages).
+  void drainBacklog(int64_t newest);
   void softReset(const ImuSample& s, double gap_s, std::string* note);
   void widenForGap(double gap_s);
   bool wheelSpeedAt(int64_t utime, double* speed) const;
@@ -133,7 +140,8 @@ class LioEstimator {
   std::deque<Keyframe> keyframes_;
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
-  int consecutive_failures_ = 0;
+  int64_t last_registered_utime_ = 0;  // last sweep that seeded the map or registered
+  bool has_registered_ = false;
   Vec3 last_post_pos_ = Vec3::Zero(), prev_post_pos_ = Vec3::Zero();  // registered positions ...
   int64_t last_post_utime_ = 0, prev_post_utime_ = 0;                 // ... of the last two sweeps
   bool has_last_post_ = false, has_prev_post_ = false;
