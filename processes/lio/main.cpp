@@ -25,7 +25,14 @@ int main(int argc, char** argv) {
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::lio::LioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
-    return livo::spin(*lcm, node.node());
+    const int rc = livo::spin(*lcm, node.node());
+    if (!quiet && opts.camera_handoff) {
+      const auto& h = node.handoffCounts();
+      std::cerr << "[" << opts.name << "] camera hand-off: " << h.priors << " priors, " << h.adopted << " posteriors adopted, "
+                << h.kept_prior << " kept the prior, " << h.missing << " unanswered (went on LiDAR-only), " << h.no_vio
+                << " images with no VIO running, " << h.images_skipped << " images before tracking or late\n";
+    }
+    return rc;
   } catch (const std::exception& e) {
     std::cerr << "livo-lio: " << e.what() << "\n";
     return 1;

@@ -1,0 +1,67 @@
+// Which map points an image is aligned on: projected with the prior, not occluded (a coarse
+// depth buffer of the recent LiDAR points and the map points: a point well behind the nearest
+// one in its cell is hidden, the paper's rejection of occluded and depth-inconsistent points),
+// not next to a depth edge (a patch straddling one changes with the viewpoint),
+// with a reference patch seen from a similar direction (the lowest score of view angle,
+// photometric error and age) whose warp into this view stays inside the stored patch, and at
+// most one per grid cell (the best textured).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "livo/camera_projection.hpp"
+#include "livo/vio/photometric_residual.hpp"
+#include "livo/vio/point_patch_map.hpp"
+#include "livo/vio/vio_options.hpp"
+
+namespace livo::vio {
+
+/// Nearest and farthest LiDAR/map point per image cell (depth and pixel).
+class DepthGrid {
+ public:
+  DepthGrid(int width, int height, int cell_px);
+  void clear();
+  void add(const Eigen::Vector2d& pixel, float z);
+  /// Nearest depth in the cell of `pixel` (infinity if none).
+  float nearest(const Eigen::Vector2d& pixel) const;
+  /// True if a point at depth z is hidden behind something nearer in its cell.
+  bool occluded(const Eigen::Vector2d& pixel, double z, double tolerance, double tolerance_rel) const {
+    return nearest(pixel) < z - (tolerance + tolerance_rel * z);
+  }
+  /// True if the points within `radius_px` of `pixel` (with the point itself, at depth z) do not
+  /// lie on one plane: inverse depth is affine in the pixel coordinates on a plane, so a least-
+  /// squares plane in (u, v, 1/z) is fitted and any deviation beyond tolerance + tolerance_rel z
+  /// (in depth) marks a depth edge or a strongly curved surface, where a patch changes with the
+  /// viewpoint. Slanted planes (a floor at a grazing angle) pass.
+  bool depthEdge(const Eigen::Vector2d& pixel, double z, double radius_px, double tolerance, double tolerance_rel) const;
+
+ private:
+  struct Cell {
+    float near_z, near_u, near_v;
+    float far_z, far_u, far_v;
+  };
+  int index(const Eigen::Vector2d& pixel) const;
+  int cell_, cols_, rows_;
+  std::vector<Cell> cells_;
+};
+
+struct SelectionStats {
+  int in_view = 0;        // project inside the image with the patch border, in the depth range
+  int occluded = 0;
+  int depth_edge = 0;     // next to a depth discontinuity
+  int no_reference = 0;   // no patch seen from close enough a direction, or the warp leaves it
+  int selected = 0;
+};
+
+/// The reference observation for a point seen from camera centre c_W at time utime, or -1.
+int chooseReference(const MapPoint& point, const Vec3& c_W, int64_t utime, const SelectionOptions& options);
+
+/// The tracked patches of the image at camera pose T_W_C (reference patches warped into it).
+std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
+                                        int64_t utime, float exposure_time, const DepthGrid& depth, int levels,
+                                        const SelectionOptions& options, SelectionStats* stats);
+
+}  // namespace livo::vio

@@ -1,0 +1,93 @@
+// The direct photometric VIO core (no LCM): the point-patch map fed with registered LiDAR
+// scans, and per image at a filter prior the coarse-to-fine iterated ESIKF update followed by map
+// maintenance (new points from the recent scans on a gradient-selected grid, new patches when
+// the view or the photometric error changed enough, pruning to the bounds).
+//
+//   VioEstimator vio(options, camera_rig);
+//   vio.addScan(scan_utime, world_points);                 // REGISTERED_SCAN
+//   ImageResult r = vio.processImage(grey, prior, P);      // at a STATE_PRIOR
+//   if (r.valid) { use r.state, r.covariance }
+//
+// Camera pose = W_T_I * T_I_C (the rig's extrinsic). The scans are in the world frame (points
+// undistorted by the LIO), so a scan from before or after the image is equally valid as a source
+// of points: only its field of view matters, and projecting it selects the points in the camera's.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "livo/camera_projection.hpp"
+#include "livo/filter_state.hpp"
+#include "livo/vio/direct_update.hpp"
+#include "livo/vio/grey_image.hpp"
+#include "livo/vio/image_pyramid.hpp"
+#include "livo/vio/point_patch_map.hpp"
+#include "livo/vio/point_selection.hpp"
+#include "livo/vio/vio_options.hpp"
+
+namespace livo::vio {
+
+struct ImageResult {
+  bool valid = false;                // an update to adopt
+  std::string why;                   // why not
+  FilterState state;                 // posterior (the prior if not valid)
+  Mat18 covariance = Mat18::Zero();
+  int iterations = 0;
+  int num_measurements = 0;          // scalar photometric residuals of the last step
+  int patches = 0;                   // patches of the last step
+  double mahalanobis = 0.0;
+  double cost_prior = 0.0, cost_post = 0.0;
+  SelectionStats selection;
+  int new_points = 0;                // added to the map from the recent scans
+  int candidates = 0;                //   recent scan points in free cells of the image
+  int candidates_hidden = 0;         //   ... refused as occluded or on a depth edge
+  int candidates_weak = 0;           //   ... cells whose best candidate had too little texture
+  int new_patches = 0;               // observations added to tracked points
+  size_t map_points = 0;             // after maintenance
+};
+
+class VioEstimator {
+ public:
+  VioEstimator(const VioOptions& options, const CameraRig& camera);
+
+  /// A registered scan (world frame, `n` points); keeps the newest `recent_scans`, one point per
+  /// map voxel.
+  void addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n);
+  void addScan(int64_t utime, const std::vector<Vec3>& points);
+
+  /// Update at an image whose time the prior refers to (image.utime already on the IMU clock).
+  ImageResult processImage(const GreyImage& image, const FilterState& prior, const Mat18& P);
+
+  /// A loop correction: moves the map and the recent scans by T_corrected_odom.
+  void applyCorrection(const Pose3& T_corrected_odom);
+  void reset();
+
+  const PointPatchMap& map() const { return map_; }
+  const VioOptions& options() const { return options_; }
+  const CameraProjection& camera() const { return camera_; }
+  const ImagePyramid& pyramid() const { return pyramid_; }  // of the last image
+  size_t recentScanPoints() const;
+
+ private:
+  struct Scan {
+    int64_t utime = 0;
+    std::vector<Vec3> points;
+  };
+  void fillDepth(const Pose3& T_W_C);
+  void maintain(const GreyImage& image, const Pose3& T_W_C, bool refresh, const std::vector<TrackedPatch>& tracked,
+                ImageResult* result);
+  bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
+                       PatchObservation* obs) const;
+
+  VioOptions options_;
+  CameraProjection camera_;
+  Pose3 T_I_C_;
+  PointPatchMap map_;
+  std::deque<Scan> scans_;   // newest last
+  ImagePyramid pyramid_;
+  DepthGrid depth_;
+};
+
+}  // namespace livo::vio

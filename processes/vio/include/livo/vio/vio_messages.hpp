@@ -1,0 +1,31 @@
+// Conversions between the LCM messages the VIO reads and writes and the core's types (the
+// filter_state_t <-> FilterState conversion itself is common/filter_state_message.hpp).
+#pragma once
+
+#include <string>
+
+#include "livo/filter_state.hpp"
+#include "livo/filter_state_t.hpp"
+#include "livo/image_t.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/vio/grey_image.hpp"
+
+namespace livo::vio {
+
+/// The state and covariance (symmetrised) of a STATE_PRIOR; false with the reason if a number is
+/// not finite, the quaternion is degenerate or the pose covariance is not positive definite.
+bool priorFromMessage(const filter_state_t& m, FilterState* x, Mat18* P, std::string* why);
+
+/// A STATE_POSTERIOR answering `prior` (same utime and request id) with state x and covariance P.
+filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
+                           const Mat18& P, bool valid, int iterations, int num_measurements);
+/// valid = 0: the prior's own numbers echoed.
+filter_state_t keptPrior(const filter_state_t& prior, const std::string& source);
+
+/// A view of the image's bytes (valid while the message lives).
+RawImage rawImage(const image_t& m);
+
+/// T_corrected_odom of a loop correction; false if not finite or degenerate.
+bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why);
+
+}  // namespace livo::vio

@@ -1,0 +1,83 @@
+// Options of the direct photometric VIO core, with their defaults (README.md lists them as the
+// `vio:` config keys). Plain structs: the core never reads files.
+#pragma once
+
+#include <string>
+
+namespace livo::vio {
+
+/// The point-patch map (paper 2.3.2): one LiDAR point per voxel, each with the patches it was
+/// observed in; bounded like the LIO map by a radius around the camera and a point count.
+struct MapOptions {
+  double voxel_size = 0.3;     // m: at most one map point per voxel
+  double radius = 30.0;        // m: points farther from the camera are dropped
+  int max_points = 10000;      // beyond this the least recently seen points are dropped
+  int max_observations = 4;    // patches kept per point (the oldest goes first)
+  int recent_scans = 2;        // REGISTERED_SCANs kept as the source of new points and occluders
+};
+
+/// Which map points take part in an update.
+struct SelectionOptions {
+  int grid_cell_px = 32;           // at most one tracked point per grid cell of the image
+  double min_depth = 0.3;          // m
+  double max_depth = 30.0;         // m
+  int depth_cell_px = 6;           // cell of the occlusion depth buffer
+  double occlusion_tolerance = 0.1;      // m: a point this much (plus the relative part) behind
+  double occlusion_tolerance_rel = 0.1;  //    the nearest LiDAR/map point in its cell is occluded
+  double max_view_angle_deg = 30.0;      // reference patches seen from farther off are not used
+  double depth_edge_radius_px = 16.0;    // the LiDAR/map points this close to a point in the image ...
+  double depth_edge_tolerance = 0.03;    // ... must lie on a plane with it to within this (m) ...
+  double depth_edge_tolerance_rel = 0.03;// ... plus this fraction of its depth; else it sits on a
+                                         // depth edge: not tracked, not added (parallax breaks
+                                         // the patch)
+  double view_angle_weight = 1.0;  // reference score: angle (deg) * this
+  double error_weight = 0.2;       //   + photometric error of the patch (grey levels) * this
+  double age_weight = 0.05;        //   + age (s) * this; the lowest score is the reference
+};
+
+/// The photometric residual (paper eq. 10) and its robust weighting.
+struct PhotometricOptions {
+  int pyramid_levels = 3;          // 1..4; the update runs coarse to fine
+  double noise_std = 30.0;         // grey levels per pixel: R = noise_std^2 I (see README: far above
+                                   // the sensor noise, as the patch residuals are correlated)
+  double huber_threshold = 10.0;   // grey levels: residuals beyond get weight threshold / |r|
+  bool affine_brightness = true;   // per-patch gain and offset (else offset only)
+  double min_gain = 0.5;           // gain bounds, relative to the exposure-time ratio (1 if unknown)
+  double max_gain = 2.0;
+  double min_ncc = 0.3;            // a patch correlating worse at the start of a level is dropped
+};
+
+/// The iterated ESIKF update and its acceptance tests.
+struct UpdateOptions {
+  int max_iterations = 4;          // per pyramid level
+  double convergence_rot = 1e-4;   // rad
+  double convergence_pos = 1e-4;   // m
+  int min_patches = 15;            // fewer usable patches: no update (valid = 0)
+  double max_mahalanobis = 50.0;   // chi-square of the pose step against the prior covariance
+  double max_step_pos = 0.3;       // m
+  double max_step_rot_deg = 5.0;
+};
+
+/// Map maintenance after each image (paper 2.3.2).
+struct MaintenanceOptions {
+  int new_point_cell_px = 32;      // grid for new points: cells with no tracked point get one
+  double min_gradient = 3.0;       // grey levels / pixel (level 1): weaker candidates are skipped
+  int max_new_points = 200;        // per image
+  double refresh_angle_deg = 10.0; // a new patch when the view turned this far from every patch
+  double refresh_distance_ratio = 1.3;  // ... or the distance changed by this factor
+  double refresh_error = 12.0;     // ... or the reference's residual RMS grew beyond this (grey levels)
+  double outlier_ncc = 0.5;        // no new patch from a view correlating worse (occluded, moved)
+};
+
+struct VioOptions {
+  MapOptions map;
+  SelectionOptions selection;
+  PhotometricOptions photometric;
+  UpdateOptions update;
+  MaintenanceOptions maintenance;
+};
+
+/// Throws std::invalid_argument naming the first option out of range.
+void validate(const VioOptions& o);
+
+}  // namespace livo::vio

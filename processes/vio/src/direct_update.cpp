@@ -1,0 +1,133 @@
+#include "livo/vio/direct_update.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+
+#include "livo/esikf_update.hpp"
+
+namespace livo::vio {
+
+namespace {
+
+// Measurement over the active patches at iterate x; returns the number of patches used.
+int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
+            const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
+            const PhotometricOptions& o, PoseInformation* info) {
+  PatchResidual e;
+  int used = 0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e)) continue;
+    accumulate(e, o, info);
+    ++used;
+  }
+  return used;
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
+                                const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
+                                const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io) {
+  std::vector<TrackedPatch>& patches = *patches_io;
+  DirectUpdateResult res;
+  res.state = prior;
+  res.covariance = P_prior;
+  FilterState x = prior;
+  Mat18 P = P_prior;
+  std::vector<char> active(patches.size(), 0);
+  PatchResidual e;
+  bool stepped_at_finest = false;
+  for (int level = pyramid.levels() - 1; level >= 0; --level) {
+    // the measurement of this level: patches that project (and, once a coarser level has aligned
+    // the image, correlate) at the current iterate; at the first level the prior may be off by more
+    // than a fine texture's correlation length, so only the robust weights guard it
+    const bool gate = res.iterations > 0;
+    int n_active = 0;
+    for (size_t i = 0; i < patches.size(); ++i) {
+      active[i] = evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], po, &e) && (!gate || e.ncc >= po.min_ncc);
+      n_active += active[i];
+    }
+    if (n_active < uo.min_patches) {
+      if (level > 0) continue;  // a finer level may still have enough
+      res.why = "too few patches correlate (" + std::to_string(n_active) + " < " + std::to_string(uo.min_patches) + ")";
+      return res;
+    }
+    for (int it = 0; it < uo.max_iterations; ++it) {
+      PoseInformation info;
+      const int used = measure(patches, active, level, pyramid, camera, T_I_C, x, po, &info);
+      if (used < uo.min_patches) break;
+      Vec18 delta;
+      informationStep(x, prior, P_prior, info.HtRinvH, info.HtRinvz, &delta, &P);
+      if (!delta.allFinite() || !P.allFinite()) {
+        res.why = "update diverged (non-finite step)";
+        return res;
+      }
+      x = x.boxplus(delta);
+      ++res.iterations;
+      if (level == 0) {
+        stepped_at_finest = true;
+        res.num_measurements = info.count;
+        res.patches = used;
+      }
+      if (delta.segment<3>(FilterState::kRot).norm() < uo.convergence_rot &&
+          delta.segment<3>(FilterState::kPos).norm() < uo.convergence_pos)
+        break;
+    }
+  }
+  if (!stepped_at_finest) {
+    res.why = "too few patches project at full resolution";
+    return res;
+  }
+
+  // photometric quality at the posterior (for map maintenance) and the cost test
+  double cost_prior = 0.0, cost_post = 0.0;
+  int n_cost = 0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    TrackedPatch& t = patches[i];
+    t.active = false;
+    if (!active[i]) continue;
+    PatchResidual ep;
+    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep) ||
+        !evaluatePatch(pyramid, 0, camera, T_I_C, x, t, po, &e))
+      continue;
+    t.active = true;
+    t.ncc = static_cast<float>(e.ncc);
+    t.rms = static_cast<float>(std::sqrt(e.r.squaredNorm() / kPatchArea));
+    cost_prior += huberCost(ep, po.huber_threshold);
+    cost_post += huberCost(e, po.huber_threshold);
+    n_cost += kPatchArea;
+  }
+  if (n_cost > 0) {
+    res.cost_prior = cost_prior / n_cost;
+    res.cost_post = cost_post / n_cost;
+  }
+  const Vec18 step = x.boxminus(prior);
+  const Vec6 dpose = step.head<6>();
+  const Eigen::LDLT<Mat6> ldlt(P_prior.topLeftCorner<6, 6>());
+  res.mahalanobis = ldlt.info() == Eigen::Success ? dpose.dot(ldlt.solve(dpose)) : INFINITY;
+  const double step_rot_deg = dpose.head<3>().norm() * 180.0 / M_PI, step_pos = dpose.tail<3>().norm();
+  if (!(res.cost_post <= 1.05 * res.cost_prior + 1e-9)) {
+    res.why = "photometric cost grew (" + fmt(res.cost_prior) + " -> " + fmt(res.cost_post) + ")";
+  } else if (!(res.mahalanobis <= uo.max_mahalanobis)) {
+    res.why = "step inconsistent with the prior (Mahalanobis^2 " + fmt(res.mahalanobis) + " > " +
+              fmt(uo.max_mahalanobis) + ")";
+  } else if (step_pos > uo.max_step_pos || step_rot_deg > uo.max_step_rot_deg) {
+    res.why = "step too large (" + fmt(step_pos) + " m, " + fmt(step_rot_deg) + " deg)";
+  } else {
+    res.valid = true;
+    res.state = x;
+    res.covariance = P;
+  }
+  return res;
+}
+
+}  // namespace livo::vio

@@ -1,0 +1,68 @@
+#include "livo/vio/patch.hpp"
+
+#include <cmath>
+
+#include <Eigen/LU>
+
+namespace livo::vio {
+
+bool extractStoredPatches(const ImagePyramid& pyramid, const Eigen::Vector2d& u0, int levels, uint8_t* out) {
+  float buf[kStoredArea];
+  for (int l = 0; l < levels; ++l) {
+    if (!pyramid.sampleGrid(l, ImagePyramid::toLevel(u0, l), kStored, buf)) return false;
+    for (int k = 0; k < kStoredArea; ++k) out[l * kStoredArea + k] = static_cast<uint8_t>(buf[k] + 0.5f);
+  }
+  return true;
+}
+
+bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pose3& T_W_Cref, const Vec3& p_W,
+                Eigen::Matrix2d* A) {
+  Eigen::Vector2d px;
+  Eigen::Matrix<double, 2, 3> Jc, Jr;
+  const Mat3 R_CW_cur = T_W_Ccur.linear().transpose(), R_CW_ref = T_W_Cref.linear().transpose();
+  if (!camera.projectWithJacobian(R_CW_cur * (p_W - T_W_Ccur.translation()), &px, &Jc)) return false;
+  if (!camera.projectWithJacobian(R_CW_ref * (p_W - T_W_Cref.translation()), &px, &Jr)) return false;
+  // tangent basis of the plane through p_W perpendicular to the reference ray
+  const Vec3 n = (p_W - T_W_Cref.translation()).normalized();
+  const Vec3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+  Eigen::Matrix<double, 3, 2> T;
+  T << t1, t2;
+  const Eigen::Matrix2d Mc = Jc * R_CW_cur * T, Mr = Jr * R_CW_ref * T;  // pixel offset per plane offset
+  const double det = Mc.determinant();
+  if (!(std::abs(det) > 1e-12)) return false;
+  *A = Mr * Mc.inverse();
+  return A->allFinite();
+}
+
+bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, float* out) {
+  constexpr double c = 0.5 * (kStored - 1), h = 0.5 * (kPatch - 1);
+  const double lim = kStored - 1;
+  for (int j = 0; j < kPatch; ++j) {
+    for (int i = 0; i < kPatch; ++i) {
+      const double dx = i - h, dy = j - h;
+      const double x = c + A(0, 0) * dx + A(0, 1) * dy, y = c + A(1, 0) * dx + A(1, 1) * dy;
+      if (!(x >= 0.0 && y >= 0.0 && x <= lim && y <= lim)) return false;
+      const int ix = std::min(static_cast<int>(x), kStored - 2), iy = std::min(static_cast<int>(y), kStored - 2);
+      const float ax = static_cast<float>(x - ix), ay = static_cast<float>(y - iy);
+      const uint8_t* r0 = stored + iy * kStored + ix;
+      const uint8_t* r1 = r0 + kStored;
+      out[j * kPatch + i] =
+          (1 - ax) * (1 - ay) * r0[0] + ax * (1 - ay) * r0[1] + (1 - ax) * ay * r1[0] + ax * ay * r1[1];
+    }
+  }
+  return true;
+}
+
+float patchGradient(const ImagePyramid& pyramid, int level, const Eigen::Vector2d& u) {
+  float w[kWindow * kWindow];
+  if (!pyramid.sampleGrid(level, u, kWindow, w)) return -1.0f;
+  float sum = 0.0f;
+  for (int j = 1; j <= kPatch; ++j)
+    for (int i = 1; i <= kPatch; ++i) {
+      const float* p = w + j * kWindow + i;
+      sum += std::abs(p[1] - p[-1]) + std::abs(p[kWindow] - p[-kWindow]);
+    }
+  return 0.5f * sum / kPatchArea;
+}
+
+}  // namespace livo::vio

@@ -1,0 +1,111 @@
+#include "livo/vio/photometric_residual.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace livo::vio {
+
+Mat26 pixelPoseJacobian(const Eigen::Matrix<double, 2, 3>& J_proj, const Mat3& R_W_I, const Pose3& T_I_C,
+                        const Vec3& p_I) {
+  // p_I = R^T (p_W - p): with R Exp(dr), p + dp:  dp_I = [p_I]x dr - R^T dp;  p_C = R_CI p_I + t_CI
+  const Mat3 R_CI = T_I_C.linear().transpose();
+  Eigen::Matrix<double, 3, 6> dpC;
+  dpC.leftCols<3>() = R_CI * so3::hat(p_I);
+  dpC.rightCols<3>() = -R_CI * R_W_I.transpose();
+  return J_proj * dpC;
+}
+
+bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const Pose3& T_I_C,
+                   const FilterState& x, const TrackedPatch& patch, const PhotometricOptions& o, PatchResidual* out) {
+  const Vec3 p_I = x.rot.transpose() * (patch.p_W - x.pos);
+  const Vec3 p_C = T_I_C.inverse() * p_I;
+  Eigen::Matrix<double, 2, 3> J;
+  if (!camera.projectWithJacobian(p_C, &out->pixel, &J)) return false;
+  float w[kWindow * kWindow];
+  if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
+  out->B = pixelPoseJacobian(J, x.rot, T_I_C, p_I) * (1.0 / static_cast<double>(1 << level));
+
+  const float* Q = patch.reference.data() + static_cast<size_t>(level) * kPatchArea;
+  // current intensities and gradients on the 8x8 interior of the 10x10 window
+  double I[kPatchArea];
+  double sum_i = 0.0, sum_q = 0.0;
+  for (int j = 0; j < kPatch; ++j)
+    for (int i = 0; i < kPatch; ++i) {
+      const int k = j * kPatch + i;
+      const float* c = w + (j + 1) * kWindow + (i + 1);
+      I[k] = c[0];
+      out->G(k, 0) = 0.5 * (c[1] - c[-1]);
+      out->G(k, 1) = 0.5 * (c[kWindow] - c[-kWindow]);
+      sum_i += I[k];
+      sum_q += Q[k];
+    }
+  const double mean_i = sum_i / kPatchArea, mean_q = sum_q / kPatchArea;
+  double sqq = 0.0, sii = 0.0, sqi = 0.0;
+  double q[kPatchArea];
+  for (int k = 0; k < kPatchArea; ++k) {
+    q[k] = Q[k] - mean_q;
+    const double di = I[k] - mean_i;
+    sqq += q[k] * q[k];
+    sii += di * di;
+    sqi += q[k] * di;
+  }
+  out->ncc = sqq > 1e-9 && sii > 1e-9 ? sqi / std::sqrt(sqq * sii) : 0.0;
+  // brightness fit: gain free within bounds (projection onto span{q, 1}), else offset only
+  const double g0 = patch.gain0, lo = o.min_gain * g0, hi = o.max_gain * g0;
+  bool gain_free = false;
+  double a = g0;
+  if (o.affine_brightness && sqq > 1e-6 * kPatchArea) {
+    a = sqi / sqq;
+    gain_free = a >= lo && a <= hi;
+    a = std::clamp(a, lo, hi);
+  }
+  out->gain = a;
+  out->offset = mean_i - a * mean_q;
+  for (int k = 0; k < kPatchArea; ++k) out->r[k] = I[k] - a * Q[k] - out->offset;
+  // project the fit out of the gradients: G - 1 mean(G) [- q (q^T G) / q^T q]
+  const Eigen::RowVector2d mean_g = out->G.colwise().mean();
+  out->G.rowwise() -= mean_g;
+  if (gain_free) {
+    const Eigen::Map<const Eigen::Matrix<double, kPatchArea, 1>> qv(q);
+    const Eigen::RowVector2d qG = qv.transpose() * out->G / sqq;
+    out->G -= qv * qG;
+  }
+  return true;
+}
+
+double huberCost(const PatchResidual& e, double d) {
+  double cost = 0.0;
+  for (int k = 0; k < kPatchArea; ++k) {
+    const double a = std::abs(e.r[k]);
+    cost += a <= d ? 0.5 * a * a : d * (a - 0.5 * d);
+  }
+  return cost;
+}
+
+double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info) {
+  const double d = o.huber_threshold;
+  Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d v = Eigen::Vector2d::Zero();
+  double cost = 0.0;
+  for (int k = 0; k < kPatchArea; ++k) {
+    const double r = e.r[k], a = std::abs(r);
+    const double wk = a <= d ? 1.0 : d / a;
+    cost += a <= d ? 0.5 * a * a : d * (a - 0.5 * d);
+    const double gx = e.G(k, 0), gy = e.G(k, 1);
+    M(0, 0) += wk * gx * gx;
+    M(0, 1) += wk * gx * gy;
+    M(1, 1) += wk * gy * gy;
+    v.x() += wk * gx * r;
+    v.y() += wk * gy * r;
+  }
+  M(1, 0) = M(0, 1);
+  const double inv_var = 1.0 / (o.noise_std * o.noise_std);
+  const Mat6 H = e.B.transpose() * M * e.B;
+  info->HtRinvH += inv_var * H;
+  info->HtRinvz += inv_var * (e.B.transpose() * v);
+  info->geometry += H;
+  info->count += kPatchArea;
+  return cost;
+}
+
+}  // namespace livo::vio

@@ -1,0 +1,122 @@
+#include "livo/vio/point_patch_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace livo::vio {
+
+PointPatchMap::PointPatchMap(const MapOptions& options) : options_(options), inv_voxel_(1.0 / options.voxel_size) {}
+
+uint64_t voxelKey(const Vec3& p, double inv_voxel_size) {
+  constexpr int64_t off = int64_t{1} << 20;
+  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
+  const auto c = [&](double v) {
+    return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v * inv_voxel_size)) + off) & mask;
+  };
+  return c(p.x()) | (c(p.y()) << 21) | (c(p.z()) << 42);
+}
+
+uint64_t PointPatchMap::keyOf(const Vec3& p) const { return voxelKey(p, inv_voxel_); }
+
+int PointPatchMap::find(const Vec3& p) const {
+  const auto it = index_.find(keyOf(p));
+  return it == index_.end() ? -1 : it->second;
+}
+
+int PointPatchMap::add(const Vec3& p, int64_t utime, PatchObservation observation) {
+  const int index = static_cast<int>(points_.size());
+  if (!index_.emplace(keyOf(p), index).second) return -1;
+  MapPoint m;
+  m.id = next_id_++;
+  m.position = p;
+  m.last_seen = utime;
+  m.observations.push_back(std::move(observation));
+  points_.push_back(std::move(m));
+  return index;
+}
+
+void PointPatchMap::addObservation(int index, PatchObservation observation) {
+  auto& obs = point(index).observations;
+  if (static_cast<int>(obs.size()) >= options_.max_observations) obs.erase(obs.begin());
+  obs.push_back(std::move(observation));
+}
+
+void PointPatchMap::prune(const Vec3& centre) {
+  // with hysteresis, so that the compaction and re-indexing run every few images, not every one:
+  // by radius once the camera moved a tenth of it, by count down to 90 % of the bound
+  const bool moved = !pruned_once_ || (centre - pruned_at_).norm() > 0.1 * options_.radius;
+  const bool full = static_cast<int>(points_.size()) > options_.max_points;
+  if (!moved && !full) return;
+  const double r2 = options_.radius * options_.radius;
+  std::vector<char> drop(points_.size(), 0);
+  std::vector<std::pair<int64_t, int64_t>> kept;  // (last_seen, id) of the points within the radius
+  std::vector<size_t> kept_index;
+  if (moved) {
+    pruned_once_ = true;
+    pruned_at_ = centre;
+  }
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (moved && (points_[i].position - centre).squaredNorm() > r2) {
+      drop[i] = 1;
+      continue;
+    }
+    kept.emplace_back(points_[i].last_seen, points_[i].id);
+    kept_index.push_back(i);
+  }
+  if (static_cast<int>(kept.size()) > options_.max_points) {
+    const size_t target = static_cast<size_t>(options_.max_points) * 9 / 10;
+    std::vector<size_t> order(kept.size());
+    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+    // the most recently seen first; ties by id, newer first
+    std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(target), order.end(),
+                     [&](size_t a, size_t b) { return kept[a] > kept[b]; });
+    for (size_t k = target; k < order.size(); ++k) drop[kept_index[order[k]]] = 1;
+  }
+  size_t out = 0;
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (drop[i]) continue;
+    if (out != i) points_[out] = std::move(points_[i]);
+    ++out;
+  }
+  if (out == points_.size()) return;
+  points_.resize(out);
+  reindex();
+}
+
+void PointPatchMap::transform(const Pose3& T) {
+  for (auto& m : points_) {
+    m.position = T * m.position;
+    for (auto& o : m.observations) o.T_W_C = T * o.T_W_C;
+  }
+  // two points may now share a voxel: both stay, the older one is indexed
+  reindex();
+}
+
+void PointPatchMap::clear() {
+  points_.clear();
+  index_.clear();
+}
+
+void PointPatchMap::reindex() {
+  index_.clear();
+  index_.reserve(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) index_.emplace(keyOf(points_[i].position), static_cast<int>(i));
+}
+
+size_t PointPatchMap::observationCount() const {
+  size_t n = 0;
+  for (const auto& m : points_) n += m.observations.size();
+  return n;
+}
+
+size_t PointPatchMap::memoryBytes() const {
+  size_t bytes = points_.capacity() * sizeof(MapPoint) + index_.size() * (sizeof(uint64_t) + sizeof(int) + 16) +
+                 index_.bucket_count() * sizeof(void*);
+  for (const auto& m : points_) {
+    bytes += m.observations.capacity() * sizeof(PatchObservation);
+    for (const auto& o : m.observations) bytes += o.pixels.capacity();
+  }
+  return bytes;
+}
+
+}  // namespace livo::vio

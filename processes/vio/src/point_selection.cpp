@@ -1,0 +1,186 @@
+#include "livo/vio/point_selection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+
+#include "livo/time.hpp"
+
+namespace livo::vio {
+
+DepthGrid::DepthGrid(int width, int height, int cell_px)
+    : cell_(std::max(1, cell_px)), cols_((width + cell_ - 1) / cell_), rows_((height + cell_ - 1) / cell_) {
+  clear();
+}
+
+void DepthGrid::clear() {
+  constexpr float inf = std::numeric_limits<float>::infinity();
+  cells_.assign(static_cast<size_t>(cols_) * rows_, Cell{inf, 0.0f, 0.0f, -inf, 0.0f, 0.0f});
+}
+
+int DepthGrid::index(const Eigen::Vector2d& pixel) const {
+  const int cx = static_cast<int>(pixel.x()) / cell_, cy = static_cast<int>(pixel.y()) / cell_;
+  if (pixel.x() < 0.0 || pixel.y() < 0.0 || cx >= cols_ || cy >= rows_) return -1;
+  return cy * cols_ + cx;
+}
+
+void DepthGrid::add(const Eigen::Vector2d& pixel, float z) {
+  const int i = index(pixel);
+  if (i < 0) return;
+  Cell& c = cells_[static_cast<size_t>(i)];
+  if (z < c.near_z) c.near_z = z, c.near_u = static_cast<float>(pixel.x()), c.near_v = static_cast<float>(pixel.y());
+  if (z > c.far_z) c.far_z = z, c.far_u = static_cast<float>(pixel.x()), c.far_v = static_cast<float>(pixel.y());
+}
+
+float DepthGrid::nearest(const Eigen::Vector2d& pixel) const {
+  const int i = index(pixel);
+  return i >= 0 ? cells_[static_cast<size_t>(i)].near_z : std::numeric_limits<float>::infinity();
+}
+
+bool DepthGrid::depthEdge(const Eigen::Vector2d& pixel, double z, double radius_px, double tolerance,
+                          double tolerance_rel) const {
+  const int x0 = std::max(0, static_cast<int>((pixel.x() - radius_px) / cell_));
+  const int x1 = std::min(cols_ - 1, static_cast<int>((pixel.x() + radius_px) / cell_));
+  const int y0 = std::max(0, static_cast<int>((pixel.y() - radius_px) / cell_));
+  const int y1 = std::min(rows_ - 1, static_cast<int>((pixel.y() + radius_px) / cell_));
+  // samples (du, dv, 1/z) relative to the point; the point itself is one
+  constexpr int kMax = 128;
+  double su[kMax], sv[kMax], sw[kMax];
+  int n = 0;
+  su[n] = 0.0, sv[n] = 0.0, sw[n] = 1.0 / z, ++n;
+  const double r2 = radius_px * radius_px;
+  auto take = [&](float zz, float u, float v) {
+    const double du = u - pixel.x(), dv = v - pixel.y();
+    if (n < kMax && du * du + dv * dv <= r2) su[n] = du, sv[n] = dv, sw[n] = 1.0 / zz, ++n;
+  };
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const Cell& c = cells_[static_cast<size_t>(y) * cols_ + x];
+      if (!std::isfinite(c.near_z)) continue;
+      take(c.near_z, c.near_u, c.near_v);
+      if (c.far_z > c.near_z) take(c.far_z, c.far_u, c.far_v);
+    }
+  if (n < 4) return false;  // too little known around the point to tell
+  // least-squares plane w = a du + b dv + c
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d row(su[i], sv[i], 1.0);
+    A += row * row.transpose();
+    b += row * sw[i];
+  }
+  Eigen::Vector3d plane = A.ldlt().solve(b);
+  if (!plane.allFinite()) plane = Eigen::Vector3d(0.0, 0.0, 1.0 / z);  // degenerate layout: a constant
+  // a depth deviation dz at depth z is an inverse-depth deviation dz / z^2
+  const double w = 1.0 / z, tol_w = (tolerance + tolerance_rel * z) * w * w;
+  for (int i = 0; i < n; ++i)
+    if (std::abs(plane.x() * su[i] + plane.y() * sv[i] + plane.z() - sw[i]) > tol_w) return true;
+  return false;
+}
+
+namespace {
+double angleDeg(const Vec3& a, const Vec3& b) {
+  const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+}
+}  // namespace
+
+int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const SelectionOptions& o) {
+  const Vec3 ray = m.position - c_W;
+  int best = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < m.observations.size(); ++j) {
+    const PatchObservation& obs = m.observations[j];
+    const double angle = angleDeg(ray, m.position - obs.T_W_C.translation());
+    if (angle > o.max_view_angle_deg) continue;
+    const double age = std::max(0.0, toSeconds(utime - obs.utime));
+    const double score = o.view_angle_weight * angle + o.error_weight * obs.error + o.age_weight * age;
+    if (score < best_score) {  // strict: the older of equal scores (deterministic)
+      best_score = score;
+      best = static_cast<int>(j);
+    }
+  }
+  return best;
+}
+
+std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
+                                        int64_t utime, float exposure_time, const DepthGrid& depth, int levels,
+                                        const SelectionOptions& o, SelectionStats* stats) {
+  SelectionStats st;
+  const CameraRig& rig = camera.rig();
+  const int cell = std::max(8, o.grid_cell_px);
+  const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
+  struct Candidate {
+    int point = -1, observation = -1;
+    float gradient = -1.0f;
+    Eigen::Matrix2d A;
+  };
+  std::vector<Candidate> grid(static_cast<size_t>(cols) * rows);
+  const Pose3 T_C_W = T_W_C.inverse();
+  const Vec3 c_W = T_W_C.translation();
+  const double border = patchBorder(levels);
+  const double corner = 0.5 * (kPatch - 1), reach = 0.5 * (kStored - 1);
+  for (size_t i = 0; i < map.size(); ++i) {
+    const MapPoint& m = map.point(static_cast<int>(i));
+    const Vec3 p_C = T_C_W * m.position;
+    if (p_C.z() < o.min_depth || p_C.z() > o.max_depth) continue;
+    Eigen::Vector2d px;
+    if (!camera.project(p_C, &px, border)) continue;
+    ++st.in_view;
+    if (depth.occluded(px, p_C.z(), o.occlusion_tolerance, o.occlusion_tolerance_rel)) {
+      ++st.occluded;
+      continue;
+    }
+    if (depth.depthEdge(px, p_C.z(), o.depth_edge_radius_px, o.depth_edge_tolerance, o.depth_edge_tolerance_rel)) {
+      ++st.depth_edge;
+      continue;
+    }
+    const int ref = chooseReference(m, c_W, utime, o);
+    Eigen::Matrix2d A;
+    bool ok = ref >= 0 && affineWarp(camera, T_W_C, m.observations[static_cast<size_t>(ref)].T_W_C, m.position, &A);
+    // the warped 8x8 patch must stay inside the stored one: check its corners
+    for (int k = 0; ok && k < 4; ++k) {
+      const Eigen::Vector2d d((k & 1) ? corner : -corner, (k & 2) ? corner : -corner);
+      ok = (A * d).cwiseAbs().maxCoeff() <= reach;
+    }
+    if (!ok) {
+      ++st.no_reference;
+      continue;
+    }
+    const PatchObservation& obs = m.observations[static_cast<size_t>(ref)];
+    Candidate& c = grid[static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell)];
+    if (obs.gradient > c.gradient) {  // strict: the earlier (older) point of equal texture
+      c.point = static_cast<int>(i);
+      c.observation = ref;
+      c.gradient = obs.gradient;
+      c.A = A;
+    }
+  }
+  std::vector<TrackedPatch> out;
+  for (const Candidate& c : grid) {
+    if (c.point < 0) continue;
+    const MapPoint& m = map.point(c.point);
+    const PatchObservation& obs = m.observations[static_cast<size_t>(c.observation)];
+    TrackedPatch t;
+    t.point = c.point;
+    t.observation = c.observation;
+    t.p_W = m.position;
+    t.gradient = c.gradient;
+    t.gain0 = exposure_time > 0.0f && obs.exposure_time > 0.0f ? exposure_time / obs.exposure_time : 1.0f;
+    bool ok = true;
+    for (int l = 0; l < levels && ok; ++l)
+      ok = warpReferencePatch(obs.level(l), c.A, t.reference.data() + static_cast<size_t>(l) * kPatchArea);
+    if (!ok) {
+      ++st.no_reference;
+      continue;
+    }
+    out.push_back(t);
+  }
+  st.selected = static_cast<int>(out.size());
+  if (stats) *stats = st;
+  return out;
+}
+
+}  // namespace livo::vio

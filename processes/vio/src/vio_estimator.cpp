@@ -1,0 +1,226 @@
+#include "livo/vio/vio_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+namespace livo::vio {
+
+namespace {
+constexpr int kMaxCandidatesPerCell = 8;  // gradient evaluations per new-point cell
+
+double angleDeg(const Vec3& a, const Vec3& b) {
+  const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+}
+}  // namespace
+
+VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
+    : options_(options),
+      camera_(camera),
+      T_I_C_(camera.T_I_C),
+      map_(options.map),
+      depth_(camera.width, camera.height, options.selection.depth_cell_px) {
+  validate(options_);
+}
+
+void VioEstimator::reset() {
+  map_.clear();
+  scans_.clear();
+}
+
+void VioEstimator::addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n) {
+  Scan s;
+  s.utime = utime;
+  const double inv = 1.0 / options_.map.voxel_size;
+  std::unordered_set<uint64_t> seen;
+  seen.reserve(n / 2 + 16);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p(x[i], y[i], z[i]);
+    if (!p.allFinite()) continue;
+    if (seen.insert(voxelKey(p, inv)).second) s.points.push_back(p);
+  }
+  // newest last; equal stamps keep arrival order
+  auto it = std::upper_bound(scans_.begin(), scans_.end(), utime, [](int64_t t, const Scan& e) { return t < e.utime; });
+  scans_.insert(it, std::move(s));
+  while (static_cast<int>(scans_.size()) > options_.map.recent_scans) scans_.pop_front();
+}
+
+void VioEstimator::addScan(int64_t utime, const std::vector<Vec3>& points) {
+  std::vector<float> x(points.size()), y(points.size()), z(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    x[i] = static_cast<float>(points[i].x());
+    y[i] = static_cast<float>(points[i].y());
+    z[i] = static_cast<float>(points[i].z());
+  }
+  addScan(utime, x.data(), y.data(), z.data(), points.size());
+}
+
+size_t VioEstimator::recentScanPoints() const {
+  size_t n = 0;
+  for (const auto& s : scans_) n += s.points.size();
+  return n;
+}
+
+void VioEstimator::applyCorrection(const Pose3& T) {
+  map_.transform(T);
+  for (auto& s : scans_)
+    for (auto& p : s.points) p = T * p;
+}
+
+void VioEstimator::fillDepth(const Pose3& T_W_C) {
+  depth_.clear();
+  const Pose3 T_C_W = T_W_C.inverse();
+  const double zmin = options_.selection.min_depth;
+  Eigen::Vector2d px;
+  auto add = [&](const Vec3& p_W) {
+    const Vec3 p_C = T_C_W * p_W;
+    if (p_C.z() >= zmin && camera_.project(p_C, &px)) depth_.add(px, static_cast<float>(p_C.z()));
+  };
+  for (const auto& s : scans_)
+    for (const auto& p : s.points) add(p);
+  for (const auto& m : map_.points()) add(m.position);
+}
+
+bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
+                                   PatchObservation* obs) const {
+  const int levels = pyramid_.levels();
+  obs->pixels.resize(static_cast<size_t>(levels) * kStoredArea);
+  if (!extractStoredPatches(pyramid_, pixel, levels, obs->pixels.data())) return false;
+  const int gl = std::min(1, levels - 1);
+  obs->utime = image.utime;
+  obs->T_W_C = T_W_C;
+  obs->exposure_time = image.exposure_time;
+  obs->gradient = patchGradient(pyramid_, gl, ImagePyramid::toLevel(pixel, gl));
+  obs->error = 0.0f;
+  return true;
+}
+
+ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState& prior, const Mat18& P) {
+  ImageResult r;
+  r.state = prior;
+  r.covariance = P;
+  const int levels = options_.photometric.pyramid_levels;
+  pyramid_.build(image.pixels, levels);
+  const Pose3 T_W_C = prior.pose() * T_I_C_;
+  fillDepth(T_W_C);
+  std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, image.utime, image.exposure_time, depth_,
+                                                    levels, options_.selection, &r.selection);
+  bool updated = false;
+  if (static_cast<int>(tracked.size()) < options_.update.min_patches) {
+    r.why = map_.size() == 0 ? std::string("the point-patch map is empty")
+                             : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
+                                   std::to_string(options_.update.min_patches) + ")";
+  } else {
+    const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, T_I_C_, options_.photometric,
+                                              options_.update, &tracked);
+    r.iterations = u.iterations;
+    r.num_measurements = u.num_measurements;
+    r.patches = u.patches;
+    r.mahalanobis = u.mahalanobis;
+    r.cost_prior = u.cost_prior;
+    r.cost_post = u.cost_post;
+    r.valid = updated = u.valid;
+    r.why = u.why;
+    if (u.valid) {
+      r.state = u.state;
+      r.covariance = u.covariance;
+    }
+  }
+  const Pose3 T_W_Cf = r.state.pose() * T_I_C_;
+  maintain(image, T_W_Cf, updated, tracked, &r);
+  map_.prune(T_W_Cf.translation());
+  r.map_points = map_.size();
+  return r;
+}
+
+void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool refresh,
+                            const std::vector<TrackedPatch>& tracked, ImageResult* r) {
+  const MaintenanceOptions& mo = options_.maintenance;
+  const SelectionOptions& so = options_.selection;
+  const CameraRig& rig = camera_.rig();
+  const int cell = std::max(8, mo.new_point_cell_px);
+  const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
+  std::vector<char> occupied(static_cast<size_t>(cols) * rows, 0);
+  const Pose3 T_C_W = T_W_C.inverse();
+  const Vec3 c_W = T_W_C.translation();
+  const double border = patchBorder(pyramid_.levels());
+  auto cellOf = [&](const Eigen::Vector2d& px) {
+    return static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell);
+  };
+
+  // tracked points: seen now; a new patch when the view or the photometric error changed enough
+  Eigen::Vector2d px;
+  for (const TrackedPatch& t : tracked) {
+    MapPoint& m = map_.point(t.point);
+    m.last_seen = image.utime;
+    if (!camera_.project(T_C_W * m.position, &px, border)) continue;
+    occupied[cellOf(px)] = 1;
+    if (!refresh || !t.active) continue;
+    m.observations[static_cast<size_t>(t.observation)].error = t.rms;
+    if (t.ncc < mo.outlier_ncc) continue;  // occluded or changed: do not learn it
+    const Vec3 ray = m.position - c_W;
+    double min_angle = std::numeric_limits<double>::infinity(), ratio = 1.0;
+    for (const auto& obs : m.observations) {
+      const Vec3 ray_obs = m.position - obs.T_W_C.translation();
+      const double a = angleDeg(ray, ray_obs);
+      if (a < min_angle) {
+        min_angle = a;
+        ratio = ray.norm() / std::max(1e-9, ray_obs.norm());
+      }
+    }
+    ratio = std::max(ratio, 1.0 / ratio);
+    if (min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || t.rms > mo.refresh_error) {
+      PatchObservation obs;
+      if (makeObservation(px, image, T_W_C, &obs)) {
+        map_.addObservation(t.point, std::move(obs));
+        ++r->new_patches;
+      }
+    }
+  }
+
+  // new points: per free cell the best-textured recent LiDAR point (newest scan first)
+  struct Best {
+    float gradient = -1.0f;
+    int evaluated = 0;
+    Vec3 p = Vec3::Zero();
+    Eigen::Vector2d px = Eigen::Vector2d::Zero();
+  };
+  std::vector<Best> best(occupied.size());
+  const int gl = std::min(1, pyramid_.levels() - 1);
+  for (auto s = scans_.rbegin(); s != scans_.rend(); ++s) {
+    for (const Vec3& p : s->points) {
+      const Vec3 p_C = T_C_W * p;
+      if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !camera_.project(p_C, &px, border)) continue;
+      const size_t c = cellOf(px);
+      Best& b = best[c];
+      if (occupied[c] || b.evaluated >= kMaxCandidatesPerCell || map_.find(p) >= 0) continue;
+      ++r->candidates;
+      if (depth_.occluded(px, p_C.z(), so.occlusion_tolerance, so.occlusion_tolerance_rel) ||
+          depth_.depthEdge(px, p_C.z(), so.depth_edge_radius_px, so.depth_edge_tolerance, so.depth_edge_tolerance_rel)) {
+        ++r->candidates_hidden;
+        continue;
+      }
+      ++b.evaluated;
+      const float g = patchGradient(pyramid_, gl, ImagePyramid::toLevel(px, gl));
+      if (g > b.gradient) {
+        b.gradient = g;
+        b.p = p;
+        b.px = px;
+      }
+    }
+  }
+  for (const Best& b : best) {
+    if (r->new_points >= mo.max_new_points) break;
+    if (b.gradient < mo.min_gradient) {
+      r->candidates_weak += b.evaluated > 0;
+      continue;
+    }
+    PatchObservation obs;
+    if (!makeObservation(b.px, image, T_W_C, &obs)) continue;
+    if (map_.add(b.p, image.utime, std::move(obs)) >= 0) ++r->new_points;
+  }
+}
+
+}  // namespace livo::vio

@@ -1,0 +1,72 @@
+#include "livo/vio/vio_messages.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "livo/filter_state_message.hpp"
+#include "livo/messages.hpp"
+
+namespace livo::vio {
+
+bool priorFromMessage(const filter_state_t& m, FilterState* x, Mat18* P, std::string* why) {
+  if (!fromFilterState(m, x, P)) {
+    *why = "prior has non-finite numbers or a degenerate quaternion";
+    return false;
+  }
+  *P = 0.5 * (*P + P->transpose());
+  const Eigen::LLT<Mat6> llt(P->topLeftCorner<6, 6>());
+  if (llt.info() != Eigen::Success) {
+    *why = "prior pose covariance is not positive definite";
+    return false;
+  }
+  return true;
+}
+
+filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
+                           const Mat18& P, bool valid, int iterations, int num_measurements) {
+  filter_state_t m = toFilterState(prior.utime, x, P, prior.request_id, source);
+  m.valid = valid ? 1 : 0;
+  m.iterations = iterations;
+  m.num_measurements = num_measurements;
+  return m;
+}
+
+filter_state_t keptPrior(const filter_state_t& prior, const std::string& source) {
+  filter_state_t m = prior;
+  m.source = source;
+  m.valid = 0;
+  m.iterations = 0;
+  m.num_measurements = 0;
+  return m;
+}
+
+RawImage rawImage(const image_t& m) {
+  RawImage r;
+  r.utime = m.utime;
+  r.width = m.width;
+  r.height = m.height;
+  r.row_stride = m.row_stride;
+  r.encoding = m.encoding;
+  r.exposure_time = m.exposure_time;
+  r.data = m.data.data();
+  r.size = std::min<size_t>(m.data.size(), m.size > 0 ? static_cast<size_t>(m.size) : 0);
+  return r;
+}
+
+bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why) {
+  if (!allFinite(m.correction_position, 3) || !allFinite(m.correction_orientation, 4)) {
+    *why = "correction is not finite";
+    return false;
+  }
+  const double* q = m.correction_orientation;
+  if (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 0.25) {
+    *why = "correction orientation is not a unit quaternion";
+    return false;
+  }
+  *T = poseFrom(m.correction_position, m.correction_orientation);
+  return true;
+}
+
+}  // namespace livo::vio

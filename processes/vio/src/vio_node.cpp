@@ -1,0 +1,175 @@
+#include "livo/vio/vio_node.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <sstream>
+
+#include "livo/message_checks.hpp"
+#include "livo/time.hpp"
+#include "livo/vio/vio_messages.hpp"
+
+namespace livo::vio {
+
+namespace {
+constexpr size_t kAnsweredIds = 64;
+
+NodeOptions nodeOptions(const VioNodeOptions& o, bool quiet) {
+  NodeOptions n;
+  n.name = o.name;
+  n.quiet = quiet;
+  return n;
+}
+}  // namespace
+
+VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
+    : opts_(std::move(options)),
+      node_(lcm, nodeOptions(opts_, quiet)),
+      vio_(opts_.vio, opts_.camera),
+      offset_us_(toUtime(opts_.camera_time_offset_s)),
+      tolerance_us_(toUtime(opts_.time_tolerance_s)) {
+  node_.declareOutput(opts_.state_posterior_channel);
+  node_.subscribe<image_t>(opts_.camera_channel, [this](const image_t& m) { onImage(m); });
+  node_.subscribe<filter_state_t>(opts_.state_prior_channel, [this](const filter_state_t& m) { onPrior(m); });
+  node_.subscribe<registered_scan_t>(opts_.registered_scan_channel, [this](const registered_scan_t& m) { onScan(m); });
+  node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
+                                     [this](const loop_correction_t& m) { onCorrection(m); });
+}
+
+void VioNode::onImage(const image_t& m) {
+  BufferedImage b;
+  b.t = m.utime + offset_us_;
+  if (!decodeGrey(rawImage(m), opts_.camera.width, opts_.camera.height, &b.image, &b.problem) ||
+      !(b.problem = imageProblem(b.image.pixels, opts_.image_check)).empty()) {
+    node_.reject(opts_.camera_channel, b.problem);
+    b.image.pixels.release();
+    ++counts_.bad_images;
+  } else {
+    ++counts_.images;
+  }
+  b.image.utime = b.t;
+  const auto it = std::upper_bound(images_.begin(), images_.end(), b.t,
+                                   [](int64_t t, const BufferedImage& e) { return t < e.t; });
+  images_.insert(it, std::move(b));
+  resolve();
+}
+
+void VioNode::onPrior(const filter_state_t& m) {
+  if (std::find(answered_ids_.begin(), answered_ids_.end(), m.request_id) != answered_ids_.end() ||
+      std::any_of(pending_.begin(), pending_.end(), [&](const filter_state_t& p) { return p.request_id == m.request_id; })) {
+    node_.reject(opts_.state_prior_channel, "duplicate prior (request id already seen): not answered again");
+    return;
+  }
+  const auto it = std::upper_bound(pending_.begin(), pending_.end(), m.utime,
+                                   [](int64_t t, const filter_state_t& p) { return t < p.utime; });
+  pending_.insert(it, m);
+  resolve();
+}
+
+void VioNode::resolve() {
+  while (!pending_.empty()) {
+    const filter_state_t prior = pending_.front();
+    // the image at the prior's time (the nearest within the tolerance)
+    auto best = images_.end();
+    for (auto it = images_.begin(); it != images_.end(); ++it)
+      if (std::llabs(it->t - prior.utime) <= tolerance_us_ &&
+          (best == images_.end() || std::llabs(it->t - prior.utime) < std::llabs(best->t - prior.utime)))
+        best = it;
+    if (best != images_.end()) {
+      pending_.pop_front();
+      const BufferedImage image = std::move(*best);
+      for (auto it = images_.begin(); it != best; ++it) counts_.unused_images += it->problem.empty();
+      images_.erase(images_.begin(), best + 1);  // it and everything older are used up
+      if (!image.problem.empty()) keep(prior, "bad image at the prior's time: " + image.problem);
+      else process(prior, image);
+      // older priors cannot get an image any more (pending_ is sorted; they were answered above)
+      continue;
+    }
+    const bool newer_image = !images_.empty() && images_.back().t > prior.utime + tolerance_us_;
+    const bool newer_prior = pending_.size() > 1;
+    if (newer_image || newer_prior || static_cast<int>(pending_.size()) > opts_.max_buffered_images) {
+      pending_.pop_front();
+      keep(prior, newer_image ? "no image at the prior's time (a newer image came)"
+                              : "no image at the prior's time (a newer prior came)");
+      continue;
+    }
+    break;  // wait for the image
+  }
+  trimImages();
+}
+
+void VioNode::trimImages() {
+  if (images_.empty()) return;
+  const int64_t horizon = images_.back().t - toUtime(opts_.image_buffer_s);
+  while (!images_.empty() &&
+         (images_.front().t < horizon || static_cast<int>(images_.size()) > opts_.max_buffered_images)) {
+    if (images_.front().problem.empty()) ++counts_.unused_images;
+    images_.pop_front();
+  }
+}
+
+void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
+  FilterState x;
+  Mat18 P;
+  std::string why;
+  if (!priorFromMessage(prior, &x, &P, &why)) {
+    node_.reject(opts_.state_prior_channel, why);
+    keep(prior, why);
+    return;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const ImageResult r = vio_.processImage(image.image, x, P);
+  node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (!r.valid) {
+    keep(prior, r.why);
+    return;
+  }
+  node_.publish(opts_.state_posterior_channel,
+                toPosterior(prior, opts_.name, r.state, r.covariance, true, r.iterations, r.num_measurements));
+  answered_ids_.push_back(prior.request_id);
+  if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
+  ++counts_.priors;
+  ++counts_.updated;
+}
+
+void VioNode::keep(const filter_state_t& prior, const std::string& why) {
+  node_.publish(opts_.state_posterior_channel, keptPrior(prior, opts_.name));
+  answered_ids_.push_back(prior.request_id);
+  if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
+  ++counts_.priors;
+  ++counts_.kept;
+  // reasons with numbers in them are grouped by their text up to the first '('
+  const std::string key = why.substr(0, why.find(" ("));
+  ++kept_reasons_[key];
+  auto it = last_warned_.find(key);
+  if (it == last_warned_.end() || prior.utime - it->second >= 1000000 || prior.utime < it->second) {
+    last_warned_[key] = prior.utime;
+    node_.warn("prior " + std::to_string(prior.request_id) + " at " + std::to_string(prior.utime) +
+               " kept (valid = 0): " + why);
+  }
+}
+
+void VioNode::onScan(const registered_scan_t& m) {
+  if (const std::string why = registeredScanProblem(m); !why.empty()) {
+    node_.reject(opts_.registered_scan_channel, why);
+    return;
+  }
+  const point_cloud_t& c = m.cloud;
+  vio_.addScan(m.utime, c.x.data(), c.y.data(), c.z.data(), static_cast<size_t>(c.num_points));
+  ++counts_.scans;
+}
+
+void VioNode::onCorrection(const loop_correction_t& m) {
+  Pose3 T;
+  std::string why;
+  if (!correctionOf(m, &T, &why)) {
+    node_.reject(opts_.loop_correction_channel, why);
+    return;
+  }
+  vio_.applyCorrection(T);
+  std::ostringstream s;
+  s << "loop correction: moved " << vio_.map().size() << " map points by " << T.translation().norm() << " m";
+  node_.info(s.str());
+}
+
+}  // namespace livo::vio

@@ -1,0 +1,102 @@
+// Rendered test data for the VIO from the simulator library (livo_sim): a sim config's scene,
+// trajectory and rig; grey images rendered at trajectory times (exposure drift, vignetting, sensor
+// noise as the simulator makes them) and LiDAR sweeps moved to the world frame with the true pose
+// at each point's firing time (what a perfect LIO would publish as REGISTERED_SCAN).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "camera_renderer.hpp"
+#include "lidar_scanner.hpp"
+#include "livo/filter_state.hpp"
+#include "livo/vio/grey_image.hpp"
+#include "simulation_setup.hpp"
+
+namespace livo_test {
+
+class SimScene {
+ public:
+  /// `config` relative to the source tree; `height` > 0 overrides the camera's image height
+  /// (keeping the principal point centred), e.g. 512 for the 640x512 benchmark image;
+  /// `lidar_model` (one of livo::kLidarModels) replaces the rig's LiDAR.
+  explicit SimScene(const std::string& config = "config/sim/room.yaml", int height = 0,
+                    const std::string& lidar_model = "") {
+    livo::sim::SimOverrides ov;
+    ov.duration_s = 30.0;
+    setup_ = livo::sim::loadSimulation(std::string(LIVO_SOURCE_DIR) + "/" + config, ov);
+    camera_ = *setup_.rig.camera;
+    if (height > 0) {
+      camera_.cy += 0.5 * (height - camera_.height);
+      camera_.height = height;
+    }
+    if (!lidar_model.empty()) setup_.rig.lidar->model = lidar_model;
+    renderer_ = std::make_unique<livo::sim::CameraRenderer>(camera_, setup_.options.camera);
+    scanner_ = std::make_unique<livo::sim::LidarScanner>(*setup_.rig.lidar, setup_.options.lidar);
+  }
+
+  const livo::CameraRig& camera() const { return camera_; }
+  const livo::sim::SimulationSetup& setup() const { return setup_; }
+  int64_t utime(double t) const { return setup_.start_utime + static_cast<int64_t>(std::llround(t * 1e6)); }
+
+  livo::Pose3 bodyPose(double t) const { return setup_.trajectory->at(t).T_W_I; }
+  livo::FilterState trueState(double t) const {
+    const auto s = setup_.trajectory->at(t);
+    livo::FilterState x;
+    x.rot = s.T_W_I.linear();
+    x.pos = s.T_W_I.translation();
+    x.vel = s.velocity;
+    return x;
+  }
+
+  /// The simulator's image (8-bit grey) at trajectory time t, noise stream k.
+  livo::sim::CameraImage rendered(double t, uint64_t k) const {
+    return renderer_->render(*setup_.scene, *setup_.trajectory, t, utime(t),
+                             livo::sim::Random(setup_.options.seed, 7, k));
+  }
+  livo::vio::GreyImage image(double t, uint64_t k) const {
+    const livo::sim::CameraImage c = rendered(t, k);
+    livo::vio::GreyImage g;
+    g.utime = c.utime;
+    g.exposure_time = c.exposure_time;
+    const cv::Mat view(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data()));
+    if (c.color) cv::cvtColor(view, g.pixels, cv::COLOR_RGB2GRAY);
+    else g.pixels = view.clone();
+    return g;
+  }
+
+  /// World points of the sweep starting at trajectory time t (true pose per point).
+  std::vector<livo::Vec3> sweep(double t, uint64_t k) const {
+    const livo::sim::LidarSweep s =
+        scanner_->scan(*setup_.scene, *setup_.trajectory, t, utime(t), t, livo::sim::Random(setup_.options.seed, 5, k));
+    std::vector<livo::Vec3> out;
+    out.reserve(s.size());
+    for (size_t j = 0; j < s.size(); ++j) {
+      const livo::Pose3 T_W_L = bodyPose(t + s.time_offset[j]) * setup_.rig.lidar->T_I_L;
+      out.push_back(T_W_L * livo::Vec3(s.x[j], s.y[j], s.z[j]));
+    }
+    return out;
+  }
+  double sweepDuration() const { return scanner_->pattern().sweepDuration(); }
+
+ private:
+  livo::sim::SimulationSetup setup_;
+  livo::CameraRig camera_;
+  std::unique_ptr<livo::sim::CameraRenderer> renderer_;
+  std::unique_ptr<livo::sim::LidarScanner> scanner_;
+};
+
+/// A prior covariance: rotation std rot_std (rad), position pos_std (m), the rest loose.
+inline livo::Mat18 priorCovariance(double rot_std, double pos_std) {
+  livo::Mat18 P = livo::Mat18::Identity() * 1e-2;
+  P.block<3, 3>(0, 0) = livo::Mat3::Identity() * rot_std * rot_std;
+  P.block<3, 3>(3, 3) = livo::Mat3::Identity() * pos_std * pos_std;
+  P.block<3, 3>(6, 6) = livo::Mat3::Identity() * 0.05;
+  return P;
+}
+
+}  // namespace livo_test

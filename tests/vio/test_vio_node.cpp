@@ -1,0 +1,391 @@
+// The livo-vio node on LCM's in-process memq:// provider, fed with images and scans of the
+// simulated room: every STATE_PRIOR answered exactly once with its request id and utime, a
+// prior waiting for its image, a prior without an image kept, bad images and malformed
+// messages refused and counted, the camera time offset, loop corrections, and identical
+// posteriors for identical inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "livo/filter_state_message.hpp"
+#include "livo/messages.hpp"
+#include "livo/vio/vio_node.hpp"
+#include "sim_fixture.hpp"
+
+using namespace livo;
+using namespace livo::vio;
+
+namespace {
+
+std::string roomConfig(const std::string& extra = "") {
+  std::ifstream f(std::string(LIVO_SOURCE_DIR) + "/config/sim/room.yaml");
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str() + extra;
+}
+
+const livo_test::SimScene& scene() {
+  static const livo_test::SimScene s;
+  return s;
+}
+
+// The seed image, the update image and a third one, rendered once per test process.
+constexpr double kT0 = 6.0, kT1 = 6.05, kT2 = 6.1;
+const GreyImage& rendered(int k) {
+  static const std::vector<GreyImage> images = {scene().image(kT0, 1), scene().image(kT1, 2), scene().image(kT2, 3)};
+  return images[static_cast<size_t>(k)];
+}
+
+image_t imageMsg(const GreyImage& g, int64_t utime) {
+  image_t m{};
+  m.utime = utime;
+  m.frame = "C";
+  m.width = g.pixels.cols;
+  m.height = g.pixels.rows;
+  m.row_stride = g.pixels.cols;
+  m.encoding = image_t::ENCODING_GRAY8;
+  m.exposure_time = g.exposure_time;
+  m.data.assign(g.pixels.datastart, g.pixels.dataend);
+  m.size = static_cast<int32_t>(m.data.size());
+  return m;
+}
+
+registered_scan_t scanMsg(int64_t utime, const std::vector<Vec3>& points, const Pose3& T_W_I) {
+  registered_scan_t s{};
+  s.utime = utime;
+  poseTo(T_W_I, s.position, s.orientation);
+  point_cloud_t& c = s.cloud;
+  c.utime = utime - 100000;
+  c.frame = "W";
+  c.sweep_duration = 0.1f;
+  for (const Vec3& p : points) {
+    c.x.push_back(static_cast<float>(p.x()));
+    c.y.push_back(static_cast<float>(p.y()));
+    c.z.push_back(static_cast<float>(p.z()));
+  }
+  c.num_points = static_cast<int32_t>(points.size());
+  c.intensity.assign(points.size(), 0.0f);
+  c.time_offset.assign(points.size(), 0.0f);
+  c.ring.assign(points.size(), -1);
+  return s;
+}
+
+filter_state_t priorMsg(int64_t utime, int64_t id, const FilterState& x, const Mat18& P) {
+  return toFilterState(utime, x, P, id, "lio");
+}
+
+FilterState offsetState(const FilterState& x) {
+  Vec18 d = Vec18::Zero();
+  d.head<3>() = Vec3(0.2, 0.3, -0.1).normalized() * (0.4 * M_PI / 180.0);
+  d.segment<3>(3) = Vec3(-0.01, 0.02, 0.01).normalized() * 0.025;
+  return x.boxplus(d);
+}
+
+const Mat18& priorP() {
+  static const Mat18 P = livo_test::priorCovariance(1.0 * M_PI / 180.0, 0.05);
+  return P;
+}
+
+template <class M>
+std::vector<uint8_t> encode(const M& m) {
+  std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+// A VioNode and an observer of its STATE_POSTERIOR on one memq:// bus.
+struct Harness {
+  lcm::LCM lcm{"memq://"};
+  std::unique_ptr<VioNode> vio;
+  Node observer{lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true}};
+  std::vector<filter_state_t> posteriors;
+  std::vector<std::vector<uint8_t>> posterior_bytes;
+
+  explicit Harness(const std::string& config = roomConfig()) {
+    EXPECT_TRUE(lcm.good());
+    vio = std::make_unique<VioNode>(lcm, readVioNodeOptions(Config::fromString(config)), true);
+    observer.subscribeRaw("STATE_POSTERIOR", [this](const void* data, int size) {
+      const auto* b = static_cast<const uint8_t*>(data);
+      posterior_bytes.emplace_back(b, b + size);
+      filter_state_t m;
+      EXPECT_EQ(m.decode(data, 0, size), size);
+      posteriors.push_back(m);
+    });
+  }
+  template <class M>
+  void send(const std::string& channel, const M& m) {
+    lcm.publish(channel, &m);
+    drain();
+  }
+  void sendRaw(const std::string& channel, const std::vector<uint8_t>& bytes) {
+    lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    drain();
+  }
+  void drain() {
+    while (lcm.handleTimeout(0) > 0) {
+    }
+  }
+  channel_stats_t stats(const std::string& channel) const {
+    for (const auto& c : vio->node().channelStats())
+      if (c.channel == channel) return c;
+    return channel_stats_t{};
+  }
+  // Two scans before kT0, the seed image and its prior at the true pose (answered valid = 0: the
+  // map is empty; the map is then seeded).
+  void seed(int64_t id = 1) {
+    const auto& s = scene();
+    send("REGISTERED_SCAN", scanMsg(s.utime(kT0 - 0.1), s.sweep(kT0 - 0.2, 1), s.bodyPose(kT0 - 0.1)));
+    send("REGISTERED_SCAN", scanMsg(s.utime(kT0), s.sweep(kT0 - 0.1, 2), s.bodyPose(kT0)));
+    send("CAMERA", imageMsg(rendered(0), s.utime(kT0)));
+    send("STATE_PRIOR", priorMsg(s.utime(kT0), id, s.trueState(kT0), priorP()));
+  }
+};
+
+double positionError(const filter_state_t& m, const FilterState& truth) { return (vec3From(m.position) - truth.pos).norm(); }
+
+}  // namespace
+
+TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
+  const VioNodeOptions d = readVioNodeOptions(Config::fromString(roomConfig()));
+  EXPECT_EQ(d.camera.width, 640);
+  EXPECT_DOUBLE_EQ(d.camera.fx, 400.0);
+  EXPECT_NEAR(d.camera.distortion[0], -0.05, 1e-12);
+  EXPECT_EQ(d.camera_channel, "CAMERA");
+  EXPECT_DOUBLE_EQ(d.camera_time_offset_s, 0.0);
+  EXPECT_EQ(d.vio.photometric.pyramid_levels, 3);
+  const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
+      "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
+      "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3}\n"
+      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n")));
+  EXPECT_EQ(o.name, "vio2");
+  EXPECT_EQ(o.state_prior_channel, "PRIOR2");
+  EXPECT_DOUBLE_EQ(o.vio.map.voxel_size, 0.25);
+  EXPECT_EQ(o.vio.map.max_points, 5000);
+  EXPECT_DOUBLE_EQ(o.vio.photometric.noise_std, 8.0);
+  EXPECT_FALSE(o.vio.photometric.affine_brightness);
+  EXPECT_EQ(o.vio.update.max_iterations, 3);
+  EXPECT_DOUBLE_EQ(o.vio.maintenance.min_gradient, 4.0);
+  EXPECT_DOUBLE_EQ(o.vio.maintenance.refresh_angle_deg, 12.0);
+  EXPECT_DOUBLE_EQ(o.vio.selection.depth_edge_radius_px, 20.0);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  photometric: {pyramid_levels: 7}\n"))),
+               ConfigError);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  image_buffer_s: -1\n"))), ConfigError);
+  std::string offset = roomConfig();
+  offset.replace(offset.find("    color: false"), 16, "    color: false\n    time_offset_s: 0.02");
+  EXPECT_DOUBLE_EQ(readVioNodeOptions(Config::fromString(offset)).camera_time_offset_s, 0.02);
+  std::string no_camera = roomConfig();
+  const size_t c0 = no_camera.find("  camera:\n"), c1 = no_camera.find("sim:");
+  no_camera.erase(c0, c1 - c0);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(no_camera)), ConfigError);
+}
+
+TEST(VioNode, AnswersEveryPriorOnceWithItsRequestIdAndUpdates) {
+  Harness h;
+  const auto& s = scene();
+  h.seed(41);
+  ASSERT_EQ(h.posteriors.size(), 1u);
+  EXPECT_EQ(h.posteriors[0].request_id, 41);
+  EXPECT_EQ(h.posteriors[0].utime, s.utime(kT0));
+  EXPECT_EQ(h.posteriors[0].valid, 0);  // nothing in the map yet
+  EXPECT_EQ(h.posteriors[0].source, "vio");
+  EXPECT_GT(h.vio->estimator().map().size(), 50u);
+
+  const FilterState truth = s.trueState(kT1), prior = offsetState(truth);
+  h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
+  EXPECT_EQ(h.posteriors.size(), 1u);  // an image alone is not answered
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 42, prior, priorP()));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  const filter_state_t& post = h.posteriors[1];
+  EXPECT_EQ(post.request_id, 42);
+  EXPECT_EQ(post.utime, s.utime(kT1));
+  ASSERT_EQ(post.valid, 1);
+  EXPECT_GT(post.iterations, 0);
+  EXPECT_GE(post.num_measurements, 50 * 64);
+  EXPECT_NEAR((prior.pos - truth.pos).norm(), 0.025, 1e-9);
+  EXPECT_LT(positionError(post, truth), 0.005);
+  EXPECT_LT(so3::Log(truth.rot.transpose() * quatFromWxyz(post.orientation).toRotationMatrix()).norm(),
+            0.1 * M_PI / 180.0);
+  // the covariance shrank on the pose
+  const Mat18 P = matrixFrom<18>(post.covariance);
+  const double trace_post = P.topLeftCorner<6, 6>().trace(), trace_prior = priorP().topLeftCorner<6, 6>().trace();
+  EXPECT_LT(trace_post, 0.5 * trace_prior);
+  EXPECT_EQ(h.vio->counts().priors, 2);
+  EXPECT_EQ(h.vio->counts().updated, 1);
+  EXPECT_EQ(h.vio->counts().kept, 1);
+  EXPECT_EQ(h.vio->node().published("STATE_POSTERIOR"), 2);
+}
+
+TEST(VioNode, HoldsAPriorUntilItsImageArrives) {
+  Harness h;
+  const auto& s = scene();
+  h.seed();
+  const FilterState truth = s.trueState(kT1);
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(truth), priorP()));
+  EXPECT_EQ(h.posteriors.size(), 1u);  // waiting
+  h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(h.posteriors[1].request_id, 2);
+  EXPECT_EQ(h.posteriors[1].valid, 1);
+  EXPECT_LT(positionError(h.posteriors[1], truth), 0.005);
+}
+
+TEST(VioNode, APriorWithoutItsImageIsKeptWhenANewerImageOrPriorComes) {
+  Harness h;
+  const auto& s = scene();
+  h.seed();
+  // no image at kT1: answered valid = 0 once the image of kT2 arrives
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, s.trueState(kT1), priorP()));
+  EXPECT_EQ(h.posteriors.size(), 1u);
+  h.send("CAMERA", imageMsg(rendered(2), s.utime(kT2)));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(h.posteriors[1].request_id, 2);
+  EXPECT_EQ(h.posteriors[1].valid, 0);
+  EXPECT_EQ(h.posteriors[1].utime, s.utime(kT1));
+  // the kept prior is echoed
+  EXPECT_EQ(std::vector<double>(h.posteriors[1].covariance, h.posteriors[1].covariance + 324),
+            std::vector<double>(priorP().data(), priorP().data() + 324));
+  // the image of kT2 still serves its own prior
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT2), 3, offsetState(s.trueState(kT2)), priorP()));
+  ASSERT_EQ(h.posteriors.size(), 3u);
+  EXPECT_EQ(h.posteriors[2].request_id, 3);
+  EXPECT_EQ(h.posteriors[2].valid, 1);
+  // a prior without an image followed by a newer prior: the first is kept, the second waits
+  h.send("STATE_PRIOR", priorMsg(s.utime(7.0), 4, s.trueState(7.0), priorP()));
+  h.send("STATE_PRIOR", priorMsg(s.utime(7.05), 5, s.trueState(7.05), priorP()));
+  ASSERT_EQ(h.posteriors.size(), 4u);
+  EXPECT_EQ(h.posteriors[3].request_id, 4);
+  EXPECT_EQ(h.posteriors[3].valid, 0);
+  EXPECT_EQ(h.vio->keptReasons().count("no image at the prior's time"), 1u);
+}
+
+TEST(VioNode, BadImagesAreRejectedAndTheirPriorsKept) {
+  Harness h;
+  const auto& s = scene();
+  h.seed();
+  GreyImage black = rendered(1);
+  black.pixels = cv::Mat(black.pixels.size(), CV_8UC1, cv::Scalar(2));
+  h.send("CAMERA", imageMsg(black, s.utime(kT1)));
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, s.trueState(kT1), priorP()));
+  GreyImage white = rendered(2);
+  white.pixels = cv::Mat(white.pixels.size(), CV_8UC1, cv::Scalar(255));
+  h.send("CAMERA", imageMsg(white, s.utime(kT2)));
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT2), 3, s.trueState(kT2), priorP()));
+  image_t small = imageMsg(rendered(2), s.utime(7.0));
+  small.width = 320;  // wrong size for the rig
+  h.send("CAMERA", small);
+  h.send("STATE_PRIOR", priorMsg(s.utime(7.0), 4, s.trueState(7.0), priorP()));
+  image_t jpeg = imageMsg(rendered(2), s.utime(7.05));
+  jpeg.encoding = image_t::ENCODING_JPEG;  // raw bytes are no JPEG
+  h.send("CAMERA", jpeg);
+  h.send("STATE_PRIOR", priorMsg(s.utime(7.05), 5, s.trueState(7.05), priorP()));
+  ASSERT_EQ(h.posteriors.size(), 5u);
+  for (size_t i = 1; i < 5; ++i) {
+    EXPECT_EQ(h.posteriors[i].request_id, static_cast<int64_t>(i + 1));
+    EXPECT_EQ(h.posteriors[i].valid, 0);
+  }
+  EXPECT_EQ(h.stats("CAMERA").rejected, 4);
+  EXPECT_EQ(h.vio->counts().bad_images, 4);
+  int64_t bad = 0;
+  for (const auto& [why, n] : h.vio->keptReasons())
+    if (why.rfind("bad image at the prior's time: ", 0) == 0) bad += n;
+  EXPECT_EQ(bad, 4);
+}
+
+TEST(VioNode, MalformedMessagesAreCountedAndNotAnswered) {
+  Harness h;
+  const auto& s = scene();
+  const std::vector<uint8_t> garbage(100, 0x42);
+  h.sendRaw("STATE_PRIOR", garbage);
+  h.sendRaw("CAMERA", garbage);
+  h.sendRaw("REGISTERED_SCAN", garbage);
+  h.sendRaw("LOOP_CORRECTION", garbage);
+  EXPECT_TRUE(h.posteriors.empty());
+  EXPECT_EQ(h.stats("STATE_PRIOR").decode_failures, 1);
+  EXPECT_EQ(h.stats("CAMERA").decode_failures, 1);
+  EXPECT_EQ(h.stats("REGISTERED_SCAN").decode_failures, 1);
+  EXPECT_EQ(h.stats("LOOP_CORRECTION").decode_failures, 1);
+  // a decodable prior with NaN is answered (valid = 0) and counted as rejected; so is a scan
+  // with NaN in its pose
+  h.send("CAMERA", imageMsg(rendered(0), s.utime(kT0)));
+  filter_state_t nan = priorMsg(s.utime(kT0), 7, s.trueState(kT0), priorP());
+  nan.position[1] = NAN;
+  h.send("STATE_PRIOR", nan);
+  ASSERT_EQ(h.posteriors.size(), 1u);
+  EXPECT_EQ(h.posteriors[0].request_id, 7);
+  EXPECT_EQ(h.posteriors[0].valid, 0);
+  EXPECT_EQ(h.stats("STATE_PRIOR").rejected, 1);
+  registered_scan_t bad = scanMsg(s.utime(kT0), {Vec3(1, 2, 3)}, s.bodyPose(kT0));
+  bad.orientation[0] = NAN;
+  h.send("REGISTERED_SCAN", bad);
+  EXPECT_EQ(h.stats("REGISTERED_SCAN").rejected, 1);
+  // a duplicate request id is not answered twice
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT0), 7, s.trueState(kT0), priorP()));
+  EXPECT_EQ(h.posteriors.size(), 1u);
+  EXPECT_EQ(h.stats("STATE_PRIOR").rejected, 2);
+}
+
+TEST(VioNode, UsesTheCameraTimeOffset) {
+  std::string config = roomConfig();
+  config.replace(config.find("    color: false"), 16, "    color: false\n    time_offset_s: 0.02");
+  Harness h(config);
+  const auto& s = scene();
+  // images stamped 20 ms before the IMU-clock time of the priors
+  const int64_t off = 20000;
+  h.send("REGISTERED_SCAN", scanMsg(s.utime(kT0 - 0.1), s.sweep(kT0 - 0.2, 1), s.bodyPose(kT0 - 0.1)));
+  h.send("REGISTERED_SCAN", scanMsg(s.utime(kT0), s.sweep(kT0 - 0.1, 2), s.bodyPose(kT0)));
+  h.send("CAMERA", imageMsg(rendered(0), s.utime(kT0) - off));
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT0), 1, s.trueState(kT0), priorP()));
+  h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1) - off));
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(s.trueState(kT1)), priorP()));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(h.posteriors[1].utime, s.utime(kT1));
+  EXPECT_EQ(h.posteriors[1].valid, 1);
+  EXPECT_LT(positionError(h.posteriors[1], s.trueState(kT1)), 0.005);
+}
+
+TEST(VioNode, LoopCorrectionMovesTheMap) {
+  Harness h;
+  const auto& s = scene();
+  h.seed();
+  const Vec3 before = h.vio->estimator().map().point(0).position;
+  const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.05)), Vec3(0.3, -0.2, 0.0));
+  loop_correction_t c{};
+  c.utime = s.utime(kT0);
+  poseTo(T, c.correction_position, c.correction_orientation);
+  c.num_keyframes = 0;
+  h.send("LOOP_CORRECTION", c);
+  EXPECT_TRUE(h.vio->estimator().map().point(0).position.isApprox(T * before, 1e-9));
+  // priors now come in the corrected frame: the update still finds the (corrected) truth
+  FilterState truth = s.trueState(kT1);
+  truth.rot = T.linear() * truth.rot;
+  truth.pos = T * truth.pos;
+  h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
+  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(truth), priorP()));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(h.posteriors[1].valid, 1);
+  EXPECT_LT(positionError(h.posteriors[1], truth), 0.005);
+}
+
+TEST(VioNode, IdenticalInputsGiveIdenticalPosteriors) {
+  std::vector<std::vector<uint8_t>> runs[2];
+  for (auto& run : runs) {
+    Harness h;
+    const auto& s = scene();
+    h.seed();
+    h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
+    h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(s.trueState(kT1)), priorP()));
+    h.send("STATE_PRIOR", priorMsg(s.utime(kT2), 3, offsetState(s.trueState(kT2)), priorP()));
+    h.send("CAMERA", imageMsg(rendered(2), s.utime(kT2)));
+    ASSERT_EQ(h.posteriors.size(), 3u);
+    EXPECT_EQ(h.posteriors[1].valid, 1);
+    EXPECT_EQ(h.posteriors[2].valid, 1);
+    run = h.posterior_bytes;
+  }
+  EXPECT_EQ(runs[0], runs[1]);
+}
