@@ -1,28 +1,18 @@
-// A camera image as the colouring core sees it: decoded to 8-bit grey or RGB (OpenCV), with its
-// stamp and exposure. Decoding never throws: a bad image gives an error string.
+// A camera image as the colouring core sees it: 8-bit grey or RGB, with its stamp and exposure.
+// Decoding is the shared one (livo/camera_image.hpp); it never throws: a bad image gives an error
+// string.
 #pragma once
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "livo/camera_image.hpp"
+
 namespace livo {
 namespace colour {
-
-enum class Encoding : int { kGray8 = 0, kRgb8 = 1, kBgr8 = 2, kJpeg = 10, kPng = 11 };
-
-/// An image as it arrives (raw bytes plus layout), independent of the message type.
-struct RawImage {
-  int64_t utime = 0;
-  int width = 0, height = 0, row_stride = 0;
-  int encoding = 0;
-  float exposure_time = 0.0f;
-  const uint8_t* data = nullptr;
-  size_t size = 0;
-};
 
 struct ColourImage {
   int64_t utime = 0;
@@ -34,8 +24,10 @@ struct ColourImage {
   Eigen::Vector3f sample(const Eigen::Vector2d& pixel) const;
 };
 
-/// Decodes `raw`; false with `error` set if it is malformed, inconsistent or undecodable.
-bool decodeImage(const RawImage& raw, ColourImage* out, std::string* error);
+/// Decodes `raw` with livo::decodeImage (grey images stay grey, colour ones become R, G, B) and
+/// takes its stamp and exposure time (0 if unknown); false with `error` set if it is malformed,
+/// undecodable, not width x height (the rig's camera) or smaller than the 2x2 sample() needs.
+bool decodeColourImage(const RawImage& raw, int width, int height, ColourImage* out, std::string* error);
 
 }  // namespace colour
 }  // namespace livo

@@ -53,19 +53,12 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
     pipeline_.addPose(m.utime, poseFrom(m.position, m.orientation));
   });
   node_.subscribe<image_t>(options_.image_channel, [this](const image_t& m) {
-    RawImage raw;
-    raw.utime = m.utime;
-    raw.width = m.width;
-    raw.height = m.height;
-    raw.row_stride = m.row_stride;
-    raw.encoding = m.encoding;
-    raw.exposure_time = m.exposure_time;
-    raw.data = m.data.data();
-    raw.size = std::min<size_t>(m.data.size(), m.size > 0 ? static_cast<size_t>(m.size) : 0);
     ColourImage img;
     std::string error;
     const int64_t dropped = pipeline_.stats().images_dropped;
-    if (!decodeImage(raw, &img, &error) || !pipeline_.addImage(std::move(img), &error)) {
+    const CameraRig& camera = pipeline_.camera();
+    if (!decodeColourImage(rawImage(m), camera.width, camera.height, &img, &error) ||
+        !pipeline_.addImage(std::move(img), &error)) {
       node_.reject(options_.image_channel, error);
       return;
     }

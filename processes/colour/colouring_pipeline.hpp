@@ -74,6 +74,7 @@ class ColouringPipeline {
   const ColourMap& map() const { return map_; }
   const ColouringStats& stats() const { return stats_; }
   const ColourOptions& options() const { return options_; }
+  const CameraRig& camera() const { return camera_.rig(); }
   size_t pendingImages() const { return images_.size(); }
 
  private:

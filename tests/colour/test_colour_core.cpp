@@ -1,12 +1,12 @@
 // The colouring core without LCM: projection against OpenCV, occlusion on a constructed scene,
-// the time window, accumulation and exposure normalisation, loop corrections, image decoding and
+// the time window, accumulation and exposure normalisation, loop corrections, the colour image
+// (decoding itself is the shared livo_camera_image, tested in tests/unit/test_camera_image.cpp) and
 // the PLY/PCD files.
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "livo/camera_projection.hpp"
 #include "colour_map.hpp"
@@ -302,45 +302,47 @@ TEST(ColouringPipeline, PendingImagesAreBoundedWhileNoScansCome) {
   EXPECT_GT(pipe.map().colouredCount(), 1000u);
 }
 
-TEST(ColourImage, DecodesRawAndCompressedAndRefusesGarbage) {
+// decodeColourImage: grey stays one channel, colour becomes R, G, B; sample() interpolates either;
+// the stamp and a usable exposure time are kept; the rig's size and sample()'s 2x2 are required.
+TEST(ColourImage, DecodesThroughTheSharedDecoderAndSamples) {
   cv::Mat rgb(4, 5, CV_8UC3);
   for (int v = 0; v < 4; ++v)
     for (int u = 0; u < 5; ++u) rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(10 * u, 20 * v, 7);
   std::vector<uint8_t> raw(rgb.datastart, rgb.dataend);
   RawImage r;
+  r.utime = 77;
   r.width = 5;
   r.height = 4;
-  r.encoding = 1;
+  r.encoding = static_cast<int>(ImageEncoding::kRgb8);
+  r.exposure_time = 0.01f;
   r.data = raw.data();
   r.size = raw.size();
   ColourImage out;
   std::string error;
-  ASSERT_TRUE(decodeImage(r, &out, &error)) << error;
+  ASSERT_TRUE(decodeColourImage(r, 5, 4, &out, &error)) << error;
+  EXPECT_FALSE(out.grey());
+  EXPECT_EQ(out.utime, 77);
+  EXPECT_FLOAT_EQ(out.exposure_time, 0.01f);
   EXPECT_NEAR(out.sample(Eigen::Vector2d(2.5, 1.0))[0], 25.0f, 1e-4);
   EXPECT_NEAR(out.sample(Eigen::Vector2d(2.0, 1.5))[1], 30.0f, 1e-4);
-  r.encoding = 2;  // BGR: channels swap
-  ASSERT_TRUE(decodeImage(r, &out, &error));
-  EXPECT_NEAR(out.sample(Eigen::Vector2d(2.0, 1.0))[2], 20.0f, 1e-4);
-  // PNG (lossless) of a BGR Mat decodes back to the same RGB
-  std::vector<uint8_t> png;
-  cv::imencode(".png", rgb, png);
-  RawImage p;
-  p.encoding = 11;
-  p.data = png.data();
-  p.size = png.size();
-  ASSERT_TRUE(decodeImage(p, &out, &error)) << error;
-  EXPECT_NEAR(out.sample(Eigen::Vector2d(3.0, 2.0))[2], 30.0f, 1e-4);  // B = the Mat's first channel
-  // short raw data, garbage JPEG, unknown encoding
-  r.size = 10;
-  EXPECT_FALSE(decodeImage(r, &out, &error));
-  std::vector<uint8_t> junk(100, 0xAB);
-  p.encoding = 10;
-  p.data = junk.data();
-  p.size = junk.size();
-  EXPECT_FALSE(decodeImage(p, &out, &error));
-  r.size = raw.size();
-  r.encoding = 42;
-  EXPECT_FALSE(decodeImage(r, &out, &error));
+  EXPECT_NEAR(out.sample(Eigen::Vector2d(4.0, 3.0))[2], 7.0f, 1e-4);  // the last pixel
+
+  std::vector<uint8_t> grey(20);
+  for (int k = 0; k < 20; ++k) grey[k] = static_cast<uint8_t>(10 * (k % 5) + k / 5);
+  r.encoding = static_cast<int>(ImageEncoding::kGray8);
+  r.data = grey.data();
+  r.size = grey.size();
+  r.exposure_time = -1.0f;  // unknown
+  ASSERT_TRUE(decodeColourImage(r, 5, 4, &out, &error)) << error;
+  EXPECT_TRUE(out.grey());
+  EXPECT_EQ(out.exposure_time, 0.0f);
+  EXPECT_TRUE(out.sample(Eigen::Vector2d(1.5, 2.5)).isApprox(Eigen::Vector3f::Constant(17.5f)));
+
+  EXPECT_FALSE(decodeColourImage(r, 6, 4, &out, &error));  // not the rig's size
+  EXPECT_NE(error.find("5x4"), std::string::npos) << error;
+  r.width = r.height = 1;
+  EXPECT_FALSE(decodeColourImage(r, 1, 1, &out, &error));  // too small to sample
+  EXPECT_NE(error.find("2x2"), std::string::npos) << error;
 }
 
 TEST(MapFiles, PlyAndPcdLoadBack) {

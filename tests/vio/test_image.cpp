@@ -1,13 +1,11 @@
-// Image handling of the VIO core: decoding every encoding to grey, refusing bad images with a
-// reason, the pyramid, patch sampling, the affine warp between views, and the depth grid's
-// occlusion and depth-edge tests.
+// Image handling of the VIO core: refusing bad images with a reason (decoding itself is the shared
+// livo_camera_image, tested in tests/unit/test_camera_image.cpp), the pyramid, patch sampling, the
+// affine warp between views, and the depth grid's occlusion and depth-edge tests.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "livo/vio/grey_image.hpp"
 #include "livo/vio/image_pyramid.hpp"
@@ -26,17 +24,10 @@ cv::Mat pattern(int w, int h) {
   return img;
 }
 
-RawImage raw(const std::vector<uint8_t>& bytes, int w, int h, int stride, ImageEncoding enc) {
-  RawImage r;
-  r.utime = 1000;
-  r.width = w;
-  r.height = h;
-  r.row_stride = stride;
-  r.encoding = static_cast<int>(enc);
-  r.exposure_time = 0.004f;
-  r.data = bytes.data();
-  r.size = bytes.size();
-  return r;
+/// Packed bytes as an image taken at 1000 us with 4 ms exposure (utime, width, height, row_stride,
+/// encoding, exposure_time, data, size).
+RawImage raw(const std::vector<uint8_t>& bytes, int w, int h, ImageEncoding enc) {
+  return RawImage{1000, w, h, 0, static_cast<int>(enc), 0.004f, bytes.data(), bytes.size()};
 }
 
 CameraRig camera() {
@@ -52,62 +43,8 @@ CameraRig camera() {
 
 }  // namespace
 
-TEST(VioImage, DecodesGreyWithStrideAndColourEncodings) {
-  const int w = 6, h = 4, stride = 8;
-  std::vector<uint8_t> grey(stride * h, 0), rgb(w * h * 3), bgr(w * h * 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      grey[y * stride + x] = static_cast<uint8_t>(10 * x + y);
-      const uint8_t R = static_cast<uint8_t>(40 * x), G = static_cast<uint8_t>(50 * y), B = 90;
-      const int k = 3 * (y * w + x);
-      rgb[k] = R, rgb[k + 1] = G, rgb[k + 2] = B;
-      bgr[k] = B, bgr[k + 1] = G, bgr[k + 2] = R;
-    }
-  GreyImage out;
-  std::string why;
-  ASSERT_TRUE(decodeGrey(raw(grey, w, h, stride, ImageEncoding::kGray8), w, h, &out, &why)) << why;
-  EXPECT_EQ(out.pixels.at<uint8_t>(3, 5), 53);
-  EXPECT_FLOAT_EQ(out.exposure_time, 0.004f);
-  GreyImage a, b;
-  ASSERT_TRUE(decodeGrey(raw(rgb, w, h, 0, ImageEncoding::kRgb8), w, h, &a, &why)) << why;
-  ASSERT_TRUE(decodeGrey(raw(bgr, w, h, 0, ImageEncoding::kBgr8), w, h, &b, &why)) << why;
-  EXPECT_EQ(cv::norm(a.pixels, b.pixels, cv::NORM_INF), 0.0);
-  // luminance 0.299 R + 0.587 G + 0.114 B of pixel (x=2, y=3): R 80, G 150, B 90
-  EXPECT_NEAR(a.pixels.at<uint8_t>(3, 2), 0.299 * 80 + 0.587 * 150 + 0.114 * 90, 1.0);
-}
-
-TEST(VioImage, DecodesPngAndJpeg) {
-  const cv::Mat img = pattern(64, 48);
-  std::vector<uint8_t> png, jpg;
-  ASSERT_TRUE(cv::imencode(".png", img, png));
-  ASSERT_TRUE(cv::imencode(".jpg", img, jpg, {cv::IMWRITE_JPEG_QUALITY, 95}));
-  GreyImage out;
-  std::string why;
-  ASSERT_TRUE(decodeGrey(raw(png, 64, 48, 0, ImageEncoding::kPng), 64, 48, &out, &why)) << why;
-  EXPECT_EQ(cv::norm(out.pixels, img, cv::NORM_INF), 0.0);
-  ASSERT_TRUE(decodeGrey(raw(jpg, 64, 48, 0, ImageEncoding::kJpeg), 64, 48, &out, &why)) << why;
-  EXPECT_LT(cv::norm(out.pixels, img, cv::NORM_L1) / img.total(), 6.0);
-}
-
 TEST(VioImage, RefusesBadImagesWithAReason) {
   const cv::Mat img = pattern(64, 48);
-  std::vector<uint8_t> bytes(img.data, img.data + img.total());
-  GreyImage out;
-  std::string why;
-  EXPECT_FALSE(decodeGrey(raw(bytes, 64, 48, 0, ImageEncoding::kGray8), 64, 50, &out, &why));
-  EXPECT_NE(why.find("64x48"), std::string::npos) << why;
-  std::vector<uint8_t> shorter(bytes.begin(), bytes.end() - 10);
-  EXPECT_FALSE(decodeGrey(raw(shorter, 64, 48, 0, ImageEncoding::kGray8), 64, 48, &out, &why));
-  EXPECT_NE(why.find("shorter"), std::string::npos) << why;
-  std::vector<uint8_t> garbage(500, 0x5a);
-  EXPECT_FALSE(decodeGrey(raw(garbage, 64, 48, 0, ImageEncoding::kJpeg), 64, 48, &out, &why));
-  EXPECT_NE(why.find("decode"), std::string::npos) << why;
-  EXPECT_FALSE(decodeGrey(raw(bytes, 64, 48, 0, static_cast<ImageEncoding>(7)), 64, 48, &out, &why));
-  EXPECT_NE(why.find("encoding"), std::string::npos) << why;
-  std::vector<uint8_t> png;
-  ASSERT_TRUE(cv::imencode(".png", img, png));
-  EXPECT_FALSE(decodeGrey(raw(png, 64, 48, 0, ImageEncoding::kPng), 32, 48, &out, &why));  // decodes to another size
-
   ImageCheckOptions o;
   EXPECT_EQ(imageProblem(img, o), "");
   cv::Mat black(48, 64, CV_8UC1, cv::Scalar(3));
@@ -118,6 +55,27 @@ TEST(VioImage, RefusesBadImagesWithAReason) {
   cv::Mat half = img.clone();
   half.rowRange(0, 24).setTo(255);  // half saturated: still usable
   EXPECT_EQ(imageProblem(half, o), "");
+
+  // readGreyImage: the shared decoder first (its reasons pass through), then these checks
+  std::vector<uint8_t> bytes(img.data, img.data + img.total());
+  GreyImage out;
+  std::string why;
+  ASSERT_TRUE(readGreyImage(raw(bytes, 64, 48, ImageEncoding::kGray8), 64, 48, o, &out, &why)) << why;
+  EXPECT_EQ(cv::norm(out.pixels, img, cv::NORM_INF), 0.0);
+  EXPECT_EQ(out.utime, 1000);
+  EXPECT_FLOAT_EQ(out.exposure_time, 0.004f);
+  EXPECT_FALSE(readGreyImage(raw(bytes, 64, 48, ImageEncoding::kGray8), 64, 50, o, &out, &why));
+  EXPECT_NE(why.find("64x48"), std::string::npos) << why;
+  std::vector<uint8_t> garbage(500, 0x5a);
+  EXPECT_FALSE(readGreyImage(raw(garbage, 64, 48, ImageEncoding::kJpeg), 64, 48, o, &out, &why));
+  EXPECT_NE(why.find("decode"), std::string::npos) << why;
+  std::vector<uint8_t> dark(black.data, black.data + black.total());
+  EXPECT_FALSE(readGreyImage(raw(dark, 64, 48, ImageEncoding::kGray8), 64, 48, o, &out, &why));
+  EXPECT_NE(why.find("black"), std::string::npos) << why;
+  RawImage unknown_exposure = raw(bytes, 64, 48, ImageEncoding::kGray8);
+  unknown_exposure.exposure_time = NAN;
+  ASSERT_TRUE(readGreyImage(unknown_exposure, 64, 48, o, &out, &why)) << why;
+  EXPECT_EQ(out.exposure_time, 0.0f);
 }
 
 TEST(VioImage, PyramidAveragesAndSamplesConsistently) {

@@ -1,6 +1,5 @@
 #include "livo/vio/vio_messages.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Cholesky>
@@ -40,19 +39,6 @@ filter_state_t keptPrior(const filter_state_t& prior, const std::string& source)
   m.iterations = 0;
   m.num_measurements = 0;
   return m;
-}
-
-RawImage rawImage(const image_t& m) {
-  RawImage r;
-  r.utime = m.utime;
-  r.width = m.width;
-  r.height = m.height;
-  r.row_stride = m.row_stride;
-  r.encoding = m.encoding;
-  r.exposure_time = m.exposure_time;
-  r.data = m.data.data();
-  r.size = std::min<size_t>(m.data.size(), m.size > 0 ? static_cast<size_t>(m.size) : 0);
-  return r;
 }
 
 bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why) {

@@ -39,8 +39,7 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
 void VioNode::onImage(const image_t& m) {
   BufferedImage b;
   b.t = m.utime + offset_us_;
-  if (!decodeGrey(rawImage(m), opts_.camera.width, opts_.camera.height, &b.image, &b.problem) ||
-      !(b.problem = imageProblem(b.image.pixels, opts_.image_check)).empty()) {
+  if (!readGreyImage(rawImage(m), opts_.camera.width, opts_.camera.height, opts_.image_check, &b.image, &b.problem)) {
     node_.reject(opts_.camera_channel, b.problem);
     b.image.pixels.release();
     ++counts_.bad_images;

@@ -6,9 +6,7 @@
 
 #include "livo/filter_state.hpp"
 #include "livo/filter_state_t.hpp"
-#include "livo/image_t.hpp"
 #include "livo/loop_correction_t.hpp"
-#include "livo/vio/grey_image.hpp"
 
 namespace livo::vio {
 
@@ -21,9 +19,6 @@ filter_state_t toPosterior(const filter_state_t& prior, const std::string& sourc
                            const Mat18& P, bool valid, int iterations, int num_measurements);
 /// valid = 0: the prior's own numbers echoed.
 filter_state_t keptPrior(const filter_state_t& prior, const std::string& source);
-
-/// A view of the image's bytes (valid while the message lives).
-RawImage rawImage(const image_t& m);
 
 /// T_corrected_odom of a loop correction; false if not finite or degenerate.
 bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why);
