@@ -1,26 +1,33 @@
-// The coarse stage's per-keyframe input, computed once and cached: a voxel-downsampled cloud and
-// FPFH features of its non-horizontal points (ground and roofs match everywhere, so they are
-// left out of matching as Quatro does with ground segmentation).
+// The coarse stage's per-keyframe input, computed once and cached: ISS keypoints of a
+// voxel-downsampled cloud, and their FPFH features quantised to byte descriptors. Near-horizontal
+// surfaces (ground, roofs) match everywhere, so points whose normal is close to vertical are not
+// keypoints, as Quatro leaves out the ground.
 #pragma once
 
+#include "feature_matching.hpp"
 #include "fpfh.hpp"
+#include "keypoints.hpp"
 #include "point_types.hpp"
 
 namespace livo::loop {
 
 struct CoarseFeatureOptions {
-  double voxel_size = 1.0;          // m
-  double normal_radius = 2.0;       // m
-  double feature_radius = 2.5;      // m
-  double max_normal_z = 0.9;        // points with |n_z| above this are not matched
+  double voxel_size = 0.6;          // m
+  double normal_radius = 1.0;       // m, normals and ISS saliency
+  double feature_radius = 2.5;      // m, FPFH
+  double max_normal_z = 0.9;        // points with |n_z| above this are not keypoints
+  int max_keypoints = 1500;         // the most salient are kept (bounds the matching time)
+  IssOptions keypoints;
 };
 
 struct CoarseFeatures {
-  Points points;      // matched points (non-horizontal), body frame of the keyframe
-  Features features;  // one per point
+  Points points;            // keypoints, in the frame of the cloud
+  Descriptors descriptors;  // one per keypoint
+  size_t size() const { return points.size(); }
 };
 
-/// From a gravity-aligned cloud (z up), so that "horizontal" means ground-like.
+/// From a gravity-aligned cloud (z up), so that "horizontal" means ground-like; the sensor at the
+/// origin (normals point towards it).
 CoarseFeatures computeCoarseFeatures(const Points& cloud, const CoarseFeatureOptions& options);
 
 }  // namespace livo::loop

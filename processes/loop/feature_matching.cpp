@@ -1,65 +1,107 @@
 #include "feature_matching.hpp"
 
 #include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdlib>
 
-#include "kdtree.hpp"
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace livo::loop {
 
-namespace {
-using FeatureTree = KdTree<Fpfh, Features>;
+static_assert(kFpfhSize == 33, "the distance below takes bins 0-31 by SAD and bin 32 by hand");
 
-// Indices of the non-zero features (zero = no normal / no neighbours).
-std::vector<int> validIndices(const Features& f) {
-  std::vector<int> out;
-  for (size_t i = 0; i < f.size(); ++i)
-    if (!f[i].isZero()) out.push_back(static_cast<int>(i));
+bool Descriptor::isZero() const {
+  return std::all_of(bins.begin(), bins.end(), [](uint8_t b) { return b == 0; });
+}
+
+Descriptor quantise(const Fpfh& feature) {
+  Descriptor d;
+  for (int k = 0; k < kFpfhSize; ++k)
+    d.bins[k] = static_cast<uint8_t>(std::clamp(std::lround(feature[k]), 0L, 255L));
+  return d;
+}
+
+Descriptors quantise(const Features& features) {
+  Descriptors out;
+  out.reserve(features.size());
+  for (const Fpfh& f : features) out.push_back(quantise(f));
   return out;
 }
-Features gather(const Features& f, const std::vector<int>& idx) {
-  Features out;
-  out.reserve(idx.size());
-  for (int i : idx) out.push_back(f[i]);
+
+namespace {
+#if defined(__SSE2__)
+// Bins 0-31 by two SSE2 sums of absolute differences, bin 32 (the last of the 33) by hand: the
+// SAD unit is the bottleneck, so this is a third faster than a third SAD over bytes 32-47.
+struct Loaded {
+  __m128i a, b;
+  int last;
+  explicit Loaded(const Descriptor& d)
+      : a(_mm_load_si128(reinterpret_cast<const __m128i*>(d.bins.data()))),
+        b(_mm_load_si128(reinterpret_cast<const __m128i*>(d.bins.data() + 16))),
+        last(d.bins[32]) {}
+};
+inline int distance(const Loaded& x, const Descriptor& d) {
+  const __m128i* p = reinterpret_cast<const __m128i*>(d.bins.data());
+  const __m128i s = _mm_add_epi64(_mm_sad_epu8(x.a, _mm_load_si128(p)), _mm_sad_epu8(x.b, _mm_load_si128(p + 1)));
+  return _mm_cvtsi128_si32(s) + _mm_cvtsi128_si32(_mm_unpackhi_epi64(s, s)) + std::abs(x.last - int(d.bins[32]));
+}
+#else
+using Loaded = Descriptor;
+inline int distance(const Descriptor& x, const Descriptor& d) {
+  int s = 0;
+  for (size_t k = 0; k < d.bins.size(); ++k) s += std::abs(int(x.bins[k]) - int(d.bins[k]));
+  return s;
+}
+#endif
+
+std::vector<int> nonZero(const Descriptors& d) {
+  std::vector<int> out;
+  for (size_t i = 0; i < d.size(); ++i)
+    if (!d[i].isZero()) out.push_back(static_cast<int>(i));
   return out;
 }
 }  // namespace
 
-Correspondences matchFeatures(const Features& source, const Features& target, const FeatureMatchingOptions& options) {
-  const std::vector<int> si = validIndices(source), ti = validIndices(target);
+int descriptorDistance(const Descriptor& a, const Descriptor& b) { return distance(Loaded(a), b); }
+
+Correspondences matchDescriptors(const Descriptors& source, const Descriptors& target,
+                                 const FeatureMatchingOptions& options) {
+  const std::vector<int> si = nonZero(source), ti = nonZero(target);
   if (si.empty() || ti.empty()) return {};
-  const Features sf = gather(source, si), tf = gather(target, ti);
-  const FeatureTree ttree(tf);
-  std::vector<int> source_to_target(sf.size());
-  std::vector<float> dist(sf.size());
-  for (size_t i = 0; i < sf.size(); ++i) {
-    size_t j;
-    float d2;
-    ttree.nearest(sf[i], j, d2);
-    source_to_target[i] = static_cast<int>(j);
-    dist[i] = d2;
-  }
-  std::vector<int> target_to_source;
-  if (options.mutual) {
-    const FeatureTree stree(sf);
-    target_to_source.assign(tf.size(), -1);
-    std::vector<char> needed(tf.size(), 0);
-    for (int j : source_to_target) needed[j] = 1;
-    for (size_t j = 0; j < tf.size(); ++j) {
-      if (!needed[j]) continue;
-      size_t i;
-      float d2;
-      stree.nearest(tf[j], i, d2);
-      target_to_source[j] = static_cast<int>(i);
+  std::vector<Descriptor> tv;
+  tv.reserve(ti.size());
+  for (int j : ti) tv.push_back(target[j]);
+  // One pass over all pairs: each source's nearest target and each target's nearest source.
+  std::vector<int> row_best(si.size(), -1), row_dist(si.size(), INT_MAX);
+  std::vector<int> col_best(tv.size(), -1), col_dist(tv.size(), INT_MAX);
+  for (size_t a = 0; a < si.size(); ++a) {
+    const Loaded s(source[si[a]]);
+    int best = -1, best_d = INT_MAX;
+    for (size_t b = 0; b < tv.size(); ++b) {
+      const int d = distance(s, tv[b]);
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(b);
+      }
+      if (d < col_dist[b]) {
+        col_dist[b] = d;
+        col_best[b] = static_cast<int>(a);
+      }
     }
+    row_best[a] = best;
+    row_dist[a] = best_d;
   }
-  std::vector<std::pair<float, Correspondence>> kept;
-  for (size_t i = 0; i < sf.size(); ++i) {
-    const int j = source_to_target[i];
-    if (options.mutual && target_to_source[j] != static_cast<int>(i)) continue;
-    kept.push_back({dist[i], {si[i], ti[j]}});
+  std::vector<std::pair<int, Correspondence>> kept;
+  for (size_t a = 0; a < si.size(); ++a) {
+    const int b = row_best[a];
+    if (options.mutual && col_best[b] != static_cast<int>(a)) continue;
+    kept.push_back({row_dist[a], {si[a], ti[b]}});
   }
   if (options.max_correspondences > 0 && kept.size() > static_cast<size_t>(options.max_correspondences)) {
-    std::stable_sort(kept.begin(), kept.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::stable_sort(kept.begin(), kept.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     kept.resize(options.max_correspondences);
   }
   Correspondences out;

@@ -8,15 +8,10 @@
 
 namespace livo::loop {
 
-struct FpfhOptions {
-  double normal_radius = 1.0;   // m
-  double feature_radius = 2.5;  // m
-};
-
-/// Features of `points` with `normals` (zero normals give zero features, which matching skips).
-Features computeFpfh(const Points& points, const Points& normals, const PointTree& tree, double radius);
-
-/// Convenience: normals and FPFH in one call, building the kd-tree.
-Features computeFpfh(const Points& points, const FpfhOptions& options);
+/// FPFH of the points `at` (indices into `points`), from the SPFH of those points and of their
+/// neighbours within `radius`; SPFH is computed only where needed. Points with zero normals get
+/// zero features (which matching skips) and are left out of their neighbours' histograms.
+Features computeFpfh(const Points& points, const Points& normals, const PointTree& tree, double radius,
+                     const std::vector<int>& at);
 
 }  // namespace livo::loop

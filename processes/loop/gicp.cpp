@@ -1,23 +1,29 @@
 #include "gicp.hpp"
 
+#include <algorithm>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 namespace livo::loop {
 
+CompactCovariance::CompactCovariance(const Mat3& m)
+    : c_{static_cast<float>(m(0, 0)), static_cast<float>(m(0, 1)), static_cast<float>(m(0, 2)),
+         static_cast<float>(m(1, 1)), static_cast<float>(m(1, 2)), static_cast<float>(m(2, 2))} {}
+
+Mat3 CompactCovariance::matrix() const {
+  Mat3 m;
+  m << c_[0], c_[1], c_[2], c_[1], c_[3], c_[4], c_[2], c_[4], c_[5];
+  return m;
+}
+
 GicpCloud GicpCloud::build(Points points, int num_neighbors, double plane_epsilon) {
   GicpCloud c;
   c.cloud = std::make_shared<const Points>(std::move(points));
   c.tree = std::make_shared<const PointTree>(*c.cloud);
-  c.covariances = estimateCovariances(*c.cloud, *c.tree, num_neighbors, plane_epsilon);
-  return c;
-}
-
-GicpCloud GicpCloud::fromParts(Points points, Covariances covariances) {
-  GicpCloud c;
-  c.cloud = std::make_shared<const Points>(std::move(points));
-  c.covariances = std::move(covariances);
-  c.tree = std::make_shared<const PointTree>(*c.cloud);
+  const Covariances full = estimateCovariances(*c.cloud, *c.tree, num_neighbors, plane_epsilon);
+  c.covariances.reserve(full.size());
+  for (const Mat3& m : full) c.covariances.emplace_back(m);
   return c;
 }
 
@@ -26,20 +32,23 @@ struct Linearisation {
   Mat6 H = Mat6::Zero();
   Vec6 b = Vec6::Zero();
   double sum_sq = 0.0;
-  int count = 0;
+  int count = 0;        // correspondences within the maximum distance
+  int overlapping = 0;  // of them, within the overlap distance
 };
 
-// Left perturbation: T' = [Exp(dr), dt] * T, so p' = p + dr x p + dt for p = T s.
-Linearisation linearise(const GicpCloud& source, const GicpCloud& target, const Pose3& T, double max_d2) {
+// Left perturbation: T' = [Exp(dr), dt] * T, so p' = p + dr x p + dt for p = T s. One nearest-
+// neighbour search per source point, bounded by the correspondence distance.
+Linearisation linearise(const GicpCloud& source, const GicpCloud& target, const Pose3& T, double max_d2,
+                        double overlap_d2, size_t stride) {
   Linearisation L;
   const Mat3 R = T.linear();
-  for (size_t i = 0; i < source.size(); ++i) {
+  for (size_t i = 0; i < source.size(); i += stride) {
     const Vec3 p = T * source.points()[i];
     size_t j;
     double d2;
-    if (!target.tree->nearest(p, j, d2) || d2 > max_d2) continue;
+    if (!target.tree->nearestWithin(p, max_d2, j, d2)) continue;
     const Vec3 e = target.points()[j] - p;  // residual
-    const Mat3 C = target.covariances[j] + R * source.covariances[i] * R.transpose();
+    const Mat3 C = target.covariances[j].matrix() + R * source.covariances[i].matrix() * R.transpose();
     const Mat3 M = C.inverse();
     Eigen::Matrix<double, 3, 6> J;  // d e / d [dr; dt]
     J.leftCols<3>() = so3::hat(p);
@@ -49,6 +58,7 @@ Linearisation linearise(const GicpCloud& source, const GicpCloud& target, const 
     L.b += JtM * e;
     L.sum_sq += d2;
     ++L.count;
+    L.overlapping += d2 <= overlap_d2;
   }
   return L;
 }
@@ -60,9 +70,16 @@ GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const 
   r.T_target_source = initial;
   if (source.size() == 0 || target.size() == 0) return r;
   const double max_d2 = options.max_correspondence_distance * options.max_correspondence_distance;
+  const double overlap_d2 = std::min(options.overlap_distance * options.overlap_distance, max_d2);
+  // Every stride-th source point (the cloud is in voxel order, so this thins it evenly).
+  const size_t stride = options.max_source_points > 0
+                            ? (source.size() + options.max_source_points - 1) / static_cast<size_t>(options.max_source_points)
+                            : 1;
+  const size_t used = (source.size() + stride - 1) / stride;
   Pose3 T = initial;
+  Linearisation L;
   for (int it = 0; it < options.max_iterations; ++it) {
-    const Linearisation L = linearise(source, target, T, max_d2);
+    L = linearise(source, target, T, max_d2, overlap_d2, stride);
     r.iterations = it + 1;
     if (L.count < 6) return r;
     const Vec6 dx = L.H.ldlt().solve(-L.b);
@@ -77,24 +94,18 @@ GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const 
       break;
     }
   }
+  // The scores come from the last linearisation, before its (converged: negligible) final step,
+  // rather than from one more pass over the source.
   r.T_target_source = T;
-  const Linearisation L = linearise(source, target, T, max_d2);
   r.num_correspondences = L.count;
   r.fitness = L.count > 0 ? L.sum_sq / L.count : 0.0;
   r.information = L.H;
+  r.overlap = static_cast<double>(L.overlapping) / static_cast<double>(used);
   if (L.count > 0) {
     Eigen::SelfAdjointEigenSolver<Mat3> es(L.H.bottomRightCorner<3, 3>() / L.count);
     r.min_translation_eigenvalue = es.eigenvalues()[0];
     if (es.eigenvalues()[2] > 0.0) r.translation_eigenvalue_ratio = es.eigenvalues()[0] / es.eigenvalues()[2];
   }
-  const double od2 = options.overlap_distance * options.overlap_distance;
-  int overlapping = 0;
-  for (const Vec3& s : source.points()) {
-    size_t j;
-    double d2;
-    if (target.tree->nearest(T * s, j, d2) && d2 <= od2) ++overlapping;
-  }
-  r.overlap = static_cast<double>(overlapping) / static_cast<double>(source.size());
   return r;
 }
 

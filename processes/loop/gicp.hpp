@@ -2,25 +2,36 @@
 // per-point covariances from kNN neighbourhoods, Gauss-Newton on SE(3).
 #pragma once
 
+#include <array>
 #include <memory>
+#include <vector>
 
 #include "local_geometry.hpp"
 #include "point_types.hpp"
 
 namespace livo::loop {
 
+/// A symmetric 3x3 matrix kept as six floats (xx, xy, xz, yy, yz, zz): a third of a Mat3. Every
+/// keyframe keeps one per fine point, so this is most of the loop closer's memory.
+class CompactCovariance {
+ public:
+  explicit CompactCovariance(const Mat3& m = Mat3::Identity());
+  Mat3 matrix() const;
+
+ private:
+  std::array<float, 6> c_;
+};
+
 /// A cloud ready for GICP: points, their covariances and a kd-tree over the points.
 /// The points live on the heap so the tree's reference survives moves and copies.
 struct GicpCloud {
   std::shared_ptr<const Points> cloud;
-  Covariances covariances;
+  std::vector<CompactCovariance> covariances;
   std::shared_ptr<const PointTree> tree;
   const Points& points() const { return *cloud; }
   size_t size() const { return cloud ? cloud->size() : 0; }
   /// Computes covariances and the tree for `points` (moved in).
   static GicpCloud build(Points points, int num_neighbors = 10, double plane_epsilon = 1e-3);
-  /// Uses given covariances (e.g. cached per keyframe and merged), builds only the tree.
-  static GicpCloud fromParts(Points points, Covariances covariances);
 };
 
 struct GicpOptions {
@@ -29,6 +40,8 @@ struct GicpOptions {
   double rotation_epsilon = 2e-4;            // rad: converged when the update is smaller
   double translation_epsilon = 1e-4;         // m
   double overlap_distance = 0.5;             // m, a source point "overlaps" within this
+  int max_source_points = 6000;              // source thinned evenly to at most this many (0: all);
+                                             // the target keeps every point
 };
 
 struct GicpResult {
@@ -36,7 +49,7 @@ struct GicpResult {
   bool converged = false;
   int iterations = 0;
   double fitness = 0.0;        // mean squared distance of correspondences within max distance, m^2
-  double overlap = 0.0;        // fraction of source points with a target point within overlap_distance
+  double overlap = 0.0;        // fraction of (used) source points with a target point within overlap_distance
   int num_correspondences = 0;
   Mat6 information = Mat6::Zero();   // Gauss-Newton Hessian at the solution, [rotation; translation]
   double min_translation_eigenvalue = 0.0;  // of the Hessian's translation block per correspondence

@@ -36,11 +36,24 @@ class KdTree {
     return knn(query, 1, &index, &squared_distance) == 1;
   }
 
-  /// Every point within `radius` (not squared), nearest first.
-  size_t radius(const Vector& query, Scalar radius, std::vector<std::pair<size_t, Scalar>>& out) const {
+  /// The nearest point closer than sqrt(max_squared_distance); false if there is none. Cheaper than
+  /// nearest() for queries far from the data: the search never looks beyond the bound.
+  bool nearestWithin(const Vector& query, Scalar max_squared_distance, size_t& index, Scalar& squared_distance) const {
+    if (size() == 0) return false;
+    BoundedNearest result(max_squared_distance);
+    index_.findNeighbors(result, query.data(), nanoflann::SearchParams());
+    if (!result.found) return false;
+    index = result.index;
+    squared_distance = result.distance;
+    return true;
+  }
+
+  /// Every point within `radius` (not squared) with its squared distance, nearest first if `sorted`.
+  size_t radius(const Vector& query, Scalar radius, std::vector<std::pair<size_t, Scalar>>& out,
+                bool sorted = true) const {
     out.clear();
     if (size() == 0) return 0;
-    return index_.radiusSearch(query.data(), radius * radius, out, nanoflann::SearchParams(32, 0.0f, true));
+    return index_.radiusSearch(query.data(), radius * radius, out, nanoflann::SearchParams(32, 0.0f, sorted));
   }
 
  private:
@@ -50,6 +63,22 @@ class KdTree {
     Scalar kdtree_get_pt(size_t i, size_t d) const { return data[i][static_cast<int>(d)]; }
     template <class Box>
     bool kdtree_get_bbox(Box&) const { return false; }
+  };
+  struct BoundedNearest {  // a nanoflann result set: one neighbour, searched only within a bound
+    explicit BoundedNearest(Scalar bound) : distance(bound) {}
+    Scalar distance;
+    size_t index = 0;
+    bool found = false;
+    bool full() const { return found; }
+    Scalar worstDist() const { return distance; }
+    bool addPoint(Scalar d, size_t i) {
+      if (d < distance) {
+        distance = d;
+        index = i;
+        found = true;
+      }
+      return true;
+    }
   };
   using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<Scalar, Adaptor>, Adaptor, kDim, size_t>;
   Adaptor adaptor_;

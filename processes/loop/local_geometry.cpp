@@ -18,23 +18,26 @@ Mat3 sampleCovariance(const Points& points, const size_t* idx, size_t n, Vec3& m
 }
 }  // namespace
 
-Points estimateNormals(const Points& points, const PointTree& tree, double radius, const Vec3& viewpoint) {
-  Points normals(points.size(), Vec3::Zero());
+std::vector<Neighbourhood> analyseNeighbourhoods(const Points& points, const PointTree& tree, double radius,
+                                                 const Vec3& viewpoint) {
+  std::vector<Neighbourhood> out(points.size());
   std::vector<std::pair<size_t, double>> nb;
   std::vector<size_t> idx;
   for (size_t i = 0; i < points.size(); ++i) {
-    tree.radius(points[i], radius, nb);
+    tree.radius(points[i], radius, nb, false);
+    Neighbourhood& h = out[i];
+    h.count = static_cast<int>(nb.size());
     if (nb.size() < 3) continue;
     idx.resize(nb.size());
     for (size_t k = 0; k < nb.size(); ++k) idx[k] = nb[k].first;
     Vec3 mean;
     const Mat3 c = sampleCovariance(points, idx.data(), idx.size(), mean);
     Eigen::SelfAdjointEigenSolver<Mat3> es(c);
-    Vec3 n = es.eigenvectors().col(0);
-    if (n.dot(viewpoint - points[i]) < 0.0) n = -n;
-    normals[i] = n;
+    h.eigenvalues = es.eigenvalues();
+    h.normal = es.eigenvectors().col(0);
+    if (h.normal.dot(viewpoint - points[i]) < 0.0) h.normal = -h.normal;
   }
-  return normals;
+  return out;
 }
 
 Covariances estimateCovariances(const Points& points, const PointTree& tree, int num_neighbors,

@@ -9,16 +9,17 @@ namespace livo::loop {
 
 using PointTree = KdTree<Vec3>;
 
-struct LocalGeometryOptions {
-  int num_neighbors = 10;         // k of the kNN neighbourhood of the covariances
-  double normal_radius = 1.0;     // m, neighbourhood of the normals (FPFH)
-  double plane_epsilon = 1e-3;    // GICP: covariance eigenvalues become (1, 1, epsilon)
+/// The shape of a point's neighbourhood within a radius: the eigen-decomposition of its scatter.
+struct Neighbourhood {
+  Vec3 normal = Vec3::Zero();       // unit, eigenvector of the smallest eigenvalue, towards the viewpoint
+  Vec3 eigenvalues = Vec3::Zero();  // ascending
+  int count = 0;                    // neighbours within the radius, the point included
 };
 
-/// Unit normals from the neighbours within `radius`, oriented towards `viewpoint` (the sensor).
-/// A point with fewer than 3 neighbours gets a zero normal.
-Points estimateNormals(const Points& points, const PointTree& tree, double radius,
-                       const Vec3& viewpoint = Vec3::Zero());
+/// Neighbourhoods of every point within `radius` (normals oriented towards `viewpoint`, the
+/// sensor). A point with fewer than 3 neighbours gets a zero normal.
+std::vector<Neighbourhood> analyseNeighbourhoods(const Points& points, const PointTree& tree, double radius,
+                                                 const Vec3& viewpoint = Vec3::Zero());
 
 /// GICP covariances from the k nearest neighbours, regularised plane-like: the eigenvectors of
 /// the sample covariance with eigenvalues replaced by (1, 1, epsilon).

@@ -25,7 +25,7 @@ Pose3 rotationOnly(const Mat3& R) {
 Pose3 LoopCloser::correction() const {
   if (keyframes_.empty()) return Pose3::Identity();
   const auto& [id, kf] = *keyframes_.rbegin();
-  return graph_.pose(id) * kf.odometry.inverse();
+  return graph_.pose(id) * kf.published.inverse();
 }
 
 std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
@@ -52,26 +52,32 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
                                 std::to_string(keyframes_.rbegin()->first));
   Keyframe kf;
   kf.utime = input.utime;
-  kf.odometry = input.pose;
+  kf.published = input.pose;
+  kf.odometry = adopted_.inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
   const Points levelled = transformed(input.cloud, rotationOnly(kf.G_R_I));
   kf.coarse = computeCoarseFeatures(levelled, options_.coarse);
   kf.fine = GicpCloud::build(voxelDownsample(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
-  kf.map_cloud = voxelDownsample(input.cloud, options_.map_voxel_size);
+  const Points map_points = voxelDownsample(input.cloud, options_.map_voxel_size);
+  kf.map_cloud.reserve(map_points.size());
+  for (const Vec3& p : map_points) kf.map_cloud.push_back(p.cast<float>());
 
   // Initial estimate: the previous keyframe's corrected pose composed with the odometry increment.
   Pose3 initial = input.pose;
   if (!keyframes_.empty()) {
     const auto& [prev_id, prev] = *keyframes_.rbegin();
-    initial = graph_.pose(prev_id) * (prev.odometry.inverse() * input.pose);
+    const Pose3 increment = prev.odometry.inverse() * kf.odometry;
+    initial = graph_.pose(prev_id) * increment;
     graph_.addNode(input.id, initial);
     PoseEdge e;
     e.from = prev_id;
     e.to = input.id;
-    e.T_from_to = prev.odometry.inverse() * input.pose;
-    e.information = relativeInformation(prev.covariance, kf.covariance, options_.odometry_rotation_floor,
-                                        options_.odometry_translation_floor);
+    e.T_from_to = increment;
+    const double step = increment.translation().norm();
+    e.information = relativeInformation(
+        prev.covariance, kf.covariance, std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * step),
+        std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * step));
     keyframes_.emplace(input.id, std::move(kf));
     graph_.addEdge(e);
   } else {
@@ -107,6 +113,8 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
     graph_.addEdge(e);
     graph_.optimize();
+    // The odometry will take on correction() = graph * published^-1 for this keyframe.
+    if (options_.odometry_adopts_corrections) adopted_ = graph_.pose(input.id) * cur.odometry.inverse();
     loops_.push_back(loop);
     result.loop = loop;
     keyframes_since_loop_ = 0;

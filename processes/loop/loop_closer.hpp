@@ -31,16 +31,28 @@ struct LoopCloserOptions {
   CandidateOptions candidates;
   LoopRegistrationOptions registration;
   PoseGraphOptions graph;
-  double odometry_rotation_floor = 2e-3;     // rad, added to the relative odometry covariance
-  double odometry_translation_floor = 2e-2;  // m
+  // Odometry edge noise, added to the relative covariance of the keyframes' absolute ones (which,
+  // from a filter with a map, barely grow and say little about the increment): a floor plus a part
+  // proportional to the distance travelled, the usual drift model of LiDAR odometry (0.5 % and
+  // 0.01 deg/m; the old 2 cm / 2 mrad per edge made 1,450 edges of a 300 s drive worth 0.8 m of
+  // random walk and let every loop's noise through).
+  double odometry_rotation_floor = 2e-4;       // rad
+  double odometry_translation_floor = 2e-3;    // m
+  double odometry_rotation_per_m = 2e-4;       // rad per metre travelled
+  double odometry_translation_per_m = 5e-3;    // m per metre travelled
   double loop_rotation_sigma = 5e-3;         // rad
   double loop_translation_sigma = 5e-2;      // m
+  /// The odometry adopts every correction before its next keyframe (livo-lio does, and lockstep
+  /// replay guarantees the order): keyframe poses after a correction are in the corrected frame.
+  /// The closer then maps them back to its raw odometry chain, so that an odometry edge never
+  /// contains a correction. False for an odometry that ignores LOOP_CORRECTION.
+  bool odometry_adopts_corrections = true;
 };
 
 struct KeyframeInput {
   int64_t id = 0;
   int64_t utime = 0;
-  Pose3 pose = Pose3::Identity();    // odometry W_T_I
+  Pose3 pose = Pose3::Identity();    // odometry W_T_I, as published (after the corrections it adopted)
   Mat6 covariance = Mat6::Zero();    // [rotation; position]
   Points cloud;                      // body frame I
 };
@@ -69,21 +81,24 @@ class LoopCloser {
 
   const PoseGraph& graph() const { return graph_; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
-  /// T_corrected_odom for the newest keyframe (identity before the first loop).
+  /// T_corrected_odom for the newest keyframe: maps the frame its pose was published in onto the
+  /// optimised one (identity before the first loop).
   Pose3 correction() const;
   int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
-  const Points& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
+  /// The keyframe's cloud for the global map (voxel-downsampled, body frame I).
+  const std::vector<Eigen::Vector3f>& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
   size_t size() const { return keyframes_.size(); }
 
  private:
   struct Keyframe {
     int64_t utime = 0;
-    Pose3 odometry = Pose3::Identity();
+    Pose3 published = Pose3::Identity();  // as received
+    Pose3 odometry = Pose3::Identity();   // in the raw odometry frame (no correction adopted)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     CoarseFeatures coarse;              // in G
     GicpCloud fine;                     // in G
-    Points map_cloud;                   // in I
+    std::vector<Eigen::Vector3f> map_cloud;  // in I, float: kept for every keyframe
   };
   std::vector<int64_t> candidates(int64_t id) const;
 
@@ -92,6 +107,7 @@ class LoopCloser {
   std::map<int64_t, Keyframe> keyframes_;
   std::vector<AcceptedLoop> loops_;
   int64_t keyframes_since_loop_ = 1000000;
+  Pose3 adopted_ = Pose3::Identity();  // the odometry's current frame <- raw odometry frame
 };
 
 }  // namespace livo::loop

@@ -21,6 +21,8 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("coarse_voxel", c.coarse.voxel_size);
   s.readOptional("fpfh_normal_radius", c.coarse.normal_radius);
   s.readOptional("fpfh_radius", c.coarse.feature_radius);
+  s.readOptional("max_keypoints", c.coarse.max_keypoints);
+  s.readOptional("keypoint_nms_radius", c.coarse.keypoints.nms_radius);
   s.readOptional("fine_voxel", c.fine_voxel_size);
   s.readOptional("search_radius", c.candidates.search_radius);
   s.readOptional("exclude_recent_s", c.candidates.exclude_recent_s);
@@ -34,8 +36,13 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("min_overlap", c.registration.acceptance.min_overlap);
   s.readOptional("min_translation_eigenvalue", c.registration.acceptance.min_translation_eigenvalue);
   s.readOptional("min_translation_eigenvalue_ratio", c.registration.acceptance.min_translation_eigenvalue_ratio);
+  s.readOptional("odometry_rotation_floor", c.odometry_rotation_floor);
+  s.readOptional("odometry_translation_floor", c.odometry_translation_floor);
+  s.readOptional("odometry_rotation_per_m", c.odometry_rotation_per_m);
+  s.readOptional("odometry_translation_per_m", c.odometry_translation_per_m);
   s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
+  s.readOptional("odometry_adopts_corrections", c.odometry_adopts_corrections);
   s.checkAllUsed();
   if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
       c.registration.quatro.noise_bound <= 0)

@@ -40,7 +40,7 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
 void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {
   Points all;
   for (const auto& [id, pose] : closer.graph().poses())
-    for (const Vec3& p : closer.mapCloud(id)) all.push_back(pose * p);
+    for (const Eigen::Vector3f& p : closer.mapCloud(id)) all.push_back(pose * p.cast<double>());
   const Points map = voxelDownsample(all, voxel_size);
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + path);

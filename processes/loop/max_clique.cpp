@@ -2,13 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace livo::loop {
 
 void Graph::addEdge(int a, int b) {
   if (a == b) return;
-  adjacency[a].push_back(b);
-  adjacency[b].push_back(a);
+  auto insert = [](std::vector<int>& list, int v) {
+    const auto it = std::lower_bound(list.begin(), list.end(), v);  // the end when edges come in order
+    if (it == list.end() || *it != v) list.insert(it, v);
+  };
+  insert(adjacency[a], b);
+  insert(adjacency[b], a);
 }
 
 namespace {
@@ -28,9 +33,17 @@ inline int first(const Bits& b) {
   return -1;
 }
 
-// Branch and bound on a small dense subproblem (Tomita & Seki's MCQ colouring bound).
+inline int count(const Bits& b) {
+  int c = 0;
+  for (uint64_t w : b) c += __builtin_popcountll(w);
+  return c;
+}
+
+// Branch and bound over a candidate set (Tomita & Seki's MCQ colouring bound), on the whole
+// graph's adjacency bitsets: subproblems need no copies of their own.
 struct SubSearch {
-  std::vector<Bits> adj;
+  explicit SubSearch(const std::vector<Bits>& adjacency) : adj(adjacency) {}
+  const std::vector<Bits>& adj;
   std::vector<int> current, best;
   int64_t branches = 0, budget = 0;
   bool out_of_budget = false;
@@ -43,11 +56,11 @@ struct SubSearch {
     }
     // Greedy colouring of P: vertices in increasing colour order.
     std::vector<int> order, colour;
-    Bits uncoloured = P;
+    Bits uncoloured = P, q(P.size());
     int k = 0;
     while (!none(uncoloured)) {
       ++k;
-      Bits q = uncoloured;
+      q = uncoloured;
       for (int v = first(q); v >= 0; v = first(q)) {
         clear(uncoloured, v);
         clear(q, v);
@@ -56,12 +69,12 @@ struct SubSearch {
         colour.push_back(k);
       }
     }
+    Bits next(P.size());
     for (int i = static_cast<int>(order.size()) - 1; i >= 0; --i) {
       if (current.size() + colour[i] <= best.size()) return;
       const int v = order[i];
       current.push_back(v);
-      Bits next = P;
-      for (size_t w = 0; w < next.size(); ++w) next[w] &= adj[v][w];
+      for (size_t w = 0; w < next.size(); ++w) next[w] = P[w] & adj[v][w];
       if (none(next)) {
         if (current.size() > best.size()) best = current;
       } else {
@@ -72,6 +85,35 @@ struct SubSearch {
     }
   }
 };
+
+// A large clique found greedily, to start branch and bound with a tight bound: from each of the
+// few vertices of the largest cores, repeatedly add the candidate of the largest core that is
+// adjacent to everything chosen so far. (Only a bound: the search after it is exact.)
+std::vector<int> greedyClique(const Graph& graph, const std::vector<int>& order, const std::vector<int>& core) {
+  constexpr int kStarts = 8;
+  const int n = graph.size();
+  std::vector<int> best{order.back()};
+  std::vector<int> cand, next;
+  for (int oi = n - 1; oi >= std::max(0, n - kStarts); --oi) {
+    const int v = order[oi];
+    if (core[v] + 1 <= static_cast<int>(best.size())) continue;
+    std::vector<int> clique{v};
+    cand.clear();
+    for (int u : graph.adjacency[v])
+      if (core[u] + 1 > static_cast<int>(best.size())) cand.push_back(u);  // adjacency lists are sorted
+    while (!cand.empty()) {
+      if (clique.size() + cand.size() <= best.size()) break;
+      const int u = *std::max_element(cand.begin(), cand.end(), [&](int a, int b) { return core[a] < core[b]; });
+      clique.push_back(u);
+      next.clear();
+      std::set_intersection(cand.begin(), cand.end(), graph.adjacency[u].begin(), graph.adjacency[u].end(),
+                            std::back_inserter(next));
+      cand.swap(next);
+    }
+    if (clique.size() > best.size()) best = clique;
+  }
+  return best;
+}
 
 }  // namespace
 
@@ -109,41 +151,49 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
     }
   }
 
-  std::vector<int> best{order.back()};
+  std::vector<int> best = greedyClique(graph, order, core);
+  const size_t words = (n + 63) / 64;
+  std::vector<Bits> adj(n, Bits(words, 0));
+  for (int v = 0; v < n; ++v)
+    for (int u : graph.adjacency[v]) set(adj[v], u);
+  Bits later(words, 0);     // vertices after v in degeneracy order (visited before it below)
+  Bits eligible(words, 0);  // vertices whose core could still beat the best
+  size_t eligible_for = 0;
+  SubSearch s(adj);
   int64_t branches = 0;
   // Vertices with the largest cores hold the largest cliques: visit them first to raise the bound.
+  // A clique is found from its vertex that comes first in degeneracy order.
   for (int oi = n - 1; oi >= 0; --oi) {
     const int v = order[oi];
-    if (core[v] + 1 <= static_cast<int>(best.size())) continue;
-    std::vector<int> cand;
-    for (int u : graph.adjacency[v])
-      if (position[u] > position[v] && core[u] + 1 > static_cast<int>(best.size())) cand.push_back(u);
-    if (static_cast<int>(cand.size()) + 1 <= static_cast<int>(best.size())) continue;
-    std::sort(cand.begin(), cand.end());
-    const int m = static_cast<int>(cand.size());
-    const size_t words = (m + 63) / 64;
-    SubSearch s;
-    s.adj.assign(m, Bits(words, 0));
-    for (int a = 0; a < m; ++a)
-      for (int u : graph.adjacency[cand[a]]) {
-        const auto it = std::lower_bound(cand.begin(), cand.end(), u);
-        if (it != cand.end() && *it == u) set(s.adj[a], static_cast<int>(it - cand.begin()));
+    if (core[v] + 1 > static_cast<int>(best.size())) {
+      if (eligible_for != best.size()) {
+        eligible_for = best.size();
+        for (int u = 0; u < n; ++u) {
+          if (core[u] + 1 > static_cast<int>(best.size())) set(eligible, u);
+          else clear(eligible, u);
+        }
       }
-    s.best.assign(best.size() - 1, -1);  // must beat best.size() including v
-    s.budget = options.max_branches - branches;
-    Bits all(words, 0);
-    for (int a = 0; a < m; ++a) set(all, a);
-    if (m > 0) s.expand(all);
-    branches += s.branches;
-    if (s.best.size() + 1 > best.size() && std::find(s.best.begin(), s.best.end(), -1) == s.best.end()) {
-      best.clear();
-      best.push_back(v);
-      for (int a : s.best) best.push_back(cand[a]);
+      Bits P(words);
+      for (size_t w = 0; w < words; ++w) P[w] = adj[v][w] & later[w] & eligible[w];
+      if (count(P) + 1 > static_cast<int>(best.size())) {
+        s.current.clear();
+        s.best.assign(best.size() - 1, -1);  // must beat best.size() including v
+        s.branches = 0;
+        s.budget = options.max_branches - branches;
+        s.expand(P);
+        branches += s.branches;
+        if (s.best.size() + 1 > best.size() && std::find(s.best.begin(), s.best.end(), -1) == s.best.end()) {
+          best.clear();
+          best.push_back(v);
+          best.insert(best.end(), s.best.begin(), s.best.end());
+        }
+        if (s.out_of_budget) {
+          if (exact) *exact = false;
+          break;
+        }
+      }
     }
-    if (s.out_of_budget) {
-      if (exact) *exact = false;
-      break;
-    }
+    set(later, v);
   }
   std::sort(best.begin(), best.end());
   return best;
@@ -153,16 +203,18 @@ Graph consistencyGraph(const Points& source, const Points& target, const Corresp
   Graph g;
   const int n = static_cast<int>(matches.size());
   g.adjacency.resize(n);
-  const double bound = 2.0 * noise_bound;
+  Points s(n), t(n);  // the matched points in order, for sequential access
   for (int i = 0; i < n; ++i) {
-    const Vec3& si = source[matches[i].source];
-    const Vec3& ti = target[matches[i].target];
-    for (int j = i + 1; j < n; ++j) {
-      const double ds = (source[matches[j].source] - si).norm();
-      const double dt = (target[matches[j].target] - ti).norm();
-      if (std::abs(ds - dt) <= bound) g.addEdge(i, j);
-    }
+    s[i] = source[matches[i].source];
+    t[i] = target[matches[i].target];
   }
+  // | |s_i - s_j| - |t_i - t_j| | <= bound, as a + c - 2 sqrt(a c) <= bound^2 with a, c the squares.
+  const double bound2 = 4.0 * noise_bound * noise_bound;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      const double a = (s[j] - s[i]).squaredNorm(), c = (t[j] - t[i]).squaredNorm();
+      if (a + c - 2.0 * std::sqrt(a * c) <= bound2) g.addEdge(i, j);
+    }
   return g;
 }
 

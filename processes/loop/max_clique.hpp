@@ -14,7 +14,7 @@ namespace livo::loop {
 struct Graph {
   std::vector<std::vector<int>> adjacency;
   int size() const { return static_cast<int>(adjacency.size()); }
-  void addEdge(int a, int b);
+  void addEdge(int a, int b);  // keeps the lists sorted and free of repeats
 };
 
 struct MaxCliqueOptions {

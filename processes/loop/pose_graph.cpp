@@ -9,28 +9,91 @@
 namespace livo::loop {
 
 namespace {
-// r = sqrt_info * [2 vec(q_meas^-1 q_from^-1 q_to); R_from^T (p_to - p_from) - p_meas].
-struct RelativePoseError {
-  RelativePoseError(const Pose3& meas, const Mat6& sqrt_info)
-      : q_meas(Quat(meas.linear()).normalized()), p_meas(meas.translation()), sqrt_info(sqrt_info) {}
+// A pose as [p; q(x, y, z, w)] with tangent [dp; dtheta]: p + dp, q Exp(dtheta) (rotation on the
+// right, translation in the world frame). The cost functions give their Jacobians directly in the
+// tangent (columns 0-5 of a 7-column block, the last column zero), so the Plus Jacobian that Ceres
+// chains them with is [I6; 0].
+class PoseManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return 6; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
+    Eigen::Map<const Vec3> p(x), dp(delta), dr(delta + 3);
+    Eigen::Map<const Quat> q(x + 3);
+    Eigen::Map<Vec3> p_out(x_plus_delta);
+    Eigen::Map<Quat> q_out(x_plus_delta + 3);
+    p_out = p + dp;
+    q_out = (q * so3::ExpQuat(dr)).normalized();
+    return true;
+  }
+  bool PlusJacobian(const double*, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, 7, 6, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.topRows<6>().setIdentity();
+    return true;
+  }
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
+    Eigen::Map<const Vec3> py(y), px(x);
+    Eigen::Map<const Quat> qy(y + 3), qx(x + 3);
+    Eigen::Map<Vec6> out(y_minus_x);
+    out.head<3>() = py - px;
+    out.tail<3>() = so3::Log(Quat(qx.conjugate() * qy));
+    return true;
+  }
+  bool MinusJacobian(const double*, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, 6, 7, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.leftCols<6>().setIdentity();
+    return true;
+  }
+};
 
-  template <class T>
-  bool operator()(const T* p_a, const T* q_a, const T* p_b, const T* q_b, T* residual) const {
-    Eigen::Map<const Eigen::Matrix<T, 3, 1>> pa(p_a), pb(p_b);
-    Eigen::Map<const Eigen::Quaternion<T>> qa(q_a), qb(q_b);
-    const Eigen::Quaternion<T> q_ab = qa.conjugate() * qb;
-    const Eigen::Matrix<T, 3, 1> p_ab = qa.conjugate() * (pb - pa);
-    const Eigen::Quaternion<T> dq = q_meas.template cast<T>().conjugate() * q_ab;
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> r(residual);
-    r.template head<3>() = T(2.0) * dq.vec();
-    r.template tail<3>() = p_ab - p_meas.template cast<T>();
-    r.applyOnTheLeft(sqrt_info.template cast<T>());
+// r = U [Log(R_m^T R_a^T R_b); R_a^T (p_b - p_a) - p_m] with U^T U the edge information.
+class RelativePoseCost final : public ceres::SizedCostFunction<6, 7, 7> {
+ public:
+  RelativePoseCost(const Pose3& meas, const Mat6& sqrt_info)
+      : q_meas_(Quat(meas.linear()).normalized()), p_meas_(meas.translation()), sqrt_info_(sqrt_info) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    Eigen::Map<const Vec3> pa(parameters[0]), pb(parameters[1]);
+    Eigen::Map<const Quat> qa(parameters[0] + 3), qb(parameters[1] + 3);
+    const Mat3 Ra = qa.toRotationMatrix();
+    const Vec3 d = Ra.transpose() * (pb - pa);
+    const Vec3 r_rot = so3::Log(Quat(q_meas_.conjugate() * qa.conjugate() * qb));
+    Vec6 r;
+    r << r_rot, d - p_meas_;
+    Eigen::Map<Vec6> out(residuals);
+    out = sqrt_info_ * r;
+    if (!jacobians) return true;
+    const Mat3 Jinv = so3::rightJacobianInverse(r_rot);
+    using Jac = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+    if (jacobians[0]) {
+      Eigen::Matrix<double, 6, 6> J;  // columns [dp_a, dtheta_a]
+      J.topLeftCorner<3, 3>().setZero();
+      J.topRightCorner<3, 3>() = -Jinv * (qb.toRotationMatrix().transpose() * Ra);
+      J.bottomLeftCorner<3, 3>() = -Ra.transpose();
+      J.bottomRightCorner<3, 3>() = so3::hat(d);
+      Eigen::Map<Jac> out(jacobians[0]);
+      out.leftCols<6>() = sqrt_info_ * J;
+      out.col(6).setZero();
+    }
+    if (jacobians[1]) {
+      Eigen::Matrix<double, 6, 6> J;  // columns [dp_b, dtheta_b]
+      J.topLeftCorner<3, 3>().setZero();
+      J.topRightCorner<3, 3>() = Jinv;
+      J.bottomLeftCorner<3, 3>() = Ra.transpose();
+      J.bottomRightCorner<3, 3>().setZero();
+      Eigen::Map<Jac> out(jacobians[1]);
+      out.leftCols<6>() = sqrt_info_ * J;
+      out.col(6).setZero();
+    }
     return true;
   }
 
-  Quat q_meas;
-  Vec3 p_meas;
-  Mat6 sqrt_info;
+ private:
+  Quat q_meas_;
+  Vec3 p_meas_;
+  Mat6 sqrt_info_;
 };
 
 Mat6 sqrtInformation(const Mat6& info) {
@@ -38,9 +101,56 @@ Mat6 sqrtInformation(const Mat6& info) {
   if (llt.info() != Eigen::Success) return Mat6::Identity();
   return llt.matrixU();  // U^T U = info
 }
+
+PoseManifold& poseManifold() {
+  static PoseManifold manifold;
+  return manifold;
+}
+
+std::array<double, 7> toBlock(const Pose3& T) {
+  std::array<double, 7> x;
+  Eigen::Map<Vec3>(x.data()) = T.translation();
+  Eigen::Map<Quat>(x.data() + 3) = Quat(T.linear()).normalized();
+  return x;
+}
+
+Pose3 fromBlock(const std::array<double, 7>& x) {
+  Pose3 T = Pose3::Identity();
+  T.linear() = Eigen::Map<const Quat>(x.data() + 3).normalized().toRotationMatrix();
+  T.translation() = Eigen::Map<const Vec3>(x.data());
+  return T;
+}
 }  // namespace
 
-void PoseGraph::addNode(int64_t id, const Pose3& initial) { poses_[id] = initial; }
+PoseGraph::PoseGraph(PoseGraphOptions options) : options_(options) {}
+PoseGraph::~PoseGraph() = default;
+PoseGraph::PoseGraph(PoseGraph&&) noexcept = default;
+PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
+
+PoseGraph::PoseGraph(const PoseGraph& other)
+    : options_(other.options_), poses_(other.poses_), blocks_(other.blocks_), edges_(other.edges_) {
+  for (auto& [id, b] : blocks_) b.in_problem = false;
+}
+
+PoseGraph& PoseGraph::operator=(const PoseGraph& other) {
+  if (this != &other) {
+    PoseGraph copy(other);
+    *this = std::move(copy);
+  }
+  return *this;
+}
+
+void PoseGraph::resetProblem() {
+  problem_.reset();
+  edges_in_problem_ = 0;
+  for (auto& [id, b] : blocks_) b.in_problem = false;
+}
+
+void PoseGraph::addNode(int64_t id, const Pose3& initial) {
+  poses_[id] = initial;
+  Block& b = blocks_[id];
+  b.x = toBlock(initial);
+}
 
 void PoseGraph::addEdge(const PoseEdge& edge) {
   if (!hasNode(edge.from) || !hasNode(edge.to))
@@ -64,38 +174,43 @@ size_t PoseGraph::numLoops() const {
 PoseGraphSummary PoseGraph::optimize() {
   PoseGraphSummary out;
   if (poses_.size() < 2 || edges_.empty()) return out;
-  struct Block {
-    Eigen::Vector3d p;
-    Eigen::Quaterniond q;
-  };
-  std::map<int64_t, Block> blocks;
-  for (const auto& [id, T] : poses_) blocks[id] = {T.translation(), Quat(T.linear()).normalized()};
-
-  ceres::Problem::Options popts;
-  popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(popts);
-  ceres::EigenQuaternionManifold quaternion_manifold;
-  for (const PoseEdge& e : edges_) {
-    Block& a = blocks.at(e.from);
-    Block& b = blocks.at(e.to);
-    auto* cost = new ceres::AutoDiffCostFunction<RelativePoseError, 6, 3, 4, 3, 4>(
-        new RelativePoseError(e.T_from_to, sqrtInformation(e.information)));
-    ceres::LossFunction* loss = (e.is_loop && options_.robust_loops) ? new ceres::CauchyLoss(options_.loop_loss_scale) : nullptr;
-    problem.AddResidualBlock(cost, loss, a.p.data(), a.q.coeffs().data(), b.p.data(), b.q.coeffs().data());
+  const int64_t first_id = blocks_.begin()->first;
+  if (problem_ && first_id != fixed_id_) resetProblem();  // a node before the fixed one was added
+  if (!problem_) {
+    ceres::Problem::Options popts;
+    popts.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_ = std::make_unique<ceres::Problem>(popts);
+    edges_in_problem_ = 0;
+    fixed_id_ = first_id;
   }
-  for (auto& [id, b] : blocks)
-    if (problem.HasParameterBlock(b.q.coeffs().data())) problem.SetManifold(b.q.coeffs().data(), &quaternion_manifold);
-  Block& first = blocks.begin()->second;
-  if (problem.HasParameterBlock(first.p.data())) {
-    problem.SetParameterBlockConstant(first.p.data());
-    problem.SetParameterBlockConstant(first.q.coeffs().data());
+  ceres::Problem& problem = *problem_;
+  auto ensureBlock = [&](int64_t id) {
+    Block& b = blocks_.at(id);
+    if (b.in_problem) return b.x.data();
+    problem.AddParameterBlock(b.x.data(), 7, &poseManifold());
+    if (id == first_id) problem.SetParameterBlockConstant(b.x.data());
+    b.in_problem = true;
+    return b.x.data();
+  };
+  for (; edges_in_problem_ < edges_.size(); ++edges_in_problem_) {
+    const PoseEdge& e = edges_[edges_in_problem_];
+    double* a = ensureBlock(e.from);
+    double* b = ensureBlock(e.to);
+    ceres::LossFunction* loss =
+        (e.is_loop && options_.robust_loops) ? new ceres::CauchyLoss(options_.loop_loss_scale) : nullptr;
+    problem.AddResidualBlock(new RelativePoseCost(e.T_from_to, sqrtInformation(e.information)), loss, a, b);
   }
 
   ceres::Solver::Options sopts;
   sopts.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   sopts.max_num_iterations = options_.max_iterations;
   sopts.function_tolerance = options_.function_tolerance;
+  sopts.parameter_tolerance = options_.parameter_tolerance;
   sopts.num_threads = 1;
+  // Warm-started, the problem is nearly linear: start Levenberg-Marquardt close to Gauss-Newton.
+  // (Ceres' default radius damps the long, soft bending modes of a keyframe chain so much that
+  // a solve took 14 iterations instead of 3.) A step that fails still shrinks the radius.
+  sopts.initial_trust_region_radius = options_.initial_trust_region_radius;
   sopts.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(sopts, &problem, &summary);
@@ -103,12 +218,8 @@ PoseGraphSummary PoseGraph::optimize() {
   out.iterations = static_cast<int>(summary.iterations.size());
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
-  for (auto& [id, b] : blocks) {
-    Pose3 T = Pose3::Identity();
-    T.linear() = b.q.normalized().toRotationMatrix();
-    T.translation() = b.p;
-    poses_[id] = T;
-  }
+  for (auto& [id, b] : blocks_)
+    if (b.in_problem) poses_[id] = fromBlock(b.x);
   return out;
 }
 

@@ -1,20 +1,32 @@
 // Pose graph of keyframe poses: odometry edges between consecutive keyframes and loop edges,
-// optimised with Ceres (SE(3) relative-pose residuals weighted by their information); the first
-// keyframe is held fixed. The paper runs iSAM2 and updates only when a loop is added; here the
-// optimisation runs on the same schedule, warm-started from the previous solution.
+// optimised with Ceres (SE(3) relative-pose residuals weighted by their information, analytic
+// Jacobians); the first keyframe is held fixed. The paper runs iSAM2 and updates only when a loop
+// is added; here the optimisation runs on the same schedule and is incremental in the ways that
+// matter for its cost: the Ceres problem persists between optimisations (new nodes and edges are
+// appended, nothing is rebuilt) and every solve is warm-started from the previous solution, so
+// a new loop costs a few Gauss-Newton steps on the whole graph. The optimum is the full solve's:
+// no node is frozen or marginalised.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "livo/so3.hpp"
 
+namespace ceres {
+class Problem;
+}
+
 namespace livo::loop {
 
 struct PoseGraphOptions {
-  int max_iterations = 20;
-  double function_tolerance = 1e-8;
+  int max_iterations = 20;            // per optimisation (a warm-started one needs 2-5)
+  double function_tolerance = 1e-9;   // relative cost decrease at which a solve stops
+  double parameter_tolerance = 1e-9;  // relative step size at which a solve stops
+  double initial_trust_region_radius = 1e12;  // large: the first steps are Gauss-Newton steps
   bool robust_loops = false;      // Cauchy loss on loop edges (off: loops are verified, and a
                                   // large first correction would be down-weighted away)
   double loop_loss_scale = 1.0;   // in units of the whitened residual
@@ -38,7 +50,13 @@ struct PoseGraphSummary {
 
 class PoseGraph {
  public:
-  explicit PoseGraph(PoseGraphOptions options = {}) : options_(options) {}
+  explicit PoseGraph(PoseGraphOptions options = {});
+  ~PoseGraph();
+  /// Copies the nodes and edges; the copy builds its own solver problem when it next optimises.
+  PoseGraph(const PoseGraph& other);
+  PoseGraph& operator=(const PoseGraph& other);
+  PoseGraph(PoseGraph&&) noexcept;
+  PoseGraph& operator=(PoseGraph&&) noexcept;
 
   /// Adds (or replaces the estimate of) a node.
   void addNode(int64_t id, const Pose3& initial);
@@ -46,6 +64,7 @@ class PoseGraph {
   /// Throws std::invalid_argument if an end is unknown.
   void addEdge(const PoseEdge& edge);
 
+  /// Minimises the whole graph from the current estimates (the previous solution for old nodes).
   PoseGraphSummary optimize();
 
   const Pose3& pose(int64_t id) const;
@@ -54,9 +73,21 @@ class PoseGraph {
   size_t numLoops() const;
 
  private:
+  // Ceres parameter block of a node: [p (3); q (x, y, z, w)]. std::map nodes do not move, so the
+  // arrays stay valid as solver blocks while the graph grows.
+  struct Block {
+    std::array<double, 7> x{};
+    bool in_problem = false;
+  };
+  void resetProblem();
+
   PoseGraphOptions options_;
   std::map<int64_t, Pose3> poses_;
+  std::map<int64_t, Block> blocks_;
   std::vector<PoseEdge> edges_;
+  std::unique_ptr<ceres::Problem> problem_;
+  size_t edges_in_problem_ = 0;
+  int64_t fixed_id_ = 0;  // the node held constant in problem_
 };
 
 /// The information of a relative edge from two absolute covariances (cov_to - cov_from,

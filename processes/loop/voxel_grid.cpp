@@ -36,12 +36,15 @@ Points voxelDownsample(const Points& points, double voxel_size) {
   std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
     return std::tie(a.x, a.y, a.z, a.index) < std::tie(b.x, b.y, b.z, b.index);
   });
+  auto sameVoxel = [](const Keyed& a, const Keyed& b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+  size_t voxels = keyed.empty() ? 0 : 1;
+  for (size_t i = 1; i < keyed.size(); ++i) voxels += !sameVoxel(keyed[i - 1], keyed[i]);
   Points out;
+  out.reserve(voxels);  // exactly: callers keep these clouds for every keyframe
   for (size_t i = 0; i < keyed.size();) {
     size_t j = i;
     Vec3 sum = Vec3::Zero();
-    while (j < keyed.size() && keyed[j].x == keyed[i].x && keyed[j].y == keyed[i].y && keyed[j].z == keyed[i].z)
-      sum += finite[keyed[j++].index];
+    while (j < keyed.size() && sameVoxel(keyed[j], keyed[i])) sum += finite[keyed[j++].index];
     out.push_back(sum / static_cast<double>(j - i));
     i = j;
   }

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <random>
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -64,6 +65,116 @@ TEST(PoseGraph, LoopEdgeCutsEndDrift) {
   EXPECT_LT(translationError(g.pose(39), truth[39]), 0.1 * before);
   EXPECT_LT(translationError(g.pose(0), truth[0]), 1e-12);
   EXPECT_EQ(g.numLoops(), 1u);
+}
+
+// Three laps of a 120-node circle with biased, noisy odometry; from the second lap on, a loop edge to the
+// first lap every 8 nodes. Solved on the node's schedule (warm-started, after every loop, new nodes
+// initialised from the previous optimised pose) the final graph equals the full batch solve.
+struct NoisyLaps {
+  std::vector<Pose3> truth, rel;
+  std::vector<PoseEdge> loops;  // by the node they close at
+  Mat6 odometry_information, loop_information;
+  static constexpr int kPerLap = 120;
+  explicit NoisyLaps(int laps) {
+    std::mt19937 rng(5);
+    std::normal_distribution<double> nr(0.0, 1e-3), nt(0.0, 1e-2), lr(0.0, 2e-3), lt(0.0, 1e-2);
+    const int n = laps * kPerLap;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * i / kPerLap;
+      truth.push_back(yawPose(a + M_PI / 2, Vec3(40 * std::cos(a), 40 * std::sin(a), 0.3 * std::sin(2 * a))));
+    }
+    rel.push_back(Pose3::Identity());
+    for (int i = 1; i < n; ++i) {
+      Pose3 d = truth[i - 1].inverse() * truth[i];
+      d.linear() = d.linear() * so3::Exp(Vec3(nr(rng), nr(rng), 2e-3 + nr(rng)));  // and a yaw bias
+      d.translation() = 1.01 * d.translation() + Vec3(nt(rng), nt(rng), nt(rng));  // and a scale error
+      rel.push_back(d);
+    }
+    for (int i = kPerLap; i < n; i += 8) {
+      const int j = i % kPerLap;
+      Pose3 m = truth[j].inverse() * truth[i];
+      m.linear() = m.linear() * so3::Exp(Vec3(lr(rng), lr(rng), lr(rng)));
+      m.translation() += Vec3(lt(rng), lt(rng), lt(rng));
+      loops.push_back({j, i, m, Mat6::Zero(), true});
+    }
+    Vec6 os, ls;
+    os << Vec3::Constant(2e-3), Vec3::Constant(3e-2);
+    ls << Vec3::Constant(2e-3), Vec3::Constant(1e-2);
+    odometry_information = os.cwiseInverse().cwiseAbs2().asDiagonal();
+    loop_information = ls.cwiseInverse().cwiseAbs2().asDiagonal();
+    for (PoseEdge& e : loops) e.information = loop_information;
+  }
+  int size() const { return static_cast<int>(truth.size()); }
+};
+
+TEST(PoseGraph, WarmStartedSolvesOnTheLoopScheduleEqualTheFullSolve) {
+  const NoisyLaps laps(3);
+  PoseGraph incremental;
+  size_t next_loop = 0;
+  int solves = 0, iterations = 0;
+  for (int i = 0; i < laps.size(); ++i) {
+    incremental.addNode(i, i == 0 ? laps.truth[0] : Pose3(incremental.pose(i - 1) * laps.rel[i]));
+    if (i > 0) incremental.addEdge({i - 1, i, laps.rel[i], laps.odometry_information, false});
+    if (next_loop < laps.loops.size() && laps.loops[next_loop].to == i) {
+      incremental.addEdge(laps.loops[next_loop++]);
+      const PoseGraphSummary s = incremental.optimize();
+      EXPECT_TRUE(s.converged) << i;
+      ++solves;
+      iterations += s.iterations;
+    }
+  }
+  ASSERT_EQ(next_loop, laps.loops.size());
+
+  PoseGraphOptions tight;
+  tight.max_iterations = 200;
+  tight.function_tolerance = 1e-14;
+  tight.parameter_tolerance = 1e-14;
+  tight.initial_trust_region_radius = 1e4;  // Ceres' default: the plain, cautious full solve
+  PoseGraph full(tight);
+  Pose3 odo = laps.truth[0];
+  for (int i = 0; i < laps.size(); ++i) {
+    if (i > 0) odo = odo * laps.rel[i];
+    full.addNode(i, odo);
+    if (i > 0) full.addEdge({i - 1, i, laps.rel[i], laps.odometry_information, false});
+  }
+  for (const PoseEdge& e : laps.loops) full.addEdge(e);
+  const double odometry_drift = translationError(odo, laps.truth.back());
+  const PoseGraphSummary fs = full.optimize();
+  EXPECT_TRUE(fs.converged);
+
+  double worst_t = 0.0, worst_r = 0.0, worst_truth = 0.0;
+  for (int i = 0; i < laps.size(); ++i) {
+    worst_t = std::max(worst_t, translationError(incremental.pose(i), full.pose(i)));
+    worst_r = std::max(worst_r, rotationErrorDeg(incremental.pose(i), full.pose(i)));
+    worst_truth = std::max(worst_truth, translationError(full.pose(i), laps.truth[i]));
+  }
+  std::printf("[pose-graph] %d warm solves, %.1f iterations each; full solve %d iterations; incremental vs full: "
+              "%.2e m, %.2e deg; odometry drift %.2f m, worst solved %.3f m\n",
+              solves, double(iterations) / solves, fs.iterations, worst_t, worst_r, odometry_drift, worst_truth);
+  EXPECT_LT(worst_t, 1e-4);
+  EXPECT_LT(worst_r, 1e-4);
+  EXPECT_GT(odometry_drift, 1.0);        // the loops had something to correct ...
+  EXPECT_LT(worst_truth, 0.1 * odometry_drift);  // ... and did
+  EXPECT_LE(double(iterations) / solves, 5.0);   // warm starts: a few steps per loop
+}
+
+// A copy keeps the nodes and edges and optimises on its own.
+TEST(PoseGraph, CopiesOptimiseIndependently) {
+  const std::vector<Pose3> truth = circle(40);
+  const std::vector<Pose3> start = driftedOdometry(truth, 0.01);
+  PoseGraph g;
+  for (int i = 0; i < 40; ++i) g.addNode(i, start[i]);
+  for (int i = 1; i < 40; ++i) g.addEdge({i - 1, i, start[i - 1].inverse() * start[i], Mat6::Identity() * 100, false});
+  g.optimize();  // builds g's solver problem (no loop yet: nothing moves)
+  PoseGraph copy = g;
+  copy.addEdge({39, 0, truth[39].inverse() * truth[0], Mat6::Identity() * 100, true});
+  copy.optimize();
+  EXPECT_LT(translationError(copy.pose(39), truth[39]), 0.5 * translationError(start[39], truth[39]));
+  EXPECT_LT(translationError(g.pose(39), start[39]), 1e-9);  // the original is untouched
+  EXPECT_EQ(g.numLoops(), 0u);
+  g.addEdge({39, 0, truth[39].inverse() * truth[0], Mat6::Identity() * 100, true});
+  g.optimize();
+  EXPECT_LT(translationError(g.pose(39), copy.pose(39)), 1e-9);
 }
 
 TEST(PoseGraph, UnknownNodeIsRejected) {

@@ -85,7 +85,7 @@ TEST(Quatro, FpfhPipelineRegistersOverlappingViews) {
     const Pose3 W_T_s = yawPose(0.3 + yaw, Vec3(3.0, -2.0, 1.8));
     const CoarseFeatures target = computeCoarseFeatures(viewFrom(scene, W_T_t.translation(), 0.3, 25, 0.02, 1), {});
     const CoarseFeatures source = computeCoarseFeatures(viewFrom(scene, W_T_s.translation(), 0.3 + yaw, 25, 0.02, 2), {});
-    const Correspondences m = matchFeatures(source.features, target.features);
+    const Correspondences m = matchDescriptors(source.descriptors, target.descriptors);
     QuatroOptions o;
     o.noise_bound = 0.3;
     const QuatroResult r = quatroRegister(source.points, target.points, m, o);

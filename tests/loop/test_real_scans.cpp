@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "loop_closer.hpp"
 #include "loop_registration.hpp"
 #include "real_scans.hpp"
 #include "synthetic_scenes.hpp"
@@ -21,12 +22,14 @@ struct Prepared {
   CoarseFeatures coarse;
   GicpCloud fine;
 };
-Prepared prepare(const Points& raw) {
-  return {computeCoarseFeatures(raw, {}), GicpCloud::build(voxelDownsample(raw, 0.3))};
+// With the options livo-loop runs with (the fine voxel size unless given).
+Prepared prepare(const Points& raw, double fine_voxel = LoopCloserOptions{}.fine_voxel_size) {
+  const LoopCloserOptions o;
+  return {computeCoarseFeatures(raw, o.coarse), GicpCloud::build(voxelDownsample(raw, fine_voxel), o.covariance_neighbors)};
 }
 
 LoopRegistrationResult registerPair(const Prepared& source, const Prepared& target) {
-  return registerLoop(source.coarse, target.coarse, source.fine, target.fine, {});
+  return registerLoop(source.coarse, target.coarse, source.fine, target.fine, LoopCloserOptions{}.registration);
 }
 
 void report(const std::string& what, const LoopRegistrationResult& r, const Pose3& truth) {
@@ -53,14 +56,15 @@ TEST(RealScans, KittiSevenKeyframesRegisterToGraphPoses) {
     const LoopRegistrationResult r = registerPair(kf[j], kf[i]);
     report("kitti07 " + std::to_string(j) + "->" + std::to_string(i), r, truth);
     // A wrong loop is worse than none: a pair may be refused (too few coarse inliers), but what is
-    // accepted must be right. The well-overlapping pairs must be accepted.
+    // accepted must be right. The well-overlapping pairs must be accepted. graph.txt is an
+    // estimated trajectory, not ground truth; the fine results agree with it to 0.1 deg and 3 cm.
     if (i < 3) {
       EXPECT_TRUE(r.accepted) << r.reason;
     }
     if (r.accepted) {
       ++accepted;
-      EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 1.0);
-      EXPECT_LT(translationError(r.T_target_source, truth), 0.25);
+      EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 0.25);
+      EXPECT_LT(translationError(r.T_target_source, truth), 0.05);
     }
   }
   EXPECT_GE(accepted, 3);
@@ -86,20 +90,25 @@ TEST(RealScans, KittiZeroFramePairMatchesGroundTruth) {
   EXPECT_TRUE(r.accepted) << r.reason;
   // KITTI sweeps are not motion-compensated: the car moves 0.86 m during this sweep, so a rigid
   // registration cannot agree with the ground truth much better than a quarter of that.
-  EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 0.5);
+  EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 0.3);
   EXPECT_LT(translationError(r.T_target_source, truth), 0.25);
 }
 
 TEST(RealScans, SmallGicpPairMatchesReference) {
   const Pose3 truth = readMatrix4(kLidar + "scan_pair/T_target_source.txt");
-  const Prepared source = prepare(readFloatPly(kLidar + "scan_pair/source.ply"));
-  const Prepared target = prepare(readFloatPly(kLidar + "scan_pair/target.ply"));
+  // Fine clouds at small_gicp's test resolution (0.3 m), like for like with its reference. At
+  // livo-loop's 0.4 m the result moves 0.8 deg from it, nearly all in roll; which of the two is
+  // nearer the truth this pair cannot tell (on simulated keyframes with ground truth, these
+  // settings leave 0.1 deg of roll and pitch error).
+  const Prepared source = prepare(readFloatPly(kLidar + "scan_pair/source.ply"), 0.3);
+  const Prepared target = prepare(readFloatPly(kLidar + "scan_pair/target.ply"), 0.3);
   const LoopRegistrationResult r = registerPair(source, target);
   report("scan_pair", r, truth);
   EXPECT_TRUE(r.accepted) << r.reason;
-  // The reference is small_gicp's own registration result, not independent ground truth.
+  // The reference is small_gicp's own registration result, not independent ground truth (its own
+  // tests accept 2.5 deg and 0.2 m around it); GICP here lands 0.46 deg and 1 cm from it.
   EXPECT_LT(rotationErrorDeg(r.T_target_source, truth), 0.5);
-  EXPECT_LT(translationError(r.T_target_source, truth), 0.05);
+  EXPECT_LT(translationError(r.T_target_source, truth), 0.03);
 }
 
 }  // namespace

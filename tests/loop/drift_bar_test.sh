@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Issue 8's drift bar end to end (ctest label "slow": about 4 minutes on two cores): five simulated
+# minutes of config/sim/campus_loop_long.yaml through the pipeline without and with livo-loop; with
+# loop closure the final keyframe trajectory's ATE must be at most half the LIO's and its end-point
+# drift at most a fifth (tests/loop/drift_bar.py), and no accepted loop may be false
+# (tests/loop/check_loops.py).
+#   tests/loop/drift_bar_test.sh SOURCE_DIR BIN_DIR
+set -uo pipefail
+root="$1"; bin="$2"
+dir=$(mktemp -d /tmp/livo-drift-bar.XXXXXX)
+trap 'rm -rf "$dir"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+export LIVO_BUILD_DIR="$(dirname "$bin")"
+config="$root/config/sim/campus_loop_long.yaml"
+"$bin/livo-sim" --config "$config" --out "$dir/campus.lcmlog" --duration 300 --quiet || fail "livo-sim failed"
+"$root/scripts/run_pipeline.sh" --log "$dir/campus.lcmlog" --config "$config" --out "$dir/lio" --without loop \
+  >/dev/null 2>"$dir/lio.err" || { cat "$dir/lio.err"; fail "the LIO-only run failed"; }
+"$root/scripts/run_pipeline.sh" --log "$dir/campus.lcmlog" --config "$config" --out "$dir/loop" \
+  >/dev/null 2>"$dir/loop.err" || { cat "$dir/loop.err"; fail "the run with loop closure failed"; }
+/usr/bin/python3 "$root/tests/loop/drift_bar.py" --log "$dir/campus.lcmlog" --lio-only "$dir/lio" \
+  --with-loop "$dir/loop" --bin "$bin" || fail "drift bar missed"
+/usr/bin/python3 "$root/tests/loop/check_loops.py" --log "$dir/campus.lcmlog" --loops "$dir/loop/loops.json" \
+  > "$dir/loops.txt" || { cat "$dir/loops.txt"; fail "false loops"; }
+tail -n 1 "$dir/loops.txt"
