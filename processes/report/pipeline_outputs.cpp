@@ -50,6 +50,7 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
         continue;
       }
       out.last_loop = m;
+      out.last_loop_after = out.odometry.empty() ? 0.0 : out.odometry.back().stamp;
       ++out.loop_corrections;
     } else if (ev->channel == ch.health) {
       health_t m;
@@ -83,7 +84,9 @@ Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
   std::vector<Anchor> anchors;
   for (const KeyframePose& k : outputs.keyframes) {
     auto it = corrected.find(k.id);
-    const Pose3 c = it != corrected.end() ? Pose3(it->second * k.pose.inverse()) : overall;
+    const bool adopted = it == corrected.end() && k.stamp > outputs.last_loop_after;
+    const Pose3 c = it != corrected.end() ? Pose3(it->second * k.pose.inverse())
+                                          : adopted ? Pose3::Identity() : overall;
     anchors.push_back({k.stamp, c});
   }
   std::stable_sort(anchors.begin(), anchors.end(), [](const Anchor& a, const Anchor& b) { return a.stamp < b.stamp; });
@@ -93,8 +96,10 @@ Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
   size_t a = 0;
   for (const StampedPose& p : outputs.odometry) {
     while (a + 1 < anchors.size() && anchors[a + 1].stamp <= p.stamp) ++a;
-    // before the first keyframe the first keyframe's correction applies (it is the map origin)
-    out.push_back({p.stamp, anchors[a].correction * p.pose});
+    // before the first keyframe the first keyframe's correction applies (it is the map origin);
+    // odometry published after the LIO adopted the correction is already corrected
+    const Pose3 c = p.stamp > outputs.last_loop_after ? Pose3::Identity() : anchors[a].correction;
+    out.push_back({p.stamp, c * p.pose});
   }
   return out;
 }

@@ -31,6 +31,8 @@ struct PipelineOutputs {
   Trajectory odometry;                          // body pose at every scan, in stamp order
   std::vector<KeyframePose> keyframes;          // in id order
   std::optional<loop_correction_t> last_loop;   // the newest LOOP_CORRECTION
+  double last_loop_after = 0.0;  // stamp of the newest odometry logged before it: later odometry and
+                                 // keyframes come from a LIO that had adopted it (design.md)
   int64_t loop_corrections = 0;
   std::map<std::string, health_t> final_health; // newest HEALTH per node
   int64_t undecodable = 0;                      // messages on these channels that did not decode
@@ -42,8 +44,9 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
 
 /// The final trajectory: each odometry pose moved by the correction of the newest keyframe at or
 /// before it, T = K_corrected * K_published^-1 * T_odometry, using the last loop correction's
-/// keyframe poses (keyframes newer than it keep its overall correction). Identical to the
-/// odometry when there was no loop correction.
+/// keyframe poses; keyframes newer than it keep its overall correction, unless they were published
+/// after it, by a LIO that had adopted it: those, and the odometry after them, are final as they
+/// are. Identical to the odometry when there was no loop correction.
 Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs);
 
 }  // namespace livo

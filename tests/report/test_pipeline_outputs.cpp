@@ -33,8 +33,12 @@ Pose3 poseAt(int i) {
 }
 
 // 20 scans, keyframes at scans 0, 5, 10, 15; a loop correction for keyframes 0..2.
-std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2, bool with_loop, bool with_nan) {
-  const std::string path = livo_test::tempPath("outputs_") + std::to_string(with_loop) + std::to_string(with_nan) + ".lcmlog";
+// With adopted_tail, that many more scans follow the correction, published by a LIO that adopted
+// it (already corrected by correction_kf2), the first of them a keyframe.
+std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2, bool with_loop, bool with_nan,
+                        int adopted_tail = 0) {
+  const std::string path = livo_test::tempPath("outputs_") + std::to_string(with_loop) + std::to_string(with_nan) +
+                           std::to_string(adopted_tail) + ".lcmlog";
   lcm::LogFile log(path, "w");
   for (int i = 0; i < 20; ++i) {
     const int64_t t = 1000000 + i * 100000;
@@ -67,6 +71,21 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
     }
     poseTo(correction_kf2, lc.correction_position, lc.correction_orientation);
     write(log, "LOOP_CORRECTION", 2000000, lc);
+    for (int i = 20; i < 20 + adopted_tail; ++i) {
+      const int64_t t = 1000000 + i * 100000;
+      odometry_t o{};
+      o.utime = t;
+      poseTo(correction_kf2 * poseAt(i), o.position, o.orientation);
+      write(log, "ODOMETRY", t, o);
+      if (i == 20) {
+        keyframe_t k{};
+        k.id = 4;
+        k.utime = t;
+        poseTo(correction_kf2 * poseAt(i), k.position, k.orientation);
+        k.cloud.frame = "I";
+        write(log, "KEYFRAME", t, k);
+      }
+    }
   }
   health_t h{};
   h.node = "lio";
@@ -116,6 +135,22 @@ TEST(PipelineOutputs, LoopCorrectionMovesEachSpanByItsKeyframe) {
     // newer keyframe 3, which the correction does not list: the overall correction c2
     const Pose3 c = i < 5 ? Pose3::Identity() : i < 10 ? c1 : c2;
     const Pose3 expected = c * poseAt(i);
+    EXPECT_NEAR((t[i].pose.matrix() - expected.matrix()).norm(), 0.0, 1e-9) << i;
+  }
+}
+
+// livo-lio adopts a loop correction: what it publishes after it is already corrected and is not
+// moved again, while what came before still is.
+TEST(PipelineOutputs, OdometryAfterAnAdoptedCorrectionIsKept) {
+  Vec6 a, b;
+  a << 0.0, 0.0, 0.02, 0.3, -0.1, 0.0;
+  b << 0.0, 0.0, -0.03, -0.5, 0.4, 0.1;
+  const Pose3 c1 = se3::Exp(a), c2 = se3::Exp(b);
+  const PipelineOutputs out = readPipelineOutputs(makeOutputs(c1, c2, true, false, 6));
+  const Trajectory t = loopCorrectedTrajectory(out);
+  ASSERT_EQ(t.size(), 26u);
+  for (int i = 0; i < 26; ++i) {
+    const Pose3 expected = (i < 5 ? Pose3::Identity() : i < 10 ? c1 : c2) * poseAt(i);
     EXPECT_NEAR((t[i].pose.matrix() - expected.matrix()).norm(), 0.0, 1e-9) << i;
   }
 }
