@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build, run and test dependency of livo-lcm from Debian 12 packages (apt only).
+# Every Python module the tests and scripts import comes from a package listed here
+# (ctest's Tools.PythonDepsPackaged checks it).
 # Idempotent: does nothing (and prints nothing) when everything is already installed.
 set -euo pipefail
 
@@ -13,8 +15,8 @@ PACKAGES=(
   # tests and benchmarks
   googletest libgtest-dev libgmock-dev libbenchmark-dev python3
   # livo-import: Ouster metadata JSON; ROS 1 bags written by the real ROS library in its tests
-  nlohmann-json3-dev python3-rosbag python3-roslz4 python3-sensor-msgs python3-geometry-msgs
-  python3-nav-msgs
+  nlohmann-json3-dev python3-rosbag python3-roslz4 python3-rospy python3-std-msgs
+  python3-sensor-msgs python3-geometry-msgs python3-nav-msgs python3-numpy
   # private bus (network namespaces) and process tools
   iproute2 util-linux procps
 )
