@@ -12,16 +12,21 @@
 #   scripts/run_pipeline.sh --log LOG --config FILE --out DIR [--realtime] [--without P,...]
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
+#                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
+# --respawn (the default with --realtime): a process that exits is restarted (at most
+# --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
+# every restart. Without it a process that dies stops the run. --kill P:SIG:AT_S sends SIG to
+# process P AT_S seconds of wall time after the replay starts (for supervision tests).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio loop colour octomap)
 
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills=""
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -35,6 +40,10 @@ while [ $# -gt 0 ]; do
     --record) record="$2"; shift 2 ;;
     --faults) faults="$2"; shift 2 ;;
     --seed) seed="$2"; shift 2 ;;
+    --respawn) respawn=1; shift ;;
+    --no-respawn) respawn=0; shift ;;
+    --max-restarts) max_restarts="$2"; shift 2 ;;
+    --kill) kills="$2"; shift 2 ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"; swap["${2%%=*}"]="${2#*=}"; shift 2 ;;
     --inside-bus) inside=1; shift ;;
     -h|--help) usage 0 ;;
@@ -42,6 +51,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -n "$log" ] && [ -n "$config" ] && [ -n "$out" ] || usage
+[ -n "$respawn" ] || respawn=$realtime
+[[ "$max_restarts" =~ ^[0-9]+$ ]] || die "--max-restarts takes a whole number"
 [ -f "$log" ] || die "no such log: $log"
 [ -f "$config" ] || die "no such config: $config"
 log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
@@ -78,7 +89,8 @@ if [ "$inside" = 0 ]; then
   rc=0
   "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
-    --faults "$faults" --seed "$seed" \
+    --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --kill "$kills" \
+    $([ "$respawn" = 1 ] && echo --respawn || echo --no-respawn) \
     $([ "$realtime" = 1 ] && echo --realtime) || rc=$?
 
   # Files for the user, whatever happened above (outputs so far are kept).
@@ -103,11 +115,16 @@ if [ "$inside" = 0 ]; then
     done
   fi
   [ "$rc" = 0 ] || warnings+=("the run failed: $(tail -n 1 "$out/logs/run.txt" 2>/dev/null)")
+  # What the replay saw go wrong on the bus (messages lost, consumers away and back).
+  while IFS= read -r line; do warnings+=("playback: ${line#*lockstep: }"); done \
+    < <(grep -E '^\[playback\] lockstep: ' "$out/logs/playback.log" 2>/dev/null | grep -v 'restarted\|exited;\|silent for\|heard again' || true)
   read -r log_s wall_s < "$out/logs/replay_times.txt" 2>/dev/null || { log_s=0; wall_s=0; }
   joined_warnings=$(IFS=';'; echo "${warnings[*]:-}")
+  injected=$(sed -n 's/^\[playback\] faults on \(.*\)$/\1/p' "$out/logs/playback.log" 2>/dev/null | paste -sd';' -)
   "$bin/livo-report" markdown --dir "$out" --log "$log" --config "$config" --processes "$(IFS=,; echo "${selected[*]}")" \
     --mode "$([ "$realtime" = 1 ] && echo 'real time' || echo lockstep)" --log-seconds "$log_s" --wall-seconds "$wall_s" \
-    --evaluation "$evaluations" --figure "$figures" --warning "$joined_warnings" >/dev/null
+    --evaluation "$evaluations" --figure "$figures" --warning "$joined_warnings" --injected "$injected" \
+    $([ "$respawn" = 1 ] && echo --restarts "$out/logs/restarts.tsv") >/dev/null
   if [ "$rc" != 0 ]; then
     echo "run_pipeline.sh: FAILED (outputs so far kept in $out):" >&2
     cat "$out/logs/run.txt" >&2 || true
@@ -121,35 +138,99 @@ fi
 exec 3>"$out/logs/run.txt"
 "$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
 logger=$!
-declare -A pids=()
-for p in "${selected[@]}"; do
+: > "$out/logs/restarts.tsv"
+declare -A pids=() restarts=() next_start=() died_at=() ended=()
+now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
+start_process() {
   # in the output folder, so the files a process writes (maps, loops.json) land there
-  (cd "$out" && exec "$(exe_of "$p")" --config "$config" --name "$p") >"$out/logs/$p.log" 2>&1 &
-  pids[$p]=$!
-done
+  (cd "$out" && exec "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+  pids[$1]=$!
+}
+for p in "${selected[@]}"; do start_process "$p"; restarts[$p]=0; done
 cleanup() {
   for p in "${!pids[@]}"; do kill -INT "${pids[$p]}" 2>/dev/null || true; done
   kill -INT "$logger" 2>/dev/null || true
 }
 trap cleanup INT TERM
+# What a restarted process starts without (processes/*/README.md, "Restarts").
+lost_on_restart() {
+  case "$1" in
+    lio) echo "filter state and local map: re-initialised from the IMU, odometry goes on in a new epoch" ;;
+    vio) echo "its patch map; lio ran LiDAR-only until it answered again" ;;
+    loop) echo "keyframes and pose graph so far: no loops to places seen before the restart" ;;
+    colour) echo "the coloured map so far (its files hold what it coloured after the restart)" ;;
+    octomap) echo "the occupancy map so far (its files hold what it mapped after the restart)" ;;
+    *) echo "its in-memory state" ;;
+  esac
+}
+# the newest "[playback] X s of log" figure, for the restart table
+log_time() { sed -n 's/^\[playback\] \([0-9.]*\) s of log.*/\1/p' "$out/logs/playback.log" 2>/dev/null | tail -n 1; }
 
 start=$(date +%s%N)
 if [ "$realtime" = 1 ]; then
   replay=(--speed 1 --consumers "$(IFS=,; echo "${selected[*]}"),record" --startup-timeout 60)
 else
-  replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 120 --startup-timeout 60)
+  replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 60 --startup-timeout 60)
+  [ "$respawn" = 1 ] && replay+=(--respawn)
 fi
 [ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")
 rc=0
 "$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
 playback=$!
-# A process that dies ends the replay at once (lockstep would otherwise wait for its stall timeout).
+t0=$(now_ms)
+declare -a kill_plan=()
+IFS=, read -ra kill_plan <<<"$kills"
+# Supervision. Without --respawn a process that dies ends the replay at once (lockstep would
+# otherwise wait for its stall timeout); with it, the process is restarted after a back-off.
 while kill -0 "$playback" 2>/dev/null; do
+  now=$(now_ms)
+  for i in "${!kill_plan[@]}"; do  # --kill P:SIG:AT_S
+    IFS=: read -r kp ksig kat <<<"${kill_plan[$i]}"
+    if [ -n "$kp" ] && [ -n "${pids[$kp]:-}" ] && \
+       [ "$(awk -v n="$now" -v t="$t0" -v a="$kat" 'BEGIN { print (n - t >= a * 1000) }')" = 1 ]; then
+      echo "run_pipeline.sh: --kill: SIG$ksig to $kp" >>"$out/logs/playback.log"
+      kill "-$ksig" "${pids[$kp]}" 2>/dev/null || true
+      unset "kill_plan[$i]"
+    fi
+  done
   for p in "${selected[@]}"; do
-    if ! kill -0 "${pids[$p]}" 2>/dev/null; then
+    if [ -n "${next_start[$p]:-}" ]; then
+      if [ "$now" -ge "${next_start[$p]}" ]; then
+        start_process "$p"
+        restarts[$p]=$((restarts[$p] + 1))
+        unset "next_start[$p]"
+        down=$(( now - died_at[$p] ))
+        printf "%d.%03d\t%s\t%s\t%s\t%d\t%d.%03d\t%s\n" $(( (died_at[$p] - t0) / 1000 )) $(( (died_at[$p] - t0) % 1000 )) \
+          "$(log_time)" "$p" "${ended[$p]}" "${restarts[$p]}" $((down / 1000)) $((down % 1000)) "$(lost_on_restart "$p")" \
+          >>"$out/logs/restarts.tsv"
+        echo "run_pipeline.sh: restarted $p (restart ${restarts[$p]} of at most $max_restarts)" >>"$out/logs/playback.log"
+      fi
+      continue
+    fi
+    [ -n "${pids[$p]:-}" ] || continue
+    kill -0 "${pids[$p]}" 2>/dev/null && continue
+    code=0; wait "${pids[$p]}" || code=$?
+    unset "pids[$p]"
+    if [ "$code" -gt 128 ]; then how="killed by SIG$(kill -l $((code - 128)) 2>/dev/null || echo $((code - 128)))"; else how="exited with code $code"; fi
+    if [ "$respawn" != 1 ]; then
       echo "process $p died; stopping the replay" >>"$out/logs/playback.log"
+      echo "process $p died during the run ($how); its last lines:" >&3
+      tail -n 15 "$out/logs/$p.log" | sed 's/^/    /' >&3
+      died=1
       kill -INT "$playback" 2>/dev/null || true
       break 2
+    fi
+    echo "=== $p $how; $( [ "${restarts[$p]}" -lt "$max_restarts" ] && echo restarting || echo 'not restarted: restart limit reached' ) ===" >>"$out/logs/$p.log"
+    if [ "${restarts[$p]}" -lt "$max_restarts" ]; then
+      died_at[$p]=$now
+      ended[$p]=$how
+      backoff=$(( 500 * (1 << restarts[$p]) )); [ "$backoff" -gt 8000 ] && backoff=8000
+      next_start[$p]=$(( now + backoff ))
+    else
+      echo "process $p $how and reached the restart limit ($max_restarts); the run goes on without it" >&3
+      printf "%s\t%s\t%s\t%s\t-\t-\t%s\n" "$(( (now - t0) / 1000 ))" "$(log_time)" "$p" "$how" "not restarted (limit of $max_restarts reached)" \
+        >>"$out/logs/restarts.tsv"
+      gave_up=1
     fi
   done
   sleep 0.2
@@ -162,13 +243,15 @@ printf "%s %d.%03d\n" "${log_s:-0}" $((ms / 1000)) $((ms % 1000)) > "$out/logs/r
 [ "$rc" = 0 ] || echo "playback failed: $(tail -n 1 "$out/logs/playback.log")" >&3
 
 # Stop the processes (they flush and send a final HEALTH), then the recorder.
-failed=0
-for p in "${selected[@]}"; do
+failed=${died:-0}
+for p in "${!pids[@]}"; do
   if ! kill -0 "${pids[$p]}" 2>/dev/null; then
     code=0; wait "${pids[$p]}" || code=$?
-    echo "process $p died during the run (exit code $code); its last lines:" >&3
-    tail -n 15 "$out/logs/$p.log" | sed 's/^/    /' >&3
-    failed=1
+    if [ "$respawn" != 1 ]; then
+      echo "process $p died during the run (exit code $code); its last lines:" >&3
+      tail -n 15 "$out/logs/$p.log" | sed 's/^/    /' >&3
+      failed=1
+    fi
     unset "pids[$p]"
   fi
 done

@@ -1,5 +1,6 @@
 #include "livo/message_registry.hpp"
 
+#include <cmath>
 #include <type_traits>
 
 #include "livo/channel_stats_t.hpp"
@@ -92,6 +93,89 @@ bool setMessageUtime(void* data, int size, int64_t utime) {
   uint64_t u = static_cast<uint64_t>(utime);
   for (int i = 7; i >= 0; --i, u >>= 8) b[i] = static_cast<uint8_t>(u & 0xff);
   return true;
+}
+
+}  // namespace livo
+
+namespace livo {
+
+namespace {
+int64_t nonFinite(double v) { return std::isfinite(v) ? 0 : 1; }
+int64_t nonFinite(float v) { return std::isfinite(v) ? 0 : 1; }
+template <class Range>
+int64_t nonFinite(const Range& values) {
+  int64_t n = 0;
+  for (const auto& v : values) n += nonFinite(v);
+  return n;
+}
+template <class T, size_t N>
+int64_t nonFinite(const T (&values)[N]) {
+  int64_t n = 0;
+  for (const auto& v : values) n += nonFinite(static_cast<double>(v));
+  return n;
+}
+
+int64_t nonFiniteIn(const point_cloud_t& m) {
+  return nonFinite(m.sweep_duration) + nonFinite(m.x) + nonFinite(m.y) + nonFinite(m.z) + nonFinite(m.intensity) +
+         nonFinite(m.time_offset);
+}
+int64_t nonFiniteIn(const imu_t& m) { return nonFinite(m.angular_velocity) + nonFinite(m.linear_acceleration); }
+int64_t nonFiniteIn(const pose_t& m) { return nonFinite(m.position) + nonFinite(m.orientation); }
+int64_t nonFiniteIn(const wheel_odometry_t& m) { return nonFinite(m.left_speed) + nonFinite(m.right_speed); }
+int64_t nonFiniteIn(const image_t& m) { return nonFinite(m.exposure_time); }
+int64_t nonFiniteIn(const odometry_t& m) {
+  return nonFinite(m.position) + nonFinite(m.orientation) + nonFinite(m.velocity) + nonFinite(m.angular_velocity) +
+         nonFinite(m.pose_covariance) + nonFinite(m.velocity_covariance) + nonFinite(m.min_information_eigenvalue);
+}
+int64_t nonFiniteIn(const filter_state_t& m) {
+  return nonFinite(m.orientation) + nonFinite(m.position) + nonFinite(m.velocity) + nonFinite(m.gyro_bias) +
+         nonFinite(m.accel_bias) + nonFinite(m.gravity) + nonFinite(m.covariance);
+}
+int64_t nonFiniteIn(const registered_scan_t& m) {
+  return nonFinite(m.position) + nonFinite(m.orientation) + nonFiniteIn(m.cloud);
+}
+int64_t nonFiniteIn(const keyframe_t& m) {
+  return nonFinite(m.position) + nonFinite(m.orientation) + nonFinite(m.pose_covariance) + nonFiniteIn(m.cloud);
+}
+int64_t nonFiniteIn(const loop_correction_t& m) {
+  int64_t n = nonFinite(m.loop_fitness) + nonFinite(m.correction_position) + nonFinite(m.correction_orientation);
+  for (const auto& p : m.position) n += nonFinite(p);
+  for (const auto& q : m.orientation) n += nonFinite(q);
+  return n;
+}
+int64_t nonFiniteIn(const colored_cloud_t& m) { return nonFinite(m.x) + nonFinite(m.y) + nonFinite(m.z); }
+int64_t nonFiniteIn(const octomap_t& m) { return nonFinite(m.resolution); }
+int64_t nonFiniteIn(const channel_stats_t& m) {
+  return nonFinite(m.median_ms) + nonFinite(m.p90_ms) + nonFinite(m.max_ms);
+}
+int64_t nonFiniteIn(const health_t& m) {
+  int64_t n = nonFinite(m.peak_rss_mb);
+  for (const auto& c : m.channels) n += nonFiniteIn(c);
+  return n;
+}
+int64_t nonFiniteIn(const progress_t&) { return 0; }
+
+template <class T>
+int64_t decodeAndCount(const void* data, int size) {
+  T m{};
+  if (m.decode(data, 0, size) != size) return -1;
+  return nonFiniteIn(m);
+}
+
+template <class... Ts>
+int64_t countFor(const void* data, int size) {
+  const uint64_t h = readBigEndian64(static_cast<const uint8_t*>(data));
+  int64_t result = -1;
+  ((static_cast<uint64_t>(Ts::getHash()) == h ? (result = decodeAndCount<Ts>(data, size), true) : false) || ...);
+  return result;
+}
+}  // namespace
+
+int64_t countNonFinite(const void* data, int size) {
+  if (size < 8) return -1;
+  return countFor<imu_t, point_cloud_t, image_t, wheel_odometry_t, pose_t, odometry_t, filter_state_t,
+                  registered_scan_t, keyframe_t, loop_correction_t, colored_cloud_t, octomap_t, progress_t,
+                  channel_stats_t, health_t>(data, size);
 }
 
 }  // namespace livo

@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+
+#include <poll.h>
+#include <unistd.h>
 
 #include "livo/health_t.hpp"
 #include "livo/progress_t.hpp"
@@ -28,9 +32,29 @@ void installSignalHandlers() {
 void requestShutdown() { g_shutdown.store(true); }
 bool shutdownRequested() { return g_shutdown.load(); }
 
+std::map<std::string, std::set<int64_t>> parseDropReceived(const std::string& spec) {
+  std::map<std::string, std::set<int64_t>> out;
+  std::stringstream ss(spec);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (item.empty()) continue;
+    const size_t colon = item.rfind(':');
+    char* end = nullptr;
+    const long long n = colon == std::string::npos ? 0 : std::strtoll(item.c_str() + colon + 1, &end, 10);
+    if (colon == std::string::npos || colon == 0 || n < 1 || *end != '\0')
+      throw std::invalid_argument("LIVO_TEST_DROP_RECEIVED: '" + item + "' is not CHANNEL:N with N >= 1");
+    out[item.substr(0, colon)].insert(n);
+  }
+  return out;
+}
+
 Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
   if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
   last_health_ = std::chrono::steady_clock::now();
+  if (const char* drop = std::getenv("LIVO_TEST_DROP_RECEIVED"); drop && options_.drop_received.empty())
+    options_.drop_received = parseDropReceived(drop);
+  // Unique per start: wall clock in ns mixed with the process id.
+  instance_ = std::chrono::system_clock::now().time_since_epoch().count() ^ (static_cast<int64_t>(getpid()) << 40);
 }
 
 Node::~Node() {
@@ -76,6 +100,15 @@ void Node::subscribeRaw(const std::string& channel, std::function<void(const voi
 
 void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
   Node& node = *sub->node;
+  ++sub->arrived;
+  if (!node.options_.drop_received.empty()) {
+    auto drop = node.options_.drop_received.find(sub->channel);
+    if (drop != node.options_.drop_received.end() && drop->second.count(sub->arrived)) {
+      std::cerr << "[" << node.options_.name << "] test hook: message " << sub->arrived << " on " << sub->channel
+                << " dropped on arrival" << std::endl;
+      return;
+    }
+  }
   node.current_ = sub;
   const auto t0 = std::chrono::steady_clock::now();
   try {
@@ -140,6 +173,8 @@ void Node::publishProgress(bool finished) {
   p.node = options_.name;
   p.sequence = progress_sequence_++;
   p.finished = finished ? 1 : 0;
+  p.instance = instance_;
+  p.idle = !finished && receiveQueueEmpty() ? 1 : 0;
   for (const auto& s : subs_) {
     p.input_channel.push_back(s.channel);
     p.handled.push_back(s.handled);
@@ -151,6 +186,13 @@ void Node::publishProgress(bool finished) {
   }
   p.num_outputs = static_cast<int32_t>(p.output_channel.size());
   lcm_.publish(options_.progress_channel, &p);
+}
+
+bool Node::receiveQueueEmpty() {
+  const int fd = lcm_.getFileno();
+  if (fd < 0) return false;
+  pollfd pfd{fd, POLLIN, 0};
+  return ::poll(&pfd, 1, 0) == 0;
 }
 
 void Node::recordWork(const std::string& what, double seconds) { work_["work:" + what].add(seconds); }

@@ -36,6 +36,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
     c.readOptional("output_channel", n.output_channel);
     c.readOptional("save_channel", n.save_channel);
     c.readOptional("map_name", n.map_name);
+    c.readOptional("max_points_per_message", n.max_points_per_message);
     c.checkAllUsed();
   }
   auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
@@ -48,6 +49,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
   if (!(o.vignetting >= 0.0 && o.vignetting < 1.0)) fail("vignetting", "must be in [0, 1)");
   if (!(o.gain_min > 0.0 && o.gain_max > o.gain_min)) fail("gain_max", "need 0 < gain_min < gain_max");
   if (o.max_count < 1) fail("max_count", "must be >= 1");
+  if (n.max_points_per_message < 1) fail("max_points_per_message", "must be >= 1");
   if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");
   return n;
 }

@@ -20,6 +20,10 @@ struct ColourNodeOptions {
   std::string output_channel = "COLORED_CLOUD";
   std::string save_channel = "COLOUR_SAVE";  // any message here writes the map files now
   std::string map_name = "colour_map";       // files <output_dir>/<map_name>.ply / .pcd
+  // COLORED_CLOUD is split into messages of at most this many points (~15 bytes each): a loop
+  // correction that moves the whole map must not become one message of tens of MB, which a UDP
+  // bus loses (design.md, pitfalls).
+  int max_points_per_message = 65536;
 };
 
 ColourNodeOptions readColourOptions(const Config& section);

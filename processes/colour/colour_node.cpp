@@ -1,5 +1,6 @@
 #include "colour_node.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -91,27 +92,30 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
 
 void ColourNode::publishRecoloured(int64_t utime) {
   const std::vector<uint32_t> ids = pipeline_.takeRecoloured();
-  if (ids.empty()) return;
-  colored_cloud_t out;
-  out.utime = utime;
-  out.frame = "W";
-  out.num_points = static_cast<int32_t>(ids.size());
-  out.x.resize(ids.size());
-  out.y.resize(ids.size());
-  out.z.resize(ids.size());
-  out.r.resize(ids.size());
-  out.g.resize(ids.size());
-  out.b.resize(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) {
-    const MapPoint& p = pipeline_.map().point(ids[i]);
-    out.x[i] = p.position.x();
-    out.y[i] = p.position.y();
-    out.z[i] = p.position.z();
-    out.r[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[0], 0.0f, 255.0f)));
-    out.g[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[1], 0.0f, 255.0f)));
-    out.b[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[2], 0.0f, 255.0f)));
+  const size_t chunk = static_cast<size_t>(options_.max_points_per_message);
+  for (size_t begin = 0; begin < ids.size(); begin += chunk) {
+    const size_t n = std::min(chunk, ids.size() - begin);
+    colored_cloud_t out;
+    out.utime = utime;
+    out.frame = "W";
+    out.num_points = static_cast<int32_t>(n);
+    out.x.resize(n);
+    out.y.resize(n);
+    out.z.resize(n);
+    out.r.resize(n);
+    out.g.resize(n);
+    out.b.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const MapPoint& p = pipeline_.map().point(ids[begin + i]);
+      out.x[i] = p.position.x();
+      out.y[i] = p.position.y();
+      out.z[i] = p.position.z();
+      out.r[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[0], 0.0f, 255.0f)));
+      out.g[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[1], 0.0f, 255.0f)));
+      out.b[i] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[2], 0.0f, 255.0f)));
+    }
+    node_.publish(options_.output_channel, out);
   }
-  node_.publish(options_.output_channel, out);
 }
 
 std::string ColourNode::plyPath() const { return output_dir_ + "/" + options_.map_name + ".ply"; }

@@ -66,6 +66,10 @@ LogSummary summarizeLog(const std::string& path) {
     if (c.count == 1) c.digest = 14695981039346656037ULL;
     const auto* b = static_cast<const uint8_t*>(ev->data);
     for (int32_t i = 0; i < ev->datalen; ++i) c.digest = (c.digest ^ b[i]) * 1099511628211ULL;
+    if (const int64_t bad = countNonFinite(ev->data, ev->datalen); bad > 0) {
+      ++c.non_finite_messages;
+      c.non_finite_values += bad;
+    }
     if (s.events == 0 || ev->timestamp < s.first_utime) s.first_utime = ev->timestamp;
     if (s.events == 0 || ev->timestamp > s.last_utime) s.last_utime = ev->timestamp;
     ++s.events;
@@ -74,7 +78,7 @@ LogSummary summarizeLog(const std::string& path) {
   return s;
 }
 
-void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest) {
+void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest, bool with_non_finite) {
   os << "path:      " << s.path << "\n";
   os << "size:      " << humanBytes(static_cast<double>(s.file_bytes)) << "\n";
   os << std::fixed << std::setprecision(3);
@@ -91,12 +95,14 @@ void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest) {
   os << "\n" << std::left << std::setw(static_cast<int>(w) + 2) << "channel" << std::setw(static_cast<int>(tw) + 2)
      << "type" << std::right << std::setw(10) << "count" << std::setw(11) << "rate Hz" << std::setw(12) << "bytes";
   if (with_digest) os << "  digest";
+  if (with_non_finite) os << "  non-finite";
   os << "\n";
   for (const auto& [name, c] : s.channels) {
     os << std::left << std::setw(static_cast<int>(w) + 2) << name << std::setw(static_cast<int>(tw) + 2) << c.type
        << std::right << std::setw(10) << c.count << std::setw(11) << std::setprecision(2) << c.rateHz() << std::setw(12)
        << humanBytes(static_cast<double>(c.bytes));
     if (with_digest) os << "  " << std::hex << std::setw(16) << std::setfill('0') << c.digest << std::dec << std::setfill(' ');
+    if (with_non_finite) os << "  " << std::setw(10) << c.non_finite_messages;
     if (c.out_of_order) os << "  (" << c.out_of_order << " out of order)";
     os << "\n";
   }

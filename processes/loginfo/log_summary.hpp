@@ -16,6 +16,8 @@ struct ChannelSummary {
   int64_t last_utime = 0;
   int64_t out_of_order = 0;    // events stamped earlier than the previous one on this channel
   uint64_t digest = 0;         // FNV-1a over the payloads in log order (determinism checks)
+  int64_t non_finite_messages = 0;  // messages holding a NaN or an infinity (countNonFinite)
+  int64_t non_finite_values = 0;
   double rateHz() const;
 };
 
@@ -33,7 +35,8 @@ struct LogSummary {
 /// Reads the whole log; throws std::runtime_error if it cannot be opened.
 LogSummary summarizeLog(const std::string& path);
 
-/// `with_digest` adds a column with each channel's payload digest.
-void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest = false);
+/// `with_digest` adds a column with each channel's payload digest; `with_non_finite` one with the
+/// number of messages that hold a NaN or an infinity in a floating-point field.
+void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest = false, bool with_non_finite = false);
 
 }  // namespace livo

@@ -34,7 +34,12 @@ int main(int argc, char** argv) {
       .option("--seed", "N", "seed of the fault injector", "1")
       .option("--out", "LOG", "write the (faulted) stream to this log instead of publishing")
       .option("--progress-channel", "CH", "channel of the nodes' PROGRESS messages", "PROGRESS")
-      .option("--stall-timeout", "S", "lockstep: give up when no consumer progresses for S seconds", "30")
+      .option("--stall-timeout", "S",
+              "lockstep: give up when a consumer is behind on a channel and its count has not moved for S seconds", "30")
+      .option("--loss-grace", "S",
+              "lockstep: an idle consumer still lacking a message published S seconds ago lost it on the bus "
+              "(reported, then not waited for)", "3")
+      .flag("--respawn", "lockstep: consumers may exit and be restarted by a supervisor; not waited for while away")
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
       .flag("--quiet", "no progress output");
@@ -55,6 +60,8 @@ int main(int argc, char** argv) {
     o.progress_channel = cli.get("--progress-channel");
     o.stall_timeout_s = cli.getDouble("--stall-timeout");
     o.startup_timeout_s = cli.getDouble("--startup-timeout");
+    o.loss_grace_s = cli.getDouble("--loss-grace");
+    o.respawn = cli.has("--respawn");
     o.quiet = cli.has("--quiet");
     if (o.speed < 0) throw std::invalid_argument("--speed must be >= 0");
     if (!o.quiet)
@@ -66,7 +73,8 @@ int main(int argc, char** argv) {
     const livo::PlaybackResult r = livo::runPlayback(o, lcm.get());
     if (!o.quiet)
       std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
-                << " s" << std::endl;
+                << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())
+                << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string()) << std::endl;
     if (!r.error.empty()) {
       std::cerr << "livo-playback: " << r.error << std::endl;
       return 1;

@@ -78,12 +78,15 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
   if (options.lockstep && options.consumers.empty())
     throw std::invalid_argument("--lockstep needs the consumer node names (--consumers a,b,...)");
 
-  LockstepGate gate(options.consumers);
-  Clock::time_point last_progress = Clock::now();
+  LockstepGateOptions gate_options;
+  gate_options.loss_grace_s = options.loss_grace_s;
+  gate_options.tolerate_restarts = options.respawn;
+  LockstepGate gate(options.consumers, gate_options);
   struct ProgressContext {
     LockstepGate* gate;
-    Clock::time_point* last;
-  } ctx{&gate, &last_progress};
+    Clock::time_point start;
+  } ctx{&gate, wall_start};
+  auto now_s = [&] { return std::chrono::duration<double>(Clock::now() - wall_start).count(); };
   // Consumers are waited for at the start in any mode; lockstep also waits after every message.
   const bool watch_progress = !sink.toFile() && !options.consumers.empty();
   lcm::Subscription* sub = nullptr;
@@ -93,7 +96,7 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
         +[](const lcm::ReceiveBuffer* rbuf, const std::string&, ProgressContext* c) {
           progress_t p;
           if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size)) return;
-          if (c->gate->onProgress(p)) *c->last = Clock::now();
+          c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count());
         },
         &ctx);
   }
@@ -101,9 +104,17 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
     lcm::LCM* lcm;
     lcm::Subscription* sub;
     ~Unsubscribe() {
-        }
+      if (lcm && sub) lcm->unsubscribe(sub);
+    }
   } unsubscribe{lcm, sub};
+  auto tellEvents = [&] {
+    for (const std::string& e : gate.takeEvents())
+      if (!options.quiet) std::cerr << "[playback] lockstep: " << e << std::endl;
+    result.lost = gate.lostMessages();
+    result.restarts = gate.restarts();
+  };
   auto fail = [&](const std::string& why) {
+    tellEvents();
     result.error = why;
     result.wall_seconds = secondsSince(wall_start);
     return result;
@@ -133,20 +144,27 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
     sink.emit(e);
     ++result.published;
     if (!lockstep) return "";
-    gate.onPublished(e.channel);
-    last_progress = Clock::now();
-    while (!gate.idle()) {
+    gate.onPublished(e.channel, now_s());
+    while (!gate.idle() || gate.awaitingRestart(now_s())) {
       if (shutdownRequested()) return "interrupted";
+      gate.checkSilent(now_s());
+      tellEvents();
       const auto dead = gate.finished();
-      if (!dead.empty()) return "lockstep: consumer " + dead.front() + " exited; still waiting for: " + gate.pendingDescription();
-      if (secondsSince(last_progress) > options.stall_timeout_s) {
+      if (!options.respawn && !dead.empty())
+        return "lockstep: consumer " + dead.front() + " exited; still waiting for: " + gate.pendingDescription();
+      if (gate.stalledFor(now_s()) > options.stall_timeout_s) {
         std::ostringstream os;
-        os << "lockstep: no progress for " << options.stall_timeout_s << " s after message " << result.published << " ("
-           << e.channel << "); waiting for: " << gate.pendingDescription();
+        os << "lockstep: stalled: no progress for " << options.stall_timeout_s << " s on what is awaited after message "
+           << result.published << " (" << e.channel << " at " << std::fixed << std::setprecision(3)
+           << result.log_seconds << " s of log); waiting for: " << gate.pendingDescription();
         return os.str();
       }
-      if (lcm->handleTimeout(100) < 0) return "lockstep: LCM provider failed";
+      if (lcm->handleTimeout(100) < 0) {
+        if (shutdownRequested()) return "interrupted";
+        return "lockstep: LCM provider failed";
+      }
     }
+    tellEvents();
     return "";
   };
 
@@ -173,6 +191,12 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
       std::cerr << "[playback] faults on " << ch << ": dropped " << c.dropped << ", cut " << c.cut << ", duplicated "
                 << c.duplicated << ", delayed " << c.delayed << ", reordered " << c.reordered << ", corrupted "
                 << c.corrupted << ", NaN clouds " << c.nan_clouds << ", time-shifted " << c.time_shifted << std::endl;
+  }
+  tellEvents();
+  if (!options.quiet && result.lost > 0) {
+    std::cerr << "[playback] lockstep: " << result.lost << " messages lost on the bus:";
+    for (const auto& [where, n] : gate.lost()) std::cerr << " " << where << " " << n << ";";
+    std::cerr << " this run is not reproducible" << std::endl;
   }
   result.wall_seconds = secondsSince(wall_start);
   if (shutdownRequested()) result.error = "interrupted";

@@ -22,7 +22,12 @@ struct PlaybackOptions {
   bool lockstep = false;
   std::vector<std::string> consumers;   // nodes to wait for at the start (and, lockstep, always)
   std::string progress_channel = "PROGRESS";
-  double stall_timeout_s = 30.0;        // lockstep: no progress for this long = a stalled consumer
+  double stall_timeout_s = 30.0;        // lockstep: a consumer behind on a channel whose count has
+                                        // not moved for this long = a stall (heartbeats do not count)
+  double loss_grace_s = 3.0;            // lockstep: an idle consumer lacking a message published this
+                                        // long ago lost it on the bus (reported, then not waited for)
+  bool respawn = false;                 // lockstep: consumers may exit and be restarted (supervised
+                                        // runs); not waited for while away
   double startup_timeout_s = 30.0;      // lockstep: time for every consumer to report once
   std::vector<Fault> faults;
   uint64_t seed = 1;
@@ -35,6 +40,8 @@ struct PlaybackResult {
   double log_seconds = 0.0;
   double wall_seconds = 0.0;
   std::string error;                    // empty on success
+  int64_t lost = 0;                     // lockstep: messages consumers never received (bus losses)
+  int restarts = 0;                     // lockstep with respawn: consumers that came back
 };
 
 /// Runs the replay to the end (or until SIGINT/SIGTERM). `lcm` may be null when out_log is set.

@@ -67,7 +67,9 @@ int markdown(int argc, char** argv) {
       .option("--wall-seconds", "S", "wall time of the replay", "0")
       .option("--evaluation", "TITLE=FILE;...", "livo-evaluate JSON files with their titles")
       .option("--figure", "CAPTION=FILE;...", "figures (paths relative to DIR)")
-      .option("--warning", "TEXT;...", "warnings to list");
+      .option("--warning", "TEXT;...", "warnings to list")
+      .option("--injected", "TEXT;...", "faults injected by playback, one entry per channel")
+      .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   const std::string dir = cli.get("--dir");
   livo::ReportInputs in;
@@ -98,6 +100,11 @@ int markdown(int argc, char** argv) {
     in.figures.emplace_back(item.substr(0, eq), item.substr(eq + 1));
   }
   for (const auto& w : splitList(cli.get("--warning"), ';')) in.warnings.push_back(w);
+  for (const auto& f : splitList(cli.get("--injected"), ';')) in.injected_faults.push_back(f);
+  if (!cli.get("--restarts").empty()) {
+    in.supervised = true;
+    in.restarts = livo::readRestarts(cli.get("--restarts"));
+  }
   for (const auto& [node, p] : in.timing.items()) {
     for (const auto& [channel, c] : p["channels"].items()) {
       if (c.value("decode_failures", 0) > 0)

@@ -1,9 +1,11 @@
 #include "run_report.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <initializer_list>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 
 namespace livo {
 
@@ -50,6 +52,27 @@ double num(const nlohmann::json& j, std::initializer_list<const char*> path) {
   return node->is_number() ? node->get<double>() : std::nan("");
 }
 }  // namespace
+
+std::vector<ProcessRestart> readRestarts(const std::string& path) {
+  std::vector<ProcessRestart> out;
+  std::ifstream f(path);
+  if (!f) return out;
+  std::string line;
+  int number = 0;
+  while (std::getline(f, line)) {
+    ++number;
+    if (line.empty()) continue;
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, '\t')) fields.push_back(field);
+    if (fields.size() != 7)
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected 7 tab-separated fields, got " +
+                               std::to_string(fields.size()));
+    out.push_back({fields[0], fields[1], fields[2], fields[3], fields[4], fields[5], fields[6]});
+  }
+  return out;
+}
 
 std::string reportMarkdown(const ReportInputs& in) {
   std::ostringstream md;
@@ -104,6 +127,27 @@ std::string reportMarkdown(const ReportInputs& in) {
        << fixed(p.value("max_ms", 0.0), 2) << " | " << fixed(p.value("peak_rss_mb", 0.0), 1) << " |\n";
   }
   md << "\n";
+
+  if (!in.injected_faults.empty()) {
+    md << "## Injected faults\n\n";
+    md << "Faults injected by `livo-playback --faults` (seeded), per channel:\n\n";
+    for (const auto& f : in.injected_faults) md << "- " << f << "\n";
+    md << "\n";
+  }
+
+  if (in.supervised || !in.restarts.empty()) {
+    md << "## Restarts\n\n";
+    if (in.restarts.empty()) {
+      md << "None: no process exited during the run.\n\n";
+    } else {
+      md << "| process | ended at (wall s) | log s | how | restart | down s | lost |\n";
+      md << "| --- | --- | --- | --- | --- | --- | --- |\n";
+      for (const auto& r : in.restarts)
+        md << "| " << r.process << " | " << r.wall_s << " | " << (r.log_s.empty() ? "?" : r.log_s) << " | " << r.ended
+           << " | " << r.restart << " | " << r.down_s << " | " << r.lost << " |\n";
+      md << "\n";
+    }
+  }
 
   md << "## Warnings\n\n";
   if (in.warnings.empty()) md << "None.\n";

@@ -63,15 +63,17 @@ image_t makeImage(const CameraRig& rig, int64_t utime) {
 struct TestNode {
   SensorRig rig;
   colour::ColourNode node;
-  TestNode(lcm::LCM& lcm, const std::string& dir) : rig(withCamera()), node(lcm, quiet(), options(), rig, dir) {}
+  TestNode(lcm::LCM& lcm, const std::string& dir, int max_points_per_message = 65536)
+      : rig(withCamera()), node(lcm, quiet(), options(max_points_per_message), rig, dir) {}
   static SensorRig withCamera() {
     SensorRig r;
     r.camera = livo_test::testCamera(false);
     return r;
   }
-  static colour::ColourNodeOptions options() {
+  static colour::ColourNodeOptions options(int max_points_per_message) {
     colour::ColourNodeOptions o;
     o.core.max_time_difference = 0.1;
+    o.max_points_per_message = max_points_per_message;
     return o;
   }
   static NodeOptions quiet() {
@@ -222,6 +224,58 @@ TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
   int found = 0;
   for (int i = 0; i < moved.num_points; ++i) found += shifted.count(cell({moved.x[i], moved.y[i], moved.z[i]})) ? 1 : 0;
   EXPECT_EQ(found, moved.num_points);
+}
+
+// A correction that moves the whole map is published in messages of at most
+// max_points_per_message points, which together carry every moved point once.
+TEST(ColourNode, SplitsLargeUpdatesIntoBoundedMessages) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  constexpr int kMaxPoints = 300;
+  TestNode t(lcm, livo_test::tempPath("colour_chunks"), kMaxPoints);
+  std::vector<colored_cloud_t> received;
+  collect(lcm, &received);
+  keyframe_t kf{};
+  kf.utime = 1000000;
+  kf.orientation[0] = 1.0;
+  kf.cloud.frame = "I";
+  lcm.publish("KEYFRAME", &kf);
+  publishStillOdometry(lcm);
+  const image_t img = makeImage(*t.rig.camera, 1050000);
+  lcm.publish("CAMERA", &img);
+  for (int64_t utime : {1100000, 1200000}) {
+    const registered_scan_t scan = makeScan(utime);
+    lcm.publish("REGISTERED_SCAN", &scan);
+  }
+  drain(lcm);
+  const size_t coloured = t.node.pipeline().map().colouredCount();
+  ASSERT_GT(coloured, 3u * kMaxPoints);
+  for (const colored_cloud_t& m : received) EXPECT_LE(m.num_points, kMaxPoints);
+  received.clear();
+
+  loop_correction_t move{};
+  move.utime = 1300000;
+  move.correction_orientation[0] = 1.0;
+  move.num_keyframes = 1;
+  move.keyframe_id = {0};
+  move.position = {{0.5, 0.0, 0.0}};
+  move.orientation = {{1.0, 0.0, 0.0, 0.0}};
+  lcm.publish("LOOP_CORRECTION", &move);
+  drain(lcm);
+  const size_t moved = t.node.pipeline().map().colouredCount();  // a few merge into shared voxels
+  EXPECT_GT(moved, coloured / 2);
+  EXPECT_EQ(received.size(), (moved + kMaxPoints - 1) / kMaxPoints);
+  size_t total = 0;
+  std::set<std::array<float, 3>> distinct;
+  for (const colored_cloud_t& m : received) {
+    EXPECT_EQ(m.utime, 1300000);
+    EXPECT_LE(m.num_points, kMaxPoints);
+    EXPECT_GT(m.num_points, 0);
+    total += static_cast<size_t>(m.num_points);
+    for (int i = 0; i < m.num_points; ++i) distinct.insert({m.x[i], m.y[i], m.z[i]});
+  }
+  EXPECT_EQ(total, moved);
+  EXPECT_EQ(distinct.size(), total);
 }
 
 TEST(ColourNode, RefusesARigWithoutCamera) {

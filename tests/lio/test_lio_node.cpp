@@ -95,9 +95,9 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
   LioNodeOptions opts = readLioNodeOptions(Config::fromString(setup.config));
   LioNode node(lcm, opts, true);
   Outputs out;
-  Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true});
+  Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true, {}});
   // a stand-in VIO on the real PROGRESS channel, so lio sees its subscriptions
-  Node vio(lcm, NodeOptions{"fake_vio", "PROGRESS", "HEALTH_VIO", 0.0, true, true});
+  Node vio(lcm, NodeOptions{"fake_vio", "PROGRESS", "HEALTH_VIO", 0.0, true, true, {}});
   if (setup.attach) setup.attach(vio);
   observer.subscribeRaw("ODOMETRY", [&](const void* data, int size) {
     const auto* b = static_cast<const uint8_t*>(data);

@@ -3,15 +3,19 @@
 #include "lockstep_gate.hpp"
 
 using livo::LockstepGate;
+using livo::LockstepGateOptions;
 using livo::progress_t;
 
 namespace {
 progress_t progress(const std::string& node, int64_t seq, std::vector<std::pair<std::string, int64_t>> in,
-                    std::vector<std::pair<std::string, int64_t>> out, bool finished = false) {
+                    std::vector<std::pair<std::string, int64_t>> out, bool finished = false, bool idle = false,
+                    int64_t instance = 1) {
   progress_t p{};
   p.node = node;
   p.sequence = seq;
   p.finished = finished;
+  p.idle = idle;
+  p.instance = instance;
   for (auto& [c, n] : in) p.input_channel.push_back(c), p.handled.push_back(n);
   for (auto& [c, n] : out) p.output_channel.push_back(c), p.published.push_back(n);
   p.num_inputs = static_cast<int32_t>(p.input_channel.size());
@@ -61,4 +65,128 @@ TEST(LockstepGate, IgnoresStaleProgressAndReportsFinished) {
   // nodes outside the consumer list publish, but are not waited for
   g.onProgress(progress("logger", 0, {{"Y", 0}}, {{"X", 1}}));
   EXPECT_FALSE(g.idle());
+}
+
+// The hang of issue 16: colour published a COLORED_CLOUD the recorder never got, while HEALTH kept
+// flowing to the recorder. The stall is measured on the pair that is behind, not on any traffic.
+TEST(LockstepGate, HeartbeatsDoNotHideAStall) {
+  LockstepGate g({"colour", "record"});
+  g.onProgress(progress("colour", 0, {{"REGISTERED_SCAN", 0}}, {{"COLORED_CLOUD", 0}, {"HEALTH", 0}}), 0.0);
+  g.onProgress(progress("record", 0, {{"COLORED_CLOUD", 0}, {"HEALTH", 0}}, {}), 0.0);
+  g.onPublished("REGISTERED_SCAN", 1.0);
+  g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 1}}, {{"COLORED_CLOUD", 1}, {"HEALTH", 0}}), 1.1);
+  EXPECT_EQ(g.pendingDescription(), "record: COLORED_CLOUD 0/1");
+  for (int k = 1; k <= 100; ++k) {  // a HEALTH a second from colour, each taken by the recorder
+    const double t = 1.1 + k;
+    g.onProgress(progress("colour", 1 + k, {{"REGISTERED_SCAN", 1}}, {{"COLORED_CLOUD", 1}, {"HEALTH", k}}), t);
+    g.onProgress(progress("record", k, {{"COLORED_CLOUD", 0}, {"HEALTH", k}}, {}), t + 0.01);
+  }
+  EXPECT_FALSE(g.idle());
+  EXPECT_NEAR(g.stalledFor(101.2), 100.1, 1e-9);  // since colour reported the cloud
+  EXPECT_EQ(g.pendingDescription(), "record: COLORED_CLOUD 0/1");
+  // a consumer that moves on the awaited channel resets its timer
+  g.onProgress(progress("record", 101, {{"COLORED_CLOUD", 1}, {"HEALTH", 100}}, {}), 102.0);
+  EXPECT_TRUE(g.idle());
+  EXPECT_EQ(g.stalledFor(500.0), 0.0);
+}
+
+// An idle consumer (nothing in its receive queue) still lacking a message published more than the
+// grace period ago never got it: counted as lost, reported once, and no longer waited for.
+TEST(LockstepGate, AnIdleConsumerLackingAnOldMessageLostIt) {
+  LockstepGateOptions o;
+  o.loss_grace_s = 3.0;
+  LockstepGate g({"lio", "record"}, o);
+  g.onProgress(progress("lio", 0, {{"LIDAR", 0}}, {{"ODOMETRY", 0}}), 0.0);
+  g.onProgress(progress("record", 0, {{"ODOMETRY", 0}}, {}), 0.0);
+  g.onPublished("LIDAR", 10.0);
+  g.onProgress(progress("lio", 1, {{"LIDAR", 1}}, {{"ODOMETRY", 2}}), 10.5);
+  // busy (not idle) long after: not a loss, it may be working through its queue
+  g.onProgress(progress("record", 1, {{"ODOMETRY", 1}}, {}, false, false), 20.0);
+  EXPECT_EQ(g.lostMessages(), 0);
+  // idle, but the message is younger than the grace period: not yet
+  g.onProgress(progress("record", 2, {{"ODOMETRY", 1}}, {}, false, true), 12.0);
+  EXPECT_EQ(g.lostMessages(), 0);
+  EXPECT_FALSE(g.idle());
+  // idle past the grace period: lost
+  g.onProgress(progress("record", 3, {{"ODOMETRY", 1}}, {}, false, true), 13.6);
+  EXPECT_EQ(g.lostMessages(), 1);
+  EXPECT_EQ(g.lost().at("record: ODOMETRY"), 1);
+  EXPECT_TRUE(g.idle());
+  const auto events = g.takeEvents();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_NE(events[0].find("record never received 1 ODOMETRY message"), std::string::npos) << events[0];
+  // the next message is waited for as usual, and a later idle report does not count the loss again
+  g.onPublished("LIDAR", 20.0);
+  g.onProgress(progress("lio", 2, {{"LIDAR", 2}}, {{"ODOMETRY", 3}}), 20.1);
+  EXPECT_FALSE(g.idle());
+  g.onProgress(progress("record", 4, {{"ODOMETRY", 2}}, {}, false, true), 30.0);
+  EXPECT_TRUE(g.idle());
+  EXPECT_EQ(g.lostMessages(), 1);
+  EXPECT_TRUE(g.takeEvents().empty());
+}
+
+// Supervised runs: a consumer that exits is not waited for; when a new instance reports, what was
+// published while it was away is lost to it and it is waited for again from there.
+TEST(LockstepGate, ToleratesRestartsWhenAsked) {
+  LockstepGateOptions o;
+  o.tolerate_restarts = true;
+  o.silent_after_s = 5.0;
+  LockstepGate g({"lio", "vio"}, o);
+  g.onProgress(progress("lio", 0, {{"IMU", 0}}, {{"STATE_PRIOR", 0}}, false, false, 7), 0.0);
+  g.onProgress(progress("vio", 0, {{"STATE_PRIOR", 0}}, {}, false, false, 8), 0.0);
+  g.onPublished("IMU", 1.0);
+  g.onProgress(progress("lio", 1, {{"IMU", 1}}, {{"STATE_PRIOR", 1}}, false, false, 7), 1.1);
+  g.onProgress(progress("vio", 1, {{"STATE_PRIOR", 0}}, {}, true, false, 8), 1.2);  // SIGTERM: final PROGRESS
+  EXPECT_TRUE(g.idle());  // vio is away
+  g.onPublished("IMU", 2.0);
+  g.onProgress(progress("lio", 2, {{"IMU", 2}}, {{"STATE_PRIOR", 2}}, false, false, 7), 2.1);
+  EXPECT_TRUE(g.idle());
+  // a new vio: counts from zero; the two priors published before it came are not its due
+  g.onProgress(progress("vio", 0, {{"STATE_PRIOR", 0}}, {}, false, false, 9), 3.0);
+  EXPECT_EQ(g.restarts(), 1);
+  EXPECT_TRUE(g.idle());
+  EXPECT_TRUE(g.finished().empty());
+  g.onPublished("IMU", 4.0);
+  g.onProgress(progress("lio", 3, {{"IMU", 3}}, {{"STATE_PRIOR", 3}}, false, false, 7), 4.1);
+  EXPECT_FALSE(g.idle());
+  EXPECT_EQ(g.pendingDescription(), "vio: STATE_PRIOR 2/3");
+  g.onProgress(progress("vio", 1, {{"STATE_PRIOR", 1}}, {}, false, false, 9), 4.2);
+  EXPECT_TRUE(g.idle());
+  // killed (no final PROGRESS): away once silent for silent_after_s
+  g.onPublished("IMU", 5.0);
+  g.onProgress(progress("lio", 4, {{"IMU", 4}}, {{"STATE_PRIOR", 4}}, false, false, 7), 5.1);
+  g.checkSilent(8.0);
+  EXPECT_FALSE(g.idle());
+  g.checkSilent(9.3);
+  EXPECT_TRUE(g.idle());
+  const auto events = g.takeEvents();
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_NE(events[0].find("vio exited"), std::string::npos);
+  EXPECT_NE(events[1].find("vio restarted; missed while it was away: 2 STATE_PRIOR"), std::string::npos) << events[1];
+  EXPECT_NE(events[2].find("vio silent"), std::string::npos);
+}
+
+// Without tolerance a restart still rebases the counts (no wait for messages it cannot have).
+TEST(LockstepGate, WithoutToleranceAnExitIsReported) {
+  LockstepGate g({"a"});
+  g.onProgress(progress("a", 0, {{"X", 0}}, {}), 0.0);
+  g.onProgress(progress("a", 1, {{"X", 0}}, {}, true), 1.0);
+  EXPECT_EQ(g.finished(), std::vector<std::string>{"a"});
+  g.checkSilent(100.0);  // no effect without tolerate_restarts
+  EXPECT_TRUE(g.takeEvents().empty());
+}
+
+TEST(LockstepGate, HoldsTheReplayWhileAConsumerRestarts) {
+  LockstepGateOptions o;
+  o.tolerate_restarts = true;
+  o.restart_wait_s = 10.0;
+  LockstepGate g({"vio"}, o);
+  g.onProgress(progress("vio", 0, {{"CAMERA", 0}}, {}, false, false, 1), 0.0);
+  EXPECT_FALSE(g.awaitingRestart(1.0));
+  g.onProgress(progress("vio", 1, {{"CAMERA", 0}}, {}, true, false, 1), 2.0);
+  EXPECT_TRUE(g.idle());
+  EXPECT_TRUE(g.awaitingRestart(11.9));  // away since 2.0
+  EXPECT_FALSE(g.awaitingRestart(12.1));  // given up waiting: the replay goes on without it
+  g.onProgress(progress("vio", 0, {{"CAMERA", 0}}, {}, false, false, 2), 5.0);
+  EXPECT_FALSE(g.awaitingRestart(5.0));
 }

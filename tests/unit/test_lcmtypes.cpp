@@ -276,3 +276,47 @@ TEST(LcmTypes, LeadingUtimeReadAndWrittenInPlace) {
   for (const auto& type : messageTypes()) with_utime += type.leading_utime;
   EXPECT_EQ(with_utime, 13);  // all but keyframe_t and channel_stats_t
 }
+
+// countNonFinite sees a NaN or an infinity in any floating-point field, nested ones included.
+TEST(LcmTypes, CountNonFiniteFindsEveryBadValue) {
+  auto count = [](const auto& m) {
+    const auto b = encode(m);
+    return countNonFinite(b.data(), static_cast<int>(b.size()));
+  };
+  odometry_t odo{};
+  odo.orientation[0] = 1.0;
+  EXPECT_EQ(count(odo), 0);
+  odo.position[1] = NAN;
+  odo.pose_covariance[35] = INFINITY;
+  EXPECT_EQ(count(odo), 2);
+
+  registered_scan_t scan{};
+  scan.orientation[0] = 1.0;
+  scan.cloud.num_points = 3;
+  scan.cloud.x = {0.f, 1.f, NAN};
+  scan.cloud.y = {0.f, 1.f, 2.f};
+  scan.cloud.z = {0.f, -INFINITY, 2.f};
+  scan.cloud.intensity.assign(3, 0.f);
+  scan.cloud.time_offset.assign(3, 0.f);
+  scan.cloud.ring.assign(3, 0);
+  EXPECT_EQ(count(scan), 2);
+
+  loop_correction_t c{};
+  c.correction_orientation[0] = 1.0;
+  c.num_keyframes = 2;
+  c.keyframe_id = {0, 1};
+  c.position = {{0.0, 0.0, 0.0}, {0.0, NAN, 0.0}};
+  c.orientation = {{1.0, 0.0, 0.0, 0.0}, {1.0, 0.0, 0.0, 0.0}};
+  EXPECT_EQ(count(c), 1);
+
+  health_t h{};
+  h.num_channels = 1;
+  h.channels.resize(1);
+  h.channels[0].median_ms = NAN;
+  EXPECT_EQ(count(h), 1);
+
+  const uint8_t junk[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  EXPECT_EQ(countNonFinite(junk, 12), -1);  // not a project message
+  const auto truncated = encode(odo);
+  EXPECT_EQ(countNonFinite(truncated.data(), static_cast<int>(truncated.size()) - 4), -1);
+}

@@ -34,7 +34,7 @@ TEST(Node, DecodesCountsFailuresAndReportsProgress) {
 
   std::vector<progress_t> progress;
   std::vector<health_t> health;
-  Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true});
+  Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true, {}});
   observer.subscribe<progress_t>("PROGRESS", [&](const progress_t& p) { progress.push_back(p); });
   observer.subscribe<health_t>("HEALTH", [&](const health_t& h) { health.push_back(h); });
 
@@ -112,7 +112,7 @@ TEST(Node, RejectsEmptyName) {
 TEST(Node, WatchesConsumersOfAChannel) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  Node producer(lcm, NodeOptions{"producer", "PROGRESS", "HEALTH", 0.0, true, true});
+  Node producer(lcm, NodeOptions{"producer", "PROGRESS", "HEALTH", 0.0, true, true, {}});
   producer.subscribe<imu_t>("STATE_PRIOR", [](const imu_t&) {});  // its own subscription
   producer.watchConsumers("STATE_PRIOR");
   producer.watchConsumers("OTHER");
@@ -121,7 +121,7 @@ TEST(Node, WatchesConsumersOfAChannel) {
   EXPECT_FALSE(producer.hasConsumers("STATE_PRIOR"));
   EXPECT_FALSE(producer.hasConsumers("UNWATCHED"));
   {
-    Node consumer(lcm, NodeOptions{"consumer", "PROGRESS", "HEALTH", 0.0, true, true});
+    Node consumer(lcm, NodeOptions{"consumer", "PROGRESS", "HEALTH", 0.0, true, true, {}});
     consumer.subscribe<imu_t>("STATE_PRIOR", [](const imu_t&) {});
     consumer.announce();
     drain(lcm);
@@ -133,7 +133,7 @@ TEST(Node, WatchesConsumersOfAChannel) {
   }
   // watching is not an input: the producer's PROGRESS lists only its own subscription
   std::vector<std::string> inputs;
-  Node listener(lcm, NodeOptions{"listener", "PROGRESS_L", "HEALTH_L", 0.0, false, true});
+  Node listener(lcm, NodeOptions{"listener", "PROGRESS_L", "HEALTH_L", 0.0, false, true, {}});
   listener.subscribe<progress_t>("PROGRESS", [&](const progress_t& p) {
     if (p.node == "producer") inputs = p.input_channel;
   });

@@ -107,7 +107,7 @@ std::vector<uint8_t> encode(const M& m) {
 struct Harness {
   lcm::LCM lcm{"memq://"};
   std::unique_ptr<VioNode> vio;
-  Node observer{lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true}};
+  Node observer{lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true, {}}};
   std::vector<filter_state_t> posteriors;
   std::vector<std::vector<uint8_t>> posterior_bytes;
 

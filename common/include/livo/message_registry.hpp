@@ -19,6 +19,11 @@ const std::vector<MessageType>& messageTypes();
 /// The type whose fingerprint starts `data`, or nullptr.
 const MessageType* identifyMessage(const void* data, int size);
 
+/// How many floating-point values of an encoded project message are not finite (NaN, inf), or -1
+/// if it is not a project message or does not decode. Covers every float/double field of every
+/// project type (a health check of recorded outputs: `livo-loginfo --nonfinite`).
+int64_t countNonFinite(const void* data, int size);
+
 /// The utime of an encoded project message whose first field is utime; false for other types.
 bool messageUtime(const void* data, int size, int64_t* utime);
 /// Rewrites that utime in place; false (and nothing changed) for other types.

@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -32,7 +33,14 @@ struct NodeOptions {
   double health_period_s = 1.0;          // wall-clock period of HEALTH messages; 0 disables
   bool publish_progress = true;          // a PROGRESS message after every handled input
   bool quiet = false;                    // no summary on stderr at shutdown
+  // Test hook for loss detection: messages on these channels with these 1-based indices are
+  // dropped on arrival as if the bus had lost them (never handled, never counted). Filled from
+  // LIVO_TEST_DROP_RECEIVED="CHANNEL:N[,CHANNEL:N...]" when the node is made; empty otherwise.
+  std::map<std::string, std::set<int64_t>> drop_received;
 };
+
+/// Parses "CHANNEL:N[,CHANNEL:N...]" (LIVO_TEST_DROP_RECEIVED); throws std::invalid_argument.
+std::map<std::string, std::set<int64_t>> parseDropReceived(const std::string& spec);
 
 class Node {
  public:
@@ -115,6 +123,7 @@ class Node {
     std::function<void(const void*, int)> handler;
     LatencyStats latency;
     int64_t handled = 0;
+    int64_t arrived = 0;  // including messages dropped by the drop_received test hook
     int64_t decode_failures = 0;
     int64_t rejected = 0;
   };
@@ -138,7 +147,11 @@ class Node {
   std::vector<lcm::Subscription*> lcm_subs_;
   std::map<std::string, int64_t> published_;
   std::map<std::string, LatencyStats> work_;
+  /// Nothing is waiting in the LCM receive queue (the provider's descriptor is not readable).
+  bool receiveQueueEmpty();
+
   int64_t progress_sequence_ = 0;
+  int64_t instance_ = 0;  // this start of the node (progress_t.instance)
   int64_t last_utime_ = 0;
   int8_t level_ = 0;
   std::string last_event_;
