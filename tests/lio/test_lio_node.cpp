@@ -89,6 +89,8 @@ struct RunSetup {
   int64_t* rejected_posteriors = nullptr;     // filled after the run
 };
 
+constexpr int64_t kBaseTime = 1'000'000'000;  // the synthetic sequence's first stamp
+
 Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullptr, const RunSetup& setup = {}) {
   lcm::LCM lcm("memq://");
   EXPECT_TRUE(lcm.good());
@@ -269,6 +271,40 @@ TEST(LioNode, RefusesBadInputAndKeepsGoing) {
   EXPECT_EQ(rejected, 3);
   EXPECT_GE(out.odometry.size(), 24u);
   for (const auto& o : out.odometry) EXPECT_TRUE(allFinite(o.position, 3));
+}
+
+// Corrupted IMU messages that still decode: a stamp 1000 s ahead, one 5 s back (each would have
+// bridged or reset the filter), and an acceleration no IMU measures. Each is refused, and the
+// odometry is byte for byte that of the clean run.
+TEST(LioNode, CorruptedImuSamplesChangeNothing) {
+  const std::vector<Message> clean = syntheticRun();
+  std::vector<Message> msgs = clean;
+  auto sampleNear = [&](int64_t utime) {
+    imu_t m;
+    for (const auto& c : clean)
+      if (c.channel == "IMU" && c.order_key >= utime) {
+        m.decode(c.bytes.data(), 0, static_cast<int>(c.bytes.size()));
+        break;
+      }
+    return m;
+  };
+  imu_t ahead = sampleNear(kBaseTime + 1'200'000);
+  ahead.utime += 1'000'000'000;
+  imu_t behind = sampleNear(kBaseTime + 1'700'000);
+  behind.utime -= 5'000'000;
+  imu_t wild = sampleNear(kBaseTime + 2'100'000);
+  wild.utime += 1'000;  // between two samples
+  wild.linear_acceleration[2] = 3.0e5;
+  msgs.push_back(encode(kBaseTime + 1'200'001, "IMU", ahead));
+  msgs.push_back(encode(kBaseTime + 1'700'001, "IMU", behind));
+  msgs.push_back(encode(kBaseTime + 2'100'001, "IMU", wild));
+  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  int64_t rejected = 0;
+  const Outputs out = runNode(msgs, &rejected);
+  const Outputs ref = runNode(clean);
+  EXPECT_EQ(rejected, 5);  // two jumps held then found unconfirmed, one out of range
+  ASSERT_GE(ref.odometry_bytes.size(), 24u);
+  EXPECT_EQ(out.odometry_bytes, ref.odometry_bytes);
 }
 
 namespace {

@@ -56,6 +56,9 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("imu_reorder_window_s", o->imu_reorder_window_s);
   c.readOptional("wheel_max_wait_s", o->wheel_max_wait_s);
   c.readOptional("clock_reset_s", o->clock_reset_s);
+  c.readOptional("clock_jump_s", o->clock_jump_s);
+  c.readOptional("imu_max_angular_velocity", o->imu_max_angular_velocity);
+  c.readOptional("imu_max_acceleration", o->imu_max_acceleration);
   c.readOptional("max_pending_scans", o->max_pending_scans);
   c.readOptional("camera_handoff", o->camera_handoff);
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);

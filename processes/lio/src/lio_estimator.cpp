@@ -282,10 +282,12 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   valid.reserve(scan.points.size());
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
   const double min_r2 = opts_.min_range * opts_.min_range, max_r2 = opts_.max_range * opts_.max_range;
+  const bool has_intensity = scan.intensity.size() == scan.points.size();
   for (size_t j = 0; j < n; ++j) {
     const Vec3& p = scan.points[j];
     const float t = scan.time_offset[j];
     if (!p.allFinite() || !std::isfinite(t) || t < 0.0f || t > end_offset) continue;
+    if (has_intensity && !std::isfinite(scan.intensity[j])) continue;  // a corrupted point
     const double r2 = p.squaredNorm();
     if (r2 < min_r2 || r2 > max_r2) continue;
     valid.push_back(j);

@@ -5,6 +5,7 @@
 
 #include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
+#include "livo/time.hpp"
 
 namespace livo::lio {
 
@@ -65,7 +66,10 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in)
   c.frame = "W";
   c.pattern = in.pattern;
   c.num_rings = in.num_rings;
-  c.sweep_duration = in.sweep_duration;
+  // the input's own value unless it is unusable (a corrupted message): then the span lio used
+  c.sweep_duration = std::isfinite(in.sweep_duration) && in.sweep_duration >= 0.0f
+                         ? in.sweep_duration
+                         : static_cast<float>(toSeconds(r.utime - r.sweep_start_utime));
   const size_t n = r.world_points.size();
   c.num_points = static_cast<int32_t>(n);
   c.x.resize(n);

@@ -51,6 +51,7 @@ void LioNode::resetAll(const std::string& why) {
   scans_.clear();
   images_.clear();
   pending_.reset();
+  held_jump_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
 }
 
@@ -60,6 +61,39 @@ void LioNode::onImu(const imu_t& m) {
     node_.reject(opts_.imu_channel, "non-finite IMU sample");
     return;
   }
+  if (s.gyro.norm() > opts_.imu_max_angular_velocity || s.accel.norm() > opts_.imu_max_acceleration) {
+    node_.reject(opts_.imu_channel, "IMU sample beyond the sensor's range (imu_max_angular_velocity, "
+                                    "imu_max_acceleration): corrupted");
+    return;
+  }
+  // A stamp that jumps (ahead by clock_jump_s or back by clock_reset_s) is held until the next
+  // sample confirms the new clock by following it closely; otherwise it was one corrupted stamp.
+  if (has_imu_) {
+    const bool jumps = s.utime > newest_imu_ + toUtime(opts_.clock_jump_s) ||
+                       s.utime < newest_imu_ - toUtime(opts_.clock_reset_s);
+    const bool confirms = held_jump_ && s.utime > held_jump_->utime &&
+                          s.utime - held_jump_->utime <= toUtime(opts_.clock_jump_s);
+    if (jumps && !confirms) {
+      if (held_jump_) node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
+      held_jump_ = s;
+      node_.reject(opts_.imu_channel, "IMU stamp jumps by " + std::to_string(toSeconds(s.utime - newest_imu_)) +
+                                          " s: held until the next sample confirms the new clock");
+      return;
+    }
+    if (held_jump_) {
+      const ImuSample first = *held_jump_;
+      held_jump_.reset();
+      if (jumps) {
+        acceptImu(first);
+      } else {
+        node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
+      }
+    }
+  }
+  acceptImu(s);
+}
+
+void LioNode::acceptImu(const ImuSample& s) {
   if (fed_any_imu_ && s.utime < fed_imu_ - toUtime(opts_.clock_reset_s)) {
     resetAll("IMU time jumped back by " + std::to_string(toSeconds(fed_imu_ - s.utime)) + " s");
   }

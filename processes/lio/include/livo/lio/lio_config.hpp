@@ -30,6 +30,13 @@ struct LioNodeOptions {
   double imu_reorder_window_s = 0.02;  // IMU is handed to the filter this far behind the newest
   double wheel_max_wait_s = 0.2;       // a sweep waits for wheel data past its end at most this long
   double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
+  double clock_jump_s = 1.0;           // an IMU stamp this far after the newest is a clock jump
+  // (either way a jumping stamp is used only once the next sample confirms the new clock: a
+  // single corrupted stamp is dropped instead of resetting or stalling the filter)
+  // IMU samples beyond a MEMS IMU's range are corrupted, not motion (finite garbage would otherwise
+  // be integrated): refused. Defaults: 2000 deg/s and 16 g, the widest common full-scale settings.
+  double imu_max_angular_velocity = 35.0;  // rad/s
+  double imu_max_acceleration = 160.0;     // m/s^2
   int max_pending_scans = 50;          // sweeps waiting for IMU; older ones are dropped beyond this
 
   // Camera hand-off (design.md): at each image time publish STATE_PRIOR and adopt the

@@ -54,6 +54,8 @@ class LioNode {
     LidarScan scan;
   };
   void onImu(const imu_t& m);
+  /// A plausible sample on a confirmed clock: into the buffer (or a reset on a clock step back).
+  void acceptImu(const ImuSample& s);
   void onLidar(const point_cloud_t& m);
   void onWheel(const wheel_odometry_t& m);
   void onCamera(const void* data, int size);
@@ -74,6 +76,7 @@ class LioNode {
   TimeBuffer<std::shared_ptr<PendingScan>> scans_;  // keyed by the sweep end (IMU clock)
   int64_t newest_imu_ = 0;
   bool has_imu_ = false;
+  std::optional<ImuSample> held_jump_;  // first sample after a clock jump, until the next confirms it
   int64_t fed_imu_ = 0;       // newest IMU stamp handed to the filter
   bool fed_any_imu_ = false;
   int64_t fed_wheel_ = 0;
