@@ -104,8 +104,12 @@ if [ "$inside" = 0 ]; then
   evaluations="" figures=""
   if [ -x "$bin/livo-evaluate" ] && [ -s "$out/odometry.tum" ] && \
      "$bin/livo-loginfo" "$log" | grep -q '^GROUND_TRUTH '; then
+    # the ground truth as replayed (recorded beside the outputs) when there is one: with --faults
+    # that shift time (jump) it carries the same stamps the estimators saw
+    gt="$log:GROUND_TRUTH"
+    "$bin/livo-loginfo" "$out/outputs.lcmlog" 2>/dev/null | grep -q '^GROUND_TRUTH ' && gt="$out/outputs.lcmlog:GROUND_TRUTH"
     for kind in odometry trajectory; do
-      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$log:GROUND_TRUTH" --align se3 \
+      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$gt" --align se3 \
           --json "$out/evaluation_$kind.json" --plot "$out/$kind.svg" >"$out/logs/evaluate_$kind.txt" 2>&1; then
         evaluations+="${evaluations:+;}$kind=$out/evaluation_$kind.json"
         figures+="${figures:+;}$kind against ground truth=$kind.svg"

@@ -265,6 +265,66 @@ TEST(LioEstimator, LidarOutageKeepsBuffersBoundedAndReseedsTheMap) {
   EXPECT_LT(synth::alignedRmse(after.est, after.gt), 0.03);
 }
 
+// An IMU gap is either an outage (time passed, the body moved: predict across it) or a clock step
+// (every stamp jumped ahead, nothing happened meanwhile). The sweep after the gap is registered
+// under both hypotheses and the one that fits the map wins: both cases stay on the truth.
+TEST(LioEstimator, ImuGapAsOutageOrClockStep) {
+  synth::SequenceSpec spec;
+  spec.duration = 10.0;
+  spec.imu_error = synth::realisticImu();
+  spec.lidar.range_noise_std = 0.01;
+  const SyntheticSequence seq(spec);
+  const int64_t t_gap = seq.scanEndUtime(50) + 2'000;  // just after a sweep end
+  constexpr int64_t kGap = 500'000;
+  for (const bool clock_step : {false, true}) {
+    SCOPED_TRACE(clock_step ? "clock step" : "IMU outage");
+    LioEstimator lio(optionsFor(spec));
+    std::vector<Vec3> est, gt;
+    std::vector<Pose3> est_pose, gt_pose;
+    int tracked_after = 0, sweeps_after = 0;
+    bool chose_still = false;
+    const auto& imu = seq.imu();
+    size_t i = 0;
+    for (int k = 0; k < seq.numScans(); ++k) {
+      LidarScan scan = seq.scan(k);
+      const int64_t shift = clock_step && scan.utime >= t_gap ? kGap : 0;
+      if (!clock_step && seq.scanEndUtime(k) > t_gap && seq.scanEndUtime(k) <= t_gap + kGap) {
+        continue;  // an outage of the whole rig's data, not only the IMU: no sweep either
+      }
+      scan.utime += shift;
+      const int64_t t_end = seq.scanEndUtime(k) + shift;
+      bool past_end = false;
+      while (i < imu.size() && !past_end) {
+        ImuSample s = imu[i++];
+        if (clock_step && s.utime >= t_gap) s.utime += kGap;
+        if (!clock_step && s.utime >= t_gap && s.utime < t_gap + kGap) continue;
+        lio.addImu(s);
+        past_end = s.utime > t_end;
+      }
+      const ScanResult r = lio.addScan(scan);
+      ASSERT_TRUE(finiteResult(r));
+      if (!r.hasOutput()) continue;
+      chose_still = chose_still || r.message.find("as if no time had passed") != std::string::npos;
+      const Pose3 truth = seq.truth(r.utime - shift);
+      est.push_back(r.state.pos);
+      gt.push_back(truth.translation());
+      est_pose.push_back(r.state.pose());
+      gt_pose.push_back(truth);
+      if (scan.utime >= t_gap) {
+        ++sweeps_after;
+        tracked_after += r.status == ScanResult::Status::kTracked;
+      }
+    }
+    EXPECT_EQ(chose_still, clock_step);
+    EXPECT_GE(sweeps_after, 40);
+    EXPECT_EQ(tracked_after, sweeps_after);
+    // one frame for the whole run: the gap left no jump in the trajectory
+    const double ate = synth::alignedRmse(est, gt);
+    std::printf("%s: ATE %.4f m over %zu sweeps\n", clock_step ? "clock step" : "IMU outage", ate, est.size());
+    EXPECT_LT(ate, 0.03);
+  }
+}
+
 TEST(LioEstimator, CameraHandOffApi) {
   synth::SequenceSpec spec;
   spec.duration = 3.0;

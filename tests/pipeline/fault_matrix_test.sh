@@ -21,9 +21,11 @@ matrix=(
   "corrupt|--faults corrupt:LIDAR:0.05,corrupt:IMU:0.02,corrupt:CAMERA:0.1|0.01|LIDAR: .*corrupted [1-9]"
   "nan|--faults nan:LIDAR:0.3|0.01|LIDAR: .*NaN clouds [1-9]"
   "cut|--faults cut:LIDAR:5:6|0.02|LIDAR: dropped 0, cut [1-9]"
-  # The clock of every sensor steps 0.5 s ahead at 6 s (a host clock step): half a second looks
-  # unobserved, the LIO predicts across it and the next sweeps register it back onto the map.
-  "jump|--faults jump:IMU:6:0.5,jump:LIDAR:6:0.5,jump:CAMERA:6:0.5|0.05|IMU: .*time-shifted [1-9]"
+  # The host clock steps 0.5 s ahead at 6 s, for every sensor and the ground truth: the LIO sees
+  # an IMU gap, and the sweep after it fits the map as if no time had passed (a clock step, not
+  # an outage). Measured: 11 cm off for half a second, then within 1 cm of the clean run; ATE
+  # 0.021 m against 0.004 m clean.
+  "jump|--faults jump:IMU:6:0.5,jump:LIDAR:6:0.5,jump:CAMERA:6:0.5,jump:GROUND_TRUTH:6:0.5|0.03|IMU: .*time-shifted [1-9]"
   "kill-vio|--respawn --kill vio:KILL:3|0.01|RESTART vio"
 )
 
@@ -33,11 +35,12 @@ matrix=(
 clean_ate=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['ate']['rmse'])" "$dir/clean/evaluation_odometry.json")
 echo "clean: ATE $clean_ate m"
 
-failures=0
+failures=0 ran=0
 for row in "${matrix[@]}"; do
   IFS='|' read -r name args bound counted <<<"$row"
   [ -z "${FAULT_ROWS:-}" ] || [[ ",$FAULT_ROWS," == *",$name,"* ]] || continue  # FAULT_ROWS=a,b: only those
   out="$dir/$name"
+  ran=$((ran + 1))
   read -ra extra <<<"$args"
   if ! "$root/scripts/run_pipeline.sh" --log "$dir/room.lcmlog" --config "$config" --out "$out" --seed 5 "${extra[@]}" \
       >/dev/null 2>"$out.err"; then
@@ -68,4 +71,4 @@ print(f'{name}: ATE {ate:.4f} m (clean {clean:.4f} m, bound +{bound} m), {len(ro
 PY
 done
 [ "$failures" = 0 ] || fail "$failures rows of the fault matrix failed"
-echo "fault matrix: ${#matrix[@]} rows passed"
+echo "fault matrix: $ran rows passed"

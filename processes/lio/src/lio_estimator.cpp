@@ -1,5 +1,7 @@
 #include "livo/lio/lio_estimator.hpp"
 
+#include <optional>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -171,6 +173,14 @@ void LioEstimator::widenForGap(double gap_s) {
   prop_.setState(prop_.state(), P);
 }
 
+void LioEstimator::noteBridgedGap(const FilterState& before) {
+  const FilterState& after = prop_.state();
+  gap_undo_rot_ = gap_undo_rot_ * (before.rot * after.rot.transpose());
+  gap_undo_pos_ += before.pos - after.pos;
+  gap_undo_vel_ += before.vel - after.vel;
+  gap_bridged_ = true;
+}
+
 void LioEstimator::stepTo(const ImuSample& s, double* worst_gap, std::string* note) {
   if (s.utime <= prop_.utime()) return;
   const double gap = static_cast<double>(s.utime - prop_.utime()) * 1e-6;
@@ -178,8 +188,12 @@ void LioEstimator::stepTo(const ImuSample& s, double* worst_gap, std::string* no
     softReset(s, gap, note);
     return;
   }
+  const FilterState before = prop_.state();
   prop_.addSample(s);
-  if (gap > opts_.max_imu_gap_s) widenForGap(gap);
+  if (gap > opts_.max_imu_gap_s) {
+    noteBridgedGap(before);
+    widenForGap(gap);
+  }
   *worst_gap = std::max(*worst_gap, gap);
 }
 
@@ -215,8 +229,12 @@ bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
       at.utime = t_end;
       softReset(at, gap, note);
     } else {
+      const FilterState before = prop_.state();
       prop_.propagateTo(t_end, next);
-      if (gap > max_gap) widenForGap(step);
+      if (gap > max_gap) {
+        noteBridgedGap(before);
+        widenForGap(step);
+      }
       worst_gap = std::max(worst_gap, gap);
     }
   }
@@ -358,14 +376,42 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     ScanToMap s2m(map_, reg, opts_.matching);
     FilterState post;
     Mat18 P_post;
-    const EsikfResult er = iteratedUpdate(
+    EsikfResult er = iteratedUpdate(
         x, P, [&](const FilterState& xi, int it, PoseInformation* info) { return s2m.evaluate(xi, it, info); },
         opts_.esikf, &post, &P_post);
+    const ScanToMap* fitted = &s2m;
+    std::optional<ScanToMap> s2m_still;
+    if (gap_bridged_) {
+      // After a bridged IMU gap the prediction assumed the gap's time really passed. If it did not
+      // (every sensor's clock stepped ahead), the body stood still meanwhile: try that too and keep
+      // the registration that finds more of the map.
+      FilterState still = x;
+      still.rot = gap_undo_rot_ * x.rot;
+      still.pos = x.pos + gap_undo_pos_;
+      still.vel = x.vel + gap_undo_vel_;
+      s2m_still.emplace(map_, reg, opts_.matching);
+      FilterState post_still;
+      Mat18 P_still;
+      const EsikfResult er_still = iteratedUpdate(
+          still, P,
+          [&](const FilterState& xi, int it, PoseInformation* info) { return s2m_still->evaluate(xi, it, info); },
+          opts_.esikf, &post_still, &P_still);
+      if (er_still.valid && er_still.info.count > (er.valid ? er.info.count : 0) * 11 / 10) {
+        appendNote(note, "after the IMU gap the sweep fits the map better as if no time had passed (" +
+                             std::to_string(er_still.info.count) + " against " + std::to_string(er.info.count) +
+                             " matches): the clock stepped");
+        x = still;
+        fitted = &*s2m_still;
+        er = er_still;
+        post = post_still;
+        P_post = P_still;
+      }
+    }
     res.num_residuals = er.info.count;
     res.iterations = er.iterations;
     res.converged = er.converged;
-    res.degeneracy = s2m.degeneracy();
-    res.min_information_eigenvalue = s2m.minInformationEigenvalue();
+    res.degeneracy = fitted->degeneracy();
+    res.min_information_eigenvalue = fitted->minInformationEigenvalue();
     const bool enough = er.valid && er.info.count >= opts_.min_residuals;
     const bool sane = enough && post.rot.allFinite() && post.pos.allFinite() && P_post.allFinite() &&
                       (post.pos - x.pos).norm() <= opts_.max_position_jump;
@@ -380,6 +426,10 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
                               : "too few point-to-plane matches (" + std::to_string(er.info.count) + ")");
     }
   }
+  gap_bridged_ = false;
+  gap_undo_rot_.setIdentity();
+  gap_undo_pos_.setZero();
+  gap_undo_vel_.setZero();
   if (res.status == ScanResult::Status::kTracked || res.status == ScanResult::Status::kMapInitialized) {
     last_registered_utime_ = t_end;
     has_registered_ = true;

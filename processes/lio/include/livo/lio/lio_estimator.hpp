@@ -120,6 +120,9 @@ class LioEstimator {
   void drainBacklog(int64_t newest);
   void softReset(const ImuSample& s, double gap_s, std::string* note);
   void widenForGap(double gap_s);
+  /// Remembers what a bridged IMU gap did to the state (from `before` to now), so that the next
+  /// sweep can also try the hypothesis that no time passed (a clock step, not an outage).
+  void noteBridgedGap(const FilterState& before);
   bool wheelSpeedAt(int64_t utime, double* speed) const;
   void insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
   void pruneMap(const Vec3& position);
@@ -145,6 +148,11 @@ class LioEstimator {
   Vec3 last_post_pos_ = Vec3::Zero(), prev_post_pos_ = Vec3::Zero();  // registered positions ...
   int64_t last_post_utime_ = 0, prev_post_utime_ = 0;                 // ... of the last two sweeps
   bool has_last_post_ = false, has_prev_post_ = false;
+  // Motion the bridged gaps since the last sweep added: the "no time passed" hypothesis undoes it.
+  bool gap_bridged_ = false;
+  Mat3 gap_undo_rot_ = Mat3::Identity();  // left factor taking the rotation back across the gaps
+  Vec3 gap_undo_pos_ = Vec3::Zero();
+  Vec3 gap_undo_vel_ = Vec3::Zero();
 };
 
 }  // namespace livo::lio
