@@ -105,6 +105,24 @@ void collect(lcm::LCM& lcm, std::vector<colored_cloud_t>* out) {
       out);
 }
 
+/// Keyframe 0 at the origin, the body still there, one image and the two scans that colour it.
+void colourTheRoomAtKeyframe0(lcm::LCM& lcm, const CameraRig& camera) {
+  keyframe_t kf{};
+  kf.id = 0;
+  kf.utime = 1000000;
+  kf.orientation[0] = 1.0;
+  kf.cloud.frame = "I";
+  lcm.publish("KEYFRAME", &kf);
+  publishStillOdometry(lcm);
+  const image_t img = makeImage(camera, 1050000);
+  lcm.publish("CAMERA", &img);
+  for (int64_t utime : {1100000, 1200000}) {
+    const registered_scan_t scan = makeScan(utime);
+    lcm.publish("REGISTERED_SCAN", &scan);
+  }
+  drain(lcm);
+}
+
 }  // namespace
 
 TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
@@ -174,20 +192,7 @@ TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
   std::vector<colored_cloud_t> received;
   collect(lcm, &received);
 
-  keyframe_t kf{};
-  kf.id = 0;
-  kf.utime = 1000000;
-  kf.orientation[0] = 1.0;
-  kf.cloud.frame = "I";
-  lcm.publish("KEYFRAME", &kf);
-  publishStillOdometry(lcm);
-  const image_t img = makeImage(*t.rig.camera, 1050000);
-  lcm.publish("CAMERA", &img);
-  for (int64_t utime : {1100000, 1200000}) {
-    const registered_scan_t scan = makeScan(utime);
-    lcm.publish("REGISTERED_SCAN", &scan);
-  }
-  drain(lcm);
+  colourTheRoomAtKeyframe0(lcm, *t.rig.camera);
   const size_t coloured = node.pipeline().map().colouredCount();
   ASSERT_GT(coloured, 1000u);
   std::vector<Eigen::Vector3f> before;
@@ -235,19 +240,7 @@ TEST(ColourNode, SplitsLargeUpdatesIntoBoundedMessages) {
   TestNode t(lcm, livo_test::tempPath("colour_chunks"), kMaxPoints);
   std::vector<colored_cloud_t> received;
   collect(lcm, &received);
-  keyframe_t kf{};
-  kf.utime = 1000000;
-  kf.orientation[0] = 1.0;
-  kf.cloud.frame = "I";
-  lcm.publish("KEYFRAME", &kf);
-  publishStillOdometry(lcm);
-  const image_t img = makeImage(*t.rig.camera, 1050000);
-  lcm.publish("CAMERA", &img);
-  for (int64_t utime : {1100000, 1200000}) {
-    const registered_scan_t scan = makeScan(utime);
-    lcm.publish("REGISTERED_SCAN", &scan);
-  }
-  drain(lcm);
+  colourTheRoomAtKeyframe0(lcm, *t.rig.camera);
   const size_t coloured = t.node.pipeline().map().colouredCount();
   ASSERT_GT(coloured, 3u * kMaxPoints);
   for (const colored_cloud_t& m : received) EXPECT_LE(m.num_points, kMaxPoints);
