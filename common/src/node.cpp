@@ -6,7 +6,9 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <cstdlib>
 #include <stdexcept>
+#include <thread>
 
 #include "livo/health_t.hpp"
 #include "livo/progress_t.hpp"
@@ -28,8 +30,27 @@ void installSignalHandlers() {
 void requestShutdown() { g_shutdown.store(true); }
 bool shutdownRequested() { return g_shutdown.load(); }
 
+int NodeOptions::handlerDelayFromEnvironment() {
+  const char* value = std::getenv("LIVO_TEST_HANDLER_DELAY_MS");
+  if (!value || !*value) return 0;
+  char* end = nullptr;
+  const long ms = std::strtol(value, &end, 10);
+  if (*end != '\0' || ms < 0 || ms > 10000)
+    throw std::invalid_argument(std::string("LIVO_TEST_HANDLER_DELAY_MS='") + value +
+                                "': expected whole milliseconds in [0, 10000]");
+  return static_cast<int>(ms);
+}
+
 Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
   if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
+  if (options_.handler_delay_max_ms < 0) throw std::invalid_argument("livo::Node: handler_delay_max_ms < 0");
+  // FNV-1a of the name: the same delays for the same node in every run (std::hash is not portable)
+  uint32_t seed = 2166136261u;
+  for (unsigned char ch : options_.name) seed = (seed ^ ch) * 16777619u;
+  handler_delay_rng_.seed(seed);
+  if (options_.handler_delay_max_ms > 0)
+    std::cerr << "[" << options_.name << "] test hook: up to " << options_.handler_delay_max_ms
+              << " ms random delay before each handler" << std::endl;
   last_health_ = std::chrono::steady_clock::now();
 }
 
@@ -76,6 +97,10 @@ void Node::subscribeRaw(const std::string& channel, std::function<void(const voi
 
 void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
   Node& node = *sub->node;
+  if (node.options_.handler_delay_max_ms > 0) {
+    std::uniform_int_distribution<int> delay_ms(0, node.options_.handler_delay_max_ms);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(node.handler_delay_rng_)));
+  }
   node.current_ = sub;
   const auto t0 = std::chrono::steady_clock::now();
   try {

@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -32,6 +33,14 @@ struct NodeOptions {
   double health_period_s = 1.0;          // wall-clock period of HEALTH messages; 0 disables
   bool publish_progress = true;          // a PROGRESS message after every handled input
   bool quiet = false;                    // no summary on stderr at shutdown
+  // Test hook for real-time hand-off tests: before each handler, sleep a random 0..N ms (uniform,
+  // seeded by the node name, so a run is repeatable per node). 0 disables it. Defaults to the
+  // environment variable LIVO_TEST_HANDLER_DELAY_MS (unset: 0); see handlerDelayFromEnvironment().
+  int handler_delay_max_ms = handlerDelayFromEnvironment();
+
+  /// LIVO_TEST_HANDLER_DELAY_MS as a number of milliseconds (0 if unset or empty); throws
+  /// std::invalid_argument naming the variable for anything but an integer in [0, 10000].
+  static int handlerDelayFromEnvironment();
 };
 
 class Node {
@@ -152,6 +161,7 @@ class Node {
   };
   std::map<std::string, Watch> watched_;  // channel -> its consumers
   lcm::Subscription* peer_sub_ = nullptr;
+  std::mt19937 handler_delay_rng_;  // seeded by the node name (handler_delay_max_ms)
 };
 
 /// Sets the shutdown flag on SIGINT/SIGTERM (idempotent).

@@ -44,6 +44,7 @@ LioEstimator::LioEstimator(LioOptions options)
     : opts_(options), prop_(options.imu_noise), map_(options.map), keyframe_selector_(options.keyframe) {}
 
 void LioEstimator::reset() {
+  frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
   prop_ = ImuPropagator(opts_.imu_noise);
   map_.clear();
   keyframe_selector_.reset();
@@ -474,7 +475,11 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat
   return true;
 }
 
-void LioEstimator::applyLoopCorrection(const Pose3& T, const std::vector<KeyframePose>& corrected) {
+void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const std::vector<KeyframePose>& corrected) {
+  const Pose3 T = correction.previous_id == frame_.correction_id ? correction.T_Ck_Cj
+                                                                  : Pose3(correction.T_Ck_O * frame_.T_C_O.inverse());
+  frame_.correction_id = correction.id;
+  frame_.T_C_O = correction.T_Ck_O;
   const Mat3 Rc = T.linear();
   // keyframes: corrected poses where given, the rigid correction elsewhere
   for (auto& kf : keyframes_) {

@@ -44,14 +44,19 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
 }
 
 void LioNode::resetAll(const std::string& why) {
-  node_.warn(why + ": re-initialising");
   lio_.reset();
+  announceReset(why);
   imu_.clear();
   wheel_.clear();
   scans_.clear();
   images_.clear();
   pending_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
+}
+
+void LioNode::announceReset(const std::string& why) {
+  ++resets_;
+  node_.warn("odometry reset to epoch " + std::to_string(lio_.frame().epoch) + ": " + why + ": re-initialising");
 }
 
 void LioNode::onImu(const imu_t& m) {
@@ -197,21 +202,25 @@ void LioNode::advance() {
 void LioNode::process(const PendingScan& p) {
   // The sweep is processed from whichever handler moved the IMU watermark past it: time it on its own.
   const auto t0 = std::chrono::steady_clock::now();
+  const int32_t epoch_before = lio_.frame().epoch;
   ScanResult r = lio_.addScan(p.scan);
+  if (lio_.frame().epoch != epoch_before) announceReset(r.message.empty() ? "the filter re-initialised" : r.message);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ++sweeps_;
   if (!r.message.empty() && r.status != ScanResult::Status::kInitializing)
     node_.warn("sweep at " + std::to_string(p.scan.utime) + " (" + toString(r.status) + "): " + r.message);
   if (!r.hasOutput()) return;
-  const odometry_t odo = toOdometry(r);
+  const odometry_t odo = toOdometry(r, lio_.frame());
   if (!finiteOdometry(odo)) {
-    node_.error("non-finite odometry withheld; re-initialising");
+    node_.error("non-finite odometry withheld");
     lio_.reset();
+    announceReset("non-finite odometry");
     return;
   }
   node_.publish(opts_.odometry_channel, odo);
-  if (opts_.publish_registered_scan) node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg));
-  if (r.is_keyframe) node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings));
+  if (opts_.publish_registered_scan)
+    node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, lio_.frame()));
+  if (r.is_keyframe) node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
 }
 
 void LioNode::handOff(int64_t utime) {
@@ -230,12 +239,21 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
-  node_.publish(opts_.state_prior_channel, toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name));
+  filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name);
+  prior.epoch = lio_.frame().epoch;
+  prior.correction_id = lio_.frame().correction_id;
+  node_.publish(opts_.state_prior_channel, prior);
   ++handoff_.priors;
   pending_ = PendingPrior{id, utime};
 }
 
 void LioNode::onPosterior(const filter_state_t& m) {
+  if (m.epoch != lio_.frame().epoch) {
+    node_.reject(opts_.state_posterior_channel, "posterior for odometry epoch " + std::to_string(m.epoch) +
+                                                    ", the filter is in epoch " + std::to_string(lio_.frame().epoch) +
+                                                    " (made before a reset): ignored");
+    return;
+  }
   if (!pending_ || m.request_id != pending_->request_id || m.utime != pending_->utime) {
     node_.reject(opts_.state_posterior_channel, "posterior answers no waiting prior (late, duplicate or foreign)");
     return;
@@ -259,11 +277,24 @@ void LioNode::onPosterior(const filter_state_t& m) {
 }
 
 void LioNode::onLoopCorrection(const loop_correction_t& m) {
-  Pose3 T;
+  LioEstimator::LoopCorrection correction;
   std::vector<LioEstimator::KeyframePose> poses;
   std::string why;
-  if (!fromMessage(m, &T, &poses, &why)) {
+  if (!fromMessage(m, &correction, &poses, &why)) {
     node_.reject(opts_.loop_correction_channel, why);
+    return;
+  }
+  const OdometryFrame& frame = lio_.frame();
+  if (m.epoch != frame.epoch) {
+    node_.reject(opts_.loop_correction_channel,
+                 "loop correction " + std::to_string(m.correction_id) + " is for odometry epoch " +
+                     std::to_string(m.epoch) + ", the filter is in epoch " + std::to_string(frame.epoch) + ": ignored");
+    return;
+  }
+  if (m.correction_id <= frame.correction_id) {
+    node_.reject(opts_.loop_correction_channel, "loop correction " + std::to_string(m.correction_id) +
+                                                    " is not after the adopted one (" +
+                                                    std::to_string(frame.correction_id) + "): ignored");
     return;
   }
   if (pending_) {
@@ -271,8 +302,9 @@ void LioNode::onLoopCorrection(const loop_correction_t& m) {
     ++handoff_.missing;
     pending_.reset();
   }
-  lio_.applyLoopCorrection(T, poses);
-  node_.info("loop correction applied (" + std::to_string(poses.size()) + " keyframes)");
+  lio_.applyLoopCorrection(correction, poses);
+  node_.info("loop correction " + std::to_string(m.correction_id) + " applied (" + std::to_string(poses.size()) +
+             " keyframes)");
   advance();
 }
 

@@ -47,6 +47,9 @@ class LioNode {
     int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
+  /// Odometry resets so far (= the current epoch).
+  int64_t resets() const { return resets_; }
+  const OdometryFrame& frame() const { return lio_.frame(); }
 
  private:
   struct PendingScan {
@@ -65,6 +68,8 @@ class LioNode {
   /// Propagates to an image time and publishes the prior (sets pending_).
   void handOff(int64_t utime);
   void resetAll(const std::string& why);
+  /// Warns (HEALTH, stderr) "odometry reset to epoch N: why" after the estimator was reset.
+  void announceReset(const std::string& why);
 
   LioNodeOptions opts_;
   Node node_;
@@ -88,6 +93,7 @@ class LioNode {
   std::optional<PendingPrior> pending_;  // prior waiting for its posterior
   int64_t next_request_id_ = 1;
   HandoffCounts handoff_;
+  int64_t resets_ = 0;
 };
 
 }  // namespace livo::lio
