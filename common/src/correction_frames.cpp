@@ -47,12 +47,13 @@ void CorrectionTable::forgetEpochsBefore(int32_t epoch) {
     it = it->second.epoch < epoch ? corrections_.erase(it) : std::next(it);
 }
 
-MapFrame::Placed MapFrame::place(int32_t epoch, int64_t correction_id) {
+MapFrame::Placed MapFrame::place(int32_t epoch, int64_t correction_id,
+                                 const std::function<void(int32_t)>& close_epoch) {
   Placed p;
   if (!started_) startEpoch(epoch, correction_id);
   if (epoch > epoch_) {
-    p.placement = Placement::kNewEpoch;
-    return p;
+    close_epoch(epoch_);
+    startEpoch(epoch, correction_id);
   }
   if (epoch < epoch_) {
     p.placement = Placement::kOldEpoch;

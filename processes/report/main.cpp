@@ -45,6 +45,7 @@ int extract(int argc, char** argv) {
   livo::writeTum(dir + "/odometry.tum", out.odometry);
   livo::writeTum(dir + "/trajectory.tum", livo::loopCorrectedTrajectory(out));
   writeText(dir + "/timing.json", livo::timingJson(out.final_health).dump(2) + "\n");
+  writeText(dir + "/resets.json", livo::resetsJson(out.resets));
   std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
             << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes\n";
   if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
@@ -98,6 +99,7 @@ int markdown(int argc, char** argv) {
     in.figures.emplace_back(item.substr(0, eq), item.substr(eq + 1));
   }
   for (const auto& w : splitList(cli.get("--warning"), ';')) in.warnings.push_back(w);
+  if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
   for (const auto& [node, p] : in.timing.items()) {
     for (const auto& [channel, c] : p["channels"].items()) {
       if (c.value("decode_failures", 0) > 0)

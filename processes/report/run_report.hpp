@@ -32,6 +32,7 @@ struct ReportInputs {
   std::vector<std::pair<std::string, nlohmann::json>> evaluations;  // title, livo-evaluate JSON
   std::vector<std::pair<std::string, std::string>> figures;         // caption, relative path
   std::vector<std::string> warnings;
+  nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
   const PipelineOutputs* outputs = nullptr;
 };
 

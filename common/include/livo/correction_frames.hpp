@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -55,7 +56,6 @@ class MapFrame {
  public:
   enum class Placement {
     kUse,           // `to_map` moves the pose (and world-frame points) into the map frame
-    kNewEpoch,      // a newer epoch: close the current map, then startEpoch() and place again
     kOldEpoch,      // from an epoch the map has left: drop it
     kUnknownFrame,  // in a correction this process never received (lost): drop it
   };
@@ -67,10 +67,10 @@ class MapFrame {
   };
 
   /// Where a pose published in (epoch, correction_id) goes. The first pose ever starts the map
-  /// in its own frame.
-  Placed place(int32_t epoch, int64_t correction_id);
-  /// Starts a new map in `epoch`, in the frame of correction `correction_id` (the first input's).
-  void startEpoch(int32_t epoch, int64_t correction_id);
+  /// in its own frame; a pose of a newer epoch (the LIO was reset) first calls
+  /// `close_epoch(old epoch)`, which must drop (or write out) the map, then starts a new map in
+  /// its own frame.
+  Placed place(int32_t epoch, int64_t correction_id, const std::function<void(int32_t)>& close_epoch);
 
   struct CorrectionStep {
     bool apply = false;               // the map moves: corrected keyframe poses, `unlisted` for the rest
@@ -86,6 +86,8 @@ class MapFrame {
   int64_t correctionId() const { return correction_id_; }
 
  private:
+  void startEpoch(int32_t epoch, int64_t correction_id);
+
   CorrectionTable table_;
   bool started_ = false;
   int32_t epoch_ = 0;

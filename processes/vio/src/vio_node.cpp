@@ -55,19 +55,15 @@ void VioNode::onImage(const image_t& m) {
 }
 
 MapFrame::Placed VioNode::placeInMap(int32_t epoch, int64_t correction_id) {
-  MapFrame::Placed placed = frame_.place(epoch, correction_id);
-  if (placed.placement == MapFrame::Placement::kNewEpoch) {
+  return frame_.place(epoch, correction_id, [&](int32_t old_epoch) {
     // the LIO was reset: its new odometry frame has nothing to do with the map's
     node_.warn("odometry epoch " + std::to_string(epoch) + " (LIO reset): dropping the map of epoch " +
-               std::to_string(frame_.epoch()) + " (" + std::to_string(vio_.map().size()) + " points) and " +
+               std::to_string(old_epoch) + " (" + std::to_string(vio_.map().size()) + " points) and " +
                std::to_string(pending_.size()) + " waiting priors");
     vio_.reset();
     pending_.clear();
     ++counts_.epochs_started;
-    frame_.startEpoch(epoch, correction_id);
-    placed = frame_.place(epoch, correction_id);
-  }
-  return placed;
+  });
 }
 
 void VioNode::onPrior(const filter_state_t& m) {
