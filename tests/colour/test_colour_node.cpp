@@ -194,7 +194,9 @@ TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
 
   loop_correction_t bad{};
   bad.utime = 1300000;
+  bad.correction_id = 1;
   bad.correction_orientation[0] = 1.0;
+  bad.odometry_to_corrected_orientation[0] = 1.0;
   bad.num_keyframes = 1;
   bad.keyframe_id = {0};
   bad.position = {{0.5, 0.0, 0.0}};

@@ -107,10 +107,15 @@ keyframe_t wallKeyframe(int64_t id, int64_t utime) {
   return k;
 }
 
+// Corrections 1, 2, ... of epoch 0 with the identity as odometry_to_corrected (keyframes the
+// correction does not list stay where they are).
 loop_correction_t correction(int64_t utime, const std::vector<std::pair<int64_t, Pose3>>& poses) {
+  static int64_t next_id = 1;
   loop_correction_t m{};
   m.utime = utime;
+  m.correction_id = next_id++;
   m.correction_orientation[0] = 1.0;
+  m.odometry_to_corrected_orientation[0] = 1.0;
   m.num_keyframes = static_cast<int32_t>(poses.size());
   for (const auto& [id, T] : poses) {
     m.keyframe_id.push_back(id);
