@@ -116,7 +116,7 @@ MapFrame::Placed OctomapNode::placeInMap(int32_t epoch, int64_t correction_id) {
                "; a new map starts");
     if (!output_dir_.empty()) writeFiles(name);
     builder_ = OctomapBuilder(options_.core, builder_.lidarExtrinsics());
-    last_publish_ = INT64_MIN;
+    last_publish_ = last_write_ = INT64_MIN;  // the new epoch's clock may be behind the old one's
   });
 }
 
