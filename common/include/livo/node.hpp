@@ -33,9 +33,9 @@ struct NodeOptions {
   double health_period_s = 1.0;          // wall-clock period of HEALTH messages; 0 disables
   bool publish_progress = true;          // a PROGRESS message after every handled input
   bool quiet = false;                    // no summary on stderr at shutdown
-  // Test hook for real-time hand-off tests: before each handler, sleep a random 0..N ms (uniform,
-  // seeded by the node name, so a run is repeatable per node). 0 disables it. Defaults to the
-  // environment variable LIVO_TEST_HANDLER_DELAY_MS (unset: 0); see handlerDelayFromEnvironment().
+  // Test hook for real-time hand-off tests: before each handler of another process's message (not of
+  // sensor input: imu, point cloud, image, wheel, pose), sleep a random 0..N ms (uniform, seeded by the
+  // node name). 0 disables it. Default: LIVO_TEST_HANDLER_DELAY_MS (handlerDelayFromEnvironment()).
   int handler_delay_max_ms = handlerDelayFromEnvironment();
 
   /// LIVO_TEST_HANDLER_DELAY_MS as a number of milliseconds (0 if unset or empty); throws
