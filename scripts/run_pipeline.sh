@@ -146,11 +146,19 @@ logger=$!
 declare -A pids=() restarts=() next_start=() died_at=() ended=()
 now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
 start_process() {
-  # in the output folder, so the files a process writes (maps, loops.json) land there
-  (cd "$out" && exec "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+  # in the output folder, so the files a process writes (maps, loops.json) land there; supervised,
+  # a process may keep what must survive a restart in LIVO_STATE_DIR (lio: its epoch and keyframe
+  # numbering), and LIVO_RESTARTS says how often it was restarted
+  if [ "$respawn" = 1 ]; then
+    (cd "$out" && LIVO_STATE_DIR="$out/state" LIVO_RESTARTS="${restarts[$1]:-0}" exec "$(exe_of "$1")" \
+      --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+  else
+    (cd "$out" && exec "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+  fi
   pids[$1]=$!
 }
-for p in "${selected[@]}"; do start_process "$p"; restarts[$p]=0; done
+mkdir -p "$out/state"
+for p in "${selected[@]}"; do restarts[$p]=0; start_process "$p"; done
 cleanup() {
   for p in "${!pids[@]}"; do kill -INT "${pids[$p]}" 2>/dev/null || true; done
   kill -INT "$logger" 2>/dev/null || true
@@ -159,7 +167,7 @@ trap cleanup INT TERM
 # What a restarted process starts without (processes/*/README.md, "Restarts").
 lost_on_restart() {
   case "$1" in
-    lio) echo "filter state and local map: re-initialised from the IMU, odometry goes on in a new epoch" ;;
+    lio) echo "filter state and local map: re-initialised from the IMU; odometry goes on in a new epoch (frame), keyframe ids go on" ;;
     vio) echo "its patch map; lio ran LiDAR-only until it answered again" ;;
     loop) echo "keyframes and pose graph so far: no loops to places seen before the restart" ;;
     colour) echo "the coloured map so far (its files hold what it coloured after the restart)" ;;
@@ -200,8 +208,8 @@ while kill -0 "$playback" 2>/dev/null; do
   for p in "${selected[@]}"; do
     if [ -n "${next_start[$p]:-}" ]; then
       if [ "$now" -ge "${next_start[$p]}" ]; then
-        start_process "$p"
         restarts[$p]=$((restarts[$p] + 1))
+        start_process "$p"
         unset "next_start[$p]"
         down=$(( now - died_at[$p] ))
         printf "%d.%03d\t%s\t%s\t%s\t%d\t%d.%03d\t%s\n" $(( (died_at[$p] - t0) / 1000 )) $(( (died_at[$p] - t0) % 1000 )) \

@@ -12,6 +12,8 @@ filter_state_t toFilterState(int64_t utime, const FilterState& x, const Mat18& P
   m.utime = utime;
   m.request_id = request_id;
   m.source = source;
+  m.epoch = 0;  // the caller sets the frame (odometry epoch and loop correction) the state is in
+  m.correction_id = 0;
   quatToWxyz(Quat(x.rot), m.orientation);
   vec3To(x.pos, m.position);
   vec3To(x.vel, m.velocity);

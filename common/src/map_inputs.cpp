@@ -25,6 +25,18 @@ std::string viewRegisteredScan(const registered_scan_t& m, RegisteredScanView* v
   return "";
 }
 
+void moveRegisteredScan(const Pose3& T, registered_scan_t* m) {
+  poseTo(T * poseFrom(m->position, m->orientation), m->position, m->orientation);
+  point_cloud_t& c = m->cloud;
+  const size_t n = std::min({c.x.size(), c.y.size(), c.z.size()});
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p = T * Vec3(c.x[i], c.y[i], c.z[i]);
+    c.x[i] = static_cast<float>(p.x());
+    c.y[i] = static_cast<float>(p.y());
+    c.z[i] = static_cast<float>(p.z());
+  }
+}
+
 std::string poseProblem(const double position[3], const double q[4]) {
   if (!allFinite(position, 3) || !allFinite(q, 4)) return "pose is not finite";
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);

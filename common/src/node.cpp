@@ -7,12 +7,19 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <cstdlib>
 #include <stdexcept>
+#include <thread>
 
 #include <poll.h>
 #include <unistd.h>
 
 #include "livo/health_t.hpp"
+#include "livo/image_t.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/point_cloud_t.hpp"
+#include "livo/pose_t.hpp"
+#include "livo/wheel_odometry_t.hpp"
 #include "livo/progress_t.hpp"
 
 namespace livo {
@@ -48,8 +55,27 @@ std::map<std::string, std::set<int64_t>> parseDropReceived(const std::string& sp
   return out;
 }
 
+int NodeOptions::handlerDelayFromEnvironment() {
+  const char* value = std::getenv("LIVO_TEST_HANDLER_DELAY_MS");
+  if (!value || !*value) return 0;
+  char* end = nullptr;
+  const long ms = std::strtol(value, &end, 10);
+  if (*end != '\0' || ms < 0 || ms > 10000)
+    throw std::invalid_argument(std::string("LIVO_TEST_HANDLER_DELAY_MS='") + value +
+                                "': expected whole milliseconds in [0, 10000]");
+  return static_cast<int>(ms);
+}
+
 Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
   if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
+  if (options_.handler_delay_max_ms < 0) throw std::invalid_argument("livo::Node: handler_delay_max_ms < 0");
+  // FNV-1a of the name: the same delays for the same node in every run (std::hash is not portable)
+  uint32_t seed = 2166136261u;
+  for (unsigned char ch : options_.name) seed = (seed ^ ch) * 16777619u;
+  handler_delay_rng_.seed(seed);
+  if (options_.handler_delay_max_ms > 0)
+    std::cerr << "[" << options_.name << "] test hook: up to " << options_.handler_delay_max_ms
+              << " ms random delay before each handler of another process's message" << std::endl;
   last_health_ = std::chrono::steady_clock::now();
   if (const char* drop = std::getenv("LIVO_TEST_DROP_RECEIVED"); drop && options_.drop_received.empty())
     options_.drop_received = parseDropReceived(drop);
@@ -98,6 +124,22 @@ void Node::subscribeRaw(const std::string& channel, std::function<void(const voi
   lcm_subs_.push_back(lcm_.subscribeFunction(channel, &Node::dispatch, sub));
 }
 
+namespace {
+// Whether an encoded message is raw sensor input (its leading 8-byte type fingerprint, big-endian).
+// The handler-delay test hook spares these: a node sleeping a mean N/2 ms per 200 Hz IMU message
+// could not keep up in real time, and the kernel would drop most of the stream.
+bool isSensorMessage(const void* data, size_t size) {
+  if (size < 8) return false;
+  const auto* b = static_cast<const uint8_t*>(data);
+  uint64_t fingerprint = 0;
+  for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | b[i];
+  for (int64_t sensor : {imu_t::getHash(), point_cloud_t::getHash(), image_t::getHash(), wheel_odometry_t::getHash(),
+                         pose_t::getHash()})
+    if (fingerprint == static_cast<uint64_t>(sensor)) return true;
+  return false;
+}
+}  // namespace
+
 void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscription* sub) {
   Node& node = *sub->node;
   ++sub->arrived;
@@ -108,6 +150,10 @@ void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscrip
                 << " dropped on arrival" << std::endl;
       return;
     }
+  }
+  if (node.options_.handler_delay_max_ms > 0 && !isSensorMessage(rbuf->data, rbuf->data_size)) {
+    std::uniform_int_distribution<int> delay_ms(0, node.options_.handler_delay_max_ms);
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(node.handler_delay_rng_)));
   }
   node.current_ = sub;
   const auto t0 = std::chrono::steady_clock::now();

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
+#include "livo/correction_frames.hpp"
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
@@ -34,8 +35,18 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
   node_.declareOutput(options_.output_channel);
 
   node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
+    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+    if (placed.placement != MapFrame::Placement::kUse) {
+      node_.reject(options_.scan_channel, placed.why);
+      return;
+    }
+    registered_scan_t moved;
+    if (placed.moved) {  // published before the LIO adopted the map's loop correction (or after one not here yet)
+      moved = m;
+      moveRegisteredScan(placed.to_map, &moved);
+    }
     RegisteredScanView v;
-    if (const std::string why = viewRegisteredScan(m, &v); !why.empty()) {
+    if (const std::string why = viewRegisteredScan(placed.moved ? moved : m, &v); !why.empty()) {
       node_.reject(options_.scan_channel, why);
       return;
     }
@@ -51,7 +62,12 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
       node_.reject(options_.odometry_channel, why);
       return;
     }
-    pipeline_.addPose(m.utime, poseFrom(m.position, m.orientation));
+    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+    if (placed.placement != MapFrame::Placement::kUse) {
+      node_.reject(options_.odometry_channel, placed.why);
+      return;
+    }
+    pipeline_.addPose(m.utime, placed.to_map * poseFrom(m.position, m.orientation));
   });
   node_.subscribe<image_t>(options_.image_channel, [this](const image_t& m) {
     ColourImage img;
@@ -73,21 +89,50 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
       node_.reject(options_.keyframe_channel, why);
       return;
     }
-    pipeline_.addKeyframe(m.id, m.utime, poseFrom(m.position, m.orientation));
+    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+    if (placed.placement != MapFrame::Placement::kUse) {
+      node_.reject(options_.keyframe_channel, placed.why);
+      return;
+    }
+    pipeline_.addKeyframe(m.id, m.utime, placed.to_map * poseFrom(m.position, m.orientation));
   });
   node_.subscribe<loop_correction_t>(options_.correction_channel, [this](const loop_correction_t& m) {
     std::map<int64_t, Pose3> corrected;
-    if (const std::string why = correctedKeyframePoses(m, &corrected); !why.empty()) {
+    Pose3 T_Ck_O;
+    std::string why = correctedKeyframePoses(m, &corrected);
+    if (why.empty()) why = correctionTransform(m, &T_Ck_O);
+    if (!why.empty()) {
       node_.reject(options_.correction_channel, why);
       return;
     }
-    const int moved = pipeline_.applyCorrection(corrected);
+    const MapFrame::CorrectionStep step = frame_.addCorrection(m.correction_id, m.epoch, T_Ck_O);
+    if (!step.apply) {
+      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + step.why);
+      return;
+    }
+    const int moved = pipeline_.applyCorrection(corrected, step.unlisted);
     std::ostringstream s;
-    s << "loop correction: " << moved << " keyframes moved the map";
+    s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved the map";
     node_.info(s.str());
     publishRecoloured(m.utime);
   });
   node_.subscribeRaw(options_.save_channel, [this](const void*, int) { saveMap(); });
+}
+
+MapFrame::Placed ColourNode::placeInMap(int32_t epoch, int64_t correction_id) {
+  return frame_.place(epoch, correction_id, [&](int32_t old_epoch) {
+    // the LIO was reset: the old map is finished as it is, written beside the final one, and a
+    // new map starts in the new odometry frame
+    pipeline_.flush();
+    publishRecoloured(node_.lastSensorTime());
+    const std::string name = options_.map_name + "_epoch" + std::to_string(old_epoch);
+    node_.warn("odometry epoch " + std::to_string(epoch) + " (LIO reset): the map of epoch " +
+               std::to_string(old_epoch) + (output_dir_.empty() ? " is dropped" : " goes to " + mapPath(name, ".ply")) +
+               "; a new map starts");
+    if (!output_dir_.empty()) saveMap(name);
+    const CameraRig camera = pipeline_.camera();
+    pipeline_ = ColouringPipeline(options_.core, camera);
+  });
 }
 
 void ColourNode::publishRecoloured(int64_t utime) {
@@ -118,10 +163,15 @@ void ColourNode::publishRecoloured(int64_t utime) {
   }
 }
 
-std::string ColourNode::plyPath() const { return output_dir_ + "/" + options_.map_name + ".ply"; }
-std::string ColourNode::pcdPath() const { return output_dir_ + "/" + options_.map_name + ".pcd"; }
+std::string ColourNode::mapPath(const std::string& name, const char* extension) const {
+  return output_dir_ + "/" + name + extension;
+}
+std::string ColourNode::plyPath() const { return mapPath(options_.map_name, ".ply"); }
+std::string ColourNode::pcdPath() const { return mapPath(options_.map_name, ".pcd"); }
 
-bool ColourNode::saveMap() {
+bool ColourNode::saveMap() { return saveMap(options_.map_name); }
+
+bool ColourNode::saveMap(const std::string& name) {
   ColouredPoints pts;
   for (const MapPoint& p : pipeline_.map().points()) {
     if (!p.coloured()) continue;
@@ -133,11 +183,12 @@ bool ColourNode::saveMap() {
   std::error_code ec;
   std::filesystem::create_directories(output_dir_, ec);
   std::string error;
-  if (!writePly(plyPath(), pts, &error) || !writePcd(pcdPath(), pts, &error)) {
+  const std::string ply = mapPath(name, ".ply"), pcd = mapPath(name, ".pcd");
+  if (!writePly(ply, pts, &error) || !writePcd(pcd, pts, &error)) {
     node_.error(error);
     return false;
   }
-  node_.info("wrote " + std::to_string(pts.size()) + " coloured points to " + plyPath() + " and " + pcdPath());
+  node_.info("wrote " + std::to_string(pts.size()) + " coloured points to " + ply + " and " + pcd);
   return true;
 }
 

@@ -8,6 +8,7 @@
 
 #include "colour_config.hpp"
 #include "colouring_pipeline.hpp"
+#include "livo/correction_frames.hpp"
 #include "livo/node.hpp"
 #include "livo/sensor_rig.hpp"
 
@@ -24,6 +25,8 @@ class ColourNode {
   void finish();
   /// Writes <output_dir>/<map_name>.ply and .pcd (coloured points only); false on failure.
   bool saveMap();
+  /// The same as <output_dir>/<name>.ply and .pcd.
+  bool saveMap(const std::string& name);
 
   Node& node() { return node_; }
   const ColouringPipeline& pipeline() const { return pipeline_; }
@@ -32,12 +35,17 @@ class ColourNode {
 
  private:
   void publishRecoloured(int64_t utime);
+  std::string mapPath(const std::string& name, const char* extension) const;
+  /// Where a pose of (epoch, correction) goes in the map; a newer epoch (a LIO reset) first
+  /// writes the map as <map_name>_epoch<N>.ply/.pcd and starts a new one.
+  MapFrame::Placed placeInMap(int32_t epoch, int64_t correction_id);
 
   Node node_;
   ColourNodeOptions options_;
   ColouringPipeline pipeline_;
   std::string output_dir_;
   bool finished_ = false;
+  MapFrame frame_;  // the map's odometry epoch and loop correction
 };
 
 }  // namespace colour

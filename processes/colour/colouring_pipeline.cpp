@@ -211,15 +211,17 @@ void ColouringPipeline::addKeyframe(int64_t id, int64_t utime, const Pose3& T_W_
   keyframes_.emplace(id, std::make_pair(utime, T_W_I));
 }
 
-int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
+int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted) {
   std::map<int64_t, Pose3> delta;
-  for (const auto& [id, pose] : corrected) {
-    auto it = keyframes_.find(id);
-    if (it == keyframes_.end() || !pose.matrix().allFinite()) continue;
-    const Pose3 d = pose * it->second.second.inverse();
+  for (auto& [id, keyframe] : keyframes_) {
+    Pose3& current = keyframe.second;
+    const auto listed = corrected.find(id);
+    const Pose3 pose = listed != corrected.end() ? listed->second : unlisted * current;
+    if (!pose.matrix().allFinite()) continue;
+    const Pose3 d = pose * current.inverse();
     if ((d.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-12) continue;
     delta[id] = d;
-    it->second.second = pose;
+    current = pose;
   }
   if (delta.empty()) return 0;
   map_.transform([&](int64_t anchor, Pose3* T) {

@@ -63,9 +63,10 @@ class ColouringPipeline {
 
   /// A keyframe: later scans' points are anchored to it until the next one.
   void addKeyframe(int64_t id, int64_t utime, const Pose3& T_W_I);
-  /// Corrected keyframe poses: points anchored to each keyframe move by corrected * current^-1.
-  /// Returns the number of keyframes that moved.
-  int applyCorrection(const std::map<int64_t, Pose3>& corrected);
+  /// Corrected keyframe poses: points anchored to each keyframe move by corrected * current^-1;
+  /// those anchored to a keyframe the correction does not list (the loop closure had not seen it
+  /// yet) move by `unlisted`, the correction's transform. Returns the number of keyframes that moved.
+  int applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted = Pose3::Identity());
 
   /// Ids of points coloured or recoloured since the last call (ascending).
   std::vector<uint32_t> takeRecoloured();

@@ -1,4 +1,5 @@
 // livo-lio --config FILE: the ESIKF LiDAR-inertial odometry as an LCM process.
+#include <cstdlib>
 #include <iostream>
 
 #include "livo/command_line.hpp"
@@ -20,6 +21,12 @@ int main(int argc, char** argv) {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
     livo::lio::LioNodeOptions opts = livo::lio::readLioNodeOptions(cfg);
     if (cli.has("--name")) opts.name = cli.get("--name");
+    // supervised runs (scripts/run_pipeline.sh --respawn): the numbering survives a restart
+    if (const char* dir = std::getenv("LIVO_STATE_DIR"); dir && *dir) {
+      opts.numbering_file = std::string(dir) + "/" + opts.name + ".numbering";
+      const char* restarts = std::getenv("LIVO_RESTARTS");
+      opts.continue_numbering = restarts && std::atoi(restarts) > 0;
+    }
     const bool quiet = cli.has("--quiet");
     if (!quiet) livo::lio::printOptions(opts, std::cerr);
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");

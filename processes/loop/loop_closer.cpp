@@ -22,10 +22,26 @@ Pose3 rotationOnly(const Mat3& R) {
 }
 }  // namespace
 
-Pose3 LoopCloser::correction() const {
-  if (keyframes_.empty()) return Pose3::Identity();
-  const auto& [id, kf] = *keyframes_.rbegin();
-  return graph_.pose(id) * kf.published.inverse();
+std::string LoopCloser::problem(const KeyframeInput& input) const {
+  if (!keyframes_.empty()) {
+    const auto& [newest_id, newest] = *keyframes_.rbegin();
+    if (input.id <= newest_id)
+      return "keyframe id " + std::to_string(input.id) + " is not after " + std::to_string(newest_id);
+    if (input.epoch < newest.epoch)
+      return "keyframe " + std::to_string(input.id) + " is of odometry epoch " + std::to_string(input.epoch) +
+             ", before the newest keyframe's (" + std::to_string(newest.epoch) + ")";
+  }
+  if (!published_.odometryToCorrected(input.epoch, input.correction_id))
+    return "keyframe " + std::to_string(input.id) + " includes loop correction " +
+           std::to_string(input.correction_id) + ", which this process did not publish for odometry epoch " +
+           std::to_string(input.epoch);
+  return "";
+}
+
+size_t LoopCloser::odometryEdgesAcrossEpochs() const {
+  size_t n = 0;
+  for (const PoseEdge& e : graph_.edges()) n += !e.is_loop && keyframes_.at(e.from).epoch != keyframes_.at(e.to).epoch;
+  return n;
 }
 
 std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
@@ -35,7 +51,7 @@ std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
   for (const auto& [other, kf] : keyframes_) {
-    if (other >= id || cur.utime - kf.utime < recent || kf.coarse.points.empty()) continue;
+    if (other >= id || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || kf.coarse.points.empty()) continue;
     const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
     if (d2 <= r2) near.push_back({d2, other});
   }
@@ -47,13 +63,11 @@ std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
 }
 
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
-  if (!keyframes_.empty() && input.id <= keyframes_.rbegin()->first)
-    throw std::invalid_argument("keyframe id " + std::to_string(input.id) + " is not after " +
-                                std::to_string(keyframes_.rbegin()->first));
+  if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
   Keyframe kf;
   kf.utime = input.utime;
-  kf.published = input.pose;
-  kf.odometry = adopted_.inverse() * input.pose;
+  kf.epoch = input.epoch;
+  kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
   const Points levelled = transformed(input.cloud, rotationOnly(kf.G_R_I));
@@ -64,11 +78,10 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   for (const Vec3& p : map_points) kf.map_cloud.push_back(p.cast<float>());
 
   // Initial estimate: the previous keyframe's corrected pose composed with the odometry increment.
-  Pose3 initial = input.pose;
-  if (!keyframes_.empty()) {
+  if (!keyframes_.empty() && keyframes_.rbegin()->second.epoch == input.epoch) {
     const auto& [prev_id, prev] = *keyframes_.rbegin();
     const Pose3 increment = prev.odometry.inverse() * kf.odometry;
-    initial = graph_.pose(prev_id) * increment;
+    const Pose3 initial = graph_.pose(prev_id) * increment;
     graph_.addNode(input.id, initial);
     PoseEdge e;
     e.from = prev_id;
@@ -81,7 +94,10 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     keyframes_.emplace(input.id, std::move(kf));
     graph_.addEdge(e);
   } else {
-    graph_.addNode(input.id, initial);
+    // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
+    // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
+    graph_.addNode(input.id, kf.odometry);
+    if (!keyframes_.empty()) graph_.holdFixed(input.id);
     keyframes_.emplace(input.id, std::move(kf));
   }
 
@@ -113,10 +129,18 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
     graph_.addEdge(e);
     graph_.optimize();
-    // The odometry will take on correction() = graph * published^-1 for this keyframe.
-    if (options_.odometry_adopts_corrections) adopted_ = graph_.pose(input.id) * cur.odometry.inverse();
+    // The odometry adopts T_Ck_O = graph * raw^-1 of this keyframe (the whole epoch's raw frame
+    // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
+    Correction c;
+    c.id = next_correction_id_++;
+    c.epoch = cur.epoch;
+    c.previous_id = published_.newest(cur.epoch);
+    c.T_Ck_O = graph_.pose(input.id) * cur.odometry.inverse();
+    c.T_Ck_Cj = c.T_Ck_O * published_.odometryToCorrected(cur.epoch, c.previous_id)->inverse();
+    published_.add(c.id, c.epoch, c.T_Ck_O);
     loops_.push_back(loop);
     result.loop = loop;
+    result.correction = c;
     keyframes_since_loop_ = 0;
     break;
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coarse_features.hpp"
+#include "livo/correction_frames.hpp"
 #include "gicp.hpp"
 #include "loop_registration.hpp"
 #include "pose_graph.hpp"
@@ -42,17 +43,14 @@ struct LoopCloserOptions {
   double odometry_translation_per_m = 5e-3;    // m per metre travelled
   double loop_rotation_sigma = 5e-3;         // rad
   double loop_translation_sigma = 5e-2;      // m
-  /// The odometry adopts every correction before its next keyframe (livo-lio does, and lockstep
-  /// replay guarantees the order): keyframe poses after a correction are in the corrected frame.
-  /// The closer then maps them back to its raw odometry chain, so that an odometry edge never
-  /// contains a correction. False for an odometry that ignores LOOP_CORRECTION.
-  bool odometry_adopts_corrections = true;
 };
 
 struct KeyframeInput {
   int64_t id = 0;
   int64_t utime = 0;
-  Pose3 pose = Pose3::Identity();    // odometry W_T_I, as published (after the corrections it adopted)
+  int32_t epoch = 0;                 // odometry epoch (keyframe_t.epoch)
+  int64_t correction_id = 0;         // the correction of this closer the pose includes (0: none)
+  Pose3 pose = Pose3::Identity();    // odometry W_T_I, as published (in correction correction_id)
   Mat6 covariance = Mat6::Zero();    // [rotation; position]
   Points cloud;                      // body frame I
 };
@@ -66,25 +64,42 @@ struct AcceptedLoop {
   double fitness = 0.0, overlap = 0.0;
 };
 
+/// What a LIO adopts after an accepted loop (loop_correction_t): correction `id` of `epoch`.
+struct Correction {
+  int64_t id = 0;
+  int32_t epoch = 0;
+  int64_t previous_id = 0;            // the previous correction of the epoch (0: none)
+  Pose3 T_Ck_O = Pose3::Identity();   // raw odometry frame of the epoch -> corrected
+  Pose3 T_Ck_Cj = Pose3::Identity();  // previous correction's frame -> corrected
+};
+
 struct AddResult {
   std::vector<LoopRegistrationResult> attempts;
   std::optional<AcceptedLoop> loop;  // set if a loop was accepted and the graph optimised
+  std::optional<Correction> correction;  // with the loop: the correction to publish
 };
 
 class LoopCloser {
  public:
   explicit LoopCloser(LoopCloserOptions options = {}) : options_(std::move(options)), graph_(options_.graph) {}
 
-  /// Adds a keyframe (ids must increase; throws std::invalid_argument otherwise) and searches
-  /// for a loop.
+  /// Why a keyframe cannot be added ("" if it can): an id not after the newest, an epoch before
+  /// the newest keyframe's, or a pose in a correction this closer did not publish for its epoch.
+  std::string problem(const KeyframeInput& input) const;
+  /// Adds a keyframe (throws std::invalid_argument if problem() is not empty) and searches for a
+  /// loop within its epoch. The pose is taken back to the raw odometry frame of its epoch through
+  /// the correction it includes, so an odometry edge holds the raw odometry increment whatever
+  /// corrections the odometry adopted before publishing it. The first keyframe of a new epoch
+  /// (after an odometry reset) starts a graph segment of its own: no odometry edge to the
+  /// previous epoch, held fixed in its raw pose; loops are searched only within an epoch.
   AddResult addKeyframe(const KeyframeInput& input);
 
   const PoseGraph& graph() const { return graph_; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
-  /// T_corrected_odom for the newest keyframe: maps the frame its pose was published in onto the
-  /// optimised one (identity before the first loop).
-  Pose3 correction() const;
   int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
+  int32_t epoch(int64_t id) const { return keyframes_.at(id).epoch; }
+  /// Odometry edges whose ends are in different epochs (0 by construction; a check for tests).
+  size_t odometryEdgesAcrossEpochs() const;
   /// The keyframe's cloud for the global map (voxel-downsampled, body frame I).
   const std::vector<Eigen::Vector3f>& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
   size_t size() const { return keyframes_.size(); }
@@ -92,8 +107,8 @@ class LoopCloser {
  private:
   struct Keyframe {
     int64_t utime = 0;
-    Pose3 published = Pose3::Identity();  // as received
-    Pose3 odometry = Pose3::Identity();   // in the raw odometry frame (no correction adopted)
+    int32_t epoch = 0;
+    Pose3 odometry = Pose3::Identity();   // in the raw odometry frame of its epoch (no correction)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     CoarseFeatures coarse;              // in G
@@ -107,7 +122,8 @@ class LoopCloser {
   std::map<int64_t, Keyframe> keyframes_;
   std::vector<AcceptedLoop> loops_;
   int64_t keyframes_since_loop_ = 1000000;
-  Pose3 adopted_ = Pose3::Identity();  // the odometry's current frame <- raw odometry frame
+  CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch
+  int64_t next_correction_id_ = 1;
 };
 
 }  // namespace livo::loop

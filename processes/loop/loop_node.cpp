@@ -42,7 +42,6 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("odometry_translation_per_m", c.odometry_translation_per_m);
   s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
-  s.readOptional("odometry_adopts_corrections", c.odometry_adopts_corrections);
   s.checkAllUsed();
   if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
       c.registration.quatro.noise_bound <= 0)
@@ -68,11 +67,6 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
     node_.reject(ch, "keyframe " + std::to_string(m.id) + " has a zero quaternion");
     return;
   }
-  if (closer_.size() > 0 && m.id <= closer_.graph().poses().rbegin()->first) {
-    node_.reject(ch, "keyframe " + std::to_string(m.id) + " is not after keyframe " +
-                         std::to_string(closer_.graph().poses().rbegin()->first) + " (out of order or repeated)");
-    return;
-  }
   const point_cloud_t& c = m.cloud;
   if (c.num_points < 0 || static_cast<size_t>(c.num_points) != c.x.size() || c.x.size() != c.y.size() ||
       c.x.size() != c.z.size()) {
@@ -84,6 +78,15 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   KeyframeInput in;
   in.id = m.id;
   in.utime = m.utime;
+  in.epoch = m.epoch;
+  in.correction_id = m.correction_id;
+  if (const std::string why = closer_.problem(in); !why.empty()) {
+    node_.reject(ch, why);
+    return;
+  }
+  if (closer_.size() > 0 && m.epoch > closer_.epoch(closer_.graph().poses().rbegin()->first))
+    node_.warn("keyframe " + std::to_string(m.id) + " starts odometry epoch " + std::to_string(m.epoch) +
+               " (the LIO was reset): a new graph segment, no odometry edge to the previous keyframe");
   in.pose = poseFrom(m.position, m.orientation);
   in.covariance = matrixFrom<6>(m.pose_covariance);
   in.cloud.reserve(c.x.size());
@@ -111,27 +114,31 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
     s << "loop " << r.loop->from_id << " -> " << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
       << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << ")";
     node_.info(s.str());
-    publishCorrection(*r.loop, m.utime);
+    publishCorrection(*r.loop, *r.correction, m.utime);
   }
 }
 
-void LoopNode::publishCorrection(const AcceptedLoop& loop, int64_t utime) {
+void LoopNode::publishCorrection(const AcceptedLoop& loop, const Correction& correction, int64_t utime) {
   loop_correction_t msg;
   msg.utime = utime;
+  msg.correction_id = correction.id;
+  msg.epoch = correction.epoch;
   msg.loop_from_id = loop.from_id;
   msg.loop_to_id = loop.to_id;
   msg.loop_fitness = loop.fitness;
-  poseTo(closer_.correction(), msg.correction_position, msg.correction_orientation);
-  const auto& poses = closer_.graph().poses();
-  msg.num_keyframes = static_cast<int32_t>(poses.size());
-  msg.keyframe_id.reserve(poses.size());
-  for (const auto& [id, T] : poses) {
+  poseTo(correction.T_Ck_Cj, msg.correction_position, msg.correction_orientation);
+  msg.previous_correction_id = correction.previous_id;
+  poseTo(correction.T_Ck_O, msg.odometry_to_corrected_position, msg.odometry_to_corrected_orientation);
+  // the keyframes of the correction's epoch (the others are in unrelated frames)
+  for (const auto& [id, T] : closer_.graph().poses()) {
+    if (closer_.epoch(id) != correction.epoch) continue;
     msg.keyframe_id.push_back(id);
     std::vector<double> p(3), q(4);
     poseTo(T, p.data(), q.data());
     msg.position.push_back(p);
     msg.orientation.push_back(q);
   }
+  msg.num_keyframes = static_cast<int32_t>(msg.keyframe_id.size());
   node_.publish(options_.loop_correction_channel, msg);
 }
 

@@ -35,7 +35,7 @@ class LoopNode {
 
  private:
   void onKeyframe(const keyframe_t& msg);
-  void publishCorrection(const AcceptedLoop& loop, int64_t utime);
+  void publishCorrection(const AcceptedLoop& loop, const Correction& correction, int64_t utime);
 
   Node node_;
   LoopNodeOptions options_;

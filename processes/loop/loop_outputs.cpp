@@ -32,9 +32,22 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"fitness", l.fitness},
                      {"overlap", l.overlap}});
   }
+  // graph segments: one per odometry epoch (a LIO reset starts a new one, with no edge to the last)
+  nlohmann::json epochs = nlohmann::json::array();
+  for (const auto& [id, pose] : closer.graph().poses()) {
+    if (epochs.empty() || epochs.back()["epoch"] != closer.epoch(id))
+      epochs.push_back({{"epoch", closer.epoch(id)}, {"first_id", id}, {"last_id", id}, {"num_keyframes", 0}});
+    epochs.back()["last_id"] = id;
+    epochs.back()["num_keyframes"] = epochs.back()["num_keyframes"].get<int64_t>() + 1;
+  }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << nlohmann::json{{"num_keyframes", closer.size()}, {"loops", loops}}.dump(2) << "\n";
+  out << nlohmann::json{{"num_keyframes", closer.size()},
+                        {"loops", loops},
+                        {"epochs", epochs},
+                        {"odometry_edges_across_epochs", closer.odometryEdgesAcrossEpochs()}}
+             .dump(2)
+      << "\n";
 }
 
 void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {

@@ -128,7 +128,11 @@ PoseGraph::PoseGraph(PoseGraph&&) noexcept = default;
 PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
 
 PoseGraph::PoseGraph(const PoseGraph& other)
-    : options_(other.options_), poses_(other.poses_), blocks_(other.blocks_), edges_(other.edges_) {
+    : options_(other.options_),
+      poses_(other.poses_),
+      blocks_(other.blocks_),
+      edges_(other.edges_),
+      held_fixed_(other.held_fixed_) {
   for (auto& [id, b] : blocks_) b.in_problem = false;
 }
 
@@ -188,7 +192,7 @@ PoseGraphSummary PoseGraph::optimize() {
     Block& b = blocks_.at(id);
     if (b.in_problem) return b.x.data();
     problem.AddParameterBlock(b.x.data(), 7, &poseManifold());
-    if (id == first_id) problem.SetParameterBlockConstant(b.x.data());
+    if (id == first_id || held_fixed_.count(id)) problem.SetParameterBlockConstant(b.x.data());
     b.in_problem = true;
     return b.x.data();
   };

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 #include <vector>
 
 #include "livo/so3.hpp"
@@ -61,6 +62,9 @@ class PoseGraph {
   /// Adds (or replaces the estimate of) a node.
   void addNode(int64_t id, const Pose3& initial);
   bool hasNode(int64_t id) const { return poses_.count(id) > 0; }
+  /// Holds a node constant like the first one: the first keyframe of a graph segment (a segment
+  /// starts after an odometry reset and has no edge to the ones before it).
+  void holdFixed(int64_t id) { held_fixed_.insert(id); }
   /// Throws std::invalid_argument if an end is unknown.
   void addEdge(const PoseEdge& edge);
 
@@ -88,6 +92,7 @@ class PoseGraph {
   std::unique_ptr<ceres::Problem> problem_;
   size_t edges_in_problem_ = 0;
   int64_t fixed_id_ = 0;  // the node held constant in problem_
+  std::set<int64_t> held_fixed_;  // first nodes of later segments (holdFixed)
 };
 
 /// The information of a relative edge from two absolute covariances (cov_to - cov_from,

@@ -191,6 +191,8 @@ OccupancyMap::OccupancyMap(const OctomapOptions& options) : options_(options), s
   clear();
 }
 OccupancyMap::~OccupancyMap() = default;
+OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
+OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
 
 void OccupancyMap::clear() {
   plain_.reset();

@@ -26,6 +26,9 @@ class OccupancyMap {
  public:
   explicit OccupancyMap(const OctomapOptions& options);
   ~OccupancyMap();
+  // movable (a builder starts a new map after an odometry reset), not copyable
+  OccupancyMap(OccupancyMap&&) noexcept;
+  OccupancyMap& operator=(OccupancyMap&&) noexcept;
 
   /// Casts a ray from `origin` to every point (world frame); non-finite points and points within
   /// min_range are skipped. Returns the number of rays inserted.

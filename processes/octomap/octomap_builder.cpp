@@ -61,12 +61,13 @@ bool OctomapBuilder::addKeyframe(int64_t id, Keyframe keyframe) {
   return true;
 }
 
-int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected) {
+int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted) {
   int moved = 0;
-  for (const auto& [id, pose] : corrected) {
-    auto it = keyframes_.find(id);
-    if (it == keyframes_.end() || !pose.matrix().allFinite()) continue;
-    Keyframe& k = it->second.keyframe;
+  for (auto& [id, stored] : keyframes_) {
+    auto it = corrected.find(id);
+    const Pose3 pose = it != corrected.end() ? it->second : unlisted * stored.keyframe.T_W_I;
+    if (!pose.matrix().allFinite()) continue;
+    Keyframe& k = stored.keyframe;
     if ((pose.matrix() - k.T_W_I.matrix()).cwiseAbs().maxCoeff() < 1e-12) continue;
     k.T_W_I = pose;
     ++moved;

@@ -28,16 +28,18 @@ struct Keyframe {
 class OctomapBuilder {
  public:
   OctomapBuilder(const OctomapOptions& options, const Pose3& T_I_L);
+  const Pose3& lidarExtrinsics() const { return T_I_L_; }
 
   /// False with `error` for a stale or malformed scan (nothing is inserted).
   bool addScan(const RegisteredScanView& scan, std::string* error);
   /// Keeps a keyframe for rebuilds (a later one with the same id replaces it); false (and nothing
   /// kept) for a non-finite pose.
   bool addKeyframe(int64_t id, Keyframe keyframe);
-  /// Moves the listed keyframes (unknown ids are ignored) and rebuilds the map from every
-  /// keyframe if a keyframe point now lies more than rebuild_tolerance from where the tree has it.
-  /// Returns the number of keyframes that moved.
-  int applyCorrection(const std::map<int64_t, Pose3>& corrected);
+  /// Moves the listed keyframes (unknown ids are ignored), the others by `unlisted` (the
+  /// correction's transform: keyframes the loop closure had not seen yet), and rebuilds the map
+  /// from every keyframe if a keyframe point now lies more than rebuild_tolerance from where the
+  /// tree has it. Returns the number of keyframes that moved.
+  int applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted = Pose3::Identity());
   /// After applyCorrection: the largest shift of a keyframe point (or LiDAR origin) from where the
   /// tree has it, m (an upper bound: |dt| + 2 sin(angle / 2) * reach), and whether it rebuilt.
   double lastCorrectionShift() const { return last_shift_; }

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
+#include "livo/correction_frames.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/map_inputs.hpp"
@@ -22,8 +23,18 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       output_dir_(std::move(output_dir)) {
   if (options_.publish_period_s > 0) node_.declareOutput(options_.output_channel);
   node_.subscribe<registered_scan_t>(options_.scan_channel, [this](const registered_scan_t& m) {
+    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+    if (placed.placement != MapFrame::Placement::kUse) {
+      node_.reject(options_.scan_channel, placed.why);
+      return;
+    }
+    registered_scan_t moved;
+    if (placed.moved) {  // published before the LIO adopted the map's loop correction
+      moved = m;
+      moveRegisteredScan(placed.to_map, &moved);
+    }
     RegisteredScanView v;
-    if (const std::string why = viewRegisteredScan(m, &v); !why.empty()) {
+    if (const std::string why = viewRegisteredScan(placed.moved ? moved : m, &v); !why.empty()) {
       node_.reject(options_.scan_channel, why);
       return;
     }
@@ -55,10 +66,15 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       node_.reject(options_.keyframe_channel, why);
       return;
     }
+    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+    if (placed.placement != MapFrame::Placement::kUse) {
+      node_.reject(options_.keyframe_channel, placed.why);
+      return;
+    }
     const point_cloud_t& c = m.cloud;
     Keyframe k;
     k.utime = m.utime;
-    k.T_W_I = poseFrom(m.position, m.orientation);
+    k.T_W_I = placed.to_map * poseFrom(m.position, m.orientation);
     for (int i = 0; i < c.num_points; ++i) {
       const Eigen::Vector3f p(c.x[i], c.y[i], c.z[i]);
       if (p.allFinite()) k.points.push_back(p);
@@ -67,18 +83,40 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
   });
   node_.subscribe<loop_correction_t>(options_.correction_channel, [this](const loop_correction_t& m) {
     std::map<int64_t, Pose3> corrected;
-    if (const std::string why = correctedKeyframePoses(m, &corrected); !why.empty()) {
+    Pose3 T_Ck_O;
+    std::string why = correctedKeyframePoses(m, &corrected);
+    if (why.empty()) why = correctionTransform(m, &T_Ck_O);
+    if (!why.empty()) {
       node_.reject(options_.correction_channel, why);
       return;
     }
-    const int moved = builder_.applyCorrection(corrected);
+    const MapFrame::CorrectionStep step = frame_.addCorrection(m.correction_id, m.epoch, T_Ck_O);
+    if (!step.apply) {
+      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + step.why);
+      return;
+    }
+    const int moved = builder_.applyCorrection(corrected, step.unlisted);
     std::ostringstream s;
-    s << "loop correction: " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
+    s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
       << " m; ";
     if (builder_.lastCorrectionRebuilt()) s << "rebuilt from " << builder_.keyframes() << " keyframes";
     else s << "tree kept (rebuild_tolerance " << options_.core.rebuild_tolerance << " m)";
     node_.info(s.str());
     if (builder_.lastCorrectionRebuilt()) publishTree(m.utime);
+  });
+}
+
+MapFrame::Placed OctomapNode::placeInMap(int32_t epoch, int64_t correction_id) {
+  return frame_.place(epoch, correction_id, [&](int32_t old_epoch) {
+    // the LIO was reset: the old map is finished as it is, written beside the final one, and a
+    // new map starts in the new odometry frame
+    const std::string name = options_.map_name + "_epoch" + std::to_string(old_epoch);
+    node_.warn("odometry epoch " + std::to_string(epoch) + " (LIO reset): the map of epoch " +
+               std::to_string(old_epoch) + (output_dir_.empty() ? " is dropped" : " goes to " + mapPath(name, ".bt")) +
+               "; a new map starts");
+    if (!output_dir_.empty()) writeFiles(name);
+    builder_ = OctomapBuilder(options_.core, builder_.lidarExtrinsics());
+    last_publish_ = last_write_ = INT64_MIN;  // the new epoch's clock may be behind the old one's
   });
 }
 
@@ -109,11 +147,18 @@ void OctomapNode::publishTree(int64_t utime) {
   node_.publish(options_.output_channel, msg);
 }
 
-bool OctomapNode::writeFiles() {
+std::string OctomapNode::mapPath(const std::string& name, const char* extension) const {
+  return output_dir_ + "/" + name + extension;
+}
+
+bool OctomapNode::writeFiles() { return writeFiles(options_.map_name); }
+
+bool OctomapNode::writeFiles(const std::string& name) {
   std::error_code ec;
   std::filesystem::create_directories(output_dir_, ec);
-  const bool ok = builder_.map().writeBinary(btPath()) && builder_.map().writeFull(otPath());
-  if (!ok) node_.error("cannot write " + btPath() + " / " + otPath());
+  const std::string bt = mapPath(name, ".bt"), ot = mapPath(name, ".ot");
+  const bool ok = builder_.map().writeBinary(bt) && builder_.map().writeFull(ot);
+  if (!ok) node_.error("cannot write " + bt + " / " + ot);
   return ok;
 }
 

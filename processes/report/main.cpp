@@ -45,6 +45,7 @@ int extract(int argc, char** argv) {
   livo::writeTum(dir + "/odometry.tum", out.odometry);
   livo::writeTum(dir + "/trajectory.tum", livo::loopCorrectedTrajectory(out));
   writeText(dir + "/timing.json", livo::timingJson(out.final_health).dump(2) + "\n");
+  writeText(dir + "/resets.json", livo::resetsJson(out.resets));
   std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
             << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes\n";
   if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
@@ -105,6 +106,7 @@ int markdown(int argc, char** argv) {
     in.supervised = true;
     in.restarts = livo::readRestarts(cli.get("--restarts"));
   }
+  if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
   for (const auto& [node, p] : in.timing.items()) {
     for (const auto& [channel, c] : p["channels"].items()) {
       if (c.value("decode_failures", 0) > 0)

@@ -21,19 +21,34 @@ struct PipelineChannels {
   std::string health = "HEALTH";
 };
 
+/// The frame a published pose is in (odometry_t / keyframe_t epoch and correction_id).
+struct PublishedFrame {
+  int32_t epoch = 0;
+  int64_t correction_id = 0;
+};
+
 struct KeyframePose {
   int64_t id = 0;
   double stamp = 0.0;
   Pose3 pose = Pose3::Identity();  // as published (odometry frame at that time)
+  PublishedFrame frame;
+};
+
+/// An LIO reset seen in the outputs: the first odometry of a new epoch.
+struct OdometryReset {
+  double stamp = 0.0;   // first odometry of the new epoch
+  int32_t epoch = 0;    // the new epoch
+  std::string reason;   // from lio's HEALTH ("odometry reset to epoch N: ..."), empty if not logged
 };
 
 struct PipelineOutputs {
   Trajectory odometry;                          // body pose at every scan, in stamp order
+  std::vector<PublishedFrame> odometry_frames;  // the frame of each odometry pose (same order)
   std::vector<KeyframePose> keyframes;          // in id order
-  std::optional<loop_correction_t> last_loop;   // the newest LOOP_CORRECTION
-  double last_loop_after = 0.0;  // stamp of the newest odometry logged before it: later odometry and
-                                 // keyframes come from a LIO that had adopted it (design.md)
+  std::map<int32_t, loop_correction_t> last_loop;  // the newest LOOP_CORRECTION of each epoch
+  std::map<int64_t, std::pair<int32_t, Pose3>> corrections;  // every correction: id -> (epoch, T_Ck_O)
   int64_t loop_corrections = 0;
+  std::vector<OdometryReset> resets;            // in stamp order
   std::map<std::string, health_t> final_health; // newest HEALTH per node
   int64_t undecodable = 0;                      // messages on these channels that did not decode
   int64_t non_finite = 0;                       // odometry poses dropped for NaN/Inf
@@ -42,11 +57,16 @@ struct PipelineOutputs {
 /// Reads the log; throws std::runtime_error naming the file if it cannot be opened.
 PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineChannels& channels = {});
 
-/// The final trajectory: each odometry pose moved by the correction of the newest keyframe at or
-/// before it, T = K_corrected * K_published^-1 * T_odometry, using the last loop correction's
-/// keyframe poses; keyframes newer than it keep its overall correction, unless they were published
-/// after it, by a LIO that had adopted it: those, and the odometry after them, are final as they
-/// are. Identical to the odometry when there was no loop correction.
+/// The final trajectory. Each pose is first taken back to the raw odometry frame of its epoch
+/// through the loop correction it says it includes (correction_id; so a pose published after lio
+/// adopted a correction is never corrected twice, whatever the arrival order), then moved by the
+/// correction of the newest keyframe of its epoch at or before it, K_corrected * K_raw^-1, using
+/// the last loop correction of that epoch (keyframes newer than it take its odometry_to_corrected).
+/// Identical to the odometry when there was no loop correction. Epochs stay separate (each in its
+/// own frame). Throws std::runtime_error for a pose in a correction the log does not hold.
 Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs);
+
+/// The resets as JSON: [{"time": s, "epoch": n, "reason": "..."}].
+std::string resetsJson(const std::vector<OdometryReset>& resets);
 
 }  // namespace livo

@@ -92,7 +92,22 @@ std::string reportMarkdown(const ReportInputs& in) {
     md << "| keyframes | " << in.outputs->keyframes.size() << " |\n";
     md << "| loop corrections | " << in.outputs->loop_corrections << " |\n";
   }
+  md << "| odometry resets | " << in.resets.size() << " (epochs 0.." << in.resets.size() << ") |\n";
   md << "\n";
+
+  if (!in.resets.empty()) {
+    md << "## Odometry resets\n\n";
+    md << "livo-lio re-initialised: the odometry restarted at the origin in a new epoch, and every consumer "
+          "started over in it (loop: a new graph segment; vio, colour, octomap: a new map; the old maps are "
+          "written as `*_epoch<N>.*`). Trajectories of different epochs are in unrelated frames.\n\n";
+    md << "| time s | new epoch | reason |\n| --- | --- | --- |\n";
+    for (const auto& r : in.resets) {
+      const std::string reason = r.value("reason", std::string());
+      md << "| " << fixed(r.value("time", 0.0), 3) << " | " << r.value("epoch", 0) << " | "
+         << (reason.empty() ? "(not in HEALTH; see logs/lio.log)" : reason) << " |\n";
+    }
+    md << "\n";
+  }
 
   if (!in.evaluations.empty()) {
     md << "## Accuracy\n\n";

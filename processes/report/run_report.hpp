@@ -51,6 +51,7 @@ struct ReportInputs {
   std::vector<std::string> injected_faults;  // playback's fault counts, one line per channel
   std::vector<ProcessRestart> restarts;
   bool supervised = false;  // the run restarted processes that exited (the Restarts section)
+  nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
   const PipelineOutputs* outputs = nullptr;
 };
 

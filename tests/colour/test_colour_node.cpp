@@ -13,6 +13,7 @@
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
+#include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "map_files.hpp"
@@ -201,7 +202,9 @@ TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
 
   loop_correction_t bad{};
   bad.utime = 1300000;
+  bad.correction_id = 1;
   bad.correction_orientation[0] = 1.0;
+  bad.odometry_to_corrected_orientation[0] = 1.0;
   bad.num_keyframes = 1;
   bad.keyframe_id = {0};
   bad.position = {{0.5, 0.0, 0.0}};
@@ -248,7 +251,9 @@ TEST(ColourNode, SplitsLargeUpdatesIntoBoundedMessages) {
 
   loop_correction_t move{};
   move.utime = 1300000;
+  move.correction_id = 1;
   move.correction_orientation[0] = 1.0;
+  move.odometry_to_corrected_orientation[0] = 1.0;
   move.num_keyframes = 1;
   move.keyframe_id = {0};
   move.position = {{0.5, 0.0, 0.0}};
@@ -269,6 +274,139 @@ TEST(ColourNode, SplitsLargeUpdatesIntoBoundedMessages) {
   }
   EXPECT_EQ(total, moved);
   EXPECT_EQ(distinct.size(), total);
+}
+
+namespace {
+/// A few world-frame points around `at` (a marker to find in the map), published in (epoch,
+/// correction) with the body at `body`.
+registered_scan_t markerScan(int64_t utime, const Eigen::Vector3f& at, const Vec3& body, int32_t epoch,
+                             int64_t correction_id) {
+  registered_scan_t s = makeScan(utime);
+  s.position[0] = body.x(), s.position[1] = body.y(), s.position[2] = body.z();
+  s.epoch = epoch;
+  s.correction_id = correction_id;
+  point_cloud_t& c = s.cloud;
+  c.x.clear(), c.y.clear(), c.z.clear();
+  for (int i = 0; i < 5; ++i) {
+    c.x.push_back(at.x() + 0.01f * i);
+    c.y.push_back(at.y());
+    c.z.push_back(at.z());
+  }
+  c.num_points = static_cast<int32_t>(c.x.size());
+  c.intensity.assign(c.x.size(), 0.f);
+  c.time_offset.assign(c.x.size(), 0.05f);
+  c.ring.assign(c.x.size(), -1);
+  return s;
+}
+
+bool mapHasPointNear(const colour::ColouringPipeline& p, const Eigen::Vector3f& at) {
+  for (const auto& point : p.map().points())
+    if ((point.position - at).norm() < 0.1f) return true;
+  return false;
+}
+
+int64_t rejectedOn(colour::ColourNode& node, const std::string& channel) {
+  for (const channel_stats_t& c : node.node().healthMessage().channels)
+    if (c.channel == channel) return c.rejected;
+  return -1;
+}
+}  // namespace
+
+// Real-time hand-offs (lcmtypes/loop_correction_t.lcm): after correction 1 moved the map, a scan
+// lio published before adopting it (correction_id 0) is moved onto it, one published after (1) is
+// used as it is (not corrected twice), one in a correction never received is refused. A scan of a
+// new odometry epoch writes the old map as <map_name>_epoch0.ply/.pcd and starts an empty one; the
+// old epoch's scans and corrections are refused afterwards.
+TEST(ColourNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  const std::string dir = livo_test::tempPath("colour_epochs");
+  TestNode t(lcm, dir);
+  colour::ColourNode& node = t.node;
+  std::vector<colored_cloud_t> received;
+  collect(lcm, &received);
+
+  keyframe_t kf{};
+  kf.id = 0;
+  kf.utime = 1000000;
+  kf.orientation[0] = 1.0;
+  kf.cloud.frame = "I";
+  lcm.publish("KEYFRAME", &kf);
+  publishStillOdometry(lcm);
+  const image_t img = makeImage(*t.rig.camera, 1050000);
+  lcm.publish("CAMERA", &img);
+  for (int64_t utime : {1100000, 1200000}) {
+    const registered_scan_t scan = makeScan(utime);
+    lcm.publish("REGISTERED_SCAN", &scan);
+  }
+  drain(lcm);
+  ASSERT_GT(node.pipeline().map().colouredCount(), 1000u);
+
+  // correction 1: the odometry frame moves 0.5 m along x
+  Pose3 T = Pose3::Identity();
+  T.translation() = Vec3(0.5, 0.0, 0.0);
+  loop_correction_t c1{};
+  c1.utime = 1250000;
+  c1.correction_id = 1;
+  poseTo(T, c1.correction_position, c1.correction_orientation);
+  poseTo(T, c1.odometry_to_corrected_position, c1.odometry_to_corrected_orientation);
+  c1.num_keyframes = 1;
+  c1.keyframe_id = {0};
+  c1.position = {{0.5, 0.0, 0.0}};
+  c1.orientation = {{1.0, 0.0, 0.0, 0.0}};
+  lcm.publish("LOOP_CORRECTION", &c1);
+  drain(lcm);
+  const size_t published = received.size();
+  ASSERT_GT(published, 0u);
+  EXPECT_EQ(received.back().utime, 1250000);  // the moved map republished
+
+  const Eigen::Vector3f a(1.0f, 2.0f, 0.3f), b(1.0f, 3.0f, 0.3f), c(1.0f, 4.0f, 0.3f), shift(0.5f, 0.f, 0.f);
+  const registered_scan_t late = markerScan(1300000, a, Vec3::Zero(), 0, 0);  // before lio adopted 1
+  lcm.publish("REGISTERED_SCAN", &late);
+  const registered_scan_t adopted = markerScan(1400000, b + shift, Vec3(0.5, 0.0, 0.0), 0, 1);  // after
+  lcm.publish("REGISTERED_SCAN", &adopted);
+  const registered_scan_t unknown = markerScan(1450000, c, Vec3::Zero(), 0, 7);  // never received here
+  lcm.publish("REGISTERED_SCAN", &unknown);
+  drain(lcm);
+  EXPECT_TRUE(mapHasPointNear(node.pipeline(), a + shift));
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), a));
+  EXPECT_TRUE(mapHasPointNear(node.pipeline(), b + shift));
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), b + 2 * shift));  // not corrected twice
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), c));
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), c + shift));
+  EXPECT_EQ(rejectedOn(node, "REGISTERED_SCAN"), 1);
+  const size_t coloured_epoch0 = node.pipeline().map().colouredCount();
+
+  // lio reset: epoch 1, its clock behind the old one
+  registered_scan_t reset = makeScan(500000);
+  reset.epoch = 1;
+  lcm.publish("REGISTERED_SCAN", &reset);
+  drain(lcm);
+  EXPECT_EQ(node.pipeline().stats().scans, 1);
+  EXPECT_EQ(node.pipeline().map().colouredCount(), 0u);
+  EXPECT_GT(node.pipeline().map().size(), 1000u);
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), a + shift));
+  colour::ColouredPoints old;
+  std::string error;
+  ASSERT_TRUE(colour::readPly(dir + "/colour_map_epoch0.ply", &old, &error)) << error;
+  EXPECT_EQ(old.size(), coloured_epoch0);
+  ASSERT_TRUE(colour::readPcd(dir + "/colour_map_epoch0.pcd", &old, &error)) << error;
+  EXPECT_EQ(old.size(), coloured_epoch0);
+
+  // the old epoch afterwards: a scan and a correction, both without effect
+  const size_t before = received.size();
+  const registered_scan_t stale = markerScan(1500000, a, Vec3::Zero(), 0, 1);
+  lcm.publish("REGISTERED_SCAN", &stale);
+  loop_correction_t c2 = c1;
+  c2.utime = 1550000;
+  c2.correction_id = 2;
+  c2.previous_correction_id = 1;
+  lcm.publish("LOOP_CORRECTION", &c2);
+  drain(lcm);
+  EXPECT_EQ(rejectedOn(node, "REGISTERED_SCAN"), 2);
+  EXPECT_EQ(node.pipeline().stats().scans, 1);
+  EXPECT_EQ(received.size(), before);
+  EXPECT_FALSE(mapHasPointNear(node.pipeline(), a));
 }
 
 TEST(ColourNode, RefusesARigWithoutCamera) {

@@ -365,7 +365,8 @@ TEST(LioEstimator, LoopCorrectionMovesStateAndRebuildsMap) {
   const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.03)), Vec3(0.5, -0.3, 0.0));
   std::vector<LioEstimator::KeyframePose> corrected;
   for (const auto& kf : lio.keyframes()) corrected.push_back({kf.id, T * kf.pose});
-  lio.applyLoopCorrection(T, corrected);
+  lio.applyLoopCorrection({1, 0, T, T}, corrected);
+  EXPECT_EQ(lio.frame().correction_id, 1);
   EXPECT_LT((lio.state().pos - (T * x0.pos)).norm(), 1e-12);
   EXPECT_LT((lio.state().vel - T.linear() * x0.vel).norm(), 1e-12);
   EXPECT_FALSE(lio.map().empty());

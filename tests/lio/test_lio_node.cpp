@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <functional>
 
+#include "livo/filter_state_message.hpp"
 #include "livo/image_t.hpp"
+#include "livo/loop_correction_t.hpp"
 #include "livo/lio/lio_node.hpp"
 #include "livo/messages.hpp"
 #include "synthetic_world.hpp"
@@ -497,3 +499,63 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
     EXPECT_LT(alignedError(out, seq), 0.002);
   }
 }
+
+namespace {
+// Real-time orders around a reset: a loop correction of the current epoch is adopted (later
+// output says so in correction_id); an IMU clock jump back re-initialises lio in epoch 1; then a
+// correction and a posterior made for epoch 0 arrive late and are both ignored.
+TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
+  std::vector<Message> msgs = syntheticRun();
+  loop_correction_t lc{};
+  lc.utime = kBase + 1'000'000;
+  lc.correction_id = 1;
+  lc.epoch = 0;
+  const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.01)), Vec3(0.2, 0.0, 0.0));
+  poseTo(T, lc.correction_position, lc.correction_orientation);
+  poseTo(T, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
+  msgs.push_back(encode(kBase + 1'000'001, "LOOP_CORRECTION", lc));
+  imu_t jumped = toImuMsg(syntheticSequence().imu().front());
+  jumped.utime = kBase - 2'000'000;  // 3.5 s back from 1.5 s: more than clock_reset_s
+  msgs.push_back(encode(kBase + 1'500'001, "IMU", jumped));
+  loop_correction_t old = lc;
+  old.correction_id = 2;
+  old.previous_correction_id = 1;
+  msgs.push_back(encode(kBase + 1'500'002, "LOOP_CORRECTION", old));
+  filter_state_t posterior = toFilterState(kBase + 1'400'000, FilterState(), Mat18::Identity(), 1, "vio");
+  posterior.epoch = 0;
+  msgs.push_back(encode(kBase + 1'500'003, "STATE_POSTERIOR", posterior));
+  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  int64_t rejected = 0, rejected_posteriors = 0;
+  RunSetup setup;
+  setup.rejected_posteriors = &rejected_posteriors;
+  const Outputs out = runNode(msgs, &rejected, setup);
+  EXPECT_EQ(rejected_posteriors, 1);
+  EXPECT_GE(rejected, 2);  // the posterior and the old epoch's correction (and late sweeps, if any)
+  ASSERT_FALSE(out.odometry.empty());
+  // lio publishes a sweep's odometry once the IMU passed its end, so a sweep ending at or just
+  // before the correction's arrival may already be in correction 1: every later sweep is, none
+  // goes back to 0, and the early ones are raw.
+  int adopted = 0, raw = 0;
+  int64_t previous_id = 0;
+  for (const odometry_t& o : out.odometry) {
+    EXPECT_TRUE(allFinite(o.position, 3));
+    if (o.epoch == 0) {
+      if (o.utime > kBase + 1'000'000) {
+        EXPECT_EQ(o.correction_id, 1) << o.utime;
+      }
+      EXPECT_GE(o.correction_id, previous_id) << o.utime;
+      EXPECT_LE(o.correction_id, 1) << o.utime;
+      previous_id = o.correction_id;
+      adopted += o.correction_id == 1;
+      raw += o.correction_id == 0;
+    } else {
+      EXPECT_EQ(o.epoch, 1);
+      EXPECT_EQ(o.correction_id, 0);  // correction 2 was for epoch 0
+    }
+  }
+  EXPECT_GT(adopted, 0);
+  EXPECT_GT(raw, 0);
+  for (const keyframe_t& k : out.keyframes) EXPECT_LE(k.epoch, 1);
+  for (size_t i = 0; i < out.scans.size(); ++i) EXPECT_EQ(out.scans[i].epoch, out.odometry[i].epoch);
+}
+}  // namespace

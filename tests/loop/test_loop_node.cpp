@@ -46,11 +46,21 @@ keyframe_t makeKeyframe(int64_t id, const Pose3& pose, const Points& cloud) {
   return k;
 }
 
+// How the simulated odometry takes the corrections it hears.
+enum class Adoption {
+  kIgnores,             // never: every keyframe has correction_id 0
+  kBeforeNextKeyframe,  // before its next keyframe (livo-lio under lockstep replay)
+  kTwoKeyframesLate,    // two keyframes later (real time: keyframes published before adoption
+                        // arrive after the correction, still in the previous frame)
+};
+
 // A loop of 36 keyframes with a yaw bias and a scale error in the odometry, run once more past
-// the start. `adopting`: the odometry takes on every correction before its next keyframe, as
-// livo-lio does (its keyframe poses jump into the corrected frame); otherwise it ignores them.
-void runDriftedLoop(bool adopting) {
-  SCOPED_TRACE(adopting ? "odometry adopts corrections" : "odometry ignores corrections");
+// the start. An adopting odometry publishes its keyframe poses in the corrected frame and says
+// which correction they include (keyframe_t.correction_id).
+void runDriftedLoop(Adoption adoption) {
+  SCOPED_TRACE(adoption == Adoption::kIgnores              ? "odometry ignores corrections"
+               : adoption == Adoption::kBeforeNextKeyframe ? "odometry adopts corrections at once"
+                                                           : "odometry adopts corrections two keyframes late");
   const Points scene = makeScene(41, 0.15);
   const int per_lap = 36, total = per_lap + 6;
   std::vector<Pose3> truth, odo;
@@ -72,7 +82,6 @@ void runDriftedLoop(bool adopting) {
   no.health_period_s = 0;
   LoopNodeOptions lo;
   lo.output_dir = livo_test::tempPath("loop-out");
-  lo.closer.odometry_adopts_corrections = adopting;
   // The graph's odometry noise model says how bad this odometry is (2 % of the distance, 0.006 rad
   // per 2.4 m step), else the graph would trust it over the loop.
   lo.closer.odometry_translation_per_m = 0.02;
@@ -81,6 +90,9 @@ void runDriftedLoop(bool adopting) {
   std::optional<loop_correction_t> last;
   int corrections = 0;
   Pose3 adopted = Pose3::Identity();  // the odometry's frame <- its raw frame
+  int64_t adopted_id = 0;
+  std::vector<std::pair<int, loop_correction_t>> heard;  // (keyframe index it arrived after, correction)
+  int index = 0;
   NodeOptions listener_options = no;
   listener_options.name = "listener";
   listener_options.publish_progress = false;
@@ -88,15 +100,23 @@ void runDriftedLoop(bool adopting) {
   listener.subscribe<loop_correction_t>("LOOP_CORRECTION", [&](const loop_correction_t& m) {
     last = m;
     ++corrections;
-    if (adopting) adopted = poseFrom(m.correction_position, m.correction_orientation) * adopted;
+    heard.push_back({index, m});
   });
+  const int delay = adoption == Adoption::kTwoKeyframesLate ? 2 : 0;
 
   std::vector<Pose3> published;
   for (int i = 0; i < total; ++i) {
+    index = i;
+    for (const auto& [after, m] : heard)
+      if (adoption != Adoption::kIgnores && m.correction_id > adopted_id && i - 1 - after >= delay) {
+        adopted = poseFrom(m.odometry_to_corrected_position, m.odometry_to_corrected_orientation);
+        adopted_id = m.correction_id;
+      }
     const Pose3& T = truth[i];
     const Points cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
     published.push_back(adopted * odo[i]);
     keyframe_t k = makeKeyframe(i, published.back(), cloud);
+    k.correction_id = adopted_id;
     lcm.publish("KEYFRAME", &k);
     drain(lcm);
     if (i == 10) {  // bad input on the way: a NaN pose and a repeated id are refused
@@ -118,11 +138,21 @@ void runDriftedLoop(bool adopting) {
   ASSERT_GT(last->num_keyframes, per_lap);  // the loop closes on the way past the start
   const double drift = translationError(odo[total - 1], truth[total - 1]);
   EXPECT_GT(drift, 3.0);
+  if (adoption != Adoption::kIgnores) {
+    ASSERT_GT(adopted_id, 0);
+    EXPECT_EQ(last->correction_id, corrections);  // 1, 2, ...
+  }
+  if (adoption == Adoption::kTwoKeyframesLate) {  // keyframes in the previous frame came after a correction
+    bool stale_after_correction = false;
+    for (size_t c = 0; c < heard.size(); ++c)
+      stale_after_correction |= heard[c].first + 1 < total;
+    EXPECT_TRUE(stale_after_correction);
+  }
   // The graph's odometry edges are the raw odometry increments whatever frame the poses came in.
   for (const PoseEdge& e : node.closer().graph().edges())
     if (!e.is_loop) {
-      EXPECT_LT(translationError(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-6) << e.from;
-      EXPECT_LT(rotationErrorDeg(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-6) << e.from;
+      EXPECT_LT(translationError(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
+      EXPECT_LT(rotationErrorDeg(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
     }
   double worst = 0.0;
   for (int i = 0; i < last->num_keyframes; ++i) {
@@ -141,8 +171,9 @@ void runDriftedLoop(bool adopting) {
   for (const auto& [id, pose] : node.closer().graph().poses())
     worst_final = std::max(worst_final, translationError(pose, truth[id]));
   EXPECT_LT(worst_final, 0.2 * drift);
-  // correction() maps the newest published pose onto its optimised one.
-  EXPECT_LT(translationError(node.closer().correction() * published.back(), node.closer().graph().poses().rbegin()->second), 1e-9);
+  // odometry_to_corrected maps the raw pose of the keyframe that closed the loop onto its optimised one
+  const Pose3 T_Ck_O = poseFrom(last->odometry_to_corrected_position, last->odometry_to_corrected_orientation);
+  EXPECT_LT(translationError(T_Ck_O * odo[last->loop_from_id], node.closer().graph().pose(last->loop_from_id)), 1e-9);
   std::printf("[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
               "%d corrections\n",
               drift, worst, worst_final, translationError(newest, truth[last->keyframe_id[n - 1]]),
@@ -158,9 +189,69 @@ void runDriftedLoop(bool adopting) {
   EXPECT_EQ(lines, total);
 }
 
-TEST(LoopNode, CorrectionBringsDriftedLoopBackToTruth) { runDriftedLoop(false); }
+TEST(LoopNode, CorrectionBringsDriftedLoopBackToTruth) { runDriftedLoop(Adoption::kIgnores); }
 
-TEST(LoopNode, OdometryThatAdoptsCorrectionsGetsTheSameCorrection) { runDriftedLoop(true); }
+TEST(LoopNode, OdometryThatAdoptsCorrectionsGetsTheSameCorrection) { runDriftedLoop(Adoption::kBeforeNextKeyframe); }
+
+// Real time: keyframes published before the odometry adopted a correction arrive after it.
+TEST(LoopNode, KeyframesPublishedBeforeAdoptionKeepRawOdometryEdges) { runDriftedLoop(Adoption::kTwoKeyframesLate); }
+
+// An odometry reset (epoch 1) at keyframe 20: the odometry restarts at the origin. No odometry
+// edge across it, a segment of its own held in its raw poses, and the edges inside each epoch are
+// the true raw increments.
+TEST(LoopNode, OdometryResetStartsANewGraphSegment) {
+  const Points scene = makeScene(41, 0.15);
+  lcm::LCM lcm("memq://");
+  NodeOptions no;
+  no.name = "loop";
+  no.quiet = true;
+  no.health_period_s = 0;
+  LoopNodeOptions lo;
+  lo.output_dir = livo_test::tempPath("loop-epochs");
+  LoopNode node(lcm, no, lo);
+  const int total = 30, reset_at = 20;
+  std::vector<Pose3> raw;  // as published: each epoch in its own raw frame
+  Pose3 origin = Pose3::Identity();  // of the current epoch
+  for (int i = 0; i < total; ++i) {
+    const double a = 2 * M_PI * i / 36;
+    const Pose3 truth = yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8));
+    if (i == reset_at) origin = truth;
+    raw.push_back(origin.inverse() * truth);
+    keyframe_t k = makeKeyframe(i, raw.back(), viewFrom(scene, truth.translation(), a + M_PI / 2, 20.0, 0.02, 100 + i));
+    k.epoch = i >= reset_at ? 1 : 0;
+    lcm.publish("KEYFRAME", &k);
+    drain(lcm);
+  }
+  // a keyframe of the old epoch after the reset, and one in a correction loop never published
+  keyframe_t late = makeKeyframe(total, raw.back(), {});
+  lcm.publish("KEYFRAME", &late);
+  keyframe_t unknown = makeKeyframe(total + 1, raw.back(), {});
+  unknown.epoch = 1;
+  unknown.correction_id = 7;
+  lcm.publish("KEYFRAME", &unknown);
+  drain(lcm);
+  ASSERT_EQ(node.closer().size(), static_cast<size_t>(total));
+  EXPECT_EQ(node.closer().odometryEdgesAcrossEpochs(), 0u);
+  int odometry_edges = 0;
+  for (const PoseEdge& e : node.closer().graph().edges()) {
+    if (e.is_loop) continue;
+    ++odometry_edges;
+    EXPECT_NE(e.to, reset_at) << "an odometry edge into the first keyframe of epoch 1";
+    EXPECT_LT(translationError(e.T_from_to, raw[e.from].inverse() * raw[e.to]), 1e-9) << e.from;
+    EXPECT_LT(rotationErrorDeg(e.T_from_to, raw[e.from].inverse() * raw[e.to]), 1e-9) << e.from;
+  }
+  EXPECT_EQ(odometry_edges, total - 2);
+  EXPECT_EQ(node.closer().graph().pose(reset_at).translation().norm(), 0.0);  // its own origin
+  int64_t rejected = -1;
+  for (const channel_stats_t& c : node.node().healthMessage().channels)
+    if (c.channel == "KEYFRAME") rejected = c.rejected;
+  EXPECT_EQ(rejected, 2);
+  node.writeOutputs();
+  std::ifstream json(lo.output_dir + "/loops.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"odometry_edges_across_epochs\": 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"first_id\": 20"), std::string::npos) << text;
+}
 
 TEST(LoopNode, EmptyAndInconsistentCloudsDoNotCrash) {
   lcm::LCM lcm("memq://");

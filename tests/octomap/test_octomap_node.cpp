@@ -107,10 +107,15 @@ keyframe_t wallKeyframe(int64_t id, int64_t utime) {
   return k;
 }
 
+// Corrections 1, 2, ... of epoch 0 with the identity as odometry_to_corrected (keyframes the
+// correction does not list stay where they are).
 loop_correction_t correction(int64_t utime, const std::vector<std::pair<int64_t, Pose3>>& poses) {
+  static int64_t next_id = 1;
   loop_correction_t m{};
   m.utime = utime;
+  m.correction_id = next_id++;
   m.correction_orientation[0] = 1.0;
+  m.odometry_to_corrected_orientation[0] = 1.0;
   m.num_keyframes = static_cast<int32_t>(poses.size());
   for (const auto& [id, T] : poses) {
     m.keyframe_id.push_back(id);
@@ -182,4 +187,127 @@ TEST(OctomapNode, RebuildsFromCorrectedKeyframesAndPublishes) {
   drain(lcm);
   EXPECT_EQ(node.builder().rebuilds(), 1);
   EXPECT_EQ(received.size(), 2u);
+}
+
+namespace {
+registered_scan_t wallScanAt(int64_t utime, float x, int32_t epoch, int64_t correction_id) {
+  registered_scan_t s = wallScan(utime);
+  for (float& px : s.cloud.x) px = x;
+  s.epoch = epoch;
+  s.correction_id = correction_id;
+  return s;
+}
+
+loop_correction_t shiftCorrection(int64_t id, int32_t epoch, int64_t previous, const Pose3& T_Ck_O,
+                                  const std::vector<std::pair<int64_t, Pose3>>& poses) {
+  loop_correction_t m = correction(1, poses);
+  m.correction_id = id;
+  m.epoch = epoch;
+  m.previous_correction_id = previous;
+  poseTo(T_Ck_O, m.correction_position, m.correction_orientation);
+  poseTo(T_Ck_O, m.odometry_to_corrected_position, m.odometry_to_corrected_orientation);
+  return m;
+}
+}  // namespace
+
+// Real-time hand-offs (lcmtypes/loop_correction_t.lcm): a scan lio published before it adopted a
+// correction arrives after the correction moved the map, and is moved onto it (not left in the old
+// frame, not corrected twice); a scan in a correction never received is refused; a scan of a new
+// odometry epoch writes the old map as <map>_epoch0.* and starts a new one; the old epoch's
+// scans and corrections are refused afterwards.
+TEST(OctomapNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  octomap_export::OctomapNodeOptions options;
+  options.publish_period_s = 0;
+  options.write_period_s = 0;
+  options.map_name = "epochs";
+  const std::string dir = livo_test::tempPath("octo_epochs");
+  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, dir);
+  auto tree = [&]() {
+    octomap_t m;
+    const std::string bytes = node.builder().map().binaryBytes();
+    m.data.assign(bytes.begin(), bytes.end());
+    return m;
+  };
+  const registered_scan_t first = wallScanAt(1000000, 2.05f, 0, 0);
+  lcm.publish("REGISTERED_SCAN", &first);
+  const keyframe_t kf0 = wallKeyframe(0, 1000000);
+  lcm.publish("KEYFRAME", &kf0);
+  drain(lcm);
+  ASSERT_EQ(node.builder().scans(), 1);
+
+  // correction 1 lifts the whole odometry frame by 2 m
+  Pose3 up = Pose3::Identity();
+  up.translation() = Vec3(0.0, 0.0, 2.0);
+  const loop_correction_t c1 = shiftCorrection(1, 0, 0, up, {{0, up}});
+  lcm.publish("LOOP_CORRECTION", &c1);
+  drain(lcm);
+  EXPECT_EQ(node.builder().rebuilds(), 1);
+  EXPECT_TRUE(occupiedIn(tree(), 2.05, 0.05, 2.05));
+
+  // published by lio before it adopted correction 1 (correction_id 0), arriving now: moved up
+  const registered_scan_t late = wallScanAt(1100000, 3.05f, 0, 0);
+  lcm.publish("REGISTERED_SCAN", &late);
+  // published after lio adopted it (its pose and points already up): used as they are
+  registered_scan_t adopted = wallScanAt(1200000, 4.05f, 0, 1);
+  adopted.position[2] = 2.0;
+  for (float& z : adopted.cloud.z) z += 2.0f;
+  lcm.publish("REGISTERED_SCAN", &adopted);
+  // in a correction this process never received
+  const registered_scan_t unknown = wallScanAt(1300000, 5.05f, 0, 7);
+  lcm.publish("REGISTERED_SCAN", &unknown);
+  drain(lcm);
+  EXPECT_EQ(node.builder().scans(), 3);
+  EXPECT_TRUE(occupiedIn(tree(), 3.05, 0.05, 2.05));
+  EXPECT_FALSE(occupiedIn(tree(), 3.05, 0.05, 0.05));
+  EXPECT_TRUE(occupiedIn(tree(), 4.05, 0.05, 2.05));
+  EXPECT_FALSE(occupiedIn(tree(), 4.05, 0.05, 4.05));  // not corrected twice
+  EXPECT_FALSE(occupiedIn(tree(), 5.05, 0.05, 0.05));
+  EXPECT_FALSE(occupiedIn(tree(), 5.05, 0.05, 2.05));
+
+  // lio reset: epoch 1 restarts the odometry (and its clock went back)
+  const registered_scan_t reset = wallScanAt(500000, 6.05f, 1, 0);
+  lcm.publish("REGISTERED_SCAN", &reset);
+  drain(lcm);
+  EXPECT_EQ(node.builder().scans(), 1);  // a new map with this scan only
+  EXPECT_EQ(node.builder().keyframes(), 0u);
+  EXPECT_TRUE(occupiedIn(tree(), 6.05, 0.05, 0.05));
+  EXPECT_FALSE(occupiedIn(tree(), 2.05, 0.05, 2.05));
+  octomap::OcTree old(0.1);
+  ASSERT_TRUE(old.readBinary(dir + "/epochs_epoch0.bt"));
+  for (double x : {2.05, 3.05, 4.05}) {
+    const octomap::OcTreeNode* n = old.search(x, 0.05, 2.05);
+    ASSERT_NE(n, nullptr) << x;
+    EXPECT_TRUE(old.isNodeOccupied(n)) << x;
+  }
+  std::unique_ptr<octomap::AbstractOcTree> old_full(octomap::AbstractOcTree::read(dir + "/epochs_epoch0.ot"));
+  EXPECT_NE(old_full, nullptr);
+
+  // the old epoch afterwards: its scans and corrections are refused, the new map does not move
+  const registered_scan_t stale = wallScanAt(1400000, 7.05f, 0, 1);
+  lcm.publish("REGISTERED_SCAN", &stale);
+  const loop_correction_t c2 = shiftCorrection(2, 0, 1, up, {{0, up}});
+  lcm.publish("LOOP_CORRECTION", &c2);
+  drain(lcm);
+  EXPECT_EQ(node.builder().scans(), 1);
+  EXPECT_EQ(node.builder().rebuilds(), 0);
+  EXPECT_FALSE(occupiedIn(tree(), 7.05, 0.05, 2.05));
+  int64_t rejected = -1;
+  for (const channel_stats_t& c : node.node().healthMessage().channels)
+    if (c.channel == "REGISTERED_SCAN") rejected = c.rejected;
+  EXPECT_EQ(rejected, 2);  // the unknown correction's scan and the old epoch's
+
+  // a correction of the new epoch moves the new map (its keyframe here) by its transform
+  const keyframe_t kf1 = wallKeyframe(1, 500000);
+  keyframe_t kf1e = kf1;
+  kf1e.epoch = 1;
+  for (float& x : kf1e.cloud.x) x = 6.05f;
+  lcm.publish("KEYFRAME", &kf1e);
+  const loop_correction_t c3 = shiftCorrection(3, 1, 0, up, {{1, up}});
+  lcm.publish("LOOP_CORRECTION", &c3);
+  drain(lcm);
+  EXPECT_EQ(node.builder().rebuilds(), 1);
+  EXPECT_TRUE(occupiedIn(tree(), 6.05, 0.05, 2.05));
+  EXPECT_FALSE(occupiedIn(tree(), 6.05, 0.05, 0.05));
 }

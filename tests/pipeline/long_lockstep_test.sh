@@ -41,5 +41,5 @@ PY
 }
 
 run campus "$root/config/sim/campus_loop.yaml" 4343
-run parking64 "$root/config/sim/parking.yaml" 7 --processes lio,vio,loop,colour,octomap
+run parking64 "$root/config/sim/parking.yaml" 7 --processes lio,vio,loop,colour
 echo "two-minute lockstep runs finished"

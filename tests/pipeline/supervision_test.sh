@@ -45,6 +45,12 @@ ate = json.load(open(out + '/evaluation_odometry.json'))['ate']['rmse']
 ref_ate = json.load(open(clean + '/evaluation_odometry.json'))['ate']['rmse']
 if p != 'lio':
     assert ate <= ref_ate + margin, f'{p}: ATE {ate:.4f} m against {ref_ate:.4f} m clean (margin {margin} m)'
+else:
+    # each restart goes on in a new odometry epoch, with keyframe ids that never repeat
+    assert '| odometry resets | 2 ' in report, f'{p}: expected two odometry resets in report.md'
+    timing = json.load(open(out + '/timing.json'))
+    rejected = timing.get('loop', {}).get('channels', {}).get('KEYFRAME', {}).get('rejected', 0)
+    assert rejected == 0, f'{p}: loop refused {rejected} keyframes after the restarts'
 print(f'{p}: 2 restarts, {len(odo)} poses (clean {len(ref)}), longest gap {gap:.2f} s, ATE {ate:.4f} m (clean {ref_ate:.4f})')
 PY
 done

@@ -69,18 +69,22 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
       lc.position.push_back({p[0], p[1], p[2]});
       lc.orientation.push_back({q[0], q[1], q[2], q[3]});
     }
+    lc.correction_id = 1;
     poseTo(correction_kf2, lc.correction_position, lc.correction_orientation);
+    poseTo(correction_kf2, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
     write(log, "LOOP_CORRECTION", 2000000, lc);
     for (int i = 20; i < 20 + adopted_tail; ++i) {
       const int64_t t = 1000000 + i * 100000;
       odometry_t o{};
       o.utime = t;
+      o.correction_id = 1;  // lio adopted correction 1
       poseTo(correction_kf2 * poseAt(i), o.position, o.orientation);
       write(log, "ODOMETRY", t, o);
       if (i == 20) {
         keyframe_t k{};
         k.id = 4;
         k.utime = t;
+        k.correction_id = 1;
         poseTo(correction_kf2 * poseAt(i), k.position, k.orientation);
         k.cloud.frame = "I";
         write(log, "KEYFRAME", t, k);
@@ -115,7 +119,7 @@ TEST(PipelineOutputs, NoLoopMeansTrajectoryEqualsOdometry) {
   EXPECT_EQ(out.odometry.size(), 19u);  // the NaN pose is dropped and counted
   EXPECT_EQ(out.non_finite, 1);
   EXPECT_EQ(out.keyframes.size(), 4u);
-  EXPECT_FALSE(out.last_loop.has_value());
+  EXPECT_TRUE(out.last_loop.empty());
   const Trajectory t = loopCorrectedTrajectory(out);
   ASSERT_EQ(t.size(), out.odometry.size());
   for (size_t i = 0; i < t.size(); ++i) EXPECT_TRUE(t[i].pose.isApprox(out.odometry[i].pose, 1e-12));
@@ -127,7 +131,7 @@ TEST(PipelineOutputs, LoopCorrectionMovesEachSpanByItsKeyframe) {
   b << 0.0, 0.0, -0.03, -0.5, 0.4, 0.1;
   const Pose3 c1 = se3::Exp(a), c2 = se3::Exp(b);
   const PipelineOutputs out = readPipelineOutputs(makeOutputs(c1, c2, true, false));
-  ASSERT_TRUE(out.last_loop.has_value());
+  ASSERT_EQ(out.last_loop.size(), 1u);
   const Trajectory t = loopCorrectedTrajectory(out);
   ASSERT_EQ(t.size(), 20u);
   for (int i = 0; i < 20; ++i) {
@@ -153,6 +157,65 @@ TEST(PipelineOutputs, OdometryAfterAnAdoptedCorrectionIsKept) {
     const Pose3 expected = (i < 5 ? Pose3::Identity() : i < 10 ? c1 : c2) * poseAt(i);
     EXPECT_NEAR((t[i].pose.matrix() - expected.matrix()).norm(), 0.0, 1e-9) << i;
   }
+}
+
+// Real-time order: odometry lio published before adopting correction 1 is logged after it (still
+// corrected, once), odometry published after adoption is kept; then a reset to epoch 1 (listed
+// with lio's reason; its odometry is in its own frame and not corrected).
+TEST(PipelineOutputs, ExplicitCorrectionIdsAndResets) {
+  Vec6 a;
+  a << 0.0, 0.0, 0.02, 0.3, -0.1, 0.0;
+  const Pose3 c = se3::Exp(a);
+  const std::string path = livo_test::tempPath("outputs_realtime") + ".lcmlog";
+  {
+    lcm::LogFile log(path, "w");
+    auto odometry = [&](int i, int32_t epoch, int64_t correction_id, const Pose3& pose) {
+      odometry_t o{};
+      o.utime = 1000000 + i * 100000;
+      o.epoch = epoch;
+      o.correction_id = correction_id;
+      poseTo(pose, o.position, o.orientation);
+      write(log, "ODOMETRY", o.utime, o);
+    };
+    keyframe_t k{};
+    k.utime = 1000000;
+    poseTo(poseAt(0), k.position, k.orientation);
+    k.cloud.frame = "I";
+    write(log, "KEYFRAME", k.utime, k);
+    for (int i = 0; i < 10; ++i) odometry(i, 0, 0, poseAt(i));
+    loop_correction_t lc{};
+    lc.utime = 1900000;
+    lc.correction_id = 1;
+    lc.num_keyframes = 1;
+    lc.keyframe_id = {0};
+    std::array<double, 3> p;
+    std::array<double, 4> q;
+    poseTo(c * poseAt(0), p.data(), q.data());
+    lc.position = {{p[0], p[1], p[2]}};
+    lc.orientation = {{q[0], q[1], q[2], q[3]}};
+    poseTo(c, lc.correction_position, lc.correction_orientation);
+    poseTo(c, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
+    write(log, "LOOP_CORRECTION", lc.utime, lc);
+    odometry(10, 0, 0, poseAt(10));      // published before lio adopted correction 1
+    odometry(11, 0, 1, c * poseAt(11));  // after
+    health_t h{};
+    h.node = "lio";
+    h.level = health_t::LEVEL_WARN;
+    h.message = "odometry reset to epoch 1: IMU time jumped back by 5.000000 s: re-initialising";
+    write(log, "HEALTH", 2150000, h);
+    odometry(12, 1, 0, poseAt(1));
+  }
+  const PipelineOutputs out = readPipelineOutputs(path);
+  const Trajectory t = loopCorrectedTrajectory(out);
+  ASSERT_EQ(t.size(), 13u);
+  for (int i = 0; i < 12; ++i)
+    EXPECT_NEAR((t[i].pose.matrix() - (c * poseAt(i)).matrix()).norm(), 0.0, 1e-9) << i;
+  EXPECT_NEAR((t[12].pose.matrix() - poseAt(1).matrix()).norm(), 0.0, 1e-12);  // epoch 1: no loop
+  ASSERT_EQ(out.resets.size(), 1u);
+  EXPECT_EQ(out.resets[0].epoch, 1);
+  EXPECT_DOUBLE_EQ(out.resets[0].stamp, 2.2);
+  EXPECT_EQ(out.resets[0].reason, "IMU time jumped back by 5.000000 s: re-initialising");
+  EXPECT_NE(resetsJson(out.resets).find("\"epoch\": 1"), std::string::npos);
 }
 
 TEST(PipelineOutputs, TimingJsonHeadlinesTheBusiestInput) {

@@ -89,7 +89,7 @@ class LivoDriver : public livo_soak::SimLioDriver {
  protected:
   // livo-lio publishes REGISTERED_SCAN; livo-vio's onScan
   void onSweep(const ScanResult& r, const livo::point_cloud_t& msg) override {
-    const livo::registered_scan_t m = livo::lio::toRegisteredScan(r, msg);
+    const livo::registered_scan_t m = livo::lio::toRegisteredScan(r, msg, mutableLio().frame());
     if (!livo::registeredScanProblem(m).empty()) {
       ++scans_refused_;
       return;

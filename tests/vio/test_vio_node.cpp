@@ -362,7 +362,9 @@ TEST(VioNode, LoopCorrectionMovesTheMap) {
   const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.05)), Vec3(0.3, -0.2, 0.0));
   loop_correction_t c{};
   c.utime = s.utime(kT0);
+  c.correction_id = 1;
   poseTo(T, c.correction_position, c.correction_orientation);
+  poseTo(T, c.odometry_to_corrected_position, c.odometry_to_corrected_orientation);
   c.num_keyframes = 0;
   h.send("LOOP_CORRECTION", c);
   EXPECT_TRUE(h.vio->estimator().map().point(0).position.isApprox(T * before, 1e-9));
@@ -371,9 +373,12 @@ TEST(VioNode, LoopCorrectionMovesTheMap) {
   truth.rot = T.linear() * truth.rot;
   truth.pos = T * truth.pos;
   h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
-  h.send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(truth), priorP()));
+  filter_state_t corrected_prior = priorMsg(s.utime(kT1), 2, offsetState(truth), priorP());
+  corrected_prior.correction_id = 1;  // lio adopted the correction
+  h.send("STATE_PRIOR", corrected_prior);
   ASSERT_EQ(h.posteriors.size(), 2u);
   EXPECT_EQ(h.posteriors[1].valid, 1);
+  EXPECT_EQ(h.posteriors[1].correction_id, 1);
   EXPECT_LT(positionError(h.posteriors[1], truth), 0.005);
 }
 

@@ -31,6 +31,10 @@ struct RegisteredScanView {
 /// The view of `m`, or why it cannot be used (registeredScanProblem()); "" when `view` was filled.
 std::string viewRegisteredScan(const registered_scan_t& m, RegisteredScanView* view);
 
+/// Moves a registered scan (its pose and world-frame points) by T: a scan published in another
+/// loop correction's frame brought into a map's (MapFrame).
+void moveRegisteredScan(const Pose3& T, registered_scan_t* m);
+
 /// Why a message pose cannot be used: non-finite numbers, or a quaternion (w, x, y, z) whose norm
 /// is not within [0.5, 2] (poseFrom() normalises it); "" if it can.
 std::string poseProblem(const double position[3], const double orientation_wxyz[4]);

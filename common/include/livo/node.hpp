@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <random>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -36,7 +37,15 @@ struct NodeOptions {
   // Test hook for loss detection: messages on these channels with these 1-based indices are
   // dropped on arrival as if the bus had lost them (never handled, never counted). Filled from
   // LIVO_TEST_DROP_RECEIVED="CHANNEL:N[,CHANNEL:N...]" when the node is made; empty otherwise.
-  std::map<std::string, std::set<int64_t>> drop_received;
+  std::map<std::string, std::set<int64_t>> drop_received = {};
+  // Test hook for real-time hand-off tests: before each handler of another process's message (not of
+  // sensor input: imu, point cloud, image, wheel, pose), sleep a random 0..N ms (uniform, seeded by the
+  // node name). 0 disables it. Default: LIVO_TEST_HANDLER_DELAY_MS (handlerDelayFromEnvironment()).
+  int handler_delay_max_ms = handlerDelayFromEnvironment();
+
+  /// LIVO_TEST_HANDLER_DELAY_MS as a number of milliseconds (0 if unset or empty); throws
+  /// std::invalid_argument naming the variable for anything but an integer in [0, 10000].
+  static int handlerDelayFromEnvironment();
 };
 
 /// Parses "CHANNEL:N[,CHANNEL:N...]" (LIVO_TEST_DROP_RECEIVED); throws std::invalid_argument.
@@ -101,6 +110,9 @@ class Node {
   void announce();
   /// Publishes HEALTH (and a heartbeat PROGRESS) if its period elapsed; spin() calls it.
   void tick();
+  /// Publishes HEALTH at once, so that an event a report must not miss (an odometry reset) is not
+  /// replaced by a later warning before the next periodic HEALTH.
+  void publishHealthNow() { publishHealth(); }
   /// Final PROGRESS (finished = 1) and HEALTH, and the summary on stderr. Idempotent.
   void finish();
 
@@ -165,6 +177,7 @@ class Node {
   };
   std::map<std::string, Watch> watched_;  // channel -> its consumers
   lcm::Subscription* peer_sub_ = nullptr;
+  std::mt19937 handler_delay_rng_;  // seeded by the node name (handler_delay_max_ms)
 };
 
 /// Sets the shutdown flag on SIGINT/SIGTERM (idempotent).

@@ -46,6 +46,7 @@ LioEstimator::LioEstimator(LioOptions options)
     : opts_(options), prop_(options.imu_noise), map_(options.map), keyframe_selector_(options.keyframe) {}
 
 void LioEstimator::reset() {
+  frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
   prop_ = ImuPropagator(opts_.imu_noise);
   map_.clear();
   keyframe_selector_.reset();
@@ -171,6 +172,12 @@ void LioEstimator::widenForGap(double gap_s) {
   P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
   P.block<3, 3>(FilterState::kVel, FilterState::kVel) += Mat3::Identity() * v * v * std::min(1.0, gap_s);
   prop_.setState(prop_.state(), P);
+}
+
+void LioEstimator::continueNumbering(int32_t epoch, int64_t next_keyframe_id) {
+  frame_ = OdometryFrame{};
+  frame_.epoch = epoch;
+  next_keyframe_id_ = next_keyframe_id;
 }
 
 void LioEstimator::noteBridgedGap(const FilterState& before) {
@@ -526,7 +533,11 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat
   return true;
 }
 
-void LioEstimator::applyLoopCorrection(const Pose3& T, const std::vector<KeyframePose>& corrected) {
+void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const std::vector<KeyframePose>& corrected) {
+  const Pose3 T = correction.previous_id == frame_.correction_id ? correction.T_Ck_Cj
+                                                                  : Pose3(correction.T_Ck_O * frame_.T_C_O.inverse());
+  frame_.correction_id = correction.id;
+  frame_.T_C_O = correction.T_Ck_O;
   const Mat3 Rc = T.linear();
   // keyframes: corrected poses where given, the rigid correction elsewhere
   for (auto& kf : keyframes_) {

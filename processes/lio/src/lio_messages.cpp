@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 
+#include "livo/correction_frames.hpp"
 #include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
 #include "livo/time.hpp"
@@ -39,7 +40,7 @@ bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why) {
   return true;
 }
 
-odometry_t toOdometry(const ScanResult& r) {
+odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame) {
   odometry_t o;
   o.utime = r.utime;
   o.parent_frame = "W";
@@ -52,12 +53,16 @@ odometry_t toOdometry(const ScanResult& r) {
   o.num_residuals = r.num_residuals;
   o.degenerate = r.degeneracy.degenerate ? 1 : 0;
   o.min_information_eigenvalue = r.min_information_eigenvalue;
+  o.epoch = frame.epoch;
+  o.correction_id = frame.correction_id;
   return o;
 }
 
-registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in) {
+registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in, const OdometryFrame& frame) {
   registered_scan_t m;
   m.utime = r.utime;
+  m.epoch = frame.epoch;
+  m.correction_id = frame.correction_id;
   poseTo(r.state.pose(), m.position, m.orientation);
   point_cloud_t& c = m.cloud;
   // points undistorted to r.utime (sweep end); cloud.utime is the sweep start so that
@@ -90,9 +95,11 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in)
   return m;
 }
 
-keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings) {
+keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings, const OdometryFrame& frame) {
   keyframe_t m;
   m.id = k.id;
+  m.epoch = frame.epoch;
+  m.correction_id = frame.correction_id;
   m.utime = k.utime;
   poseTo(k.pose, m.position, m.orientation);
   matrixTo<6>(k.pose_covariance, m.pose_covariance);
@@ -119,8 +126,8 @@ keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings) {
   return m;
 }
 
-bool fromMessage(const loop_correction_t& m, Pose3* T, std::vector<LioEstimator::KeyframePose>* poses,
-                 std::string* why) {
+bool fromMessage(const loop_correction_t& m, LioEstimator::LoopCorrection* correction,
+                 std::vector<LioEstimator::KeyframePose>* poses, std::string* why) {
   std::map<int64_t, Pose3> corrected;
   if (std::string problem = correctedKeyframePoses(m, &corrected); !problem.empty()) {
     *why = "loop correction: " + problem;
@@ -130,7 +137,18 @@ bool fromMessage(const loop_correction_t& m, Pose3* T, std::vector<LioEstimator:
     *why = "loop correction transform: " + problem;
     return false;
   }
-  *T = poseFrom(m.correction_position, m.correction_orientation);
+  if (std::string problem = correctionTransform(m, &correction->T_Ck_O); !problem.empty()) {
+    *why = "loop correction: " + problem;
+    return false;
+  }
+  if (m.previous_correction_id < 0 || m.previous_correction_id >= m.correction_id) {
+    *why = "loop correction " + std::to_string(m.correction_id) + ": previous_correction_id " +
+           std::to_string(m.previous_correction_id) + " is not before it";
+    return false;
+  }
+  correction->id = m.correction_id;
+  correction->previous_id = m.previous_correction_id;
+  correction->T_Ck_Cj = poseFrom(m.correction_position, m.correction_orientation);
   poses->clear();
   for (const auto& [id, pose] : corrected) poses->push_back({id, pose});
   return true;

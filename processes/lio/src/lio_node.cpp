@@ -1,8 +1,10 @@
 #include "livo/lio/lio_node.hpp"
 
 #include <chrono>
+#include <fstream>
 #include <iostream>
 
+#include "livo/file_output.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/message_registry.hpp"
 #include "livo/messages.hpp"
@@ -41,11 +43,34 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
   node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
+  if (opts_.continue_numbering && !opts_.numbering_file.empty()) {
+    std::ifstream f(opts_.numbering_file);
+    std::string epoch_key, id_key;
+    int32_t epoch = 0;
+    int64_t next_id = 0;
+    if (f >> epoch_key >> epoch >> id_key >> next_id && epoch_key == "epoch" && id_key == "next_keyframe_id" &&
+        epoch >= 0 && next_id >= 0) {
+      lio_.continueNumbering(epoch + 1, next_id);
+      node_.warn("restarted: odometry goes on in epoch " + std::to_string(epoch + 1) + " (a new frame), keyframe ids from " +
+                 std::to_string(next_id));
+    } else {
+      node_.warn("restarted, but " + opts_.numbering_file + " holds no numbering: starting at epoch 0");
+    }
+  }
+  saveNumbering();
+}
+
+void LioNode::saveNumbering() {
+  if (opts_.numbering_file.empty()) return;
+  const std::string text = "epoch " + std::to_string(lio_.frame().epoch) + "\nnext_keyframe_id " +
+                           std::to_string(lio_.nextKeyframeId()) + "\n";
+  std::string error;
+  if (!writeFileAtomically(opts_.numbering_file, {text}, &error)) node_.warn("cannot keep the numbering: " + error);
 }
 
 void LioNode::resetAll(const std::string& why) {
-  node_.warn(why + ": re-initialising");
   lio_.reset();
+  announceReset(why);
   imu_.clear();
   wheel_.clear();
   scans_.clear();
@@ -53,6 +78,13 @@ void LioNode::resetAll(const std::string& why) {
   pending_.reset();
   held_jump_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
+}
+
+void LioNode::announceReset(const std::string& why) {
+  ++resets_;
+  node_.warn("odometry reset to epoch " + std::to_string(lio_.frame().epoch) + ": " + why + ": re-initialising");
+  node_.publishHealthNow();  // the reason reaches resets.json / report.md even if a warning follows
+  saveNumbering();
 }
 
 void LioNode::onImu(const imu_t& m) {
@@ -231,21 +263,28 @@ void LioNode::advance() {
 void LioNode::process(const PendingScan& p) {
   // The sweep is processed from whichever handler moved the IMU watermark past it: time it on its own.
   const auto t0 = std::chrono::steady_clock::now();
+  const int32_t epoch_before = lio_.frame().epoch;
   ScanResult r = lio_.addScan(p.scan);
+  if (lio_.frame().epoch != epoch_before) announceReset(r.message.empty() ? "the filter re-initialised" : r.message);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ++sweeps_;
   if (!r.message.empty() && r.status != ScanResult::Status::kInitializing)
     node_.warn("sweep at " + std::to_string(p.scan.utime) + " (" + toString(r.status) + "): " + r.message);
   if (!r.hasOutput()) return;
-  const odometry_t odo = toOdometry(r);
+  const odometry_t odo = toOdometry(r, lio_.frame());
   if (!finiteOdometry(odo)) {
-    node_.error("non-finite odometry withheld; re-initialising");
+    node_.error("non-finite odometry withheld");
     lio_.reset();
+    announceReset("non-finite odometry");
     return;
   }
   node_.publish(opts_.odometry_channel, odo);
-  if (opts_.publish_registered_scan) node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg));
-  if (r.is_keyframe) node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings));
+  if (opts_.publish_registered_scan)
+    node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, lio_.frame()));
+  if (r.is_keyframe) {
+    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
+    saveNumbering();
+  }
 }
 
 void LioNode::handOff(int64_t utime) {
@@ -264,12 +303,21 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
-  node_.publish(opts_.state_prior_channel, toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name));
+  filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name);
+  prior.epoch = lio_.frame().epoch;
+  prior.correction_id = lio_.frame().correction_id;
+  node_.publish(opts_.state_prior_channel, prior);
   ++handoff_.priors;
   pending_ = PendingPrior{id, utime};
 }
 
 void LioNode::onPosterior(const filter_state_t& m) {
+  if (m.epoch != lio_.frame().epoch) {
+    node_.reject(opts_.state_posterior_channel, "posterior for odometry epoch " + std::to_string(m.epoch) +
+                                                    ", the filter is in epoch " + std::to_string(lio_.frame().epoch) +
+                                                    " (made before a reset): ignored");
+    return;
+  }
   if (!pending_ || m.request_id != pending_->request_id || m.utime != pending_->utime) {
     node_.reject(opts_.state_posterior_channel, "posterior answers no waiting prior (late, duplicate or foreign)");
     return;
@@ -293,11 +341,24 @@ void LioNode::onPosterior(const filter_state_t& m) {
 }
 
 void LioNode::onLoopCorrection(const loop_correction_t& m) {
-  Pose3 T;
+  LioEstimator::LoopCorrection correction;
   std::vector<LioEstimator::KeyframePose> poses;
   std::string why;
-  if (!fromMessage(m, &T, &poses, &why)) {
+  if (!fromMessage(m, &correction, &poses, &why)) {
     node_.reject(opts_.loop_correction_channel, why);
+    return;
+  }
+  const OdometryFrame& frame = lio_.frame();
+  if (m.epoch != frame.epoch) {
+    node_.reject(opts_.loop_correction_channel,
+                 "loop correction " + std::to_string(m.correction_id) + " is for odometry epoch " +
+                     std::to_string(m.epoch) + ", the filter is in epoch " + std::to_string(frame.epoch) + ": ignored");
+    return;
+  }
+  if (m.correction_id <= frame.correction_id) {
+    node_.reject(opts_.loop_correction_channel, "loop correction " + std::to_string(m.correction_id) +
+                                                    " is not after the adopted one (" +
+                                                    std::to_string(frame.correction_id) + "): ignored");
     return;
   }
   if (pending_) {
@@ -305,8 +366,9 @@ void LioNode::onLoopCorrection(const loop_correction_t& m) {
     ++handoff_.missing;
     pending_.reset();
   }
-  lio_.applyLoopCorrection(T, poses);
-  node_.info("loop correction applied (" + std::to_string(poses.size()) + " keyframes)");
+  lio_.applyLoopCorrection(correction, poses);
+  node_.info("loop correction " + std::to_string(m.correction_id) + " applied (" + std::to_string(poses.size()) +
+             " keyframes)");
   advance();
 }
 

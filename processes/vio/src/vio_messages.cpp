@@ -26,6 +26,8 @@ bool priorFromMessage(const filter_state_t& m, FilterState* x, Mat18* P, std::st
 filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
                            const Mat18& P, bool valid, int iterations, int num_measurements) {
   filter_state_t m = toFilterState(prior.utime, x, P, prior.request_id, source);
+  m.epoch = prior.epoch;
+  m.correction_id = prior.correction_id;
   m.valid = valid ? 1 : 0;
   m.iterations = iterations;
   m.num_measurements = num_measurements;
@@ -39,20 +41,6 @@ filter_state_t keptPrior(const filter_state_t& prior, const std::string& source)
   m.iterations = 0;
   m.num_measurements = 0;
   return m;
-}
-
-bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why) {
-  if (!allFinite(m.correction_position, 3) || !allFinite(m.correction_orientation, 4)) {
-    *why = "correction is not finite";
-    return false;
-  }
-  const double* q = m.correction_orientation;
-  if (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3] < 0.25) {
-    *why = "correction orientation is not a unit quaternion";
-    return false;
-  }
-  *T = poseFrom(m.correction_position, m.correction_orientation);
-  return true;
 }
 
 }  // namespace livo::vio

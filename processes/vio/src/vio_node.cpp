@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "livo/correction_frames.hpp"
 #include "livo/message_checks.hpp"
 #include "livo/time.hpp"
 #include "livo/vio/vio_messages.hpp"
@@ -53,7 +54,29 @@ void VioNode::onImage(const image_t& m) {
   resolve();
 }
 
+MapFrame::Placed VioNode::placeInMap(int32_t epoch, int64_t correction_id) {
+  return frame_.place(epoch, correction_id, [&](int32_t old_epoch) {
+    // the LIO was reset: its new odometry frame has nothing to do with the map's
+    node_.warn("odometry epoch " + std::to_string(epoch) + " (LIO reset): dropping the map of epoch " +
+               std::to_string(old_epoch) + " (" + std::to_string(vio_.map().size()) + " points) and " +
+               std::to_string(pending_.size()) + " waiting priors");
+    vio_.reset();
+    pending_.clear();
+    ++counts_.epochs_started;
+  });
+}
+
 void VioNode::onPrior(const filter_state_t& m) {
+  const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+  if (placed.placement == MapFrame::Placement::kOldEpoch) {
+    // lio was reset since: it ignores any answer, so none is sent
+    node_.reject(opts_.state_prior_channel, "prior " + std::to_string(m.request_id) + " " + placed.why);
+    return;
+  }
+  if (placed.placement == MapFrame::Placement::kUnknownFrame) {
+    keep(m, placed.why);
+    return;
+  }
   if (std::find(answered_ids_.begin(), answered_ids_.end(), m.request_id) != answered_ids_.end() ||
       std::any_of(pending_.begin(), pending_.end(), [&](const filter_state_t& p) { return p.request_id == m.request_id; })) {
     node_.reject(opts_.state_prior_channel, "duplicate prior (request id already seen): not answered again");
@@ -61,6 +84,13 @@ void VioNode::onPrior(const filter_state_t& m) {
   }
   const auto it = std::upper_bound(pending_.begin(), pending_.end(), m.utime,
                                    [](int64_t t, const filter_state_t& p) { return t < p.utime; });
+  if (placed.moved) {
+    // the map and the prior are in different loop corrections (it was made before lio adopted the
+    // newest one the map has): the image could only be matched after moving one onto the other
+    keep(m, "prior made in another loop correction than the map's (" + std::to_string(m.correction_id) + " vs " +
+                std::to_string(frame_.correctionId()) + ")");
+    return;
+  }
   pending_.insert(it, m);
   resolve();
 }
@@ -153,18 +183,34 @@ void VioNode::onScan(const registered_scan_t& m) {
     node_.reject(opts_.registered_scan_channel, why);
     return;
   }
+  const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+  if (placed.placement != MapFrame::Placement::kUse) {
+    node_.reject(opts_.registered_scan_channel, placed.why);
+    return;
+  }
   const point_cloud_t& c = m.cloud;
-  vio_.addScan(m.utime, c.x.data(), c.y.data(), c.z.data(), static_cast<size_t>(c.num_points));
+  if (placed.moved) {  // made before lio adopted the map's correction: moved onto it
+    std::vector<Vec3> points(static_cast<size_t>(c.num_points));
+    for (size_t i = 0; i < points.size(); ++i) points[i] = placed.to_map * Vec3(c.x[i], c.y[i], c.z[i]);
+    vio_.addScan(m.utime, points);
+  } else {
+    vio_.addScan(m.utime, c.x.data(), c.y.data(), c.z.data(), static_cast<size_t>(c.num_points));
+  }
   ++counts_.scans;
 }
 
 void VioNode::onCorrection(const loop_correction_t& m) {
-  Pose3 T;
-  std::string why;
-  if (!correctionOf(m, &T, &why)) {
-    node_.reject(opts_.loop_correction_channel, why);
+  Pose3 T_Ck_O;
+  if (const std::string why = correctionTransform(m, &T_Ck_O); !why.empty()) {
+    node_.reject(opts_.loop_correction_channel, "loop correction: " + why);
     return;
   }
+  const MapFrame::CorrectionStep step = frame_.addCorrection(m.correction_id, m.epoch, T_Ck_O);
+  if (!step.apply) {
+    node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + step.why);
+    return;
+  }
+  const Pose3& T = step.unlisted;
   vio_.applyCorrection(T);
   std::ostringstream s;
   s << "loop correction: moved " << vio_.map().size() << " map points by " << T.translation().norm() << " m";

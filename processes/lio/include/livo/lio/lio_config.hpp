@@ -29,6 +29,12 @@ struct LioNodeOptions {
 
   double imu_reorder_window_s = 0.02;  // IMU is handed to the filter this far behind the newest
   double wheel_max_wait_s = 0.2;       // a sweep waits for wheel data past its end at most this long
+  // Supervised runs (scripts/run_pipeline.sh --respawn): the odometry epoch and the next keyframe
+  // id are kept in this file (written at every keyframe and reset); a restarted lio with
+  // `continue_numbering` starts at the next epoch and the next id. Empty: not kept.
+  std::string numbering_file;
+  bool continue_numbering = false;
+
   double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
   double clock_jump_s = 1.0;           // an IMU stamp this far after the newest is a clock jump
   // (either way a jumping stamp is used only once the next sample confirms the new clock: a

@@ -65,6 +65,14 @@ struct ScanResult {
 
 const char* toString(ScanResult::Status s);
 
+/// The frame the estimator's poses are in (lcmtypes/loop_correction_t.lcm): its odometry epoch
+/// (+1 at every reset) and the newest loop correction adopted in it.
+struct OdometryFrame {
+  int32_t epoch = 0;
+  int64_t correction_id = 0;             // 0: the raw odometry frame O of the epoch
+  Pose3 T_C_O = Pose3::Identity();       // odometry_to_corrected of that correction
+};
+
 class LioEstimator {
  public:
   explicit LioEstimator(LioOptions options = {});
@@ -103,11 +111,27 @@ class LioEstimator {
     int64_t id;
     Pose3 pose;  // corrected W_T_I
   };
-  /// Loop correction: moves the state by T_corrected_odom, replaces the poses of the listed
-  /// keyframes (the others move with T_corrected_odom) and rebuilds the local map from them.
-  void applyLoopCorrection(const Pose3& T_corrected_odom, const std::vector<KeyframePose>& corrected);
+  /// A loop correction to adopt: its id, T_Ck_O, and T_Ck_Cj from the previous correction j.
+  struct LoopCorrection {
+    int64_t id = 0;
+    int64_t previous_id = 0;
+    Pose3 T_Ck_O = Pose3::Identity();
+    Pose3 T_Ck_Cj = Pose3::Identity();
+  };
+  /// Loop correction: moves the state from the current frame onto C_k (by T_Ck_Cj when the
+  /// estimator is in j, by T_Ck_O * T_C_O^-1 when it missed corrections), replaces the poses of
+  /// the listed keyframes (the others move likewise) and rebuilds the local map from them. The
+  /// caller checks the epoch and that the id is newer than frame().correction_id.
+  void applyLoopCorrection(const LoopCorrection& correction, const std::vector<KeyframePose>& corrected);
+  const OdometryFrame& frame() const { return frame_; }
+  int64_t nextKeyframeId() const { return next_keyframe_id_; }
+  /// A restarted process goes on where the previous one left its numbering: it starts in odometry
+  /// epoch `epoch` (a new frame: the earlier state and map are gone) with keyframe ids from
+  /// `next_keyframe_id`, so consumers never see an id or an epoch twice.
+  void continueNumbering(int32_t epoch, int64_t next_keyframe_id);
 
-  /// Forgets everything (state, map, keyframes, buffers): the next IMU samples re-initialise.
+  /// Forgets everything (state, map, keyframes, buffers): the next IMU samples re-initialise in a
+  /// new odometry epoch (frame().epoch + 1, no correction).
   void reset();
 
  private:
@@ -141,6 +165,7 @@ class LioEstimator {
   bool has_wheel_ = false;
   Vec3 last_prune_position_ = Vec3::Zero();
   std::deque<Keyframe> keyframes_;
+  OdometryFrame frame_;
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
   int64_t last_registered_utime_ = 0;  // last sweep that seeded the map or registered

@@ -22,19 +22,20 @@ WheelSample fromMessage(const wheel_odometry_t& m);
 /// without time offsets.
 bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why);
 
-odometry_t toOdometry(const ScanResult& r);
+/// The output messages carry the frame they are in (epoch, correction_id).
+odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame);
 /// The undistorted sweep in frame "W": every point is expressed at the sweep end (the
 /// message's utime, the odometry time), while cloud.utime is the sweep start in the IMU clock
 /// (input utime + LiDAR time offset) and each point keeps its input time_offset, so
 /// cloud.utime + time_offset is the point's capture time (what the colouring process uses to pick
 /// images). cloud.sweep_duration, ring and intensity come from the input.
-registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& input);
+registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& input, const OdometryFrame& frame);
 /// The keyframe's downsampled body-frame cloud with the input intensities; time offsets zero
 /// (the cloud is undistorted to the keyframe's utime).
-keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings);
+keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings, const OdometryFrame& frame);
 
-/// The loop correction as T_corrected_odom and the corrected keyframe poses.
-bool fromMessage(const loop_correction_t& m, Pose3* T_corr, std::vector<LioEstimator::KeyframePose>* poses,
-                 std::string* why);
+/// The loop correction (id, transforms) and the corrected keyframe poses.
+bool fromMessage(const loop_correction_t& m, LioEstimator::LoopCorrection* correction,
+                 std::vector<LioEstimator::KeyframePose>* poses, std::string* why);
 
 }  // namespace livo::lio

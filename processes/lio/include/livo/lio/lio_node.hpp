@@ -47,6 +47,9 @@ class LioNode {
     int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
+  /// Odometry resets so far (= the current epoch).
+  int64_t resets() const { return resets_; }
+  const OdometryFrame& frame() const { return lio_.frame(); }
 
  private:
   struct PendingScan {
@@ -56,6 +59,8 @@ class LioNode {
   void onImu(const imu_t& m);
   /// A plausible sample on a confirmed clock: into the buffer (or a reset on a clock step back).
   void acceptImu(const ImuSample& s);
+  /// Writes the epoch and the next keyframe id to opts_.numbering_file (if set).
+  void saveNumbering();
   void onLidar(const point_cloud_t& m);
   void onWheel(const wheel_odometry_t& m);
   void onCamera(const void* data, int size);
@@ -67,6 +72,8 @@ class LioNode {
   /// Propagates to an image time and publishes the prior (sets pending_).
   void handOff(int64_t utime);
   void resetAll(const std::string& why);
+  /// Warns (HEALTH, stderr) "odometry reset to epoch N: why" after the estimator was reset.
+  void announceReset(const std::string& why);
 
   LioNodeOptions opts_;
   Node node_;
@@ -91,6 +98,7 @@ class LioNode {
   std::optional<PendingPrior> pending_;  // prior waiting for its posterior
   int64_t next_request_id_ = 1;
   HandoffCounts handoff_;
+  int64_t resets_ = 0;
 };
 
 }  // namespace livo::lio

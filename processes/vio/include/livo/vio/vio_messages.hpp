@@ -20,7 +20,4 @@ filter_state_t toPosterior(const filter_state_t& prior, const std::string& sourc
 /// valid = 0: the prior's own numbers echoed.
 filter_state_t keptPrior(const filter_state_t& prior, const std::string& source);
 
-/// T_corrected_odom of a loop correction; false if not finite or degenerate.
-bool correctionOf(const loop_correction_t& m, Pose3* T, std::string* why);
-
 }  // namespace livo::vio

@@ -18,6 +18,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "livo/correction_frames.hpp"
 #include "livo/filter_state_t.hpp"
 #include "livo/image_t.hpp"
 #include "livo/loop_correction_t.hpp"
@@ -43,6 +44,7 @@ class VioNode {
     int64_t bad_images = 0;    // refused (size, decoding, black, blown out)
     int64_t unused_images = 0; // dropped from the buffer without a prior
     int64_t scans = 0;         // registered scans taken into the map source
+    int64_t epochs_started = 0;// odometry epochs after the first (LIO resets): the map was dropped
   };
   const Counts& counts() const { return counts_; }
   /// Why priors were answered valid = 0, and how often.
@@ -63,6 +65,9 @@ class VioNode {
   void process(const filter_state_t& prior, const BufferedImage& image);
   void keep(const filter_state_t& prior, const std::string& why);
   void trimImages();
+  /// Where a pose of (epoch, correction) goes in the map; a newer epoch (a LIO reset) first drops
+  /// the map, the waiting priors and the corrections of the old epoch.
+  MapFrame::Placed placeInMap(int32_t epoch, int64_t correction_id);
 
   VioNodeOptions opts_;
   Node node_;
@@ -73,6 +78,7 @@ class VioNode {
   std::deque<filter_state_t> pending_; // priors waiting for their image, by utime
   std::deque<int64_t> answered_ids_;   // recent request ids, to answer each only once
   Counts counts_;
+  MapFrame frame_;  // the map's odometry epoch and loop correction
   std::map<std::string, int64_t> kept_reasons_;
   std::map<std::string, int64_t> last_warned_;  // reason -> sensor time of its last warning
 };
