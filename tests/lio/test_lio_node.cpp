@@ -517,6 +517,8 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
   imu_t jumped = toImuMsg(syntheticSequence().imu().front());
   jumped.utime = kBase - 2'000'000;  // 3.5 s back from 1.5 s: more than clock_reset_s
   msgs.push_back(encode(kBase + 1'500'001, "IMU", jumped));
+  jumped.utime += 5'000;  // the next sample confirms the new clock (a lone one would be dropped)
+  msgs.push_back(encode(kBase + 1'500'001, "IMU", jumped));
   loop_correction_t old = lc;
   old.correction_id = 2;
   old.previous_correction_id = 1;
