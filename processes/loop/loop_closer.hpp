@@ -1,16 +1,20 @@
-// The loop-closure core without middleware: a keyframe store (gravity-aligned clouds with cached
-// coarse features and GICP covariances), radius candidates, coarse-to-fine registration and the
-// pose graph, optimised only when a loop is accepted.
+// The loop-closure core without middleware: a keyframe store (body-frame clouds on disk, their
+// coarse features and GICP covariances derived on demand and cached for the most recently used
+// keyframes), radius candidates, coarse-to-fine registration and the pose graph, optimised only
+// when a loop is accepted.
 #pragma once
 
 #include <cstdint>
+#include <list>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "coarse_features.hpp"
 #include "gicp.hpp"
+#include "livo/spill_file.hpp"
 #include "loop_registration.hpp"
 #include "pose_graph.hpp"
 
@@ -28,6 +32,10 @@ struct LoopCloserOptions {
   double fine_voxel_size = 0.4;     // m
   int covariance_neighbors = 10;
   double map_voxel_size = 0.2;      // m, clouds kept for the global map
+  /// Keyframes whose coarse features and GICP clouds stay in memory (the newest and the recent
+  /// loop candidates); the others are derived again from the stored cloud when a candidate.
+  int feature_cache_keyframes = 32;
+  std::string spill_directory;      // where the keyframe clouds go ("" : the temp directory)
   CandidateOptions candidates;
   LoopRegistrationOptions registration;
   PoseGraphOptions graph;
@@ -73,7 +81,8 @@ struct AddResult {
 
 class LoopCloser {
  public:
-  explicit LoopCloser(LoopCloserOptions options = {}) : options_(std::move(options)), graph_(options_.graph) {}
+  explicit LoopCloser(LoopCloserOptions options = {})
+      : options_(std::move(options)), graph_(options_.graph), clouds_(0.0, options_.spill_directory) {}
 
   /// Adds a keyframe (ids must increase; throws std::invalid_argument otherwise) and searches
   /// for a loop.
@@ -85,9 +94,13 @@ class LoopCloser {
   /// optimised one (identity before the first loop).
   Pose3 correction() const;
   int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
-  /// The keyframe's cloud for the global map (voxel-downsampled, body frame I).
-  const std::vector<Eigen::Vector3f>& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
+  /// The keyframe's cloud for the global map (voxel-downsampled, body frame I), from the store.
+  Points mapCloud(int64_t id) const;
   size_t size() const { return keyframes_.size(); }
+  /// Keyframes whose derived features are in memory now (<= feature_cache_keyframes).
+  size_t cachedFeatures() const { return cache_.size(); }
+  /// Bytes of keyframe clouds on disk.
+  uint64_t storedCloudBytes() const { return clouds_.diskBytes(); }
 
  private:
   struct Keyframe {
@@ -96,15 +109,24 @@ class LoopCloser {
     Pose3 odometry = Pose3::Identity();   // in the raw odometry frame (no correction adopted)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
-    CoarseFeatures coarse;              // in G
-    GicpCloud fine;                     // in G
-    std::vector<Eigen::Vector3f> map_cloud;  // in I, float: kept for every keyframe
+    bool has_keypoints = false;         // its coarse features are not empty
+  };
+  /// What registration needs of a keyframe, derived from its stored cloud.
+  struct Features {
+    CoarseFeatures coarse;  // in G
+    GicpCloud fine;         // in G
   };
   std::vector<int64_t> candidates(int64_t id) const;
+  std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
+  /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
+  std::shared_ptr<const Features> features(int64_t id);
+  void cacheFeatures(int64_t id, std::shared_ptr<const Features> f);
 
   LoopCloserOptions options_;
   PoseGraph graph_;
   std::map<int64_t, Keyframe> keyframes_;
+  KeyframeCloudStore clouds_;  // body frame I, float as received (lossless: loops do not change)
+  std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;
   int64_t keyframes_since_loop_ = 1000000;
   Pose3 adopted_ = Pose3::Identity();  // the odometry's current frame <- raw odometry frame

@@ -24,6 +24,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("max_keypoints", c.coarse.max_keypoints);
   s.readOptional("keypoint_nms_radius", c.coarse.keypoints.nms_radius);
   s.readOptional("fine_voxel", c.fine_voxel_size);
+  s.readOptional("feature_cache_keyframes", c.feature_cache_keyframes);
   s.readOptional("search_radius", c.candidates.search_radius);
   s.readOptional("exclude_recent_s", c.candidates.exclude_recent_s);
   s.readOptional("max_candidates", c.candidates.max_candidates);
