@@ -119,13 +119,14 @@ std::string ColourNode::pcdPath() const { return output_dir_ + "/" + options_.ma
 
 bool ColourNode::saveMap() {
   ColouredPoints pts;
-  for (const MapPoint& p : pipeline_.map().points()) {
-    if (!p.coloured()) continue;
+  pipeline_.settleMap();  // the tiles on disk too, corrected
+  pipeline_.map().forEachPoint([&](const MapPoint& p) {
+    if (!p.coloured()) return;
     pts.position.push_back(p.position);
     std::array<uint8_t, 3> c;
     for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[k], 0.0f, 255.0f)));
     pts.rgb.push_back(c);
-  }
+  });
   std::error_code ec;
   std::filesystem::create_directories(output_dir_, ec);
   std::string error;

@@ -67,8 +67,12 @@ class ColouringPipeline {
   /// Returns the number of keyframes that moved.
   int applyCorrection(const std::map<int64_t, Pose3>& corrected);
 
-  /// Ids of points coloured or recoloured since the last call (ascending).
+  /// Ids of points coloured or recoloured since the last call (ascending), and of coloured points
+  /// that came back from disk moved by a correction.
   std::vector<uint32_t> takeRecoloured();
+  /// Brings the map tiles on disk up to date with the corrections (see ColourMap); then
+  /// map().forEachPoint visits one point per voxel. For the files.
+  void settleMap();
   void setObserver(std::function<void(const Observation&)> observer) { observer_ = std::move(observer); }
 
   const ColourMap& map() const { return map_; }
@@ -85,6 +89,9 @@ class ColouringPipeline {
   void processReady(bool flushing);
   bool processImage(const ColourImage& image);
   int64_t windowUs() const { return static_cast<int64_t>(options_.max_time_difference * 1e6); }
+  /// Forgets ids the map freed (tiles written to disk) and adds the points that came back moved.
+  void afterTileChanges(std::vector<uint32_t> freed);
+  void markRecoloured(uint32_t id);
 
   ColourOptions options_;
   CameraProjection camera_;
