@@ -28,7 +28,7 @@ done
 name="$(basename "$config" .yaml)"
 log="${log:-$root/logs/${name}_${duration}s.lcmlog}"
 out="${out:-$root/logs/soak_${name}_${duration}s}"
-for tool in livo-sim livo-report livo-loginfo; do
+for tool in livo-sim livo-report; do
   [ -x "$bin/$tool" ] || { echo "soak_pipeline.sh: $bin/$tool missing: run scripts/build.sh" >&2; exit 1; }
 done
 mkdir -p "$(dirname "$log")"
