@@ -92,7 +92,9 @@ std::vector<Eigen::Vector3f> KeyframeCloudStore::get(int64_t id) const {
   file_.read(e.record, &bytes);
   out.resize(e.points);
   if (!e.quantised) {
-    std::memcpy(out.data(), bytes.data(), bytes.size());
+    // Vector3f is three packed floats (no padding): the bytes are the array as written
+    static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "packed points");
+    std::memcpy(static_cast<void*>(out.data()), bytes.data(), bytes.size());
     return out;
   }
   const auto* q = reinterpret_cast<const int16_t*>(bytes.data());
