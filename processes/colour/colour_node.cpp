@@ -1,6 +1,7 @@
 #include "colour_node.hpp"
 
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
@@ -134,7 +135,12 @@ bool ColourNode::saveMap() {
     node_.error(error);
     return false;
   }
-  node_.info("wrote " + std::to_string(pts.size()) + " coloured points to " + plyPath() + " and " + pcdPath());
+  const ColourMap& map = pipeline_.map();
+  std::ostringstream s;
+  s << "wrote " << pts.size() << " coloured points to " << plyPath() << " and " << pcdPath() << " (map tiles: "
+    << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.spilledTiles()
+    << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB)";
+  node_.info(s.str());
   return true;
 }
 

@@ -140,7 +140,9 @@ void LoopNode::writeOutputs() {
   if (options_.output_dir.empty()) return;
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
-             std::to_string(closer_.loops().size()) + " loops)");
+             std::to_string(closer_.loops().size()) + " loops; " + std::to_string(closer_.size()) +
+             " keyframe clouds on disk, " + std::to_string(closer_.storedCloudBytes() / 1000000) + " MB; features of " +
+             std::to_string(closer_.cachedFeatures()) + " keyframes in memory)");
 }
 
 }  // namespace livo::loop
