@@ -50,11 +50,17 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   map_.setTime(scan.utime);
   ActiveScan active{INT64_MAX, INT64_MIN, {}};
   active.points.reserve(scan.num_points);
+  const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
+  const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
   for (int j = 0; j < scan.num_points; ++j) {
     const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
     if (!p.allFinite() || !std::isfinite(dt) || p.cwiseAbs().maxCoeff() > 1e5f) {
       ++stats_.points_rejected;
+      continue;
+    }
+    if ((p - body).squaredNorm() > reach * reach) {
+      ++stats_.points_out_of_reach;
       continue;
     }
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));

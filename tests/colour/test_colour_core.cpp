@@ -253,6 +253,28 @@ TEST(ColouringPipeline, LoopCorrectionMovesPointsWithTheirKeyframe) {
   EXPECT_EQ(pipe.applyCorrection({{1, corrected}}), 0);      // already there
 }
 
+// Scan points farther than max_depth + map_margin (30 + 10 m) from the body cannot be coloured
+// by any image of their time window: they are counted and stay out of the map (with a 100 m LiDAR
+// they would otherwise keep every tile in reach in memory; see the colour README, Memory).
+TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColouringPipeline pipe(ColourOptions{}, rig);
+  Pose3 B = Pose3::Identity();
+  B.translation() = Vec3(100.0, -50.0, 2.0);
+  std::vector<float> x{139.9f, 140.1f, 100.f, 59.9f}, y{-50.f, -50.f, -10.5f, -50.f}, z{2.f, 2.f, 2.f, 2.f},
+      dt{0.f, 0.f, 0.f, 0.f};
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(2000000, x, y, z, dt, B), &error)) << error;
+  EXPECT_EQ(pipe.map().size(), 2u);  // 39.9 m and 39.5 m away; the two 40.1 m away left out
+  EXPECT_EQ(pipe.stats().points_out_of_reach, 2);
+  EXPECT_EQ(pipe.stats().points_in, 2);
+  ColourOptions wide;
+  wide.map_margin = 100.0;
+  ColouringPipeline all(wide, rig);
+  ASSERT_TRUE(all.addScan(viewOf(2000000, x, y, z, dt, B), &error)) << error;
+  EXPECT_EQ(all.map().size(), 4u);
+}
+
 TEST(ColouringPipeline, RefusesStaleStampsAndSkipsNonFinitePoints) {
   const CameraRig rig = livo_test::testCamera(false);
   ColouringPipeline pipe(ColourOptions{}, rig);
