@@ -14,8 +14,9 @@ struct MemoryProfile {
   /// Per node: (sensor seconds since first_seconds, peak RSS MB), in time order.
   std::map<std::string, std::vector<std::pair<double, double>>> samples;
   /// The node's peak RSS reported at or before `seconds` since the start (NaN: no report yet, or
-  /// the run ended before `seconds`).
+  /// the run ended more than kEndSlack_s before `seconds`).
   double peakAt(const std::string& node, double seconds) const;
+  static constexpr double kEndSlack_s = 2.0;  // two health periods
 };
 
 /// Reads every HEALTH message (channel `health_channel`); throws std::runtime_error if the log
