@@ -8,6 +8,9 @@ ColourNodeOptions readColourOptions(const Config& c) {
   ColourOptions& o = n.core;
   if (!c.isNull()) {
     c.readOptional("voxel_size", o.voxel_size);
+    c.readOptional("tile_size", o.tile_size);
+    c.readOptional("tile_idle_s", o.tile_idle_s);
+    c.readOptional("map_margin", o.map_margin);
     c.readOptional("max_time_difference", o.max_time_difference);
     c.readOptional("max_depth", o.max_depth);
     c.readOptional("min_depth", o.min_depth);
@@ -41,6 +44,9 @@ ColourNodeOptions readColourOptions(const Config& c) {
   }
   auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
   if (!(o.voxel_size > 0.0)) fail("voxel_size", "must be > 0");
+  if (!(o.tile_size >= o.voxel_size && o.tile_size <= 1000.0)) fail("tile_size", "must be in [voxel_size, 1000] m");
+  if (!(o.tile_idle_s >= 0.0)) fail("tile_idle_s", "must be >= 0");
+  if (!(o.map_margin >= 0.0)) fail("map_margin", "must be >= 0");
   if (!(o.max_time_difference >= 0.0)) fail("max_time_difference", "must be >= 0");
   if (!(o.min_depth > 0.0 && o.max_depth > o.min_depth)) fail("max_depth", "need 0 < min_depth < max_depth");
   if (o.depth_cell_px < 1) fail("depth_cell_px", "must be >= 1");

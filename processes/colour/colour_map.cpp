@@ -2,9 +2,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 
 namespace livo {
 namespace colour {
+
+namespace {
+// A map point as written to disk (the exact floats: it comes back as it was).
+struct StoredPoint {
+  float position[3];
+  float colour[3];
+  int32_t count;
+  int32_t rejected;
+  int64_t anchor;
+};
+static_assert(std::is_trivially_copyable<StoredPoint>::value && sizeof(StoredPoint) == 40, "written byte for byte");
+
+StoredPoint stored(const MapPoint& p) {
+  StoredPoint s;
+  for (int k = 0; k < 3; ++k) s.position[k] = p.position[k], s.colour[k] = p.colour[k];
+  s.count = p.count;
+  s.rejected = p.rejected;
+  s.anchor = p.anchor;
+  return s;
+}
+
+MapPoint restored(const StoredPoint& s) {
+  MapPoint p;
+  p.position = Eigen::Vector3f(s.position[0], s.position[1], s.position[2]);
+  p.colour = Eigen::Vector3f(s.colour[0], s.colour[1], s.colour[2]);
+  p.count = s.count;
+  p.rejected = s.rejected;
+  p.anchor = s.anchor;
+  return p;
+}
+}  // namespace
 
 uint32_t ColourMap::VoxelIndex::findOrInsert(uint64_t key, uint32_t id, bool* inserted) {
   if (2 * (size_ + 1) > slots_.size()) grow();
@@ -24,6 +57,28 @@ uint32_t ColourMap::VoxelIndex::findOrInsert(uint64_t key, uint32_t id, bool* in
   }
 }
 
+void ColourMap::VoxelIndex::erase(uint64_t key) {
+  const size_t mask = slots_.size() - 1;
+  size_t i = home(key);
+  while (slots_[i].key != key) {
+    if (slots_[i].key == kEmpty) return;
+    i = (i + 1) & mask;
+  }
+  // backward shift: move later entries of the probe run into the hole if their home allows it
+  for (size_t j = (i + 1) & mask;; j = (j + 1) & mask) {
+    if (slots_[j].key == kEmpty) break;
+    const size_t h = home(slots_[j].key);
+    // slot j's entry may move to i if i lies cyclically in [h, j)
+    const bool movable = (j > i) ? (h <= i || h > j) : (h <= i && h > j);
+    if (movable) {
+      slots_[i] = slots_[j];
+      i = j;
+    }
+  }
+  slots_[i] = Slot{};
+  --size_;
+}
+
 void ColourMap::VoxelIndex::reset(size_t expected) {
   size_t n = 1024;
   while (n < 2 * expected + 2) n *= 2;
@@ -40,7 +95,11 @@ void ColourMap::VoxelIndex::grow() {
     if (s.key != kEmpty) findOrInsert(s.key, s.id, &inserted);
 }
 
-ColourMap::ColourMap(double voxel_size) : voxel_(voxel_size > 0 ? voxel_size : 0.05) { index_.reset(0); }
+ColourMap::ColourMap(double voxel_size, TileOptions tiles)
+    : voxel_(voxel_size > 0 ? voxel_size : 0.05), tile_options_(std::move(tiles)) {
+  voxels_per_tile_ = std::max<int64_t>(1, std::llround(tile_options_.tile_size / voxel_));
+  index_.reset(0);
+}
 
 uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
   auto k = [this](float v) {
@@ -49,14 +108,61 @@ uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
   return (k(p.x()) << 42) | (k(p.y()) << 21) | k(p.z());
 }
 
-uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created) {
+uint64_t ColourMap::tileKey(const Eigen::Vector3f& p) const {
+  // the tile of the voxel (not of the point), so that a voxel lies in exactly one tile
+  auto t = [this](float v) {
+    const int64_t voxel = static_cast<int64_t>(std::floor(v / voxel_));
+    const int64_t tile = voxel >= 0 ? voxel / voxels_per_tile_ : -((-voxel + voxels_per_tile_ - 1) / voxels_per_tile_);
+    return static_cast<uint64_t>(static_cast<uint32_t>(static_cast<int32_t>(tile)));
+  };
+  return (t(p.x()) << 32) | t(p.y());
+}
+
+uint32_t ColourMap::insertMerged(const MapPoint& p, Tile* tile) {
+  const uint32_t next = free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
   bool inserted = false;
-  const uint32_t id = index_.findOrInsert(key(p), static_cast<uint32_t>(points_.size()), &inserted);
+  const uint32_t id = index_.findOrInsert(key(p.position), next, &inserted);
+  if (inserted) {
+    if (free_.empty()) {
+      points_.push_back(p);
+    } else {
+      free_.pop_back();
+      points_[id] = p;
+    }
+    tile->ids.push_back(id);
+  } else {
+    MapPoint& q = points_[id];
+    const int n = q.count + p.count;
+    if (n > 0) q.colour = (q.colour * float(q.count) + p.colour * float(p.count)) / float(n);
+    q.count = n;
+    q.rejected += p.rejected;
+  }
+  return id;
+}
+
+ColourMap::Tile& ColourMap::residentTile(uint64_t tile_key) {
+  Tile& t = tiles_[tile_key];  // unordered_map: references stay valid as tiles are added
+  if (t.spilled) reload(tile_key, &t);
+  if (t.last_used < now_) t.last_used = now_;
+  return t;
+}
+
+uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created) {
+  Tile& tile = residentTile(tileKey(p));
+  const uint32_t next = free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
+  bool inserted = false;
+  const uint32_t id = index_.findOrInsert(key(p), next, &inserted);
   if (inserted) {
     MapPoint mp;
     mp.position = p;
     mp.anchor = anchor;
-    points_.push_back(mp);
+    if (free_.empty()) {
+      points_.push_back(mp);
+    } else {
+      free_.pop_back();
+      points_[id] = mp;
+    }
+    tile.ids.push_back(id);
   }
   if (created) *created = inserted;
   return id;
@@ -74,41 +180,204 @@ bool ColourMap::accumulate(uint32_t id, const Eigen::Vector3f& c, const Accumula
 }
 
 size_t ColourMap::colouredCount() const {
-  return static_cast<size_t>(std::count_if(points_.begin(), points_.end(), [](const MapPoint& p) { return p.coloured(); }));
+  size_t n = static_cast<size_t>(
+      std::count_if(points_.begin(), points_.end(), [](const MapPoint& p) { return p.live() && p.coloured(); }));
+  for (const auto& [k, t] : tiles_)
+    if (t.spilled) n += t.spilled_coloured;
+  return n;
+}
+
+size_t ColourMap::residentTiles() const {
+  return static_cast<size_t>(std::count_if(tiles_.begin(), tiles_.end(), [](const auto& kt) { return !kt.second.spilled; }));
 }
 
 void ColourMap::transform(const std::function<bool(int64_t, Pose3*)>& delta) {
   Pose3 T;
   int64_t cached_anchor = INT64_MIN;
   bool cached_ok = false;
+  size_t live = 0;
   for (MapPoint& p : points_) {
+    if (!p.live()) continue;
+    ++live;
     if (p.anchor != cached_anchor) {
       cached_anchor = p.anchor;
       cached_ok = delta(p.anchor, &T);
     }
     if (cached_ok) p.position = (T * p.position.cast<double>()).cast<float>();
   }
-  // re-index, merging points that now share a voxel
-  std::vector<MapPoint> kept;
-  kept.reserve(points_.size());
-  remap_.assign(points_.size(), 0);
-  index_.reset(points_.size());
-  for (size_t i = 0; i < points_.size(); ++i) {
-    const MapPoint& p = points_[i];
-    bool inserted = false;
-    const uint32_t id = index_.findOrInsert(key(p.position), static_cast<uint32_t>(kept.size()), &inserted);
-    if (inserted) {
-      kept.push_back(p);
-    } else {
-      MapPoint& q = kept[id];
-      const int n = q.count + p.count;
-      if (n > 0) q.colour = (q.colour * float(q.count) + p.colour * float(p.count)) / float(n);
-      q.count = n;
-      q.rejected += p.rejected;
-    }
-    remap_[i] = id;
+  // re-index, merging points that now share a voxel (a tile on disk they land in comes back)
+  std::vector<MapPoint> old;
+  old.swap(points_);
+  points_.reserve(live);
+  free_.clear();
+  remap_.assign(old.size(), 0);
+  index_.reset(live);
+  for (auto& [k, t] : tiles_)
+    if (!t.spilled) t.ids.clear();
+  for (size_t i = 0; i < old.size(); ++i) {
+    if (!old[i].live()) continue;
+    remap_[i] = insertMerged(old[i], &residentTile(tileKey(old[i].position)));
   }
-  points_.swap(kept);
+  ++epoch_;
+}
+
+void ColourMap::readTile(const Tile& tile, std::vector<MapPoint>* points) const {
+  std::vector<uint8_t> bytes;
+  spill_->read(tile.record, &bytes);
+  uint64_t n_points = 0, n_anchors = 0;
+  std::memcpy(&n_points, bytes.data(), 8);
+  std::memcpy(&n_anchors, bytes.data() + 8, 8);
+  const uint8_t* a = bytes.data() + 16;
+  std::map<int64_t, Pose3> deltas;  // stored anchor pose -> current one
+  for (uint64_t i = 0; i < n_anchors; ++i, a += 8 + 16 * 8) {
+    int64_t anchor = 0;
+    std::memcpy(&anchor, a, 8);
+    Eigen::Matrix4d stored;
+    std::memcpy(stored.data(), a + 8, 16 * 8);
+    auto it = anchor_poses_.find(anchor);
+    if (it == anchor_poses_.end() || (it->second.matrix() - stored).cwiseAbs().maxCoeff() < 1e-12) continue;
+    Pose3 s;
+    s.matrix() = stored;
+    deltas[anchor] = it->second * s.inverse();
+  }
+  points->resize(n_points);
+  for (uint64_t i = 0; i < n_points; ++i, a += sizeof(StoredPoint)) {
+    StoredPoint sp;
+    std::memcpy(&sp, a, sizeof(sp));
+    (*points)[i] = restored(sp);
+  }
+  if (deltas.empty()) return;
+  for (MapPoint& p : *points) {
+    auto it = deltas.find(p.anchor);
+    if (it != deltas.end()) p.position = (it->second * p.position.cast<double>()).cast<float>();
+  }
+}
+
+void ColourMap::reload(uint64_t tile_key, Tile* tile) {
+  std::vector<MapPoint> stored;
+  readTile(*tile, &stored);
+  const bool moved = tile->epoch < epoch_;
+  tile->spilled = false;
+  tile->spilled_coloured = 0;
+  if (reload_log_) reload_log_->push_back(tile_key);
+  for (const MapPoint& p : stored) {
+    const uint64_t k = tileKey(p.position);
+    Tile& destination = k == tile_key ? *tile : residentTile(k);
+    const uint32_t id = insertMerged(p, &destination);
+    if (moved && p.coloured()) moved_on_reload_.push_back(id);
+  }
+}
+
+void ColourMap::spill(Tile* tile, std::vector<uint32_t>* freed) {
+  std::vector<MapPoint> pts;
+  pts.reserve(tile->ids.size());
+  std::map<int64_t, Pose3> anchors;
+  for (uint32_t id : tile->ids) {
+    MapPoint& p = points_[id];
+    pts.push_back(p);
+    auto it = anchor_poses_.find(p.anchor);
+    if (it != anchor_poses_.end()) anchors.emplace(p.anchor, it->second);
+    index_.erase(key(p.position));
+    p.rejected = -1;
+    free_.push_back(id);
+    freed->push_back(id);
+  }
+  if (!spill_) spill_ = std::make_unique<SpillFile>(tile_options_.spill_directory);
+  std::vector<uint8_t> bytes(16 + anchors.size() * (8 + 16 * 8) + pts.size() * sizeof(StoredPoint));
+  const uint64_t n_points = pts.size(), n_anchors = anchors.size();
+  std::memcpy(bytes.data(), &n_points, 8);
+  std::memcpy(bytes.data() + 8, &n_anchors, 8);
+  uint8_t* a = bytes.data() + 16;
+  for (const auto& [anchor, pose] : anchors) {
+    std::memcpy(a, &anchor, 8);
+    const Eigen::Matrix4d m = pose.matrix();
+    std::memcpy(a + 8, m.data(), 16 * 8);
+    a += 8 + 16 * 8;
+  }
+  for (const MapPoint& p : pts) {
+    const StoredPoint sp = stored(p);
+    std::memcpy(a, &sp, sizeof(sp));
+    a += sizeof(sp);
+  }
+  tile->record = spill_->append(bytes.data(), bytes.size());
+  tile->spilled = true;
+  tile->epoch = epoch_;
+  tile->spilled_coloured = static_cast<size_t>(std::count_if(pts.begin(), pts.end(), [](const MapPoint& p) { return p.coloured(); }));
+  std::vector<uint32_t>().swap(tile->ids);
+}
+
+namespace {
+void dropFreed(std::vector<uint32_t>* ids, std::vector<uint32_t> freed) {
+  if (freed.empty() || ids->empty()) return;
+  std::sort(freed.begin(), freed.end());
+  ids->erase(std::remove_if(ids->begin(), ids->end(),
+                            [&](uint32_t id) { return std::binary_search(freed.begin(), freed.end(), id); }),
+             ids->end());
+}
+}  // namespace
+
+std::vector<uint32_t> ColourMap::evictIdle(int64_t utime) {
+  std::vector<uint32_t> freed;
+  if (tile_options_.idle_s <= 0.0) return freed;
+  const int64_t before = utime - static_cast<int64_t>(tile_options_.idle_s * 1e6);
+  std::vector<uint64_t> idle;
+  for (const auto& [k, t] : tiles_)
+    if (!t.spilled && t.last_used < before) idle.push_back(k);
+  std::sort(idle.begin(), idle.end());  // the same order whatever the hash table's
+  for (uint64_t k : idle) {
+    Tile& t = tiles_.at(k);
+    if (t.ids.empty()) {
+      tiles_.erase(k);
+      continue;
+    }
+    spill(&t, &freed);
+  }
+  dropFreed(&moved_on_reload_, freed);
+  return freed;
+}
+
+std::vector<uint32_t> ColourMap::settleSpilledTiles() {
+  std::vector<uint32_t> freed;
+  std::vector<uint64_t> stale;
+  for (const auto& [k, t] : tiles_)
+    if (t.spilled && t.epoch < epoch_) stale.push_back(k);
+  std::sort(stale.begin(), stale.end());
+  std::vector<uint64_t> loaded;
+  reload_log_ = &loaded;
+  for (uint64_t k : stale) {
+    Tile& t = tiles_.at(k);
+    if (!t.spilled) continue;  // came back with an earlier one
+    loaded.clear();
+    reload(k, &t);
+    std::sort(loaded.begin(), loaded.end());
+    for (uint64_t back : loaded) {
+      Tile& b = tiles_.at(back);
+      if (!b.spilled && !b.ids.empty()) spill(&b, &freed);
+    }
+  }
+  reload_log_ = nullptr;
+  dropFreed(&moved_on_reload_, freed);
+  return freed;
+}
+
+void ColourMap::forEachPoint(const std::function<void(const MapPoint&)>& visit) const {
+  for (const MapPoint& p : points_)
+    if (p.live()) visit(p);
+  std::vector<uint64_t> spilled;
+  for (const auto& [k, t] : tiles_)
+    if (t.spilled) spilled.push_back(k);
+  std::sort(spilled.begin(), spilled.end());
+  std::vector<MapPoint> pts;
+  for (uint64_t k : spilled) {
+    readTile(tiles_.at(k), &pts);
+    for (const MapPoint& p : pts) visit(p);
+  }
+}
+
+std::vector<uint32_t> ColourMap::takeMovedOnReload() {
+  std::vector<uint32_t> out;
+  out.swap(moved_on_reload_);
+  return out;
 }
 
 }  // namespace colour

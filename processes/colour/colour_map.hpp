@@ -1,15 +1,26 @@
 // The coloured point map: one point per voxel (the first measured in it), each with a robust
 // running-mean colour, the time it was last measured and the keyframe it is anchored to (so a
 // loop correction can move it with that keyframe).
+//
+// Memory: the voxels are grouped into square tiles (tile_size metres in x and y, all heights).
+// A tile that has taken no scan point for idle_s of sensor time goes to disk (a SpillFile) and its
+// points leave memory; a scan point falling into it brings it back. A loop correction moves the
+// resident points at once; a tile on disk keeps, per anchor, the keyframe pose its points were
+// stored at and is moved when it comes back (or for the files: settleSpilledTiles()), so every
+// voxel still holds one point whatever was on disk.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "livo/so3.hpp"
+#include "livo/spill_file.hpp"
 
 namespace livo {
 namespace colour {
@@ -18,9 +29,10 @@ struct MapPoint {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  // world frame
   Eigen::Vector3f colour = Eigen::Vector3f::Zero();    // running mean, 0..255 (exposure-normalised)
   int32_t count = 0;           // accepted observations
-  int32_t rejected = 0;        // observations refused as outliers
+  int32_t rejected = 0;        // observations refused as outliers (-1: a free slot)
   int64_t anchor = -1;         // keyframe id it moves with (-1: none)
   bool coloured() const { return count > 0; }
+  bool live() const { return rejected >= 0; }
 };
 
 struct AccumulationOptions {
@@ -29,24 +41,53 @@ struct AccumulationOptions {
   int max_count = 50;
 };
 
+struct TileOptions {
+  double tile_size = 16.0;  // m, rounded to whole voxels
+  double idle_s = 10.0;     // sensor time without a new point before a tile goes to disk (0: never)
+  std::string spill_directory;  // "" : the temp directory
+};
+
 class ColourMap {
  public:
-  explicit ColourMap(double voxel_size);
+  explicit ColourMap(double voxel_size, TileOptions tiles = {});
 
-  /// The point of the voxel containing p (created at p if the voxel is empty).
+  /// The time scan points are added at (the tiles they touch are "used" then).
+  void setTime(int64_t utime) { now_ = utime; }
+  /// The point of the voxel containing p (created at p if the voxel is empty); a tile on disk
+  /// comes back first.
   uint32_t addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created = nullptr);
   /// Robust running mean; false if the observation was refused as an outlier.
   bool accumulate(uint32_t id, const Eigen::Vector3f& colour, const AccumulationOptions& options);
 
-  /// Moves points by the delta of their anchor (`delta(anchor, &T)` false: leave them) and
-  /// re-indexes the voxels; points that land in an occupied voxel are merged (colours weighted).
+  /// The pose the map's points of `anchor` are in (set on a keyframe and by every correction).
+  void setAnchorPose(int64_t anchor, const Pose3& T_W_I) { anchor_poses_[anchor] = T_W_I; }
+  /// Moves resident points by the delta of their anchor (`delta(anchor, &T)` false: leave them)
+  /// and re-indexes the voxels; points that land in an occupied voxel are merged (colours
+  /// weighted). Call setAnchorPose for the moved anchors first: tiles on disk follow them.
   void transform(const std::function<bool(int64_t anchor, Pose3* delta)>& delta);
 
+  /// Writes the tiles unused since before `utime - idle_s` to disk; returns the ids freed.
+  std::vector<uint32_t> evictIdle(int64_t utime);
+  /// Brings back, one at a time, the tiles on disk whose anchors moved since they were written,
+  /// merges them and writes them out again (the files then hold one point per voxel); returns
+  /// the ids freed.
+  std::vector<uint32_t> settleSpilledTiles();
+  /// Every point, resident and on disk (on disk: moved to the current anchor poses).
+  void forEachPoint(const std::function<void(const MapPoint&)>& visit) const;
+  /// Ids of points that came back from disk moved by a correction since the last call.
+  std::vector<uint32_t> takeMovedOnReload();
+
+  /// Resident slots (a free slot has live() false).
   const std::vector<MapPoint>& points() const { return points_; }
   MapPoint& point(uint32_t id) { return points_[id]; }
   const MapPoint& point(uint32_t id) const { return points_[id]; }
   size_t size() const { return points_.size(); }
+  /// Coloured points, resident and on disk.
   size_t colouredCount() const;
+  size_t residentPoints() const { return points_.size() - free_.size(); }
+  size_t residentTiles() const;
+  size_t spilledTiles() const { return tiles_.size() - residentTiles(); }
+  uint64_t spilledBytes() const { return spill_ ? spill_->size() : 0; }
   double voxelSize() const { return voxel_; }
   /// Ids of points removed by the last transform() merge are remapped here (old id -> new id).
   const std::vector<uint32_t>& lastRemap() const { return remap_; }
@@ -58,6 +99,8 @@ class ColourMap {
    public:
     /// The id stored for key, after storing `id` for it if it had none (*inserted tells which).
     uint32_t findOrInsert(uint64_t key, uint32_t id, bool* inserted);
+    /// Removes key (backward-shift deletion: no tombstones).
+    void erase(uint64_t key);
     /// Empties the index, sized for `expected` keys.
     void reset(size_t expected);
 
@@ -72,12 +115,38 @@ class ColourMap {
     std::vector<Slot> slots_;
     size_t size_ = 0;
   };
+  struct Tile {
+    std::vector<uint32_t> ids;  // resident points
+    int64_t last_used = INT64_MIN;
+    bool spilled = false;
+    SpillFile::Record record;       // on disk: the points and their anchors' poses
+    size_t spilled_coloured = 0;
+    uint64_t epoch = 0;             // transform()s before it was written (behind epoch_: stale)
+  };
 
   uint64_t key(const Eigen::Vector3f& p) const;
+  uint64_t tileKey(const Eigen::Vector3f& p) const;
+  /// Inserts a point (a new voxel, or merged into the voxel's point); its tile must be resident.
+  uint32_t insertMerged(const MapPoint& p, Tile* tile);
+  Tile& residentTile(uint64_t tile_key);
+  void reload(uint64_t tile_key, Tile* tile);
+  void spill(Tile* tile, std::vector<uint32_t>* freed);
+  void readTile(const Tile& tile, std::vector<MapPoint>* points) const;
+
   double voxel_;
+  int64_t voxels_per_tile_;
+  TileOptions tile_options_;
+  int64_t now_ = INT64_MIN;
   std::vector<MapPoint> points_;
+  std::vector<uint32_t> free_;
   VoxelIndex index_;
+  std::unordered_map<uint64_t, Tile> tiles_;
+  std::map<int64_t, Pose3> anchor_poses_;
+  std::unique_ptr<SpillFile> spill_;
   std::vector<uint32_t> remap_;
+  std::vector<uint32_t> moved_on_reload_;
+  uint64_t epoch_ = 0;                          // transform()s so far
+  std::vector<uint64_t>* reload_log_ = nullptr;  // settleSpilledTiles(): the tiles reload() brought back
 };
 
 }  // namespace colour

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
@@ -173,13 +174,14 @@ bool ColourNode::saveMap() { return saveMap(options_.map_name); }
 
 bool ColourNode::saveMap(const std::string& name) {
   ColouredPoints pts;
-  for (const MapPoint& p : pipeline_.map().points()) {
-    if (!p.coloured()) continue;
+  pipeline_.settleMap();  // the tiles on disk too, corrected
+  pipeline_.map().forEachPoint([&](const MapPoint& p) {
+    if (!p.coloured()) return;
     pts.position.push_back(p.position);
     std::array<uint8_t, 3> c;
     for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[k], 0.0f, 255.0f)));
     pts.rgb.push_back(c);
-  }
+  });
   std::error_code ec;
   std::filesystem::create_directories(output_dir_, ec);
   std::string error;
@@ -188,7 +190,12 @@ bool ColourNode::saveMap(const std::string& name) {
     node_.error(error);
     return false;
   }
-  node_.info("wrote " + std::to_string(pts.size()) + " coloured points to " + ply + " and " + pcd);
+  const ColourMap& map = pipeline_.map();
+  std::ostringstream s;
+  s << "wrote " << pts.size() << " coloured points to " << ply << " and " << pcd << " (map tiles: "
+    << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.spilledTiles()
+    << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB)";
+  node_.info(s.str());
   return true;
 }
 

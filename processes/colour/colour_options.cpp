@@ -6,7 +6,9 @@ namespace livo {
 namespace colour {
 
 void printColourOptions(const ColourOptions& o, std::ostream& os) {
-  os << "colour: voxel_size " << o.voxel_size << " m, max_time_difference " << o.max_time_difference
+  os << "colour: voxel_size " << o.voxel_size << " m, tiles " << o.tile_size << " m to disk after " << o.tile_idle_s
+     << " s idle, points within max_depth + " << o.map_margin
+     << " m of the body, max_time_difference " << o.max_time_difference
      << " s, depth " << o.min_depth << ".." << o.max_depth << " m, border " << o.border_px << " px, at most "
      << o.max_pending_images << " images waiting\n"
      << "  occlusion: cell " << o.depth_cell_px << " px, occluder_radius " << o.occluder_radius

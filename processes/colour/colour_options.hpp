@@ -10,6 +10,14 @@ namespace colour {
 struct ColourOptions {
   // Map
   double voxel_size = 0.05;            // m: one map point per voxel (the first point measured in it)
+  double tile_size = 16.0;             // m: the map is kept in square tiles (x, y) ...
+  double tile_idle_s = 20.0;           // ... and a tile without a new point for this long (sensor
+                                       // time) goes to disk until a point falls in it again (0: never)
+  double map_margin = 10.0;            // m: scan points farther than max_depth + map_margin from the
+                                       // body at the scan time are not put in the map: no image within
+                                       // max_time_difference can colour them (body speed below
+                                       // map_margin / max_time_difference, 33 m/s), and with a long-range
+                                       // LiDAR they would keep every tile in reach in memory
   // Which images a point may take colour from
   double max_time_difference = 0.3;    // s: |t_point - t_image| at most (point = when last measured)
   double max_depth = 30.0;             // m in front of the camera

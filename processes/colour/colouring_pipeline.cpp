@@ -24,7 +24,11 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
     : options_(options),
       camera_(camera),
       depth_(camera.width, camera.height, std::max(camera.fx, camera.fy), depthOptions(options)),
-      map_(options.voxel_size),
+      map_(options.voxel_size,
+           // a tile stays while the scans an image may still need (2 windows + 1 s) can touch it
+           TileOptions{options.tile_size,
+                       options.tile_idle_s > 0 ? std::max(options.tile_idle_s, 2 * options.max_time_difference + 2.0) : 0.0,
+                       ""}),
       reference_exposure_(options.reference_exposure_s) {}
 
 void ColouringPipeline::addPose(int64_t utime, const Pose3& T_W_I) { poses_.add(utime, T_W_I); }
@@ -43,13 +47,20 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   poses_.add(scan.utime, scan.T_W_I);
   ++stats_.scans;
   const int64_t anchor = keyframes_.empty() ? -1 : keyframes_.rbegin()->first;
+  map_.setTime(scan.utime);
   ActiveScan active{INT64_MAX, INT64_MIN, {}};
   active.points.reserve(scan.num_points);
+  const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
+  const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
   for (int j = 0; j < scan.num_points; ++j) {
     const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
     if (!p.allFinite() || !std::isfinite(dt) || p.cwiseAbs().maxCoeff() > 1e5f) {
       ++stats_.points_rejected;
+      continue;
+    }
+    if ((p - body).squaredNorm() > reach * reach) {
+      ++stats_.points_out_of_reach;
       continue;
     }
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));
@@ -65,6 +76,7 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   while (!active_.empty() && active_.front().t_max < keep_from) active_.pop_front();
   poses_.dropBefore(keep_from);
   processReady(false);
+  afterTileChanges(map_.evictIdle(scan.utime));
   return true;
 }
 
@@ -178,7 +190,6 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   }
   stats_.last_gain = gain;
   AccumulationOptions acc{options_.outlier_threshold, options_.outlier_min_count, options_.max_count};
-  if (recoloured_flag_.size() < map_.size()) recoloured_flag_.resize(map_.size(), 0);
   size_t k = 0;
   for (const Candidate& c : candidates) {
     if (k >= ids.size() || ids[k] != c.id) continue;
@@ -189,14 +200,37 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
       continue;
     }
     ++stats_.accepted;
-    if (!recoloured_flag_[c.id]) {
-      recoloured_flag_[c.id] = 1;
-      recoloured_.push_back(c.id);
-    }
+    markRecoloured(c.id);
     if (observer_) observer_({c.id, image.utime, c.pixel, T_W_C.translation(), col});
   }
   return true;
 }
+
+void ColouringPipeline::markRecoloured(uint32_t id) {
+  if (recoloured_flag_.size() < map_.size()) recoloured_flag_.resize(map_.size(), 0);
+  if (!recoloured_flag_[id]) {
+    recoloured_flag_[id] = 1;
+    recoloured_.push_back(id);
+  }
+}
+
+void ColouringPipeline::afterTileChanges(std::vector<uint32_t> freed) {
+  if (!freed.empty()) {
+    std::sort(freed.begin(), freed.end());
+    auto gone = [&](uint32_t id) { return std::binary_search(freed.begin(), freed.end(), id); };
+    // the scans an image may still need touch only resident tiles (idle_s > their span): this
+    // only guards against a caller that never takes the recoloured ids
+    for (ActiveScan& s : active_)
+      s.points.erase(std::remove_if(s.points.begin(), s.points.end(), [&](const auto& pt) { return gone(pt.first); }),
+                     s.points.end());
+    recoloured_.erase(std::remove_if(recoloured_.begin(), recoloured_.end(), gone), recoloured_.end());
+    for (uint32_t id : freed)
+      if (id < recoloured_flag_.size()) recoloured_flag_[id] = 0;
+  }
+  for (uint32_t id : map_.takeMovedOnReload()) markRecoloured(id);
+}
+
+void ColouringPipeline::settleMap() { afterTileChanges(map_.settleSpilledTiles()); }
 
 std::vector<uint32_t> ColouringPipeline::takeRecoloured() {
   std::vector<uint32_t> out;
@@ -208,7 +242,7 @@ std::vector<uint32_t> ColouringPipeline::takeRecoloured() {
 
 void ColouringPipeline::addKeyframe(int64_t id, int64_t utime, const Pose3& T_W_I) {
   if (!T_W_I.matrix().allFinite()) return;
-  keyframes_.emplace(id, std::make_pair(utime, T_W_I));
+  if (keyframes_.emplace(id, std::make_pair(utime, T_W_I)).second) map_.setAnchorPose(id, T_W_I);
 }
 
 int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted) {
@@ -222,6 +256,7 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
     if ((d.matrix() - Eigen::Matrix4d::Identity()).cwiseAbs().maxCoeff() < 1e-12) continue;
     delta[id] = d;
     current = pose;
+    map_.setAnchorPose(id, pose);
   }
   if (delta.empty()) return 0;
   map_.transform([&](int64_t anchor, Pose3* T) {
@@ -242,11 +277,12 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
   recoloured_.clear();
   for (uint32_t id = 0; id < map_.size(); ++id) {
     const MapPoint& mp = map_.point(id);
-    if (mp.coloured() && (delta.count(mp.anchor) || std::binary_search(rec.begin(), rec.end(), id))) {
+    if (mp.live() && mp.coloured() && (delta.count(mp.anchor) || std::binary_search(rec.begin(), rec.end(), id))) {
       recoloured_flag_[id] = 1;
       recoloured_.push_back(id);
     }
   }
+  afterTileChanges({});  // tiles that came back while re-indexing
   return static_cast<int>(delta.size());
 }
 

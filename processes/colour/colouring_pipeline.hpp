@@ -41,6 +41,7 @@ struct Observation {
 
 struct ColouringStats {
   int64_t scans = 0, points_in = 0, points_rejected = 0;
+  int64_t points_out_of_reach = 0;  // beyond max_depth + map_margin from the body: not mapped
   int64_t images = 0, images_without_pose = 0, images_dropped = 0;  // dropped: waited beyond max_pending_images
   int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
   int64_t gain_estimates = 0;
@@ -53,7 +54,8 @@ class ColouringPipeline {
 
   /// Body pose samples (ODOMETRY, REGISTERED_SCAN).
   void addPose(int64_t utime, const Pose3& T_W_I);
-  /// Adds a scan's points to the map (non-finite points are skipped and counted) and processes
+  /// Adds a scan's points to the map (non-finite points are skipped and counted, points farther
+  /// than max_depth + map_margin from the body counted and left out) and processes
   /// the images it makes ready. False (and nothing changes) for a scan older than the last one.
   bool addScan(const RegisteredScanView& scan, std::string* error);
   /// Queues an image; processes it at once if it is ready. False if older than the last image.
@@ -68,8 +70,12 @@ class ColouringPipeline {
   /// yet) move by `unlisted`, the correction's transform. Returns the number of keyframes that moved.
   int applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted = Pose3::Identity());
 
-  /// Ids of points coloured or recoloured since the last call (ascending).
+  /// Ids of points coloured or recoloured since the last call (ascending), and of coloured points
+  /// that came back from disk moved by a correction.
   std::vector<uint32_t> takeRecoloured();
+  /// Brings the map tiles on disk up to date with the corrections (see ColourMap); then
+  /// map().forEachPoint visits one point per voxel. For the files.
+  void settleMap();
   void setObserver(std::function<void(const Observation&)> observer) { observer_ = std::move(observer); }
 
   const ColourMap& map() const { return map_; }
@@ -86,6 +92,9 @@ class ColouringPipeline {
   void processReady(bool flushing);
   bool processImage(const ColourImage& image);
   int64_t windowUs() const { return static_cast<int64_t>(options_.max_time_difference * 1e6); }
+  /// Forgets ids the map freed (tiles written to disk) and adds the points that came back moved.
+  void afterTileChanges(std::vector<uint32_t> freed);
+  void markRecoloured(uint32_t id);
 
   ColourOptions options_;
   CameraProjection camera_;

@@ -51,7 +51,7 @@ std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
   for (const auto& [other, kf] : keyframes_) {
-    if (other >= id || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || kf.coarse.points.empty()) continue;
+    if (other >= id || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints) continue;
     const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
     if (d2 <= r2) near.push_back({d2, other});
   }
@@ -62,6 +62,45 @@ std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
   return out;
 }
 
+std::shared_ptr<const LoopCloser::Features> LoopCloser::deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const {
+  auto f = std::make_shared<Features>();
+  const Points levelled = transformed(cloud_I, rotationOnly(G_R_I));
+  f->coarse = computeCoarseFeatures(levelled, options_.coarse);
+  f->fine = GicpCloud::build(voxelDownsample(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
+  return f;
+}
+
+void LoopCloser::cacheFeatures(int64_t id, std::shared_ptr<const Features> f) {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it)
+    if (it->first == id) {
+      cache_.erase(it);
+      break;
+    }
+  cache_.emplace_front(id, std::move(f));
+  while (cache_.size() > static_cast<size_t>(std::max(1, options_.feature_cache_keyframes))) cache_.pop_back();
+}
+
+std::shared_ptr<const LoopCloser::Features> LoopCloser::features(int64_t id) {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it)
+    if (it->first == id) {
+      cache_.splice(cache_.begin(), cache_, it);
+      return it->second;
+    }
+  Points cloud_I;
+  for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
+  std::shared_ptr<const Features> f = deriveFeatures(cloud_I, keyframes_.at(id).G_R_I);
+  cacheFeatures(id, f);
+  return f;
+}
+
+Points LoopCloser::mapCloud(int64_t id) const {
+  Points cloud_I;
+  for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
+  Points map = voxelDownsample(cloud_I, options_.map_voxel_size);
+  for (Vec3& p : map) p = p.cast<float>().cast<double>();  // float, as the global map has always kept them
+  return map;
+}
+
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
   Keyframe kf;
@@ -70,12 +109,16 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
-  const Points levelled = transformed(input.cloud, rotationOnly(kf.G_R_I));
-  kf.coarse = computeCoarseFeatures(levelled, options_.coarse);
-  kf.fine = GicpCloud::build(voxelDownsample(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
-  const Points map_points = voxelDownsample(input.cloud, options_.map_voxel_size);
-  kf.map_cloud.reserve(map_points.size());
-  for (const Vec3& p : map_points) kf.map_cloud.push_back(p.cast<float>());
+  // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
+  std::vector<Eigen::Vector3f> cloud_f;
+  cloud_f.reserve(input.cloud.size());
+  for (const Vec3& p : input.cloud) cloud_f.push_back(p.cast<float>());
+  clouds_.put(input.id, cloud_f);
+  Points cloud_I;
+  cloud_I.reserve(cloud_f.size());
+  for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
+  std::shared_ptr<const Features> cur_features = deriveFeatures(cloud_I, kf.G_R_I);
+  kf.has_keypoints = !cur_features->coarse.points.empty();
 
   // Initial estimate: the previous keyframe's corrected pose composed with the odometry increment.
   if (!keyframes_.empty() && keyframes_.rbegin()->second.epoch == input.epoch) {
@@ -103,11 +146,14 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
 
   AddResult result;
   if (++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes) return result;
+  cacheFeatures(input.id, cur_features);
   const Keyframe& cur = keyframes_.at(input.id);
-  if (cur.coarse.points.empty()) return result;
+  if (!cur.has_keypoints) return result;
   for (int64_t cand : candidates(input.id)) {
     const Keyframe& target = keyframes_.at(cand);
-    LoopRegistrationResult r = registerLoop(cur.coarse, target.coarse, cur.fine, target.fine, options_.registration);
+    const std::shared_ptr<const Features> target_features = features(cand);
+    LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
+                                            target_features->fine, options_.registration);
     result.attempts.push_back(r);
     if (!r.accepted) continue;
     AcceptedLoop loop;

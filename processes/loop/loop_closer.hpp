@@ -1,10 +1,13 @@
-// The loop-closure core without middleware: a keyframe store (gravity-aligned clouds with cached
-// coarse features and GICP covariances), radius candidates, coarse-to-fine registration and the
-// pose graph, optimised only when a loop is accepted.
+// The loop-closure core without middleware: a keyframe store (body-frame clouds on disk, their
+// coarse features and GICP covariances derived on demand and cached for the most recently used
+// keyframes), radius candidates, coarse-to-fine registration and the pose graph, optimised only
+// when a loop is accepted.
 #pragma once
 
 #include <cstdint>
+#include <list>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +15,7 @@
 #include "coarse_features.hpp"
 #include "livo/correction_frames.hpp"
 #include "gicp.hpp"
+#include "livo/spill_file.hpp"
 #include "loop_registration.hpp"
 #include "pose_graph.hpp"
 
@@ -29,6 +33,10 @@ struct LoopCloserOptions {
   double fine_voxel_size = 0.4;     // m
   int covariance_neighbors = 10;
   double map_voxel_size = 0.2;      // m, clouds kept for the global map
+  /// Keyframes whose coarse features and GICP clouds stay in memory (the newest and the recent
+  /// loop candidates); the others are derived again from the stored cloud when a candidate.
+  int feature_cache_keyframes = 32;
+  std::string spill_directory;      // where the keyframe clouds go ("" : the temp directory)
   CandidateOptions candidates;
   LoopRegistrationOptions registration;
   PoseGraphOptions graph;
@@ -81,7 +89,8 @@ struct AddResult {
 
 class LoopCloser {
  public:
-  explicit LoopCloser(LoopCloserOptions options = {}) : options_(std::move(options)), graph_(options_.graph) {}
+  explicit LoopCloser(LoopCloserOptions options = {})
+      : options_(std::move(options)), graph_(options_.graph), clouds_(0.0, options_.spill_directory) {}
 
   /// Why a keyframe cannot be added ("" if it can): an id not after the newest, an epoch before
   /// the newest keyframe's, or a pose in a correction this closer did not publish for its epoch.
@@ -100,9 +109,13 @@ class LoopCloser {
   int32_t epoch(int64_t id) const { return keyframes_.at(id).epoch; }
   /// Odometry edges whose ends are in different epochs (0 by construction; a check for tests).
   size_t odometryEdgesAcrossEpochs() const;
-  /// The keyframe's cloud for the global map (voxel-downsampled, body frame I).
-  const std::vector<Eigen::Vector3f>& mapCloud(int64_t id) const { return keyframes_.at(id).map_cloud; }
+  /// The keyframe's cloud for the global map (voxel-downsampled, body frame I), from the store.
+  Points mapCloud(int64_t id) const;
   size_t size() const { return keyframes_.size(); }
+  /// Keyframes whose derived features are in memory now (<= feature_cache_keyframes).
+  size_t cachedFeatures() const { return cache_.size(); }
+  /// Bytes of keyframe clouds on disk.
+  uint64_t storedCloudBytes() const { return clouds_.diskBytes(); }
 
  private:
   struct Keyframe {
@@ -111,15 +124,24 @@ class LoopCloser {
     Pose3 odometry = Pose3::Identity();   // in the raw odometry frame of its epoch (no correction)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
-    CoarseFeatures coarse;              // in G
-    GicpCloud fine;                     // in G
-    std::vector<Eigen::Vector3f> map_cloud;  // in I, float: kept for every keyframe
+    bool has_keypoints = false;         // its coarse features are not empty
+  };
+  /// What registration needs of a keyframe, derived from its stored cloud.
+  struct Features {
+    CoarseFeatures coarse;  // in G
+    GicpCloud fine;         // in G
   };
   std::vector<int64_t> candidates(int64_t id) const;
+  std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
+  /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
+  std::shared_ptr<const Features> features(int64_t id);
+  void cacheFeatures(int64_t id, std::shared_ptr<const Features> f);
 
   LoopCloserOptions options_;
   PoseGraph graph_;
   std::map<int64_t, Keyframe> keyframes_;
+  KeyframeCloudStore clouds_;  // body frame I, float as received (lossless: loops do not change)
+  std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;
   int64_t keyframes_since_loop_ = 1000000;
   CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch

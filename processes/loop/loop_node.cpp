@@ -24,6 +24,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("max_keypoints", c.coarse.max_keypoints);
   s.readOptional("keypoint_nms_radius", c.coarse.keypoints.nms_radius);
   s.readOptional("fine_voxel", c.fine_voxel_size);
+  s.readOptional("feature_cache_keyframes", c.feature_cache_keyframes);
   s.readOptional("search_radius", c.candidates.search_radius);
   s.readOptional("exclude_recent_s", c.candidates.exclude_recent_s);
   s.readOptional("max_candidates", c.candidates.max_candidates);
@@ -146,7 +147,9 @@ void LoopNode::writeOutputs() {
   if (options_.output_dir.empty()) return;
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
-             std::to_string(closer_.loops().size()) + " loops)");
+             std::to_string(closer_.loops().size()) + " loops; " + std::to_string(closer_.size()) +
+             " keyframe clouds on disk, " + std::to_string(closer_.storedCloudBytes() / 1000000) + " MB; features of " +
+             std::to_string(closer_.cachedFeatures()) + " keyframes in memory)");
 }
 
 }  // namespace livo::loop

@@ -51,10 +51,11 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
 }
 
 void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {
-  Points all;
+  // keyframe by keyframe into per-voxel sums: memory grows with the mapped area, not the run
+  VoxelCentroids centroids(voxel_size);
   for (const auto& [id, pose] : closer.graph().poses())
-    for (const Eigen::Vector3f& p : closer.mapCloud(id)) all.push_back(pose * p.cast<double>());
-  const Points map = voxelDownsample(all, voxel_size);
+    for (const Vec3& p : closer.mapCloud(id)) centroids.add(pose * p);
+  const Points map = centroids.centroids();
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + path);
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << map.size()

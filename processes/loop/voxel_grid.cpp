@@ -52,3 +52,33 @@ Points voxelDownsample(const Points& points, double voxel_size) {
 }
 
 }  // namespace livo::loop
+
+namespace livo::loop {
+
+void VoxelCentroids::add(const Vec3& p) {
+  if (!p.allFinite()) return;
+  if (voxel_ <= 0.0) {
+    all_.push_back(p);
+    return;
+  }
+  const double inv = 1.0 / voxel_;
+  Sum& s = sums_[Key{static_cast<int64_t>(std::floor(p.x() * inv)), static_cast<int64_t>(std::floor(p.y() * inv)),
+                     static_cast<int64_t>(std::floor(p.z() * inv))}];
+  s.sum += p;
+  ++s.count;
+}
+
+Points VoxelCentroids::centroids() const {
+  if (voxel_ <= 0.0) return all_;
+  std::vector<std::pair<Key, const Sum*>> keyed;
+  keyed.reserve(sums_.size());
+  for (const auto& [k, s] : sums_) keyed.emplace_back(k, &s);
+  std::sort(keyed.begin(), keyed.end(),
+            [](const auto& a, const auto& b) { return std::tie(a.first.x, a.first.y, a.first.z) < std::tie(b.first.x, b.first.y, b.first.z); });
+  Points out;
+  out.reserve(keyed.size());
+  for (const auto& [k, s] : keyed) out.push_back(s->sum / static_cast<double>(s->count));
+  return out;
+}
+
+}  // namespace livo::loop

@@ -7,7 +7,7 @@ namespace livo {
 namespace octomap_export {
 
 OctomapBuilder::OctomapBuilder(const OctomapOptions& options, const Pose3& T_I_L)
-    : options_(options), T_I_L_(T_I_L), map_(options) {}
+    : options_(options), T_I_L_(T_I_L), map_(options), clouds_(options.keyframe_step) {}
 
 bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error) {
   if (have_previous_ && scan.utime <= previous_utime_) {
@@ -57,17 +57,18 @@ bool OctomapBuilder::addKeyframe(int64_t id, Keyframe keyframe) {
   k.in_tree = keyframe.T_W_I;
   k.reach = T_I_L_.translation().norm();
   for (const Eigen::Vector3f& p : keyframe.points) k.reach = std::max(k.reach, double(p.norm()));
-  k.keyframe = std::move(keyframe);
+  k.utime = keyframe.utime;
+  k.T_W_I = keyframe.T_W_I;
+  clouds_.put(id, keyframe.points);
   return true;
 }
 
 int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected, const Pose3& unlisted) {
   int moved = 0;
-  for (auto& [id, stored] : keyframes_) {
+  for (auto& [id, k] : keyframes_) {
     auto it = corrected.find(id);
-    const Pose3 pose = it != corrected.end() ? it->second : unlisted * stored.keyframe.T_W_I;
+    const Pose3 pose = it != corrected.end() ? it->second : unlisted * k.T_W_I;
     if (!pose.matrix().allFinite()) continue;
-    Keyframe& k = stored.keyframe;
     if ((pose.matrix() - k.T_W_I.matrix()).cwiseAbs().maxCoeff() < 1e-12) continue;
     k.T_W_I = pose;
     ++moved;
@@ -77,7 +78,7 @@ int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected, c
   last_shift_ = 0.0;
   for (const auto& [id, k] : keyframes_) {
     const Pose3& a = k.in_tree;
-    const Pose3& b = k.keyframe.T_W_I;
+    const Pose3& b = k.T_W_I;
     const double angle = so3::Log(Mat3(a.linear().transpose() * b.linear())).norm();
     last_shift_ = std::max(last_shift_, (b.translation() - a.translation()).norm() + 2.0 * std::sin(0.5 * angle) * k.reach);
   }
@@ -91,13 +92,13 @@ int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected, c
 void OctomapBuilder::rebuild() {
   map_.clear();
   std::vector<Eigen::Vector3f> world;
-  for (auto& [id, stored] : keyframes_) {
-    const Keyframe& kf = stored.keyframe;
+  for (auto& [id, kf] : keyframes_) {
+    const std::vector<Eigen::Vector3f> points = clouds_.get(id);
     world.clear();
-    world.reserve(kf.points.size());
-    for (const Eigen::Vector3f& p : kf.points) world.push_back((kf.T_W_I * p.cast<double>()).cast<float>());
+    world.reserve(points.size());
+    for (const Eigen::Vector3f& p : points) world.push_back((kf.T_W_I * p.cast<double>()).cast<float>());
     map_.insertRays(world, (kf.T_W_I * T_I_L_).translation());
-    stored.in_tree = kf.T_W_I;
+    kf.in_tree = kf.T_W_I;
   }
   ++rebuilds_;
 }

@@ -4,7 +4,8 @@
 // map is rebuilt from the corrected keyframe poses, each cloud cast from its LiDAR origin
 // T_W_I * T_I_L. A correction that moves no keyframe point by more than rebuild_tolerance from
 // where the tree has it leaves the tree as it is (the shifts are measured against the poses of
-// the last rebuild, so small corrections cannot add up unnoticed).
+// the last rebuild, so small corrections cannot add up unnoticed). The keyframe clouds live on
+// disk (KeyframeCloudStore, quantised to keyframe_step): memory holds only their poses.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@
 
 #include "livo/map_inputs.hpp"
 #include "livo/so3.hpp"
+#include "livo/spill_file.hpp"
 #include "occupancy_map.hpp"
 
 namespace livo {
@@ -50,10 +52,13 @@ class OctomapBuilder {
   int64_t scans() const { return scans_; }
   int64_t rebuilds() const { return rebuilds_; }
   size_t keyframes() const { return keyframes_.size(); }
+  /// Bytes of keyframe clouds on disk.
+  uint64_t storedKeyframeBytes() const { return clouds_.diskBytes(); }
 
  private:
   struct StoredKeyframe {
-    Keyframe keyframe;
+    int64_t utime = 0;
+    Pose3 T_W_I = Pose3::Identity();    // current (corrected) pose
     Pose3 in_tree = Pose3::Identity();  // the pose the tree has this keyframe's data at
     double reach = 0.0;                 // farthest point (or the LiDAR origin) from the body origin, m
   };
@@ -62,6 +67,7 @@ class OctomapBuilder {
   Pose3 T_I_L_;
   OccupancyMap map_;
   std::map<int64_t, StoredKeyframe> keyframes_;
+  KeyframeCloudStore clouds_;  // body frame I
   double last_shift_ = 0.0;
   bool last_rebuilt_ = false;
   bool have_previous_ = false;

@@ -166,7 +166,9 @@ void OctomapNode::finish() {
   if (finished_) return;
   finished_ = true;
   if (writeFiles())
-    node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) + " leaves)");
+    node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) + " leaves; " +
+               std::to_string(builder_.keyframes()) + " keyframe clouds on disk, " +
+               std::to_string(builder_.storedKeyframeBytes() / 1000000) + " MB)");
 }
 
 }  // namespace octomap_export

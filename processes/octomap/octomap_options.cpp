@@ -10,7 +10,7 @@ void printOctomapOptions(const OctomapOptions& o, std::ostream& os) {
      << " m, prob_hit " << o.prob_hit << ", prob_miss " << o.prob_miss << ", clamping " << o.clamping_min << ".."
      << o.clamping_max << ", threshold " << o.occupancy_threshold << ", " << (o.colour ? "ColorOcTree" : "OcTree")
      << ", free_margin " << o.free_margin << " m, origin_segments " << o.origin_segments << ", rebuild_tolerance "
-     << o.rebuild_tolerance << " m\n";
+     << o.rebuild_tolerance << " m, keyframe_step " << o.keyframe_step << " m\n";
 }
 
 }  // namespace octomap_export

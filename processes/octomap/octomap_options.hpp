@@ -23,6 +23,8 @@ struct OctomapOptions {
   double rebuild_tolerance = 0.05;  // m: a loop correction rebuilds the tree from the keyframes only
                                     // if it moves some keyframe point farther than this from where
                                     // the tree has it (0: after any change)
+  double keyframe_step = 0.01;    // m: keyframe clouds are kept on disk for rebuilds, quantised to
+                                  // int16 in these steps (0: float, lossless)
 };
 
 void printOctomapOptions(const OctomapOptions& o, std::ostream& os);

@@ -1,11 +1,13 @@
 // livo-report: turns a pipeline run's recorded outputs into the files the user gets back.
 //   livo-report extract OUTPUTS.lcmlog --dir DIR     odometry.tum, trajectory.tum, timing.json
 //   livo-report markdown --dir DIR [...]             report.md from those and livo-evaluate's JSON
+//   livo-report memory OUTPUTS.lcmlog [--at S,S,...]  peak RSS per process at sensor times (HEALTH)
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "livo/command_line.hpp"
+#include "memory_profile.hpp"
 #include "pipeline_outputs.hpp"
 #include "run_report.hpp"
 
@@ -122,10 +124,29 @@ int markdown(int argc, char** argv) {
   return 0;
 }
 
+int memory(int argc, char** argv) {
+  livo::CommandLine cli("livo-report memory", "Prints each process's peak RSS at sensor times, from the HEALTH messages of a run's outputs log.");
+  cli.positional("OUTPUTS", "LCM log recorded during the run")
+      .option("--at", "S,S,...", "seconds of sensor time since the first HEALTH", "300,900,1800")
+      .option("--health-channel", "CH", "node health", "HEALTH");
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  std::vector<double> at;
+  for (const std::string& s : splitList(cli.get("--at"))) at.push_back(std::stod(s));
+  const livo::MemoryProfile p = livo::readMemoryProfile(cli.get("OUTPUTS"), cli.get("--health-channel"));
+  if (p.samples.empty()) {
+    std::cerr << "livo-report: no HEALTH messages with a sensor time in " << cli.get("OUTPUTS") << "\n";
+    return 1;
+  }
+  std::cout << livo::memoryTable(p, at);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string usage = "usage: livo-report extract OUTPUTS.lcmlog --dir DIR | livo-report markdown --dir DIR [...]\n";
+  const std::string usage =
+      "usage: livo-report extract OUTPUTS.lcmlog --dir DIR | livo-report markdown --dir DIR [...] | "
+      "livo-report memory OUTPUTS.lcmlog [--at S,...]\n";
   if (argc < 2) {
     std::cerr << usage;
     return 2;
@@ -134,6 +155,7 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "extract") return extract(argc - 1, argv + 1);
     if (cmd == "markdown") return markdown(argc - 1, argv + 1);
+    if (cmd == "memory") return memory(argc - 1, argv + 1);
     if (cmd == "--help") {
       std::cout << usage;
       return 0;

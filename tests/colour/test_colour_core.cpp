@@ -253,6 +253,28 @@ TEST(ColouringPipeline, LoopCorrectionMovesPointsWithTheirKeyframe) {
   EXPECT_EQ(pipe.applyCorrection({{1, corrected}}), 0);      // already there
 }
 
+// Scan points farther than max_depth + map_margin (30 + 10 m) from the body cannot be coloured
+// by any image of their time window: they are counted and stay out of the map (with a 100 m LiDAR
+// they would otherwise keep every tile in reach in memory; see the colour README, Memory).
+TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColouringPipeline pipe(ColourOptions{}, rig);
+  Pose3 B = Pose3::Identity();
+  B.translation() = Vec3(100.0, -50.0, 2.0);
+  std::vector<float> x{139.9f, 140.1f, 100.f, 59.9f}, y{-50.f, -50.f, -10.5f, -50.f}, z{2.f, 2.f, 2.f, 2.f},
+      dt{0.f, 0.f, 0.f, 0.f};
+  std::string error;
+  ASSERT_TRUE(pipe.addScan(viewOf(2000000, x, y, z, dt, B), &error)) << error;
+  EXPECT_EQ(pipe.map().size(), 2u);  // 39.9 m and 39.5 m away; the two 40.1 m away left out
+  EXPECT_EQ(pipe.stats().points_out_of_reach, 2);
+  EXPECT_EQ(pipe.stats().points_in, 2);
+  ColourOptions wide;
+  wide.map_margin = 100.0;
+  ColouringPipeline all(wide, rig);
+  ASSERT_TRUE(all.addScan(viewOf(2000000, x, y, z, dt, B), &error)) << error;
+  EXPECT_EQ(all.map().size(), 4u);
+}
+
 TEST(ColouringPipeline, RefusesStaleStampsAndSkipsNonFinitePoints) {
   const CameraRig rig = livo_test::testCamera(false);
   ColouringPipeline pipe(ColourOptions{}, rig);
@@ -366,4 +388,96 @@ TEST(MapFiles, PlyAndPcdLoadBack) {
   std::string error;
   ColouredPoints none;
   EXPECT_FALSE(readPly(livo_test::tempPath("missing.ply"), &none, &error));
+}
+
+// Tiles written to disk come back with exactly the same points and colours, and a correction
+// made while a tile is on disk moves its points when it comes back.
+namespace {
+std::vector<MapPoint> allPoints(const ColourMap& map) {
+  std::vector<MapPoint> out;
+  map.forEachPoint([&](const MapPoint& p) { out.push_back(p); });
+  std::sort(out.begin(), out.end(), [](const MapPoint& a, const MapPoint& b) {
+    return std::lexicographical_compare(a.position.data(), a.position.data() + 3, b.position.data(), b.position.data() + 3);
+  });
+  return out;
+}
+bool samePoint(const MapPoint& a, const MapPoint& b) {
+  return a.position == b.position && a.colour == b.colour && a.count == b.count && a.rejected == b.rejected &&
+         a.anchor == b.anchor;
+}
+}  // namespace
+
+TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
+  ColourMap map(0.05, TileOptions{2.0, 1.0, ""});
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-5.f, 5.f), c(0.f, 255.f);
+  map.setTime(1000000);
+  AccumulationOptions acc;
+  for (int i = 0; i < 3000; ++i) {
+    const uint32_t id = map.addPoint(Eigen::Vector3f(u(rng), u(rng), 0.2f * u(rng)), i % 3);
+    for (int k = 0; k < i % 4; ++k) map.accumulate(id, Eigen::Vector3f(c(rng), c(rng), c(rng)), acc);
+  }
+  const std::vector<MapPoint> before = allPoints(map);
+  const size_t coloured = map.colouredCount();
+  ASSERT_GT(before.size(), 2500u);
+  EXPECT_TRUE(map.evictIdle(1500000).empty());  // used within idle_s
+  const std::vector<uint32_t> freed = map.evictIdle(2500000);
+  EXPECT_EQ(freed.size(), before.size());
+  EXPECT_EQ(map.residentPoints(), 0u);
+  EXPECT_EQ(map.residentTiles(), 0u);
+  EXPECT_GE(map.spilledTiles(), 25u);  // 10 x 10 m in 2 m tiles
+  EXPECT_EQ(map.colouredCount(), coloured);
+  std::vector<MapPoint> on_disk = allPoints(map);
+  ASSERT_EQ(on_disk.size(), before.size());
+  for (size_t i = 0; i < before.size(); ++i) ASSERT_TRUE(samePoint(on_disk[i], before[i])) << i;
+  // a point falling into each tile brings it back: every voxel finds its old point
+  map.setTime(3000000);
+  for (const MapPoint& p : before) {
+    bool created = true;
+    const uint32_t id = map.addPoint(p.position, 99, &created);
+    EXPECT_FALSE(created);
+    ASSERT_TRUE(samePoint(map.point(id), p));
+  }
+  EXPECT_EQ(map.spilledTiles(), 0u);
+  EXPECT_EQ(map.residentPoints(), before.size());
+  EXPECT_TRUE(map.takeMovedOnReload().empty());  // nothing moved
+}
+
+TEST(ColourMapTiles, ACorrectionMovesTilesOnDiskWhenTheyComeBack) {
+  ColourMap map(0.05, TileOptions{2.0, 1.0, ""});
+  map.setAnchorPose(0, Pose3::Identity());
+  map.setAnchorPose(1, Pose3::Identity());
+  map.setTime(1000000);
+  AccumulationOptions acc;
+  for (int i = 0; i < 200; ++i) {
+    const uint32_t id = map.addPoint(Eigen::Vector3f(0.1f * i + 0.025f, 0.525f, 0.025f), i < 100 ? 0 : 1);
+    map.accumulate(id, Eigen::Vector3f(10.f, 20.f, float(i)), acc);
+  }
+  map.evictIdle(5000000);
+  ASSERT_EQ(map.residentPoints(), 0u);
+  Pose3 moved = Pose3::Identity();
+  moved.translation() = Vec3(0.0, 0.5, 0.0);  // anchor 1 moves 0.5 m in y
+  map.setAnchorPose(1, moved);
+  map.transform([&](int64_t anchor, Pose3* T) {
+    if (anchor != 1) return false;
+    *T = moved;
+    return true;
+  });
+  std::vector<MapPoint> pts = allPoints(map);
+  ASSERT_EQ(pts.size(), 200u);
+  for (const MapPoint& p : pts) EXPECT_NEAR(p.position.y(), p.anchor == 1 ? 1.025 : 0.525, 1e-6);
+  // the files: settled tiles hold the moved points once, in the tiles they now lie in
+  map.settleSpilledTiles();
+  EXPECT_EQ(map.residentPoints(), 0u);
+  pts = allPoints(map);
+  ASSERT_EQ(pts.size(), 200u);
+  for (const MapPoint& p : pts) EXPECT_NEAR(p.position.y(), p.anchor == 1 ? 1.025 : 0.525, 1e-6);
+  EXPECT_EQ(map.colouredCount(), 200u);
+  // coming back on a new point: the moved point is found where it now is
+  map.setTime(6000000);
+  bool created = true;
+  const uint32_t id = map.addPoint(Eigen::Vector3f(15.025f, 1.03f, 0.03f), 7, &created);
+  EXPECT_FALSE(created);
+  EXPECT_EQ(map.point(id).anchor, 1);
+  EXPECT_FLOAT_EQ(map.point(id).colour.z(), 150.f);
 }

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <optional>
 
 #include <gtest/gtest.h>
@@ -251,6 +252,60 @@ TEST(LoopNode, OdometryResetStartsANewGraphSegment) {
   const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"odometry_edges_across_epochs\": 0"), std::string::npos) << text;
   EXPECT_NE(text.find("\"first_id\": 20"), std::string::npos) << text;
+}
+
+// The keyframe features are derived from the clouds on disk on demand, with an LRU cache: the
+// loops, the graph and the map do not depend on the cache size (1: every candidate derived from
+// the stored cloud; 1000: all kept, as before the store).
+TEST(LoopCloser, ResultsDoNotDependOnTheFeatureCacheSize) {
+  const Points scene = makeScene(41, 0.15);
+  const int per_lap = 36, total = per_lap + 6;
+  auto run = [&](int cache) {
+    LoopCloserOptions o;
+    o.feature_cache_keyframes = cache;
+    o.odometry_translation_per_m = 0.02;
+    o.odometry_rotation_per_m = 2.5e-3;
+    auto closer = std::make_unique<LoopCloser>(o);
+    Pose3 odo = Pose3::Identity();
+    Pose3 previous_truth = Pose3::Identity();
+    for (int i = 0; i < total; ++i) {
+      const double a = 2 * M_PI * i / per_lap;
+      const Pose3 truth = yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8));
+      if (i == 0) {
+        odo = truth;
+      } else {
+        Pose3 rel = previous_truth.inverse() * truth;
+        rel.linear() = Eigen::AngleAxisd(0.006, Vec3::UnitZ()).toRotationMatrix() * rel.linear();
+        rel.translation() *= 1.02;
+        odo = odo * rel;
+      }
+      previous_truth = truth;
+      KeyframeInput in;
+      in.id = i;
+      in.utime = 1000000 + i * 2000000;
+      in.pose = odo;  // raw odometry (correction_id 0): no correction adopted
+      in.cloud = viewFrom(scene, truth.translation(), a + M_PI / 2, 20.0, 0.02, 100 + i);
+      closer->addKeyframe(in);
+      EXPECT_LE(closer->cachedFeatures(), static_cast<size_t>(cache));
+    }
+    return closer;
+  };
+  const auto one = run(1), all = run(1000);
+  ASSERT_GE(all->loops().size(), 1u);
+  ASSERT_EQ(one->loops().size(), all->loops().size());
+  for (size_t i = 0; i < all->loops().size(); ++i) {
+    EXPECT_EQ(one->loops()[i].from_id, all->loops()[i].from_id);
+    EXPECT_EQ(one->loops()[i].to_id, all->loops()[i].to_id);
+    EXPECT_TRUE(one->loops()[i].T_to_from.matrix() == all->loops()[i].T_to_from.matrix()) << i;
+  }
+  for (const auto& [id, pose] : all->graph().poses())
+    EXPECT_TRUE(one->graph().poses().at(id).matrix() == pose.matrix()) << id;
+  EXPECT_EQ(one->storedCloudBytes(), all->storedCloudBytes());
+  for (int id : {0, 17, total - 1}) {
+    const Points a = one->mapCloud(id), b = all->mapCloud(id);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) ASSERT_TRUE(a[i] == b[i]);
+  }
 }
 
 TEST(LoopNode, EmptyAndInconsistentCloudsDoNotCrash) {

@@ -29,5 +29,21 @@ TEST(VoxelGrid, OutputIndependentOfInputOrder) {
 
 TEST(VoxelGrid, EmptyInput) { EXPECT_TRUE(voxelDownsample({}, 0.5).empty()); }
 
+// global_map.ply is streamed keyframe by keyframe into VoxelCentroids: the same centroids, in the
+// same order, bit for bit, as voxelDownsample of every point at once (negative coordinates too).
+TEST(VoxelGrid, StreamedCentroidsEqualTheDownsamplingOfAllPoints) {
+  Points a;
+  for (int i = 0; i < 5000; ++i) a.push_back(Vec3(std::sin(i * 1.3) * 7, std::cos(i * 0.7) * 7, std::sin(i * 0.11) * 2));
+  a.push_back(Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0));
+  for (double voxel : {0.2, 0.5, 0.0}) {
+    VoxelCentroids streamed(voxel);
+    for (const Vec3& p : a) streamed.add(p);
+    const Points expected = voxelDownsample(a, voxel), got = streamed.centroids();
+    ASSERT_EQ(got.size(), expected.size()) << voxel;
+    EXPECT_EQ(streamed.voxels(), expected.size());
+    for (size_t i = 0; i < got.size(); ++i) ASSERT_TRUE(got[i] == expected[i]) << voxel << " " << i;
+  }
+}
+
 }  // namespace
 }  // namespace livo::loop
