@@ -221,6 +221,8 @@ void Node::publishProgress(bool finished) {
   p.finished = finished ? 1 : 0;
   p.instance = instance_;
   p.idle = !finished && receiveQueueEmpty() ? 1 : 0;
+  p.idle_checked_us =
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
   for (const auto& s : subs_) {
     p.input_channel.push_back(s.channel);
     p.handled.push_back(s.handled);

@@ -205,51 +205,73 @@ void ColourMap::transform(const std::function<bool(int64_t, Pose3*)>& delta) {
     }
     if (cached_ok) p.position = (T * p.position.cast<double>()).cast<float>();
   }
-  // re-index, merging points that now share a voxel (a tile on disk they land in comes back)
+  // re-index, merging points that now share a voxel; those that land in a tile on disk join it
+  // there (a correction is no use of a tile: it neither comes back nor stays longer in memory)
   std::vector<MapPoint> old;
   old.swap(points_);
   points_.reserve(live);
   free_.clear();
-  remap_.assign(old.size(), 0);
+  remap_.assign(old.size(), kGone);
   index_.reset(live);
   for (auto& [k, t] : tiles_)
     if (!t.spilled) t.ids.clear();
-  for (size_t i = 0; i < old.size(); ++i) {
-    if (!old[i].live()) continue;
-    remap_[i] = insertMerged(old[i], &residentTile(tileKey(old[i].position)));
-  }
+  std::map<uint64_t, std::vector<MapPoint>> to_disk;
+  for (size_t i = 0; i < old.size(); ++i)
+    if (old[i].live()) remap_[i] = placeMoved(old[i], &to_disk);
   ++epoch_;
+  appendToDisk(to_disk);
+}
+
+uint32_t ColourMap::placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk) {
+  const uint64_t k = tileKey(p.position);
+  auto it = tiles_.find(k);
+  if (it != tiles_.end() && it->second.spilled) {
+    (*to_disk)[k].push_back(p);
+    return kGone;
+  }
+  // a tile that did not exist yet is created unused: it goes to disk at the next eviction
+  Tile& tile = it != tiles_.end() ? it->second : tiles_[k];
+  return insertMerged(p, &tile);
+}
+
+void ColourMap::appendToDisk(const std::map<uint64_t, std::vector<MapPoint>>& to_disk) {
+  for (const auto& [k, pts] : to_disk) appendRecord(&tiles_.at(k), pts);
 }
 
 void ColourMap::readTile(const Tile& tile, std::vector<MapPoint>* points) const {
+  points->clear();
   std::vector<uint8_t> bytes;
-  spill_->read(tile.record, &bytes);
-  uint64_t n_points = 0, n_anchors = 0;
-  std::memcpy(&n_points, bytes.data(), 8);
-  std::memcpy(&n_anchors, bytes.data() + 8, 8);
-  const uint8_t* a = bytes.data() + 16;
-  std::map<int64_t, Pose3> deltas;  // stored anchor pose -> current one
-  for (uint64_t i = 0; i < n_anchors; ++i, a += 8 + 16 * 8) {
-    int64_t anchor = 0;
-    std::memcpy(&anchor, a, 8);
-    Eigen::Matrix4d stored;
-    std::memcpy(stored.data(), a + 8, 16 * 8);
-    auto it = anchor_poses_.find(anchor);
-    if (it == anchor_poses_.end() || (it->second.matrix() - stored).cwiseAbs().maxCoeff() < 1e-12) continue;
-    Pose3 s;
-    s.matrix() = stored;
-    deltas[anchor] = it->second * s.inverse();
-  }
-  points->resize(n_points);
-  for (uint64_t i = 0; i < n_points; ++i, a += sizeof(StoredPoint)) {
-    StoredPoint sp;
-    std::memcpy(&sp, a, sizeof(sp));
-    (*points)[i] = restored(sp);
-  }
-  if (deltas.empty()) return;
-  for (MapPoint& p : *points) {
-    auto it = deltas.find(p.anchor);
-    if (it != deltas.end()) p.position = (it->second * p.position.cast<double>()).cast<float>();
+  for (const SpillFile::Record& record : tile.records) {
+    spill_->read(record, &bytes);
+    uint64_t n_points = 0, n_anchors = 0;
+    std::memcpy(&n_points, bytes.data(), 8);
+    std::memcpy(&n_anchors, bytes.data() + 8, 8);
+    const uint8_t* a = bytes.data() + 16;
+    std::map<int64_t, Pose3> deltas;  // stored anchor pose -> current one
+    for (uint64_t i = 0; i < n_anchors; ++i, a += 8 + 16 * 8) {
+      int64_t anchor = 0;
+      std::memcpy(&anchor, a, 8);
+      Eigen::Matrix4d stored;
+      std::memcpy(stored.data(), a + 8, 16 * 8);
+      auto it = anchor_poses_.find(anchor);
+      if (it == anchor_poses_.end() || (it->second.matrix() - stored).cwiseAbs().maxCoeff() < 1e-12) continue;
+      Pose3 s;
+      s.matrix() = stored;
+      deltas[anchor] = it->second * s.inverse();
+    }
+    const size_t first = points->size();
+    points->resize(first + n_points);
+    for (uint64_t i = 0; i < n_points; ++i, a += sizeof(StoredPoint)) {
+      StoredPoint sp;
+      std::memcpy(&sp, a, sizeof(sp));
+      (*points)[first + i] = restored(sp);
+    }
+    if (deltas.empty()) continue;
+    for (size_t i = first; i < points->size(); ++i) {
+      MapPoint& p = (*points)[i];
+      auto it = deltas.find(p.anchor);
+      if (it != deltas.end()) p.position = (it->second * p.position.cast<double>()).cast<float>();
+    }
   }
 }
 
@@ -259,28 +281,20 @@ void ColourMap::reload(uint64_t tile_key, Tile* tile) {
   const bool moved = tile->epoch < epoch_;
   tile->spilled = false;
   tile->spilled_coloured = 0;
-  if (reload_log_) reload_log_->push_back(tile_key);
+  tile->records.clear();
+  std::map<uint64_t, std::vector<MapPoint>> to_disk;
   for (const MapPoint& p : stored) {
-    const uint64_t k = tileKey(p.position);
-    Tile& destination = k == tile_key ? *tile : residentTile(k);
-    const uint32_t id = insertMerged(p, &destination);
-    if (moved && p.coloured()) moved_on_reload_.push_back(id);
+    const uint32_t id = tileKey(p.position) == tile_key ? insertMerged(p, tile) : placeMoved(p, &to_disk);
+    if (moved && id != kGone && p.coloured()) moved_on_reload_.push_back(id);
   }
+  appendToDisk(to_disk);
 }
 
-void ColourMap::spill(Tile* tile, std::vector<uint32_t>* freed) {
-  std::vector<MapPoint> pts;
-  pts.reserve(tile->ids.size());
+void ColourMap::appendRecord(Tile* tile, const std::vector<MapPoint>& pts) {
   std::map<int64_t, Pose3> anchors;
-  for (uint32_t id : tile->ids) {
-    MapPoint& p = points_[id];
-    pts.push_back(p);
+  for (const MapPoint& p : pts) {
     auto it = anchor_poses_.find(p.anchor);
     if (it != anchor_poses_.end()) anchors.emplace(p.anchor, it->second);
-    index_.erase(key(p.position));
-    p.rejected = -1;
-    free_.push_back(id);
-    freed->push_back(id);
   }
   if (!spill_) spill_ = std::make_unique<SpillFile>(tile_options_.spill_directory);
   std::vector<uint8_t> bytes(16 + anchors.size() * (8 + 16 * 8) + pts.size() * sizeof(StoredPoint));
@@ -299,11 +313,30 @@ void ColourMap::spill(Tile* tile, std::vector<uint32_t>* freed) {
     std::memcpy(a, &sp, sizeof(sp));
     a += sizeof(sp);
   }
-  tile->record = spill_->append(bytes.data(), bytes.size());
+  if (tile->records.empty()) tile->epoch = epoch_;
+  tile->records.push_back(spill_->append(bytes.data(), bytes.size()));
   tile->spilled = true;
-  tile->epoch = epoch_;
-  tile->spilled_coloured = static_cast<size_t>(std::count_if(pts.begin(), pts.end(), [](const MapPoint& p) { return p.coloured(); }));
+  tile->spilled_coloured += static_cast<size_t>(std::count_if(pts.begin(), pts.end(), [](const MapPoint& p) { return p.coloured(); }));
+}
+
+void ColourMap::spill(Tile* tile, std::vector<uint32_t>* freed) {
+  // points never coloured are not kept: a scan that measures the voxel again creates it anew
+  std::vector<MapPoint> pts;
+  pts.reserve(tile->ids.size());
+  for (uint32_t id : tile->ids) {
+    MapPoint& p = points_[id];
+    if (p.coloured()) pts.push_back(p);
+    index_.erase(key(p.position));
+    p.rejected = -1;
+    free_.push_back(id);
+    freed->push_back(id);
+  }
   std::vector<uint32_t>().swap(tile->ids);
+  if (pts.empty()) {
+    tile->spilled = false;  // nothing to keep: the caller forgets the tile
+    return;
+  }
+  appendRecord(tile, pts);
 }
 
 namespace {
@@ -326,11 +359,8 @@ std::vector<uint32_t> ColourMap::evictIdle(int64_t utime) {
   std::sort(idle.begin(), idle.end());  // the same order whatever the hash table's
   for (uint64_t k : idle) {
     Tile& t = tiles_.at(k);
-    if (t.ids.empty()) {
-      tiles_.erase(k);
-      continue;
-    }
     spill(&t, &freed);
+    if (!t.spilled) tiles_.erase(k);  // nothing coloured in it
   }
   dropFreed(&moved_on_reload_, freed);
   return freed;
@@ -338,24 +368,21 @@ std::vector<uint32_t> ColourMap::evictIdle(int64_t utime) {
 
 std::vector<uint32_t> ColourMap::settleSpilledTiles() {
   std::vector<uint32_t> freed;
-  std::vector<uint64_t> stale;
-  for (const auto& [k, t] : tiles_)
-    if (t.spilled && t.epoch < epoch_) stale.push_back(k);
-  std::sort(stale.begin(), stale.end());
-  std::vector<uint64_t> loaded;
-  reload_log_ = &loaded;
-  for (uint64_t k : stale) {
-    Tile& t = tiles_.at(k);
-    if (!t.spilled) continue;  // came back with an earlier one
-    loaded.clear();
-    reload(k, &t);
-    std::sort(loaded.begin(), loaded.end());
-    for (uint64_t back : loaded) {
-      Tile& b = tiles_.at(back);
-      if (!b.spilled && !b.ids.empty()) spill(&b, &freed);
+  // a tile brought back may append points to one settled before it: go round until none is left
+  for (;;) {
+    std::vector<uint64_t> stale;
+    for (const auto& [k, t] : tiles_)
+      if (unsettled(t)) stale.push_back(k);
+    if (stale.empty()) break;
+    std::sort(stale.begin(), stale.end());
+    for (uint64_t k : stale) {
+      Tile& t = tiles_.at(k);
+      if (!unsettled(t)) continue;
+      reload(k, &t);
+      spill(&t, &freed);
+      if (!t.spilled) tiles_.erase(k);
     }
   }
-  reload_log_ = nullptr;
   dropFreed(&moved_on_reload_, freed);
   return freed;
 }

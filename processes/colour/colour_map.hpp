@@ -7,7 +7,9 @@
 // points leave memory; a scan point falling into it brings it back. A loop correction moves the
 // resident points at once; a tile on disk keeps, per anchor, the keyframe pose its points were
 // stored at and is moved when it comes back (or for the files: settleSpilledTiles()), so every
-// voxel still holds one point whatever was on disk.
+// voxel still holds one point whatever was on disk. Neither a correction nor a tile coming back
+// brings a tile on disk back or counts as its use: points they move into one are appended to it
+// on disk (another record, merged when it comes back).
 #pragma once
 
 #include <cstdint>
@@ -63,14 +65,16 @@ class ColourMap {
   void setAnchorPose(int64_t anchor, const Pose3& T_W_I) { anchor_poses_[anchor] = T_W_I; }
   /// Moves resident points by the delta of their anchor (`delta(anchor, &T)` false: leave them)
   /// and re-indexes the voxels; points that land in an occupied voxel are merged (colours
-  /// weighted). Call setAnchorPose for the moved anchors first: tiles on disk follow them.
+  /// weighted), points that land in a tile on disk go to disk with it (lastRemap(): kGone).
+  /// Call setAnchorPose for the moved anchors first: tiles on disk follow them.
   void transform(const std::function<bool(int64_t anchor, Pose3* delta)>& delta);
 
-  /// Writes the tiles unused since before `utime - idle_s` to disk; returns the ids freed.
+  /// Writes the tiles unused since before `utime - idle_s` to disk (their coloured points: one
+  /// never coloured is measured anew if a scan comes back to it); returns the ids freed.
   std::vector<uint32_t> evictIdle(int64_t utime);
-  /// Brings back, one at a time, the tiles on disk whose anchors moved since they were written,
-  /// merges them and writes them out again (the files then hold one point per voxel); returns
-  /// the ids freed.
+  /// Brings back, one at a time, the tiles on disk whose anchors moved since they were written or
+  /// that took points from elsewhere, merges them and writes them out again (the files then hold
+  /// one point per voxel); returns the ids freed.
   std::vector<uint32_t> settleSpilledTiles();
   /// Every point, resident and on disk (on disk: moved to the current anchor poses).
   void forEachPoint(const std::function<void(const MapPoint&)>& visit) const;
@@ -89,8 +93,10 @@ class ColourMap {
   size_t spilledTiles() const { return tiles_.size() - residentTiles(); }
   uint64_t spilledBytes() const { return spill_ ? spill_->size() : 0; }
   double voxelSize() const { return voxel_; }
-  /// Ids of points removed by the last transform() merge are remapped here (old id -> new id).
+  /// The last transform()'s ids: old id -> new id (merged points share one), kGone for points
+  /// that went to a tile on disk.
   const std::vector<uint32_t>& lastRemap() const { return remap_; }
+  static constexpr uint32_t kGone = ~uint32_t{0};
 
  private:
   /// Voxel key -> point id, open addressing with linear probing, grown at 50 % load: one lookup
@@ -119,19 +125,30 @@ class ColourMap {
     std::vector<uint32_t> ids;  // resident points
     int64_t last_used = INT64_MIN;
     bool spilled = false;
-    SpillFile::Record record;       // on disk: the points and their anchors' poses
+    // on disk: records of points with their anchors' poses; the first is the tile as it was
+    // written, later ones points a correction or another tile's return moved into it (their
+    // voxels may repeat: merged when it comes back)
+    std::vector<SpillFile::Record> records;
     size_t spilled_coloured = 0;
-    uint64_t epoch = 0;             // transform()s before it was written (behind epoch_: stale)
+    uint64_t epoch = 0;             // transform()s before its first record was written (behind epoch_: stale)
   };
 
   uint64_t key(const Eigen::Vector3f& p) const;
   uint64_t tileKey(const Eigen::Vector3f& p) const;
   /// Inserts a point (a new voxel, or merged into the voxel's point); its tile must be resident.
   uint32_t insertMerged(const MapPoint& p, Tile* tile);
+  /// The tile, brought back from disk if it was there, and marked used now.
   Tile& residentTile(uint64_t tile_key);
+  /// Inserts a point moved by a correction or a reload: into its tile if resident (not marking
+  /// it used), else into `to_disk` for that tile (returns kGone).
+  uint32_t placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk);
+  /// Appends points (at their anchors' current poses) to a tile's records on disk.
+  void appendRecord(Tile* tile, const std::vector<MapPoint>& points);
+  void appendToDisk(const std::map<uint64_t, std::vector<MapPoint>>& to_disk);
   void reload(uint64_t tile_key, Tile* tile);
   void spill(Tile* tile, std::vector<uint32_t>* freed);
   void readTile(const Tile& tile, std::vector<MapPoint>* points) const;
+  bool unsettled(const Tile& t) const { return t.spilled && (t.epoch < epoch_ || t.records.size() > 1); }
 
   double voxel_;
   int64_t voxels_per_tile_;
@@ -146,7 +163,6 @@ class ColourMap {
   std::vector<uint32_t> remap_;
   std::vector<uint32_t> moved_on_reload_;
   uint64_t epoch_ = 0;                          // transform()s so far
-  std::vector<uint64_t>* reload_log_ = nullptr;  // settleSpilledTiles(): the tiles reload() brought back
 };
 
 }  // namespace colour

@@ -265,11 +265,18 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
     *T = it->second;
     return true;
   });
+  // points that went to a tile on disk leave the scans (no image can colour them there) and are
+  // published when their tile comes back
   const auto& remap = map_.lastRemap();
-  for (ActiveScan& s : active_)
+  for (ActiveScan& s : active_) {
     for (auto& pt : s.points) pt.first = remap[pt.first];
+    s.points.erase(std::remove_if(s.points.begin(), s.points.end(),
+                                  [](const auto& pt) { return pt.first == ColourMap::kGone; }),
+                   s.points.end());
+  }
   std::vector<uint32_t> rec;
-  for (uint32_t id : recoloured_) rec.push_back(remap[id]);
+  for (uint32_t id : recoloured_)
+    if (remap[id] != ColourMap::kGone) rec.push_back(remap[id]);
   std::sort(rec.begin(), rec.end());
   rec.erase(std::unique(rec.begin(), rec.end()), rec.end());
   // every point that moved is "recoloured" (its published position changed)
@@ -282,7 +289,6 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
       recoloured_.push_back(id);
     }
   }
-  afterTileChanges({});  // tiles that came back while re-indexing
   return static_cast<int>(delta.size());
 }
 

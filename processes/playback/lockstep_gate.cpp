@@ -17,7 +17,7 @@ bool LockstepGate::isConsumer(const std::string& node) const {
   return std::find(consumers_.begin(), consumers_.end(), node) != consumers_.end();
 }
 
-bool LockstepGate::onProgress(const progress_t& p, double now_s) {
+bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_checked_s) {
   const bool is_new = !nodes_.count(p.node);
   NodeState& n = nodes_[p.node];
   bool changed = is_new;
@@ -82,7 +82,8 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s) {
       events_.push_back("consumer " + p.node + " exited; not waited for until it restarts");
     }
   }
-  if (p.idle && !p.finished && isConsumer(p.node)) detectLosses(p.node, n, now_s);
+  if (p.idle && !p.finished && isConsumer(p.node))
+    detectLosses(p.node, n, std::isfinite(idle_checked_s) ? std::min(idle_checked_s, now_s) : now_s);
   updateWaiting(now_s);
   return changed;
 }
@@ -119,10 +120,10 @@ int64_t LockstepGate::deficit(const NodeState& n, const std::string& channel) co
   return totalPublished(channel) - (h == n.handled.end() ? 0 : h->second) - (o == n.offset.end() ? 0 : o->second);
 }
 
-void LockstepGate::detectLosses(const std::string& node, NodeState& n, double now_s) {
+void LockstepGate::detectLosses(const std::string& node, NodeState& n, double idle_at_s) {
   for (const auto& [channel, handled] : n.handled) {
     if (deficit(n, channel) <= 0) continue;
-    const int64_t old = publishedBy(channel, now_s - options_.loss_grace_s) - handled - n.offset[channel];
+    const int64_t old = publishedBy(channel, idle_at_s - options_.loss_grace_s) - handled - n.offset[channel];
     if (old <= 0) continue;
     n.offset[channel] += old;
     lost_total_[node + ": " + channel] += old;

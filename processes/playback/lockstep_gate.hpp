@@ -13,6 +13,7 @@
 //   new instance of it reports; messages published while it was away are lost to it.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -36,9 +37,12 @@ class LockstepGate {
   explicit LockstepGate(std::vector<std::string> consumers, LockstepGateOptions options = {});
 
   /// Records a node's PROGRESS received at `now_s` (only the newest sequence of each instance
-  /// counts). Returns true if it moved anything on (a count changed, or the node is new, restarted
-  /// or finished), false for a heartbeat that repeats what was known.
-  bool onProgress(const progress_t& p, double now_s = 0.0);
+  /// counts). `idle_checked_s` is when the node checked its queue (progress_t.idle_checked_us on the
+  /// caller's clock; NaN: unknown, taken as now_s): a report checked before a message was published
+  /// says nothing about that message, however late it is received. Returns true if it moved
+  /// anything on (a count changed, or the node is new, restarted or finished), false for a
+  /// heartbeat that repeats what was known.
+  bool onProgress(const progress_t& p, double now_s = 0.0, double idle_checked_s = std::nan(""));
   /// Playback published one more message on `channel` at `now_s`.
   void onPublished(const std::string& channel, double now_s = 0.0);
   /// tolerate_restarts: marks consumers not heard for silent_after_s as away (call periodically).
@@ -89,7 +93,7 @@ class LockstepGate {
   int64_t publishedBy(const std::string& channel, double t_s) const;
   int64_t deficit(const NodeState& n, const std::string& channel) const;
   void notePublished(const std::string& channel, double now_s);
-  void detectLosses(const std::string& node, NodeState& n, double now_s);
+  void detectLosses(const std::string& node, NodeState& n, double idle_at_s);
   void updateWaiting(double now_s);
   bool isConsumer(const std::string& node) const;
 

@@ -96,7 +96,12 @@ PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
         +[](const lcm::ReceiveBuffer* rbuf, const std::string&, ProgressContext* c) {
           progress_t p;
           if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size)) return;
-          c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count());
+          // the node's monotonic clock is this process's steady clock (one host)
+          const double idle_checked_s =
+              p.idle_checked_us > 0
+                  ? p.idle_checked_us * 1e-6 - std::chrono::duration<double>(c->start.time_since_epoch()).count()
+                  : std::nan("");
+          c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count(), idle_checked_s);
         },
         &ctx);
   }

@@ -418,8 +418,14 @@ TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
     for (int k = 0; k < i % 4; ++k) map.accumulate(id, Eigen::Vector3f(c(rng), c(rng), c(rng)), acc);
   }
   const std::vector<MapPoint> before = allPoints(map);
+  std::vector<MapPoint> coloured_before;
+  for (const MapPoint& p : before)
+    if (p.coloured()) coloured_before.push_back(p);
   const size_t coloured = map.colouredCount();
+  ASSERT_EQ(coloured, coloured_before.size());
   ASSERT_GT(before.size(), 2500u);
+  ASSERT_GT(coloured, 2000u);
+  ASSERT_LT(coloured, before.size());
   EXPECT_TRUE(map.evictIdle(1500000).empty());  // used within idle_s
   const std::vector<uint32_t> freed = map.evictIdle(2500000);
   EXPECT_EQ(freed.size(), before.size());
@@ -427,20 +433,74 @@ TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
   EXPECT_EQ(map.residentTiles(), 0u);
   EXPECT_GE(map.spilledTiles(), 25u);  // 10 x 10 m in 2 m tiles
   EXPECT_EQ(map.colouredCount(), coloured);
+  // on disk: the coloured points, exactly (one never coloured is not kept)
   std::vector<MapPoint> on_disk = allPoints(map);
-  ASSERT_EQ(on_disk.size(), before.size());
-  for (size_t i = 0; i < before.size(); ++i) ASSERT_TRUE(samePoint(on_disk[i], before[i])) << i;
-  // a point falling into each tile brings it back: every voxel finds its old point
+  ASSERT_EQ(on_disk.size(), coloured_before.size());
+  for (size_t i = 0; i < on_disk.size(); ++i) ASSERT_TRUE(samePoint(on_disk[i], coloured_before[i])) << i;
+  // a point falling into each tile brings it back: every coloured voxel finds its old point, a
+  // voxel never coloured is measured anew
   map.setTime(3000000);
   for (const MapPoint& p : before) {
-    bool created = true;
+    bool created = false;
     const uint32_t id = map.addPoint(p.position, 99, &created);
-    EXPECT_FALSE(created);
-    ASSERT_TRUE(samePoint(map.point(id), p));
+    EXPECT_EQ(created, !p.coloured());
+    if (p.coloured()) ASSERT_TRUE(samePoint(map.point(id), p));
+    else EXPECT_EQ(map.point(id).anchor, 99);
   }
   EXPECT_EQ(map.spilledTiles(), 0u);
   EXPECT_EQ(map.residentPoints(), before.size());
   EXPECT_TRUE(map.takeMovedOnReload().empty());  // nothing moved
+}
+
+// A correction neither brings a tile on disk back nor keeps one in memory: points it moves into a
+// tile on disk join that tile there, and the files still hold one point per voxel.
+TEST(ColourMapTiles, ACorrectionLeavesTilesOnDisk) {
+  ColourMap map(0.05, TileOptions{2.0, 1.0, ""});
+  map.setAnchorPose(0, Pose3::Identity());
+  map.setAnchorPose(1, Pose3::Identity());
+  AccumulationOptions acc;
+  // tile x in [0, 2): anchor 0, goes to disk; tile x in [2, 4): anchor 1, stays
+  map.setTime(1000000);
+  for (int i = 0; i < 20; ++i) map.accumulate(map.addPoint(Eigen::Vector3f(0.1f * i + 0.025f, 0.025f, 0.025f), 0), Eigen::Vector3f(0.f, 0.f, 100.f), acc);
+  map.setTime(3000000);
+  std::vector<uint32_t> ids;
+  for (int i = 0; i < 20; ++i) {
+    ids.push_back(map.addPoint(Eigen::Vector3f(2.0f + 0.1f * i + 0.025f, 0.025f, 0.025f), 1));
+    map.accumulate(ids.back(), Eigen::Vector3f(0.f, 0.f, 200.f), acc);
+  }
+  map.evictIdle(2500000);
+  ASSERT_EQ(map.spilledTiles(), 1u);
+  ASSERT_EQ(map.residentPoints(), 20u);
+  // anchor 1 moves 1 m back in x: its first 10 points land in the tile on disk, all of them in
+  // voxels it holds (x 1.025 .. 1.925, all occupied by anchor 0's points)
+  Pose3 moved = Pose3::Identity();
+  moved.translation() = Vec3(-1.0, 0.0, 0.0);
+  map.setAnchorPose(1, moved);
+  map.setTime(3500000);
+  map.transform([&](int64_t anchor, Pose3* T) {
+    if (anchor != 1) return false;
+    *T = moved;
+    return true;
+  });
+  EXPECT_EQ(map.spilledTiles(), 1u);
+  EXPECT_EQ(map.residentPoints(), 10u);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(map.lastRemap()[ids[i]] == ColourMap::kGone, i < 10) << i;
+  EXPECT_EQ(map.colouredCount(), 40u);
+  // the correction was no use of the resident tile: it goes to disk on its own schedule
+  EXPECT_EQ(map.evictIdle(4500000).size(), 10u);
+  EXPECT_EQ(map.residentPoints(), 0u);
+  // the files: one point per voxel, the 10 overlapping voxels merged (colours weighted)
+  map.settleSpilledTiles();
+  const std::vector<MapPoint> pts = allPoints(map);
+  ASSERT_EQ(pts.size(), 30u);
+  int merged = 0;
+  for (const MapPoint& p : pts) {
+    if (p.count == 2) {
+      ++merged;
+      EXPECT_FLOAT_EQ(p.colour.z(), 150.f);
+    }
+  }
+  EXPECT_EQ(merged, 10);
 }
 
 TEST(ColourMapTiles, ACorrectionMovesTilesOnDiskWhenTheyComeBack) {

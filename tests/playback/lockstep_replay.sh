@@ -14,11 +14,13 @@ playback_args=(--quiet)
 
 run() {  # run OUT [stage1 die args...]
   local out="$1"; shift
-  lcm-logger --quiet -c 'STAGE.*' -f "$out" & local logger=$!
+  # the recorder is a lockstep consumer too: nothing reaches the log before it listens, and a
+  # message it did not get is reported like any other loss (an lcm-logger started with a sleep
+  # raced the replay on a loaded machine)
+  env -u LIVO_TEST_DROP_RECEIVED "$bin/livo-record" --out "$out" --channels STAGE1,STAGE2 --name record 2>"$out.record.err" & local logger=$!
   "$bin/test-lockstep-consumer" stage1 "$@" & local s1=$!
   "$bin/test-lockstep-consumer" stage2 & local s2=$!
-  sleep 0.5
-  timeout 120 "$bin/livo-playback" "$dir/in.lcmlog" --lockstep --consumers stage1,stage2 --stall-timeout 3 \
+  timeout 120 "$bin/livo-playback" "$dir/in.lcmlog" --lockstep --consumers stage1,stage2,record --stall-timeout 3 \
     ${playback_args[@]+"${playback_args[@]}"} 2>"$out.err"
   local rc=$?
   sleep 0.3
