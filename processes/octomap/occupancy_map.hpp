@@ -1,10 +1,21 @@
 // The OctoMap being built: an octomap::OcTree, or a ColorOcTree when colours are wanted, filled
 // by ray casting from the sensor origin; written as .bt (binary occupancy, always an OcTree so
 // every viewer reads it) and .ot (full, with colours); occupied leaves listed for evaluation.
+//
+// Memory: the octree is kept as tiles, cubes of 2^k voxels that are whole subtrees of the one
+// tree (options.tile_size, rounded). Each tile is an octree of its own holding only its keys; a
+// tile no ray has updated for tile_idle_s of sensor time is written to a scratch file (pruned
+// first, for an OcTree: lossless) and leaves memory, and comes back when a ray reaches it again.
+// The files are written tile by tile, as the one octree they make (octomap's formats, streamed:
+// the levels above the tiles are made from the tiles' roots), so a map much larger than memory
+// can still be written whole. Above the tiles nothing is pruned (the files stay valid octrees,
+// a few nodes larger than octomap's own prune() would leave them).
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <iosfwd>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,11 +26,11 @@
 
 namespace octomap {
 class OcTree;
-class ColorOcTree;
 class AbstractOccupancyOcTree;
 }  // namespace octomap
 
 namespace livo {
+class SpillFile;
 namespace octomap_export {
 
 class OccupancyMap {
@@ -48,6 +59,14 @@ class OccupancyMap {
   size_t setColours(const std::vector<Eigen::Vector3f>& points, const std::vector<std::array<uint8_t, 3>>& rgb);
   void clear();
 
+  /// Sensor time of the updates that follow (a tile updated then is in use then).
+  void setTime(int64_t utime) { now_ = utime; }
+  /// Writes the tiles not updated since before now - tile_idle_s to disk; returns how many.
+  size_t evictIdle();
+  size_t residentTiles() const;
+  size_t spilledTiles() const;
+  uint64_t spilledBytes() const;
+
   /// Occupancy of the leaf containing p: 1 occupied, 0 free, -1 unknown.
   int classify(const Eigen::Vector3d& p) const;
   /// Centres of occupied voxels at the finest resolution (pruned nodes expanded).
@@ -56,23 +75,34 @@ class OccupancyMap {
 
   bool writeBinary(const std::string& path) const;  // .bt
   bool writeFull(const std::string& path) const;    // .ot
-  /// The same as bytes (for the OCTOMAP message).
-  std::string binaryBytes() const;
-  std::string fullBytes() const;
+  /// The same as bytes; `resident_only`: only the tiles in memory (the OCTOMAP message: the area
+  /// updated in the last tile_idle_s, bounded however large the map grows).
+  std::string binaryBytes(bool resident_only = false) const;
+  std::string fullBytes(bool resident_only = false) const;
   std::string treeType() const;
 
   const OctomapOptions& options() const { return options_; }
 
  private:
-  const octomap::AbstractOccupancyOcTree& tree() const;
-  std::unique_ptr<octomap::OcTree> occupancyOnly() const;  // for .bt of a colour tree
-  void refreshInner() const;
+  struct Tile;
+  enum class Format { kFull, kBinary };
+  struct TileSummary;
+  /// The tile of a key, brought back from disk if it is there, marked used now.
+  Tile& residentTile(uint64_t tile_index);
+  void spill(Tile* tile);
+  /// A tile's tree: the resident one, or (for a tile on disk) one read back into `holder`.
+  octomap::AbstractOccupancyOcTree& treeOf(const Tile& tile, std::unique_ptr<octomap::AbstractOccupancyOcTree>* holder) const;
+  std::unique_ptr<octomap::AbstractOccupancyOcTree> newTree() const;
+  void refreshResident() const;
+  bool writeTree(std::ostream& out, Format format, bool resident_only) const;
 
   OctomapOptions options_;
-  std::unique_ptr<Scratch> scratch_;  // key sets reused across sweeps
-  std::unique_ptr<octomap::OcTree> plain_;
-  std::unique_ptr<octomap::ColorOcTree> colour_;
-  mutable bool inner_dirty_ = false;
+  int tile_bits_ = 16;  // a tile spans 2^tile_bits_ keys per axis
+  std::unique_ptr<octomap::OcTree> keys_;  // empty: the key arithmetic (same resolution)
+  std::unique_ptr<Scratch> scratch_;       // key sets reused across sweeps
+  std::map<uint64_t, std::unique_ptr<Tile>> tiles_;  // by tile index
+  std::unique_ptr<SpillFile> spill_;
+  int64_t now_ = INT64_MIN;
 };
 
 }  // namespace octomap_export

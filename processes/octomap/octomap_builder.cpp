@@ -42,7 +42,9 @@ bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error)
     slice.points = &slices[s];
     cast.push_back(slice);
   }
+  map_.setTime(scan.utime);
   map_.insertSweep(cast);
+  map_.evictIdle();
   have_previous_ = true;
   previous_utime_ = scan.utime;
   previous_pose_ = scan.T_W_I;
@@ -97,7 +99,10 @@ void OctomapBuilder::rebuild() {
     world.clear();
     world.reserve(points.size());
     for (const Eigen::Vector3f& p : points) world.push_back((kf.T_W_I * p.cast<double>()).cast<float>());
+    // in time order, as the sweeps came: tiles the rebuild has passed go to disk as they did then
+    map_.setTime(kf.utime);
     map_.insertRays(world, (kf.T_W_I * T_I_L_).translation());
+    map_.evictIdle();
     kf.in_tree = kf.T_W_I;
   }
   ++rebuilds_;

@@ -135,7 +135,9 @@ void OctomapNode::periodic(int64_t utime) {
 void OctomapNode::publishTree(int64_t utime) {
   if (options_.publish_period_s <= 0) return;
   last_publish_ = utime;
-  const std::string bytes = builder_.map().binaryBytes();
+  // the tiles in memory: the area updated in the last tile_idle_s (all of a small map), so the
+  // message stays bounded however large the map grows; the files hold all of it
+  const std::string bytes = builder_.map().binaryBytes(true);
   octomap_t msg;
   msg.utime = utime;
   msg.frame = "W";
@@ -168,7 +170,10 @@ void OctomapNode::finish() {
   if (writeFiles())
     node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) + " leaves; " +
                std::to_string(builder_.keyframes()) + " keyframe clouds on disk, " +
-               std::to_string(builder_.storedKeyframeBytes() / 1000000) + " MB)");
+               std::to_string(builder_.storedKeyframeBytes() / 1000000) + " MB; tiles " +
+               std::to_string(builder_.map().residentTiles()) + " in memory, " +
+               std::to_string(builder_.map().spilledTiles()) + " on disk, " +
+               std::to_string(builder_.map().spilledBytes() / 1000000) + " MB)");
 }
 
 }  // namespace octomap_export

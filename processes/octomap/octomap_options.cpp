@@ -10,7 +10,8 @@ void printOctomapOptions(const OctomapOptions& o, std::ostream& os) {
      << " m, prob_hit " << o.prob_hit << ", prob_miss " << o.prob_miss << ", clamping " << o.clamping_min << ".."
      << o.clamping_max << ", threshold " << o.occupancy_threshold << ", " << (o.colour ? "ColorOcTree" : "OcTree")
      << ", free_margin " << o.free_margin << " m, origin_segments " << o.origin_segments << ", rebuild_tolerance "
-     << o.rebuild_tolerance << " m, keyframe_step " << o.keyframe_step << " m\n";
+     << o.rebuild_tolerance << " m, keyframe_step " << o.keyframe_step << " m, tile_size " << o.tile_size
+     << " m, tile_idle_s " << o.tile_idle_s << " s\n";
 }
 
 }  // namespace octomap_export

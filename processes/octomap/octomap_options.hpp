@@ -25,6 +25,11 @@ struct OctomapOptions {
                                     // the tree has it (0: after any change)
   double keyframe_step = 0.01;    // m: keyframe clouds are kept on disk for rebuilds, quantised to
                                   // int16 in these steps (0: float, lossless)
+  double tile_size = 25.6;        // m: the tree is kept as cubes of this size (rounded to a power of
+                                  // two voxels; subtrees of the one octree), each written to disk
+                                  // when idle (0: one tile, never written out)
+  double tile_idle_s = 20.0;      // s of sensor time without an update before a tile goes to disk
+                                  // (0: never)
 };
 
 void printOctomapOptions(const OctomapOptions& o, std::ostream& os);
