@@ -417,6 +417,18 @@ void OccupancyMap::spill(Tile* tile) {
 }
 
 size_t OccupancyMap::evictIdle() {
+  // pruning is lossless for an OcTree (eight equal leaves become their parent; an update below
+  // expands it again) and keeps the free space a sweep clears to a few nodes once it is clamped
+  if (!options_.colour && !tiles_.empty()) {
+    auto it = tiles_.lower_bound(prune_next_);
+    for (size_t tried = 0; tried < tiles_.size(); ++tried, ++it) {
+      if (it == tiles_.end()) it = tiles_.begin();
+      if (it->second->spilled) continue;
+      static_cast<octomap::OcTree&>(*it->second->tree).prune();
+      prune_next_ = it->first + 1;
+      break;
+    }
+  }
   if (options_.tile_idle_s <= 0.0 || now_ == INT64_MIN) return 0;
   const int64_t before = now_ - static_cast<int64_t>(options_.tile_idle_s * 1e6);
   size_t n = 0;

@@ -61,7 +61,8 @@ class OccupancyMap {
 
   /// Sensor time of the updates that follow (a tile updated then is in use then).
   void setTime(int64_t utime) { now_ = utime; }
-  /// Writes the tiles not updated since before now - tile_idle_s to disk; returns how many.
+  /// Writes the tiles not updated since before now - tile_idle_s to disk, and (OcTree) prunes the
+  /// next resident tile in turn, so clamped free space stays collapsed; returns the tiles written.
   size_t evictIdle();
   size_t residentTiles() const;
   size_t spilledTiles() const;
@@ -103,6 +104,7 @@ class OccupancyMap {
   std::map<uint64_t, std::unique_ptr<Tile>> tiles_;  // by tile index
   std::unique_ptr<SpillFile> spill_;
   int64_t now_ = INT64_MIN;
+  uint64_t prune_next_ = 0;  // tile index the round-robin pruning goes on from
 };
 
 }  // namespace octomap_export

@@ -28,7 +28,7 @@ struct OctomapOptions {
   double tile_size = 25.6;        // m: the tree is kept as cubes of this size (rounded to a power of
                                   // two voxels; subtrees of the one octree), each written to disk
                                   // when idle (0: one tile, never written out)
-  double tile_idle_s = 20.0;      // s of sensor time without an update before a tile goes to disk
+  double tile_idle_s = 5.0;       // s of sensor time without an update before a tile goes to disk
                                   // (0: never)
 };
 
