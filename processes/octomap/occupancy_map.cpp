@@ -85,15 +85,6 @@ struct OccupancyMap::Scratch {
   octomap::KeyRay ray;
 };
 
-struct OccupancyMap::Tile {
-  std::unique_ptr<octomap::AbstractOccupancyOcTree> tree;  // resident
-  bool spilled = false;
-  SpillFile::Record record;  // on disk: the tree in octomap's full format
-  size_t leaves = 0;         // on disk: its leaf count
-  int64_t last_used = INT64_MIN;
-  bool dirty = false;        // inner nodes not refreshed since the last update
-};
-
 // What the levels above the tiles need of a tile's root (the node at the tiles' depth), and the
 // size of its subtree in the format being written.
 struct OccupancyMap::TileSummary {
@@ -104,6 +95,22 @@ struct OccupancyMap::TileSummary {
   bool leaf = false;       // binary: the root is a (maximum-likelihood) leaf ...
   bool occupied = false;   // ... and occupied
   uint64_t nodes = 0;      // nodes of its subtree in this format
+  bool present = false;    // the tile holds a node at all
+};
+
+struct OccupancyMap::Tile {
+  std::unique_ptr<octomap::AbstractOccupancyOcTree> tree;  // resident
+  bool spilled = false;
+  int64_t last_used = INT64_MIN;
+  bool dirty = false;        // inner nodes not refreshed since the last update
+  // on disk: the tree's node stream (octomap's full format from the root: after the levels above
+  // the tile's root it is the tile's part of a .ot as it is) and the tile's part of a .bt, with
+  // what the levels above need of each, so a file is written without decoding a tile on disk
+  SpillFile::Record record;
+  uint64_t full_offset = 0;  // bytes of `record` before the tile's root
+  SpillFile::Record binary;
+  TileSummary full_summary, binary_summary;
+  size_t leaves = 0;         // on disk: its leaf count
 };
 
 namespace {
@@ -398,6 +405,37 @@ octomap::AbstractOccupancyOcTree& OccupancyMap::treeOf(const Tile& tile,
   return **holder;
 }
 
+OccupancyMap::TileSummary OccupancyMap::summarize(const octomap::AbstractOccupancyOcTree& tree, Format format,
+                                                   std::string* payload) const {
+  const int depth = kTreeDepth - tile_bits_;
+  TileSummary s;
+  withTree(options_.colour, const_cast<octomap::AbstractOccupancyOcTree&>(tree), [&](auto& t) {
+    const auto* root = tileRoot(t, depth);
+    if (!root) return 0;
+    s.present = true;
+    s.log_odds = root->getLogOdds();
+    if constexpr (std::is_same_v<std::decay_t<decltype(t)>, octomap::ColorOcTree>) {
+      const auto c = root->getColor();
+      s.rgb = {c.r, c.g, c.b};
+    }
+    if (format == Format::kBinary) {
+      std::string scratch;
+      const BinaryNode b = encodeBinary(t, root, payload ? payload : &scratch, depth > 0);
+      s.leaf = b.leaf;
+      s.occupied = b.occupied;
+      s.nodes = b.nodes;
+    } else if (payload) {
+      std::ostringstream out;
+      s.nodes = writeFullNode(t, root, &out);
+      *payload = out.str();
+    } else {
+      s.nodes = writeFullNode(t, root, nullptr);
+    }
+    return 0;
+  });
+  return s;
+}
+
 void OccupancyMap::spill(Tile* tile) {
   std::ostringstream out;
   withTree(options_.colour, *tile->tree, [&](auto& t) {
@@ -406,11 +444,20 @@ void OccupancyMap::spill(Tile* tile) {
     if (!options_.colour) t.prune();
     tile->leaves = t.getNumLeafNodes();
     t.writeData(out);  // no header: read back into a tree of the type (octomap's read() prints)
+    // the levels above the tile's root hold one node each: its data and a byte of children
+    using Node = typename std::decay_t<decltype(t)>::NodeType;
+    std::ostringstream one;
+    Node().writeData(one);
+    tile->full_offset = static_cast<uint64_t>(kTreeDepth - tile_bits_) * (one.str().size() + 1);
     return 0;
   });
   const std::string bytes = out.str();
+  std::string binary_bytes;
+  tile->full_summary = summarize(*tile->tree, Format::kFull, nullptr);
+  tile->binary_summary = summarize(*tile->tree, Format::kBinary, &binary_bytes);
   if (!spill_) spill_ = std::make_unique<SpillFile>();
   tile->record = spill_->append(bytes.data(), bytes.size());
+  tile->binary = spill_->append(binary_bytes.data(), binary_bytes.size());
   tile->tree.reset();
   tile->spilled = true;
   tile->dirty = false;
@@ -548,7 +595,8 @@ size_t OccupancyMap::leafCount() const {
 
 // The one octree the tiles make, in octomap's full (.ot) or binary (.bt) format, streamed: first
 // every tile's root and subtree size (the header needs the node count), then the levels above the
-// tiles, each tile's subtree in its place. Tiles on disk are read back one at a time, twice.
+// tiles, each tile's subtree in its place. A tile on disk is not decoded: what the file needs of it
+// was written beside it when it went there.
 bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_only) const {
   refreshResident();
   const int depth = kTreeDepth - tile_bits_;  // of the tiles' roots
@@ -556,31 +604,13 @@ bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_onl
   std::vector<TileSummary> tiles;
   for (const auto& [index, tile] : tiles_) {
     if (resident_only && tile->spilled) continue;
-    std::unique_ptr<octomap::AbstractOccupancyOcTree> holder;
-    TileSummary s;
+    TileSummary s = tile->spilled ? (binary ? tile->binary_summary : tile->full_summary)
+                                  : summarize(*tile->tree, format, nullptr);
+    if (!s.present) continue;
     s.index = index;
-    const bool present = withTree(options_.colour, treeOf(*tile, &holder), [&](auto& t) {
-      const auto* root = tileRoot(t, depth);
-      if (!root) return false;
-      s.log_odds = root->getLogOdds();
-      if constexpr (std::is_same_v<std::decay_t<decltype(t)>, octomap::ColorOcTree>) {
-        const auto c = root->getColor();
-        s.rgb = {c.r, c.g, c.b};
-      }
-      if (binary) {
-        std::string scratch;
-        const BinaryNode b = encodeBinary(t, root, &scratch, depth > 0);
-        s.leaf = b.leaf;
-        s.occupied = b.occupied;
-        s.nodes = b.nodes;
-      } else {
-        s.nodes = writeFullNode(t, root, nullptr);
-      }
-      return true;
-    });
-    if (!present) continue;
     // depth-first order: at every level the child index (x bit 1, y bit 2, z bit 4)
     const uint64_t x = index >> 32, y = (index >> 16) & 0xFFFF, z = index & 0xFFFF;
+    s.morton = 0;
     for (int d = depth - 1; d >= 0; --d)
       s.morton = (s.morton << 3) | (((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2));
     tiles.push_back(s);
@@ -620,18 +650,17 @@ bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_onl
     return me;
   };
   auto tilePayload = [&](const TileSummary& s) {
-    std::unique_ptr<octomap::AbstractOccupancyOcTree> holder;
-    withTree(options_.colour, treeOf(*tiles_.at(s.index), &holder), [&](auto& t) {
-      const auto* root = tileRoot(t, depth);
-      if (binary) {
-        std::string bytes;
-        encodeBinary(t, root, &bytes, depth > 0);
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-      } else {
-        writeFullNode(t, root, &out);
-      }
-      return 0;
-    });
+    const Tile& tile = *tiles_.at(s.index);
+    if (tile.spilled) {  // as written when it went to disk
+      std::vector<uint8_t> bytes;
+      spill_->read(binary ? tile.binary : tile.record, &bytes);
+      const size_t skip = binary ? 0 : tile.full_offset;
+      out.write(reinterpret_cast<const char*>(bytes.data()) + skip, static_cast<std::streamsize>(bytes.size() - skip));
+      return;
+    }
+    std::string bytes;
+    summarize(*tile.tree, format, &bytes);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   };
   std::function<void(size_t, size_t, int)> write = [&](size_t lo, size_t hi, int d) {
     if (d == depth) {

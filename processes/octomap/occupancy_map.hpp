@@ -95,6 +95,9 @@ class OccupancyMap {
   octomap::AbstractOccupancyOcTree& treeOf(const Tile& tile, std::unique_ptr<octomap::AbstractOccupancyOcTree>* holder) const;
   std::unique_ptr<octomap::AbstractOccupancyOcTree> newTree() const;
   void refreshResident() const;
+  /// What the file needs of a tile: its root's data and subtree size, and (payload) its part of
+  /// the file in `format`.
+  TileSummary summarize(const octomap::AbstractOccupancyOcTree& tree, Format format, std::string* payload) const;
   bool writeTree(std::ostream& out, Format format, bool resident_only) const;
 
   OctomapOptions options_;
