@@ -82,6 +82,7 @@ void ColourMap::VoxelIndex::erase(uint64_t key) {
 void ColourMap::VoxelIndex::reset(size_t expected) {
   size_t n = 1024;
   while (n < 2 * expected + 2) n *= 2;
+  if (n != slots_.size()) std::vector<Slot>().swap(slots_);  // the old table goes before the new one comes
   slots_.assign(n, Slot{});
   size_ = 0;
 }
@@ -118,12 +119,14 @@ uint64_t ColourMap::tileKey(const Eigen::Vector3f& p) const {
   return (t(p.x()) << 32) | t(p.y());
 }
 
-uint32_t ColourMap::insertMerged(const MapPoint& p, Tile* tile) {
-  const uint32_t next = free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
+uint32_t ColourMap::insertMerged(const MapPoint& p, Tile* tile, uint32_t slot) {
+  const uint32_t next = slot != kNewSlot ? slot : free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
   bool inserted = false;
   const uint32_t id = index_.findOrInsert(key(p.position), next, &inserted);
   if (inserted) {
-    if (free_.empty()) {
+    if (slot != kNewSlot) {
+      points_[id] = p;
+    } else if (free_.empty()) {
       points_.push_back(p);
     } else {
       free_.pop_back();
@@ -205,24 +208,29 @@ void ColourMap::transform(const std::function<bool(int64_t, Pose3*)>& delta) {
     }
     if (cached_ok) p.position = (T * p.position.cast<double>()).cast<float>();
   }
-  // re-index, merging points that now share a voxel; those that land in a tile on disk join it
-  // there (a correction is no use of a tile: it neither comes back nor stays longer in memory)
-  std::vector<MapPoint> old;
-  old.swap(points_);
-  points_.reserve(live);
+  // Re-index in place, merging points that now share a voxel; those that land in a tile on disk
+  // join it there (a correction is no use of a tile: it neither comes back nor stays longer in
+  // memory). The live points are compacted to the front in their order: slot `end` <= i, and a
+  // point merges only into one already compacted, so no second copy of the map is needed.
+  remap_.assign(points_.size(), kGone);
   free_.clear();
-  remap_.assign(old.size(), kGone);
   index_.reset(live);
   for (auto& [k, t] : tiles_)
     if (!t.spilled) t.ids.clear();
   std::map<uint64_t, std::vector<MapPoint>> to_disk;
-  for (size_t i = 0; i < old.size(); ++i)
-    if (old[i].live()) remap_[i] = placeMoved(old[i], &to_disk);
+  uint32_t end = 0;
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (!points_[i].live()) continue;
+    const MapPoint p = points_[i];
+    remap_[i] = placeMoved(p, &to_disk, end);
+    if (remap_[i] == end) ++end;
+  }
+  points_.resize(end);
   ++epoch_;
   appendToDisk(to_disk);
 }
 
-uint32_t ColourMap::placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk) {
+uint32_t ColourMap::placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk, uint32_t slot) {
   const uint64_t k = tileKey(p.position);
   auto it = tiles_.find(k);
   if (it != tiles_.end() && it->second.spilled) {
@@ -231,7 +239,7 @@ uint32_t ColourMap::placeMoved(const MapPoint& p, std::map<uint64_t, std::vector
   }
   // a tile that did not exist yet is created unused: it goes to disk at the next eviction
   Tile& tile = it != tiles_.end() ? it->second : tiles_[k];
-  return insertMerged(p, &tile);
+  return insertMerged(p, &tile, slot);
 }
 
 void ColourMap::appendToDisk(const std::map<uint64_t, std::vector<MapPoint>>& to_disk) {

@@ -135,13 +135,16 @@ class ColourMap {
 
   uint64_t key(const Eigen::Vector3f& p) const;
   uint64_t tileKey(const Eigen::Vector3f& p) const;
+  static constexpr uint32_t kNewSlot = ~uint32_t{0};
   /// Inserts a point (a new voxel, or merged into the voxel's point); its tile must be resident.
-  uint32_t insertMerged(const MapPoint& p, Tile* tile);
+  /// A new voxel's point goes to `slot` (overwritten; kNewSlot: a free slot or the end).
+  uint32_t insertMerged(const MapPoint& p, Tile* tile, uint32_t slot = kNewSlot);
   /// The tile, brought back from disk if it was there, and marked used now.
   Tile& residentTile(uint64_t tile_key);
   /// Inserts a point moved by a correction or a reload: into its tile if resident (not marking
-  /// it used), else into `to_disk` for that tile (returns kGone).
-  uint32_t placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk);
+  /// it used; a new voxel's point to `slot` as in insertMerged), else into `to_disk` for that
+  /// tile (returns kGone).
+  uint32_t placeMoved(const MapPoint& p, std::map<uint64_t, std::vector<MapPoint>>* to_disk, uint32_t slot = kNewSlot);
   /// Appends points (at their anchors' current poses) to a tile's records on disk.
   void appendRecord(Tile* tile, const std::vector<MapPoint>& points);
   void appendToDisk(const std::map<uint64_t, std::vector<MapPoint>>& to_disk);

@@ -173,7 +173,16 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     Vec6 sigma;
     sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
     e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
+    const Pose3 discrepancy = loop.T_to_from.inverse() * graph_.pose(cand).inverse() * graph_.pose(input.id);
+    loop.residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
+    loop.residual_translation = discrepancy.translation().norm();
+    loop.corrected = loop.residual_translation >= options_.min_correction_translation ||
+                     loop.residual_rotation >= options_.min_correction_rotation;
     graph_.addEdge(e);
+    loops_.push_back(loop);
+    result.loop = loop;
+    keyframes_since_loop_ = 0;
+    if (!loop.corrected) break;
     graph_.optimize();
     // The odometry adopts T_Ck_O = graph * raw^-1 of this keyframe (the whole epoch's raw frame
     // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
@@ -184,10 +193,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     c.T_Ck_O = graph_.pose(input.id) * cur.odometry.inverse();
     c.T_Ck_Cj = c.T_Ck_O * published_.odometryToCorrected(cur.epoch, c.previous_id)->inverse();
     published_.add(c.id, c.epoch, c.T_Ck_O);
-    loops_.push_back(loop);
-    result.loop = loop;
     result.correction = c;
-    keyframes_since_loop_ = 0;
     break;
   }
   return result;

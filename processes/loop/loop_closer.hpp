@@ -51,6 +51,14 @@ struct LoopCloserOptions {
   double odometry_translation_per_m = 5e-3;    // m per metre travelled
   double loop_rotation_sigma = 5e-3;         // rad
   double loop_translation_sigma = 5e-2;      // m
+  /// A verified loop that the current estimate already satisfies to within these (the loop edge's
+  /// residual before optimising) is added to the graph but neither optimised nor published: it
+  /// would move the estimate by less than the maps resolve, and every correction costs each
+  /// consumer a pass over its map. On a route driven again and again nearly every keyframe closes
+  /// a loop; without this gate the soak published a correction every 4 keyframes (2,068 in 30 min)
+  /// and re-solved the whole graph each time. The edge still counts in the next optimisation.
+  double min_correction_translation = 0.02;  // m
+  double min_correction_rotation = 1.75e-3;  // rad (0.1 deg: 5 cm at 30 m range)
 };
 
 struct KeyframeInput {
@@ -70,6 +78,10 @@ struct AcceptedLoop {
   Pose3 T_to_from = Pose3::Identity();  // I_to <- I_from
   int coarse_inliers = 0;
   double fitness = 0.0, overlap = 0.0;
+  /// The loop edge's residual under the estimate before the loop was added (the measured
+  /// T_to_from against the graph's), as rotation angle (rad) and translation (m).
+  double residual_rotation = 0.0, residual_translation = 0.0;
+  bool corrected = false;  // the graph was optimised and a correction published for it
 };
 
 /// What a LIO adopts after an accepted loop (loop_correction_t): correction `id` of `epoch`.
@@ -83,8 +95,8 @@ struct Correction {
 
 struct AddResult {
   std::vector<LoopRegistrationResult> attempts;
-  std::optional<AcceptedLoop> loop;  // set if a loop was accepted and the graph optimised
-  std::optional<Correction> correction;  // with the loop: the correction to publish
+  std::optional<AcceptedLoop> loop;  // set if a loop was accepted (added to the graph)
+  std::optional<Correction> correction;  // if the loop changed the estimate: the correction to publish
 };
 
 class LoopCloser {
@@ -105,6 +117,8 @@ class LoopCloser {
 
   const PoseGraph& graph() const { return graph_; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
+  /// Accepted loops that were optimised and published as a correction.
+  size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
   int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
   int32_t epoch(int64_t id) const { return keyframes_.at(id).epoch; }
   /// Odometry edges whose ends are in different epochs (0 by construction; a check for tests).

@@ -43,6 +43,8 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("odometry_translation_per_m", c.odometry_translation_per_m);
   s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
+  s.readOptional("min_correction_translation", c.min_correction_translation);
+  s.readOptional("min_correction_rotation", c.min_correction_rotation);
   s.checkAllUsed();
   if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
       c.registration.quatro.noise_bound <= 0)
@@ -113,9 +115,11 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   if (r.loop) {
     std::ostringstream s;
     s << "loop " << r.loop->from_id << " -> " << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
-      << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << ")";
+      << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << "; residual "
+      << r.loop->residual_translation << " m, " << r.loop->residual_rotation * 180.0 / M_PI << " deg)";
+    if (!r.correction) s << ": the estimate agrees, no correction";
     node_.info(s.str());
-    publishCorrection(*r.loop, *r.correction, m.utime);
+    if (r.correction) publishCorrection(*r.loop, *r.correction, m.utime);
   }
 }
 
@@ -147,7 +151,8 @@ void LoopNode::writeOutputs() {
   if (options_.output_dir.empty()) return;
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
-             std::to_string(closer_.loops().size()) + " loops; " + std::to_string(closer_.size()) +
+             std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
+             " corrections; " + std::to_string(closer_.size()) +
              " keyframe clouds on disk, " + std::to_string(closer_.storedCloudBytes() / 1000000) + " MB; features of " +
              std::to_string(closer_.cachedFeatures()) + " keyframes in memory)");
 }

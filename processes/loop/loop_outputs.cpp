@@ -1,5 +1,6 @@
 #include "loop_outputs.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -30,7 +31,10 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"T_to_from", {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
                      {"coarse_inliers", l.coarse_inliers},
                      {"fitness", l.fitness},
-                     {"overlap", l.overlap}});
+                     {"overlap", l.overlap},
+                     {"residual_translation", l.residual_translation},
+                     {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
+                     {"corrected", l.corrected}});
   }
   // graph segments: one per odometry epoch (a LIO reset starts a new one, with no edge to the last)
   nlohmann::json epochs = nlohmann::json::array();
@@ -44,6 +48,7 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
   if (!out) throw std::runtime_error("cannot write " + path);
   out << nlohmann::json{{"num_keyframes", closer.size()},
                         {"loops", loops},
+                        {"corrections", closer.corrections()},
                         {"epochs", epochs},
                         {"odometry_edges_across_epochs", closer.odometryEdgesAcrossEpochs()}}
              .dump(2)

@@ -308,6 +308,47 @@ TEST(LoopCloser, ResultsDoNotDependOnTheFeatureCacheSize) {
   }
 }
 
+// Exact odometry around a loop and past the start: the loops are verified and kept in the graph,
+// but the estimate already satisfies them, so nothing is optimised or published; with the gate at
+// zero the same loops each publish a correction.
+TEST(LoopCloser, LoopsTheEstimateAlreadySatisfiesAreKeptWithoutACorrection) {
+  const Points scene = makeScene(41, 0.15);
+  const int per_lap = 36, total = per_lap + 6;
+  auto run = [&](double min_translation, double min_rotation) {
+    LoopCloserOptions o;
+    o.min_correction_translation = min_translation;
+    o.min_correction_rotation = min_rotation;
+    auto closer = std::make_unique<LoopCloser>(o);
+    int published = 0;
+    for (int i = 0; i < total; ++i) {
+      const double a = 2 * M_PI * i / per_lap;
+      KeyframeInput in;
+      in.id = i;
+      in.utime = 1000000 + i * 2000000;
+      in.pose = yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8));
+      in.cloud = viewFrom(scene, in.pose.translation(), a + M_PI / 2, 20.0, 0.02, 100 + i);
+      const AddResult r = closer->addKeyframe(in);
+      EXPECT_EQ(r.correction.has_value(), r.loop.has_value() && r.loop->corrected) << i;
+      published += r.correction.has_value();
+    }
+    EXPECT_EQ(closer->corrections(), static_cast<size_t>(published));
+    EXPECT_EQ(closer->graph().numLoops(), closer->loops().size());
+    return closer;
+  };
+  const auto gated = run(0.02, 1.75e-3);
+  ASSERT_GE(gated->loops().size(), 2u);
+  EXPECT_EQ(gated->corrections(), 0u);
+  for (const AcceptedLoop& l : gated->loops()) {
+    EXPECT_FALSE(l.corrected);
+    EXPECT_LT(l.residual_translation, 0.02);
+    EXPECT_LT(l.residual_rotation, 1.75e-3);
+  }
+  const auto ungated = run(0.0, 0.0);
+  ASSERT_EQ(ungated->loops().size(), gated->loops().size());
+  EXPECT_EQ(ungated->corrections(), ungated->loops().size());
+  for (const AcceptedLoop& l : ungated->loops()) EXPECT_TRUE(l.corrected);
+}
+
 TEST(LoopNode, EmptyAndInconsistentCloudsDoNotCrash) {
   lcm::LCM lcm("memq://");
   NodeOptions no;
