@@ -51,7 +51,8 @@ std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
   for (const auto& [other, kf] : keyframes_) {
-    if (other >= id || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints) continue;
+    if (other >= id || kf.node != other || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints)
+      continue;  // graph nodes only: a keyframe that joined one is represented by it
     const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
     if (d2 <= r2) near.push_back({d2, other});
   }
@@ -101,6 +102,77 @@ Points LoopCloser::mapCloud(int64_t id) const {
   return map;
 }
 
+Pose3 LoopCloser::pose(int64_t id) const {
+  const Keyframe& k = keyframes_.at(id);
+  return k.node == id ? graph_.pose(id) : graph_.pose(k.node) * k.T_node_kf;
+}
+
+void LoopCloser::forEachPose(const std::function<void(int64_t, const Pose3&)>& visit) const {
+  for (const auto& [id, k] : keyframes_) visit(id, pose(id));
+}
+
+std::optional<int64_t> LoopCloser::mergeCandidate(int64_t id, const Vec3& p) const {
+  const Keyframe& cur = keyframes_.at(id);
+  const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+  std::optional<int64_t> best;
+  double best_d2 = options_.merge_distance * options_.merge_distance;
+  for (const auto& [other, kf] : keyframes_) {
+    if (other >= id || kf.node != other || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints)
+      continue;
+    const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
+    if (d2 <= best_d2) {
+      best_d2 = d2;
+      best = other;
+    }
+  }
+  return best;
+}
+
+Mat6 LoopCloser::loopCovariance() const {
+  Vec6 sigma;
+  sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
+  return sigma.cwiseAbs2().asDiagonal();
+}
+
+Mat6 LoopCloser::chainCovariance(const Keyframe& to) const {
+  // the odometry part: the increment's covariance from the absolute ones, floored by the drift
+  // model over the path; the loop part (if the chain starts with one) adds its covariance
+  // (isotropic blocks, so carrying it to the end of the chain is left out)
+  const Keyframe& start = keyframes_.at(chain_.start);
+  const Mat6 odometry =
+      relativeInformation(start.covariance, to.covariance,
+                          std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+                          std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
+          .inverse();
+  return chain_.via_loop ? Mat6(odometry + loopCovariance()) : odometry;
+}
+
+std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t current, AcceptedLoop* loop) {
+  // where the loop puts the keyframe (the joined or loop node's pose and the measured offset)
+  // against where the odometry has it now (in the newest correction it was sent)
+  const Keyframe& cur = keyframes_.at(current);
+  const Pose3 implied = graph_.pose(loop->to_id) * loop->T_to_from;
+  const Pose3 odometry = *published_.odometryToCorrected(cur.epoch, published_.newest(cur.epoch)) * cur.odometry;
+  const Pose3 discrepancy = implied.inverse() * odometry;
+  loop->residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
+  loop->residual_translation = discrepancy.translation().norm();
+  loop->corrected = loop->residual_translation >= options_.min_correction_translation ||
+                    loop->residual_rotation >= options_.min_correction_rotation;
+  if (edge) graph_.addEdge(*edge);
+  if (!loop->corrected) return std::nullopt;
+  graph_.optimize();
+  // The odometry adopts T_Ck_O = corrected * raw^-1 of this keyframe (the whole epoch's raw frame
+  // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
+  Correction c;
+  c.id = next_correction_id_++;
+  c.epoch = cur.epoch;
+  c.previous_id = published_.newest(cur.epoch);
+  c.T_Ck_O = pose(current) * cur.odometry.inverse();
+  c.T_Ck_Cj = c.T_Ck_O * published_.odometryToCorrected(cur.epoch, c.previous_id)->inverse();
+  published_.add(c.id, c.epoch, c.T_Ck_O);
+  return c;
+}
+
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
   Keyframe kf;
@@ -109,6 +181,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
+  kf.node = input.id;
   // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
   std::vector<Eigen::Vector3f> cloud_f;
   cloud_f.reserve(input.cloud.size());
@@ -119,33 +192,92 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
   std::shared_ptr<const Features> cur_features = deriveFeatures(cloud_I, kf.G_R_I);
   kf.has_keypoints = !cur_features->coarse.points.empty();
+  const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
 
-  // Initial estimate: the previous keyframe's corrected pose composed with the odometry increment.
-  if (!keyframes_.empty() && keyframes_.rbegin()->second.epoch == input.epoch) {
-    const auto& [prev_id, prev] = *keyframes_.rbegin();
-    const Pose3 increment = prev.odometry.inverse() * kf.odometry;
-    const Pose3 initial = graph_.pose(prev_id) * increment;
-    graph_.addNode(input.id, initial);
-    PoseEdge e;
-    e.from = prev_id;
-    e.to = input.id;
-    e.T_from_to = increment;
-    const double step = increment.translation().norm();
-    e.information = relativeInformation(
-        prev.covariance, kf.covariance, std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * step),
-        std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * step));
-    keyframes_.emplace(input.id, std::move(kf));
-    graph_.addEdge(e);
-  } else {
+  AddResult result;
+  if (keyframes_.empty() || keyframes_.rbegin()->second.epoch != input.epoch) {
     // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
     // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
     graph_.addNode(input.id, kf.odometry);
     if (!keyframes_.empty()) graph_.holdFixed(input.id);
     keyframes_.emplace(input.id, std::move(kf));
+    chain_ = Chain{input.id, input.id, Pose3::Identity(), false, 0.0};
+  } else {
+    const Keyframe& prev = keyframes_.rbegin()->second;
+    chain_.path += (prev.odometry.inverse() * kf.odometry).translation().norm();
+    // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
+    const Pose3 T_node_kf = chain_.T_node_start * (keyframes_.at(chain_.start).odometry.inverse() * kf.odometry);
+    const Pose3 estimate = graph_.pose(chain_.node) * T_node_kf;
+    const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+    const bool older_node = kf.utime - keyframes_.at(chain_.node).utime >= recent;
+    if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
+      // passing again near the older node the odometry hangs from: the keyframe joins it
+      kf.node = chain_.node;
+      kf.T_node_kf = T_node_kf;
+      keyframes_.emplace(input.id, std::move(kf));
+      return result;
+    }
+    keyframes_.emplace(input.id, kf);
+    if (options_.merge_distance > 0 && kf.has_keypoints) {
+      if (const std::optional<int64_t> near = mergeCandidate(input.id, estimate.translation())) {
+        const Keyframe& target = keyframes_.at(*near);
+        const std::shared_ptr<const Features> target_features = features(*near);
+        LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
+                                                target_features->fine, options_.registration);
+        result.attempts.push_back(r);
+        if (r.accepted) {
+          // the keyframe joins the older node; the graph gets the edge chain node -> that node
+          AcceptedLoop loop;
+          loop.from_id = input.id;
+          loop.to_id = *near;
+          loop.from_utime = kf.utime;
+          loop.to_utime = target.utime;
+          loop.T_to_from = rotationOnly(target.G_R_I).inverse() * r.T_target_source * rotationOnly(kf.G_R_I);
+          loop.coarse_inliers = r.coarse.num_inliers;
+          loop.fitness = r.fine.fitness;
+          loop.overlap = r.fine.overlap;
+          loop.merged = true;
+          Keyframe& joined = keyframes_.at(input.id);
+          joined.node = *near;
+          joined.T_node_kf = loop.T_to_from;
+          PoseEdge e;  // none if the chain's node is the joined one (no new relation)
+          e.from = chain_.node;
+          e.to = *near;
+          e.T_from_to = T_node_kf * loop.T_to_from.inverse();
+          e.is_loop = true;
+          const Mat6 cov = chainCovariance(joined) + loopCovariance();
+          e.information = cov.inverse();
+          e.information = 0.5 * (e.information + e.information.transpose()).eval();
+          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, &loop);
+          loops_.push_back(loop);
+          result.loop = loop;
+          keyframes_since_loop_ = 0;
+          chain_ = Chain{*near, input.id, loop.T_to_from, true, 0.0};
+          return result;
+        }
+      }
+    }
+    // a node of its own, with the chain's measurement from the node before
+    PoseEdge e;
+    e.from = chain_.node;
+    e.to = input.id;
+    e.T_from_to = T_node_kf;
+    e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
+    const Keyframe& start = keyframes_.at(chain_.start);
+    e.information = chain_.via_loop
+                        ? Mat6(chainCovariance(kf).inverse())
+                        : relativeInformation(start.covariance, kf.covariance,
+                                              std::hypot(options_.odometry_rotation_floor,
+                                                         options_.odometry_rotation_per_m * chain_.path),
+                                              std::hypot(options_.odometry_translation_floor,
+                                                         options_.odometry_translation_per_m * chain_.path));
+    graph_.addNode(input.id, estimate);
+    graph_.addEdge(e);
+    chain_ = Chain{input.id, input.id, Pose3::Identity(), false, 0.0};
+    if (!result.attempts.empty()) return result;  // the nearest older node did not register: no second try
   }
 
-  AddResult result;
-  if (++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes) return result;
+  if (cooling) return result;
   cacheFeatures(input.id, cur_features);
   const Keyframe& cur = keyframes_.at(input.id);
   if (!cur.has_keypoints) return result;
@@ -173,27 +305,10 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     Vec6 sigma;
     sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
     e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
-    const Pose3 discrepancy = loop.T_to_from.inverse() * graph_.pose(cand).inverse() * graph_.pose(input.id);
-    loop.residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
-    loop.residual_translation = discrepancy.translation().norm();
-    loop.corrected = loop.residual_translation >= options_.min_correction_translation ||
-                     loop.residual_rotation >= options_.min_correction_rotation;
-    graph_.addEdge(e);
+    result.correction = addLoopEdge(&e, input.id, &loop);
     loops_.push_back(loop);
     result.loop = loop;
     keyframes_since_loop_ = 0;
-    if (!loop.corrected) break;
-    graph_.optimize();
-    // The odometry adopts T_Ck_O = graph * raw^-1 of this keyframe (the whole epoch's raw frame
-    // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
-    Correction c;
-    c.id = next_correction_id_++;
-    c.epoch = cur.epoch;
-    c.previous_id = published_.newest(cur.epoch);
-    c.T_Ck_O = graph_.pose(input.id) * cur.odometry.inverse();
-    c.T_Ck_Cj = c.T_Ck_O * published_.odometryToCorrected(cur.epoch, c.previous_id)->inverse();
-    published_.add(c.id, c.epoch, c.T_Ck_O);
-    result.correction = c;
     break;
   }
   return result;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <list>
 #include <map>
 #include <memory>
@@ -51,14 +52,22 @@ struct LoopCloserOptions {
   double odometry_translation_per_m = 5e-3;    // m per metre travelled
   double loop_rotation_sigma = 5e-3;         // rad
   double loop_translation_sigma = 5e-2;      // m
-  /// A verified loop that the current estimate already satisfies to within these (the loop edge's
-  /// residual before optimising) is added to the graph but neither optimised nor published: it
+  /// A verified loop that the odometry already satisfies to within these (the new keyframe's pose
+  /// in the newest correction against where the loop puts it) is added to the graph but neither
+  /// optimised nor published: it
   /// would move the estimate by less than the maps resolve, and every correction costs each
   /// consumer a pass over its map. On a route driven again and again nearly every keyframe closes
   /// a loop; without this gate the soak published a correction every 4 keyframes (2,068 in 30 min)
   /// and re-solved the whole graph each time. The edge still counts in the next optimisation.
   double min_correction_translation = 0.02;  // m
   double min_correction_rotation = 1.75e-3;  // rad (0.1 deg: 5 cm at 30 m range)
+  /// Reduced pose graph (Johannsson et al., "Temporally scalable visual SLAM using a reduced pose
+  /// graph", 2013): where the route passes again, a keyframe within this distance of an older
+  /// graph node joins that node instead of becoming a node of its own (registered to it, or, near
+  /// the node it already hangs from, by odometry), and the pass adds edges between the old nodes.
+  /// The graph, and the cost and memory of a solve, then grow with the area mapped, not with the
+  /// time driven. 0: every keyframe is a node.
+  double merge_distance = 2.0;  // m
 };
 
 struct KeyframeInput {
@@ -78,10 +87,14 @@ struct AcceptedLoop {
   Pose3 T_to_from = Pose3::Identity();  // I_to <- I_from
   int coarse_inliers = 0;
   double fitness = 0.0, overlap = 0.0;
-  /// The loop edge's residual under the estimate before the loop was added (the measured
-  /// T_to_from against the graph's), as rotation angle (rad) and translation (m).
+  /// How far the odometry's pose of the new keyframe (in the newest correction sent) is from
+  /// where the loop puts it (the older keyframe's pose and T_to_from), before optimising, as
+  /// rotation angle (rad) and translation (m): the correction gate's measure.
   double residual_rotation = 0.0, residual_translation = 0.0;
   bool corrected = false;  // the graph was optimised and a correction published for it
+  /// The new keyframe joined the older one (reduced pose graph): the edge went from the node the
+  /// odometry came from to `to_id`, and the residual is that edge's.
+  bool merged = false;
 };
 
 /// What a LIO adopts after an accepted loop (loop_correction_t): correction `id` of `epoch`.
@@ -115,7 +128,15 @@ class LoopCloser {
   /// previous epoch, held fixed in its raw pose; loops are searched only within an epoch.
   AddResult addKeyframe(const KeyframeInput& input);
 
+  /// Graph nodes are a subset of the keyframes (merge_distance); every keyframe has a pose.
   const PoseGraph& graph() const { return graph_; }
+  /// A keyframe's corrected pose: its node's, or its node's composed with its offset from it.
+  Pose3 pose(int64_t id) const;
+  /// Every keyframe, in id order, with its corrected pose.
+  void forEachPose(const std::function<void(int64_t id, const Pose3& pose)>& visit) const;
+  /// The graph node a keyframe belongs to (its own id if it is one).
+  int64_t node(int64_t id) const { return keyframes_.at(id).node; }
+  int64_t newestId() const { return keyframes_.empty() ? -1 : keyframes_.rbegin()->first; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
   /// Accepted loops that were optimised and published as a correction.
   size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
@@ -139,6 +160,17 @@ class LoopCloser {
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     bool has_keypoints = false;         // its coarse features are not empty
+    int64_t node = 0;                   // the graph node it belongs to (its own id if it is one)
+    Pose3 T_node_kf = Pose3::Identity();  // its pose in that node's frame (identity for a node)
+  };
+  /// Where the newest keyframe hangs from: a graph node, through an optional loop measurement to
+  /// keyframe `start`, then raw odometry from `start` on.
+  struct Chain {
+    int64_t node = -1;
+    int64_t start = -1;
+    Pose3 T_node_start = Pose3::Identity();
+    bool via_loop = false;  // T_node_start is a loop measurement (else start == node)
+    double path = 0.0;      // m of odometry from start
   };
   /// What registration needs of a keyframe, derived from its stored cloud.
   struct Features {
@@ -146,6 +178,14 @@ class LoopCloser {
     GicpCloud fine;         // in G
   };
   std::vector<int64_t> candidates(int64_t id) const;
+  /// The nearest older node (not within exclude_recent_s) of the epoch within merge_distance of p.
+  std::optional<int64_t> mergeCandidate(int64_t id, const Vec3& p) const;
+  /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts).
+  Mat6 chainCovariance(const Keyframe& to) const;
+  Mat6 loopCovariance() const;
+  /// Adds a loop edge (if any); unless the odometry already satisfies the loop, optimises and returns the
+  /// correction for keyframe `current` (loop gets its residual and `corrected`).
+  std::optional<Correction> addLoopEdge(const PoseEdge* edge, int64_t current, AcceptedLoop* loop);
   std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
   /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
   std::shared_ptr<const Features> features(int64_t id);
@@ -160,6 +200,7 @@ class LoopCloser {
   int64_t keyframes_since_loop_ = 1000000;
   CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch
   int64_t next_correction_id_ = 1;
+  Chain chain_;
 };
 
 }  // namespace livo::loop

@@ -45,10 +45,13 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
   s.readOptional("min_correction_translation", c.min_correction_translation);
   s.readOptional("min_correction_rotation", c.min_correction_rotation);
+  s.readOptional("merge_distance", c.merge_distance);
   s.checkAllUsed();
   if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
       c.registration.quatro.noise_bound <= 0)
     throw ConfigError(s.where("coarse_voxel") + ": voxel sizes, search_radius and noise_bound must be > 0");
+  if (c.merge_distance < 0 || c.min_correction_translation < 0 || c.min_correction_rotation < 0)
+    throw ConfigError(s.where("merge_distance") + ": merge_distance and min_correction_* must be >= 0");
   return o;
 }
 
@@ -87,7 +90,7 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
     node_.reject(ch, why);
     return;
   }
-  if (closer_.size() > 0 && m.epoch > closer_.epoch(closer_.graph().poses().rbegin()->first))
+  if (closer_.size() > 0 && m.epoch > closer_.epoch(closer_.newestId()))
     node_.warn("keyframe " + std::to_string(m.id) + " starts odometry epoch " + std::to_string(m.epoch) +
                " (the LIO was reset): a new graph segment, no odometry edge to the previous keyframe");
   in.pose = poseFrom(m.position, m.orientation);
@@ -114,7 +117,8 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   }
   if (r.loop) {
     std::ostringstream s;
-    s << "loop " << r.loop->from_id << " -> " << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
+    s << (r.loop->merged ? "keyframe " : "loop ") << r.loop->from_id << (r.loop->merged ? " joins " : " -> ")
+      << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
       << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << "; residual "
       << r.loop->residual_translation << " m, " << r.loop->residual_rotation * 180.0 / M_PI << " deg)";
     if (!r.correction) s << ": the estimate agrees, no correction";
@@ -135,14 +139,14 @@ void LoopNode::publishCorrection(const AcceptedLoop& loop, const Correction& cor
   msg.previous_correction_id = correction.previous_id;
   poseTo(correction.T_Ck_O, msg.odometry_to_corrected_position, msg.odometry_to_corrected_orientation);
   // the keyframes of the correction's epoch (the others are in unrelated frames)
-  for (const auto& [id, T] : closer_.graph().poses()) {
-    if (closer_.epoch(id) != correction.epoch) continue;
+  closer_.forEachPose([&](int64_t id, const Pose3& T) {
+    if (closer_.epoch(id) != correction.epoch) return;
     msg.keyframe_id.push_back(id);
     std::vector<double> p(3), q(4);
     poseTo(T, p.data(), q.data());
     msg.position.push_back(p);
     msg.orientation.push_back(q);
-  }
+  });
   msg.num_keyframes = static_cast<int32_t>(msg.keyframe_id.size());
   node_.publish(options_.loop_correction_channel, msg);
 }
@@ -152,7 +156,7 @@ void LoopNode::writeOutputs() {
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
              std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
-             " corrections; " + std::to_string(closer_.size()) +
+             " corrections; " + std::to_string(closer_.graph().poses().size()) + " graph nodes, " + std::to_string(closer_.size()) +
              " keyframe clouds on disk, " + std::to_string(closer_.storedCloudBytes() / 1000000) + " MB; features of " +
              std::to_string(closer_.cachedFeatures()) + " keyframes in memory)");
 }

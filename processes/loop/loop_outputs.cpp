@@ -15,7 +15,7 @@ namespace livo::loop {
 
 void writeKeyframeTrajectory(const std::string& path, const LoopCloser& closer) {
   Trajectory t;
-  for (const auto& [id, pose] : closer.graph().poses()) t.push_back({toSeconds(closer.utime(id)), pose});
+  closer.forEachPose([&](int64_t id, const Pose3& pose) { t.push_back({toSeconds(closer.utime(id)), pose}); });
   writeTum(path, t);
 }
 
@@ -34,21 +34,23 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"overlap", l.overlap},
                      {"residual_translation", l.residual_translation},
                      {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
-                     {"corrected", l.corrected}});
+                     {"corrected", l.corrected},
+                     {"merged", l.merged}});
   }
   // graph segments: one per odometry epoch (a LIO reset starts a new one, with no edge to the last)
   nlohmann::json epochs = nlohmann::json::array();
-  for (const auto& [id, pose] : closer.graph().poses()) {
+  closer.forEachPose([&](int64_t id, const Pose3&) {
     if (epochs.empty() || epochs.back()["epoch"] != closer.epoch(id))
       epochs.push_back({{"epoch", closer.epoch(id)}, {"first_id", id}, {"last_id", id}, {"num_keyframes", 0}});
     epochs.back()["last_id"] = id;
     epochs.back()["num_keyframes"] = epochs.back()["num_keyframes"].get<int64_t>() + 1;
-  }
+  });
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
   out << nlohmann::json{{"num_keyframes", closer.size()},
                         {"loops", loops},
                         {"corrections", closer.corrections()},
+                        {"graph_nodes", closer.graph().poses().size()},
                         {"epochs", epochs},
                         {"odometry_edges_across_epochs", closer.odometryEdgesAcrossEpochs()}}
              .dump(2)
@@ -58,8 +60,9 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
 void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {
   // keyframe by keyframe into per-voxel sums: memory grows with the mapped area, not the run
   VoxelCentroids centroids(voxel_size);
-  for (const auto& [id, pose] : closer.graph().poses())
+  closer.forEachPose([&](int64_t id, const Pose3& pose) {
     for (const Vec3& p : closer.mapCloud(id)) centroids.add(pose * p);
+  });
   const Points map = centroids.centroids();
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + path);

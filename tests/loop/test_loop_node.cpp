@@ -169,12 +169,12 @@ void runDriftedLoop(Adoption adoption) {
   EXPECT_LT(rotationErrorDeg(newest, truth[last->keyframe_id[n - 1]]), 0.1 * rotation_drift);
   // The final keyframe trajectory: every keyframe, also those after the last correction.
   double worst_final = 0.0;
-  for (const auto& [id, pose] : node.closer().graph().poses())
-    worst_final = std::max(worst_final, translationError(pose, truth[id]));
+  node.closer().forEachPose(
+      [&](int64_t id, const Pose3& pose) { worst_final = std::max(worst_final, translationError(pose, truth[id])); });
   EXPECT_LT(worst_final, 0.2 * drift);
   // odometry_to_corrected maps the raw pose of the keyframe that closed the loop onto its optimised one
   const Pose3 T_Ck_O = poseFrom(last->odometry_to_corrected_position, last->odometry_to_corrected_orientation);
-  EXPECT_LT(translationError(T_Ck_O * odo[last->loop_from_id], node.closer().graph().pose(last->loop_from_id)), 1e-9);
+  EXPECT_LT(translationError(T_Ck_O * odo[last->loop_from_id], node.closer().pose(last->loop_from_id)), 1e-9);
   std::printf("[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
               "%d corrections\n",
               drift, worst, worst_final, translationError(newest, truth[last->keyframe_id[n - 1]]),
@@ -347,6 +347,48 @@ TEST(LoopCloser, LoopsTheEstimateAlreadySatisfiesAreKeptWithoutACorrection) {
   ASSERT_EQ(ungated->loops().size(), gated->loops().size());
   EXPECT_EQ(ungated->corrections(), ungated->loops().size());
   for (const AcceptedLoop& l : ungated->loops()) EXPECT_TRUE(l.corrected);
+}
+
+// Three laps of the same circle with exact odometry: the keyframes of the second and third laps
+// join the first lap's nodes (reduced pose graph), so the graph stays at one lap's nodes while
+// every keyframe keeps a pose; with merge_distance 0 every keyframe is a node.
+TEST(LoopCloser, KeyframesPassingAgainJoinTheOlderNodes) {
+  const Points scene = makeScene(41, 0.15);
+  const int per_lap = 36, total = 3 * per_lap;
+  auto run = [&](double merge_distance) {
+    LoopCloserOptions o;
+    o.merge_distance = merge_distance;
+    o.candidates.exclude_recent_s = 20.0;
+    auto closer = std::make_unique<LoopCloser>(o);
+    std::vector<Pose3> truth;
+    for (int i = 0; i < total; ++i) {
+      const double a = 2 * M_PI * i / per_lap;
+      KeyframeInput in;
+      in.id = i;
+      in.utime = 1000000 + i * 2000000;
+      // a little off the first lap's path, so that joining is a registration, not an identity
+      const double r = 14.0 + 0.3 * (i / per_lap);
+      in.pose = yawPose(a + M_PI / 2, Vec3(r * std::cos(a), r * std::sin(a), 1.8));
+      in.cloud = viewFrom(scene, in.pose.translation(), a + M_PI / 2, 20.0, 0.02, 100 + i);
+      truth.push_back(in.pose);
+      closer->addKeyframe(in);
+    }
+    EXPECT_EQ(closer->size(), static_cast<size_t>(total));
+    double worst = 0.0;
+    closer->forEachPose([&](int64_t id, const Pose3& T) { worst = std::max(worst, translationError(T, truth[id])); });
+    EXPECT_LT(worst, 0.05);
+    return closer;
+  };
+  const auto reduced = run(2.0);
+  EXPECT_LE(reduced->graph().poses().size(), static_cast<size_t>(per_lap + 4));
+  size_t merged = 0;
+  for (const AcceptedLoop& l : reduced->loops()) merged += l.merged;
+  EXPECT_GE(merged, static_cast<size_t>(per_lap));
+  int own_nodes = 0;  // keyframes of the later laps that became nodes (a registration that failed)
+  for (int id = per_lap + 2; id < total; ++id) own_nodes += reduced->node(id) >= per_lap;
+  EXPECT_LE(own_nodes, 4);
+  const auto full = run(0.0);
+  EXPECT_EQ(full->graph().poses().size(), static_cast<size_t>(total));
 }
 
 TEST(LoopNode, EmptyAndInconsistentCloudsDoNotCrash) {
