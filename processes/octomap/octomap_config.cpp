@@ -22,6 +22,8 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
     c.readOptional("keyframe_step", o.keyframe_step);
     c.readOptional("tile_size", o.tile_size);
     c.readOptional("tile_idle_s", o.tile_idle_s);
+    c.readOptional("rebuild_keyframes_per_scan", o.rebuild_keyframes_per_scan);
+    c.readOptional("keyframe_spacing", o.keyframe_spacing);
     c.readOptional("scan_channel", n.scan_channel);
     c.readOptional("colour_channel", n.colour_channel);
     c.readOptional("keyframe_channel", n.keyframe_channel);
@@ -46,6 +48,8 @@ OctomapNodeOptions readOctomapOptions(const Config& c) {
   if (!(o.keyframe_step >= 0.0 && o.keyframe_step <= 0.1)) fail("keyframe_step", "must be in [0, 0.1] m");
   if (!(o.tile_size == 0.0 || o.tile_size >= 2.0 * o.resolution)) fail("tile_size", "must be 0 (one tile) or >= 2 voxels");
   if (!(o.tile_idle_s >= 0.0)) fail("tile_idle_s", "must be >= 0");
+  if (o.rebuild_keyframes_per_scan < 0) fail("rebuild_keyframes_per_scan", "must be >= 0");
+  if (!(o.keyframe_spacing >= 0.0)) fail("keyframe_spacing", "must be >= 0");
   if (n.publish_period_s < 0.0) fail("publish_period_s", "must be >= 0");
   if (n.write_period_s < 0.0) fail("write_period_s", "must be >= 0");
   if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");

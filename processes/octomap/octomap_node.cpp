@@ -43,6 +43,11 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       node_.reject(options_.scan_channel, error);
       return;
     }
+    if (builder_.takeRebuildFinished()) {
+      node_.info("staged rebuild done: the map is rebuilt from " + std::to_string(builder_.keyframes()) +
+                 " keyframes" + (builder_.rebuilding() ? " (another started: keyframes moved while it ran)" : ""));
+      publishTree(m.utime);
+    }
     periodic(m.utime);
   });
   if (options_.core.colour) {
@@ -99,10 +104,15 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
     std::ostringstream s;
     s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
       << " m; ";
-    if (builder_.lastCorrectionRebuilt()) s << "rebuilt from " << builder_.keyframes() << " keyframes";
+    const bool staged = options_.core.rebuild_keyframes_per_scan > 0;
+    if (builder_.lastCorrectionRebuilt() && staged)
+      s << "staged rebuild from " << builder_.keyframes() << " keyframes, " << options_.core.rebuild_keyframes_per_scan
+        << " a scan";
+    else if (builder_.lastCorrectionRebuilt()) s << "rebuilt from " << builder_.keyframes() << " keyframes";
+    else if (builder_.rebuilding()) s << "a staged rebuild is under way (what it cast before is taken up when it ends)";
     else s << "tree kept (rebuild_tolerance " << options_.core.rebuild_tolerance << " m)";
     node_.info(s.str());
-    if (builder_.lastCorrectionRebuilt()) publishTree(m.utime);
+    if (builder_.lastCorrectionRebuilt() && !staged) publishTree(m.utime);
   });
 }
 
@@ -114,6 +124,7 @@ MapFrame::Placed OctomapNode::placeInMap(int32_t epoch, int64_t correction_id) {
     node_.warn("odometry epoch " + std::to_string(epoch) + " (LIO reset): the map of epoch " +
                std::to_string(old_epoch) + (output_dir_.empty() ? " is dropped" : " goes to " + mapPath(name, ".bt")) +
                "; a new map starts");
+    builder_.finishRebuild();
     if (!output_dir_.empty()) writeFiles(name);
     builder_ = OctomapBuilder(options_.core, builder_.lidarExtrinsics());
     last_publish_ = last_write_ = INT64_MIN;  // the new epoch's clock may be behind the old one's
@@ -167,9 +178,11 @@ bool OctomapNode::writeFiles(const std::string& name) {
 void OctomapNode::finish() {
   if (finished_) return;
   finished_ = true;
+  builder_.finishRebuild();
   if (writeFiles())
     node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) + " leaves; " +
-               std::to_string(builder_.keyframes()) + " keyframe clouds on disk, " +
+               std::to_string(builder_.keyframes()) + " keyframe clouds on disk (" +
+               std::to_string(builder_.keyframesNotKept()) + " not kept: keyframe_spacing), " +
                std::to_string(builder_.storedKeyframeBytes() / 1000000) + " MB; tiles " +
                std::to_string(builder_.map().residentTiles()) + " in memory, " +
                std::to_string(builder_.map().spilledTiles()) + " on disk, " +

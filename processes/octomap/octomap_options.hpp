@@ -30,6 +30,12 @@ struct OctomapOptions {
                                   // when idle (0: one tile, never written out)
   double tile_idle_s = 5.0;       // s of sensor time without an update before a tile goes to disk
                                   // (0: never)
+  int rebuild_keyframes_per_scan = 0;  // a rebuild casts this many keyframes per registered scan into
+                                       // a second tree that replaces the map when all are cast (the
+                                       // map stays usable meanwhile); 0: all at once at the correction
+  double keyframe_spacing = 0.0;  // m: a keyframe within this distance of one kept for rebuilds is
+                                  // not kept (its sweep is in the map all the same), so rebuilds
+                                  // cost what the area costs, not the drive (0: keep every one)
 };
 
 void printOctomapOptions(const OctomapOptions& o, std::ostream& os);

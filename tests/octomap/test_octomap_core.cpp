@@ -166,6 +166,96 @@ TEST(OctomapBuilder, RebuildsFromCorrectedKeyframes) {
   EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 2.55)), 1);
 }
 
+namespace {
+// A wall of points 3 m ahead of `origin` along +x (or behind it, along -x), world frame.
+std::vector<Eigen::Vector3f> wallAhead(const Eigen::Vector3f& origin, float direction = 1.f) {
+  std::vector<Eigen::Vector3f> pts;
+  for (int i = -5; i <= 5; ++i)
+    for (int j = 0; j <= 10; ++j) pts.push_back(origin + Eigen::Vector3f(direction * 3.05f, 0.1f * i + 0.05f, 0.1f * j + 0.05f));
+  return pts;
+}
+struct ScanArrays {
+  std::vector<float> x, y, z, dt;
+  RegisteredScanView view(int64_t utime, const std::vector<Eigen::Vector3f>& pts, const Pose3& T_W_I) {
+    x.clear(), y.clear(), z.clear(), dt.clear();
+    for (const auto& p : pts) x.push_back(p.x()), y.push_back(p.y()), z.push_back(p.z()), dt.push_back(0.f);
+    RegisteredScanView v;
+    v.utime = utime;
+    v.cloud_utime = utime - 100000;
+    v.num_points = static_cast<int>(x.size());
+    v.x = x.data(), v.y = y.data(), v.z = z.data(), v.time_offset = dt.data();
+    v.T_W_I = T_W_I;
+    return v;
+  }
+};
+}  // namespace
+
+// A staged rebuild (rebuild_keyframes_per_scan 1): after the correction the map is the old one
+// until the scans have cast every kept keyframe into the second tree, which then holds the
+// keyframes at their corrected poses and the sweeps since the correction.
+TEST(OctomapBuilder, AStagedRebuildReplacesTheMapWhenEveryKeyframeIsCast) {
+  OctomapOptions o = options(false);
+  o.rebuild_keyframes_per_scan = 1;
+  OctomapBuilder builder(o, Pose3::Identity());
+  ScanArrays arrays;
+  std::string error;
+  for (int i = 0; i < 3; ++i) {
+    Pose3 T = Pose3::Identity();
+    T.translation() = Vec3(0.0, 0.4 * i, 0.0);
+    Keyframe k;
+    k.utime = 1000000 + i * 100000;
+    k.T_W_I = T;
+    for (const auto& p : wallAhead(Eigen::Vector3f::Zero())) k.points.push_back(p);  // body frame
+    std::vector<Eigen::Vector3f> world;
+    for (const auto& p : k.points) world.push_back((T * p.cast<double>()).cast<float>());
+    ASSERT_TRUE(builder.addScan(arrays.view(k.utime, world, T), &error)) << error;
+    builder.addKeyframe(i, k);
+  }
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 0.55)), 1);
+  std::map<int64_t, Pose3> corrected;
+  for (int i = 0; i < 3; ++i) {
+    Pose3 T = Pose3::Identity();
+    T.translation() = Vec3(0.0, 0.4 * i, 2.0);
+    corrected[i] = T;
+  }
+  EXPECT_EQ(builder.applyCorrection(corrected), 3);
+  EXPECT_TRUE(builder.lastCorrectionRebuilt());
+  EXPECT_TRUE(builder.rebuilding());
+  EXPECT_EQ(builder.rebuilds(), 0);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 0.55)), 1);  // still the old map
+  // the sweeps after the correction look the other way
+  Pose3 now = corrected[2];
+  for (int s = 0; s < 3; ++s) {
+    const int64_t t = 2000000 + s * 100000;
+    EXPECT_FALSE(builder.takeRebuildFinished());
+    ASSERT_TRUE(builder.addScan(arrays.view(t, wallAhead(now.translation().cast<float>(), -1.f), now), &error)) << error;
+    EXPECT_EQ(builder.rebuilding(), s < 2) << s;
+  }
+  EXPECT_TRUE(builder.takeRebuildFinished());
+  EXPECT_FALSE(builder.takeRebuildFinished());
+  EXPECT_EQ(builder.rebuilds(), 1);
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 0.55)), -1);  // the old wall is gone
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(3.05, 0.05, 2.55)), 1);   // the keyframes' wall, moved
+  EXPECT_EQ(builder.map().classify(Eigen::Vector3d(-3.05, 0.85, 2.55)), 1);  // the sweeps since
+}
+
+// keyframe_spacing: keyframes nearer than it to a kept one are not kept for rebuilds.
+TEST(OctomapBuilder, KeyframesNearAKeptOneAreNotKept) {
+  OctomapOptions o = options(false);
+  o.keyframe_spacing = 1.0;
+  OctomapBuilder builder(o, Pose3::Identity());
+  for (int i = 0; i < 10; ++i) {
+    Keyframe k;
+    k.utime = 1000000 + i * 100000;
+    k.T_W_I.translation() = Vec3(0.4 * i, 0.0, 0.0);
+    k.points = wallAhead(Eigen::Vector3f::Zero());
+    EXPECT_TRUE(builder.addKeyframe(i, k));
+  }
+  // kept: 0, 1.2, 2.4, 3.6 m (each the first at 1 m or more from every kept one)
+  EXPECT_EQ(builder.keyframes(), 4u);
+  EXPECT_EQ(builder.keyframesNotKept(), 6);
+}
+
 // After a loop correction the tree holds exactly the keyframes' clouds at their corrected poses,
 // each ray-cast from that keyframe's LiDAR origin T_W_I * T_I_L (not the body origin): a keyframe
 // whose pose changed moves its wall and its free space, an unchanged one stays, and the sweeps
