@@ -102,6 +102,21 @@ Points LoopCloser::mapCloud(int64_t id) const {
   return map;
 }
 
+AcceptedLoop LoopCloser::acceptedLoop(int64_t from_id, const Keyframe& from, int64_t to_id, const Keyframe& to,
+                                      const LoopRegistrationResult& r) const {
+  AcceptedLoop loop;
+  loop.from_id = from_id;
+  loop.to_id = to_id;
+  loop.from_utime = from.utime;
+  loop.to_utime = to.utime;
+  // registration works in the levelled frames G; the loop is between the body frames I
+  loop.T_to_from = rotationOnly(to.G_R_I).inverse() * r.T_target_source * rotationOnly(from.G_R_I);
+  loop.coarse_inliers = r.coarse.num_inliers;
+  loop.fitness = r.fine.fitness;
+  loop.overlap = r.fine.overlap;
+  return loop;
+}
+
 Pose3 LoopCloser::pose(int64_t id) const {
   const Keyframe& k = keyframes_.at(id);
   return k.node == id ? graph_.pose(id) : graph_.pose(k.node) * k.T_node_kf;
@@ -227,15 +242,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
         result.attempts.push_back(r);
         if (r.accepted) {
           // the keyframe joins the older node; the graph gets the edge chain node -> that node
-          AcceptedLoop loop;
-          loop.from_id = input.id;
-          loop.to_id = *near;
-          loop.from_utime = kf.utime;
-          loop.to_utime = target.utime;
-          loop.T_to_from = rotationOnly(target.G_R_I).inverse() * r.T_target_source * rotationOnly(kf.G_R_I);
-          loop.coarse_inliers = r.coarse.num_inliers;
-          loop.fitness = r.fine.fitness;
-          loop.overlap = r.fine.overlap;
+          AcceptedLoop loop = acceptedLoop(input.id, kf, *near, target, r);
           loop.merged = true;
           Keyframe& joined = keyframes_.at(input.id);
           joined.node = *near;
@@ -288,15 +295,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
                                             target_features->fine, options_.registration);
     result.attempts.push_back(r);
     if (!r.accepted) continue;
-    AcceptedLoop loop;
-    loop.from_id = input.id;
-    loop.to_id = cand;
-    loop.from_utime = cur.utime;
-    loop.to_utime = target.utime;
-    loop.T_to_from = rotationOnly(target.G_R_I).inverse() * r.T_target_source * rotationOnly(cur.G_R_I);
-    loop.coarse_inliers = r.coarse.num_inliers;
-    loop.fitness = r.fine.fitness;
-    loop.overlap = r.fine.overlap;
+    AcceptedLoop loop = acceptedLoop(input.id, cur, cand, target, r);
     PoseEdge e;
     e.from = cand;
     e.to = input.id;

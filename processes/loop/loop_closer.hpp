@@ -185,6 +185,9 @@ class LoopCloser {
   Mat6 loopCovariance() const;
   /// Adds a loop edge (if any); unless the odometry already satisfies the loop, optimises and returns the
   /// correction for keyframe `current` (loop gets its residual and `corrected`).
+  /// A verified registration of keyframe from_id (source) against to_id (target) as a loop.
+  AcceptedLoop acceptedLoop(int64_t from_id, const Keyframe& from, int64_t to_id, const Keyframe& to,
+                            const LoopRegistrationResult& r) const;
   std::optional<Correction> addLoopEdge(const PoseEdge* edge, int64_t current, AcceptedLoop* loop);
   std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
   /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
