@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -81,8 +82,10 @@ class ColourMap {
   /// Ids of points that came back from disk moved by a correction since the last call.
   std::vector<uint32_t> takeMovedOnReload();
 
-  /// Resident slots (a free slot has live() false).
-  const std::vector<MapPoint>& points() const { return points_; }
+  /// Resident slots (a free slot has live() false). A deque: the map grows a block at a time,
+  /// never by reallocating (a vector reserves up to twice the points it holds, and holds the old
+  /// and the new array at once while it grows).
+  const std::deque<MapPoint>& points() const { return points_; }
   MapPoint& point(uint32_t id) { return points_[id]; }
   const MapPoint& point(uint32_t id) const { return points_[id]; }
   size_t size() const { return points_.size(); }
@@ -99,8 +102,9 @@ class ColourMap {
   static constexpr uint32_t kGone = ~uint32_t{0};
 
  private:
-  /// Voxel key -> point id, open addressing with linear probing, grown at 50 % load: one lookup
-  /// per scan point, several times faster than std::unordered_map at a few 100k points.
+  /// Voxel key -> point id, open addressing with linear probing, grown at 75 % load (sized for
+  /// 50 % after a reset): one lookup per scan point, several times faster than
+  /// std::unordered_map at a few 100k points.
   class VoxelIndex {
    public:
     /// The id stored for key, after storing `id` for it if it had none (*inserted tells which).
@@ -157,7 +161,7 @@ class ColourMap {
   int64_t voxels_per_tile_;
   TileOptions tile_options_;
   int64_t now_ = INT64_MIN;
-  std::vector<MapPoint> points_;
+  std::deque<MapPoint> points_;
   std::vector<uint32_t> free_;
   VoxelIndex index_;
   std::unordered_map<uint64_t, Tile> tiles_;
