@@ -13,6 +13,9 @@
 
 #include <poll.h>
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "livo/health_t.hpp"
 #include "livo/image_t.hpp"
@@ -68,6 +71,13 @@ int NodeOptions::handlerDelayFromEnvironment() {
 
 Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
   if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
+#if defined(__GLIBC__)
+  // Blocks of 256 kB or more (clouds, key sets, features, map arrays) are mapped and unmapped on
+  // their own. glibc's default raises this threshold after the first such block is freed, and from
+  // then on serves them from the heap, where an hours-long run of different sizes fragments it
+  // and resident memory creeps up although nothing is kept (issue 16's soak).
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+#endif
   if (options_.handler_delay_max_ms < 0) throw std::invalid_argument("livo::Node: handler_delay_max_ms < 0");
   // FNV-1a of the name: the same delays for the same node in every run (std::hash is not portable)
   uint32_t seed = 2166136261u;
