@@ -13,20 +13,22 @@
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
+#                           [--stop-grace S]
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
 # every restart. Without it a process that dies stops the run. --kill P:SIG:AT_S sends SIG to
-# process P AT_S seconds of wall time after the replay starts (for supervision tests).
+# process P AT_S seconds of wall time after the replay starts (for supervision tests). At the end
+# every process gets SIGINT and --stop-grace seconds (60) to write its files before SIGKILL.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio loop colour octomap)
 
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills=""
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -44,6 +46,7 @@ while [ $# -gt 0 ]; do
     --no-respawn) respawn=0; shift ;;
     --max-restarts) max_restarts="$2"; shift 2 ;;
     --kill) kills="$2"; shift 2 ;;
+    --stop-grace) stop_grace="$2"; shift 2 ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"; swap["${2%%=*}"]="${2#*=}"; shift 2 ;;
     --inside-bus) inside=1; shift ;;
     -h|--help) usage 0 ;;
@@ -53,6 +56,7 @@ done
 [ -n "$log" ] && [ -n "$config" ] && [ -n "$out" ] || usage
 [ -n "$respawn" ] || respawn=$realtime
 [[ "$max_restarts" =~ ^[0-9]+$ ]] || die "--max-restarts takes a whole number"
+[[ "$stop_grace" =~ ^[0-9]+$ ]] || die "--stop-grace takes whole seconds"
 [ -f "$log" ] || die "no such log: $log"
 [ -f "$config" ] || die "no such config: $config"
 log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
@@ -89,7 +93,7 @@ if [ "$inside" = 0 ]; then
   rc=0
   "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
-    --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --kill "$kills" \
+    --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --kill "$kills" --stop-grace "$stop_grace" \
     $([ "$respawn" = 1 ] && echo --respawn || echo --no-respawn) \
     $([ "$realtime" = 1 ] && echo --realtime) || rc=$?
 
@@ -269,9 +273,9 @@ for p in "${!pids[@]}"; do
 done
 for p in "${!pids[@]}"; do kill -INT "${pids[$p]}" 2>/dev/null || true; done
 for p in "${!pids[@]}"; do
-  for _ in $(seq 200); do kill -0 "${pids[$p]}" 2>/dev/null || break; sleep 0.1; done
+  for _ in $(seq $((stop_grace * 10))); do kill -0 "${pids[$p]}" 2>/dev/null || break; sleep 0.1; done
   if kill -0 "${pids[$p]}" 2>/dev/null; then
-    echo "process $p did not stop within 20 s of SIGINT; killed" >&3
+    echo "process $p did not stop within $stop_grace s of SIGINT; killed" >&3
     kill -KILL "${pids[$p]}" 2>/dev/null || true
     failed=1
   fi
