@@ -132,6 +132,7 @@ PoseGraph::PoseGraph(const PoseGraph& other)
       poses_(other.poses_),
       blocks_(other.blocks_),
       edges_(other.edges_),
+      loop_edges_(other.loop_edges_),
       held_fixed_(other.held_fixed_) {
   for (auto& [id, b] : blocks_) b.in_problem = false;
 }
@@ -156,11 +157,32 @@ void PoseGraph::addNode(int64_t id, const Pose3& initial) {
   b.x = toBlock(initial);
 }
 
-void PoseGraph::addEdge(const PoseEdge& edge) {
+bool PoseGraph::addEdge(const PoseEdge& edge) {
   if (!hasNode(edge.from) || !hasNode(edge.to))
     throw std::invalid_argument("pose graph edge " + std::to_string(edge.from) + " -> " + std::to_string(edge.to) +
                                 " names an unknown node");
+  if (edge.is_loop && options_.fuse_parallel_loops) {
+    const auto [it, fresh] = loop_edges_.try_emplace({edge.from, edge.to}, edges_.size());
+    if (!fresh) {
+      // Both measure T_from_to with the residual [Log(R_m^T R); p - p_m]: around the first, the
+      // second sits at m2 = [Log(R_1^T R_2); p_2] and the first at m1 = [0; p_1], and their sum of
+      // squares is minimised at x = (L1 + L2)^-1 (L1 m1 + L2 m2) with information L1 + L2.
+      PoseEdge& e = edges_[it->second];
+      const Mat3 R1 = e.T_from_to.linear();
+      Vec6 m1, m2;
+      m1 << Vec3::Zero(), e.T_from_to.translation();
+      m2 << so3::Log(Mat3(R1.transpose() * edge.T_from_to.linear())), edge.T_from_to.translation();
+      const Mat6 L = e.information + edge.information;
+      const Vec6 x = L.ldlt().solve(e.information * m1 + edge.information * m2);
+      e.T_from_to.linear() = R1 * so3::Exp(Vec3(x.head<3>()));
+      e.T_from_to.translation() = x.tail<3>();
+      e.information = 0.5 * (L + L.transpose());
+      if (it->second < edges_in_problem_) resetProblem();  // its residual is rebuilt at the next solve
+      return false;
+    }
+  }
   edges_.push_back(edge);
+  return true;
 }
 
 const Pose3& PoseGraph::pose(int64_t id) const {

@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "livo/so3.hpp"
@@ -31,6 +32,10 @@ struct PoseGraphOptions {
   bool robust_loops = false;      // Cauchy loss on loop edges (off: loops are verified, and a
                                   // large first correction would be down-weighted away)
   double loop_loss_scale = 1.0;   // in units of the whitened residual
+  /// A loop edge between the same two nodes, in the same direction, as an earlier loop edge is
+  /// fused into it (information-weighted, to first order: the same optimum) instead of added:
+  /// passes over a mapped route then add no edges once their node pairs are in the graph.
+  bool fuse_parallel_loops = true;
 };
 
 /// T_from_to measured with information (inverse covariance, [rotation; translation]).
@@ -65,8 +70,9 @@ class PoseGraph {
   /// Holds a node constant like the first one: the first keyframe of a graph segment (a segment
   /// starts after an odometry reset and has no edge to the ones before it).
   void holdFixed(int64_t id) { held_fixed_.insert(id); }
-  /// Throws std::invalid_argument if an end is unknown.
-  void addEdge(const PoseEdge& edge);
+  /// Throws std::invalid_argument if an end is unknown. A loop edge parallel to an earlier one
+  /// is fused into it (fuse_parallel_loops); returns false then.
+  bool addEdge(const PoseEdge& edge);
 
   /// Minimises the whole graph from the current estimates (the previous solution for old nodes).
   PoseGraphSummary optimize();
@@ -89,6 +95,7 @@ class PoseGraph {
   std::map<int64_t, Pose3> poses_;
   std::map<int64_t, Block> blocks_;
   std::vector<PoseEdge> edges_;
+  std::map<std::pair<int64_t, int64_t>, size_t> loop_edges_;  // (from, to) -> index in edges_
   std::unique_ptr<ceres::Problem> problem_;
   size_t edges_in_problem_ = 0;
   int64_t fixed_id_ = 0;  // the node held constant in problem_
