@@ -23,13 +23,13 @@ Pose3 rotationOnly(const Mat3& R) {
 }  // namespace
 
 std::string LoopCloser::problem(const KeyframeInput& input) const {
-  if (!keyframes_.empty()) {
-    const auto& [newest_id, newest] = *keyframes_.rbegin();
+  if (!placements_.empty()) {
+    const int64_t newest_id = placements_.back().id;
     if (input.id <= newest_id)
       return "keyframe id " + std::to_string(input.id) + " is not after " + std::to_string(newest_id);
-    if (input.epoch < newest.epoch)
+    if (input.epoch < newest_.epoch)
       return "keyframe " + std::to_string(input.id) + " is of odometry epoch " + std::to_string(input.epoch) +
-             ", before the newest keyframe's (" + std::to_string(newest.epoch) + ")";
+             ", before the newest keyframe's (" + std::to_string(newest_.epoch) + ")";
   }
   if (!published_.odometryToCorrected(input.epoch, input.correction_id))
     return "keyframe " + std::to_string(input.id) + " includes loop correction " +
@@ -38,25 +38,36 @@ std::string LoopCloser::problem(const KeyframeInput& input) const {
   return "";
 }
 
+const LoopCloser::Placement& LoopCloser::placement(int64_t id) const {
+  const auto it = std::lower_bound(placements_.begin(), placements_.end(), id,
+                                   [](const Placement& p, int64_t i) { return p.id < i; });
+  if (it == placements_.end() || it->id != id) throw std::out_of_range("unknown keyframe " + std::to_string(id));
+  return *it;
+}
+
 size_t LoopCloser::odometryEdgesAcrossEpochs() const {
   size_t n = 0;
-  for (const PoseEdge& e : graph_.edges()) n += !e.is_loop && keyframes_.at(e.from).epoch != keyframes_.at(e.to).epoch;
+  for (const PoseEdge& e : graph_.edges()) n += !e.is_loop && nodes_.at(e.from).epoch != nodes_.at(e.to).epoch;
   return n;
 }
 
-std::vector<int64_t> LoopCloser::candidates(int64_t id) const {
-  const Keyframe& cur = keyframes_.at(id);
-  const Vec3 p = graph_.pose(id).translation();
-  const double r2 = options_.candidates.search_radius * options_.candidates.search_radius;
+std::vector<std::pair<double, int64_t>> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
+                                                                   double radius) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
-  for (const auto& [other, kf] : keyframes_) {
-    if (other >= id || kf.node != other || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints)
-      continue;  // graph nodes only: a keyframe that joined one is represented by it
-    const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
-    if (d2 <= r2) near.push_back({d2, other});
+  for (const auto& [id, node] : nodes_) {
+    if (id >= kf_id) break;
+    if (node.epoch != kf.epoch || kf.utime - node.utime < recent || !node.has_keypoints) continue;
+    const double d2 = (graph_.pose(id).translation() - p).squaredNorm();
+    if (d2 <= radius * radius) near.push_back({d2, id});
   }
   std::sort(near.begin(), near.end());
+  return near;
+}
+
+std::vector<int64_t> LoopCloser::candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
+  // graph nodes only: a keyframe that joined one is represented by it
+  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.candidates.search_radius);
   std::vector<int64_t> out;
   for (size_t i = 0; i < near.size() && static_cast<int>(i) < options_.candidates.max_candidates; ++i)
     out.push_back(near[i].second);
@@ -89,7 +100,7 @@ std::shared_ptr<const LoopCloser::Features> LoopCloser::features(int64_t id) {
     }
   Points cloud_I;
   for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
-  std::shared_ptr<const Features> f = deriveFeatures(cloud_I, keyframes_.at(id).G_R_I);
+  std::shared_ptr<const Features> f = deriveFeatures(cloud_I, nodes_.at(id).G_R_I);
   cacheFeatures(id, f);
   return f;
 }
@@ -118,29 +129,18 @@ AcceptedLoop LoopCloser::acceptedLoop(int64_t from_id, const Keyframe& from, int
 }
 
 Pose3 LoopCloser::pose(int64_t id) const {
-  const Keyframe& k = keyframes_.at(id);
+  const Placement& k = placement(id);
   return k.node == id ? graph_.pose(id) : graph_.pose(k.node) * k.T_node_kf;
 }
 
 void LoopCloser::forEachPose(const std::function<void(int64_t, const Pose3&)>& visit) const {
-  for (const auto& [id, k] : keyframes_) visit(id, pose(id));
+  for (const Placement& k : placements_) visit(k.id, k.node == k.id ? graph_.pose(k.id) : graph_.pose(k.node) * k.T_node_kf);
 }
 
-std::optional<int64_t> LoopCloser::mergeCandidate(int64_t id, const Vec3& p) const {
-  const Keyframe& cur = keyframes_.at(id);
-  const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
-  std::optional<int64_t> best;
-  double best_d2 = options_.merge_distance * options_.merge_distance;
-  for (const auto& [other, kf] : keyframes_) {
-    if (other >= id || kf.node != other || kf.epoch != cur.epoch || cur.utime - kf.utime < recent || !kf.has_keypoints)
-      continue;
-    const double d2 = (graph_.pose(other).translation() - p).squaredNorm();
-    if (d2 <= best_d2) {
-      best_d2 = d2;
-      best = other;
-    }
-  }
-  return best;
+std::optional<int64_t> LoopCloser::mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
+  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.merge_distance);
+  if (near.empty()) return std::nullopt;
+  return near.front().second;
 }
 
 Mat6 LoopCloser::loopCovariance() const {
@@ -153,19 +153,18 @@ Mat6 LoopCloser::chainCovariance(const Keyframe& to) const {
   // the odometry part: the increment's covariance from the absolute ones, floored by the drift
   // model over the path; the loop part (if the chain starts with one) adds its covariance
   // (isotropic blocks, so carrying it to the end of the chain is left out)
-  const Keyframe& start = keyframes_.at(chain_.start);
   const Mat6 odometry =
-      relativeInformation(start.covariance, to.covariance,
+      relativeInformation(chain_.start_keyframe.covariance, to.covariance,
                           std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
                           std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
           .inverse();
   return chain_.via_loop ? Mat6(odometry + loopCovariance()) : odometry;
 }
 
-std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t current, AcceptedLoop* loop) {
+std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t current, const Keyframe& cur,
+                                                  AcceptedLoop* loop) {
   // where the loop puts the keyframe (the joined or loop node's pose and the measured offset)
   // against where the odometry has it now (in the newest correction it was sent)
-  const Keyframe& cur = keyframes_.at(current);
   const Pose3 implied = graph_.pose(loop->to_id) * loop->T_to_from;
   const Pose3 odometry = *published_.odometryToCorrected(cur.epoch, published_.newest(cur.epoch)) * cur.odometry;
   const Pose3 discrepancy = implied.inverse() * odometry;
@@ -188,6 +187,14 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   return c;
 }
 
+void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate,
+                         const std::vector<Eigen::Vector3f>& cloud) {
+  graph_.addNode(id, estimate);
+  nodes_.emplace(id, kf);
+  clouds_.put(id, cloud);
+  placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity()});
+}
+
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
   Keyframe kf;
@@ -196,46 +203,50 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
-  kf.node = input.id;
   // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
   std::vector<Eigen::Vector3f> cloud_f;
   cloud_f.reserve(input.cloud.size());
   for (const Vec3& p : input.cloud) cloud_f.push_back(p.cast<float>());
-  clouds_.put(input.id, cloud_f);
-  Points cloud_I;
-  cloud_I.reserve(cloud_f.size());
-  for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
-  std::shared_ptr<const Features> cur_features = deriveFeatures(cloud_I, kf.G_R_I);
-  kf.has_keypoints = !cur_features->coarse.points.empty();
+  const auto deriveCurrent = [&] {
+    Points cloud_I;
+    cloud_I.reserve(cloud_f.size());
+    for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
+    std::shared_ptr<const Features> f = deriveFeatures(cloud_I, kf.G_R_I);
+    kf.has_keypoints = !f->coarse.points.empty();
+    return f;
+  };
   const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
+  const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
+  const Pose3 previous_odometry = newest_.odometry;
+  newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;
-  if (keyframes_.empty() || keyframes_.rbegin()->second.epoch != input.epoch) {
+  std::shared_ptr<const Features> cur_features;
+  if (first_of_epoch) {
     // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
     // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
-    graph_.addNode(input.id, kf.odometry);
-    if (!keyframes_.empty()) graph_.holdFixed(input.id);
-    keyframes_.emplace(input.id, std::move(kf));
-    chain_ = Chain{input.id, input.id, Pose3::Identity(), false, 0.0};
+    const bool first = placements_.empty();
+    cur_features = deriveCurrent();
+    addNode(input.id, kf, kf.odometry, cloud_f);
+    if (!first) graph_.holdFixed(input.id);
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0};
   } else {
-    const Keyframe& prev = keyframes_.rbegin()->second;
-    chain_.path += (prev.odometry.inverse() * kf.odometry).translation().norm();
+    chain_.path += (previous_odometry.inverse() * kf.odometry).translation().norm();
     // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
-    const Pose3 T_node_kf = chain_.T_node_start * (keyframes_.at(chain_.start).odometry.inverse() * kf.odometry);
+    const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
     const Pose3 estimate = graph_.pose(chain_.node) * T_node_kf;
     const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
-    const bool older_node = kf.utime - keyframes_.at(chain_.node).utime >= recent;
+    const bool older_node = kf.utime - nodes_.at(chain_.node).utime >= recent;
     if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
-      // passing again near the older node the odometry hangs from: the keyframe joins it
-      kf.node = chain_.node;
-      kf.T_node_kf = T_node_kf;
-      keyframes_.emplace(input.id, std::move(kf));
+      // passing again near the older node the odometry hangs from: the keyframe joins it (its
+      // cloud and features are not needed: the node represents it)
+      placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf});
       return result;
     }
-    keyframes_.emplace(input.id, kf);
+    cur_features = deriveCurrent();
     if (options_.merge_distance > 0 && kf.has_keypoints) {
-      if (const std::optional<int64_t> near = mergeCandidate(input.id, estimate.translation())) {
-        const Keyframe& target = keyframes_.at(*near);
+      if (const std::optional<int64_t> near = mergeCandidate(input.id, kf, estimate.translation())) {
+        const Keyframe& target = nodes_.at(*near);
         const std::shared_ptr<const Features> target_features = features(*near);
         LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
                                                 target_features->fine, options_.registration);
@@ -244,22 +255,20 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
           // the keyframe joins the older node; the graph gets the edge chain node -> that node
           AcceptedLoop loop = acceptedLoop(input.id, kf, *near, target, r);
           loop.merged = true;
-          Keyframe& joined = keyframes_.at(input.id);
-          joined.node = *near;
-          joined.T_node_kf = loop.T_to_from;
+          placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop.T_to_from});
           PoseEdge e;  // none if the chain's node is the joined one (no new relation)
           e.from = chain_.node;
           e.to = *near;
           e.T_from_to = T_node_kf * loop.T_to_from.inverse();
           e.is_loop = true;
-          const Mat6 cov = chainCovariance(joined) + loopCovariance();
+          const Mat6 cov = chainCovariance(kf) + loopCovariance();
           e.information = cov.inverse();
           e.information = 0.5 * (e.information + e.information.transpose()).eval();
-          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, &loop);
+          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &loop);
           loops_.push_back(loop);
           result.loop = loop;
           keyframes_since_loop_ = 0;
-          chain_ = Chain{*near, input.id, loop.T_to_from, true, 0.0};
+          chain_ = Chain{*near, input.id, kf, loop.T_to_from, true, 0.0};
           return result;
         }
       }
@@ -270,32 +279,30 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.to = input.id;
     e.T_from_to = T_node_kf;
     e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
-    const Keyframe& start = keyframes_.at(chain_.start);
     e.information = chain_.via_loop
                         ? Mat6(chainCovariance(kf).inverse())
-                        : relativeInformation(start.covariance, kf.covariance,
+                        : relativeInformation(chain_.start_keyframe.covariance, kf.covariance,
                                               std::hypot(options_.odometry_rotation_floor,
                                                          options_.odometry_rotation_per_m * chain_.path),
                                               std::hypot(options_.odometry_translation_floor,
                                                          options_.odometry_translation_per_m * chain_.path));
-    graph_.addNode(input.id, estimate);
+    addNode(input.id, kf, estimate, cloud_f);
     graph_.addEdge(e);
-    chain_ = Chain{input.id, input.id, Pose3::Identity(), false, 0.0};
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0};
     if (!result.attempts.empty()) return result;  // the nearest older node did not register: no second try
   }
 
   if (cooling) return result;
   cacheFeatures(input.id, cur_features);
-  const Keyframe& cur = keyframes_.at(input.id);
-  if (!cur.has_keypoints) return result;
-  for (int64_t cand : candidates(input.id)) {
-    const Keyframe& target = keyframes_.at(cand);
+  if (!kf.has_keypoints) return result;
+  for (int64_t cand : candidates(input.id, kf, graph_.pose(input.id).translation())) {
+    const Keyframe& target = nodes_.at(cand);
     const std::shared_ptr<const Features> target_features = features(cand);
     LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
                                             target_features->fine, options_.registration);
     result.attempts.push_back(r);
     if (!r.accepted) continue;
-    AcceptedLoop loop = acceptedLoop(input.id, cur, cand, target, r);
+    AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);
     PoseEdge e;
     e.from = cand;
     e.to = input.id;
@@ -304,7 +311,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     Vec6 sigma;
     sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
     e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
-    result.correction = addLoopEdge(&e, input.id, &loop);
+    result.correction = addLoopEdge(&e, input.id, kf, &loop);
     loops_.push_back(loop);
     result.loop = loop;
     keyframes_since_loop_ = 0;

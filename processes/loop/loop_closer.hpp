@@ -1,7 +1,7 @@
-// The loop-closure core without middleware: a keyframe store (body-frame clouds on disk, their
-// coarse features and GICP covariances derived on demand and cached for the most recently used
-// keyframes), radius candidates, coarse-to-fine registration and the pose graph, optimised only
-// when a loop is accepted.
+// The loop-closure core without middleware: a keyframe store (the graph nodes' body-frame clouds
+// on disk, their coarse features and GICP covariances derived on demand and cached for the most
+// recently used nodes; every other keyframe only as an offset from its node), radius candidates,
+// coarse-to-fine registration and the pose graph, optimised only when a loop is accepted.
 #pragma once
 
 #include <cstdint>
@@ -135,24 +135,26 @@ class LoopCloser {
   /// Every keyframe, in id order, with its corrected pose.
   void forEachPose(const std::function<void(int64_t id, const Pose3& pose)>& visit) const;
   /// The graph node a keyframe belongs to (its own id if it is one).
-  int64_t node(int64_t id) const { return keyframes_.at(id).node; }
-  int64_t newestId() const { return keyframes_.empty() ? -1 : keyframes_.rbegin()->first; }
+  int64_t node(int64_t id) const { return placement(id).node; }
+  int64_t newestId() const { return placements_.empty() ? -1 : placements_.back().id; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
   /// Accepted loops that were optimised and published as a correction.
   size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
-  int64_t utime(int64_t id) const { return keyframes_.at(id).utime; }
-  int32_t epoch(int64_t id) const { return keyframes_.at(id).epoch; }
+  int64_t utime(int64_t id) const { return placement(id).utime; }
+  int32_t epoch(int64_t id) const { return placement(id).epoch; }
   /// Odometry edges whose ends are in different epochs (0 by construction; a check for tests).
   size_t odometryEdgesAcrossEpochs() const;
   /// The keyframe's cloud for the global map (voxel-downsampled, body frame I), from the store.
   Points mapCloud(int64_t id) const;
-  size_t size() const { return keyframes_.size(); }
+  size_t size() const { return placements_.size(); }
   /// Keyframes whose derived features are in memory now (<= feature_cache_keyframes).
   size_t cachedFeatures() const { return cache_.size(); }
   /// Bytes of keyframe clouds on disk.
   uint64_t storedCloudBytes() const { return clouds_.diskBytes(); }
 
  private:
+  /// What the closer knows of a keyframe when it arrives, and keeps for graph nodes (registration
+  /// targets, the global map) and for the start of the chain the newest keyframe hangs from.
   struct Keyframe {
     int64_t utime = 0;
     int32_t epoch = 0;
@@ -160,7 +162,15 @@ class LoopCloser {
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     bool has_keypoints = false;         // its coarse features are not empty
-    int64_t node = 0;                   // the graph node it belongs to (its own id if it is one)
+  };
+  /// What every keyframe keeps (the reduced pose graph's keyframes are mostly not nodes): where it
+  /// is relative to its node. About 170 bytes, so a keyframe that joined an older node costs next to
+  /// nothing however long the run.
+  struct Placement {
+    int64_t id = 0;
+    int64_t utime = 0;
+    int32_t epoch = 0;
+    int64_t node = 0;                     // the graph node it belongs to (its own id if it is one)
     Pose3 T_node_kf = Pose3::Identity();  // its pose in that node's frame (identity for a node)
   };
   /// Where the newest keyframe hangs from: a graph node, through an optional loop measurement to
@@ -168,6 +178,7 @@ class LoopCloser {
   struct Chain {
     int64_t node = -1;
     int64_t start = -1;
+    Keyframe start_keyframe;  // the odometry's reference (a node's, or a keyframe that joined one)
     Pose3 T_node_start = Pose3::Identity();
     bool via_loop = false;  // T_node_start is a loop measurement (else start == node)
     double path = 0.0;      // m of odometry from start
@@ -177,9 +188,14 @@ class LoopCloser {
     CoarseFeatures coarse;  // in G
     GicpCloud fine;         // in G
   };
-  std::vector<int64_t> candidates(int64_t id) const;
+  const Placement& placement(int64_t id) const;  // throws std::out_of_range for an unknown id
+  /// Graph nodes of the keyframe's epoch older than exclude_recent_s with keypoints, nearest first,
+  /// within `radius` of p.
+  std::vector<std::pair<double, int64_t>> olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
+                                                         double radius) const;
+  std::vector<int64_t> candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
   /// The nearest older node (not within exclude_recent_s) of the epoch within merge_distance of p.
-  std::optional<int64_t> mergeCandidate(int64_t id, const Vec3& p) const;
+  std::optional<int64_t> mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
   /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts).
   Mat6 chainCovariance(const Keyframe& to) const;
   Mat6 loopCovariance() const;
@@ -188,7 +204,9 @@ class LoopCloser {
   /// A verified registration of keyframe from_id (source) against to_id (target) as a loop.
   AcceptedLoop acceptedLoop(int64_t from_id, const Keyframe& from, int64_t to_id, const Keyframe& to,
                             const LoopRegistrationResult& r) const;
-  std::optional<Correction> addLoopEdge(const PoseEdge* edge, int64_t current, AcceptedLoop* loop);
+  std::optional<Correction> addLoopEdge(const PoseEdge* edge, int64_t current, const Keyframe& cur, AcceptedLoop* loop);
+  /// Makes keyframe `id` a graph node at `estimate` (its cloud goes to the store).
+  void addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const std::vector<Eigen::Vector3f>& cloud);
   std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
   /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
   std::shared_ptr<const Features> features(int64_t id);
@@ -196,8 +214,10 @@ class LoopCloser {
 
   LoopCloserOptions options_;
   PoseGraph graph_;
-  std::map<int64_t, Keyframe> keyframes_;
-  KeyframeCloudStore clouds_;  // body frame I, float as received (lossless: loops do not change)
+  std::vector<Placement> placements_;  // every keyframe, in id order
+  std::map<int64_t, Keyframe> nodes_;  // the graph nodes' keyframes
+  Keyframe newest_;                    // the newest keyframe (valid if placements_ is not empty)
+  KeyframeCloudStore clouds_;  // the nodes' clouds, body frame I, float as received (lossless)
   std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;
   int64_t keyframes_since_loop_ = 1000000;

@@ -23,6 +23,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "colour_config.hpp"
 #include "colouring_pipeline.hpp"
 #include "livo/command_line.hpp"
 #include "octomap_builder.hpp"
@@ -281,7 +282,9 @@ int main(int argc, char** argv) {
     ov.duration_s = cli.getDouble("--duration");
     const sim::SimulationSetup setup = sim::loadSimulation(cli.get("--config"), ov);
     const Config cfg = Config::load(cli.get("--config"));
-    colour::ColourOptions co;  // the bar's photometric calibration: the simulator's camera model
+    // the config's colour: section (defaults if absent) with the bar's photometric calibration:
+    // the simulator's camera model
+    colour::ColourOptions co = colour::readColourOptions(cfg.optionalSection("colour")).core;
     co.vignetting = setup.options.camera.vignetting;
     co.reference_exposure_s = setup.options.camera.exposure_time;
     // the config's octomap: section (defaults if absent), at the bar's resolution and the sensor's range
