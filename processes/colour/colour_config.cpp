@@ -10,6 +10,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
     c.readOptional("voxel_size", o.voxel_size);
     c.readOptional("tile_size", o.tile_size);
     c.readOptional("tile_idle_s", o.tile_idle_s);
+    c.readOptional("max_resident_points", o.max_resident_points);
     c.readOptional("map_margin", o.map_margin);
     c.readOptional("max_time_difference", o.max_time_difference);
     c.readOptional("max_depth", o.max_depth);
@@ -46,6 +47,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
   if (!(o.voxel_size > 0.0)) fail("voxel_size", "must be > 0");
   if (!(o.tile_size >= o.voxel_size && o.tile_size <= 1000.0)) fail("tile_size", "must be in [voxel_size, 1000] m");
   if (!(o.tile_idle_s >= 0.0)) fail("tile_idle_s", "must be >= 0");
+  if (o.max_resident_points < 0) fail("max_resident_points", "must be >= 0 (0: no limit)");
   if (!(o.map_margin >= 0.0)) fail("map_margin", "must be >= 0");
   if (!(o.max_time_difference >= 0.0)) fail("max_time_difference", "must be >= 0");
   if (!(o.min_depth > 0.0 && o.max_depth > o.min_depth)) fail("max_depth", "need 0 < min_depth < max_depth");

@@ -48,6 +48,12 @@ struct TileOptions {
   double tile_size = 16.0;  // m, rounded to whole voxels
   double idle_s = 10.0;     // sensor time without a new point before a tile goes to disk (0: never)
   std::string spill_directory;  // "" : the temp directory
+  /// Resident points above which the least recently used tiles go to disk before they are idle_s
+  /// idle (0: no limit), but none used within the last `min_idle_s` (the scans an image may still
+  /// need). Where the route passes again and again, the tiles of the idle window hold more points
+  /// with every pass; this keeps the memory flat, at the price of bringing tiles back more often.
+  size_t max_resident_points = 0;
+  double min_idle_s = 0.0;
 };
 
 class ColourMap {
@@ -71,7 +77,9 @@ class ColourMap {
   void transform(const std::function<bool(int64_t anchor, Pose3* delta)>& delta);
 
   /// Writes the tiles unused since before `utime - idle_s` to disk (their coloured points: one
-  /// never coloured is measured anew if a scan comes back to it); returns the ids freed.
+  /// never coloured is measured anew if a scan comes back to it), then, while more than
+  /// max_resident_points are resident, the least recently used ones unused since before
+  /// `utime - min_idle_s`; returns the ids freed.
   std::vector<uint32_t> evictIdle(int64_t utime);
   /// Brings back, one at a time, the tiles on disk whose anchors moved since they were written or
   /// that took points from elsewhere, merges them and writes them out again (the files then hold
@@ -94,6 +102,8 @@ class ColourMap {
   size_t residentPoints() const { return points_.size() - free_.size(); }
   size_t residentTiles() const;
   size_t spilledTiles() const { return tiles_.size() - residentTiles(); }
+  /// Tiles that went to disk before they were idle_s idle (max_resident_points), so far.
+  size_t tilesEvictedForMemory() const { return evicted_for_memory_; }
   uint64_t spilledBytes() const { return spill_ ? spill_->size() : 0; }
   double voxelSize() const { return voxel_; }
   /// The last transform()'s ids: old id -> new id (merged points share one), kGone for points
@@ -170,6 +180,7 @@ class ColourMap {
   std::vector<uint32_t> remap_;
   std::vector<uint32_t> moved_on_reload_;
   uint64_t epoch_ = 0;                          // transform()s so far
+  size_t evicted_for_memory_ = 0;
 };
 
 }  // namespace colour

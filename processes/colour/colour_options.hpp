@@ -13,6 +13,9 @@ struct ColourOptions {
   double tile_size = 16.0;             // m: the map is kept in square tiles (x, y) ...
   double tile_idle_s = 20.0;           // ... and a tile without a new point for this long (sensor
                                        // time) goes to disk until a point falls in it again (0: never)
+  int max_resident_points = 2500000;   // more points in memory than this: the least recently used
+                                       // tiles go to disk sooner (none an image may still need;
+                                       // 0: no limit). ~65 bytes a point with its index slot
   double map_margin = 10.0;            // m: scan points farther than max_depth + map_margin from the
                                        // body at the scan time are not put in the map: no image within
                                        // max_time_difference can colour them (body speed below

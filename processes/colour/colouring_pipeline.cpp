@@ -28,7 +28,8 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
            // a tile stays while the scans an image may still need (2 windows + 1 s) can touch it
            TileOptions{options.tile_size,
                        options.tile_idle_s > 0 ? std::max(options.tile_idle_s, 2 * options.max_time_difference + 2.0) : 0.0,
-                       ""}),
+                       "", static_cast<size_t>(std::max(0, options.max_resident_points)),
+                       2 * options.max_time_difference + 2.0}),
       reference_exposure_(options.reference_exposure_s) {}
 
 void ColouringPipeline::addPose(int64_t utime, const Pose3& T_W_I) { poses_.add(utime, T_W_I); }

@@ -452,6 +452,43 @@ TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
   EXPECT_TRUE(map.takeMovedOnReload().empty());  // nothing moved
 }
 
+// Beyond max_resident_points the least recently used tiles go to disk before they are idle, but
+// never one an image may still need (used within min_idle_s); they come back as they were.
+TEST(ColourMapTiles, BeyondTheResidentBudgetTheLeastRecentlyUsedTilesGoToDisk) {
+  TileOptions tiles{2.0, 100.0, ""};
+  tiles.max_resident_points = 2500;
+  tiles.min_idle_s = 1.5;
+  ColourMap map(0.05, tiles);
+  AccumulationOptions acc;
+  std::vector<MapPoint> tile_a;
+  // three 2 m tiles of 1,000 coloured points each, used at 1, 2 and 3 s
+  for (int tile = 0; tile < 3; ++tile) {
+    map.setTime((tile + 1) * 1000000);
+    for (int i = 0; i < 1000; ++i) {
+      const uint32_t id = map.addPoint(Eigen::Vector3f(2.0f * tile + 0.05f * (i % 40) + 0.01f, 0.05f * (i / 40) + 0.01f, 0.5f), tile);
+      map.accumulate(id, Eigen::Vector3f(10.0f * tile, 20.0f, 30.0f), acc);
+      if (tile == 0) tile_a.push_back(map.point(id));
+    }
+  }
+  ASSERT_EQ(map.residentPoints(), 3000u);
+  EXPECT_TRUE(map.evictIdle(3000000).size() == 1000u);  // the oldest tile: the budget holds again
+  EXPECT_EQ(map.residentPoints(), 2000u);
+  EXPECT_EQ(map.tilesEvictedForMemory(), 1u);
+  EXPECT_EQ(map.residentTiles(), 2u);
+  // over budget again, but the other two were used within min_idle_s: they stay
+  map.setTime(3200000);
+  for (int i = 0; i < 1000; ++i) map.addPoint(Eigen::Vector3f(6.01f + 0.05f * (i % 40), 0.05f * (i / 40) + 0.01f, 0.5f), 3);
+  EXPECT_TRUE(map.evictIdle(3300000).empty());
+  EXPECT_EQ(map.residentPoints(), 3000u);
+  // the first tile comes back exactly as it went
+  map.setTime(4000000);
+  bool created = true;
+  const uint32_t id = map.addPoint(tile_a[17].position, 9, &created);
+  EXPECT_FALSE(created);
+  EXPECT_TRUE(samePoint(map.point(id), tile_a[17]));
+  EXPECT_EQ(map.residentPoints(), 4000u);
+}
+
 // A correction neither brings a tile on disk back nor keeps one in memory: points it moves into a
 // tile on disk join that tile there, and the files still hold one point per voxel.
 TEST(ColourMapTiles, ACorrectionLeavesTilesOnDisk) {
