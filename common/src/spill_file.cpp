@@ -1,8 +1,10 @@
 #include "livo/spill_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -30,9 +32,10 @@ SpillFile::~SpillFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-SpillFile::SpillFile(SpillFile&& other) noexcept : fd_(other.fd_), end_(other.end_) {
+SpillFile::SpillFile(SpillFile&& other) noexcept : fd_(other.fd_), end_(other.end_), live_(other.live_) {
   other.fd_ = -1;
   other.end_ = 0;
+  other.live_ = 0;
 }
 
 SpillFile& SpillFile::operator=(SpillFile&& other) noexcept {
@@ -40,8 +43,10 @@ SpillFile& SpillFile::operator=(SpillFile&& other) noexcept {
     if (fd_ >= 0) ::close(fd_);
     fd_ = other.fd_;
     end_ = other.end_;
+    live_ = other.live_;
     other.fd_ = -1;
     other.end_ = 0;
+    other.live_ = 0;
   }
   return *this;
 }
@@ -57,7 +62,26 @@ SpillFile::Record SpillFile::append(const void* data, size_t bytes) {
     done += static_cast<size_t>(n);
   }
   end_ += bytes;
+  live_ += bytes;
   return r;
+}
+
+uint64_t SpillFile::allocatedBytes() const {
+  struct stat st {};
+  if (fd_ < 0 || ::fstat(fd_, &st) != 0) return 0;
+  return static_cast<uint64_t>(st.st_blocks) * 512u;
+}
+
+void SpillFile::release(const Record& record) {
+  if (record.bytes == 0 || fd_ < 0) return;
+  live_ -= std::min(live_, record.bytes);
+  // only the blocks wholly inside the record: a block it shares with a neighbour stays
+  constexpr uint64_t kBlock = 4096;
+  const uint64_t from = (record.offset + kBlock - 1) / kBlock * kBlock;
+  const uint64_t to = (record.offset + record.bytes) / kBlock * kBlock;
+  if (to > from)
+    (void)::fallocate(fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(from),
+                      static_cast<off_t>(to - from));  // best effort (EOPNOTSUPP: the space stays used)
 }
 
 void SpillFile::read(const Record& record, std::vector<uint8_t>* out) const {
@@ -96,6 +120,7 @@ void KeyframeCloudStore::put(int64_t id, const std::vector<Eigen::Vector3f>& poi
     if (e.quantised) e.record = file_.append(q.data(), q.size() * sizeof(int16_t));
   }
   if (!e.quantised) e.record = file_.append(points.data(), points.size() * sizeof(Eigen::Vector3f));
+  if (const auto it = index_.find(id); it != index_.end()) file_.release(it->second.record);
   index_[id] = e;
 }
 

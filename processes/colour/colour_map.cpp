@@ -289,6 +289,7 @@ void ColourMap::reload(uint64_t tile_key, Tile* tile) {
   const bool moved = tile->epoch < epoch_;
   tile->spilled = false;
   tile->spilled_coloured = 0;
+  for (const SpillFile::Record& r : tile->records) spill_->release(r);  // the disk space goes back
   tile->records.clear();
   std::map<uint64_t, std::vector<MapPoint>> to_disk;
   for (const MapPoint& p : stored) {

@@ -104,7 +104,10 @@ class ColourMap {
   size_t spilledTiles() const { return tiles_.size() - residentTiles(); }
   /// Tiles that went to disk before they were idle_s idle (max_resident_points), so far.
   size_t tilesEvictedForMemory() const { return evicted_for_memory_; }
-  uint64_t spilledBytes() const { return spill_ ? spill_->size() : 0; }
+  /// Bytes of the tiles on disk (the scratch file's live records).
+  uint64_t spilledBytes() const { return spill_ ? spill_->liveBytes() : 0; }
+  /// Bytes written to the scratch file so far (tiles come back and go again).
+  uint64_t spillWrittenBytes() const { return spill_ ? spill_->size() : 0; }
   double voxelSize() const { return voxel_; }
   /// The last transform()'s ids: old id -> new id (merged points share one), kGone for points
   /// that went to a tile on disk.

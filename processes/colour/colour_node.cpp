@@ -195,7 +195,8 @@ bool ColourNode::saveMap(const std::string& name) {
   s << "wrote " << pts.size() << " coloured points to " << ply << " and " << pcd << " (map tiles: "
     << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.tilesEvictedForMemory()
     << " sent to disk early for memory, " << map.spilledTiles()
-    << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB)";
+    << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB live of "
+    << map.spillWrittenBytes() / 1e6 << " MB written)";
   node_.info(s.str());
   return true;
 }

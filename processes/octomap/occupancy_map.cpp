@@ -380,6 +380,8 @@ OccupancyMap::Tile& OccupancyMap::residentTile(uint64_t tile_index) {
     std::unique_ptr<octomap::AbstractOccupancyOcTree> back;
     treeOf(t, &back);
     t.tree = std::move(back);
+    spill_->release(t.record);  // the disk space goes back (written again when it goes)
+    spill_->release(t.binary);
     t.spilled = false;
     t.leaves = 0;
   } else if (!t.tree) {
@@ -491,7 +493,7 @@ size_t OccupancyMap::residentTiles() const {
   return static_cast<size_t>(std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return !t.second->spilled; }));
 }
 size_t OccupancyMap::spilledTiles() const { return tiles_.size() - residentTiles(); }
-uint64_t OccupancyMap::spilledBytes() const { return spill_ ? spill_->size() : 0; }
+uint64_t OccupancyMap::spilledBytes() const { return spill_ ? spill_->liveBytes() : 0; }
 
 void OccupancyMap::refreshResident() const {
   for (const auto& [index, tile] : tiles_) {

@@ -66,7 +66,7 @@ class OccupancyMap {
   size_t evictIdle();
   size_t residentTiles() const;
   size_t spilledTiles() const;
-  uint64_t spilledBytes() const;
+  uint64_t spilledBytes() const;  // the tiles on disk (the scratch file's live records)
 
   /// Occupancy of the leaf containing p: 1 occupied, 0 free, -1 unknown.
   int classify(const Eigen::Vector3d& p) const;

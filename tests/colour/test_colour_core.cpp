@@ -448,6 +448,8 @@ TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
     else EXPECT_EQ(map.point(id).anchor, 99);
   }
   EXPECT_EQ(map.spilledTiles(), 0u);
+  EXPECT_EQ(map.spilledBytes(), 0u);  // every record was given back
+  EXPECT_GT(map.spillWrittenBytes(), 40u * coloured);
   EXPECT_EQ(map.residentPoints(), before.size());
   EXPECT_TRUE(map.takeMovedOnReload().empty());  // nothing moved
 }

@@ -33,6 +33,31 @@ TEST(SpillFile, RecordsComeBackByteForByte) {
   EXPECT_EQ(back, a);
 }
 
+TEST(SpillFile, ReleasedRecordsGiveTheirDiskSpaceBack) {
+  SpillFile f;
+  std::vector<uint8_t> a(1 << 20), b(1 << 20), c(1000);
+  for (size_t i = 0; i < a.size(); ++i) a[i] = static_cast<uint8_t>(i * 7), b[i] = static_cast<uint8_t>(i * 13);
+  for (size_t i = 0; i < c.size(); ++i) c[i] = static_cast<uint8_t>(i);
+  const SpillFile::Record ra = f.append(a.data(), a.size());
+  const SpillFile::Record rb = f.append(b.data(), b.size());
+  const SpillFile::Record rc = f.append(c.data(), c.size());
+  EXPECT_EQ(f.liveBytes(), a.size() + b.size() + c.size());
+  const uint64_t allocated = f.allocatedBytes();
+  EXPECT_GE(allocated, a.size() + b.size());
+  f.release(rb);
+  EXPECT_EQ(f.liveBytes(), a.size() + c.size());
+  EXPECT_EQ(f.size(), a.size() + b.size() + c.size());  // offsets are not reused
+  // the hole: all of b's blocks but the one it shares with c (the temp file system punches holes:
+  // ext4, xfs, btrfs, tmpfs all do)
+  EXPECT_LE(f.allocatedBytes(), allocated - b.size() + 4096);
+  // the neighbours are intact
+  std::vector<uint8_t> back;
+  f.read(ra, &back);
+  EXPECT_EQ(back, a);
+  f.read(rc, &back);
+  EXPECT_EQ(back, c);
+}
+
 TEST(SpillFile, RefusesADirectoryItCannotWriteTo) {
   EXPECT_THROW(SpillFile("/nonexistent/livo"), std::runtime_error);
 }

@@ -34,12 +34,21 @@ class SpillFile {
   Record append(const void* data, size_t bytes);
   /// Reads a record back into out (resized); throws std::runtime_error on a read error.
   void read(const Record& record, std::vector<uint8_t>* out) const;
-  /// Bytes written so far (records read back are not reclaimed: the file only grows).
+  /// Gives a record no longer needed back to the file system: a hole is punched over the whole
+  /// blocks it covers (its offsets are not reused, so other records stay where they are). Where
+  /// the file system cannot punch holes the space stays in use (liveBytes() still drops).
+  void release(const Record& record);
+  /// Bytes written so far (the file's length, holes included).
   uint64_t size() const { return end_; }
+  /// Bytes of the records not released: about what the file takes on disk.
+  uint64_t liveBytes() const { return live_; }
+  /// Bytes the file system has allocated to the file (fstat's blocks).
+  uint64_t allocatedBytes() const;
 
  private:
   int fd_ = -1;
   uint64_t end_ = 0;
+  uint64_t live_ = 0;
 };
 
 /// Keyframe clouds (body frame, float) by id, on disk. step > 0: each coordinate quantised to
@@ -56,7 +65,7 @@ class KeyframeCloudStore {
   bool contains(int64_t id) const { return index_.count(id) > 0; }
   size_t size() const { return index_.size(); }
   double step() const { return step_; }
-  uint64_t diskBytes() const { return file_.size(); }
+  uint64_t diskBytes() const { return file_.liveBytes(); }
 
  private:
   struct Entry {
