@@ -46,6 +46,8 @@ class ColourNode {
   std::string output_dir_;
   bool finished_ = false;
   MapFrame frame_;  // the map's odometry epoch and loop correction
+  static constexpr int64_t kStatusPeriodUs = 60000000;
+  int64_t last_status_utime_ = INT64_MIN / 2;
 };
 
 }  // namespace colour
