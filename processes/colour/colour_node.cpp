@@ -184,15 +184,18 @@ std::string ColourNode::pcdPath() const { return mapPath(options_.map_name, ".pc
 bool ColourNode::saveMap() { return saveMap(options_.map_name); }
 
 bool ColourNode::saveMap(const std::string& name) {
-  ColouredPoints pts;
   pipeline_.settleMap();  // the tiles on disk too, corrected
-  pipeline_.map().forEachPoint([&](const MapPoint& p) {
-    if (!p.coloured()) return;
-    pts.position.push_back(p.position);
-    std::array<uint8_t, 3> c;
-    for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[k], 0.0f, 255.0f)));
-    pts.rgb.push_back(c);
-  });
+  // streamed from the map (resident tiles, then those on disk one at a time): no copy of it
+  PointStream pts;
+  pts.visit = [this](const auto& emit) {
+    pipeline_.map().forEachPoint([&](const MapPoint& p) {
+      if (!p.coloured()) return;
+      std::array<uint8_t, 3> c;
+      for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(std::lround(std::clamp(p.colour[k], 0.0f, 255.0f)));
+      emit(p.position, c);
+    });
+  };
+  pts.visit([&pts](const Eigen::Vector3f&, const std::array<uint8_t, 3>&) { ++pts.count; });
   std::error_code ec;
   std::filesystem::create_directories(output_dir_, ec);
   std::string error;
@@ -203,7 +206,7 @@ bool ColourNode::saveMap(const std::string& name) {
   }
   const ColourMap& map = pipeline_.map();
   std::ostringstream s;
-  s << "wrote " << pts.size() << " coloured points to " << ply << " and " << pcd << " (map tiles: "
+  s << "wrote " << pts.count << " coloured points to " << ply << " and " << pcd << " (map tiles: "
     << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.tilesEvictedForMemory()
     << " sent to disk early for memory, " << map.spilledTiles()
     << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB live of "

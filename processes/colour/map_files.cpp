@@ -13,12 +13,6 @@ namespace colour {
 
 namespace {
 
-template <class T>
-void put(std::vector<char>* out, const T& v) {
-  const char* p = reinterpret_cast<const char*>(&v);
-  out->insert(out->end(), p, p + sizeof(T));
-}
-
 bool readHeader(std::ifstream& in, const std::string& end_marker, std::vector<std::string>* lines) {
   std::string line;
   while (std::getline(in, line)) {
@@ -36,32 +30,65 @@ uint32_t packRgb(const std::array<uint8_t, 3>& c) {
 
 }  // namespace
 
-bool writePly(const std::string& path, const ColouredPoints& pts, std::string* error) {
+namespace {
+// The points after a header, streamed; false (with error) if the stream is not `count` points long.
+bool writePoints(const std::string& path, const std::string& header, const PointStream& pts, bool pcd,
+                 std::string* error) {
+  size_t visited = 0;
+  const bool ok = writeFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out << header;
+        char record[16];
+        pts.visit([&](const Eigen::Vector3f& p, const std::array<uint8_t, 3>& c) {
+          ++visited;
+          std::memcpy(record, p.data(), 12);
+          if (pcd) {
+            const uint32_t rgb = packRgb(c);  // the bits of PCL's packed float rgb
+            std::memcpy(record + 12, &rgb, 4);
+          } else {
+            std::memcpy(record + 12, c.data(), 3);
+          }
+          out.write(record, pcd ? 16 : 15);
+        });
+        return visited == pts.count && static_cast<bool>(out);
+      },
+      error);
+  if (!ok && visited != pts.count && error)
+    *error = path + ": the map gave " + std::to_string(visited) + " points, not the " + std::to_string(pts.count) +
+             " the header announced";
+  return ok;
+}
+
+PointStream streamOf(const ColouredPoints& pts) {
+  return {pts.size(), [&pts](const auto& emit) {
+            for (size_t i = 0; i < pts.size(); ++i) emit(pts.position[i], pts.rgb[i]);
+          }};
+}
+}  // namespace
+
+bool writePly(const std::string& path, const PointStream& pts, std::string* error) {
   std::ostringstream h;
   h << "ply\nformat binary_little_endian 1.0\ncomment livo-colour map, world frame W, metres\n"
-    << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+    << "element vertex " << pts.count << "\nproperty float x\nproperty float y\nproperty float z\n"
     << "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
-  std::vector<char> body;
-  body.reserve(pts.size() * 15);
-  for (size_t i = 0; i < pts.size(); ++i) {
-    for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
-    for (int k = 0; k < 3; ++k) put(&body, pts.rgb[i][k]);
-  }
-  return writeFileAtomically(path, {h.str(), std::string_view(body.data(), body.size())}, error);
+  return writePoints(path, h.str(), pts, false, error);
+}
+
+bool writePcd(const std::string& path, const PointStream& pts, std::string* error) {
+  std::ostringstream h;
+  h << "# .PCD v0.7 - livo-colour map, world frame W\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
+    << "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " << pts.count << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
+    << pts.count << "\nDATA binary\n";
+  return writePoints(path, h.str(), pts, true, error);
+}
+
+bool writePly(const std::string& path, const ColouredPoints& pts, std::string* error) {
+  return writePly(path, streamOf(pts), error);
 }
 
 bool writePcd(const std::string& path, const ColouredPoints& pts, std::string* error) {
-  std::ostringstream h;
-  h << "# .PCD v0.7 - livo-colour map, world frame W\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
-    << "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " << pts.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
-    << pts.size() << "\nDATA binary\n";
-  std::vector<char> body;
-  body.reserve(pts.size() * 16);
-  for (size_t i = 0; i < pts.size(); ++i) {
-    for (int k = 0; k < 3; ++k) put(&body, pts.position[i][k]);
-    put(&body, packRgb(pts.rgb[i]));  // the bits of PCL's packed float rgb
-  }
-  return writeFileAtomically(path, {h.str(), std::string_view(body.data(), body.size())}, error);
+  return writePcd(path, streamOf(pts), error);
 }
 
 bool readPly(const std::string& path, ColouredPoints* pts, std::string* error) {

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,16 @@ struct ColouredPoints {
   size_t size() const { return position.size(); }
 };
 
-/// Writes atomically (temporary file, then rename); false with `error` on failure.
+/// Visits `count` coloured points, the same ones in the same order at every call: a map too large
+/// to copy is written straight from where it is.
+struct PointStream {
+  size_t count = 0;
+  std::function<void(const std::function<void(const Eigen::Vector3f&, const std::array<uint8_t, 3>&)>&)> visit;
+};
+/// Writes atomically (temporary file, then rename); false with `error` on failure (also when the
+/// stream visits other than `count` points).
+bool writePly(const std::string& path, const PointStream& points, std::string* error);
+bool writePcd(const std::string& path, const PointStream& points, std::string* error);
 bool writePly(const std::string& path, const ColouredPoints& points, std::string* error);
 bool writePcd(const std::string& path, const ColouredPoints& points, std::string* error);
 /// Reads the files written above (binary, these fields; others are refused with a message).

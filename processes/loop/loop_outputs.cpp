@@ -1,12 +1,16 @@
 #include "loop_outputs.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <memory>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
+#include "livo/spill_file.hpp"
 #include "livo/time.hpp"
 #include "livo/trajectory_io.hpp"
 #include "voxel_grid.hpp"
@@ -58,21 +62,66 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
 }
 
 void writeGlobalMapPly(const std::string& path, const LoopCloser& closer, double voxel_size) {
-  // keyframe by keyframe into per-voxel sums: memory grows with the mapped area, not the run
-  VoxelCentroids centroids(voxel_size);
-  // the graph's nodes: a keyframe that joined one saw what it saw, from within merge_distance
-  // (all keyframes would cost ten times as long at exit after a long drive on one route)
+  // The graph's nodes (a keyframe that joined one saw what it saw, from within merge_distance),
+  // their map clouds at the final poses, downsampled to voxel centroids. Built slab by slab (x
+  // ranges of kSlabVoxels voxels): the points go to a scratch file per slab first, so memory holds
+  // the voxels of one slab, not of the whole map (1.1 M voxels, ~130 MB, after the 30 min soak).
+  // Slabs in x order, each sorted by voxel, give VoxelCentroids' order over the whole map, and each
+  // voxel sums its points in the same order: the file is what one VoxelCentroids would give.
+  constexpr int64_t kSlabVoxels = 64;
+  constexpr size_t kFlushPoints = 8192;
+  struct Slab {
+    std::vector<Vec3> buffer;
+    std::vector<SpillFile::Record> records;
+  };
+  std::map<int64_t, Slab> slabs;
+  std::unique_ptr<SpillFile> scratch;
+  const double inv = voxel_size > 0 ? 1.0 / voxel_size : 0.0;
   for (const auto& [id, pose] : closer.graph().poses())
-    for (const Vec3& p : closer.mapCloud(id)) centroids.add(pose * p);
-  const Points map = centroids.centroids();
+    for (const Vec3& p : closer.mapCloud(id)) {
+      const Vec3 q = pose * p;
+      if (!q.allFinite()) continue;
+      const int64_t vx = static_cast<int64_t>(std::floor(q.x() * inv));
+      Slab& slab = slabs[vx >= 0 ? vx / kSlabVoxels : -((-vx + kSlabVoxels - 1) / kSlabVoxels)];
+      slab.buffer.push_back(q);
+      if (slab.buffer.size() >= kFlushPoints) {
+        if (!scratch) scratch = std::make_unique<SpillFile>();
+        slab.records.push_back(scratch->append(slab.buffer.data(), slab.buffer.size() * sizeof(Vec3)));
+        slab.buffer.clear();
+      }
+    }
+  if (!scratch) scratch = std::make_unique<SpillFile>();
+  std::vector<SpillFile::Record> output;  // each slab's centroids as float, in slab order
+  uint64_t vertices = 0;
+  std::vector<uint8_t> bytes;
+  for (auto& [index, slab] : slabs) {
+    VoxelCentroids centroids(voxel_size);
+    for (const SpillFile::Record& r : slab.records) {
+      scratch->read(r, &bytes);
+      for (size_t i = 0; i + sizeof(Vec3) <= bytes.size(); i += sizeof(Vec3)) {
+        Vec3 q;
+        std::memcpy(q.data(), bytes.data() + i, sizeof(Vec3));
+        centroids.add(q);
+      }
+      scratch->release(r);
+    }
+    for (const Vec3& q : slab.buffer) centroids.add(q);
+    Slab().buffer.swap(slab.buffer);
+    std::vector<float> xyz;
+    for (const Vec3& c : centroids.centroids())
+      xyz.insert(xyz.end(), {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())});
+    vertices += xyz.size() / 3;
+    output.push_back(scratch->append(xyz.data(), xyz.size() * sizeof(float)));
+  }
   std::ofstream out(path, std::ios::binary);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << map.size()
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << vertices
       << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-  for (const Vec3& p : map) {
-    const float xyz[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
-    out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+  for (const SpillFile::Record& r : output) {
+    scratch->read(r, &bytes);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
+  if (!out) throw std::runtime_error("cannot write " + path);
 }
 
 void writeLoopOutputs(const std::string& dir, const LoopCloser& closer, double map_voxel_size) {
