@@ -57,12 +57,14 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
       return;
     }
     publishRecoloured(m.utime);
+    if (first_scan_utime_ == INT64_MIN) first_scan_utime_ = m.utime;
     if (m.utime - last_status_utime_ >= kStatusPeriodUs) {
       // a long run says where its memory and disk go, once a minute of sensor time
       last_status_utime_ = m.utime;
       const ColourMap& map = pipeline_.map();
       std::ostringstream s;
-      s << "map at " << std::fixed << std::setprecision(0) << m.utime * 1e-6 << " s: " << map.residentPoints()
+      s << "map after " << std::fixed << std::setprecision(0) << (m.utime - first_scan_utime_) * 1e-6
+        << " s of scans: " << map.residentPoints()
         << " points in " << map.residentTiles() << " tiles in memory, " << map.spilledTiles() << " tiles on disk ("
         << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB), " << map.tilesEvictedForMemory()
         << " sent early for memory";

@@ -48,6 +48,7 @@ class ColourNode {
   MapFrame frame_;  // the map's odometry epoch and loop correction
   static constexpr int64_t kStatusPeriodUs = 60000000;
   int64_t last_status_utime_ = INT64_MIN / 2;
+  int64_t first_scan_utime_ = INT64_MIN;
 };
 
 }  // namespace colour
