@@ -371,23 +371,27 @@ std::vector<uint32_t> ColourMap::evictIdle(int64_t utime) {
     spill(&t, &freed);
     if (!t.spilled) tiles_.erase(k);  // nothing coloured in it
   }
-  if (tile_options_.max_resident_points > 0 && residentPoints() > tile_options_.max_resident_points) {
-    // over the budget: the least recently used tiles that no image can still need, oldest first
-    const int64_t needed_from = utime - static_cast<int64_t>(tile_options_.min_idle_s * 1e6);
-    std::vector<std::pair<int64_t, uint64_t>> lru;
-    for (const auto& [k, t] : tiles_)
-      if (!t.spilled && t.last_used < needed_from) lru.push_back({t.last_used, k});
-    std::sort(lru.begin(), lru.end());
-    for (const auto& [last_used, k] : lru) {
-      if (residentPoints() <= tile_options_.max_resident_points) break;
-      Tile& t = tiles_.at(k);
-      spill(&t, &freed);
-      ++evicted_for_memory_;
-      if (!t.spilled) tiles_.erase(k);
-    }
-  }
+  evictForBudget(utime, 0, &freed);
   dropFreed(&moved_on_reload_, freed);
   return freed;
+}
+
+void ColourMap::evictForBudget(int64_t utime, size_t incoming, std::vector<uint32_t>* freed) {
+  const size_t budget = tile_options_.max_resident_points;
+  if (budget == 0 || residentPoints() + incoming <= budget) return;
+  // over the budget: the least recently used tiles that no image can still need, oldest first
+  const int64_t needed_from = utime - static_cast<int64_t>(tile_options_.min_idle_s * 1e6);
+  std::vector<std::pair<int64_t, uint64_t>> lru;
+  for (const auto& [k, t] : tiles_)
+    if (!t.spilled && t.last_used < needed_from) lru.push_back({t.last_used, k});
+  std::sort(lru.begin(), lru.end());
+  for (const auto& [last_used, k] : lru) {
+    if (residentPoints() + incoming <= budget) break;
+    Tile& t = tiles_.at(k);
+    spill(&t, freed);
+    ++evicted_for_memory_;
+    if (!t.spilled) tiles_.erase(k);
+  }
 }
 
 std::vector<uint32_t> ColourMap::settleSpilledTiles() {
@@ -400,8 +404,11 @@ std::vector<uint32_t> ColourMap::settleSpilledTiles() {
     if (stale.empty()) break;
     std::sort(stale.begin(), stale.end());
     for (uint64_t k : stale) {
+      if (!unsettled(tiles_.at(k))) continue;
+      // room for it within the budget first (a save must not take more memory than the run)
+      evictForBudget(now_, tiles_.at(k).spilled_coloured, &freed);
       Tile& t = tiles_.at(k);
-      if (!unsettled(t)) continue;
+      if (!unsettled(t)) continue;  // (evicting may have appended to it)
       reload(k, &t);
       spill(&t, &freed);
       if (!t.spilled) tiles_.erase(k);

@@ -167,6 +167,9 @@ class ColourMap {
   void appendToDisk(const std::map<uint64_t, std::vector<MapPoint>>& to_disk);
   void reload(uint64_t tile_key, Tile* tile);
   void spill(Tile* tile, std::vector<uint32_t>* freed);
+  /// Writes the least recently used tiles not used since `utime - min_idle_s` to disk until
+  /// `incoming` more points fit in max_resident_points (0: no budget).
+  void evictForBudget(int64_t utime, size_t incoming, std::vector<uint32_t>* freed);
   void readTile(const Tile& tile, std::vector<MapPoint>* points) const;
   bool unsettled(const Tile& t) const { return t.spilled && (t.epoch < epoch_ || t.records.size() > 1); }
 

@@ -489,6 +489,21 @@ TEST(ColourMapTiles, BeyondTheResidentBudgetTheLeastRecentlyUsedTilesGoToDisk) {
   EXPECT_FALSE(created);
   EXPECT_TRUE(samePoint(map.point(id), tile_a[17]));
   EXPECT_EQ(map.residentPoints(), 4000u);
+  // a save settles the tiles on disk a correction made stale: each comes back within the budget
+  // (the least recently used resident tiles make room first), and every point is still there
+  map.evictIdle(4000000);
+  ASSERT_LE(map.residentPoints(), 3000u);
+  map.transform([](int64_t, Pose3* T) {
+    *T = Pose3::Identity();
+    return true;
+  });
+  map.setTime(10000000);
+  const size_t coloured = map.colouredCount(), evicted = map.tilesEvictedForMemory();
+  map.settleSpilledTiles();
+  // 3,000 resident + the stale tile's 1,000: two resident tiles went first (without: a peak of 4,000)
+  EXPECT_EQ(map.tilesEvictedForMemory(), evicted + 2);
+  EXPECT_LE(map.residentPoints(), 2500u);
+  EXPECT_EQ(map.colouredCount(), coloured);
 }
 
 // A correction neither brings a tile on disk back nor keeps one in memory: points it moves into a
