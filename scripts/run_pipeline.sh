@@ -90,6 +90,11 @@ if [ "$inside" = 0 ]; then
   swaps=()
   for p in "${!swap[@]}"; do swaps+=(--swap "$p=${swap[$p]}"); done
   echo "run_pipeline.sh: ${selected[*]} on $(basename "$log") -> $out" >&2
+  # outputs.lcmlog records clouds: about as large as the input log (a full disk fails every process)
+  free_mb=$(df -Pm "$out" | awk 'NR == 2 { print $4 }')
+  log_mb=$(( $(stat -c %s "$log") / 1048576 ))
+  [ "${free_mb:-0}" -ge $(( log_mb + 500 )) ] || \
+    echo "run_pipeline.sh: warning: $free_mb MB free where $out is; the outputs may need about $log_mb MB and more" >&2
   rc=0
   "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
