@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
       .option("--lidar-rings", "N", "rosbag: beams of the LiDAR (default: from the cloud)")
       .option("--lidar-time-field", "NAME", "rosbag: per-point time field (default: time, t, offset_time, timestamp)")
       .option("--lidar-time-unit", "s|ms|us|ns", "rosbag: unit of the time field (default: ns if integer, s if float)")
+      .flag("--no-azimuth-times", "rosbag: a spinning LiDAR's cloud without a time field keeps every point at the sweep start (default: times from the azimuth)")
       .option("--imu-accel-unit", "auto|m/s2|g", "rosbag: acceleration unit", "auto")
       .option("--imu-gyro-unit", "rad/s|deg/s", "rosbag: angular rate unit", "rad/s")
       .flag("--use-bag-time", "rosbag: stamp messages with the bag's receive time instead of header.stamp")
@@ -117,6 +118,7 @@ int main(int argc, char** argv) {
     if (cli.has("--lidar-rings")) r.lidar.num_rings = static_cast<int>(cli.getInt("--lidar-rings"));
     r.lidar.time_field = cli.get("--lidar-time-field");
     r.lidar.time_unit = cli.get("--lidar-time-unit");
+    r.lidar.azimuth_times = !cli.has("--no-azimuth-times");
 
     job.euroc.decode_png = cli.has("--decode-png");
     job.ouster.metadata_file = cli.get("--metadata");

@@ -62,6 +62,42 @@ int64_t floorDiv(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0
 
 }  // namespace
 
+std::vector<float> azimuthTimeOffsets(const std::vector<float>& x, const std::vector<float>& y,
+                                      const std::vector<float>& order, double sweep_duration, bool* clockwise) {
+  std::vector<float> out(x.size(), 0.0f);
+  if (x.empty()) return out;
+  constexpr double kTurn = 2.0 * M_PI;
+  auto wrapPi = [&](double a) { return a - kTurn * std::floor((a + M_PI) / kTurn); };  // [-pi, pi)
+  std::vector<double> az(x.size());
+  for (size_t i = 0; i < x.size(); ++i) az[i] = std::atan2(double(y[i]), double(x[i]));
+  // the net turn along the points' order: negative = clockwise seen from above (azimuth falls)
+  double turn = 0.0;
+  for (size_t i = 1; i < az.size(); ++i) turn += wrapPi(az[i] - az[i - 1]);
+  const double dir = turn <= 0.0 ? -1.0 : 1.0;
+  if (clockwise) *clockwise = dir < 0.0;
+  // where the sweep starts: the circular mean of the first column's azimuths, each taken back by
+  // its place (a mean over the beams, so a beam staggered in azimuth does not set the start)
+  const float first = *std::min_element(order.begin(), order.end());
+  double sum_cos = 0.0, sum_sin = 0.0;
+  for (size_t i = 0; i < az.size(); ++i)
+    if (order[i] == first) {
+      const double a = az[i] - dir * kTurn * order[i];
+      sum_cos += std::cos(a), sum_sin += std::sin(a);
+    }
+  const double start = std::atan2(sum_sin, sum_cos);
+  const float last = std::nextafter(static_cast<float>(sweep_duration), 0.0f);
+  for (size_t i = 0; i < az.size(); ++i) {
+    double fraction = dir * (az[i] - start) / kTurn;
+    fraction -= std::floor(fraction);  // [0, 1)
+    // the turn it belongs to, from its place in the order: a point a hair behind the start (the
+    // first column's stagger, float rounding) is at the start, not at the end, and the reverse
+    if (fraction - order[i] > 0.5) fraction = 0.0;
+    if (order[i] - fraction > 0.5) fraction = 1.0;
+    out[i] = std::min(static_cast<float>(fraction * sweep_duration), last);
+  }
+  return out;
+}
+
 PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointCloudConversionOptions& o,
                                         const std::string& where) {
   auto fail = [&](const std::string& field, const std::string& what) -> DecodeError {
@@ -103,6 +139,7 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
   // Per-point values first, then the time reference.
   std::vector<float> xs, ys, zs, is;
   std::vector<int16_t> rings;
+  std::vector<uint32_t> place;  // without a time field: column (organised) or index (firing order)
   std::vector<double> times;  // raw time values, scaled to seconds (relative) or kept (absolute)
   xs.reserve(points), ys.reserve(points), zs.reserve(points), is.reserve(points), rings.reserve(points);
   double scale = 1.0;
@@ -142,7 +179,10 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
       }
       rings.push_back(static_cast<int16_t>(ring));
       max_ring = std::max(max_ring, ring);
-      if (ft) times.push_back(readValue(p + ft.f->offset, ft.f->datatype, m.is_bigendian));
+      if (ft)
+        times.push_back(readValue(p + ft.f->offset, ft.f->datatype, m.is_bigendian));
+      else  // organised: rows are beams, a column is a firing; else the cloud is in firing order
+        place.push_back(m.height > 1 ? col : row * m.width + col);
     }
   }
 
@@ -184,7 +224,22 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
         offsets[j] = static_cast<float>((times[j] - static_cast<double>(utime) * 1e-6 / abs_scale) * abs_scale);
     }
   } else if (!ft) {
-    layout << " (no per-point time)";
+    const bool spinning = o.pattern >= 0 ? o.pattern == point_cloud_t::PATTERN_SPINNING
+                                         : !(find(m, {"offset_time"}) || (find(m, {"tag"}) && find(m, {"line"})));
+    if (o.azimuth_times && spinning && xs.size() > 1) {
+      // the place of a point in the sweep, 0..1: its column over the width (organised: rows are
+      // beams); in firing order, its column (a run of one point per ring, when the rings are known)
+      // over the columns
+      const uint32_t rings = m.height > 1 ? 1u : static_cast<uint32_t>(std::max(1, max_ring + 1));
+      const double columns = m.height > 1 ? m.width : std::ceil(static_cast<double>(points) / rings);
+      std::vector<float> order(place.size());
+      for (size_t j = 0; j < place.size(); ++j) order[j] = static_cast<float>((place[j] / rings) / columns);
+      bool clockwise = true;
+      offsets = azimuthTimeOffsets(xs, ys, order, o.sweep_duration, &clockwise);
+      layout << " (no per-point time: from the azimuth, " << (clockwise ? "clockwise" : "counter-clockwise") << ")";
+    } else {
+      layout << " (no per-point time)";
+    }
   }
 
   point_cloud_t& c = out.cloud;

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "livo/point_cloud_t.hpp"
 #include "ros_messages.hpp"
@@ -36,7 +37,21 @@ struct PointCloudConversionOptions {
   int pattern = -1;             // -1: solid-state if a Livox field (offset_time, tag+line) is present
   std::string frame = "L";
   double max_relative_span_s = 1.0;  // per-point times spanning more than this mean wrong units
+  /// A spinning LiDAR's cloud without a time field: per-point times from the azimuth (the sweep
+  /// starts at the first point's azimuth and turns the way the points' order turns), as the KITTI
+  /// importer does; false: every point at the sweep start.
+  bool azimuth_times = true;
 };
+
+/// Per-point times (seconds after the sweep start) of a spinning LiDAR's points from their azimuth,
+/// one turn per sweep. `order` is each point's place in the firing sequence (0..1: its column over
+/// the width in an organised cloud, its index over the count in one in firing order); the net turn
+/// along the points gives the direction (clockwise seen from above for Velodyne, Ouster, Hesai), the
+/// first point and its place give the start azimuth, and the place decides the turn of points within
+/// a hair of the start (the stagger of the first column). *clockwise tells which was found.
+std::vector<float> azimuthTimeOffsets(const std::vector<float>& x, const std::vector<float>& y,
+                                      const std::vector<float>& order, double sweep_duration,
+                                      bool* clockwise = nullptr);
 
 struct PointCloudConversion {
   point_cloud_t cloud;
