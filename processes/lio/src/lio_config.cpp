@@ -30,7 +30,7 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   lidar.readOptional("max_range", l.max_range);
   double range_noise = 0.0;
   if (lidar.readOptional("range_noise_std", range_noise) && range_noise > 0.0)
-    l.matching.point_noise_std = std::max(l.matching.point_noise_std, 3.0 * range_noise);
+    l.matching = matchingForRangeNoise(range_noise, l.matching);  // lio.matching.* may still override
   lidar.read("T_I_L", l.extrinsics.T_I_L);
 
   const Config cam = rig.optionalSection("camera");

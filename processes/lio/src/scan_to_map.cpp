@@ -6,6 +6,22 @@
 
 namespace livo::lio {
 
+ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOptions& base) {
+  constexpr double kTunedNoise = 0.01;  // m, the range noise the defaults were tuned at
+  ScanToMapOptions o = base;
+  const double sigma = range_noise_std;
+  if (!(sigma > kTunedNoise)) return o;
+  const double growth = std::min(1.0, (sigma - kTunedNoise) / (2.0 * kTunedNoise));  // 0 at 1 cm, 1 from 3 cm
+  o.plane.num_neighbors = base.plane.num_neighbors + static_cast<int>(std::lround(3.0 * growth));
+  o.plane.max_plane_thickness = std::max(base.plane.max_plane_thickness, 2.0 * sigma);
+  const double tuned_k = base.plane.num_neighbors;
+  const double floor2 = std::max(0.0, base.point_noise_std * base.point_noise_std -
+                                          (1.0 + 1.0 / tuned_k) * kTunedNoise * kTunedNoise);
+  o.point_noise_std = std::max(base.point_noise_std,
+                               std::sqrt(floor2 + (1.0 + 1.0 / o.plane.num_neighbors) * sigma * sigma));
+  return o;
+}
+
 ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options)
     : map_(map), points_(body_points), opts_(options), matches_(body_points.size()), gate_(body_points.size()) {
   for (size_t i = 0; i < points_.size(); ++i)

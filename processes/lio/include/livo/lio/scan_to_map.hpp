@@ -27,6 +27,15 @@ struct ScanToMapOptions {
   bool remove_degenerate = true;        // drop the information of degenerate directions
 };
 
+/// The matching options for a LiDAR whose range noise (1 sigma, along the beam) is `range_noise_std`,
+/// from `base` (the options tuned at 1 cm): one residual's standard deviation is the model floor of
+/// the 1 cm tuning (plane curvature, discretisation: sqrt(0.03^2 - 1.2 * 0.01^2) = 2.8 cm) combined with
+/// the point's noise and that of a plane fitted to k noisy neighbours, sqrt(floor^2 + (1 + 1/k) sigma^2),
+/// never below base's; a plane's neighbours may lie 2 sigma from it (never thinner than base's); and k
+/// grows from base's (5) at 1 cm to base + 3 at 3 cm and more, so the fitted plane averages the noise.
+/// At 1 cm and below the result is `base`.
+ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOptions& base = {});
+
 class ScanToMap {
  public:
   /// `map` must outlive this object and stay unchanged while it is used.
