@@ -1,0 +1,210 @@
+#!/usr/bin/env python3
+"""Issue 19's table: the estimators on the hard simulator, seeds not tuned on, one command.
+
+    scripts/hard_table.py --out DIR [--configs room_hard,corridor_hard,...] [--seeds 101,102,103]
+                          [--duration 60] [--long-duration 300] [--keep-logs]
+
+For every config (config/sim/NAME.yaml) and seed: livo-sim writes the log (campus_loop_long*: the
+long duration), then scripts/run_pipeline.sh runs
+  lio    the LIO alone                     -> ATE, ATE per distance, divergence, degenerate sweeps
+  livo   lio + vio (configs with a camera) -> ATE against the LIO's
+  loop   lio + loop (configs with loop:)   -> false loops (tests/loop/check_loops.py against the
+                                              ground truth), end-point drift against the LIO's
+and DIR/table.md gets one row per run with the bars of issue 19 checked:
+  LIO ATE <= 0.10 m and <= 0.5 % of the distance, no divergence (odometry over >= 90 % of the run,
+  no pose more than 1 m off), degeneracy flagged in a corridor, LIVO ATE no worse than the LIO's,
+  no false loop, and on campus_loop_long_hard the end-point drift cut by at least half.
+Exit status 1 if any bar is missed. Runs one after the other (each run uses both cores).
+"""
+import argparse, json, math, os, struct, subprocess, sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'loop'))
+import check_loops as cl  # noqa: E402  (ground-truth reading and interpolation, pure Python)
+
+DEFAULT_CONFIGS = 'room_hard,corridor_hard,campus_loop_hard,campus_loop_long_hard,parking_hard,euroc_v1_01_hard'
+
+
+def read_channel(path, channel):
+    """(utime, payload) of every event on one channel of an LCM log."""
+    out = []
+    with open(path, 'rb') as f:
+        data = f.read()
+    i = 0
+    while i + 28 <= len(data):
+        sync, _, utime, clen, dlen = struct.unpack_from('>IqqII', data, i)
+        if sync != 0xEDA1DA01:
+            raise SystemExit('%s: bad sync at byte %d' % (path, i))
+        i += 28
+        ch = data[i:i + clen].decode()
+        i += clen
+        if ch == channel:
+            out.append((utime, data[i:i + dlen]))
+        i += dlen
+    return out
+
+
+def degenerate_sweeps(outputs):
+    """Count of ODOMETRY messages with the degenerate flag set (livo.odometry_t)."""
+    n = 0
+    for _, p in read_channel(outputs, 'ODOMETRY'):
+        o = 16  # fingerprint, utime
+        for _ in range(2):  # parent_frame, child_frame
+            length, = struct.unpack_from('>i', p, o)
+            o += 4 + length
+        o += 8 * (3 + 4 + 3 + 3 + 36 + 9) + 4  # poses, covariances, num_residuals
+        n += p[o] != 0
+    return n
+
+
+def section_names(config):
+    return {line.split(':')[0] for line in open(config) if line[:1].isalpha() and ':' in line}
+
+
+def has_camera(config):
+    in_rig = False
+    for line in open(config):
+        if line.startswith('rig:'):
+            in_rig = True
+        elif line[:1].isalpha():
+            in_rig = False
+        elif in_rig and line.startswith('  camera:'):
+            return True
+    return False
+
+
+def run(cmd, log, env=None):
+    with open(log, 'w') as f:
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, env=env)
+    return r.returncode == 0
+
+
+def evaluation(run_dir, name='odometry'):
+    path = os.path.join(run_dir, 'evaluation_%s.json' % name)
+    return json.load(open(path)) if os.path.exists(path) else None
+
+
+def end_drift(tum, gt, times):
+    rows = [[float(x) for x in l.split()] for l in open(tum) if l.strip() and not l.startswith('#')]
+    if not rows:
+        return float('nan')
+    (t0, *p0), (t1, *p1) = rows[0][:4], rows[-1][:4]
+    q0 = (rows[0][7], rows[0][4], rows[0][5], rows[0][6])
+    g0p, g0q, _ = cl.interp(gt, times, t0)
+    g1p, _, _ = cl.interp(gt, times, t1)
+    d = cl.qrot(cl.qmul(g0q, cl.qconj(q0)), tuple(p1[i] - p0[i] for i in range(3)))
+    return math.dist(tuple(g0p[i] + d[i] for i in range(3)), g1p)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('--out', required=True)
+    ap.add_argument('--configs', default=DEFAULT_CONFIGS)
+    ap.add_argument('--seeds', default='101,102,103', help='seeds not used for tuning')
+    ap.add_argument('--duration', type=float, default=60.0)
+    ap.add_argument('--long-duration', type=float, default=300.0, help='campus_loop_long*')
+    ap.add_argument('--keep-logs', action='store_true')
+    a = ap.parse_args()
+    build = os.environ.get('LIVO_BUILD_DIR', os.path.join(ROOT, 'build'))
+    bin_dir = os.path.join(build, 'bin')
+    env = dict(os.environ, LIVO_BUILD_DIR=build)
+    os.makedirs(a.out, exist_ok=True)
+    rows, failures = [], []
+
+    for name in a.configs.split(','):
+        config = os.path.join(ROOT, 'config', 'sim', name + '.yaml')
+        if not os.path.exists(config):
+            raise SystemExit('hard_table.py: no config %s' % config)
+        sections = section_names(config)
+        duration = a.long_duration if name.startswith('campus_loop_long') else a.duration
+        for seed in a.seeds.split(','):
+            tag = '%s_s%s' % (name, seed)
+            base = os.path.join(a.out, tag)
+            os.makedirs(base, exist_ok=True)
+            log = base + '.lcmlog'
+            print('%s: simulating %.0f s' % (tag, duration), file=sys.stderr, flush=True)
+            if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', log, '--seed', seed,
+                        '--duration', str(duration), '--quiet'], base + '.sim.txt'):
+                failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
+                continue
+            variants = [('lio', 'lio')]
+            if 'vio' in sections and has_camera(config):
+                variants.append(('livo', 'lio,vio'))
+            if 'loop' in sections:
+                variants.append(('loop', 'lio,loop'))
+            ok = {}
+            for variant, processes in variants:
+                print('%s: %s' % (tag, variant), file=sys.stderr, flush=True)
+                ok[variant] = run([os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
+                                   '--out', os.path.join(base, variant), '--processes', processes],
+                                  os.path.join(base, variant + '.txt'), env)
+            row = {'config': name, 'seed': seed}
+            lio = evaluation(os.path.join(base, 'lio'))
+            if not ok['lio'] or lio is None:
+                failures.append('%s: the LIO run failed (%s/lio.txt)' % (tag, base))
+                rows.append(row)
+                continue
+            ate = lio['ate']
+            length = lio['end_point']['path_length_m']
+            row.update(lio_ate=ate['rmse'], length=length, percent=100.0 * ate['rmse'] / max(length, 1e-9),
+                       diverged=ate['coverage'] < 0.9 or ate['max'] > 1.0,
+                       degenerate=degenerate_sweeps(os.path.join(base, 'lio', 'outputs.lcmlog')))
+            if row['lio_ate'] > 0.10 or row['percent'] > 0.5:
+                failures.append('%s: LIO ATE %.4f m, %.3f %% of %.0f m' % (tag, row['lio_ate'], row['percent'], length))
+            if row['diverged']:
+                failures.append('%s: the LIO diverged (coverage %.2f, max error %.2f m)' % (tag, ate['coverage'], ate['max']))
+            if name.startswith('corridor') and row['degenerate'] == 0:
+                failures.append('%s: no degenerate sweep flagged in the corridor' % tag)
+            if 'livo' in ok:
+                livo = evaluation(os.path.join(base, 'livo'))
+                row['livo_ate'] = livo['ate']['rmse'] if ok['livo'] and livo else float('nan')
+                if not row['livo_ate'] <= row['lio_ate']:
+                    failures.append('%s: LIVO ATE %.4f m worse than the LIO\'s %.4f m' % (tag, row['livo_ate'], row['lio_ate']))
+            if 'loop' in ok:
+                loops_json = os.path.join(base, 'loop', 'loops.json')
+                if not ok['loop'] or not os.path.exists(loops_json):
+                    failures.append('%s: the loop run failed (%s/loop.txt)' % (tag, base))
+                else:
+                    check = subprocess.run([sys.executable, os.path.join(ROOT, 'tests', 'loop', 'check_loops.py'),
+                                            '--log', log, '--loops', loops_json], capture_output=True, text=True)
+                    row['loops'] = len(json.load(open(loops_json))['loops'])
+                    counts = [l.split() for l in check.stdout.splitlines() if l.startswith('false loops:')]
+                    if check.returncode not in (0, 1) or not counts:
+                        failures.append('%s: check_loops.py failed: %s' % (tag, check.stderr.strip()[-200:]))
+                        counts = [['', '', '0']]
+                    row['false_loops'] = int(counts[-1][2])
+                    if row['false_loops']:
+                        failures.append('%s: %d false loops' % (tag, row['false_loops']))
+                    gt = cl.read_ground_truth(log)
+                    times = [g[0] for g in gt]
+                    row['end_lio'] = end_drift(os.path.join(base, 'lio', 'odometry.tum'), gt, times)
+                    row['end_loop'] = end_drift(os.path.join(base, 'loop', 'keyframes.tum'), gt, times)
+                    if name.startswith('campus_loop_long') and not row['end_loop'] <= 0.5 * row['end_lio']:
+                        failures.append('%s: end-point drift %.3f m with loop closure against %.3f m without' % (
+                            tag, row['end_loop'], row['end_lio']))
+            rows.append(row)
+            if not a.keep_logs:
+                os.remove(log)
+
+    def f(row, key, fmt):
+        return fmt % row[key] if key in row else '-'
+    lines = ['| config | seed | distance m | LIO ATE m | % of distance | diverged | degenerate sweeps | LIVO ATE m |'
+             ' loops (false) | end drift m: LIO / loop |',
+             '| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |']
+    for r in rows:
+        loops = '%d (%d)' % (r['loops'], r['false_loops']) if 'loops' in r else '-'
+        drift = '%.3f / %.3f' % (r['end_lio'], r['end_loop']) if 'end_loop' in r else '-'
+        lines.append('| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |' % (
+            r['config'], r['seed'], f(r, 'length', '%.0f'), f(r, 'lio_ate', '%.4f'), f(r, 'percent', '%.3f'),
+            ('yes' if r['diverged'] else 'no') if 'diverged' in r else '-', f(r, 'degenerate', '%d'),
+            f(r, 'livo_ate', '%.4f'), loops, drift))
+    lines.append('')
+    lines += ['bars missed:'] + ['- ' + x for x in failures] if failures else ['every bar met']
+    text = '\n'.join(lines) + '\n'
+    open(os.path.join(a.out, 'table.md'), 'w').write(text)
+    print(text)
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
