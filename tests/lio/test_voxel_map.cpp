@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "livo/lio/voxel_map.hpp"
@@ -152,4 +154,108 @@ TEST(VoxelMap, ScanDownsamplingKeepsTheFirstPointPerVoxel) {
   EXPECT_EQ(idx, (std::vector<size_t>{0, 2, 3}));
   const auto sub = voxelDownsample(pts, std::vector<size_t>{1, 4, 2}, 0.5);
   EXPECT_EQ(sub, (std::vector<size_t>{1, 2}));
+}
+
+namespace {
+// A 20 x 20 x 4 m room, and a 2 x 2 x 1.5 m box (a parked car) at x 4..6 that may be there.
+double castRoom(const Vec3& o, const Vec3& d, bool with_box) {
+  double best = std::numeric_limits<double>::infinity();
+  auto plane = [&](int axis, double at) {
+    if (std::abs(d[axis]) < 1e-12) return;
+    const double t = (at - o[axis]) / d[axis];
+    if (t > 0.0) best = std::min(best, t);
+  };
+  plane(2, 0.0), plane(2, 4.0), plane(0, 10.0), plane(0, -10.0), plane(1, 10.0), plane(1, -10.0);
+  if (with_box) {
+    const Vec3 lo(4.0, -1.0, 0.0), hi(6.0, 1.0, 1.5);
+    double t0 = 0.0, t1 = best;
+    for (int a = 0; a < 3; ++a) {
+      const double inv = 1.0 / d[a];
+      double ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+    }
+    if (t0 <= t1) best = std::min(best, t0);
+  }
+  return best;
+}
+
+// One sweep of a 16-beam spinning LiDAR (-15..15 deg, 0.2 deg azimuth steps) from o.
+std::vector<Vec3> sweepFrom(const Vec3& o, bool with_box) {
+  std::vector<Vec3> pts;
+  for (int ring = 0; ring < 16; ++ring) {
+    const double el = (-15.0 + 2.0 * ring) * M_PI / 180.0;
+    for (int col = 0; col < 1800; ++col) {
+      const double az = col * 0.2 * M_PI / 180.0;
+      const Vec3 d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      const double t = castRoom(o, d, with_box);
+      if (std::isfinite(t) && t < 30.0) pts.push_back(o + t * d);
+    }
+  }
+  return pts;
+}
+
+bool onTheBox(const Vec3& p) { return p.x() > 3.95 && p.x() < 6.05 && std::abs(p.y()) < 1.05 && p.z() < 1.55 && p.z() > 0.05; }
+}  // namespace
+
+// The box is mapped, then leaves: in the second that follows, beams through where it stood remove
+// its points once three sweeps saw through them (none go in the first two sweeps), while the floor,
+// walls and ceiling the beams graze or end on stay.
+TEST(VoxelMap, PointsSeenThroughInThreeSweepsLeaveTheMap) {
+  VoxelMap map;
+  const Vec3 start(0.0, 0.3, 1.5);
+  map.insert(sweepFrom(start, true));
+  map.insert(sweepFrom(start + Vec3(0.2, 0.0, 0.0), true));
+  auto count = [&](bool box) {
+    size_t n = 0;
+    for (const Vec3& p : map.points()) n += onTheBox(p) == box;
+    return n;
+  };
+  const size_t box_points = count(true), static_points = count(false);
+  ASSERT_GT(box_points, 30u);  // 0.4 m spacing: a few dozen on the faces the sensor saw
+
+  SeenThroughOptions o;
+  o.ray_stride = 1;
+  size_t removed = 0;
+  std::vector<std::pair<Vec3, std::vector<Vec3>>> sweeps;
+  for (int sweep = 0; sweep < 12; ++sweep) {  // a second at 10 Hz
+    // the sensor walks on, bobbing: each sweep's rings cross the box's place at other heights
+    const Vec3 origin = start + Vec3(0.3 + 0.05 * sweep, -0.03 * sweep, 0.04 * std::sin(1.3 * sweep));
+    const std::vector<Vec3> endpoints = sweepFrom(origin, false);
+    removed += map.removeSeenThrough(origin, endpoints, o);
+    sweeps.emplace_back(origin, endpoints);
+    if (sweep < 2) {
+      EXPECT_EQ(removed, 0u) << "after sweep " << sweep;
+    }
+    map.insert(endpoints);
+  }
+  const size_t box_left = count(true);
+  EXPECT_LT(box_left, box_points / 2) << "of " << box_points << " box points";
+  // a box point still there was seen through in fewer than three sweeps (brute force over the beams)
+  for (const Vec3& p : map.points()) {
+    if (!onTheBox(p)) continue;
+    int seen_through = 0;
+    for (const auto& [origin, endpoints] : sweeps) {
+      bool through = false;
+      for (size_t e = 0; e < endpoints.size() && !through; ++e) {
+        const Vec3 w = endpoints[e] - origin;
+        const double range = w.norm(), along = (p - origin).dot(w / range);
+        const double reach = range - std::max(o.end_margin, o.end_margin_fraction * range);
+        const double radius = o.beam_radius + o.beam_divergence * along;
+        through = range > o.min_range && range <= o.max_range && along >= o.min_range && along <= reach &&
+                  (p - origin).squaredNorm() - along * along < radius * radius;
+      }
+      seen_through += through;
+    }
+    EXPECT_LT(seen_through, o.misses_to_remove) << "box point " << p.transpose() << " stayed";
+  }
+  // the static points (floor, walls, ceiling) the beams removed: at most 0.5 %
+  const size_t static_removed = removed - (box_points - box_left);
+  EXPECT_LE(static_removed, static_points / 200) << "of " << static_points;
+
+  // off: nothing is removed
+  VoxelMap kept;
+  kept.insert(sweepFrom(start, true));
+  o.enabled = false;
+  EXPECT_EQ(kept.removeSeenThrough(start, sweepFrom(start, false), o), 0u);
 }

@@ -102,6 +102,16 @@ void readLio(const Config& c, LioNodeOptions* o) {
   map.readOptional("min_point_distance", l.map.min_point_distance);
   map.readOptional("radius", l.map_radius);
   map.readOptional("prune_distance", l.map_prune_distance);
+  const Config seen = map.optionalSection("seen_through");
+  seen.readOptional("enabled", l.seen_through.enabled);
+  seen.readOptional("beam_radius", l.seen_through.beam_radius);
+  seen.readOptional("beam_divergence", l.seen_through.beam_divergence);
+  seen.readOptional("end_margin", l.seen_through.end_margin);
+  seen.readOptional("end_margin_fraction", l.seen_through.end_margin_fraction);
+  seen.readOptional("min_range", l.seen_through.min_range);
+  seen.readOptional("max_range", l.seen_through.max_range);
+  seen.readOptional("misses_to_remove", l.seen_through.misses_to_remove);
+  seen.readOptional("ray_stride", l.seen_through.ray_stride);
 
   const Config m = c.optionalSection("matching");
   m.readOptional("num_neighbors", l.matching.plane.num_neighbors);
@@ -140,6 +150,11 @@ void readLio(const Config& c, LioNodeOptions* o) {
     if (!ok) throw ConfigError(c.where(key) + ": must be positive");
   };
   positive(l.map.voxel_size > 0 && l.map.max_points_per_voxel > 0, "map");
+  const SeenThroughOptions& st = l.seen_through;
+  positive(st.beam_radius >= 0 && st.beam_divergence >= 0 && st.end_margin >= 0 && st.end_margin_fraction >= 0 &&
+               st.min_range >= 0 && st.max_range > st.min_range && st.misses_to_remove >= 1 &&
+               st.misses_to_remove <= 100 && st.ray_stride >= 1,
+           "map.seen_through");
   positive(l.scan_voxel_size > 0 && l.point_stride > 0, "scan_voxel_size");
   positive(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors");
   positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");

@@ -264,8 +264,14 @@ bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed) const {
   return false;
 }
 
-void LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterState& x) {
-  for (const auto& p : body) map_.insert(Vec3(x.rot * p + x.pos));
+size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterState& x) {
+  std::vector<Vec3> world(body.size());
+  for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
+  // the beams leave the LiDAR where it is at the sweep end (the frame the sweep is undistorted to)
+  const Vec3 lidar = x.rot * opts_.extrinsics.T_I_L.translation() + x.pos;
+  const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through);
+  map_.insert(world);
+  return removed;
 }
 
 void LioEstimator::pruneMap(const Vec3& position) {
@@ -456,7 +462,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
 
   // 6. map insertion and the local window
   if (res.status != ScanResult::Status::kPredicted) {
-    insertIntoMap(reg, x);
+    res.map_points_seen_through = insertIntoMap(reg, x);
     last_registered_body_ = reg;
     pruneMap(x.pos);
   }

@@ -24,18 +24,26 @@ bool VoxelMap::insert(const Vec3& p) {
   if (v == next) {
     voxels_.push_back(Voxel{key, 0, static_cast<int32_t>(cx), static_cast<int32_t>(cy), static_cast<int32_t>(cz)});
     pool_.resize(pool_.size() + stride_);
+    misses_.resize(misses_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0);
   }
   Voxel& vox = voxels_[static_cast<size_t>(v)];
-  if (vox.count >= opts_.max_points_per_voxel) return false;
   float* pts = voxelPoints(v);
+  uint8_t* misses = voxelMisses(v);
   const double min_d2 = opts_.min_point_distance * opts_.min_point_distance;
+  const double seen_d2 = opts_.seen_again_distance * opts_.seen_again_distance;
+  bool near = false;
   for (int i = 0; i < vox.count; ++i) {
     const double dx = pts[3 * i] - p.x(), dy = pts[3 * i + 1] - p.y(), dz = pts[3 * i + 2] - p.z();
-    if (dx * dx + dy * dy + dz * dz < min_d2) return false;
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 < seen_d2) misses[i] = 0;  // seen again
+    near = near || d2 < min_d2;
   }
+  if (near) return false;
+  if (vox.count >= opts_.max_points_per_voxel) return false;
   pts[3 * vox.count] = static_cast<float>(p.x());
   pts[3 * vox.count + 1] = static_cast<float>(p.y());
   pts[3 * vox.count + 2] = static_cast<float>(p.z());
+  misses[vox.count] = 0;
   ++vox.count;
   return true;
 }
@@ -118,6 +126,93 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
   return found;
 }
 
+void VoxelMap::removePoint(int32_t v, int i) {
+  Voxel& vox = voxels_[static_cast<size_t>(v)];
+  float* pts = voxelPoints(v);
+  uint8_t* misses = voxelMisses(v);
+  const int last = --vox.count;
+  std::copy_n(pts + 3 * last, 3, pts + 3 * i);
+  misses[i] = misses[last];
+}
+
+namespace {
+constexpr uint8_t kSeenThroughThisSweep = 0x80;
+}  // namespace
+
+void VoxelMap::markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach,
+                               const SeenThroughOptions& o, std::vector<int32_t>* touched) {
+  const float* pts = voxelPoints(v);
+  uint8_t* misses = voxelMisses(v);
+  for (int i = 0; i < voxels_[static_cast<size_t>(v)].count; ++i) {
+    if (misses[i] & kSeenThroughThisSweep) continue;
+    const Vec3 q = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]) - origin;
+    const double along = q.dot(dir);
+    if (along < o.min_range || along > reach) continue;
+    const double radius = o.beam_radius + o.beam_divergence * along;
+    if (q.squaredNorm() - along * along >= radius * radius) continue;
+    touched->push_back(v);
+    misses[i] |= kSeenThroughThisSweep;
+  }
+}
+
+size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints,
+                                   const SeenThroughOptions& o) {
+  if (!o.enabled || voxels_.empty() || !origin.allFinite()) return 0;
+  std::vector<int32_t> touched;  // voxels holding a point seen through in this sweep
+  const double step = 0.5 * opts_.voxel_size;
+  const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));
+  for (size_t e = 0; e < endpoints.size(); e += stride) {
+    const Vec3 w = endpoints[e] - origin;
+    const double range = w.norm();
+    if (!(range > o.min_range) || range > o.max_range) continue;
+    const Vec3 dir = w / range;
+    const double reach = range - std::max(o.end_margin, o.end_margin_fraction * range);
+    // the voxels within the beam's radius of the ray up to `reach`: the cube of half-size
+    // step / 2 + radius around every sample holds every voxel the ray passes within radius of
+    const double half = 0.5 * step + o.beam_radius + o.beam_divergence * reach;
+    VoxelKey visited[16];  // the ray's last voxels (a point is flagged once a sweep anyway)
+    int filled = 0, cursor = 0;
+    for (double t = o.min_range; t < reach + step; t += step) {
+      const Vec3 c = origin + std::min(t, reach) * dir;
+      int64_t lo[3], hi[3];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = static_cast<int64_t>(std::floor((c[a] - half) * inv_size_));
+        hi[a] = static_cast<int64_t>(std::floor((c[a] + half) * inv_size_));
+      }
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+            const VoxelKey key = packVoxel(x, y, z);
+            if (std::find(visited, visited + filled, key) != visited + filled) continue;
+            visited[cursor] = key;
+            cursor = (cursor + 1) % 16;
+            filled = std::min(filled + 1, 16);
+            const int32_t v = index_.find(key);
+            if (v >= 0) markSeenThrough(v, origin, dir, reach, o, &touched);
+          }
+    }
+  }
+  // one miss per sweep for every point seen through; those with enough go
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  size_t removed = 0;
+  for (int32_t v : touched) {
+    uint8_t* misses = voxelMisses(v);
+    for (int i = 0; i < voxels_[static_cast<size_t>(v)].count;) {
+      if (misses[i] & kSeenThroughThisSweep) {
+        misses[i] = static_cast<uint8_t>((misses[i] & ~kSeenThroughThisSweep) + 1);
+        if (misses[i] >= o.misses_to_remove) {
+          removePoint(v, i);
+          ++removed;
+          continue;  // the last point moved into slot i
+        }
+      }
+      ++i;
+    }
+  }
+  return removed;
+}
+
 size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   const double r2 = radius * radius;
   const double vs = opts_.voxel_size;
@@ -129,6 +224,8 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
     if (kept != v) {
       voxels_[kept] = vox;
       std::copy_n(&pool_[v * stride_], stride_, &pool_[kept * stride_]);
+      const size_t slots = static_cast<size_t>(opts_.max_points_per_voxel);
+      std::copy_n(&misses_[v * slots], slots, &misses_[kept * slots]);
     }
     ++kept;
   }
@@ -136,8 +233,10 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   if (removed == 0) return 0;
   voxels_.resize(kept);
   pool_.resize(kept * stride_);
+  misses_.resize(kept * static_cast<size_t>(opts_.max_points_per_voxel));
   voxels_.shrink_to_fit();
   pool_.shrink_to_fit();
+  misses_.shrink_to_fit();
   index_.resetFor(kept);
   for (size_t v = 0; v < kept; ++v) index_.insert(voxels_[v].key, static_cast<int32_t>(v));
   return removed;
@@ -146,6 +245,7 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
 void VoxelMap::clear() {
   voxels_.clear();
   pool_.clear();
+  misses_.clear();
   index_.resetFor(0);
 }
 

@@ -45,6 +45,7 @@ struct ScanResult {
   int num_points = 0;       // valid points of the sweep
   int num_registered = 0;   // after downsampling
   int num_residuals = 0;    // point-to-plane residuals of the last iterate
+  size_t map_points_seen_through = 0;  // map points this sweep's beams removed (SeenThroughOptions)
   int iterations = 0;
   bool converged = false;
   DegeneracyReport degeneracy;
@@ -148,7 +149,9 @@ class LioEstimator {
   /// sweep can also try the hypothesis that no time passed (a clock step, not an outage).
   void noteBridgedGap(const FilterState& before);
   bool wheelSpeedAt(int64_t utime, double* speed) const;
-  void insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
+  /// Removes the map points the sweep's beams pass through, then adds the sweep; returns how many
+  /// map points were removed.
+  size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
   void pruneMap(const Vec3& position);
 
   LioOptions opts_;

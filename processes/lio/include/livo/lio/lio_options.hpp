@@ -27,6 +27,7 @@ struct LioOptions {
 
   // map and registration
   VoxelMapOptions map;
+  SeenThroughOptions seen_through;     // points later beams pass through leave the map
   double map_radius = 100.0;           // m, local window kept around the body
   double map_prune_distance = 10.0;    // m travelled between window prunings
   ScanToMapOptions matching;

@@ -1,6 +1,7 @@
 // The LiDAR map: a hashed voxel grid with a bounded number of points per voxel (like KISS-ICP's
 // VoxelHashMap), exact k-nearest-neighbour search within a radius, insertion under a
-// minimum-spacing downsampling rule, and removal of voxels outside a moving local window.
+// minimum-spacing downsampling rule, removal of voxels outside a moving local window, and removal
+// of points that later beams pass through (something moved away, or an early pose was off).
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,26 @@ struct VoxelMapOptions {
   double voxel_size = 1.0;         // m, edge of a hash voxel
   int max_points_per_voxel = 20;   // a full voxel takes no more points
   double min_point_distance = 0.4; // m, a new point this close to one in its voxel is dropped
+  double seen_again_distance = 0.1; // m, a new point this close to a stored one is a new sighting
+                                    // of it (SeenThroughOptions)
+};
+
+/// Free-space carving: a stored point that beams pass through in `misses_to_remove` sweeps, with
+/// no new point landing near it in between, is removed (a parked car that left, a pedestrian, a
+/// point placed by an early pose that was off). A beam passes through a point when the point lies
+/// within the beam's radius (radius + divergence * distance) of the ray and nearer than the beam's
+/// return by more than the margin (max(end_margin, end_margin_fraction * range)): the margin keeps
+/// the surface the beam hits, and the floor a beam grazes on its way there, out of the test.
+struct SeenThroughOptions {
+  bool enabled = true;
+  double beam_radius = 0.03;          // m at the sensor
+  double beam_divergence = 0.003;     // rad (VLP-16: 3 mrad horizontal)
+  double end_margin = 1.0;            // m
+  double end_margin_fraction = 0.2;   // of the beam's range
+  double min_range = 1.0;             // m, points nearer the sensor are not tested
+  double max_range = 40.0;            // m, longer beams are not cast
+  int misses_to_remove = 3;           // sweeps seeing through a point before it goes
+  int ray_stride = 4;                 // every n-th beam of a sweep is cast
 };
 
 class VoxelMap {
@@ -27,6 +48,11 @@ class VoxelMap {
   /// Up to k nearest stored points within max_distance of q (exact), nearest first; returns the
   /// count. out_points / out_sq_dist must hold k entries. Requires k <= 32.
   int knn(const Vec3& q, int k, double max_distance, Vec3* out_points, double* out_sq_dist) const;
+
+  /// Casts the beams from `origin` (world) to every `ray_stride`-th of `endpoints` (one sweep)
+  /// and removes the points seen through in `misses_to_remove` sweeps (see SeenThroughOptions).
+  /// Returns how many points were removed.
+  size_t removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& options);
 
   /// Drops voxels whose centre is farther than radius from centre (the local window); returns
   /// how many voxels were removed.
@@ -48,12 +74,19 @@ class VoxelMap {
   };
   const float* voxelPoints(int32_t v) const { return &pool_[static_cast<size_t>(v) * stride_]; }
   float* voxelPoints(int32_t v) { return &pool_[static_cast<size_t>(v) * stride_]; }
+  uint8_t* voxelMisses(int32_t v) { return &misses_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
+  void removePoint(int32_t v, int i);
+  /// Flags voxel v's points that the ray origin + t dir (t <= reach) passes through this sweep.
+  void markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach, const SeenThroughOptions& o,
+                       std::vector<int32_t>* touched);
 
   VoxelMapOptions opts_;
   double inv_size_;
   size_t stride_;            // floats per voxel: 3 * max_points_per_voxel
   std::vector<Voxel> voxels_;
   std::vector<float> pool_;  // voxel v's points at [v * stride_, v * stride_ + 3 * count)
+  std::vector<uint8_t> misses_;  // per point slot: sweeps that saw through it since it was last seen;
+                                 // the high bit marks "seen through in the current sweep"
   FlatKeyIndex index_;
   std::vector<int> offsets_; // 27 neighbour offsets as (dx, dy, dz) triples, search radius 1
 };
