@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iomanip>
 #include <ostream>
+#include <sstream>
 
 #include "scene_config.hpp"
 #include "trajectory_config.hpp"
@@ -22,6 +23,96 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
   return base_dir + "/" + path;
 }
 
+std::string number(double x) {
+  std::ostringstream os;
+  os << x;
+  return os.str();
+}
+
+/// A scalar error within +-limit; a 1-sigma (draw) must also be >= 0.
+void readErrorWithin(const Config& c, const std::string& key, double limit, bool sigma, double* v) {
+  if (!c.readOptional(key, *v)) return;
+  if (!(std::abs(*v) <= limit)) throw ConfigError(c.where(key) + ": must be within +-" + number(limit));
+  if (sigma && *v < 0.0) throw ConfigError(c.where(key) + ": a 1-sigma (calibration_errors.draw) must be >= 0");
+}
+
+/// A 3-vector error, every component as readErrorWithin.
+void readErrorWithin(const Config& c, const std::string& key, double limit, bool sigma, Vec3* v) {
+  if (!c.readOptional(key, *v)) return;
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs((*v)[i]) <= limit)) throw ConfigError(c.where(key) + ": components must be within +-" + number(limit));
+    if (sigma && (*v)[i] < 0.0) throw ConfigError(c.where(key) + ": a 1-sigma (calibration_errors.draw) must be >= 0");
+  }
+}
+
+void requireSensor(const Config& c, const std::string& key, bool present, const std::string& sensor) {
+  if (c.has(key) && !present) throw ConfigError(c.where(key) + ": the rig has no " + sensor);
+}
+
+void readExtrinsicError(const Config& parent, const std::string& key, bool sigma, ExtrinsicError* e) {
+  const Config c = parent.optionalSection(key);
+  readErrorWithin(c, "translation", 1.0, sigma, &e->translation);
+  readErrorWithin(c, "rpy_deg", 10.0, sigma, &e->rpy_deg);
+  c.checkAllUsed();
+}
+
+void readCalibrationErrors(const Config& c, const SensorRig& rig, CalibrationErrors* e) {
+  c.readOptional("draw", e->draw);
+  requireSensor(c, "lidar", rig.lidar.has_value(), "lidar");
+  requireSensor(c, "lidar_time_offset_s", rig.lidar.has_value(), "lidar");
+  requireSensor(c, "camera", rig.camera.has_value(), "camera");
+  requireSensor(c, "camera_time_offset_s", rig.camera.has_value(), "camera");
+  requireSensor(c, "wheel", rig.wheel.has_value(), "wheel encoder");
+  requireSensor(c, "wheel_time_offset_s", rig.wheel.has_value(), "wheel encoder");
+  readExtrinsicError(c, "lidar", e->draw, &e->lidar);
+  readExtrinsicError(c, "camera", e->draw, &e->camera);
+  readExtrinsicError(c, "wheel", e->draw, &e->wheel);
+  readErrorWithin(c, "lidar_time_offset_s", 0.5, e->draw, &e->lidar_time_offset_s);
+  readErrorWithin(c, "camera_time_offset_s", 0.5, e->draw, &e->camera_time_offset_s);
+  readErrorWithin(c, "wheel_time_offset_s", 0.5, e->draw, &e->wheel_time_offset_s);
+  c.checkAllUsed();
+}
+
+// The sim.imu keys of the IMU error model (refused for recorded IMU streams).
+const std::vector<std::string> kImuErrorKeys = {"gyro_scale_ppm",     "accel_scale_ppm",  "gyro_misalignment_mrad",
+                                                "accel_misalignment_mrad", "gyro_g_sensitivity", "gyro_bias_per_c",
+                                                "accel_bias_per_c",   "temperature"};
+
+void readImuErrors(const Config& imu, bool sigma, ImuErrors* e) {
+  readErrorWithin(imu, "gyro_scale_ppm", 1e5, sigma, &e->gyro_scale_ppm);
+  readErrorWithin(imu, "accel_scale_ppm", 1e5, sigma, &e->accel_scale_ppm);
+  readErrorWithin(imu, "gyro_misalignment_mrad", 50.0, sigma, &e->gyro_misalignment_mrad);
+  readErrorWithin(imu, "accel_misalignment_mrad", 50.0, sigma, &e->accel_misalignment_mrad);
+  readErrorWithin(imu, "gyro_g_sensitivity", 0.01, sigma, &e->gyro_g_sensitivity);
+  readErrorWithin(imu, "gyro_bias_per_c", 0.01, sigma, &e->gyro_bias_per_c);
+  readErrorWithin(imu, "accel_bias_per_c", 0.1, sigma, &e->accel_bias_per_c);
+  const Config temp = imu.optionalSection("temperature");
+  ImuTemperature& T = e->temperature;
+  temp.readOptional("start_c", T.start_c);
+  T.end_c = T.start_c;
+  temp.readOptional("end_c", T.end_c);
+  temp.readOptional("ramp_s", T.ramp_s);
+  if (!(T.start_c >= -60.0 && T.start_c <= 150.0)) throw ConfigError(temp.where("start_c") + ": must be in -60..150 deg C");
+  if (!(T.end_c >= -60.0 && T.end_c <= 150.0)) throw ConfigError(temp.where("end_c") + ": must be in -60..150 deg C");
+  if (!(T.ramp_s > 0.0)) throw ConfigError(temp.where("ramp_s") + ": must be > 0");
+  temp.checkAllUsed();
+}
+
+void refuseImuErrorsOnARecording(const Config& imu) {
+  for (const std::string& key : kImuErrorKeys)
+    if (imu.has(key))
+      throw ConfigError(imu.where(key) + ": a recorded trajectory publishes its real IMU samples unchanged; "
+                        "the IMU error model cannot be applied to them (remove the key)");
+}
+
+/// The errors of this run: as configured, or drawn from the seed with the configured 1-sigmas.
+void resolveErrors(SimulationSetup* s) {
+  const SimOptions& o = s->options;
+  const bool draw = o.calibration_errors.draw;
+  s->calibration_errors = draw ? drawCalibrationErrors(o.calibration_errors, o.seed) : o.calibration_errors;
+  s->imu_errors = draw ? drawImuErrors(o.imu_errors, o.seed) : o.imu_errors;
+}
+
 void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   sim.readOptional("start_time_s", o->start_time_s);
   sim.readOptional("duration_s", o->duration_s);
@@ -37,9 +128,11 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!(o->ground_truth_rate_hz > 0.0)) throw ConfigError(sim.where("ground_truth_rate_hz") + ": must be > 0");
   if (o->threads < 1 || o->threads > 256) throw ConfigError(sim.where("threads") + ": must be in 1..256");
 
+  readCalibrationErrors(sim.optionalSection("calibration_errors"), rig, &o->calibration_errors);
   const Config imu = sim.optionalSection("imu");
   imu.readOptional("initial_gyro_bias", o->initial_gyro_bias);
   imu.readOptional("initial_accel_bias", o->initial_accel_bias);
+  readImuErrors(imu, o->calibration_errors.draw, &o->imu_errors);
   imu.checkAllUsed();
 
   const Config lidar = sim.optionalSection("lidar");
@@ -125,7 +218,10 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
     s.options.duration_s = *overrides.duration_s;
   }
 
+  resolveErrors(&s);
+
   if (s.recorded) {
+    refuseImuErrorsOnARecording(sim.optionalSection("imu"));
     if (sim.has("start_time_s"))
       throw ConfigError(sim.where("start_time_s") + ": a recorded trajectory takes its start time from the recording");
     // the span covered by both the ground truth and the IMU
@@ -144,6 +240,39 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   sim.checkAllUsed();
   return s;
 }
+
+namespace {
+
+void printExtrinsicError(const std::string& sensor, const ExtrinsicError& e, double time_offset_s, std::ostream& os) {
+  os << "    " << sensor << ": T_err translation [" << e.translation.transpose() << "] m, rpy_deg ["
+     << e.rpy_deg.transpose() << "], time offset error " << time_offset_s * 1e3 << " ms\n";
+}
+
+void printCalibrationErrors(const SimulationSetup& s, std::ostream& os) {
+  const CalibrationErrors& e = s.calibration_errors;
+  os << "  calibration errors (the TRUTH, never in rig:; T_I_X_true = T_I_X_rig * T_err, a message stamped t was "
+        "measured at t + offset), "
+     << (e.draw ? "drawn with seed " + std::to_string(s.options.seed) + " from the configured 1-sigmas" : "as configured")
+     << ":\n";
+  if (s.rig.lidar) printExtrinsicError("lidar", e.lidar, e.lidar_time_offset_s, os);
+  if (s.rig.camera) printExtrinsicError("camera", e.camera, e.camera_time_offset_s, os);
+  if (s.rig.wheel) printExtrinsicError("wheel", e.wheel, e.wheel_time_offset_s, os);
+  os << "  the rig as rendered (truth):\n";
+  printSensorRig(trueRig(s.rig, e), os);
+}
+
+void printImuErrors(const SimulationSetup& s, std::ostream& os) {
+  const ImuErrors& e = s.imu_errors;
+  os << "  IMU errors (the TRUTH" << (s.options.calibration_errors.draw ? ", drawn" : "") << "):\n    gyro scale ["
+     << e.gyro_scale_ppm.transpose() << "] ppm, misalignment [" << e.gyro_misalignment_mrad.transpose()
+     << "] mrad, g-sensitivity [" << e.gyro_g_sensitivity.transpose() << "] rad/s per m/s^2, bias ["
+     << e.gyro_bias_per_c.transpose() << "] rad/s per C\n    accel scale [" << e.accel_scale_ppm.transpose()
+     << "] ppm, misalignment [" << e.accel_misalignment_mrad.transpose() << "] mrad, bias ["
+     << e.accel_bias_per_c.transpose() << "] m/s^2 per C\n    temperature " << e.temperature.start_c << " -> "
+     << e.temperature.end_c << " C over " << e.temperature.ramp_s << " s\n";
+}
+
+}  // namespace
 
 void printSimulation(const SimulationSetup& s, std::ostream& os) {
   const SimOptions& o = s.options;
@@ -171,6 +300,8 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
        << o.camera.vignetting << "\n";
   if (s.rig.wheel)
     os << "  wheel: scale errors left " << o.wheel_left_scale << ", right " << o.wheel_right_scale << "\n";
+  if (s.imu_errors.any()) printImuErrors(s, os);
+  if (s.calibration_errors.any()) printCalibrationErrors(s, os);
 }
 
 }  // namespace sim

@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "calibration_errors.hpp"
 #include "camera_renderer.hpp"
+#include "imu_model.hpp"
 #include "lidar_pattern.hpp"
 #include "livo/asl_dataset.hpp"
 #include "livo/config.hpp"
@@ -32,6 +34,8 @@ struct SimOptions {
   CameraEffects camera;
   double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;
+  ImuErrors imu_errors;                 // sim.imu error model, as configured (1-sigmas if drawn)
+  CalibrationErrors calibration_errors; // sim.calibration_errors, as configured (1-sigmas if drawn)
 };
 
 /// Command-line values that take precedence over the file.
@@ -53,6 +57,9 @@ struct SimulationSetup {
   double trajectory_time_offset = 0.0;  // trajectory time at start_utime
   bool recorded = false;                // re-simulation along a recording:
   std::vector<ImuSample> recorded_imu;  //   its real IMU stream, published untouched
+  // The truth of this run (drawn from the seed when calibration_errors.draw is on): never in `rig`.
+  CalibrationErrors calibration_errors;
+  ImuErrors imu_errors;
 
   /// BodyTrajectory time of a stamp.
   double trajectoryTime(int64_t utime) const {

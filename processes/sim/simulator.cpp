@@ -8,6 +8,7 @@
 #include <optional>
 #include <thread>
 
+#include "calibration_errors.hpp"
 #include "camera_renderer.hpp"
 #include "imu_model.hpp"
 #include "lidar_scanner.hpp"
@@ -62,7 +63,9 @@ Simulator::Simulator(const SimulationSetup& setup) : setup_(setup) {}
 SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
   const auto wall0 = std::chrono::steady_clock::now();
   const SimulationSetup& s = setup_;
-  const SensorRig& rig = s.rig;
+  const SensorRig& rig = s.rig;               // the belief: stamps, channels, noise
+  const SensorRig mounted = trueRig(rig, s.calibration_errors);  // the truth: what the sensors see
+  const CalibrationErrors& errors = s.calibration_errors;
   const SimOptions& o = s.options;
   const BodyTrajectory& trajectory = *s.trajectory;
   const Scene& scene = *s.scene;
@@ -82,14 +85,14 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
   int64_t sweep_us = 0;
   if (rig.lidar) {
     stats.messages[rig.channels.lidar] = 0;
-    scanner = std::make_unique<LidarScanner>(*rig.lidar, o.lidar);
+    scanner = std::make_unique<LidarScanner>(*mounted.lidar, o.lidar);
     sweep_us = static_cast<int64_t>(std::llround(scanner->pattern().sweepDuration() * 1e6));
   }
   std::unique_ptr<CameraRenderer> renderer;
   int64_t camera_offset_us = 0;
   if (rig.camera) {
     stats.messages[rig.channels.camera] = 0;
-    renderer = std::make_unique<CameraRenderer>(*rig.camera, o.camera);
+    renderer = std::make_unique<CameraRenderer>(*mounted.camera, o.camera);
     camera_offset_us = static_cast<int64_t>(std::llround(rig.camera->time_offset_s * 1e6));
   }
 
@@ -120,6 +123,7 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     } else {
       for (int64_t u; (u = stampOf(start, imu_k, rig.imu.rate_hz)) < c1; ++imu_k) {
         ImuReading r = idealImuReading(trajectory.at(s.trajectoryTime(u)), rig.imu.gravity, u);
+        if (s.imu_errors.any()) applyImuErrors(s.imu_errors, (u - start) * 1e-6, &r);
         imu_noise.apply(&r);
         imus.push_back(r);
       }
@@ -132,7 +136,9 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     }
     if (rig.wheel) {
       for (int64_t u; (u = stampOf(start, wheel_k, rig.wheel->rate_hz)) < c1; ++wheel_k) {
-        WheelReading r = idealWheelReading(trajectory.at(s.trajectoryTime(u)), *rig.wheel, u);
+        // stamped u, measured at IMU time u + the wheel's time offset error
+        const double t = s.trajectoryTime(u) + errors.wheel_time_offset_s;
+        WheelReading r = idealWheelReading(trajectory.at(t), *mounted.wheel, u);
         wheel_noise->apply(&r);
         wheels.push_back(r);
         pending.push_back({u, kWheelRank, wheels.size() - 1});
@@ -146,7 +152,9 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
         const size_t slot = sweeps.size() - 1;
         const int64_t k = sweep_k;
         jobs.push_back([&, slot, k, u] {
-          sweeps[slot] = scanner->scan(scene, trajectory, s.trajectoryTime(u), u, (u - start) * 1e-6,
+          // stamped u, swept from IMU time u + the LiDAR's time offset error
+          const double t0 = s.trajectoryTime(u) + errors.lidar_time_offset_s;
+          sweeps[slot] = scanner->scan(scene, trajectory, t0, u, (u - start) * 1e-6,
                                        Random(o.seed, kLidarStream, static_cast<uint64_t>(k)));
         });
       }
@@ -158,8 +166,10 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
         const size_t slot = images.size() - 1;
         const int64_t k = frame_k;
         jobs.push_back([&, slot, k, u] {
-          // rendered at IMU time u, stamped on the camera's clock (rig camera time_offset_s)
-          images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u), u - camera_offset_us,
+          // stamped on the camera's clock as the rig believes it (rig camera time_offset_s) and logged at
+          // IMU time u; rendered at u + the camera's time offset error
+          images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u) + errors.camera_time_offset_s,
+                                          u - camera_offset_us,
                                           Random(o.seed, kCameraStream, static_cast<uint64_t>(k)));
           images[slot].log_utime = u;
         });
