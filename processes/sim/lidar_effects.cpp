@@ -11,6 +11,29 @@ namespace {
 constexpr double kZ90 = 1.2815515655446004;
 
 double standardNormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+
+/// One echo from the hits [first, end) of a group (sorted by range).
+Echo mergedEcho(const std::vector<SubRayHit>& hits, size_t first, size_t end) {
+  const SubRayHit& nearest = hits[first];
+  Echo echo;
+  if (end - first == 1) {  // a single surface: its own reflectivity and incidence
+    echo.range = nearest.range;
+    echo.reflectivity = nearest.reflectivity;
+    echo.cos_incidence = nearest.cos_incidence;
+    echo.share = nearest.weight;
+    return echo;
+  }
+  double power = 0.0, weighted_range = 0.0, share = 0.0;
+  for (size_t i = first; i < end; ++i) {
+    power += hits[i].power();
+    weighted_range += hits[i].power() * hits[i].range;
+    share += hits[i].weight;
+  }
+  echo.range = power > 0.0 ? weighted_range / power : nearest.range;
+  echo.reflectivity = power * echo.range * echo.range / share;
+  echo.share = share;
+  return echo;
+}
 }  // namespace
 
 double rangeNoiseStd(const LidarEffects& e, double base_std, double range, double apparent_reflectivity) {
@@ -38,33 +61,6 @@ std::vector<SubRay> footprintSubRays(const LidarEffects& e) {
   }
   return rays;
 }
-
-namespace {
-
-/// One echo from the hits [first, end) of a group (sorted by range).
-Echo mergedEcho(const std::vector<SubRayHit>& hits, size_t first, size_t end) {
-  const SubRayHit& nearest = hits[first];
-  Echo echo;
-  if (end - first == 1) {  // a single surface: its own reflectivity and incidence
-    echo.range = nearest.range;
-    echo.reflectivity = nearest.reflectivity;
-    echo.cos_incidence = nearest.cos_incidence;
-    echo.share = nearest.weight;
-    return echo;
-  }
-  double power = 0.0, weighted_range = 0.0, share = 0.0;
-  for (size_t i = first; i < end; ++i) {
-    power += hits[i].power();
-    weighted_range += hits[i].power() * hits[i].range;
-    share += hits[i].weight;
-  }
-  echo.range = power > 0.0 ? weighted_range / power : nearest.range;
-  echo.reflectivity = power * echo.range * echo.range / share;
-  echo.share = share;
-  return echo;
-}
-
-}  // namespace
 
 Echo strongestEcho(std::vector<SubRayHit>* hits, double separation) {
   std::sort(hits->begin(), hits->end(), [](const SubRayHit& a, const SubRayHit& b) { return a.range < b.range; });
