@@ -6,8 +6,39 @@
 namespace livo {
 namespace sim {
 
-LidarScanner::LidarScanner(const LidarRig& rig, const LidarPatternOptions& pattern_options)
-    : rig_(rig), pattern_(rig.model, rig.rate_hz, pattern_options) {}
+LidarScanner::LidarScanner(const LidarRig& rig, const LidarPatternOptions& pattern_options, const LidarEffects& effects)
+    : rig_(rig), pattern_(rig.model, rig.rate_hz, pattern_options), effects_(effects) {
+  if (effects_.footprint()) sub_rays_ = footprintSubRays(effects_);
+}
+
+Echo LidarScanner::axisEcho(const Scene& scene, const Ray& ray) const {
+  const RayHit hit = scene.cast(ray, 1e-6, rig_.max_range);
+  Echo echo;
+  if (!hit.valid()) return echo;
+  echo.range = hit.t;
+  echo.reflectivity = scene.material(hit.object).reflectivity;
+  echo.cos_incidence = std::abs(scene.surface(ray, hit).normal.dot(ray.direction));
+  return echo;
+}
+
+Echo LidarScanner::footprintEcho(const Scene& scene, const Ray& ray, const Vec3& up,
+                                 std::vector<SubRayHit>* hits) const {
+  Vec3 horizontal = up.cross(ray.direction);
+  if (horizontal.norm() < 1e-9) horizontal = ray.direction.unitOrthogonal();
+  horizontal.normalize();
+  const Vec3 vertical = ray.direction.cross(horizontal);
+  hits->clear();
+  for (const SubRay& s : sub_rays_) {
+    Ray sub = ray;
+    sub.direction =
+        (ray.direction + std::tan(s.horizontal) * horizontal + std::tan(s.vertical) * vertical).normalized();
+    const RayHit hit = scene.cast(sub, 1e-6, rig_.max_range);
+    if (!hit.valid()) continue;  // this part of the beam goes to the sky: the return weakens
+    const double cos_incidence = std::abs(scene.surface(sub, hit).normal.dot(sub.direction));
+    hits->push_back({hit.t, s.weight, scene.material(hit.object).reflectivity, cos_incidence});
+  }
+  return strongestEcho(hits, effects_.echo_separation_m);
+}
 
 LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajectory, double t0, int64_t utime,
                               double sensor_time0, Random rng) const {
@@ -20,6 +51,8 @@ LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajecto
   for (auto* v : {&sweep.x, &sweep.y, &sweep.z, &sweep.intensity, &sweep.time_offset}) v->reserve(expected);
   sweep.ring.reserve(expected);
 
+  std::vector<SubRayHit> hits;
+  hits.reserve(sub_rays_.size());
   const Mat3 R_IL = rig_.T_I_L.linear();
   const Vec3 t_IL = rig_.T_I_L.translation();
   for (int c = 0; c < pattern_.columns(); ++c) {
@@ -41,14 +74,15 @@ LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajecto
       // draw the noise for every beam so each beam's noise does not depend on other beams' hits
       const double noise = rng.normal();
       const double drop = rng.uniform();
-      const RayHit hit = scene.cast(ray, 1e-6, rig_.max_range);
-      if (!hit.valid() || hit.t < rig_.min_range) continue;
+      const double detect = effects_.detection() ? rng.uniform() : 0.0;
+      const Echo echo = sub_rays_.empty() ? axisEcho(scene, ray) : footprintEcho(scene, ray, R_WL.col(2), &hits);
+      if (!echo.valid() || echo.range < rig_.min_range) continue;
       if (drop < rig_.dropout_probability) continue;
-      const double range = hit.t + rig_.range_noise_std * noise;
+      const double apparent = echo.apparentReflectivity();
+      if (detect >= detectionProbability(effects_, echo.range, apparent)) continue;
+      const double range = echo.range + rangeNoiseStd(effects_, rig_.range_noise_std, echo.range, apparent) * noise;
       if (range < rig_.min_range || range > rig_.max_range) continue;
-      const SurfacePoint sp = scene.surface(ray, hit);
-      const double cos_incidence = std::abs(sp.normal.dot(ray.direction));
-      const double intensity = 255.0 * scene.material(hit.object).reflectivity * cos_incidence;
+      const double intensity = 255.0 * echo.reflectivity * echo.cos_incidence * echo.share;
       const Vec3 q = d_L * range;
       sweep.x.push_back(static_cast<float>(q.x()));
       sweep.y.push_back(static_cast<float>(q.y()));

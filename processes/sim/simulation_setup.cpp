@@ -113,6 +113,30 @@ void resolveErrors(SimulationSetup* s) {
   s->imu_errors = draw ? drawImuErrors(o.imu_errors, o.seed) : o.imu_errors;
 }
 
+void readLidarEffects(const Config& lidar, LidarEffects* e) {
+  lidar.readOptional("range_noise_per_m", e->range_noise_per_m);
+  lidar.readOptional("noise_reflectivity_exponent", e->noise_reflectivity_exponent);
+  lidar.readOptional("max_range_at_10pct", e->max_range_at_10pct);
+  lidar.readOptional("detection_softness", e->detection_softness);
+  std::vector<double> divergence;
+  if (lidar.readOptional("beam_divergence_mrad", divergence)) {
+    if (divergence.size() != 2)
+      throw ConfigError(lidar.where("beam_divergence_mrad") + ": must be [horizontal, vertical]");
+    e->beam_divergence_mrad = {{divergence[0], divergence[1]}};
+  }
+  lidar.readOptional("echo_separation_m", e->echo_separation_m);
+  if (!(e->range_noise_per_m >= 0.0 && e->range_noise_per_m <= 0.1))
+    throw ConfigError(lidar.where("range_noise_per_m") + ": must be in [0, 0.1]");
+  if (!(e->noise_reflectivity_exponent >= 0.0 && e->noise_reflectivity_exponent <= 2.0))
+    throw ConfigError(lidar.where("noise_reflectivity_exponent") + ": must be in [0, 2]");
+  if (!(e->max_range_at_10pct >= 0.0)) throw ConfigError(lidar.where("max_range_at_10pct") + ": must be >= 0");
+  if (!(e->detection_softness > 0.0 && e->detection_softness <= 2.0))
+    throw ConfigError(lidar.where("detection_softness") + ": must be in (0, 2]");
+  for (double d : e->beam_divergence_mrad)
+    if (!(d >= 0.0 && d <= 50.0)) throw ConfigError(lidar.where("beam_divergence_mrad") + ": must be in [0, 50] mrad");
+  if (!(e->echo_separation_m >= 0.0)) throw ConfigError(lidar.where("echo_separation_m") + ": must be >= 0");
+}
+
 void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   sim.readOptional("start_time_s", o->start_time_s);
   sim.readOptional("duration_s", o->duration_s);
@@ -140,6 +164,7 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   lidar.readOptional("columns", o->lidar.columns);
   lidar.readOptional("start_azimuth_deg", o->lidar.start_azimuth_deg);
   if (o->lidar.columns < 0 || o->lidar.columns > 100000) throw ConfigError(lidar.where("columns") + ": must be in 0..100000");
+  readLidarEffects(lidar, &o->lidar_effects);
   lidar.checkAllUsed();
 
   const Config cam = sim.optionalSection("camera");
@@ -170,6 +195,20 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!(o->wheel_left_scale > 0.0)) throw ConfigError(wheel.where("left_scale") + ": must be > 0");
   if (!(o->wheel_right_scale > 0.0)) throw ConfigError(wheel.where("right_scale") + ": must be > 0");
   wheel.checkAllUsed();
+}
+
+void printLidarEffects(const LidarEffects& e, std::ostream& os) {
+  os << "  lidar effects:";
+  if (!e.any()) os << " off";
+  if (e.range_noise_per_m > 0.0)
+    os << " range noise +" << e.range_noise_per_m * 100 << " cm/m (at 50 %, reflectivity exponent "
+       << e.noise_reflectivity_exponent << ");";
+  if (e.detection())
+    os << " detection 90 % at " << e.max_range_at_10pct << " m for 10 % (softness " << e.detection_softness << ");";
+  if (e.footprint())
+    os << " beam " << e.beam_divergence_mrad[0] << " x " << e.beam_divergence_mrad[1]
+       << " mrad FWHM, echoes merge within " << e.echo_separation_m << " m";
+  os << "\n";
 }
 
 }  // namespace
@@ -293,6 +332,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
   if (s.rig.lidar)
     os << "  lidar: columns " << (o.lidar.columns ? std::to_string(o.lidar.columns) : std::string("model default"))
        << ", start azimuth " << o.lidar.start_azimuth_deg << " deg\n";
+  if (s.rig.lidar) printLidarEffects(o.lidar_effects, os);
   if (s.rig.camera)
     os << "  camera: exposure " << o.camera.exposure_time * 1e3 << " ms +-" << o.camera.exposure_variation * 100
        << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples

@@ -11,6 +11,7 @@
 #include "calibration_errors.hpp"
 #include "camera_renderer.hpp"
 #include "imu_model.hpp"
+#include "lidar_effects.hpp"
 #include "lidar_pattern.hpp"
 #include "livo/asl_dataset.hpp"
 #include "livo/config.hpp"
@@ -31,6 +32,7 @@ struct SimOptions {
   Vec3 initial_gyro_bias = Vec3::Zero();   // rad/s
   Vec3 initial_accel_bias = Vec3::Zero();  // m/s^2
   LidarPatternOptions lidar;
+  LidarEffects lidar_effects;         // sim.lidar receiver effects, all off by default
   CameraEffects camera;
   double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;

@@ -85,7 +85,7 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
   int64_t sweep_us = 0;
   if (rig.lidar) {
     stats.messages[rig.channels.lidar] = 0;
-    scanner = std::make_unique<LidarScanner>(*mounted.lidar, o.lidar);
+    scanner = std::make_unique<LidarScanner>(*mounted.lidar, o.lidar, o.lidar_effects);
     sweep_us = static_cast<int64_t>(std::llround(scanner->pattern().sweepDuration() * 1e6));
   }
   std::unique_ptr<CameraRenderer> renderer;
