@@ -41,7 +41,7 @@ LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajecto
       // draw the noise for every beam so each beam's noise does not depend on other beams' hits
       const double noise = rng.normal();
       const double drop = rng.uniform();
-      const RayHit hit = scene.cast(ray, 1e-6, rig_.max_range);
+      const RayHit hit = scene.cast(ray, CastContext::lidar(t0 + time_offset, rng.key()), 1e-6, rig_.max_range);
       if (!hit.valid() || hit.t < rig_.min_range) continue;
       if (drop < rig_.dropout_probability) continue;
       const double range = hit.t + rig_.range_noise_std * noise;
