@@ -33,7 +33,7 @@ struct Material {
   double v_offset = 0.0;
   MaterialKind kind = MaterialKind::kOpaque;
   double glass_return_probability = 0.05;  // glass: chance a LiDAR beam returns from this object
-  double glass_transmission = 0.85;        // glass: share of the light from behind, per surface
+  double glass_transmission = 0.95;        // glass: share of the light from behind, per surface
   double leaf_density = 1.0;               // vegetation: extinction coefficient (1/m), free path 1/this
 };
 
