@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace livo {
 namespace sim {
@@ -24,11 +25,13 @@ CameraRenderer::CameraRenderer(const CameraRig& rig, const CameraEffects& effect
 }
 
 void CameraRenderer::buildTiles() {
-  constexpr int kTile = 16;
+  // a rolling shutter sees each row from its own pose: one-row tiles
+  const bool rolling = effects_.rolling_shutter_s > 0.0;
+  const int tile_w = rolling ? 32 : 16, tile_h = rolling ? 1 : 16;
   const int w = rig_.width, h = rig_.height;
-  for (int y0 = 0; y0 < h; y0 += kTile) {
-    for (int x0 = 0; x0 < w; x0 += kTile) {
-      Tile t{x0, y0, std::min(w, x0 + kTile), std::min(h, y0 + kTile), {}, true};
+  for (int y0 = 0; y0 < h; y0 += tile_h) {
+    for (int x0 = 0; x0 < w; x0 += tile_w) {
+      Tile t{x0, y0, std::min(w, x0 + tile_w), std::min(h, y0 + tile_h), {}, true};
       // bounding cone of the tile's rays: axis = mean ray, half-angle = largest deviation
       Vec3 axis = Vec3::Zero();
       for (int y = t.y0; y < t.y1; ++y)
@@ -61,6 +64,18 @@ double CameraRenderer::exposureAt(double t) const {
   return effects_.exposure_time * (1.0 + effects_.exposure_variation * drift);
 }
 
+double CameraRenderer::illuminationAt(double t) const {
+  const double w = 2.0 * M_PI / effects_.exposure_period_s;
+  const double drift = 0.6 * std::sin(w * t) + 0.4 * std::sin(2.71 * w * t + 1.3);
+  return 1.0 + effects_.exposure_variation * drift;
+}
+
+double CameraRenderer::rowTimeOffset(int y) const {
+  if (effects_.rolling_shutter_s == 0.0) return 0.0;
+  const double line_delay = effects_.rolling_shutter_s / rig_.height;
+  return line_delay * (y - 0.5 * (rig_.height - 1));
+}
+
 Eigen::Vector3f CameraRenderer::shade(const Scene& scene, const Ray& ray, const RayHit& hit) const {
   if (!hit.valid()) {
     const float up = static_cast<float>(std::max(0.0, ray.direction.z()));
@@ -77,12 +92,38 @@ Eigen::Vector3f CameraRenderer::shade(const Scene& scene, const Ray& ray, const 
   return texture.sample(sp.u, sp.v, footprint) * static_cast<float>(light);
 }
 
-void CameraRenderer::accumulate(const Scene& scene, const Pose3& T_W_C, float weight, std::vector<float>* rgb) const {
-  const Mat3 R = T_W_C.linear();
+Eigen::Vector3f CameraRenderer::shadeThroughGlass(const Scene& scene, const Ray& ray, RayHit hit,
+                                                  const CastContext& context) const {
+  constexpr int kMaxGlassLayers = 4;
+  if (!hit.valid() || scene.material(hit.object).kind != MaterialKind::kGlass) return shade(scene, ray, hit);
+  Eigen::Vector3f colour = Eigen::Vector3f::Zero();
+  float share = 1.0f;
+  for (int layer = 0; layer < kMaxGlassLayers && hit.valid(); ++layer) {
+    const Material& m = scene.material(hit.object);
+    if (m.kind != MaterialKind::kGlass) break;
+    const float transmission = static_cast<float>(m.glass_transmission);
+    colour += share * (1.0f - transmission) * shade(scene, ray, hit);
+    share *= transmission;
+    hit = scene.cast(ray, context, hit.t + 1e-6);
+  }
+  return colour + share * shade(scene, ray, hit);
+}
+
+void CameraRenderer::accumulate(const Scene& scene, const PoseAt& T_W_C_at, double t, uint64_t key, float weight,
+                                std::vector<float>* rgb) const {
+  Mat3 R = Mat3::Identity();
   Ray ray;
-  ray.origin = T_W_C.translation();
+  double pose_time = std::numeric_limits<double>::quiet_NaN();
   Scene::Candidates candidates;
   for (const Tile& tile : tiles_) {
+    const double row_time = t + rowTimeOffset(tile.y0);  // one-row tiles under a rolling shutter
+    if (!(row_time == pose_time)) {
+      const Pose3 T_W_C = T_W_C_at(row_time);
+      R = T_W_C.linear();
+      ray.origin = T_W_C.translation();
+      pose_time = row_time;
+    }
+    CastContext context = CastContext::camera(row_time, 0);
     if (tile.culled) {
       const Vec3 normals[4] = {R * tile.normals[0], R * tile.normals[1], R * tile.normals[2], R * tile.normals[3]};
       scene.cullPyramid(ray.origin, normals, &candidates);
@@ -92,9 +133,10 @@ void CameraRenderer::accumulate(const Scene& scene, const Pose3& T_W_C, float we
       for (int x = tile.x0; x < tile.x1; ++x) {
         const size_t k = static_cast<size_t>(y) * rig_.width + x;
         ray.direction = R * rays_[k].cast<double>();
-        const RayHit hit = tile.culled ? scene.castAmong(ray, candidates, hint) : scene.cast(ray);
+        context.key = mix64(key ^ (k * 0x9e3779b97f4a7c15ULL));
+        const RayHit hit = tile.culled ? scene.castAmong(ray, candidates, hint, context) : scene.cast(ray, context);
         hint = hit.object;
-        const Eigen::Vector3f c = shade(scene, ray, hit);
+        const Eigen::Vector3f c = shadeThroughGlass(scene, ray, hit, context);
         float* px = &(*rgb)[3 * k];
         px[0] += weight * c[0];
         px[1] += weight * c[1];
@@ -106,13 +148,19 @@ void CameraRenderer::accumulate(const Scene& scene, const Pose3& T_W_C, float we
 
 CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime,
                                    Random rng) const {
-  const double exposure = exposureAt(t_mid);
+  return render(scene, trajectory, t_mid, utime, rng, ExposureSetting{exposureAt(t_mid), 1.0});
+}
+
+CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime,
+                                   Random rng, const ExposureSetting& setting) const {
+  const double exposure = setting.exposure;
   const int samples = std::max(1, effects_.motion_blur_samples);
+  const uint64_t key = rng.key();  // seeds the per-pixel interactions (vegetation depth)
+  auto T_W_C_at = [&](double t) { return Pose3(trajectory.at(t).T_W_I * rig_.T_I_C); };
   std::vector<float> rgb(rays_.size() * 3, 0.0f);
   for (int s = 0; s < samples; ++s) {
     const double t = samples == 1 ? t_mid : t_mid + exposure * ((s + 0.5) / samples - 0.5);
-    const Pose3 T_W_C = trajectory.at(t).T_W_I * rig_.T_I_C;
-    accumulate(scene, T_W_C, 1.0f / samples, &rgb);
+    accumulate(scene, T_W_C_at, t, mix64(key + static_cast<uint64_t>(s)), 1.0f / samples, &rgb);
   }
   CameraImage img;
   img.utime = utime;
@@ -123,7 +171,8 @@ CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& tra
   img.exposure_time = static_cast<float>(exposure);
   const int channels = rig_.color ? 3 : 1;
   img.data.resize(rays_.size() * channels);
-  const double gain = 255.0 * effects_.brightness * exposure / effects_.exposure_time;
+  const double illumination = effects_.auto_exposure.enabled ? illuminationAt(t_mid) : 1.0;
+  const double gain = 255.0 * effects_.brightness * exposure / effects_.exposure_time * setting.gain * illumination;
   auto quantize = [&](double v) {
     v += effects_.noise_std * rng.normal();
     return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));

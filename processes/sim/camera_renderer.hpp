@@ -1,9 +1,14 @@
 // Renders camera images by casting one ray per pixel into the textured scene: Lambertian shading
-// under the scene light, sky where nothing is hit, exposure that drifts over time (auto-exposure),
-// optional motion blur (averaged sub-frames over the exposure), vignetting and sensor noise.
+// under the scene light, sky where nothing is hit, seen through glass, exposure that drifts over
+// time, optional motion blur (averaged sub-frames over the exposure), optional rolling shutter
+// (each row from the pose and scene at its own time), gain and exposure set by an auto-exposure
+// controller (auto_exposure.hpp, run by the simulator frame after frame), vignetting and noise.
 #pragma once
 
+#include <functional>
 #include <vector>
+
+#include "auto_exposure.hpp"
 
 #include "livo/sensor_rig.hpp"
 #include "pinhole_camera.hpp"
@@ -23,6 +28,8 @@ struct CameraEffects {
   double noise_std = 1.5;            // sensor noise, grey levels
   double brightness = 1.0;           // overall gain
   double vignetting = 0.25;          // brightness loss at the image corners (0..1)
+  double rolling_shutter_s = 0.0;    // readout time, top row to bottom row (0 = global shutter)
+  AutoExposureOptions auto_exposure; // when enabled, exposure_variation drifts the scene light instead
 };
 
 class CameraRenderer {
@@ -31,14 +38,26 @@ class CameraRenderer {
 
   /// The image whose exposure is centred on trajectory time `t_mid` (stamped `utime`).
   CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime, Random rng) const;
+  /// The same with the exposure and gain an auto-exposure controller chose.
+  CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime, Random rng,
+                     const ExposureSetting& setting) const;
 
-  /// Exposure time at trajectory time t.
+  /// Exposure time at trajectory time t (the drift without auto exposure).
   double exposureAt(double t) const;
+  /// Relative scene light at trajectory time t (the drift with auto exposure).
+  double illuminationAt(double t) const;
+  /// Time of row y's mid-exposure relative to the image stamp (the centre row's mid-exposure).
+  double rowTimeOffset(int y) const;
   const PinholeCamera& camera() const { return camera_; }
 
  private:
-  void accumulate(const Scene& scene, const Pose3& T_W_C, float weight, std::vector<float>* rgb) const;
+  using PoseAt = std::function<Pose3(double)>;
+  /// Adds weight x the image seen at time t (each row at t + rowTimeOffset) to rgb.
+  void accumulate(const Scene& scene, const PoseAt& T_W_C_at, double t, uint64_t key, float weight,
+                  std::vector<float>* rgb) const;
   Eigen::Vector3f shade(const Scene& scene, const Ray& ray, const RayHit& hit) const;
+  /// shade() behind glass surfaces: each mixes its own shade in by (1 - transmission).
+  Eigen::Vector3f shadeThroughGlass(const Scene& scene, const Ray& ray, RayHit hit, const CastContext& context) const;
 
   /// A block of pixels whose rays all lie inside a pyramid (camera frame), used to cull the scene
   /// once per block instead of traversing it once per pixel.

@@ -67,6 +67,7 @@ struct RayHit {
   double t = kInfinity;
   int object = -1;
   int face = 0;
+  double time = 0.0;  // scene time of the cast (where a moving object was when it was hit)
   bool valid() const { return object >= 0; }
 };
 

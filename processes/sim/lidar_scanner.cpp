@@ -11,8 +11,8 @@ LidarScanner::LidarScanner(const LidarRig& rig, const LidarPatternOptions& patte
   if (effects_.footprint()) sub_rays_ = footprintSubRays(effects_);
 }
 
-Echo LidarScanner::axisEcho(const Scene& scene, const Ray& ray) const {
-  const RayHit hit = scene.cast(ray, 1e-6, rig_.max_range);
+Echo LidarScanner::axisEcho(const Scene& scene, const Ray& ray, const CastContext& context) const {
+  const RayHit hit = scene.cast(ray, context, 1e-6, rig_.max_range);
   Echo echo;
   if (!hit.valid()) return echo;
   echo.range = hit.t;
@@ -21,18 +21,22 @@ Echo LidarScanner::axisEcho(const Scene& scene, const Ray& ray) const {
   return echo;
 }
 
-Echo LidarScanner::footprintEcho(const Scene& scene, const Ray& ray, const Vec3& up,
+Echo LidarScanner::footprintEcho(const Scene& scene, const Ray& ray, const Vec3& up, const CastContext& context,
                                  std::vector<SubRayHit>* hits) const {
   Vec3 horizontal = up.cross(ray.direction);
   if (horizontal.norm() < 1e-9) horizontal = ray.direction.unitOrthogonal();
   horizontal.normalize();
   const Vec3 vertical = ray.direction.cross(horizontal);
   hits->clear();
-  for (const SubRay& s : sub_rays_) {
+  for (size_t i = 0; i < sub_rays_.size(); ++i) {
+    const SubRay& s = sub_rays_[i];
+    // each part of the beam draws its own glass and vegetation depths (its own key)
+    CastContext sub_context = context;
+    sub_context.key = context.key ^ (0x9E3779B97F4A7C15ull * (i + 1));
     Ray sub = ray;
     sub.direction =
         (ray.direction + std::tan(s.horizontal) * horizontal + std::tan(s.vertical) * vertical).normalized();
-    const RayHit hit = scene.cast(sub, 1e-6, rig_.max_range);
+    const RayHit hit = scene.cast(sub, sub_context, 1e-6, rig_.max_range);
     if (!hit.valid()) continue;  // this part of the beam goes to the sky: the return weakens
     const double cos_incidence = std::abs(scene.surface(sub, hit).normal.dot(sub.direction));
     hits->push_back({hit.t, s.weight, scene.material(hit.object).reflectivity, cos_incidence});
@@ -75,7 +79,9 @@ LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajecto
       const double noise = rng.normal();
       const double drop = rng.uniform();
       const double detect = effects_.detection() ? rng.uniform() : 0.0;
-      const Echo echo = sub_rays_.empty() ? axisEcho(scene, ray) : footprintEcho(scene, ray, R_WL.col(2), &hits);
+      const CastContext context = CastContext::lidar(t0 + time_offset, rng.key());
+      const Echo echo = sub_rays_.empty() ? axisEcho(scene, ray, context)
+                                          : footprintEcho(scene, ray, R_WL.col(2), context, &hits);
       if (!echo.valid() || echo.range < rig_.min_range) continue;
       if (drop < rig_.dropout_probability) continue;
       const double apparent = echo.apparentReflectivity();

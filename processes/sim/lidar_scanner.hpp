@@ -31,10 +31,11 @@ class LidarScanner {
 
  private:
   /// The return of a single ray along the beam axis.
-  Echo axisEcho(const Scene& scene, const Ray& ray) const;
+  Echo axisEcho(const Scene& scene, const Ray& ray, const CastContext& context) const;
   /// The strongest return of the beam footprint around `ray`; `up` is the sensor's z axis (the
   /// footprint's vertical); `hits` is scratch space.
-  Echo footprintEcho(const Scene& scene, const Ray& ray, const Vec3& up, std::vector<SubRayHit>* hits) const;
+  Echo footprintEcho(const Scene& scene, const Ray& ray, const Vec3& up, const CastContext& context,
+                     std::vector<SubRayHit>* hits) const;
 
   LidarRig rig_;
   LidarPattern pattern_;

@@ -45,6 +45,10 @@ class Random {
     return result;
   }
 
+  /// A hash of the current state, without advancing it: seeds per-ray streams (e.g. a LiDAR beam's
+  /// vegetation depth) without changing the draws that follow.
+  uint64_t key() const { return mix64(s_[0] ^ rotl(s_[1], 17) ^ rotl(s_[2], 31) ^ rotl(s_[3], 47)); }
+
   /// Uniform in [0, 1).
   double uniform() { return static_cast<double>(next() >> 11) * (1.0 / 9007199254740992.0); }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }

@@ -1,6 +1,7 @@
 #include "scene_config.hpp"
 
 #include <map>
+#include <stdexcept>
 
 #include "random.hpp"
 
@@ -90,15 +91,58 @@ Placement readRepeat(const Config& c) {
   return p;
 }
 
-void readObject(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
-  const std::string type = c.get<std::string>("type");
+double unitInterval(const Config& c, const std::string& key, double value) {
+  c.readOptional(key, value);
+  if (!(value >= 0.0 && value <= 1.0)) throw ConfigError(c.where(key) + ": must be in [0, 1]");
+  return value;
+}
+
+/// texture, reflectivity, and `material: opaque | glass` with glass's return_probability, transmission.
+Material readMaterial(const Config& c, const std::map<std::string, int>& textures) {
   const std::string tex = c.get<std::string>("texture");
   const auto it = textures.find(tex);
   if (it == textures.end()) throw ConfigError(c.where("texture") + ": unknown texture '" + tex + "'");
   Material m;
   m.texture = it->second;
-  c.readOptional("reflectivity", m.reflectivity);
-  if (m.reflectivity < 0.0 || m.reflectivity > 1.0) throw ConfigError(c.where("reflectivity") + ": must be in [0, 1]");
+  m.reflectivity = unitInterval(c, "reflectivity", m.reflectivity);
+  std::string kind = "opaque";
+  c.readOptional("material", kind);
+  if (kind == "glass") {
+    m.kind = MaterialKind::kGlass;
+    m.glass_return_probability = unitInterval(c, "return_probability", m.glass_return_probability);
+    m.glass_transmission = unitInterval(c, "transmission", m.glass_transmission);
+  } else if (kind != "opaque") {
+    throw ConfigError(c.where("material") + ": unknown material '" + kind + "' (known: opaque, glass)");
+  }
+  return m;
+}
+
+/// A box or cylinder crown of leaves (`shape`, its size keys, `leaf_density` in 1/m).
+Shape readVegetation(const Config& c, Material* m) {
+  if (m->kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": vegetation has no material key");
+  m->kind = MaterialKind::kVegetation;
+  m->leaf_density = positive(c, "leaf_density");
+  std::string form = "cylinder";
+  c.readOptional("shape", form);
+  Shape shape;
+  if (form == "box") {
+    shape.type = ShapeType::kBox;
+    const Vec3 size = c.get<Vec3>("size");
+    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
+    shape.half_size = 0.5 * size;
+  } else if (form == "cylinder") {
+    shape.type = ShapeType::kCylinder;
+    const double radius = positive(c, "radius"), height = positive(c, "height");
+    shape.half_size = Vec3(radius, radius, 0.5 * height);
+  } else {
+    throw ConfigError(c.where("shape") + ": unknown vegetation shape '" + form + "' (known: box, cylinder)");
+  }
+  return shape;
+}
+
+void readObject(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
+  const std::string type = c.get<std::string>("type");
+  Material m = readMaterial(c, textures);
   const Vec3 center = c.get<Vec3>("center");
   const Placement placement = readRepeat(c);
 
@@ -108,7 +152,10 @@ void readObject(Scene& scene, const Config& c, const std::string& name, const st
   Vec3 rpy = Vec3::Zero();
   const bool has_rpy = c.readOptional("rpy_deg", rpy);
   shape.rotation = rotationFromRpyDeg(rpy);
-  if (type == "plane") {
+  if (type == "vegetation") {
+    shape = readVegetation(c, &m);
+    shape.rotation = rotationFromRpyDeg(rpy);
+  } else if (type == "plane") {
     shape.type = ShapeType::kPlane;
     if (c.has("normal")) {
       if (has_rpy) throw ConfigError(c.where("normal") + ": give normal or rpy_deg, not both");
@@ -134,6 +181,7 @@ void readObject(Scene& scene, const Config& c, const std::string& name, const st
     shape.type = ShapeType::kSphere;
     shape.half_size = Vec3::Constant(positive(c, "radius"));
   } else if (type == "heightfield") {
+    if (m.kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": a height field is opaque");
     if (has_rpy) throw ConfigError(c.where("rpy_deg") + ": a height field is axis-aligned");
     is_height_field = true;
     const std::vector<double> size = c.get<std::vector<double>>("size");
@@ -160,7 +208,7 @@ void readObject(Scene& scene, const Config& c, const std::string& name, const st
     hf.seed = static_cast<uint64_t>(seed);
   } else {
     throw ConfigError(c.where("type") + ": unknown object type '" + type +
-                      "' (known: plane, box, cylinder, sphere, heightfield)");
+                      "' (known: plane, box, cylinder, sphere, heightfield, vegetation)");
   }
   c.checkAllUsed();
 
@@ -186,6 +234,52 @@ void readObject(Scene& scene, const Config& c, const std::string& name, const st
         scene.addShape(full, s, mi);
       }
     }
+  }
+}
+
+std::vector<Vec3> readPath(const Config& c) {
+  const auto flat = c.get<std::vector<double>>("path");
+  if (flat.size() % 3 != 0 || flat.size() < 6)
+    throw ConfigError(c.where("path") + ": expected x, y, z triples of at least 2 ground points");
+  std::vector<Vec3> points;
+  for (size_t i = 0; i < flat.size(); i += 3) points.emplace_back(flat[i], flat[i + 1], flat[i + 2]);
+  return points;
+}
+
+/// A pedestrian (upright cylinder, 0.5 m across, 1.75 m tall) or a car (box 4.5 x 1.8 x 1.5 m)
+/// walking a closed path; `size` overrides the body.
+void readMover(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
+  const std::string type = c.get<std::string>("type");
+  const Material m = readMaterial(c, textures);
+  Shape body;
+  std::vector<double> size;
+  const bool has_size = c.readOptional("size", size);
+  if (type == "pedestrian") {
+    body.type = ShapeType::kCylinder;
+    if (!has_size) size = {0.5, 1.75};
+    if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+      throw ConfigError(c.where("size") + ": a pedestrian's size is [diameter, height] > 0");
+    body.half_size = Vec3(0.5 * size[0], 0.5 * size[0], 0.5 * size[1]);
+  } else if (type == "car") {
+    body.type = ShapeType::kBox;
+    if (!has_size) size = {4.5, 1.8, 1.5};
+    if (size.size() != 3 || !(size[0] > 0.0) || !(size[1] > 0.0) || !(size[2] > 0.0))
+      throw ConfigError(c.where("size") + ": a car's size is [length, width, height] > 0");
+    body.half_size = 0.5 * Vec3(size[0], size[1], size[2]);
+  } else {
+    throw ConfigError(c.where("type") + ": unknown mover type '" + type + "' (known: pedestrian, car)");
+  }
+  MoverPath path;
+  path.waypoints = readPath(c);
+  c.read("speed", path.speed);
+  if (!(path.speed >= 0.0 && path.speed <= 100.0)) throw ConfigError(c.where("speed") + ": must be in [0, 100] m/s");
+  c.readOptional("phase", path.phase);
+  if (!(path.phase >= 0.0 && path.phase < 1.0)) throw ConfigError(c.where("phase") + ": must be in [0, 1)");
+  c.checkAllUsed();
+  try {
+    scene.addMover(name, MovingObject(body, path), m);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(c.where("path") + ": " + e.what());
   }
 }
 
@@ -216,6 +310,10 @@ std::unique_ptr<Scene> readScene(const Config& c) {
   const Config objects = c.section("objects");
   if (objects.keys().empty()) throw ConfigError(c.where("objects") + ": the scene has no objects");
   for (const std::string& name : objects.keys()) readObject(*scene, objects.section(name), name, textures);
+  if (c.has("movers")) {
+    const Config movers = c.section("movers");
+    for (const std::string& name : movers.keys()) readMover(*scene, movers.section(name), name, textures);
+  }
   c.checkAllUsed();
   scene->build();
   return scene;

@@ -114,6 +114,30 @@ bool intersectSphere(const Shape& s, const LocalRay& r, double t_min, double t_m
   return false;
 }
 
+/// Overlap of the ray with the slab |o_i + t d_i| <= h on axis i, clipped into [*lo, *hi].
+bool clipSlab(double o, double d, double h, double* lo, double* hi) {
+  if (d == 0.0) return std::abs(o) <= h;
+  double a = (-h - o) / d, b = (h - o) / d;
+  if (a > b) std::swap(a, b);
+  *lo = std::max(*lo, a);
+  *hi = std::min(*hi, b);
+  return *lo <= *hi;
+}
+
+/// Overlap of the ray with the infinite cylinder x^2 + y^2 <= r^2, clipped into [*lo, *hi].
+bool clipDisc(const LocalRay& r, double radius, double* lo, double* hi) {
+  const double a = r.d.x() * r.d.x() + r.d.y() * r.d.y();
+  const double c = r.o.x() * r.o.x() + r.o.y() * r.o.y() - radius * radius;
+  if (a == 0.0) return c <= 0.0;
+  const double b = r.o.x() * r.d.x() + r.o.y() * r.d.y();
+  const double disc = b * b - a * c;
+  if (disc < 0.0) return false;
+  const double sq = std::sqrt(disc);
+  *lo = std::max(*lo, (-b - sq) / a);
+  *hi = std::min(*hi, (-b + sq) / a);
+  return *lo <= *hi;
+}
+
 }  // namespace
 
 bool Shape::bounded() const {
@@ -143,6 +167,34 @@ bool intersectShape(const Shape& s, const Ray& ray, double t_min, double t_max, 
     case ShapeType::kSphere: return intersectSphere(s, r, t_min, t_max, t);
   }
   return false;
+}
+
+bool shapeInterval(const Shape& s, const Ray& ray, double* t_in, double* t_out) {
+  const LocalRay r = toLocal(s, ray);
+  double lo = -kInfinity, hi = kInfinity;
+  bool inside = false;
+  switch (s.type) {
+    case ShapeType::kPlane: return false;
+    case ShapeType::kBox:
+      inside = clipSlab(r.o.x(), r.d.x(), s.half_size.x(), &lo, &hi) &&
+               clipSlab(r.o.y(), r.d.y(), s.half_size.y(), &lo, &hi) &&
+               clipSlab(r.o.z(), r.d.z(), s.half_size.z(), &lo, &hi);
+      break;
+    case ShapeType::kCylinder:
+      inside = clipDisc(r, s.half_size.x(), &lo, &hi) && clipSlab(r.o.z(), r.d.z(), s.half_size.z(), &lo, &hi);
+      break;
+    case ShapeType::kSphere: {
+      const double b = r.o.dot(r.d), c = r.o.squaredNorm() - s.half_size.x() * s.half_size.x();
+      const double disc = b * b - c;
+      inside = disc >= 0.0;
+      if (inside) lo = -b - std::sqrt(disc), hi = -b + std::sqrt(disc);
+      break;
+    }
+  }
+  if (!inside) return false;
+  *t_in = lo;
+  *t_out = hi;
+  return true;
 }
 
 SurfacePoint shapeSurface(const Shape& s, const Ray& ray, double t, int face) {

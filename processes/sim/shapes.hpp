@@ -31,6 +31,10 @@ struct Shape {
 /// Nearest intersection with t in (t_min, t_max); `face` identifies the surface patch hit.
 bool intersectShape(const Shape& shape, const Ray& ray, double t_min, double t_max, double* t, int* face);
 
+/// The parameter range [*t_in, *t_out] over which the ray is inside a box, cylinder or sphere (t_in
+/// may be negative if the origin is inside); false if the ray misses it or it is a plane.
+bool shapeInterval(const Shape& shape, const Ray& ray, double* t_in, double* t_out);
+
 /// Position, normal (facing the ray origin) and texture coordinates at a hit.
 SurfacePoint shapeSurface(const Shape& shape, const Ray& ray, double t, int face);
 

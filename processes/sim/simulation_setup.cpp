@@ -137,6 +137,28 @@ void readLidarEffects(const Config& lidar, LidarEffects* e) {
   if (!(e->echo_separation_m >= 0.0)) throw ConfigError(lidar.where("echo_separation_m") + ": must be >= 0");
 }
 
+/// sim.camera.auto_exposure: present = on.
+void readAutoExposure(const Config& cam, CameraEffects* e) {
+  if (!cam.has("auto_exposure")) return;
+  const Config ae = cam.section("auto_exposure");
+  AutoExposureOptions& a = e->auto_exposure;
+  a.enabled = true;
+  ae.readOptional("target_mean", a.target_mean);
+  ae.readOptional("min_exposure", a.min_exposure);
+  ae.readOptional("max_exposure", a.max_exposure);
+  ae.readOptional("min_gain", a.min_gain);
+  ae.readOptional("max_gain", a.max_gain);
+  ae.readOptional("rate", a.rate);
+  if (!(a.target_mean > 0.0 && a.target_mean < 255.0)) throw ConfigError(ae.where("target_mean") + ": must be in (0, 255)");
+  if (!(a.min_exposure > 0.0)) throw ConfigError(ae.where("min_exposure") + ": must be > 0");
+  if (!(a.max_exposure >= a.min_exposure)) throw ConfigError(ae.where("max_exposure") + ": must be >= min_exposure");
+  if (!(a.min_gain >= 1.0)) throw ConfigError(ae.where("min_gain") + ": must be >= 1");
+  if (!(a.max_gain >= a.min_gain && a.max_gain <= 1000.0))
+    throw ConfigError(ae.where("max_gain") + ": must be in [min_gain, 1000]");
+  if (!(a.rate > 0.0 && a.rate <= 1.0)) throw ConfigError(ae.where("rate") + ": must be in (0, 1]");
+  ae.checkAllUsed();
+}
+
 void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   sim.readOptional("start_time_s", o->start_time_s);
   sim.readOptional("duration_s", o->duration_s);
@@ -177,6 +199,8 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   cam.readOptional("noise_std", e.noise_std);
   cam.readOptional("brightness", e.brightness);
   cam.readOptional("vignetting", e.vignetting);
+  cam.readOptional("rolling_shutter_s", e.rolling_shutter_s);
+  readAutoExposure(cam, &e);
   if (!(e.exposure_time > 0.0)) throw ConfigError(cam.where("exposure_time") + ": must be > 0");
   if (!(e.exposure_variation >= 0.0 && e.exposure_variation < 1.0))
     throw ConfigError(cam.where("exposure_variation") + ": must be in [0, 1)");
@@ -186,6 +210,8 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!(e.noise_std >= 0.0)) throw ConfigError(cam.where("noise_std") + ": must be >= 0");
   if (!(e.brightness > 0.0)) throw ConfigError(cam.where("brightness") + ": must be > 0");
   if (!(e.vignetting >= 0.0 && e.vignetting <= 1.0)) throw ConfigError(cam.where("vignetting") + ": must be in [0, 1]");
+  if (!(e.rolling_shutter_s >= 0.0) || (rig.camera && !(e.rolling_shutter_s <= 1.0 / rig.camera->rate_hz)))
+    throw ConfigError(cam.where("rolling_shutter_s") + ": must be in [0, 1 / rate_hz] (the readout fits in a frame)");
   cam.checkAllUsed();
 
   const Config wheel = sim.optionalSection("wheel");
@@ -322,8 +348,10 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
   os.unsetf(std::ios::floatfield);
   os << std::setprecision(6) << ", ground truth at " << o.ground_truth_rate_hz << " Hz, seed " << o.seed << ", "
      << o.threads << " threads\n";
-  os << "  scene: " << s.scene_source << ": " << s.scene->objectCount() << " objects, " << s.scene->textureCount()
-     << " textures\n";
+  os << "  scene: " << s.scene_source << ": " << s.scene->objectCount() - s.scene->moverCount() << " objects, "
+     << s.scene->textureCount() << " textures";
+  if (s.scene->moverCount() > 0) os << ", " << s.scene->moverCount() << " moving objects";
+  os << "\n";
   os << "  trajectory: " << s.trajectory_description << "\n";
   if (s.recorded) os << "  IMU: the recording's own samples, unchanged\n";
   else
@@ -337,7 +365,16 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
     os << "  camera: exposure " << o.camera.exposure_time * 1e3 << " ms +-" << o.camera.exposure_variation * 100
        << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples
        << ", noise " << o.camera.noise_std << " DN, brightness " << o.camera.brightness << ", vignetting "
-       << o.camera.vignetting << "\n";
+       << o.camera.vignetting;
+  if (s.rig.camera && o.camera.rolling_shutter_s > 0.0)
+    os << ", rolling shutter readout " << o.camera.rolling_shutter_s * 1e3 << " ms";
+  if (s.rig.camera) os << "\n";
+  if (s.rig.camera && o.camera.auto_exposure.enabled) {
+    const AutoExposureOptions& a = o.camera.auto_exposure;
+    os << "  camera auto exposure: target mean " << a.target_mean << ", exposure " << a.min_exposure * 1e3 << ".."
+       << a.max_exposure * 1e3 << " ms, gain " << a.min_gain << ".." << a.max_gain << ", rate " << a.rate
+       << " per frame (exposure_variation drifts the scene light)\n";
+  }
   if (s.rig.wheel)
     os << "  wheel: scale errors left " << o.wheel_left_scale << ", right " << o.wheel_right_scale << "\n";
   if (s.imu_errors.any()) printImuErrors(s, os);

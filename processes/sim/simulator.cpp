@@ -95,6 +95,8 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     renderer = std::make_unique<CameraRenderer>(*mounted.camera, o.camera);
     camera_offset_us = static_cast<int64_t>(std::llround(rig.camera->time_offset_s * 1e6));
   }
+  std::optional<AutoExposure> auto_exposure;  // carried from chunk to chunk
+  if (renderer && o.camera.auto_exposure.enabled) auto_exposure.emplace(o.camera.auto_exposure, o.camera.exposure_time);
 
   int64_t imu_k = 0, gt_k = 0, wheel_k = 0, sweep_k = 0, frame_k = 0;
   size_t recorded_k = 0;
@@ -160,20 +162,29 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
       }
     }
     if (renderer) {
+      std::vector<std::function<void()>> frames;
       for (int64_t u; (u = stampOf(start, frame_k, rig.camera->rate_hz, 0.5)) < c1; ++frame_k) {
         pending.push_back({u, kCameraRank, images.size()});
         images.emplace_back();
         const size_t slot = images.size() - 1;
         const int64_t k = frame_k;
-        jobs.push_back([&, slot, k, u] {
+        frames.push_back([&, slot, k, u] {
           // stamped on the camera's clock as the rig believes it (rig camera time_offset_s) and logged at
           // IMU time u; rendered at u + the camera's time offset error
-          images[slot] = renderer->render(scene, trajectory, s.trajectoryTime(u) + errors.camera_time_offset_s,
-                                          u - camera_offset_us,
-                                          Random(o.seed, kCameraStream, static_cast<uint64_t>(k)));
+          const double t = s.trajectoryTime(u) + errors.camera_time_offset_s;
+          const Random rng(o.seed, kCameraStream, static_cast<uint64_t>(k));
+          if (auto_exposure) {
+            images[slot] = renderer->render(scene, trajectory, t, u - camera_offset_us, rng, auto_exposure->setting());
+            auto_exposure->update(AutoExposure::meanLevel(images[slot].data));
+          } else {
+            images[slot] = renderer->render(scene, trajectory, t, u - camera_offset_us, rng);
+          }
           images[slot].log_utime = u;
         });
       }
+      // the controller meters each image for the next: one job renders the chunk's frames in order
+      if (auto_exposure) jobs.push_back([frames] { for (const auto& f : frames) f(); });
+      else jobs.insert(jobs.end(), frames.begin(), frames.end());
     }
     runJobs(jobs, o.threads);
 

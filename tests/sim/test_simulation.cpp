@@ -160,6 +160,67 @@ TEST(Simulation, CameraTimeOffsetStampsImagesOnTheCameraClock) {
   }
 }
 
+namespace {
+/// The room config with every world and camera effect of this file switched on: an inline scene
+/// with a glass pane, a vegetation crown, a walker and a car; rolling shutter and auto exposure.
+std::string roomWithEveryEffect() {
+  std::ifstream in(configPath("room"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string scene_key = "  scene_file: scenes/room.yaml\n";
+  const size_t at = yaml.find(scene_key);
+  EXPECT_NE(at, std::string::npos);
+  yaml.replace(at, scene_key.size(), R"(  scene:
+    textures:
+      grey: {pattern: noise, scale: 0.5, color: [0.8, 0.8, 0.8]}
+      leaves: {pattern: noise, scale: 0.1, color: [0.2, 0.5, 0.15], color2: [0.1, 0.3, 0.05]}
+    objects:
+      room: {type: box, center: [0, 0, 2], size: [14, 14, 4], texture: grey}
+      pane: {type: box, center: [3.5, 0, 1.5], size: [0.01, 3, 2], texture: grey, material: glass, return_probability: 0.2, transmission: 0.7}
+      bush: {type: vegetation, shape: cylinder, center: [-4, 4, 1], radius: 1.2, height: 2, texture: leaves, leaf_density: 1.5}
+    movers:
+      walker: {type: pedestrian, path: [-5, -5, 0, 5, -5, 0], speed: 1.4, phase: 0.3, texture: grey, reflectivity: 0.3}
+      car: {type: car, path: [-5, 5.5, 0, 5, 5.5, 0, 5, -5.5, 0], speed: 5, texture: leaves}
+)");
+  const std::string noise_key = "    noise_std: 1.5\n";
+  const size_t cam = yaml.find(noise_key);
+  EXPECT_NE(cam, std::string::npos);
+  yaml.insert(cam + noise_key.size(), "    rolling_shutter_s: 0.02\n    auto_exposure: {target_mean: 90, rate: 0.6}\n");
+  return yaml;
+}
+}  // namespace
+
+TEST(Simulation, EveryWorldAndCameraEffectStaysByteIdenticalWhateverTheThreads) {
+  const std::string yaml = roomWithEveryEffect();
+  std::vector<std::string> logs;
+  for (int threads : {1, 2}) {
+    SimOverrides o;
+    o.duration_s = 0.6;
+    o.threads = threads;
+    const SimulationSetup setup = loadSimulation(Config::fromString(yaml, "room_effects.yaml"), "", o);
+    EXPECT_EQ(setup.scene->moverCount(), 2u);
+    EXPECT_TRUE(setup.options.camera.auto_exposure.enabled);
+    const std::string path = livo_test::tempPath("sim_") + "room_effects_" + std::to_string(threads) + ".lcmlog";
+    {
+      LogWriter writer(path, setup.rig.channels);
+      Simulator(setup).run(writer);
+    }
+    logs.push_back(readBytes(path));
+  }
+  ASSERT_GT(logs[0].size(), 1000000u);
+  EXPECT_TRUE(logs[0] == logs[1]);
+  // the controller moves the exposure away from the configured start
+  SimOverrides o;
+  o.duration_s = 0.6;
+  const SimulationSetup setup = loadSimulation(Config::fromString(yaml, "room_effects.yaml"), "", o);
+  test::CollectingSink sink;
+  Simulator(setup).run(sink);
+  ASSERT_GE(sink.images.size(), 10u);
+  EXPECT_FLOAT_EQ(sink.images.front().exposure_time, 0.006f);
+  EXPECT_NE(sink.images.back().exposure_time, sink.images.front().exposure_time);
+}
+
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
   for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking"}) {
     SCOPED_TRACE(name);
@@ -244,6 +305,30 @@ TEST(SimulationConfig, ErrorsNameTheFileAndKey) {
             std::string::npos);
   EXPECT_NE(configError(rig + "vio: {}\nsimulation: {}\n").find("simulation: unknown section"), std::string::npos);
   EXPECT_NE(configError(rig + "sim:\n  duration_s: -1\n" + test::boxRoomScene() + good_traj).find("sim.duration_s: must be > 0"),
+            std::string::npos);
+  // world and camera effects
+  std::string scene_with = test::boxRoomScene();
+  scene_with += "    movers:\n      bus: {type: bus, path: [0,0,0, 1,0,0], speed: 1, texture: grey}\n";
+  EXPECT_NE(configError(rig + "sim:\n" + scene_with + good_traj).find("sim.scene.movers.bus.type: unknown mover type 'bus'"),
+            std::string::npos);
+  std::string glass = test::boxRoomScene();
+  glass.replace(glass.find("reflectivity: 0.5}"), 18, "reflectivity: 0.5, material: glass, transmission: 1.5}");
+  EXPECT_NE(configError(rig + "sim:\n" + glass + good_traj).find("sim.scene.objects.room.transmission: must be in [0, 1]"),
+            std::string::npos);
+  std::string bush = test::boxRoomScene();
+  bush += "      bush: {type: vegetation, shape: cone, center: [0,0,1], radius: 1, height: 2, texture: grey, leaf_density: 1}\n";
+  EXPECT_NE(configError(rig + "sim:\n" + bush + good_traj).find("sim.scene.objects.bush.shape: unknown vegetation shape 'cone'"),
+            std::string::npos);
+  const std::string cam_rig = rig + "  camera: {width: 64, height: 48, fx: 40, fy: 40, cx: 31.5, cy: 23.5, distortion: [0,0,0,0], "
+                                    "rate_hz: 20, T_I_C: {translation: [0,0,0], rpy_deg: [-90,0,-90]}}\n";
+  EXPECT_NE(configError(cam_rig + "sim:\n  camera: {rolling_shutter_s: 0.06}\n" + test::boxRoomScene() + good_traj)
+                .find("sim.camera.rolling_shutter_s: must be in [0, 1 / rate_hz]"),
+            std::string::npos);
+  EXPECT_NE(configError(cam_rig + "sim:\n  camera: {auto_exposure: {rate: 0}}\n" + test::boxRoomScene() + good_traj)
+                .find("sim.camera.auto_exposure.rate: must be in (0, 1]"),
+            std::string::npos);
+  EXPECT_NE(configError(cam_rig + "sim:\n  camera: {auto_exposure: {target: 90}}\n" + test::boxRoomScene() + good_traj)
+                .find("sim.camera.auto_exposure.target"),
             std::string::npos);
   EXPECT_THROW(loadSimulation("/nonexistent/config.yaml"), ConfigError);
 }
