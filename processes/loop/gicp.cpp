@@ -1,6 +1,7 @@
 #include "gicp.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -62,6 +63,37 @@ Linearisation linearise(const GicpCloud& source, const GicpCloud& target, const 
   }
   return L;
 }
+
+// The point-to-plane part of the cost at T (one more pass over the source): the normal of each
+// pair's summed covariance, the Jacobian of the residual along it, and the residual's variance.
+void planeInformation(const GicpCloud& source, const GicpCloud& target, const Pose3& T, double max_d2, size_t stride,
+                      GicpResult& r) {
+  const Mat3 R = T.linear();
+  Mat6 H = Mat6::Zero();
+  double sum_sq = 0.0;
+  int count = 0;
+  for (size_t i = 0; i < source.size(); i += stride) {
+    const Vec3 p = T * source.points()[i];
+    size_t j;
+    double d2;
+    if (!target.tree->nearestWithin(p, max_d2, j, d2)) continue;
+    const Mat3 C = target.covariances[j].matrix() + R * source.covariances[i].matrix() * R.transpose();
+    Eigen::SelfAdjointEigenSolver<Mat3> es;
+    es.compute(C);
+    const Vec3 n = es.eigenvectors().col(0);
+    Eigen::Matrix<double, 1, 6> Jn;  // d (n . e) / d [dr; dt], e = t - p
+    Jn.leftCols<3>() = n.transpose() * so3::hat(p);
+    Jn.rightCols<3>() = -n.transpose();
+    H += Jn.transpose() * Jn;
+    const double en = n.dot(target.points()[j] - p);
+    sum_sq += en * en;
+    ++count;
+  }
+  if (count <= 6 || sum_sq <= 0.0) return;
+  r.plane_residual_variance = sum_sq / (count - 6);
+  r.plane_correspondences = count;
+  r.plane_information = H / r.plane_residual_variance;
+}
 }  // namespace
 
 GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const Pose3& initial,
@@ -101,6 +133,7 @@ GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const 
   r.fitness = L.count > 0 ? L.sum_sq / L.count : 0.0;
   r.information = L.H;
   r.overlap = static_cast<double>(L.overlapping) / static_cast<double>(used);
+  if (r.converged) planeInformation(source, target, T, max_d2, stride, r);
   if (L.count > 0) {
     Eigen::SelfAdjointEigenSolver<Mat3> es(L.H.bottomRightCorner<3, 3>() / L.count);
     r.min_translation_eigenvalue = es.eigenvalues()[0];

@@ -51,7 +51,20 @@ struct GicpResult {
   double fitness = 0.0;        // mean squared distance of correspondences within max distance, m^2
   double overlap = 0.0;        // fraction of (used) source points with a target point within overlap_distance
   int num_correspondences = 0;
-  Mat6 information = Mat6::Zero();   // Gauss-Newton Hessian at the solution, [rotation; translation]
+  /// Gauss-Newton Hessian of the GICP cost at the solution, [rotation; translation], for a left
+  /// perturbation in the target frame (T' = [Exp(dr), dt] T). Its scale is that of the regularised
+  /// covariances (1 m^2 in the plane, plane_epsilon along the normal), not of the sensor, and its
+  /// in-plane terms constrain directions the surfaces do not (a corridor along its axis): it steers
+  /// the solver, it is no covariance (see plane_information).
+  Mat6 information = Mat6::Zero();
+  /// Point-to-plane information at the solution, same perturbation and order: sum of J^T n n^T J
+  /// over the correspondences (n the normal of the pair's summed covariance) divided by
+  /// plane_residual_variance. Only the normal components constrain the pose; their noise comes
+  /// from the residuals themselves (sensor noise, surface roughness, sampling), so this is an
+  /// inverse covariance to the extent the correspondences are independent and the surfaces planar.
+  Mat6 plane_information = Mat6::Zero();
+  double plane_residual_variance = 0.0;  // m^2: sum of (n . e)^2 over (correspondences - 6)
+  int plane_correspondences = 0;
   double min_translation_eigenvalue = 0.0;  // of the Hessian's translation block per correspondence
   /// Smallest over largest eigenvalue of that block: near 0 when one direction is constrained only
   /// by the weak in-plane terms (a corridor along its axis), whatever the point count.

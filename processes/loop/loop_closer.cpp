@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "voxel_grid.hpp"
@@ -122,6 +123,7 @@ AcceptedLoop LoopCloser::acceptedLoop(int64_t from_id, const Keyframe& from, int
   loop.to_utime = to.utime;
   // registration works in the levelled frames G; the loop is between the body frames I
   loop.T_to_from = rotationOnly(to.G_R_I).inverse() * r.T_target_source * rotationOnly(from.G_R_I);
+  loop.covariance = loopCovariance(r, from);
   loop.coarse_inliers = r.coarse.num_inliers;
   loop.fitness = r.fine.fitness;
   loop.overlap = r.fine.overlap;
@@ -143,22 +145,109 @@ std::optional<int64_t> LoopCloser::mergeCandidate(int64_t kf_id, const Keyframe&
   return near.front().second;
 }
 
-Mat6 LoopCloser::loopCovariance() const {
-  Vec6 sigma;
-  sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
-  return sigma.cwiseAbs2().asDiagonal();
+Mat6 LoopCloser::loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const {
+  if (!options_.registration_information) {
+    Vec6 sigma;
+    sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
+    return sigma.cwiseAbs2().asDiagonal();
+  }
+  // registered between the levelled frames: T_I = Q_to^-1 T_G Q_from, so T_I Exp(xi_I) =
+  // Q_to^-1 T_G Exp(xi_G) Q_from gives xi_I = Ad(Q_from^-1) xi_G (a rotation: both blocks rotated)
+  const Mat6 cov_G = registrationCovariance(r.fine, r.T_target_source, options_.loop_information);
+  Mat6 A = Mat6::Zero();
+  A.topLeftCorner<3, 3>() = A.bottomRightCorner<3, 3>() = from.G_R_I.transpose();
+  return A * cov_G * A.transpose();
+}
+
+DriftModel LoopCloser::driftModel() const {
+  return {options_.odometry_rotation_floor, options_.odometry_translation_floor, options_.odometry_rotation_per_m,
+          options_.odometry_translation_per_m};
+}
+
+std::optional<RefusedLoop> LoopCloser::inconsistency(const AcceptedLoop& loop, const Keyframe& from,
+                                                     const Pose3& W_T_from) const {
+  if (!options_.consistency_check) return std::nullopt;
+  const Keyframe& to = nodes_.at(loop.to_id);
+  const DriftModel drift = driftModel();
+  RefusedLoop refusal;
+  refusal.from_id = loop.from_id;
+  refusal.to_id = loop.to_id;
+  refusal.merged = loop.merged;
+  refusal.T_to_from = loop.T_to_from;
+  std::ostringstream why;
+  // the graph's relative pose of the two, uncertain by the odometry's drift over the path between them
+  const double path = std::abs(from.path - to.path);
+  const Pose3 graph_T = graph_.pose(loop.to_id).inverse() * W_T_from;
+  const double chi2 = poseChi2(graph_T, driftCovariance(path, drift), loop.T_to_from, loop.covariance);
+  if (chi2 > options_.consistency_chi2) {
+    refusal.against = "odometry";
+    refusal.chi2 = chi2;
+    refusal.path = path;
+    why << "inconsistent with the odometry: chi2 " << chi2 << " > " << options_.consistency_chi2 << " over " << path
+        << " m (" << (graph_T.inverse() * loop.T_to_from).translation().norm() << " m apart)";
+    refusal.reason = why.str();
+    return refusal;
+  }
+  // the cycle through the earlier loop with the least odometry on either side (C <- D), if any has
+  // less than the path above: T_to_from = odo(to -> C) T_C_D odo(D -> from)
+  long best = -1;
+  double best_path = path, best_1 = 0.0, best_3 = 0.0;
+  for (size_t k = 0; k < loops_.size(); ++k) {
+    if (anchors_[k].epoch != from.epoch) continue;
+    const double l1 = std::abs(to.path - nodes_.at(loops_[k].to_id).path);
+    const double l3 = std::abs(anchors_[k].from_path - from.path);
+    if (l1 + l3 < best_path) {
+      best = static_cast<long>(k);
+      best_path = l1 + l3;
+      best_1 = l1;
+      best_3 = l3;
+    }
+  }
+  if (best < 0) return std::nullopt;
+  const AcceptedLoop& earlier = loops_[best];
+  const Pose3 T1 = to.odometry.inverse() * nodes_.at(earlier.to_id).odometry;
+  const Pose3 T3 = anchors_[best].from_odometry.inverse() * from.odometry;
+  const Mat6 cov12 = composedCovariance(driftCovariance(best_1, drift), earlier.T_to_from, earlier.covariance);
+  const Mat6 cov = composedCovariance(cov12, T3, driftCovariance(best_3, drift));
+  const double cycle_chi2 = poseChi2(T1 * earlier.T_to_from * T3, cov, loop.T_to_from, loop.covariance);
+  if (cycle_chi2 <= options_.consistency_chi2) return std::nullopt;
+  refusal.against = "loop";
+  refusal.against_from_id = earlier.from_id;
+  refusal.against_to_id = earlier.to_id;
+  refusal.chi2 = cycle_chi2;
+  refusal.path = best_path;
+  why << "inconsistent with loop " << earlier.from_id << " -> " << earlier.to_id << ": chi2 " << cycle_chi2 << " > "
+      << options_.consistency_chi2 << " over a cycle with " << best_path << " m of odometry";
+  refusal.reason = why.str();
+  return refusal;
+}
+
+void LoopCloser::accept(const AcceptedLoop& loop, const Keyframe& from, AddResult& result) {
+  loops_.push_back(loop);
+  anchors_.push_back(LoopAnchor{from.epoch, from.odometry, from.path});
+  result.loop = loop;
+  keyframes_since_loop_ = 0;
+}
+
+LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, int64_t to_id,
+                                                const Features& to) const {
+  LoopRegistrationResult r = registerLoop(from.coarse, to.coarse, from.fine, to.fine, options_.registration);
+  if (options_.registration_hook) options_.registration_hook(from_id, to_id, r);
+  return r;
 }
 
 Mat6 LoopCloser::chainCovariance(const Keyframe& to) const {
   // the odometry part: the increment's covariance from the absolute ones, floored by the drift
   // model over the path; the loop part (if the chain starts with one) adds its covariance
-  // (isotropic blocks, so carrying it to the end of the chain is left out)
+  // (carried to the end of the chain)
   const Mat6 odometry =
       relativeInformation(chain_.start_keyframe.covariance, to.covariance,
                           std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
                           std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
           .inverse();
-  return chain_.via_loop ? Mat6(odometry + loopCovariance()) : odometry;
+  if (!chain_.via_loop) return odometry;
+  // T_node_to = T_node_start (the loop) * the odometry increment from start to `to`
+  return composedCovariance(chain_.loop_covariance, chain_.start_keyframe.odometry.inverse() * to.odometry, odometry);
 }
 
 std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t current, const Keyframe& cur,
@@ -218,6 +307,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
   const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
   const Pose3 previous_odometry = newest_.odometry;
+  kf.path = first_of_epoch ? 0.0 : newest_.path + (previous_odometry.inverse() * kf.odometry).translation().norm();
   newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;
@@ -229,7 +319,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     cur_features = deriveCurrent();
     addNode(input.id, kf, kf.odometry, cloud_f);
     if (!first) graph_.holdFixed(input.id);
-    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0};
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
   } else {
     chain_.path += (previous_odometry.inverse() * kf.odometry).translation().norm();
     // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
@@ -248,27 +338,32 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
       if (const std::optional<int64_t> near = mergeCandidate(input.id, kf, estimate.translation())) {
         const Keyframe& target = nodes_.at(*near);
         const std::shared_ptr<const Features> target_features = features(*near);
-        LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
-                                                target_features->fine, options_.registration);
+        LoopRegistrationResult r = registerPair(input.id, *cur_features, *near, *target_features);
         result.attempts.push_back(r);
+        std::optional<AcceptedLoop> loop;
         if (r.accepted) {
+          loop = acceptedLoop(input.id, kf, *near, target, r);
+          loop->merged = true;
+          if (std::optional<RefusedLoop> refusal = inconsistency(*loop, kf, estimate)) {
+            refused_.push_back(*refusal);
+            result.refused.push_back(*refusal);
+            loop.reset();  // it becomes a node of its own (below)
+          }
+        }
+        if (loop) {
           // the keyframe joins the older node; the graph gets the edge chain node -> that node
-          AcceptedLoop loop = acceptedLoop(input.id, kf, *near, target, r);
-          loop.merged = true;
-          placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop.T_to_from});
+          placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from});
           PoseEdge e;  // none if the chain's node is the joined one (no new relation)
           e.from = chain_.node;
           e.to = *near;
-          e.T_from_to = T_node_kf * loop.T_to_from.inverse();
+          e.T_from_to = T_node_kf * loop->T_to_from.inverse();
           e.is_loop = true;
-          const Mat6 cov = chainCovariance(kf) + loopCovariance();
-          e.information = cov.inverse();
-          e.information = 0.5 * (e.information + e.information.transpose()).eval();
-          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &loop);
-          loops_.push_back(loop);
-          result.loop = loop;
-          keyframes_since_loop_ = 0;
-          chain_ = Chain{*near, input.id, kf, loop.T_to_from, true, 0.0};
+          const Mat6 cov = composedCovariance(chainCovariance(kf), loop->T_to_from.inverse(),
+                                              inverseCovariance(loop->T_to_from, loop->covariance));
+          e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
+          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &*loop);
+          accept(*loop, kf, result);
+          chain_ = Chain{*near, input.id, kf, loop->T_to_from, true, 0.0, loop->covariance};
           return result;
         }
       }
@@ -280,7 +375,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.T_from_to = T_node_kf;
     e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
     e.information = chain_.via_loop
-                        ? Mat6(chainCovariance(kf).inverse())
+                        ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
                         : relativeInformation(chain_.start_keyframe.covariance, kf.covariance,
                                               std::hypot(options_.odometry_rotation_floor,
                                                          options_.odometry_rotation_per_m * chain_.path),
@@ -288,7 +383,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
                                                          options_.odometry_translation_per_m * chain_.path));
     addNode(input.id, kf, estimate, cloud_f);
     graph_.addEdge(e);
-    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0};
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
     if (!result.attempts.empty()) return result;  // the nearest older node did not register: no second try
   }
 
@@ -298,23 +393,23 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   for (int64_t cand : candidates(input.id, kf, graph_.pose(input.id).translation())) {
     const Keyframe& target = nodes_.at(cand);
     const std::shared_ptr<const Features> target_features = features(cand);
-    LoopRegistrationResult r = registerLoop(cur_features->coarse, target_features->coarse, cur_features->fine,
-                                            target_features->fine, options_.registration);
+    LoopRegistrationResult r = registerPair(input.id, *cur_features, cand, *target_features);
     result.attempts.push_back(r);
     if (!r.accepted) continue;
     AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);
+    if (std::optional<RefusedLoop> refusal = inconsistency(loop, kf, graph_.pose(input.id))) {
+      refused_.push_back(*refusal);
+      result.refused.push_back(*refusal);
+      continue;
+    }
     PoseEdge e;
     e.from = cand;
     e.to = input.id;
     e.T_from_to = loop.T_to_from;
     e.is_loop = true;
-    Vec6 sigma;
-    sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
-    e.information = sigma.cwiseInverse().cwiseAbs2().asDiagonal();
+    e.information = informationFromCovariance(edgeCovarianceFromRight(loop.T_to_from, loop.covariance));
     result.correction = addLoopEdge(&e, input.id, kf, &loop);
-    loops_.push_back(loop);
-    result.loop = loop;
-    keyframes_since_loop_ = 0;
+    accept(loop, kf, result);
     break;
   }
   return result;

@@ -17,6 +17,8 @@
 #include "livo/correction_frames.hpp"
 #include "gicp.hpp"
 #include "livo/spill_file.hpp"
+#include "loop_consistency.hpp"
+#include "loop_information.hpp"
 #include "loop_registration.hpp"
 #include "pose_graph.hpp"
 
@@ -50,8 +52,23 @@ struct LoopCloserOptions {
   double odometry_translation_floor = 2e-3;    // m
   double odometry_rotation_per_m = 2e-4;       // rad per metre travelled
   double odometry_translation_per_m = 5e-3;    // m per metre travelled
-  double loop_rotation_sigma = 5e-3;         // rad
-  double loop_translation_sigma = 5e-2;      // m
+  /// A loop edge's covariance: from its fine registration (GICP's point-to-plane information,
+  /// floored and capped per `loop_information`: loop_information.hpp), or (false) the fixed
+  /// diagonal below, as before.
+  bool registration_information = true;
+  LoopInformationOptions loop_information;
+  double loop_rotation_sigma = 5e-3;         // rad (registration_information false)
+  double loop_translation_sigma = 5e-2;      // m (registration_information false)
+  /// A verified loop enters the graph only if it agrees, within the chi-square bound, with the
+  /// graph's relative pose of its two keyframes (covariance: the odometry's drift model above over
+  /// the odometry's path between them) and with the cycle through the earlier loop nearest to it
+  /// (loop_consistency.hpp). Refused loops are counted with their reason.
+  bool consistency_check = true;
+  double consistency_chi2 = kChi2Six999;  // 6 degrees of freedom, p = 0.999
+  /// For tests only (empty in the process): sees, and may change, every registration result of
+  /// keyframe `from_id` (source) against node `to_id` (target) before it is judged, e.g. to plant
+  /// a false loop. The result's T_target_source is between the levelled frames G of the two.
+  std::function<void(int64_t from_id, int64_t to_id, LoopRegistrationResult& result)> registration_hook;
   /// A verified loop that the odometry already satisfies to within these (the new keyframe's pose
   /// in the newest correction against where the loop puts it) is added to the graph but neither
   /// optimised nor published: it
@@ -95,6 +112,20 @@ struct AcceptedLoop {
   /// The new keyframe joined the older one (reduced pose graph): the edge went from the node the
   /// odometry came from to `to_id`, and the residual is that edge's.
   bool merged = false;
+  /// Covariance of T_to_from's right perturbation ([rotation; translation in I_from]).
+  Mat6 covariance = Mat6::Zero();
+};
+
+/// A verified loop the consistency check kept out of the graph.
+struct RefusedLoop {
+  int64_t from_id = 0, to_id = 0;
+  bool merged = false;       // it would have joined keyframe from_id to node to_id
+  Pose3 T_to_from = Pose3::Identity();
+  std::string against;       // "odometry" (the graph's relative pose) or "loop" (a cycle with an earlier one)
+  int64_t against_from_id = -1, against_to_id = -1;  // the earlier loop (against "loop")
+  double chi2 = 0.0;         // of the check that failed (bound: consistency_chi2)
+  double path = 0.0;         // m of odometry in the prediction it was checked against
+  std::string reason;        // the above in words
 };
 
 /// What a LIO adopts after an accepted loop (loop_correction_t): correction `id` of `epoch`.
@@ -110,6 +141,7 @@ struct AddResult {
   std::vector<LoopRegistrationResult> attempts;
   std::optional<AcceptedLoop> loop;  // set if a loop was accepted (added to the graph)
   std::optional<Correction> correction;  // if the loop changed the estimate: the correction to publish
+  std::vector<RefusedLoop> refused;      // verified loops the consistency check refused
 };
 
 class LoopCloser {
@@ -138,6 +170,7 @@ class LoopCloser {
   int64_t node(int64_t id) const { return placement(id).node; }
   int64_t newestId() const { return placements_.empty() ? -1 : placements_.back().id; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
+  const std::vector<RefusedLoop>& refusedLoops() const { return refused_; }
   /// Accepted loops that were optimised and published as a correction.
   size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
   int64_t utime(int64_t id) const { return placement(id).utime; }
@@ -161,6 +194,7 @@ class LoopCloser {
     Pose3 odometry = Pose3::Identity();   // in the raw odometry frame of its epoch (no correction)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
+    double path = 0.0;                  // m of odometry from the first keyframe of its epoch
     bool has_keypoints = false;         // its coarse features are not empty
   };
   /// What every keyframe keeps (the reduced pose graph's keyframes are mostly not nodes): where it
@@ -182,6 +216,13 @@ class LoopCloser {
     Pose3 T_node_start = Pose3::Identity();
     bool via_loop = false;  // T_node_start is a loop measurement (else start == node)
     double path = 0.0;      // m of odometry from start
+    Mat6 loop_covariance = Mat6::Zero();  // of T_node_start (right perturbation), if via_loop
+  };
+  /// What the consistency check needs of an accepted loop besides AcceptedLoop (parallel to loops_).
+  struct LoopAnchor {
+    int32_t epoch = 0;
+    Pose3 from_odometry = Pose3::Identity();  // raw odometry of the loop's from keyframe
+    double from_path = 0.0;
   };
   /// What registration needs of a keyframe, derived from its stored cloud.
   struct Features {
@@ -196,9 +237,18 @@ class LoopCloser {
   std::vector<int64_t> candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
   /// The nearest older node (not within exclude_recent_s) of the epoch within merge_distance of p.
   std::optional<int64_t> mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
-  /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts).
+  /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts), right
+  /// perturbation of T_node_to.
   Mat6 chainCovariance(const Keyframe& to) const;
-  Mat6 loopCovariance() const;
+  /// A loop's covariance (right perturbation of T_to_from in the body frames) from its registration.
+  Mat6 loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const;
+  DriftModel driftModel() const;
+  /// Why the loop (from keyframe `from`, whose graph pose is W_T_from) must not enter the graph,
+  /// if it must not: the consistency check.
+  std::optional<RefusedLoop> inconsistency(const AcceptedLoop& loop, const Keyframe& from, const Pose3& W_T_from) const;
+  void accept(const AcceptedLoop& loop, const Keyframe& from, AddResult& result);
+  /// Runs the registration of from_id against to_id (and the test hook).
+  LoopRegistrationResult registerPair(int64_t from_id, const Features& from, int64_t to_id, const Features& to) const;
   /// Adds a loop edge (if any); unless the odometry already satisfies the loop, optimises and returns the
   /// correction for keyframe `current` (loop gets its residual and `corrected`).
   /// A verified registration of keyframe from_id (source) against to_id (target) as a loop.
@@ -220,6 +270,8 @@ class LoopCloser {
   KeyframeCloudStore clouds_;  // the nodes' clouds, body frame I, float as received (lossless)
   std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;
+  std::vector<LoopAnchor> anchors_;    // parallel to loops_
+  std::vector<RefusedLoop> refused_;
   int64_t keyframes_since_loop_ = 1000000;
   CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch
   int64_t next_correction_id_ = 1;

@@ -43,6 +43,14 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("odometry_translation_per_m", c.odometry_translation_per_m);
   s.readOptional("loop_rotation_sigma", c.loop_rotation_sigma);
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
+  s.readOptional("registration_information", c.registration_information);
+  s.readOptional("loop_min_rotation_sigma", c.loop_information.min_rotation_sigma);
+  s.readOptional("loop_min_translation_sigma", c.loop_information.min_translation_sigma);
+  s.readOptional("loop_max_rotation_sigma", c.loop_information.max_rotation_sigma);
+  s.readOptional("loop_max_translation_sigma", c.loop_information.max_translation_sigma);
+  s.readOptional("loop_min_constrained_fraction", c.loop_information.min_constrained_fraction);
+  s.readOptional("consistency_check", c.consistency_check);
+  s.readOptional("consistency_chi2", c.consistency_chi2);
   s.readOptional("min_correction_translation", c.min_correction_translation);
   s.readOptional("min_correction_rotation", c.min_correction_rotation);
   s.readOptional("merge_distance", c.merge_distance);
@@ -52,6 +60,16 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
     throw ConfigError(s.where("coarse_voxel") + ": voxel sizes, search_radius and noise_bound must be > 0");
   if (c.merge_distance < 0 || c.min_correction_translation < 0 || c.min_correction_rotation < 0)
     throw ConfigError(s.where("merge_distance") + ": merge_distance and min_correction_* must be >= 0");
+  const LoopInformationOptions& li = c.loop_information;
+  if (!(li.min_rotation_sigma > 0 && li.min_translation_sigma > 0 && li.max_rotation_sigma > li.min_rotation_sigma &&
+        li.max_translation_sigma > li.min_translation_sigma && li.min_constrained_fraction >= 0 &&
+        li.min_constrained_fraction < 1))
+    throw ConfigError(s.where("loop_min_rotation_sigma") +
+                      ": loop_min_*_sigma must be > 0, loop_max_*_sigma greater than them and "
+                      "loop_min_constrained_fraction in [0, 1)");
+  if (!(c.loop_rotation_sigma > 0 && c.loop_translation_sigma > 0))
+    throw ConfigError(s.where("loop_rotation_sigma") + ": loop_rotation_sigma and loop_translation_sigma must be > 0");
+  if (!(c.consistency_chi2 > 0)) throw ConfigError(s.where("consistency_chi2") + ": consistency_chi2 must be > 0");
   return o;
 }
 
@@ -115,6 +133,10 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
       << a.fine.translation_eigenvalue_ratio << "): " << (a.accepted ? "accepted" : a.reason);
     node_.info(s.str());
   }
+  for (const RefusedLoop& f : r.refused)
+    node_.warn((f.merged ? "keyframe " : "loop ") + std::to_string(f.from_id) + (f.merged ? " joining " : " -> ") +
+               std::to_string(f.to_id) + " refused (" + std::to_string(closer_.refusedLoops().size()) + " so far): " +
+               f.reason);
   if (r.loop) {
     std::ostringstream s;
     s << (r.loop->merged ? "keyframe " : "loop ") << r.loop->from_id << (r.loop->merged ? " joins " : " -> ")
@@ -151,12 +173,23 @@ void LoopNode::publishCorrection(const AcceptedLoop& loop, const Correction& cor
   node_.publish(options_.loop_correction_channel, msg);
 }
 
+std::string LoopNode::summary() const {
+  size_t by_odometry = 0;
+  for (const RefusedLoop& f : closer_.refusedLoops()) by_odometry += f.against == "odometry";
+  const size_t refused = closer_.refusedLoops().size();
+  return std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
+         " corrections, " + std::to_string(refused) + " refused as inconsistent (" + std::to_string(by_odometry) +
+         " with the odometry, " + std::to_string(refused - by_odometry) + " with an earlier loop)";
+}
+
 void LoopNode::writeOutputs() {
-  if (options_.output_dir.empty()) return;
+  if (options_.output_dir.empty()) {
+    node_.info(summary());
+    return;
+  }
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
-  node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" +
-             std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
-             " corrections; " + std::to_string(closer_.graph().poses().size()) + " graph nodes, " + std::to_string(closer_.size()) +
+  node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" + summary() + "; " +
+             std::to_string(closer_.graph().poses().size()) + " graph nodes, " + std::to_string(closer_.size()) +
              " keyframe clouds on disk, " + std::to_string(closer_.storedCloudBytes() / 1000000) + " MB; features of " +
              std::to_string(closer_.cachedFeatures()) + " keyframes in memory)");
 }

@@ -32,6 +32,8 @@ class LoopNode {
   const LoopCloser& closer() const { return closer_; }
   /// Writes the output files (if an output folder is set).
   void writeOutputs();
+  /// Loops accepted, corrections published and loops refused by the consistency check, by reason.
+  std::string summary() const;
 
  private:
   void onKeyframe(const keyframe_t& msg);

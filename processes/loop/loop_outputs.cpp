@@ -39,7 +39,26 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"residual_translation", l.residual_translation},
                      {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
                      {"corrected", l.corrected},
-                     {"merged", l.merged}});
+                     {"merged", l.merged},
+                     {"sigma_rotation_deg", {std::sqrt(l.covariance(0, 0)) * 180.0 / M_PI, std::sqrt(l.covariance(1, 1)) * 180.0 / M_PI,
+                                             std::sqrt(l.covariance(2, 2)) * 180.0 / M_PI}},
+                     {"sigma_translation", {std::sqrt(l.covariance(3, 3)), std::sqrt(l.covariance(4, 4)), std::sqrt(l.covariance(5, 5))}}});
+  }
+  nlohmann::json refused = nlohmann::json::array();
+  size_t refused_by_odometry = 0;
+  for (const RefusedLoop& f : closer.refusedLoops()) {
+    refused_by_odometry += f.against == "odometry";
+    const Vec3 t = f.T_to_from.translation();
+    refused.push_back({{"from_id", f.from_id},
+                       {"to_id", f.to_id},
+                       {"merged", f.merged},
+                       {"T_to_from_translation", {t.x(), t.y(), t.z()}},
+                       {"against", f.against},
+                       {"against_from_id", f.against_from_id},
+                       {"against_to_id", f.against_to_id},
+                       {"chi2", f.chi2},
+                       {"path", f.path},
+                       {"reason", f.reason}});
   }
   // graph segments: one per odometry epoch (a LIO reset starts a new one, with no edge to the last)
   nlohmann::json epochs = nlohmann::json::array();
@@ -54,6 +73,10 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
   out << nlohmann::json{{"num_keyframes", closer.size()},
                         {"loops", loops},
                         {"corrections", closer.corrections()},
+                        {"refused_loops", refused},
+                        {"num_refused_loops", closer.refusedLoops().size()},
+                        {"refused_against_odometry", refused_by_odometry},
+                        {"refused_against_loop", closer.refusedLoops().size() - refused_by_odometry},
                         {"graph_nodes", closer.graph().poses().size()},
                         {"epochs", epochs},
                         {"odometry_edges_across_epochs", closer.odometryEdgesAcrossEpochs()}}

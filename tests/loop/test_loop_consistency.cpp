@@ -1,0 +1,175 @@
+// The consistency check before a loop enters the graph: false loops planted into a drifting run
+// (registration results between places 7-13 m apart claimed as the same place, or off by 1.5 m
+// and 5 deg; near candidates off by 0.5 m and 1 deg) are refused, the true loops still enter, and the trajectory is what it is without
+// the planted loops; with the check off the same plants enter and bend the trajectory.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "loop_closer.hpp"
+#include "loop_consistency.hpp"
+#include "synthetic_scenes.hpp"
+#include "voxel_grid.hpp"
+
+namespace livo::loop {
+namespace {
+using namespace livo::loop::testing;
+
+// Two laps and a bit of a 14 m circle, a keyframe every 10 deg (2.4 m), with odometry drifting
+// as the default drift model allows: 3e-4 rad of yaw and 0.3 % of scale per step.
+struct DriftingLaps {
+  static constexpr int kPerLap = 36;
+  std::vector<Pose3> truth, odometry;
+  explicit DriftingLaps(int total) {
+    for (int i = 0; i < total; ++i) {
+      const double a = 2 * M_PI * i / kPerLap;
+      truth.push_back(yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8)));
+    }
+    odometry.push_back(truth[0]);
+    for (int i = 1; i < total; ++i) {
+      Pose3 rel = truth[i - 1].inverse() * truth[i];
+      rel.linear() = Eigen::AngleAxisd(3e-4, Vec3::UnitZ()).toRotationMatrix() * rel.linear();
+      rel.translation() *= 1.003;
+      odometry.push_back(odometry.back() * rel);
+    }
+  }
+};
+
+struct LapRun {
+  std::unique_ptr<LoopCloser> closer;
+  std::shared_ptr<std::set<std::pair<int64_t, int64_t>>> planted =
+      std::make_shared<std::set<std::pair<int64_t, int64_t>>>();  // (from, to), filled by the hook
+  double worst = 0.0;                              // m, final keyframe poses against the truth
+};
+
+// What the registration says of the candidates 7-13 m away (which it registers correctly here)
+// and of the near candidates of every third keyframe of the second lap: as it is, nothing
+// (refused: the runs without false loops), or false loops.
+enum class Far { kAsIs, kNothing, kFalseLoop };
+LapRun runLaps(const DriftingLaps& laps, const Points& scene, bool check, Far far, const GicpResult& realistic) {
+  LapRun run;
+  LoopCloserOptions o;
+  o.merge_distance = 0.0;  // every keyframe a node: every pass is a loop candidate
+  o.consistency_check = check;
+  if (far != Far::kAsIs)
+    o.registration_hook = [&laps, &realistic, far, planted = run.planted, plants = 0](int64_t from, int64_t to, LoopRegistrationResult& r) mutable {
+      const Pose3 T = laps.truth[to].inverse() * laps.truth[from];  // G = I: no roll or pitch
+      const double d = T.translation().norm();
+      const bool far_pair = d >= 7.0 && d <= 13.0;
+      const bool near_pair = from >= 40 && from % 3 == 0 && d < 4.0;
+      if (!far_pair && !near_pair) return;
+      if (far == Far::kNothing) {
+        r.accepted = false;
+        r.reason = "withheld by the test";
+        return;
+      }
+      // a registration that "succeeded" between places that look alike: as confident as a real one
+      r.accepted = true;
+      r.reason.clear();
+      r.fine = realistic;
+      r.T_target_source = T;
+      if (near_pair) {  // a near miss the odometry alone would allow: 0.5 m and 1 deg
+        r.T_target_source.translation() += Vec3(0.0, 0.5, 0.0);
+        r.T_target_source.linear() = r.T_target_source.linear() * Eigen::AngleAxisd(0.0175, Vec3::UnitZ()).toRotationMatrix();
+      } else if (plants++ % 2 == 0) {
+        r.T_target_source.translation().setZero();  // "the same place": off by d
+      } else {
+        r.T_target_source.translation() += Vec3(0.0, 1.5, 0.0);  // a subtler one: 1.5 m and 5 deg
+        r.T_target_source.linear() = r.T_target_source.linear() * Eigen::AngleAxisd(0.087, Vec3::UnitZ()).toRotationMatrix();
+      }
+      planted->insert({from, to});
+    };
+  run.closer = std::make_unique<LoopCloser>(o);
+  for (size_t i = 0; i < laps.truth.size(); ++i) {
+    KeyframeInput in;
+    in.id = static_cast<int64_t>(i);
+    in.utime = 1000000 + in.id * 2000000;
+    in.pose = laps.odometry[i];
+    const Pose3& T = laps.truth[i];
+    in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    run.closer->addKeyframe(in);
+  }
+  run.closer->forEachPose(
+      [&](int64_t id, const Pose3& pose) { run.worst = std::max(run.worst, translationError(pose, laps.truth[id])); });
+  return run;
+}
+
+std::set<std::pair<int64_t, int64_t>> pairs(const LoopCloser& c) {
+  std::set<std::pair<int64_t, int64_t>> out;
+  for (const AcceptedLoop& l : c.loops()) out.insert({l.from_id, l.to_id});
+  return out;
+}
+
+TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
+  const Points scene = makeScene(41, 0.15);
+  const DriftingLaps laps(2 * DriftingLaps::kPerLap + 6);
+  // the information a real registration of two keyframes 2.4 m apart claims
+  const GicpCloud a = GicpCloud::build(voxelDownsample(viewFrom(scene, laps.truth[0].translation(), M_PI / 2, 20.0, 0.02, 1), 0.4));
+  const GicpCloud b = GicpCloud::build(voxelDownsample(viewFrom(scene, laps.truth[1].translation(), M_PI / 2 + M_PI / 18, 20.0, 0.02, 2), 0.4));
+  const GicpResult realistic = gicpRegister(b, a, laps.truth[0].inverse() * laps.truth[1], {});
+  ASSERT_TRUE(realistic.converged);
+
+  const LapRun as_is = runLaps(laps, scene, true, Far::kAsIs, {});
+  const LapRun as_is_unchecked = runLaps(laps, scene, false, Far::kAsIs, {});
+  const LapRun clean = runLaps(laps, scene, true, Far::kNothing, {});
+  const LapRun planted = runLaps(laps, scene, true, Far::kFalseLoop, realistic);
+  const LapRun planted_unchecked = runLaps(laps, scene, false, Far::kFalseLoop, realistic);
+  const double drift = translationError(laps.odometry.back(), laps.truth.back());
+  std::printf("[loop-consistency] all candidates as registered: %zu loops, none refused, worst %.3f m\n",
+              as_is.closer->loops().size(), as_is.worst);
+  std::printf("[loop-consistency] odometry drift %.2f m; without the far candidates: %zu loops, worst %.3f m; %zu planted: %zu refused, "
+              "%zu loops, worst %.3f m; unchecked with the plants: %zu loops, worst %.3f m\n",
+              drift, clean.closer->loops().size(), clean.worst, planted.planted->size(),
+              planted.closer->refusedLoops().size(), planted.closer->loops().size(), planted.worst,
+              planted_unchecked.closer->loops().size(), planted_unchecked.worst);
+  for (const RefusedLoop& f : planted.closer->refusedLoops())
+    std::printf("[loop-consistency]   refused %ld -> %ld: %s\n", long(f.from_id), long(f.to_id), f.reason.c_str());
+
+  // the true loops pass the check: it refuses none and keeps the loops of an unchecked run
+  ASSERT_GE(as_is.closer->loops().size(), 8u);
+  EXPECT_TRUE(as_is.closer->refusedLoops().empty());
+  EXPECT_EQ(pairs(*as_is.closer), pairs(*as_is_unchecked.closer));
+  ASSERT_GE(clean.closer->loops().size(), 4u);
+  EXPECT_TRUE(clean.closer->refusedLoops().empty());
+  EXPECT_GT(drift, 0.3);  // there was something to correct ...
+  EXPECT_LT(clean.worst, 0.5 * drift);  // ... and the loops did
+
+  // every planted loop is refused, nothing else is, and the true loops enter as without plants
+  ASSERT_GE(planted.planted->size(), 4u);
+  EXPECT_EQ(planted.closer->refusedLoops().size(), planted.planted->size());
+  size_t against_loop = 0;
+  for (const RefusedLoop& f : planted.closer->refusedLoops()) {
+    EXPECT_EQ(planted.planted->count({f.from_id, f.to_id}), 1u) << f.from_id << " -> " << f.to_id;
+    EXPECT_GT(f.chi2, LoopCloserOptions{}.consistency_chi2);
+    against_loop += f.against == "loop";
+  }
+  EXPECT_GE(against_loop, 1u);  // some only the cycle through an earlier loop caught
+  EXPECT_EQ(pairs(*planted.closer), pairs(*clean.closer));
+  for (const auto& [id, pose] : clean.closer->graph().poses())
+    EXPECT_LT(translationError(planted.closer->graph().pose(id), pose), 1e-9) << id;
+  EXPECT_NEAR(planted.worst, clean.worst, 1e-9);
+
+  // without the check the same plants enter and bend the trajectory
+  EXPECT_GT(planted_unchecked.closer->loops().size(), clean.closer->loops().size());
+  EXPECT_GT(planted_unchecked.worst, 3 * clean.worst);
+}
+
+// The drift model: a heading drift's lever arm dominates the translation over long paths.
+TEST(LoopConsistency, DriftCovarianceGrowsWithThePath) {
+  const DriftModel m;
+  const Mat6 short_path = driftCovariance(0.0, m), long_path = driftCovariance(100.0, m);
+  EXPECT_NEAR(std::sqrt(short_path(0, 0)), m.rotation_floor, 1e-12);
+  EXPECT_NEAR(std::sqrt(short_path(3, 3)), m.translation_floor, 1e-12);
+  EXPECT_NEAR(std::sqrt(long_path(0, 0)), std::hypot(m.rotation_floor, 100 * m.rotation_per_m), 1e-12);
+  // 0.5 m of scale-like drift and 1 m of lever arm (2e-4 rad/m over 100 m, half of it on average)
+  EXPECT_NEAR(std::sqrt(long_path(3, 3)), std::sqrt(2e-3 * 2e-3 + 0.5 * 0.5 + 1.0), 1e-9);
+  // a pose 1 m off along x against the long path's prediction: chi2 = 1 / var
+  const Pose3 off = yawPose(0.0, Vec3(1, 0, 0));
+  EXPECT_NEAR(poseChi2(Pose3::Identity(), long_path, off, Mat6::Zero()), 1.0 / long_path(3, 3), 1e-9);
+}
+
+}  // namespace
+}  // namespace livo::loop
