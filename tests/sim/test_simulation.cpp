@@ -222,7 +222,8 @@ TEST(Simulation, EveryWorldAndCameraEffectStaysByteIdenticalWhateverTheThreads) 
 }
 
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
-  for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking"}) {
+  for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking", "hall_noisy", "room_hard",
+                                  "corridor_hard", "campus_loop_hard", "campus_loop_long_hard", "parking_hard"}) {
     SCOPED_TRACE(name);
     const double duration = 0.5;
     const SimulationSetup setup = loadSimulation(configPath(name));
