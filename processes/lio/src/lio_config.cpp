@@ -145,6 +145,25 @@ void readLio(const Config& c, LioNodeOptions* o) {
   w.readOptional("vertical_noise_std", l.wheel.vertical_noise_std);
   w.readOptional("max_sample_gap_s", l.wheel.max_sample_gap_s);
   w.readOptional("gate_chi2", l.wheel.gate_chi2);
+  const Config ws = w.optionalSection("scale");
+  WheelScaleOptions& s = l.wheel_scale;
+  ws.readOptional("enabled", s.enabled);
+  ws.readOptional("prior_std", s.prior_std);
+  ws.readOptional("random_walk", s.random_walk);
+  ws.readOptional("displacement_noise_std", s.displacement_noise_std);
+  ws.readOptional("min_speed", s.min_speed);
+  ws.readOptional("gate_chi2", s.gate_chi2);
+  ws.readOptional("max_interval_s", s.max_interval_s);
+  auto inRange = [&](bool ok, const char* key, const char* what) {
+    if (!ok) throw ConfigError(ws.where(key) + ": " + what);
+  };
+  inRange(s.prior_std >= 0.0 && s.prior_std <= 0.5, "prior_std", "must be in [0, 0.5]");
+  inRange(s.random_walk >= 0.0 && s.random_walk <= 0.01, "random_walk", "must be in [0, 0.01] 1/sqrt(s)");
+  inRange(s.displacement_noise_std > 0.0 && s.displacement_noise_std <= 1.0, "displacement_noise_std",
+          "must be in (0, 1] m");
+  inRange(s.min_speed > 0.0, "min_speed", "must be positive");
+  inRange(s.gate_chi2 > 0.0, "gate_chi2", "must be positive");
+  inRange(s.max_interval_s > 0.0 && s.max_interval_s <= 10.0, "max_interval_s", "must be in (0, 10] s");
 
   auto positive = [&](bool ok, const char* key) {
     if (!ok) throw ConfigError(c.where(key) + ": must be positive");
@@ -196,7 +215,16 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
      << "\n"
      << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
-     << (l.wheel.enabled ? "on" : "off") << std::endl;
+     << (l.wheel.enabled ? "on" : "off");
+  if (l.wheel.enabled) {
+    const WheelScaleOptions& s = l.wheel_scale;
+    if (s.enabled)
+      os << " (scale calibration: prior 1 +/- " << s.prior_std << ", random walk " << s.random_walk
+         << "/sqrt(s), displacement noise " << s.displacement_noise_std << " m, above " << s.min_speed << " m/s)";
+    else
+      os << " (scale calibration off)";
+  }
+  os << std::endl;
 }
 
 }  // namespace livo::lio

@@ -43,7 +43,11 @@ const char* toString(ScanResult::Status s) {
 }
 
 LioEstimator::LioEstimator(LioOptions options)
-    : opts_(options), prop_(options.imu_noise), map_(options.map), keyframe_selector_(options.keyframe) {}
+    : opts_(options),
+      prop_(options.imu_noise),
+      map_(options.map),
+      keyframe_selector_(options.keyframe),
+      wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {}
 
 void LioEstimator::reset() {
   frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
@@ -55,6 +59,7 @@ void LioEstimator::reset() {
   imu_.clear();
   wheel_.clear();
   has_imu_ = has_wheel_ = false;
+  has_scale_anchor_ = false;
   keyframes_.clear();
   last_registered_body_.clear();
   has_last_post_ = has_prev_post_ = false;
@@ -250,18 +255,39 @@ bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
          prop_.covariance().allFinite();
 }
 
-bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed) const {
+bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed, double* scale_variance) const {
   for (size_t i = 1; i < wheel_.size(); ++i) {
     const WheelSample& a = wheel_[i - 1];
     const WheelSample& b = wheel_[i];
     if (a.utime <= utime && utime <= b.utime) {
       if (static_cast<double>(b.utime - a.utime) * 1e-6 > opts_.wheel.max_sample_gap_s) return false;
       const double alpha = b.utime > a.utime ? static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime) : 0.0;
-      *speed = 0.5 * ((1.0 - alpha) * (a.left_speed + a.right_speed) + alpha * (b.left_speed + b.right_speed));
+      // scales of exactly 1 (calibration off) leave the speeds bit for bit as they came
+      const WheelSample ca = wheel_scale_.correct(a), cb = wheel_scale_.correct(b);
+      *speed = 0.5 * ((1.0 - alpha) * (ca.left_speed + ca.right_speed) + alpha * (cb.left_speed + cb.right_speed));
+      const WheelSample raw{utime, (1.0 - alpha) * a.left_speed + alpha * b.left_speed,
+                            (1.0 - alpha) * a.right_speed + alpha * b.right_speed};
+      *scale_variance = opts_.wheel_scale.enabled ? wheel_scale_.meanSpeedVariance(raw) : 0.0;
       return true;
     }
   }
   return false;
+}
+
+void LioEstimator::learnWheelScales(const ScanResult& res, const FilterState& x, const WheelTravel* travel) {
+  // a degenerate registration leaves some direction to the IMU and the wheels themselves: the
+  // scales would learn from their own speeds
+  const bool anchor = res.status == ScanResult::Status::kTracked && !res.degeneracy.degenerate;
+  if (anchor && travel) {
+    WheelTravel t = *travel;
+    t.duration_s = static_cast<double>(res.utime - scale_anchor_utime_) * 1e-6;
+    t.predicted = predictedWheelTravel(scale_anchor_pose_, x.pose(), opts_.wheel.T_I_B, opts_.wheel.track_width,
+                                       &t.forward_distance);
+    wheel_scale_.update(t, res.utime);
+  }
+  has_scale_anchor_ = anchor;
+  scale_anchor_pose_ = x.pose();
+  scale_anchor_utime_ = res.utime;
 }
 
 size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterState& x) {
@@ -348,13 +374,25 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   FilterState x = prior;
   Mat18 P = P_prior;
 
-  // 4. wheel velocity (before the LiDAR update)
+  // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
+  // wheel-scale anchor (learnt from after the LiDAR update)
+  WheelTravel travel;
+  bool has_travel = false;
   if (opts_.wheel.enabled) {
-    double speed = 0.0;
-    if (wheelSpeedAt(t_end, &speed)) {
-      const WheelUpdateResult w = wheelVelocityUpdate(&x, &P, prop_.lastSample().gyro, speed, opts_.wheel);
-      if (!w.applied) appendNote(note, "wheel speed rejected (chi2 " + fmt(w.chi2) + ")");
+    if (opts_.wheel_scale.enabled && has_scale_anchor_)
+      has_travel = integrateWheelSpeeds(wheel_, scale_anchor_utime_, t_end, opts_.wheel.max_sample_gap_s,
+                                        &travel.measured, &travel.measured_noise_gain);
+    double speed = 0.0, scale_variance = 0.0;
+    if (wheelSpeedAt(t_end, &speed, &scale_variance)) {
+      const WheelUpdateResult w =
+          wheelVelocityUpdate(&x, &P, prop_.lastSample().gyro, speed, opts_.wheel, scale_variance);
+      ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
+      if (!w.applied)
+        appendNote(note, "wheel speed rejected (chi2 " + fmt(w.chi2) + "; filter minus wheels forward " +
+                             fmt(w.innovation.x()) + ", lateral " + fmt(w.innovation.y()) + ", vertical " +
+                             fmt(w.innovation.z()) + " m/s)");
     } else {
+      ++wheel_counts_.no_reading;
       appendNote(note, "no wheel reading around the sweep end");
     }
     while (wheel_.size() > 2 && wheel_[1].utime <= t_end) wheel_.pop_front();
@@ -459,6 +497,8 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     has_last_post_ = true;
   }
   prop_.setState(x, P);
+  res.utime = t_end;
+  if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
 
   // 6. map insertion and the local window
   if (res.status != ScanResult::Status::kPredicted) {
@@ -544,6 +584,7 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
                                                                   : Pose3(correction.T_Ck_O * frame_.T_C_O.inverse());
   frame_.correction_id = correction.id;
   frame_.T_C_O = correction.T_Ck_O;
+  has_scale_anchor_ = false;  // its pose is in the frame before the correction
   const Mat3 Rc = T.linear();
   // keyframes: corrected poses where given, the rigid correction elsewhere
   for (auto& kf : keyframes_) {

@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "livo/file_output.hpp"
 #include "livo/lio/lio_messages.hpp"
@@ -12,6 +14,8 @@
 namespace livo::lio {
 
 namespace {
+constexpr double kWheelLogPeriodS = 30.0;  // sensor time between wheel summaries in the log
+
 NodeOptions nodeOptions(const LioNodeOptions& o, bool quiet) {
   NodeOptions n;
   n.name = o.name;
@@ -270,6 +274,10 @@ void LioNode::process(const PendingScan& p) {
   ++sweeps_;
   if (!r.message.empty() && r.status != ScanResult::Status::kInitializing)
     node_.warn("sweep at " + std::to_string(p.scan.utime) + " (" + toString(r.status) + "): " + r.message);
+  if (opts_.lio.wheel.enabled && r.utime - last_wheel_log_ >= toUtime(kWheelLogPeriodS)) {
+    if (last_wheel_log_ != 0) node_.info(wheelSummary());
+    last_wheel_log_ = r.utime;
+  }
   if (!r.hasOutput()) return;
   const odometry_t odo = toOdometry(r, lio_.frame());
   if (!finiteOdometry(odo)) {
@@ -285,6 +293,23 @@ void LioNode::process(const PendingScan& p) {
     node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
     saveNumbering();
   }
+}
+
+std::string LioNode::wheelSummary() const {
+  const LioEstimator::WheelCounts& n = lio_.wheelCounts();
+  std::ostringstream os;
+  os << "wheel updates: " << n.accepted << " accepted, " << n.rejected << " rejected (chi2 gate), " << n.no_reading
+     << " without a reading; ";
+  if (!opts_.lio.wheel_scale.enabled) {
+    os << "scale calibration off";
+    return os.str();
+  }
+  const WheelScaleEstimator& s = lio_.wheelScale();
+  const WheelScaleEstimator::Counts& c = s.counts();
+  os << std::fixed << std::setprecision(4) << "scales left " << s.scales().x() << " +/- " << s.stds().x() << ", right "
+     << s.scales().y() << " +/- " << s.stds().y() << " (" << c.learned << " intervals learnt from, " << c.outliers
+     << " gated as slip, " << c.unobservable << " unobservable)";
+  return os.str();
 }
 
 void LioNode::handOff(int64_t utime) {

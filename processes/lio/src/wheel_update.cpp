@@ -22,19 +22,20 @@ Mat3x18 wheelVelocityJacobian(const FilterState& x, const Vec3&, const Pose3& T_
 }
 
 WheelUpdateResult wheelVelocityUpdate(FilterState* x, Mat18* P, const Vec3& gyro, double forward_speed,
-                                      const WheelOptions& o) {
+                                      const WheelOptions& o, double extra_forward_variance) {
   WheelUpdateResult res;
   const Vec3 z = wheelFrameVelocity(*x, gyro, o.T_I_B) - Vec3(forward_speed, 0.0, 0.0);
   const Mat3x18 H = wheelVelocityJacobian(*x, gyro, o.T_I_B);
   Mat3 R = Mat3::Zero();
   // the mean of two wheels: variance halves
-  R.diagonal() << 0.5 * o.speed_noise_std * o.speed_noise_std, o.lateral_noise_std * o.lateral_noise_std,
+  R.diagonal() << 0.5 * o.speed_noise_std * o.speed_noise_std + extra_forward_variance, o.lateral_noise_std * o.lateral_noise_std,
       o.vertical_noise_std * o.vertical_noise_std;
   const Eigen::Matrix<double, 18, 3> PHt = (*P) * H.transpose();
   const Mat3 Sinn = H * PHt + R;
   const Eigen::LLT<Mat3> llt(Sinn);
   if (llt.info() != Eigen::Success) return res;
   res.chi2 = z.dot(llt.solve(z));
+  res.innovation = z;
   if (!(res.chi2 <= o.gate_chi2)) return res;
   const Eigen::Matrix<double, 18, 3> K = llt.solve(PHt.transpose()).transpose();
   const Vec18 dx = -K * z;

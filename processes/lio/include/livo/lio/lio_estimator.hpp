@@ -131,6 +131,17 @@ class LioEstimator {
   /// `next_keyframe_id`, so consumers never see an id or an epoch twice.
   void continueNumbering(int32_t epoch, int64_t next_keyframe_id);
 
+  /// What became of the wheel velocity updates (kept across resets).
+  struct WheelCounts {
+    int64_t accepted = 0;    // applied
+    int64_t rejected = 0;    // chi-square gated ("wheel speed rejected": slip, or a wrong scale)
+    int64_t no_reading = 0;  // no wheel reading around the sweep end
+  };
+  const WheelCounts& wheelCounts() const { return wheel_counts_; }
+  /// The online wheel scale calibration (wheel_scale.hpp), kept across resets (it belongs to the
+  /// vehicle, not to an odometry epoch); scales 1, never updated, with options.wheel_scale off.
+  const WheelScaleEstimator& wheelScale() const { return wheel_scale_; }
+
   /// Forgets everything (state, map, keyframes, buffers): the next IMU samples re-initialise in a
   /// new odometry epoch (frame().epoch + 1, no correction).
   void reset();
@@ -148,7 +159,11 @@ class LioEstimator {
   /// Remembers what a bridged IMU gap did to the state (from `before` to now), so that the next
   /// sweep can also try the hypothesis that no time passed (a clock step, not an outage).
   void noteBridgedGap(const FilterState& before);
-  bool wheelSpeedAt(int64_t utime, double* speed) const;
+  /// Mean of the scale-corrected wheel speeds at utime, and its variance due to the scales.
+  bool wheelSpeedAt(int64_t utime, double* speed, double* scale_variance) const;
+  /// After the LiDAR update: learns the wheel scales from the travel since the last anchor (a
+  /// registered, non-degenerate sweep) and makes this sweep the next anchor if it is one.
+  void learnWheelScales(const ScanResult& res, const FilterState& x, const WheelTravel* travel);
   /// Removes the map points the sweep's beams pass through, then adds the sweep; returns how many
   /// map points were removed.
   size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
@@ -166,6 +181,11 @@ class LioEstimator {
   bool has_imu_ = false;
   int64_t last_wheel_utime_ = 0;
   bool has_wheel_ = false;
+  WheelScaleEstimator wheel_scale_;
+  WheelCounts wheel_counts_;
+  bool has_scale_anchor_ = false;       // the last sweep starts a wheel-scale interval
+  Pose3 scale_anchor_pose_ = Pose3::Identity();
+  int64_t scale_anchor_utime_ = 0;
   Vec3 last_prune_position_ = Vec3::Zero();
   std::deque<Keyframe> keyframes_;
   OdometryFrame frame_;

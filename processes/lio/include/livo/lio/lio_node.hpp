@@ -47,6 +47,10 @@ class LioNode {
     int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
+  /// "wheel updates: A accepted, R rejected (chi2 gate), N without a reading; scales left
+  /// l +/- sl, right r +/- sr (L intervals learnt from, O gated as slip, U unobservable)", or the
+  /// calibration being off. Printed every wheel_log_period_s of sensor time and at exit.
+  std::string wheelSummary() const;
   /// Odometry resets so far (= the current epoch).
   int64_t resets() const { return resets_; }
   const OdometryFrame& frame() const { return lio_.frame(); }
@@ -89,6 +93,7 @@ class LioNode {
   int64_t fed_wheel_ = 0;
   bool fed_any_wheel_ = false;
   int64_t sweeps_ = 0;
+  int64_t last_wheel_log_ = 0;  // IMU time of the last periodic wheel summary
 
   struct PendingPrior {
     int64_t request_id;

@@ -9,6 +9,7 @@
 #include "livo/lio/lidar_scan.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "livo/lio/voxel_map.hpp"
+#include "livo/lio/wheel_scale.hpp"
 #include "livo/lio/wheel_update.hpp"
 
 namespace livo::lio {
@@ -49,6 +50,7 @@ struct LioOptions {
   size_t max_stored_keyframes = 300;   // keyframe clouds kept for map rebuilds (bounded memory)
 
   WheelOptions wheel;
+  WheelScaleOptions wheel_scale;  // online scale calibration (used only with wheel.enabled)
 };
 
 }  // namespace livo::lio

@@ -39,10 +39,13 @@ Mat3x18 wheelVelocityJacobian(const FilterState& x, const Vec3& gyro_measured, c
 struct WheelUpdateResult {
   bool applied = false;
   double chi2 = 0.0;  // normalised innovation squared
+  Vec3 innovation = Vec3::Zero();  // predicted minus measured velocity of B in B, m/s
 };
 
 /// Updates (x, P) with the forward speed (mean of the wheels) and zero lateral/vertical velocity.
+/// extra_forward_variance (m²/s²) adds to the forward speed's variance (e.g. the uncertainty of
+/// the wheel scales, wheel_scale.hpp).
 WheelUpdateResult wheelVelocityUpdate(FilterState* x, Mat18* P, const Vec3& gyro_measured, double forward_speed,
-                                      const WheelOptions& options);
+                                      const WheelOptions& options, double extra_forward_variance = 0.0);
 
 }  // namespace livo::lio
