@@ -20,34 +20,15 @@ import argparse, json, math, os, struct, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'loop'))
-import check_loops as cl  # noqa: E402  (ground-truth reading and interpolation, pure Python)
+import check_loops as cl  # noqa: E402  (LCM log reading, ground truth, interpolation; pure Python)
 
 DEFAULT_CONFIGS = 'room_hard,corridor_hard,campus_loop_hard,campus_loop_long_hard,parking_hard,euroc_v1_01_hard'
-
-
-def read_channel(path, channel):
-    """(utime, payload) of every event on one channel of an LCM log."""
-    out = []
-    with open(path, 'rb') as f:
-        data = f.read()
-    i = 0
-    while i + 28 <= len(data):
-        sync, _, utime, clen, dlen = struct.unpack_from('>IqqII', data, i)
-        if sync != 0xEDA1DA01:
-            raise SystemExit('%s: bad sync at byte %d' % (path, i))
-        i += 28
-        ch = data[i:i + clen].decode()
-        i += clen
-        if ch == channel:
-            out.append((utime, data[i:i + dlen]))
-        i += dlen
-    return out
 
 
 def degenerate_sweeps(outputs):
     """Count of ODOMETRY messages with the degenerate flag set (livo.odometry_t)."""
     n = 0
-    for _, p in read_channel(outputs, 'ODOMETRY'):
+    for _, p in cl.read_channel(outputs, 'ODOMETRY'):
         o = 16  # fingerprint, utime
         for _ in range(2):  # parent_frame, child_frame
             length, = struct.unpack_from('>i', p, o)

@@ -9,22 +9,28 @@ keyframes (interpolated at their stamps) by more than the bounds. Exit status 1 
 import argparse, bisect, json, math, struct, sys
 
 
-def read_ground_truth(path, channel="GROUND_TRUTH"):
+def read_channel(path, channel):
+    """(utime, payload) of every event on one channel of an LCM log."""
     out = []
     with open(path, "rb") as f:
         data = f.read()
     i = 0
     while i + 28 <= len(data):
-        sync, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
+        sync, _, utime, clen, dlen = struct.unpack_from(">IqqII", data, i)
         if sync != 0xEDA1DA01:
-            raise SystemExit("bad sync at %d" % i)
+            raise SystemExit("%s: bad sync at byte %d" % (path, i))
         i += 28
         ch = data[i:i + clen].decode()
         i += clen
-        payload = data[i:i + dlen]
+        if ch == channel:
+            out.append((utime, data[i:i + dlen]))
         i += dlen
-        if ch != channel:
-            continue
+    return out
+
+
+def read_ground_truth(path, channel="GROUND_TRUTH"):
+    out = []
+    for _, payload in read_channel(path, channel):
         o = 8  # fingerprint
         utime, = struct.unpack_from(">q", payload, o); o += 8
         for _ in range(2):

@@ -70,6 +70,21 @@ Points viewFrom(const Points& scene, const Vec3& viewpoint, double yaw, double r
   return out;
 }
 
+Points corridorView(double x0, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 0.01);
+  Points out;
+  for (double x = -15.0; x <= 15.0; x += 0.1)
+    for (double u = -1.5; u <= 1.5; u += 0.1) {
+      out.push_back(Vec3(x, u, -1.5 + n(rng)));
+      out.push_back(Vec3(x, u, 1.5 + n(rng)));
+      out.push_back(Vec3(x, -1.5 + n(rng), u));
+      out.push_back(Vec3(x, 1.5 + n(rng), u));
+    }
+  for (Vec3& p : out) p.x() -= x0;
+  return out;
+}
+
 Pose3 yawPose(double yaw, const Vec3& t) {
   Pose3 T = Pose3::Identity();
   T.linear() = Eigen::AngleAxisd(yaw, Vec3::UnitZ()).toRotationMatrix();

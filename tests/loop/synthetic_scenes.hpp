@@ -16,6 +16,10 @@ Points makeScene(uint32_t seed, double spacing = 0.1);
 /// `yaw` (a keyframe cloud), with Gaussian noise of `noise` m per axis.
 Points viewFrom(const Points& scene, const Vec3& viewpoint, double yaw, double range, double noise, uint32_t seed);
 
+/// A straight corridor (floor, ceiling, two walls, 3 x 3 m, 30 m long along x, 1 cm noise) seen
+/// from x = x0: GICP fits it at any offset along the axis.
+Points corridorView(double x0, uint32_t seed);
+
 /// Pose with yaw about z and translation.
 Pose3 yawPose(double yaw, const Vec3& t);
 

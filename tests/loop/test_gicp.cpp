@@ -38,21 +38,6 @@ TEST(Gicp, ConvergesFromCoarseResult) {
 // it perfectly at any offset along the axis, as the two false loops on config/sim/corridor.yaml
 // did (fitness 0.05-0.07, overlap 0.87-0.91, absolute translation eigenvalue 0.8-1.8, above its
 // 0.05 bound). The eigenvalue ratio tells it from a well-conditioned scene.
-Points corridorView(double x0, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.01);
-  Points out;
-  for (double x = -15.0; x <= 15.0; x += 0.1)
-    for (double u = -1.5; u <= 1.5; u += 0.1) {
-      out.push_back(Vec3(x, u, -1.5 + n(rng)));
-      out.push_back(Vec3(x, u, 1.5 + n(rng)));
-      out.push_back(Vec3(x, -1.5 + n(rng), u));
-      out.push_back(Vec3(x, 1.5 + n(rng), u));
-    }
-  for (Vec3& p : out) p.x() -= x0;
-  return out;
-}
-
 TEST(Gicp, CorridorIsDegenerateByEigenvalueRatio) {
   const GicpCloud target = GicpCloud::build(voxelDownsample(corridorView(0.0, 1), 0.4));
   const GicpCloud source = GicpCloud::build(voxelDownsample(corridorView(5.0, 2), 0.4));

@@ -85,26 +85,11 @@ TEST(LoopInformation, CovariancePredictsTheSpreadOfTheRegistrationError) {
   }
 }
 
-// The corridor of test_gicp (3 x 3 m, seen from x = 0 and x = 5): the point-to-plane information
+// The corridor (synthetic_scenes.hpp, 3 x 3 m, seen from x = 0 and x = 5): the point-to-plane information
 // leaves the axis unconstrained, so the edge keeps only the cap's information along it, while the
 // across-axis directions are as precise as the walls make them. The GICP Hessian itself, scaled by
 // the same residual variance, would claim millimetres along the axis from its in-plane
 // regularisation terms.
-Points corridorView(double x0, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0.0, 0.01);
-  Points out;
-  for (double x = -15.0; x <= 15.0; x += 0.1)
-    for (double u = -1.5; u <= 1.5; u += 0.1) {
-      out.push_back(Vec3(x, u, -1.5 + n(rng)));
-      out.push_back(Vec3(x, u, 1.5 + n(rng)));
-      out.push_back(Vec3(x, -1.5 + n(rng), u));
-      out.push_back(Vec3(x, 1.5 + n(rng), u));
-    }
-  for (Vec3& p : out) p.x() -= x0;
-  return out;
-}
-
 TEST(LoopInformation, CorridorAxisKeepsOnlyTheCapsInformation) {
   const GicpCloud target = GicpCloud::build(voxelDownsample(corridorView(0.0, 1), 0.4));
   const GicpCloud source = GicpCloud::build(voxelDownsample(corridorView(5.0, 2), 0.4));
