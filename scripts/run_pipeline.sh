@@ -134,9 +134,12 @@ if [ "$inside" = 0 ]; then
   read -r log_s wall_s < "$out/logs/replay_times.txt" 2>/dev/null || { log_s=0; wall_s=0; }
   joined_warnings=$(IFS=';'; echo "${warnings[*]:-}")
   injected=$(sed -n 's/^\[playback\] faults on \(.*\)$/\1/p' "$out/logs/playback.log" 2>/dev/null | paste -sd';' -)
+  # the LIO's last word on its wheel updates (accepted, rejected, learned scales)
+  sensor_use=$(grep -ho 'wheel updates: .*' "$out/logs/lio.log" 2>/dev/null | tail -n 1 | sed 's/^/lio: /; s/;/,/g' || true)
   "$bin/livo-report" markdown --dir "$out" --log "$log" --config "$config" --processes "$(IFS=,; echo "${selected[*]}")" \
     --mode "$([ "$realtime" = 1 ] && echo 'real time' || echo lockstep)" --log-seconds "$log_s" --wall-seconds "$wall_s" \
     --evaluation "$evaluations" --figure "$figures" --warning "$joined_warnings" --injected "$injected" \
+    --sensor-use "$sensor_use" \
     $([ "$respawn" = 1 ] && echo --restarts "$out/logs/restarts.tsv") >/dev/null
   if [ "$rc" != 0 ]; then
     echo "run_pipeline.sh: FAILED (outputs so far kept in $out):" >&2

@@ -72,6 +72,7 @@ int markdown(int argc, char** argv) {
       .option("--figure", "CAPTION=FILE;...", "figures (paths relative to DIR)")
       .option("--warning", "TEXT;...", "warnings to list")
       .option("--injected", "TEXT;...", "faults injected by playback, one entry per channel")
+      .option("--sensor-use", "TEXT;...", "what the estimators did with each sensor, one entry per line of their summaries")
       .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   const std::string dir = cli.get("--dir");
@@ -104,6 +105,7 @@ int markdown(int argc, char** argv) {
   }
   for (const auto& w : splitList(cli.get("--warning"), ';')) in.warnings.push_back(w);
   for (const auto& f : splitList(cli.get("--injected"), ';')) in.injected_faults.push_back(f);
+  for (const auto& f : splitList(cli.get("--sensor-use"), ';')) in.sensor_use.push_back(f);
   if (!cli.get("--restarts").empty()) {
     in.supervised = true;
     in.restarts = livo::readRestarts(cli.get("--restarts"));

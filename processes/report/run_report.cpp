@@ -143,6 +143,13 @@ std::string reportMarkdown(const ReportInputs& in) {
   }
   md << "\n";
 
+  if (!in.sensor_use.empty()) {
+    md << "## Sensor use\n\n";
+    md << "What the estimators did with their inputs, from their summaries at exit:\n\n";
+    for (const auto& f : in.sensor_use) md << "- " << f << "\n";
+    md << "\n";
+  }
+
   if (!in.injected_faults.empty()) {
     md << "## Injected faults\n\n";
     md << "Faults injected by `livo-playback --faults` (seeded), per channel:\n\n";

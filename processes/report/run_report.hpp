@@ -49,6 +49,7 @@ struct ReportInputs {
   std::vector<std::pair<std::string, std::string>> figures;         // caption, relative path
   std::vector<std::string> warnings;
   std::vector<std::string> injected_faults;  // playback's fault counts, one line per channel
+  std::vector<std::string> sensor_use;       // what the estimators did with each sensor ("lio: wheel updates: ...")
   std::vector<ProcessRestart> restarts;
   bool supervised = false;  // the run restarted processes that exited (the Restarts section)
   nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)

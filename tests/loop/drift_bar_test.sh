@@ -17,6 +17,8 @@ config="$root/config/sim/campus_loop_long.yaml"
   >/dev/null 2>"$dir/lio.err" || { cat "$dir/lio.err"; fail "the LIO-only run failed"; }
 "$root/scripts/run_pipeline.sh" --log "$dir/campus.lcmlog" --config "$config" --out "$dir/loop" \
   >/dev/null 2>"$dir/loop.err" || { cat "$dir/loop.err"; fail "the run with loop closure failed"; }
+grep -q '^- lio: wheel updates: [0-9]* accepted' "$dir/lio/report.md" \
+  || fail "report.md does not count the LIO's wheel updates (Sensor use)"
 /usr/bin/python3 "$root/tests/loop/drift_bar.py" --log "$dir/campus.lcmlog" --lio-only "$dir/lio" \
   --with-loop "$dir/loop" --bin "$bin" || fail "drift bar missed"
 /usr/bin/python3 "$root/tests/loop/check_loops.py" --log "$dir/campus.lcmlog" --loops "$dir/loop/loops.json" \
