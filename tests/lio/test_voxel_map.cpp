@@ -259,3 +259,45 @@ TEST(VoxelMap, PointsSeenThroughInThreeSweepsLeaveTheMap) {
   o.enabled = false;
   EXPECT_EQ(kept.removeSeenThrough(start, sweepFrom(start, false), o), 0u);
 }
+
+TEST(VoxelMap, BetterObservedPointsReplaceWorseOnes) {
+  VoxelMapOptions o;
+  o.voxel_size = 1.0;
+  o.max_points_per_voxel = 2;
+  o.min_point_distance = 0.2;
+  o.refresh_range_ratio = 0.5;
+  VoxelMap map(o);
+  auto stored = [&] {
+    auto p = map.points();
+    std::sort(p.begin(), p.end(), [](const Vec3& a, const Vec3& b) { return a.x() < b.x(); });
+    return p;
+  };
+  const Vec3 far_origin(-30.0, 0.0, 0.0);  // seen from 30 m
+  EXPECT_EQ(map.insert({Vec3(0.1, 0.5, 0.5)}, far_origin), 1u);
+  // 0.1 m from it, seen from 20 m: not better by half, dropped
+  EXPECT_EQ(map.insert({Vec3(0.2, 0.5, 0.5)}, Vec3(-19.8, 0.5, 0.5)), 0u);
+  EXPECT_EQ(stored().front(), Vec3(0.1, 0.5, 0.5).cast<float>().cast<double>());
+  // seen from 10 m (a third of 30): replaces it
+  EXPECT_EQ(map.insert({Vec3(0.15, 0.5, 0.5)}, Vec3(-9.85, 0.5, 0.5)), 1u);
+  ASSERT_EQ(map.numPoints(), 1u);
+  EXPECT_NEAR(stored().front().x(), 0.15, 1e-6);
+  // a second point seen from 40 m fills the voxel; a third, seen from 15 m, replaces the point seen
+  // from farthest (40 m), not the one seen from 10 m
+  EXPECT_EQ(map.insert({Vec3(0.8, 0.5, 0.5)}, Vec3(-39.2, 0.5, 0.5)), 1u);
+  EXPECT_EQ(map.insert({Vec3(0.5, 0.9, 0.5)}, Vec3(-14.5, 0.9, 0.5)), 1u);
+  ASSERT_EQ(map.numPoints(), 2u);
+  EXPECT_NEAR(stored()[0].x(), 0.15, 1e-6);
+  EXPECT_NEAR(stored()[1].x(), 0.5, 1e-6);
+  // a fourth from 9 m is not within half of either (10 m, 15 m): dropped
+  EXPECT_EQ(map.insert({Vec3(0.9, 0.1, 0.1)}, Vec3(-8.1, 0.1, 0.1)), 0u);
+  // points inserted without their sensor position count as perfectly observed: never replaced
+  VoxelMap rebuilt(o);
+  EXPECT_TRUE(rebuilt.insert(Vec3(0.1, 0.5, 0.5)));
+  EXPECT_EQ(rebuilt.insert({Vec3(0.15, 0.5, 0.5)}, Vec3(0.14, 0.5, 0.5)), 0u);
+  // ratio 0: the first points stay (the map before refreshing existed)
+  o.refresh_range_ratio = 0.0;
+  VoxelMap first(o);
+  EXPECT_EQ(first.insert({Vec3(0.1, 0.5, 0.5)}, far_origin), 1u);
+  EXPECT_EQ(first.insert({Vec3(0.15, 0.5, 0.5)}, Vec3(0.14, 0.5, 0.5)), 0u);
+  EXPECT_NEAR(first.points().front().x(), 0.1, 1e-6);
+}

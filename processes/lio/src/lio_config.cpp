@@ -100,6 +100,8 @@ void readLio(const Config& c, LioNodeOptions* o) {
   map.readOptional("voxel_size", l.map.voxel_size);
   map.readOptional("max_points_per_voxel", l.map.max_points_per_voxel);
   map.readOptional("min_point_distance", l.map.min_point_distance);
+  map.readOptional("seen_again_distance", l.map.seen_again_distance);
+  map.readOptional("refresh_range_ratio", l.map.refresh_range_ratio);
   map.readOptional("radius", l.map_radius);
   map.readOptional("prune_distance", l.map_prune_distance);
   const Config seen = map.optionalSection("seen_through");
@@ -169,6 +171,8 @@ void readLio(const Config& c, LioNodeOptions* o) {
     if (!ok) throw ConfigError(c.where(key) + ": must be positive");
   };
   positive(l.map.voxel_size > 0 && l.map.max_points_per_voxel > 0, "map");
+  if (!(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0))
+    throw ConfigError(c.where("map") + ".refresh_range_ratio: must be in [0, 1)");
   const SeenThroughOptions& st = l.seen_through;
   positive(st.beam_radius >= 0 && st.beam_divergence >= 0 && st.end_margin >= 0 && st.end_margin_fraction >= 0 &&
                st.min_range >= 0 && st.max_range > st.min_range && st.misses_to_remove >= 1 &&

@@ -296,7 +296,7 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   // the beams leave the LiDAR where it is at the sweep end (the frame the sweep is undistorted to)
   const Vec3 lidar = x.rot * opts_.extrinsics.T_I_L.translation() + x.pos;
   const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through);
-  map_.insert(world);
+  map_.insert(world, lidar);
   return removed;
 }
 
@@ -609,7 +609,11 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
   const Vec3 here = initialized_ ? prop_.state().pos : T.translation();
   for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
     if ((it->pose.translation() - here).norm() > opts_.map_radius) continue;
-    for (const auto& p : it->cloud) map_.insert(Vec3(it->pose * p));
+    const Vec3 lidar = it->pose * opts_.extrinsics.T_I_L.translation();
+    for (const auto& p : it->cloud) {
+      const Vec3 w = it->pose * p;
+      map_.insert(w, (w - lidar).norm());
+    }
   }
   if (initialized_) insertIntoMap(last_registered_body_, prop_.state());
   last_prune_position_ = here;

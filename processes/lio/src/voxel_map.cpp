@@ -13,7 +13,9 @@ VoxelMap::VoxelMap(VoxelMapOptions options) : opts_(options) {
   stride_ = 3 * static_cast<size_t>(opts_.max_points_per_voxel);
 }
 
-bool VoxelMap::insert(const Vec3& p) {
+bool VoxelMap::insert(const Vec3& p) { return insert(p, 0.0); }
+
+bool VoxelMap::insert(const Vec3& p, double range) {
   if (!p.allFinite()) return false;
   const int64_t cx = static_cast<int64_t>(std::floor(p.x() * inv_size_));
   const int64_t cy = static_cast<int64_t>(std::floor(p.y() * inv_size_));
@@ -25,32 +27,48 @@ bool VoxelMap::insert(const Vec3& p) {
     voxels_.push_back(Voxel{key, 0, static_cast<int32_t>(cx), static_cast<int32_t>(cy), static_cast<int32_t>(cz)});
     pool_.resize(pool_.size() + stride_);
     misses_.resize(misses_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0);
+    ranges_.resize(ranges_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0.0f);
   }
   Voxel& vox = voxels_[static_cast<size_t>(v)];
   float* pts = voxelPoints(v);
   uint8_t* misses = voxelMisses(v);
+  float* ranges = voxelRanges(v);
   const double min_d2 = opts_.min_point_distance * opts_.min_point_distance;
   const double seen_d2 = opts_.seen_again_distance * opts_.seen_again_distance;
-  bool near = false;
+  int nearest = -1;  // the nearest stored point closer than min_point_distance
+  double nearest_d2 = min_d2;
+  int farthest_seen = -1;  // the stored point seen from the longest range
   for (int i = 0; i < vox.count; ++i) {
     const double dx = pts[3 * i] - p.x(), dy = pts[3 * i + 1] - p.y(), dz = pts[3 * i + 2] - p.z();
     const double d2 = dx * dx + dy * dy + dz * dz;
     if (d2 < seen_d2) misses[i] = 0;  // seen again
-    near = near || d2 < min_d2;
+    if (d2 < nearest_d2) nearest = i, nearest_d2 = d2;
+    if (farthest_seen < 0 || ranges[i] > ranges[farthest_seen]) farthest_seen = i;
   }
-  if (near) return false;
-  if (vox.count >= opts_.max_points_per_voxel) return false;
-  pts[3 * vox.count] = static_cast<float>(p.x());
-  pts[3 * vox.count + 1] = static_cast<float>(p.y());
-  pts[3 * vox.count + 2] = static_cast<float>(p.z());
-  misses[vox.count] = 0;
-  ++vox.count;
+  int slot = vox.count;
+  if (nearest >= 0 || vox.count >= opts_.max_points_per_voxel) {
+    slot = nearest >= 0 ? nearest : farthest_seen;
+    if (!(range < opts_.refresh_range_ratio * ranges[slot])) return false;
+  } else {
+    ++vox.count;
+  }
+  pts[3 * slot] = static_cast<float>(p.x());
+  pts[3 * slot + 1] = static_cast<float>(p.y());
+  pts[3 * slot + 2] = static_cast<float>(p.z());
+  misses[slot] = 0;
+  ranges[slot] = static_cast<float>(range);
   return true;
 }
 
 size_t VoxelMap::insert(const std::vector<Vec3>& points) {
   size_t n = 0;
-  for (const auto& p : points) n += insert(p) ? 1 : 0;
+  for (const auto& p : points) n += insert(p, 0.0) ? 1 : 0;
+  return n;
+}
+
+size_t VoxelMap::insert(const std::vector<Vec3>& points, const Vec3& origin) {
+  size_t n = 0;
+  for (const auto& p : points) n += insert(p, (p - origin).norm()) ? 1 : 0;
   return n;
 }
 
@@ -133,6 +151,7 @@ void VoxelMap::removePoint(int32_t v, int i) {
   const int last = --vox.count;
   std::copy_n(pts + 3 * last, 3, pts + 3 * i);
   misses[i] = misses[last];
+  voxelRanges(v)[i] = voxelRanges(v)[last];
 }
 
 namespace {
@@ -226,6 +245,7 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
       std::copy_n(&pool_[v * stride_], stride_, &pool_[kept * stride_]);
       const size_t slots = static_cast<size_t>(opts_.max_points_per_voxel);
       std::copy_n(&misses_[v * slots], slots, &misses_[kept * slots]);
+      std::copy_n(&ranges_[v * slots], slots, &ranges_[kept * slots]);
     }
     ++kept;
   }
@@ -234,9 +254,11 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   voxels_.resize(kept);
   pool_.resize(kept * stride_);
   misses_.resize(kept * static_cast<size_t>(opts_.max_points_per_voxel));
+  ranges_.resize(kept * static_cast<size_t>(opts_.max_points_per_voxel));
   voxels_.shrink_to_fit();
   pool_.shrink_to_fit();
   misses_.shrink_to_fit();
+  ranges_.shrink_to_fit();
   index_.resetFor(kept);
   for (size_t v = 0; v < kept; ++v) index_.insert(voxels_[v].key, static_cast<int32_t>(v));
   return removed;
@@ -246,6 +268,7 @@ void VoxelMap::clear() {
   voxels_.clear();
   pool_.clear();
   misses_.clear();
+  ranges_.clear();
   index_.resetFor(0);
 }
 

@@ -17,6 +17,12 @@ struct VoxelMapOptions {
   double min_point_distance = 0.4; // m, a new point this close to one in its voxel is dropped
   double seen_again_distance = 0.1; // m, a new point this close to a stored one is a new sighting
                                     // of it (SeenThroughOptions)
+  // Refresh: a point seen from a range below this fraction of the range a stored point was seen
+  // from replaces it (the stored point within min_point_distance of it or, in a full voxel, the one
+  // seen from farthest): range noise, beam footprint and grazing smear all grow with range, so the
+  // map converges to its best-observed points instead of keeping the first (in a corridor walked
+  // forward, every wall is first seen far away and at grazing incidence). 0: first points stay.
+  double refresh_range_ratio = 0.5;
 };
 
 /// Free-space carving: a stored point that beams pass through in `misses_to_remove` sweeps, with
@@ -41,9 +47,14 @@ class VoxelMap {
  public:
   explicit VoxelMap(VoxelMapOptions options = {});
 
-  /// Adds points under the downsampling rule; returns how many were stored.
+  /// Adds points under the downsampling rule; returns how many were stored. Points given without
+  /// the sensor position they were seen from count as seen from range 0 (never refreshed).
   size_t insert(const std::vector<Vec3>& points);
   bool insert(const Vec3& p);
+  /// Same for the points of one sweep seen from `origin`, refreshing worse-observed stored points
+  /// (VoxelMapOptions::refresh_range_ratio); returns how many were stored or replaced one.
+  size_t insert(const std::vector<Vec3>& points, const Vec3& origin);
+  bool insert(const Vec3& p, double range);
 
   /// Up to k nearest stored points within max_distance of q (exact), nearest first; returns the
   /// count. out_points / out_sq_dist must hold k entries. Requires k <= 32.
@@ -75,6 +86,7 @@ class VoxelMap {
   const float* voxelPoints(int32_t v) const { return &pool_[static_cast<size_t>(v) * stride_]; }
   float* voxelPoints(int32_t v) { return &pool_[static_cast<size_t>(v) * stride_]; }
   uint8_t* voxelMisses(int32_t v) { return &misses_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
+  float* voxelRanges(int32_t v) { return &ranges_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
   void removePoint(int32_t v, int i);
   /// Flags voxel v's points that the ray origin + t dir (t <= reach) passes through this sweep.
   void markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach, const SeenThroughOptions& o,
@@ -87,6 +99,7 @@ class VoxelMap {
   std::vector<float> pool_;  // voxel v's points at [v * stride_, v * stride_ + 3 * count)
   std::vector<uint8_t> misses_;  // per point slot: sweeps that saw through it since it was last seen;
                                  // the high bit marks "seen through in the current sweep"
+  std::vector<float> ranges_;    // per point slot: the range it was seen from (refresh)
   FlatKeyIndex index_;
   std::vector<int> offsets_; // 27 neighbour offsets as (dx, dy, dz) triples, search radius 1
 };
