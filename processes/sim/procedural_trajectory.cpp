@@ -9,19 +9,6 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-/// Sum of sinusoids and its first three derivatives.
-void evalWaves(const std::vector<Sinusoid>& waves, double s, double out[4]) {
-  out[0] = out[1] = out[2] = out[3] = 0.0;
-  for (const Sinusoid& w : waves) {
-    const double om = 2.0 * M_PI * w.frequency_hz;
-    const double sn = std::sin(om * s + w.phase), cs = std::cos(om * s + w.phase);
-    out[0] += w.amplitude * sn;
-    out[1] += w.amplitude * om * cs;
-    out[2] -= w.amplitude * om * om * sn;
-    out[3] -= w.amplitude * om * om * om * cs;
-  }
-}
-
 Mat3 rotX(double a) { return Eigen::AngleAxisd(a, Vec3::UnitX()).toRotationMatrix(); }
 Mat3 rotY(double a) { return Eigen::AngleAxisd(a, Vec3::UnitY()).toRotationMatrix(); }
 Mat3 rotZ(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix(); }
@@ -41,6 +28,18 @@ MotionShake scaled(MotionShake m, double scale) {
 }
 
 }  // namespace
+
+void sumOfSinusoids(const std::vector<Sinusoid>& waves, double s, double out[4]) {
+  out[0] = out[1] = out[2] = out[3] = 0.0;
+  for (const Sinusoid& w : waves) {
+    const double om = 2.0 * M_PI * w.frequency_hz;
+    const double sn = std::sin(om * s + w.phase), cs = std::cos(om * s + w.phase);
+    out[0] += w.amplitude * sn;
+    out[1] += w.amplitude * om * cs;
+    out[2] -= w.amplitude * om * om * sn;
+    out[3] -= w.amplitude * om * om * om * cs;
+  }
+}
 
 MotionShake handheldShake(double scale) {
   MotionShake m;
@@ -74,8 +73,8 @@ MotionShake flightShake(double scale) {
 ProceduralTrajectory::ProceduralTrajectory(std::unique_ptr<Path> path, const ProceduralTrajectoryOptions& options)
     : path_(std::move(path)), options_(options) {}
 
-ProceduralTrajectory::Warp ProceduralTrajectory::warp(double t) const {
-  const double hold = options_.start_still_s, ramp = options_.ramp_s;
+PathTimeWarp rampedPathTime(double t, double start_still_s, double ramp_s) {
+  const double hold = start_still_s, ramp = ramp_s;
   if (t <= hold) return {0.0, 0.0, 0.0, 0.0};
   if (ramp > 0.0 && t < hold + ramp) {
     // s' = 35x^4 - 84x^5 + 70x^6 - 20x^7: its first three derivatives vanish at both ends, so
@@ -91,14 +90,14 @@ ProceduralTrajectory::Warp ProceduralTrajectory::warp(double t) const {
 }
 
 BodyState ProceduralTrajectory::at(double t) const {
-  const Warp w = warp(t);
+  const PathTimeWarp w = rampedPathTime(t, options_.start_still_s, options_.ramp_s);
   const PathSample base = path_->at(w.s);
 
   // position with shake, derivatives in path time, then in time
   Vec3 p = base.p, p1 = base.d1, p2 = base.d2, p3 = base.d3;
   double wave[4];
   for (int i = 0; i < 3; ++i) {
-    evalWaves(options_.shake.position[i], w.s, wave);
+    sumOfSinusoids(options_.shake.position[i], w.s, wave);
     p[i] += wave[0], p1[i] += wave[1], p2[i] += wave[2], p3[i] += wave[3];
   }
   BodyState st;
@@ -117,7 +116,7 @@ BodyState ProceduralTrajectory::at(double t) const {
     omega_base = Vec3(0.0, 0.0, yaw_rate_s * w.d1);
   } else {
     double yw[4];
-    evalWaves({options_.yaw_wave}, w.s, yw);
+    sumOfSinusoids({options_.yaw_wave}, w.s, yw);
     const double yaw = options_.yaw_rate * w.s + yw[0];
     const double yaw_dot = (options_.yaw_rate + yw[1]) * w.d1;
     const Vec3 u = st.acceleration + Vec3(0.0, 0.0, options_.gravity);
@@ -135,9 +134,9 @@ BodyState ProceduralTrajectory::at(double t) const {
 
   // attitude shake: R_pert = Rz(c) Ry(b) Rx(a)
   double ra[4], pb[4], yc[4];
-  evalWaves(options_.shake.attitude[0], w.s, ra);
-  evalWaves(options_.shake.attitude[1], w.s, pb);
-  evalWaves(options_.shake.attitude[2], w.s, yc);
+  sumOfSinusoids(options_.shake.attitude[0], w.s, ra);
+  sumOfSinusoids(options_.shake.attitude[1], w.s, pb);
+  sumOfSinusoids(options_.shake.attitude[2], w.s, yc);
   const Mat3 Rx = rotX(ra[0]), Ry = rotY(pb[0]), Rz = rotZ(yc[0]);
   const Mat3 R_pert = Rz * Ry * Rx;
   const Vec3 omega_pert = (Rx.transpose() * Ry.transpose() * Vec3(0.0, 0.0, yc[1]) + Rx.transpose() * Vec3(0.0, pb[1], 0.0) +

@@ -1,6 +1,6 @@
 // A procedural body trajectory: a smooth path, small sinusoidal shake in position and attitude,
-// a still start with a smooth (C3) speed ramp, and an attitude that either follows the heading (walks,
-// drives) or aligns the body z axis with the thrust (multirotor flight). Every derivative is
+// a still start with a smooth (C3) speed ramp, and an attitude that either follows the heading (walks)
+// or aligns the body z axis with the thrust (multirotor flight). Cars: car_trajectory.hpp. Every derivative is
 // analytic, so IMU samples are exact.
 #pragma once
 
@@ -26,7 +26,7 @@ struct MotionShake {
 };
 
 enum class AttitudeMode {
-  kFollowHeading,  // yaw along the horizontal velocity of the path
+  kFollowHeading,  // yaw along the horizontal velocity of the path (no side slip at the body origin)
   kThrustAligned,  // body z along acceleration + gravity, yaw from yaw_rate / yaw_wave
 };
 
@@ -45,17 +45,21 @@ MotionShake handheldShake(double scale);
 MotionShake carShake(double scale);
 MotionShake flightShake(double scale);
 
+/// Sum of sinusoids at path time s: value and its first three derivatives in s.
+void sumOfSinusoids(const std::vector<Sinusoid>& waves, double s, double out[4]);
+
+struct PathTimeWarp {
+  double s, d1, d2, d3;  // path time and its derivatives in t
+};
+/// Path time at time t: still for start_still_s, then a smooth (C3) ramp to full speed over ramp_s.
+PathTimeWarp rampedPathTime(double t, double start_still_s, double ramp_s);
+
 class ProceduralTrajectory : public BodyTrajectory {
  public:
   ProceduralTrajectory(std::unique_ptr<Path> path, const ProceduralTrajectoryOptions& options);
   BodyState at(double t) const override;
 
  private:
-  struct Warp {
-    double s, d1, d2, d3;  // path time and its derivatives in t
-  };
-  Warp warp(double t) const;
-
   std::unique_ptr<Path> path_;
   ProceduralTrajectoryOptions options_;
 };

@@ -270,12 +270,6 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
     s.scene_source = path;
   }
 
-  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir);
-  s.trajectory = std::move(traj.trajectory);
-  s.trajectory_description = traj.description;
-  s.recorded = traj.recorded;
-  s.recorded_imu = std::move(traj.recorded_imu);
-
   if (overrides.seed) s.options.seed = *overrides.seed;
   if (overrides.threads) s.options.threads = *overrides.threads;
   if (overrides.duration_s) {
@@ -284,6 +278,15 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   }
 
   resolveErrors(&s);
+
+  // a car's rear axle is where the wheels truly are
+  const SensorRig mounted = trueRig(s.rig, s.calibration_errors);
+  const Pose3 T_I_rear_axle = mounted.wheel ? mounted.wheel->T_I_B : Pose3::Identity();
+  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir, T_I_rear_axle);
+  s.trajectory = std::move(traj.trajectory);
+  s.trajectory_description = traj.description;
+  s.recorded = traj.recorded;
+  s.recorded_imu = std::move(traj.recorded_imu);
 
   if (s.recorded) {
     refuseImuErrorsOnARecording(sim.optionalSection("imu"));

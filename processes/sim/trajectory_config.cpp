@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "car_trajectory.hpp"
 #include "livo/trajectory_io.hpp"
 #include "procedural_trajectory.hpp"
 #include "recorded_trajectory.hpp"
@@ -60,7 +61,8 @@ TrajectoryConfig readRecorded(const Config& c, const std::string& base_dir) {
 
 }  // namespace
 
-TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir) {
+TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
+                                      const Pose3& T_I_rear_axle) {
   const std::string type = c.get<std::string>("type");
   if (type == "recorded") {
     TrajectoryConfig out = readRecorded(c, base_dir);
@@ -119,7 +121,14 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
   c.checkAllUsed();
   os << ", still for " << o.start_still_s << " s then a " << o.ramp_s << " s ramp, shake x" << shake;
   TrajectoryConfig out;
-  out.trajectory = std::make_unique<ProceduralTrajectory>(std::move(path), o);
+  if (type == "car") {
+    const Vec3 p_BI = T_I_rear_axle.inverse().translation();
+    os << "; rear axle " << p_BI.x() << " m behind and " << p_BI.z() << " m below the body origin";
+    out.trajectory = std::make_unique<CarTrajectory>(
+        std::move(path), CarTrajectoryOptions{o.start_still_s, o.ramp_s, o.shake, T_I_rear_axle});
+  } else {
+    out.trajectory = std::make_unique<ProceduralTrajectory>(std::move(path), o);
+  }
   out.description = os.str();
   return out;
 }

@@ -20,8 +20,11 @@ struct TrajectoryConfig {
   std::vector<ImuSample> recorded_imu;    // recorded: the real IMU samples
 };
 
-/// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths.
-TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir);
+/// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths;
+/// `T_I_rear_axle` is where a car's rear axle is, the TRUE wheel base frame (identity: at the body
+/// origin, for a rig without wheel encoder).
+TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
+                                      const Pose3& T_I_rear_axle = Pose3::Identity());
 
 }  // namespace sim
 }  // namespace livo

@@ -3,6 +3,7 @@
 // the simulator reproduces the ground-truth trajectory.
 #include <gtest/gtest.h>
 
+#include "car_trajectory.hpp"
 #include "livo/trajectory_io.hpp"
 #include "paths.hpp"
 #include "procedural_trajectory.hpp"
@@ -30,6 +31,16 @@ std::unique_ptr<BodyTrajectory> flight() {
   o.yaw_wave = {0.4, 0.2, 0.0};
   return std::make_unique<ProceduralTrajectory>(
       std::make_unique<LissajousPath>(Vec3(0, 0, 1.5), Vec3(1.5, 1.2, 0.4), Vec3(0.31, 0.42, 0.53), Vec3(0, 0.5, 1.0)), o);
+}
+
+/// A car with a roof IMU 1.2 m ahead of and 1.5 m above the rear axle, mounted a little tilted.
+std::unique_ptr<BodyTrajectory> car() {
+  CarTrajectoryOptions o;
+  o.shake = carShake(1.0);
+  o.T_I_B.linear() = so3::Exp(Vec3(0.01, -0.02, 0.03));
+  o.T_I_B.translation() = Vec3(-1.2, 0.05, -1.5);
+  std::vector<Vec3> w = {{0, 0, 1.8}, {60, 0, 1.8}, {60, 40, 1.8}, {0, 40, 1.8}};
+  return std::make_unique<CarTrajectory>(std::make_unique<BSplineLoopPath>(w, 8.0, 6.0), o);
 }
 
 void expectDerivativesConsistent(const BodyTrajectory& traj) {
@@ -87,8 +98,8 @@ struct ImuIntegrator {
   }
 };
 
-void expectImuIntegratesToGroundTruth(const std::string& trajectory_yaml) {
-  const std::string yaml = test::noiseFreeImuRig() + "sim:\n  duration_s: 10.5\n  ground_truth_rate_hz: 50\n" +
+void expectImuIntegratesToGroundTruth(const std::string& trajectory_yaml, const std::string& rig_extra = "") {
+  const std::string yaml = test::noiseFreeImuRig() + rig_extra + "sim:\n  duration_s: 10.5\n  ground_truth_rate_hz: 50\n" +
                            test::boxRoomScene() + "  trajectory:\n" + trajectory_yaml;
   const SimulationSetup setup = loadSimulation(Config::fromString(yaml, "imu_test.yaml"), "");
   test::CollectingSink sink;
@@ -117,6 +128,7 @@ void expectImuIntegratesToGroundTruth(const std::string& trajectory_yaml) {
 
 TEST(BodyTrajectory, HandheldDerivativesAreExact) { expectDerivativesConsistent(*handheld()); }
 TEST(BodyTrajectory, FlightDerivativesAreExact) { expectDerivativesConsistent(*flight()); }
+TEST(BodyTrajectory, CarDerivativesAreExact) { expectDerivativesConsistent(*car()); }
 
 TEST(BodyTrajectory, StillStartThenMoving) {
   const auto t = handheld();
@@ -201,4 +213,16 @@ TEST(ImuIntegration, CarLoopReproducesGroundTruth) {
     start_still_s: 0.5
     ramp_s: 2.0
 )");
+}
+
+TEST(ImuIntegration, CarWithRearAxleBehindTheImuReproducesGroundTruth) {
+  expectImuIntegratesToGroundTruth(R"(
+    type: car
+    waypoints: [0, 0, 1.8,  60, 0, 1.8,  60, 40, 1.8,  0, 40, 1.8]
+    speed: 8
+    control_spacing: 6
+    start_still_s: 0.5
+    ramp_s: 2.0
+)",
+                                   "  wheel: {rate_hz: 50, track_width: 1.6, speed_noise_std: 0, T_I_B: {translation: [-1.2, 0.1, -1.5], rpy_deg: [1, -2, 3]}}\n");
 }
