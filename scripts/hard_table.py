@@ -16,10 +16,10 @@ and DIR/table.md gets one row per run with the bars of issue 19 checked:
   no false loop, and on campus_loop_long_hard the end-point drift cut by at least half.
 Where the LIO flags most sweeps degenerate (the corridor: its axis is unobservable to the LiDAR and
 left to the IMU) the ATE and divergence bars apply to LIVO, the estimate with a sensor for that axis.
-End-point drift: the drift at the run's last return within 10 m of its start (revisit_drift).
+End-point drift: the drift at the run's last return within 10 m of its start (check_loops.revisit_drift).
 Exit status 1 if any bar is missed. Runs one after the other (each run uses both cores).
 """
-import argparse, json, math, os, struct, subprocess, sys
+import argparse, json, os, struct, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'loop'))
@@ -71,35 +71,6 @@ def run(cmd, log, env=None):
 def evaluation(run_dir, name='odometry'):
     path = os.path.join(run_dir, 'evaluation_%s.json' % name)
     return json.load(open(path)) if os.path.exists(path) else None
-
-
-def read_tum(path):
-    return [[float(x) for x in l.split()] for l in open(path) if l.strip() and not l.startswith('#')]
-
-
-def revisit_drift(tum, gt, times, radius=10.0, min_path=100.0):
-    """Drift at the last return to the start: the estimate's displacement from its first pose to its
-    last pose within `radius` m of the true start (after `min_path` m of travel), in the first pose's
-    frame, against the truth's the same way. Relative, so the start attitude (a few mrad of tilt from
-    the IMU's errors) costs at most radius x angle; nan when the run never comes back."""
-    rows = read_tum(tum)
-    if not rows:
-        return float('nan')
-    g0p, g0q, _ = cl.interp(gt, times, rows[0][0])
-    path, last, end = 0.0, g0p, None
-    for r in rows:
-        gp, gq, _ = cl.interp(gt, times, r[0])
-        path += math.dist(gp, last)
-        last = gp
-        if path >= min_path and math.dist(gp[:2], g0p[:2]) <= radius:
-            end = (r, gp, gq)
-    if end is None:
-        return float('nan')
-    r, gp, _ = end
-    q0 = (rows[0][7], rows[0][4], rows[0][5], rows[0][6])
-    est = cl.qrot(cl.qconj(q0), tuple(r[1 + i] - rows[0][1 + i] for i in range(3)))
-    true = cl.qrot(cl.qconj(g0q), tuple(gp[i] - g0p[i] for i in range(3)))
-    return math.dist(est, true)
 
 
 def main():
@@ -195,8 +166,8 @@ def main():
                         failures.append('%s: %d false loops' % (tag, row['false_loops']))
                     gt = cl.read_ground_truth(log)
                     times = [g[0] for g in gt]
-                    row['end_lio'] = revisit_drift(os.path.join(base, 'lio', 'odometry.tum'), gt, times)
-                    row['end_loop'] = revisit_drift(os.path.join(base, 'loop', 'keyframes.tum'), gt, times)
+                    row['end_lio'] = cl.revisit_drift(cl.read_tum(os.path.join(base, 'lio', 'odometry.tum')), gt, times)
+                    row['end_loop'] = cl.revisit_drift(cl.read_tum(os.path.join(base, 'loop', 'keyframes.tum')), gt, times)
                     if name.startswith('campus_loop_long') and not row['end_loop'] <= 0.5 * row['end_lio']:
                         failures.append('%s: end-point drift %.3f m with loop closure against %.3f m without' % (
                             tag, row['end_loop'], row['end_lio']))

@@ -68,6 +68,42 @@ def interp(gt, times, t):
     return p, tuple(x / n for x in q), abs(t - (t0 if a < 0.5 else t1))
 
 
+def read_tum(path):
+    """(t, position, quaternion w x y z) of every pose of a TUM trajectory file."""
+    out = []
+    for line in open(path):
+        if line.startswith('#') or not line.strip():
+            continue
+        v = [float(x) for x in line.split()]
+        out.append((v[0], tuple(v[1:4]), (v[7], v[4], v[5], v[6])))
+    return out
+
+
+def revisit_drift(traj, gt, times, radius=10.0, min_path=100.0):
+    """Drift at the last return to the start: the trajectory's displacement from its first pose to
+    its last pose within `radius` m (horizontally) of the true start, after `min_path` m of travel,
+    in the first pose's frame, against the ground truth's taken the same way. Relative, so the start
+    attitude (a few mrad of tilt from an IMU's errors) costs at most radius x angle, where a
+    first-pose alignment of the far end would turn it into metres; nan if the run never comes back."""
+    if not traj:
+        return float('nan')
+    t0, p0, q0 = traj[0]
+    g0p, g0q, _ = interp(gt, times, t0)
+    path, last, end = 0.0, g0p, None
+    for t, p, _ in traj:
+        gp, _, _ = interp(gt, times, t)
+        path += math.dist(gp, last)
+        last = gp
+        if path >= min_path and math.dist(gp[:2], g0p[:2]) <= radius:
+            end = (p, gp)
+    if end is None:
+        return float('nan')
+    p, gp = end
+    est = qrot(qconj(q0), tuple(p[i] - p0[i] for i in range(3)))
+    true = qrot(qconj(g0q), tuple(gp[i] - g0p[i] for i in range(3)))
+    return math.dist(est, true)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--log", required=True)
