@@ -184,6 +184,16 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   std::string offset = roomConfig();
   offset.replace(offset.find("    color: false"), 16, "    color: false\n    time_offset_s: 0.02");
   EXPECT_DOUBLE_EQ(readVioNodeOptions(Config::fromString(offset)).camera_time_offset_s, 0.02);
+  // the rig's rolling-shutter readout (a datasheet number): 0 by default, at most one frame
+  EXPECT_DOUBLE_EQ(d.camera.rolling_shutter_s, 0.0);
+  std::string readout = roomConfig();
+  readout.replace(readout.find("    color: false"), 16, "    color: false\n    rolling_shutter_s: 0.02");
+  EXPECT_DOUBLE_EQ(readVioNodeOptions(Config::fromString(readout)).camera.rolling_shutter_s, 0.02);
+  for (const char* bad : {"-0.001", "0.06"}) {  // 20 Hz: a frame is 0.05 s
+    std::string b = roomConfig();
+    b.replace(b.find("    color: false"), 16, std::string("    color: false\n    rolling_shutter_s: ") + bad);
+    EXPECT_THROW(readVioNodeOptions(Config::fromString(b)), ConfigError) << bad;
+  }
   std::string no_camera = roomConfig();
   const size_t c0 = no_camera.find("  camera:\n"), c1 = no_camera.find("sim:");
   no_camera.erase(c0, c1 - c0);

@@ -14,11 +14,11 @@ namespace {
 // Measurement over the active patches at iterate x; returns the number of patches used.
 int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
             const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
-            const PhotometricOptions& o, PoseInformation* info) {
+            const PhotometricOptions& o, const RollingShutter& shutter, PoseInformation* info) {
   PatchResidual e;
   int used = 0;
   for (size_t i = 0; i < patches.size(); ++i) {
-    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e)) continue;
+    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e, shutter)) continue;
     accumulate(e, o, info);
     ++used;
   }
@@ -36,7 +36,8 @@ std::string fmt(double v) {
 
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
-                                const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io) {
+                                const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io,
+                                const RollingShutter& shutter) {
   std::vector<TrackedPatch>& patches = *patches_io;
   DirectUpdateResult res;
   res.state = prior;
@@ -53,7 +54,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     const bool gate = res.iterations > 0;
     int n_active = 0;
     for (size_t i = 0; i < patches.size(); ++i) {
-      active[i] = evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], po, &e) && (!gate || e.ncc >= po.min_ncc);
+      active[i] = evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], po, &e, shutter) && (!gate || e.ncc >= po.min_ncc);
       n_active += active[i];
     }
     if (n_active < uo.min_patches) {
@@ -63,7 +64,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
       PoseInformation info;
-      const int used = measure(patches, active, level, pyramid, camera, T_I_C, x, po, &info);
+      const int used = measure(patches, active, level, pyramid, camera, T_I_C, x, po, shutter, &info);
       if (used < uo.min_patches) break;
       Vec18 delta;
       informationStep(x, prior, P_prior, info.HtRinvH, info.HtRinvz, &delta, &P);
@@ -96,8 +97,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     t.active = false;
     if (!active[i]) continue;
     PatchResidual ep;
-    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep) ||
-        !evaluatePatch(pyramid, 0, camera, T_I_C, x, t, po, &e))
+    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep, shutter) ||
+        !evaluatePatch(pyramid, 0, camera, T_I_C, x, t, po, &e, shutter))
       continue;
     t.active = true;
     t.ncc = static_cast<float>(e.ncc);

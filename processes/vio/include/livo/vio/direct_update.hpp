@@ -34,6 +34,7 @@ struct DirectUpdateResult {
 /// Runs the update; fills each patch's active / ncc / rms (level 0, at the posterior).
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& photometric,
-                                const UpdateOptions& update, std::vector<TrackedPatch>* patches);
+                                const UpdateOptions& update, std::vector<TrackedPatch>* patches,
+                                const RollingShutter& shutter = RollingShutter());
 
 }  // namespace livo::vio

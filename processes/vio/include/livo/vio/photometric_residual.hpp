@@ -20,6 +20,7 @@
 #include "livo/filter_state.hpp"
 #include "livo/vio/image_pyramid.hpp"
 #include "livo/vio/patch.hpp"
+#include "livo/vio/rolling_shutter.hpp"
 #include "livo/vio/vio_options.hpp"
 
 namespace livo::vio {
@@ -55,11 +56,16 @@ struct PatchResidual {
   Eigen::Matrix<double, kPatchArea, 6> jacobian() const { return G * B; }
 };
 
-/// Evaluates the patch at level `level` for the state x; false if the point does not project
-/// with its window inside that level.
+/// d pixel / d [δrot δpos] of the stamp's body pose for a point seen through a rolling shutter
+/// at row time s.dt (the row's time held fixed: its change with the pose is second order).
+Mat26 pixelPoseJacobian(const ShutterProjection& s, const RollingShutter& shutter, const Pose3& T_I_C);
+
+/// Evaluates the patch at level `level` for the state x (at the image stamp; each point seen at its
+/// row's time under a rolling shutter); false if the point does not project with its window
+/// inside that level.
 bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const Pose3& T_I_C,
                    const FilterState& x, const TrackedPatch& patch, const PhotometricOptions& options,
-                   PatchResidual* out);
+                   PatchResidual* out, const RollingShutter& shutter = RollingShutter());
 
 /// Adds the patch's Huber-weighted information (H^T R^-1 H, H^T R^-1 z with R = noise_std^2) to
 /// `info`; returns its Huber cost (sum over pixels, grey levels^2).

@@ -25,6 +25,7 @@
 #include "livo/vio/image_pyramid.hpp"
 #include "livo/vio/point_patch_map.hpp"
 #include "livo/vio/point_selection.hpp"
+#include "livo/vio/rolling_shutter.hpp"
 #include "livo/vio/vio_options.hpp"
 
 namespace livo::vio {
@@ -76,10 +77,13 @@ class VioEstimator {
     std::vector<Vec3> points;
   };
   void fillDepth(const Pose3& T_W_C);
-  void maintain(const GreyImage& image, const Pose3& T_W_C, bool refresh, const std::vector<TrackedPatch>& tracked,
+  void maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh, const std::vector<TrackedPatch>& tracked,
                 ImageResult* result);
   bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
                        PatchObservation* obs) const;
+  /// The shutter of an image at state x: the rig's line time and the body rate since the last
+  /// image's posterior (zero for the first image, after a gap or a correction).
+  RollingShutter shutterAt(int64_t utime, const FilterState& x) const;
 
   VioOptions options_;
   CameraProjection camera_;
@@ -88,6 +92,9 @@ class VioEstimator {
   std::deque<Scan> scans_;   // newest last
   ImagePyramid pyramid_;
   DepthGrid depth_;
+  RollingShutter shutter_;       // line time of the rig; no motion
+  int64_t last_utime_ = -1;      // the last image's time and posterior rotation (body rate)
+  Mat3 last_rot_ = Mat3::Identity();
 };
 
 }  // namespace livo::vio
