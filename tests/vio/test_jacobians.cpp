@@ -265,3 +265,35 @@ TEST(VioRollingShutter, PixelJacobianWrtTheStampPoseMatchesNumeric) {
     EXPECT_GT((pixelPoseJacobian(J0, x.rot, rig.T_I_C, p_I0) - B).norm(), 1e-3 * B.norm());
   }
 }
+
+TEST(VioJacobians, PixelJacobianWrtTheCameraRotationMatchesNumeric) {
+  // Bc = d pixel / d φ for the extrinsic T_I_C Exp(φ) (online camera-rotation calibration), with a
+  // rolling shutter, at every level
+  const CameraRig rig = distortedCamera();
+  const CameraProjection cam(rig);
+  const FilterState x = movingState();
+  const RollingShutter s = brisk(rig);
+  const cv::Mat img(rig.height, rig.width, CV_8UC1, cv::Scalar(100));
+  ImagePyramid pyr;
+  pyr.build(img, 3);
+  auto withRotation = [&](const Vec3& phi) { return rig.T_I_C * se3::fromRotationTranslation(so3::Exp(phi), Vec3::Zero()); };
+  for (int level = 0; level < 3; ++level)
+    for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.3, 2.5), Vec3(-0.45, 0.3, 4.0)}) {
+      TrackedPatch t;
+      t.p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());
+      PatchResidual e;
+      ASSERT_TRUE(evaluatePatch(pyr, level, cam, rig.T_I_C, x, t, PhotometricOptions(), &e, s));
+      const double h = 1e-7;
+      for (int k = 0; k < 3; ++k) {
+        Vec3 d = Vec3::Zero();
+        d[k] = h;
+        PatchResidual ep, em;
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(d), x, t, PhotometricOptions(), &ep, s));
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(-d), x, t, PhotometricOptions(), &em, s));
+        const Eigen::Vector2d num = (ep.pixel - em.pixel) / (2 * h) / static_cast<double>(1 << level);
+        EXPECT_GT(num.norm(), 50.0 / (1 << level));  // a radian turns the view by hundreds of pixels
+        // the row time follows the pixel (a few per cent, as for the pose Jacobian)
+        EXPECT_LT((e.Bc.col(k) - num).norm(), 0.05 * num.norm()) << "level " << level << " column " << k;
+      }
+    }
+}

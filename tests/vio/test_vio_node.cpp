@@ -166,7 +166,8 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
       "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3}\n"
-      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n")));
+      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n"
+      "  calibration: {camera_rotation_std_deg: 0.3, camera_rotation_walk_deg: 0.002}\n")));
   EXPECT_EQ(o.name, "vio2");
   EXPECT_EQ(o.state_prior_channel, "PRIOR2");
   EXPECT_DOUBLE_EQ(o.vio.map.voxel_size, 0.25);
@@ -177,6 +178,11 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_DOUBLE_EQ(o.vio.maintenance.min_gradient, 4.0);
   EXPECT_DOUBLE_EQ(o.vio.maintenance.refresh_angle_deg, 12.0);
   EXPECT_DOUBLE_EQ(o.vio.selection.depth_edge_radius_px, 20.0);
+  EXPECT_DOUBLE_EQ(d.vio.calibration.camera_rotation_std_deg, 0.0);  // off unless asked for
+  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_std_deg, 0.3);
+  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_walk_deg, 0.002);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {camera_rotation_std_deg: -1}\n"))),
+               ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  photometric: {pyramid_levels: 7}\n"))),
                ConfigError);

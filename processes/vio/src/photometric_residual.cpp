@@ -31,6 +31,8 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
   float w[kWindow * kWindow];
   if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
   out->B = pixelPoseJacobian(s, shutter, T_I_C) * (1.0 / static_cast<double>(1 << level));
+  // p_C = Exp(-φ) p_C0: d p_C / d φ = [p_C]x
+  out->Bc = s.J_proj * so3::hat(T_I_C.inverse() * s.p_I) * (1.0 / static_cast<double>(1 << level));
 
   const float* Q = patch.reference.data() + static_cast<size_t>(level) * kPatchArea;
   // current intensities and gradients on the 8x8 interior of the 10x10 window
@@ -90,6 +92,11 @@ double huberCost(const PatchResidual& e, double d) {
 }
 
 double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info) {
+  return accumulate(e, o, info, nullptr);
+}
+
+double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info,
+                  CameraRotationInformation* ci) {
   const double d = o.huber_threshold;
   Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
   Eigen::Vector2d v = Eigen::Vector2d::Zero();
@@ -112,6 +119,11 @@ double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInfor
   info->HtRinvz += inv_var * (e.B.transpose() * v);
   info->geometry += H;
   info->count += kPatchArea;
+  if (ci) {
+    ci->S_xc += inv_var * (e.B.transpose() * M * e.Bc);
+    ci->S_cc += inv_var * (e.Bc.transpose() * M * e.Bc);
+    ci->g_c += inv_var * (e.Bc.transpose() * v);
+  }
   return cost;
 }
 

@@ -77,6 +77,10 @@ void readVio(const Config& c, VioNodeOptions* n) {
   rf.readOptional("error", o.maintenance.refresh_error);
   rf.readOptional("min_ncc", o.maintenance.outlier_ncc);
 
+  const Config cal = c.optionalSection("calibration");
+  cal.readOptional("camera_rotation_std_deg", o.calibration.camera_rotation_std_deg);
+  cal.readOptional("camera_rotation_walk_deg", o.calibration.camera_rotation_walk_deg);
+
   auto require = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };

@@ -25,6 +25,8 @@ VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
       depth_(camera.width, camera.height, options.selection.depth_cell_px),
       shutter_(RollingShutter::fromReadout(camera.rolling_shutter_s, camera.height)) {
   validate(options_);
+  const double std = options_.calibration.camera_rotation_std_deg * M_PI / 180.0;
+  camera_rotation_cov_ = Mat3::Identity() * std * std;
 }
 
 void VioEstimator::reset() {
@@ -126,8 +128,18 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
                              : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
                                    std::to_string(options_.update.min_patches) + ")";
   } else {
+    const bool calibrate = options_.calibration.camera_rotation_std_deg > 0.0;
+    if (calibrate && last_utime_ >= 0 && image.utime > last_utime_) {
+      const double walk = options_.calibration.camera_rotation_walk_deg * M_PI / 180.0;
+      camera_rotation_cov_ += Mat3::Identity() * walk * walk * 1e-6 * static_cast<double>(image.utime - last_utime_);
+    }
     const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, T_I_C_, options_.photometric,
-                                              options_.update, &tracked, shutter);
+                                              options_.update, &tracked, shutter,
+                                              calibrate ? &camera_rotation_cov_ : nullptr);
+    if (calibrate && u.valid) {
+      T_I_C_ = T_I_C_ * se3::fromRotationTranslation(so3::Exp(u.camera_rotation), Vec3::Zero());
+      camera_rotation_cov_ = 0.5 * (u.camera_rotation_cov + u.camera_rotation_cov.transpose());
+    }
     r.iterations = u.iterations;
     r.num_measurements = u.num_measurements;
     r.patches = u.patches;

@@ -68,6 +68,8 @@ class VioEstimator {
   const PointPatchMap& map() const { return map_; }
   const VioOptions& options() const { return options_; }
   const CameraProjection& camera() const { return camera_; }
+  /// The camera extrinsic in use (the rig's, corrected online if calibration is on).
+  const Pose3& cameraExtrinsic() const { return T_I_C_; }
   const ImagePyramid& pyramid() const { return pyramid_; }  // of the last image
   size_t recentScanPoints() const;
 
@@ -95,6 +97,7 @@ class VioEstimator {
   RollingShutter shutter_;       // line time of the rig; no motion
   int64_t last_utime_ = -1;      // the last image's time and posterior rotation (body rate)
   Mat3 last_rot_ = Mat3::Identity();
+  Mat3 camera_rotation_cov_ = Mat3::Zero();  // of the correction folded into T_I_C_ (if estimated)
 };
 
 }  // namespace livo::vio
