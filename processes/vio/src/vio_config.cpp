@@ -12,6 +12,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   c.readOptional("name", n->name);
   const Config ch = c.optionalSection("channels");
   ch.readOptional("camera", n->camera_channel);
+  ch.readOptional("imu", n->imu_channel);
   ch.readOptional("state_prior", n->state_prior_channel);
   ch.readOptional("state_posterior", n->state_posterior_channel);
   ch.readOptional("registered_scan", n->registered_scan_channel);
@@ -103,6 +104,7 @@ VioNodeOptions readVioNodeOptions(const Config& root) {
   n.camera = *sensor_rig.camera;
   n.camera_time_offset_s = n.camera.time_offset_s;
   n.camera_channel = sensor_rig.channels.camera;
+  n.imu_channel = sensor_rig.channels.imu;
   const Config vio = root.optionalSection("vio");
   if (!vio.isNull()) {
     readVio(vio, &n);

@@ -10,6 +10,8 @@ namespace livo::vio {
 namespace {
 constexpr int kMaxCandidatesPerCell = 8;  // gradient evaluations per new-point cell
 constexpr double kMaxRateInterval = 0.25; // s: the body rate from two images farther apart is not used
+constexpr int64_t kGyroWindow = 15000;    // us: gyro samples this close to the image give its body rate
+constexpr int64_t kGyroKept = 200000;     // us: samples kept behind the newest
 
 double angleDeg(const Vec3& a, const Vec3& b) {
   const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
@@ -35,8 +37,23 @@ void VioEstimator::reset() {
   last_utime_ = -1;
 }
 
+void VioEstimator::addGyro(int64_t utime, const Vec3& w) {
+  if (!shutter_.active() || !w.allFinite()) return;
+  if (!gyro_.empty() && utime < gyro_.back().first) gyro_.clear();  // time went back: a new replay
+  gyro_.emplace_back(utime, w);
+  while (gyro_.front().first < utime - kGyroKept) gyro_.pop_front();
+}
+
 RollingShutter VioEstimator::shutterAt(int64_t utime, const FilterState& x) const {
   RollingShutter s = shutter_;
+  Vec3 sum = Vec3::Zero();
+  int n = 0;
+  for (const auto& g : gyro_)
+    if (std::abs(g.first - utime) <= kGyroWindow) sum += g.second, ++n;
+  if (s.active() && n > 0) {
+    s.omega_I = sum / n - x.gyro_bias;
+    return s;
+  }
   const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
   if (s.active() && last_utime_ >= 0 && dt > 0.0 && dt <= kMaxRateInterval)
     s.omega_I = so3::Log(last_rot_.transpose() * x.rot) / dt;
