@@ -76,11 +76,14 @@ CameraRig readCamera(const Config& c) {
   c.read("T_I_C", cam.T_I_C);
   c.readOptional("time_offset_s", cam.time_offset_s);
   if (!(std::abs(cam.time_offset_s) < 1.0)) throw ConfigError(c.where("time_offset_s") + ": must be within (-1, 1) s");
+  c.readOptional("rolling_shutter_s", cam.rolling_shutter_s);
   if (cam.width <= 0 || cam.width > 10000) throw ConfigError(c.where("width") + ": must be in 1..10000");
   if (cam.height <= 0 || cam.height > 10000) throw ConfigError(c.where("height") + ": must be in 1..10000");
   requirePositive(c, "fx", cam.fx);
   requirePositive(c, "fy", cam.fy);
   requirePositive(c, "rate_hz", cam.rate_hz);
+  if (!(cam.rolling_shutter_s >= 0.0 && cam.rolling_shutter_s <= 1.0 / cam.rate_hz))
+    throw ConfigError(c.where("rolling_shutter_s") + ": must be within [0, 1 / rate_hz] s");
   return cam;
 }
 

@@ -174,3 +174,126 @@ TEST(VioJacobians, PhotometricJacobianWrtPoseErrorMatchesNumeric) {
   }
   EXPECT_EQ(checked, 12);
 }
+
+namespace {
+
+// A rolling shutter reading 512 rows in 20 ms, the body turning at about 1.2 rad/s and moving at
+// 1.5 m/s (brisk handheld motion).
+RollingShutter brisk(const CameraRig& rig) {
+  RollingShutter s = RollingShutter::fromReadout(0.02, rig.height);
+  s.omega_I = Vec3(0.4, -0.9, 0.7);
+  return s;
+}
+
+FilterState movingState() {
+  FilterState x = bodyState();
+  x.vel = Vec3(1.2, -0.6, 0.7);
+  return x;
+}
+
+}  // namespace
+
+TEST(VioRollingShutter, PointIsSeenFromThePoseOfItsRow) {
+  const CameraRig rig = distortedCamera();
+  const CameraProjection cam(rig);
+  const FilterState x = movingState();
+  const RollingShutter s = brisk(rig);
+  EXPECT_DOUBLE_EQ(s.line_time, 0.02 / 512);
+  EXPECT_DOUBLE_EQ(s.rowTime(255.5), 0.0);   // the stamp is the centre row's
+  EXPECT_DOUBLE_EQ(s.rowTime(511.0), 255.5 * 0.02 / 512);  // the last row: half a readout (less half a line) later
+  for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.5, 2.5), Vec3(-0.55, 0.4, 4.0), Vec3(0.6, 0.45, 1.2)}) {
+    const Vec3 p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());
+    ShutterProjection sp;
+    ASSERT_TRUE(projectThroughShutter(cam, rig.T_I_C, x, s, p_W, &sp));
+    // consistent: the row's pose sees the point at that very row
+    const Pose3 T_W_C = cameraPoseAt(x, s, s.rowTime(sp.pixel.y()), rig.T_I_C);
+    Eigen::Vector2d px;
+    ASSERT_TRUE(cam.project(T_W_C.inverse() * p_W, &px));
+    EXPECT_LT((px - sp.pixel).norm(), 0.01);
+    // and far from where the stamp's pose sees it (rows away from the centre)
+    Eigen::Vector2d px0;
+    ASSERT_TRUE(cam.project((x.pose() * rig.T_I_C).inverse() * p_W, &px0));
+    EXPECT_GT((px0 - sp.pixel).norm(), 0.5);
+    // a global shutter is the stamp's projection
+    ShutterProjection g;
+    ASSERT_TRUE(projectThroughShutter(cam, rig.T_I_C, x, RollingShutter::fromReadout(0.0, rig.height), p_W, &g));
+    EXPECT_LT((g.pixel - px0).norm(), 1e-9);
+    EXPECT_EQ(g.dt, 0.0);
+  }
+}
+
+TEST(VioRollingShutter, PixelJacobianWrtTheStampPoseMatchesNumeric) {
+  const CameraRig rig = distortedCamera();
+  const CameraProjection cam(rig);
+  const FilterState x = movingState();
+  const RollingShutter s = brisk(rig);
+  const Pose3 T_C_I = rig.T_I_C.inverse();
+  for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.5, 2.5), Vec3(-0.55, 0.4, 4.0), Vec3(0.6, 0.45, 1.2)}) {
+    const Vec3 p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());
+    ShutterProjection sp;
+    ASSERT_TRUE(projectThroughShutter(cam, rig.T_I_C, x, s, p_W, &sp));
+    ASSERT_GT(std::abs(sp.dt), 1e-3);
+    const Mat26 B = pixelPoseJacobian(sp, s, rig.T_I_C);
+    // the pixel of the pose at the row's time held fixed (the Jacobian's definition) ...
+    auto atFixedRow = [&](const FilterState& y) {
+      Eigen::Vector2d q;
+      const Pose3 T_W_C = cameraPoseAt(y, s, sp.dt, rig.T_I_C);
+      EXPECT_TRUE(cam.project(T_W_C.inverse() * p_W, &q));
+      return q;
+    };
+    // ... and with the row following the pose (what the image sees)
+    auto followingRow = [&](const FilterState& y) {
+      ShutterProjection q;
+      EXPECT_TRUE(projectThroughShutter(cam, rig.T_I_C, y, s, p_W, &q));
+      return q.pixel;
+    };
+    const double h = 1e-7;
+    for (int k = 0; k < 6; ++k) {
+      Vec18 d = Vec18::Zero();
+      d[k] = h;
+      const Eigen::Vector2d fixed = (atFixedRow(x.boxplus(d)) - atFixedRow(x.boxplus(-d))) / (2 * h);
+      const Eigen::Vector2d full = (followingRow(x.boxplus(d)) - followingRow(x.boxplus(-d))) / (2 * h);
+      EXPECT_LT((B.col(k) - fixed).norm(), 1e-5 * (1.0 + fixed.norm())) << "column " << k;
+      // the row's own motion is a few per cent at this rate
+      EXPECT_LT((B.col(k) - full).norm(), 0.05 * full.norm()) << "column " << k;
+    }
+    // the global-shutter Jacobian at the stamp's pose differs from it by more than rounding
+    Eigen::Matrix<double, 2, 3> J0;
+    Eigen::Vector2d px0;
+    const Vec3 p_I0 = x.rot.transpose() * (p_W - x.pos);
+    ASSERT_TRUE(cam.projectWithJacobian(T_C_I * p_I0, &px0, &J0));
+    EXPECT_GT((pixelPoseJacobian(J0, x.rot, rig.T_I_C, p_I0) - B).norm(), 1e-3 * B.norm());
+  }
+}
+
+TEST(VioJacobians, PixelJacobianWrtTheCameraRotationMatchesNumeric) {
+  // Bc = d pixel / d φ for the extrinsic T_I_C Exp(φ) (online camera-rotation calibration), with a
+  // rolling shutter, at every level
+  const CameraRig rig = distortedCamera();
+  const CameraProjection cam(rig);
+  const FilterState x = movingState();
+  const RollingShutter s = brisk(rig);
+  const cv::Mat img(rig.height, rig.width, CV_8UC1, cv::Scalar(100));
+  ImagePyramid pyr;
+  pyr.build(img, 3);
+  auto withRotation = [&](const Vec3& phi) { return rig.T_I_C * se3::fromRotationTranslation(so3::Exp(phi), Vec3::Zero()); };
+  for (int level = 0; level < 3; ++level)
+    for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.3, 2.5), Vec3(-0.45, 0.3, 4.0)}) {
+      TrackedPatch t;
+      t.p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());
+      PatchResidual e;
+      ASSERT_TRUE(evaluatePatch(pyr, level, cam, rig.T_I_C, x, t, PhotometricOptions(), &e, s));
+      const double h = 1e-7;
+      for (int k = 0; k < 3; ++k) {
+        Vec3 d = Vec3::Zero();
+        d[k] = h;
+        PatchResidual ep, em;
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(d), x, t, PhotometricOptions(), &ep, s));
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(-d), x, t, PhotometricOptions(), &em, s));
+        const Eigen::Vector2d num = (ep.pixel - em.pixel) / (2 * h) / static_cast<double>(1 << level);
+        EXPECT_GT(num.norm(), 50.0 / (1 << level));  // a radian turns the view by hundreds of pixels
+        // the row time follows the pixel (a few per cent, as for the pose Jacobian)
+        EXPECT_LT((e.Bc.col(k) - num).norm(), 0.05 * num.norm()) << "level " << level << " column " << k;
+      }
+    }
+}

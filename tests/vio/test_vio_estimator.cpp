@@ -172,3 +172,27 @@ TEST(VioEstimator, RejectsAnUpdateThatContradictsThePrior) {
   EXPECT_EQ(r.state.boxminus(prior).norm(), 0.0);
   EXPECT_TRUE(r.covariance == P);
 }
+
+TEST(VioEstimator, RollingShutterRowsArePlacedWithTheGyroRate) {
+  CameraRig rig = livo_test::SimScene().camera();
+  rig.rolling_shutter_s = 0.02;
+  VioEstimator vio(VioOptions{}, rig);
+  const int64_t t = 1'700'000'000'000'000;
+  FilterState x;
+  x.gyro_bias = Vec3(0.01, -0.02, 0.03);
+  // no samples and no earlier image: no rate
+  EXPECT_EQ(vio.shutterAt(t, x).omega_I, Vec3::Zero());
+  EXPECT_DOUBLE_EQ(vio.shutterAt(t, x).line_time, 0.02 / rig.height);
+  // the mean of the samples within 15 ms of the image, less the state's gyro bias
+  vio.addGyro(t - 30000, Vec3(9.0, 9.0, 9.0));  // too early
+  vio.addGyro(t - 10000, Vec3(0.4, 0.0, -0.2));
+  vio.addGyro(t - 5000, Vec3(0.6, 0.2, -0.4));
+  vio.addGyro(t + 5000, Vec3(0.5, 0.1, -0.3));
+  vio.addGyro(t + 20000, Vec3(-9.0, 9.0, 9.0));  // too late
+  EXPECT_TRUE(vio.shutterAt(t, x).omega_I.isApprox(Vec3(0.49, 0.12, -0.33), 1e-12));
+  // a global shutter needs no rate
+  VioEstimator global(VioOptions{}, livo_test::SimScene().camera());
+  global.addGyro(t, Vec3(1.0, 1.0, 1.0));
+  EXPECT_FALSE(global.shutterAt(t, x).active());
+  EXPECT_EQ(global.shutterAt(t, x).omega_I, Vec3::Zero());
+}

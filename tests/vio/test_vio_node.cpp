@@ -166,7 +166,8 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
       "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3}\n"
-      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n")));
+      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n"
+      "  calibration: {camera_rotation_std_deg: 0.3, camera_rotation_walk_deg: 0.002}\n")));
   EXPECT_EQ(o.name, "vio2");
   EXPECT_EQ(o.state_prior_channel, "PRIOR2");
   EXPECT_DOUBLE_EQ(o.vio.map.voxel_size, 0.25);
@@ -177,6 +178,11 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_DOUBLE_EQ(o.vio.maintenance.min_gradient, 4.0);
   EXPECT_DOUBLE_EQ(o.vio.maintenance.refresh_angle_deg, 12.0);
   EXPECT_DOUBLE_EQ(o.vio.selection.depth_edge_radius_px, 20.0);
+  EXPECT_DOUBLE_EQ(d.vio.calibration.camera_rotation_std_deg, 0.0);  // off unless asked for
+  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_std_deg, 0.3);
+  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_walk_deg, 0.002);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {camera_rotation_std_deg: -1}\n"))),
+               ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  photometric: {pyramid_levels: 7}\n"))),
                ConfigError);
@@ -184,6 +190,16 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   std::string offset = roomConfig();
   offset.replace(offset.find("    color: false"), 16, "    color: false\n    time_offset_s: 0.02");
   EXPECT_DOUBLE_EQ(readVioNodeOptions(Config::fromString(offset)).camera_time_offset_s, 0.02);
+  // the rig's rolling-shutter readout (a datasheet number): 0 by default, at most one frame
+  EXPECT_DOUBLE_EQ(d.camera.rolling_shutter_s, 0.0);
+  std::string readout = roomConfig();
+  readout.replace(readout.find("    color: false"), 16, "    color: false\n    rolling_shutter_s: 0.02");
+  EXPECT_DOUBLE_EQ(readVioNodeOptions(Config::fromString(readout)).camera.rolling_shutter_s, 0.02);
+  for (const char* bad : {"-0.001", "0.06"}) {  // 20 Hz: a frame is 0.05 s
+    std::string b = roomConfig();
+    b.replace(b.find("    color: false"), 16, std::string("    color: false\n    rolling_shutter_s: ") + bad);
+    EXPECT_THROW(readVioNodeOptions(Config::fromString(b)), ConfigError) << bad;
+  }
   std::string no_camera = roomConfig();
   const size_t c0 = no_camera.find("  camera:\n"), c1 = no_camera.find("sim:");
   no_camera.erase(c0, c1 - c0);

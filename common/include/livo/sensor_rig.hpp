@@ -53,6 +53,8 @@ struct CameraRig {
   bool color = false;                 // RGB8 if true, else GRAY8
   Pose3 T_I_C = Pose3::Identity();    // p_I = T_I_C * p_C
   double time_offset_s = 0.0;         // image utime + time_offset_s = the same instant on the IMU clock
+  double rolling_shutter_s = 0.0;     // readout time, first to last row (0: global shutter); the
+                                      // stamp is the centre row's
 };
 
 /// Differential-drive wheel encoder; base frame B: x forward, z up.

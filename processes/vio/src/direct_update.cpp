@@ -14,12 +14,13 @@ namespace {
 // Measurement over the active patches at iterate x; returns the number of patches used.
 int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
             const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
-            const PhotometricOptions& o, PoseInformation* info) {
+            const PhotometricOptions& o, const RollingShutter& shutter, PoseInformation* info,
+            CameraRotationInformation* ci) {
   PatchResidual e;
   int used = 0;
   for (size_t i = 0; i < patches.size(); ++i) {
-    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e)) continue;
-    accumulate(e, o, info);
+    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e, shutter)) continue;
+    accumulate(e, o, info, ci);
     ++used;
   }
   return used;
@@ -36,7 +37,8 @@ std::string fmt(double v) {
 
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
-                                const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io) {
+                                const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io,
+                                const RollingShutter& shutter, const Mat3* cam_cov) {
   std::vector<TrackedPatch>& patches = *patches_io;
   DirectUpdateResult res;
   res.state = prior;
@@ -46,6 +48,14 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   std::vector<char> active(patches.size(), 0);
   PatchResidual e;
   bool stepped_at_finest = false;
+  // the camera-rotation correction φ (a nuisance with its own prior N(0, cam_cov), uncorrelated
+  // with the filter): eliminated from each step by its Schur complement, then solved for
+  Vec3 phi = Vec3::Zero();
+  Mat3 cam_info_prior = Mat3::Zero(), A = Mat3::Identity();
+  Eigen::Matrix<double, 6, 3> S_xc = Eigen::Matrix<double, 6, 3>::Zero();
+  Mat6 S_xx = Mat6::Zero();  // the pose's own information of the last step
+  if (cam_cov) cam_info_prior = cam_cov->inverse();
+  auto cameraAt = [&](const Vec3& f) { return cam_cov ? T_I_C * se3::fromRotationTranslation(so3::Exp(f), Vec3::Zero()) : T_I_C; };
   for (int level = pyramid.levels() - 1; level >= 0; --level) {
     // the measurement of this level: patches that project (and, once a coarser level has aligned
     // the image, correlate) at the current iterate; at the first level the prior may be off by more
@@ -53,7 +63,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     const bool gate = res.iterations > 0;
     int n_active = 0;
     for (size_t i = 0; i < patches.size(); ++i) {
-      active[i] = evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], po, &e) && (!gate || e.ncc >= po.min_ncc);
+      active[i] = evaluatePatch(pyramid, level, camera, cameraAt(phi), x, patches[i], po, &e, shutter) && (!gate || e.ncc >= po.min_ncc);
       n_active += active[i];
     }
     if (n_active < uo.min_patches) {
@@ -63,15 +73,30 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
       PoseInformation info;
-      const int used = measure(patches, active, level, pyramid, camera, T_I_C, x, po, &info);
+      CameraRotationInformation ci;
+      const int used = measure(patches, active, level, pyramid, camera, cameraAt(phi), x, po, shutter, &info,
+                               cam_cov ? &ci : nullptr);
       if (used < uo.min_patches) break;
       Vec18 delta;
-      informationStep(x, prior, P_prior, info.HtRinvH, info.HtRinvz, &delta, &P);
+      Mat6 S = info.HtRinvH;
+      Vec6 g = info.HtRinvz;
+      S_xx = S;
+      Vec3 r_c = Vec3::Zero();
+      if (cam_cov) {
+        A = ci.S_cc + cam_info_prior;
+        r_c = ci.g_c + cam_info_prior * phi;
+        S_xc = ci.S_xc;
+        const Eigen::LDLT<Mat3> Ainv(A);
+        S -= S_xc * Ainv.solve(S_xc.transpose());
+        g -= S_xc * Ainv.solve(r_c);
+      }
+      informationStep(x, prior, P_prior, S, g, &delta, &P);
       if (!delta.allFinite() || !P.allFinite()) {
         res.why = "update diverged (non-finite step)";
         return res;
       }
       x = x.boxplus(delta);
+      if (cam_cov) phi -= A.ldlt().solve(r_c + S_xc.transpose() * delta.head<6>());
       ++res.iterations;
       if (level == 0) {
         stepped_at_finest = true;
@@ -96,8 +121,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     t.active = false;
     if (!active[i]) continue;
     PatchResidual ep;
-    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep) ||
-        !evaluatePatch(pyramid, 0, camera, T_I_C, x, t, po, &e))
+    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep, shutter) ||
+        !evaluatePatch(pyramid, 0, camera, cameraAt(phi), x, t, po, &e, shutter))
       continue;
     t.active = true;
     t.ncc = static_cast<float>(e.ncc);
@@ -126,6 +151,12 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     res.valid = true;
     res.state = x;
     res.covariance = P;
+    if (cam_cov) {
+      // φ's posterior: its information less what the pose (under its prior) explains of it
+      const Mat6 pose_info = S_xx + P_prior.topLeftCorner<6, 6>().inverse();
+      res.camera_rotation = phi;
+      res.camera_rotation_cov = (A - S_xc.transpose() * pose_info.ldlt().solve(S_xc)).inverse();
+    }
   }
   return res;
 }

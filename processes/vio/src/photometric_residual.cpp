@@ -15,15 +15,24 @@ Mat26 pixelPoseJacobian(const Eigen::Matrix<double, 2, 3>& J_proj, const Mat3& R
   return J_proj * dpC;
 }
 
+Mat26 pixelPoseJacobian(const ShutterProjection& s, const RollingShutter& shutter, const Pose3& T_I_C) {
+  // the row's pose R Exp(ω dt): R Exp(δθ) Exp(ω dt) = R Exp(ω dt) Exp(Exp(ω dt)^T δθ), p + δp + v dt
+  Mat26 B = pixelPoseJacobian(s.J_proj, s.R_W_I, T_I_C, s.p_I);
+  if (s.dt != 0.0) B.leftCols<3>() *= shutter.rotationSince(s.dt).transpose();
+  return B;
+}
+
 bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const Pose3& T_I_C,
-                   const FilterState& x, const TrackedPatch& patch, const PhotometricOptions& o, PatchResidual* out) {
-  const Vec3 p_I = x.rot.transpose() * (patch.p_W - x.pos);
-  const Vec3 p_C = T_I_C.inverse() * p_I;
-  Eigen::Matrix<double, 2, 3> J;
-  if (!camera.projectWithJacobian(p_C, &out->pixel, &J)) return false;
+                   const FilterState& x, const TrackedPatch& patch, const PhotometricOptions& o, PatchResidual* out,
+                   const RollingShutter& shutter) {
+  ShutterProjection s;
+  if (!projectThroughShutter(camera, T_I_C, x, shutter, patch.p_W, &s)) return false;
+  out->pixel = s.pixel;
   float w[kWindow * kWindow];
   if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
-  out->B = pixelPoseJacobian(J, x.rot, T_I_C, p_I) * (1.0 / static_cast<double>(1 << level));
+  out->B = pixelPoseJacobian(s, shutter, T_I_C) * (1.0 / static_cast<double>(1 << level));
+  // p_C = Exp(-φ) p_C0: d p_C / d φ = [p_C]x
+  out->Bc = s.J_proj * so3::hat(T_I_C.inverse() * s.p_I) * (1.0 / static_cast<double>(1 << level));
 
   const float* Q = patch.reference.data() + static_cast<size_t>(level) * kPatchArea;
   // current intensities and gradients on the 8x8 interior of the 10x10 window
@@ -83,6 +92,11 @@ double huberCost(const PatchResidual& e, double d) {
 }
 
 double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info) {
+  return accumulate(e, o, info, nullptr);
+}
+
+double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info,
+                  CameraRotationInformation* ci) {
   const double d = o.huber_threshold;
   Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
   Eigen::Vector2d v = Eigen::Vector2d::Zero();
@@ -105,6 +119,11 @@ double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInfor
   info->HtRinvz += inv_var * (e.B.transpose() * v);
   info->geometry += H;
   info->count += kPatchArea;
+  if (ci) {
+    ci->S_xc += inv_var * (e.B.transpose() * M * e.Bc);
+    ci->S_cc += inv_var * (e.Bc.transpose() * M * e.Bc);
+    ci->g_c += inv_var * (e.Bc.transpose() * v);
+  }
   return cost;
 }
 

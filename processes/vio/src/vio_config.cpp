@@ -12,6 +12,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   c.readOptional("name", n->name);
   const Config ch = c.optionalSection("channels");
   ch.readOptional("camera", n->camera_channel);
+  ch.readOptional("imu", n->imu_channel);
   ch.readOptional("state_prior", n->state_prior_channel);
   ch.readOptional("state_posterior", n->state_posterior_channel);
   ch.readOptional("registered_scan", n->registered_scan_channel);
@@ -77,6 +78,10 @@ void readVio(const Config& c, VioNodeOptions* n) {
   rf.readOptional("error", o.maintenance.refresh_error);
   rf.readOptional("min_ncc", o.maintenance.outlier_ncc);
 
+  const Config cal = c.optionalSection("calibration");
+  cal.readOptional("camera_rotation_std_deg", o.calibration.camera_rotation_std_deg);
+  cal.readOptional("camera_rotation_walk_deg", o.calibration.camera_rotation_walk_deg);
+
   auto require = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
@@ -99,6 +104,7 @@ VioNodeOptions readVioNodeOptions(const Config& root) {
   n.camera = *sensor_rig.camera;
   n.camera_time_offset_s = n.camera.time_offset_s;
   n.camera_channel = sensor_rig.channels.camera;
+  n.imu_channel = sensor_rig.channels.imu;
   const Config vio = root.optionalSection("vio");
   if (!vio.isNull()) {
     readVio(vio, &n);

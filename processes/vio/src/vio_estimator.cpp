@@ -9,6 +9,9 @@ namespace livo::vio {
 
 namespace {
 constexpr int kMaxCandidatesPerCell = 8;  // gradient evaluations per new-point cell
+constexpr double kMaxRateInterval = 0.25; // s: the body rate from two images farther apart is not used
+constexpr int64_t kGyroWindow = 15000;    // us: gyro samples this close to the image give its body rate
+constexpr int64_t kGyroKept = 200000;     // us: samples kept behind the newest
 
 double angleDeg(const Vec3& a, const Vec3& b) {
   const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
@@ -21,13 +24,40 @@ VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
       camera_(camera),
       T_I_C_(camera.T_I_C),
       map_(options.map),
-      depth_(camera.width, camera.height, options.selection.depth_cell_px) {
+      depth_(camera.width, camera.height, options.selection.depth_cell_px),
+      shutter_(RollingShutter::fromReadout(camera.rolling_shutter_s, camera.height)) {
   validate(options_);
+  const double std = options_.calibration.camera_rotation_std_deg * M_PI / 180.0;
+  camera_rotation_cov_ = Mat3::Identity() * std * std;
 }
 
 void VioEstimator::reset() {
   map_.clear();
   scans_.clear();
+  last_utime_ = -1;
+}
+
+void VioEstimator::addGyro(int64_t utime, const Vec3& w) {
+  if (!shutter_.active() || !w.allFinite()) return;
+  if (!gyro_.empty() && utime < gyro_.back().first) gyro_.clear();  // time went back: a new replay
+  gyro_.emplace_back(utime, w);
+  while (gyro_.front().first < utime - kGyroKept) gyro_.pop_front();
+}
+
+RollingShutter VioEstimator::shutterAt(int64_t utime, const FilterState& x) const {
+  RollingShutter s = shutter_;
+  Vec3 sum = Vec3::Zero();
+  int n = 0;
+  for (const auto& g : gyro_)
+    if (std::abs(g.first - utime) <= kGyroWindow) sum += g.second, ++n;
+  if (s.active() && n > 0) {
+    s.omega_I = sum / n - x.gyro_bias;
+    return s;
+  }
+  const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
+  if (s.active() && last_utime_ >= 0 && dt > 0.0 && dt <= kMaxRateInterval)
+    s.omega_I = so3::Log(last_rot_.transpose() * x.rot) / dt;
+  return s;
 }
 
 void VioEstimator::addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n) {
@@ -65,6 +95,7 @@ size_t VioEstimator::recentScanPoints() const {
 
 void VioEstimator::applyCorrection(const Pose3& T) {
   map_.transform(T);
+  last_utime_ = -1;
   for (auto& s : scans_)
     for (auto& p : s.points) p = T * p;
 }
@@ -104,6 +135,7 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   const int levels = options_.photometric.pyramid_levels;
   pyramid_.build(image.pixels, levels);
   const Pose3 T_W_C = prior.pose() * T_I_C_;
+  const RollingShutter shutter = shutterAt(image.utime, prior);
   fillDepth(T_W_C);
   std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, image.utime, image.exposure_time, depth_,
                                                     levels, options_.selection, &r.selection);
@@ -113,8 +145,18 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
                              : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
                                    std::to_string(options_.update.min_patches) + ")";
   } else {
+    const bool calibrate = options_.calibration.camera_rotation_std_deg > 0.0;
+    if (calibrate && last_utime_ >= 0 && image.utime > last_utime_) {
+      const double walk = options_.calibration.camera_rotation_walk_deg * M_PI / 180.0;
+      camera_rotation_cov_ += Mat3::Identity() * walk * walk * 1e-6 * static_cast<double>(image.utime - last_utime_);
+    }
     const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, T_I_C_, options_.photometric,
-                                              options_.update, &tracked);
+                                              options_.update, &tracked, shutter,
+                                              calibrate ? &camera_rotation_cov_ : nullptr);
+    if (calibrate && u.valid) {
+      T_I_C_ = T_I_C_ * se3::fromRotationTranslation(so3::Exp(u.camera_rotation), Vec3::Zero());
+      camera_rotation_cov_ = 0.5 * (u.camera_rotation_cov + u.camera_rotation_cov.transpose());
+    }
     r.iterations = u.iterations;
     r.num_measurements = u.num_measurements;
     r.patches = u.patches;
@@ -128,14 +170,15 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
       r.covariance = u.covariance;
     }
   }
-  const Pose3 T_W_Cf = r.state.pose() * T_I_C_;
-  maintain(image, T_W_Cf, updated, tracked, &r);
-  map_.prune(T_W_Cf.translation());
+  maintain(image, r.state, shutter, updated, tracked, &r);
+  map_.prune((r.state.pose() * T_I_C_).translation());
+  last_utime_ = image.utime;
+  last_rot_ = r.state.rot;
   r.map_points = map_.size();
   return r;
 }
 
-void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool refresh,
+void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh,
                             const std::vector<TrackedPatch>& tracked, ImageResult* r) {
   const MaintenanceOptions& mo = options_.maintenance;
   const SelectionOptions& so = options_.selection;
@@ -143,9 +186,14 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
   const int cell = std::max(8, mo.new_point_cell_px);
   const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
   std::vector<char> occupied(static_cast<size_t>(cols) * rows, 0);
+  const double border = patchBorder(pyramid_.levels());
+  const Pose3 T_W_C = x.pose() * T_I_C_;
   const Pose3 T_C_W = T_W_C.inverse();
   const Vec3 c_W = T_W_C.translation();
-  const double border = patchBorder(pyramid_.levels());
+  // where a point is seen (its row's pose under a rolling shutter) and that row's camera pose
+  ShutterProjection sp;
+  auto seen = [&](const Vec3& p_W) { return projectThroughShutter(camera_, T_I_C_, x, shutter, p_W, &sp, border); };
+  auto rowCamera = [&](double dt) { return dt == 0.0 ? T_W_C : cameraPoseAt(x, shutter, dt, T_I_C_); };
   auto cellOf = [&](const Eigen::Vector2d& px) {
     return static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell);
   };
@@ -155,7 +203,8 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
   for (const TrackedPatch& t : tracked) {
     MapPoint& m = map_.point(t.point);
     m.last_seen = image.utime;
-    if (!camera_.project(T_C_W * m.position, &px, border)) continue;
+    if (!seen(m.position)) continue;
+    px = sp.pixel;
     occupied[cellOf(px)] = 1;
     if (!refresh || !t.active) continue;
     m.observations[static_cast<size_t>(t.observation)].error = t.rms;
@@ -173,7 +222,7 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
     ratio = std::max(ratio, 1.0 / ratio);
     if (min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || t.rms > mo.refresh_error) {
       PatchObservation obs;
-      if (makeObservation(px, image, T_W_C, &obs)) {
+      if (makeObservation(px, image, rowCamera(sp.dt), &obs)) {
         map_.addObservation(t.point, std::move(obs));
         ++r->new_patches;
       }
@@ -186,13 +235,15 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
     int evaluated = 0;
     Vec3 p = Vec3::Zero();
     Eigen::Vector2d px = Eigen::Vector2d::Zero();
+    double dt = 0.0;  // row time
   };
   std::vector<Best> best(occupied.size());
   const int gl = std::min(1, pyramid_.levels() - 1);
   for (auto s = scans_.rbegin(); s != scans_.rend(); ++s) {
     for (const Vec3& p : s->points) {
       const Vec3 p_C = T_C_W * p;
-      if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !camera_.project(p_C, &px, border)) continue;
+      if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !seen(p)) continue;
+      px = sp.pixel;
       const size_t c = cellOf(px);
       Best& b = best[c];
       if (occupied[c] || b.evaluated >= kMaxCandidatesPerCell || map_.find(p) >= 0) continue;
@@ -208,6 +259,7 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
         b.gradient = g;
         b.p = p;
         b.px = px;
+        b.dt = sp.dt;
       }
     }
   }
@@ -218,7 +270,7 @@ void VioEstimator::maintain(const GreyImage& image, const Pose3& T_W_C, bool ref
       continue;
     }
     PatchObservation obs;
-    if (!makeObservation(b.px, image, T_W_C, &obs)) continue;
+    if (!makeObservation(b.px, image, rowCamera(b.dt), &obs)) continue;
     if (map_.add(b.p, image.utime, std::move(obs)) >= 0) ++r->new_points;
   }
 }

@@ -35,6 +35,9 @@ void validate(const VioOptions& o) {
   require(o.update.min_patches >= 1, "update.min_patches must be >= 1");
   require(o.update.max_mahalanobis > 0.0, "update.max_mahalanobis must be > 0");
   require(o.update.max_step_pos > 0.0 && o.update.max_step_rot_deg > 0.0, "update: step bounds must be > 0");
+  require(o.calibration.camera_rotation_std_deg >= 0.0 && o.calibration.camera_rotation_std_deg <= 10.0,
+          "calibration.camera_rotation_std_deg must be in [0, 10]");
+  require(o.calibration.camera_rotation_walk_deg >= 0.0, "calibration.camera_rotation_walk_deg must be >= 0");
   require(o.maintenance.new_point_cell_px >= 8, "new_points.cell_px must be >= 8");
   require(o.maintenance.max_new_points >= 0, "new_points.max_per_image must be >= 0");
   require(o.maintenance.refresh_angle_deg > 0.0 && o.maintenance.refresh_distance_ratio >= 1.0,

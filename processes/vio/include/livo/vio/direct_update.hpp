@@ -29,11 +29,15 @@ struct DirectUpdateResult {
   double cost_prior = 0.0;            // Huber cost per residual at level 0 over the final patches:
   double cost_post = 0.0;             //   at the prior and at the posterior
   double mahalanobis = 0.0;           // squared, of the pose step against the prior covariance
+  Vec3 camera_rotation = Vec3::Zero();  // estimated correction φ of T_I_C (when estimated)
+  Mat3 camera_rotation_cov = Mat3::Zero();
 };
 
 /// Runs the update; fills each patch's active / ncc / rms (level 0, at the posterior).
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& photometric,
-                                const UpdateOptions& update, std::vector<TrackedPatch>* patches);
+                                const UpdateOptions& update, std::vector<TrackedPatch>* patches,
+                                const RollingShutter& shutter = RollingShutter(),
+                                const Mat3* camera_rotation_cov = nullptr);
 
 }  // namespace livo::vio

@@ -20,6 +20,7 @@
 #include "livo/filter_state.hpp"
 #include "livo/vio/image_pyramid.hpp"
 #include "livo/vio/patch.hpp"
+#include "livo/vio/rolling_shutter.hpp"
 #include "livo/vio/vio_options.hpp"
 
 namespace livo::vio {
@@ -48,6 +49,7 @@ struct PatchResidual {
   Eigen::Matrix<double, kPatchArea, 1> r;  // residuals, grey levels
   Eigen::Matrix<double, kPatchArea, 2> G;  // d r / d pixel (level pixels), brightness fit projected out
   Mat26 B;                                 // d pixel (level) / d pose
+  Eigen::Matrix<double, 2, 3> Bc;          // d pixel (level) / d camera rotation (T_I_C Exp(φ))
   Eigen::Vector2d pixel;                   // level-0 projection
   double gain = 1.0, offset = 0.0, ncc = 0.0;
 
@@ -55,15 +57,32 @@ struct PatchResidual {
   Eigen::Matrix<double, kPatchArea, 6> jacobian() const { return G * B; }
 };
 
-/// Evaluates the patch at level `level` for the state x; false if the point does not project
-/// with its window inside that level.
+/// d pixel / d [δrot δpos] of the stamp's body pose for a point seen through a rolling shutter
+/// at row time s.dt (the row's time held fixed: its change with the pose is second order).
+Mat26 pixelPoseJacobian(const ShutterProjection& s, const RollingShutter& shutter, const Pose3& T_I_C);
+
+/// Evaluates the patch at level `level` for the state x (at the image stamp; each point seen at its
+/// row's time under a rolling shutter); false if the point does not project with its window
+/// inside that level.
 bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const Pose3& T_I_C,
                    const FilterState& x, const TrackedPatch& patch, const PhotometricOptions& options,
-                   PatchResidual* out);
+                   PatchResidual* out, const RollingShutter& shutter = RollingShutter());
 
 /// Adds the patch's Huber-weighted information (H^T R^-1 H, H^T R^-1 z with R = noise_std^2) to
 /// `info`; returns its Huber cost (sum over pixels, grey levels^2).
 double accumulate(const PatchResidual& e, const PhotometricOptions& options, PoseInformation* info);
+
+/// The information of the camera-rotation correction φ (T_I_C Exp(φ), camera frame) beside the
+/// pose's: S_xc = H_x^T R^-1 H_c, S_cc = H_c^T R^-1 H_c, g_c = H_c^T R^-1 z.
+struct CameraRotationInformation {
+  Eigen::Matrix<double, 6, 3> S_xc = Eigen::Matrix<double, 6, 3>::Zero();
+  Mat3 S_cc = Mat3::Zero();
+  Vec3 g_c = Vec3::Zero();
+};
+
+/// accumulate() that also adds the camera-rotation terms of the same Huber-weighted residuals.
+double accumulate(const PatchResidual& e, const PhotometricOptions& options, PoseInformation* info,
+                  CameraRotationInformation* camera_info);
 
 /// Huber cost of the residuals alone.
 double huberCost(const PatchResidual& e, double threshold);

@@ -17,6 +17,7 @@ struct VioNodeOptions {
   std::string name = "vio";
   // channels
   std::string camera_channel = "CAMERA";  // rig.channels.camera unless vio.channels.camera
+  std::string imu_channel = "IMU";        // rig.channels.imu unless vio.channels.imu (rolling shutter only)
   std::string state_prior_channel = "STATE_PRIOR";
   std::string state_posterior_channel = "STATE_POSTERIOR";
   std::string registered_scan_channel = "REGISTERED_SCAN";

@@ -25,6 +25,7 @@
 #include "livo/vio/image_pyramid.hpp"
 #include "livo/vio/point_patch_map.hpp"
 #include "livo/vio/point_selection.hpp"
+#include "livo/vio/rolling_shutter.hpp"
 #include "livo/vio/vio_options.hpp"
 
 namespace livo::vio {
@@ -57,6 +58,8 @@ class VioEstimator {
   void addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n);
   void addScan(int64_t utime, const std::vector<Vec3>& points);
 
+  /// A gyro sample (IMU clock, body frame): the body rate a rolling shutter's rows are placed with.
+  void addGyro(int64_t utime, const Vec3& angular_velocity);
   /// Update at an image whose time the prior refers to (image.utime already on the IMU clock).
   ImageResult processImage(const GreyImage& image, const FilterState& prior, const Mat18& P);
 
@@ -67,8 +70,14 @@ class VioEstimator {
   const PointPatchMap& map() const { return map_; }
   const VioOptions& options() const { return options_; }
   const CameraProjection& camera() const { return camera_; }
+  /// The camera extrinsic in use (the rig's, corrected online if calibration is on).
+  const Pose3& cameraExtrinsic() const { return T_I_C_; }
   const ImagePyramid& pyramid() const { return pyramid_; }  // of the last image
   size_t recentScanPoints() const;
+  /// The shutter of an image at state x: the rig's line time and the body rate: the mean gyro
+  /// sample within kGyroWindow of the image less the state's gyro bias; without samples the
+  /// rotation since the last image's posterior (zero for the first image, after a gap or a correction).
+  RollingShutter shutterAt(int64_t utime, const FilterState& x) const;
 
  private:
   struct Scan {
@@ -76,7 +85,7 @@ class VioEstimator {
     std::vector<Vec3> points;
   };
   void fillDepth(const Pose3& T_W_C);
-  void maintain(const GreyImage& image, const Pose3& T_W_C, bool refresh, const std::vector<TrackedPatch>& tracked,
+  void maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh, const std::vector<TrackedPatch>& tracked,
                 ImageResult* result);
   bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
                        PatchObservation* obs) const;
@@ -88,6 +97,11 @@ class VioEstimator {
   std::deque<Scan> scans_;   // newest last
   ImagePyramid pyramid_;
   DepthGrid depth_;
+  RollingShutter shutter_;       // line time of the rig; no motion
+  int64_t last_utime_ = -1;      // the last image's time and posterior rotation (body rate)
+  Mat3 last_rot_ = Mat3::Identity();
+  std::deque<std::pair<int64_t, Vec3>> gyro_;  // recent gyro samples, oldest first
+  Mat3 camera_rotation_cov_ = Mat3::Zero();  // of the correction folded into T_I_C_ (if estimated)
 };
 
 }  // namespace livo::vio

@@ -21,6 +21,7 @@
 #include "livo/correction_frames.hpp"
 #include "livo/filter_state_t.hpp"
 #include "livo/image_t.hpp"
+#include "livo/imu_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/registered_scan_t.hpp"

@@ -69,12 +69,20 @@ struct MaintenanceOptions {
   double outlier_ncc = 0.5;        // no new patch from a view correlating worse (occluded, moved)
 };
 
+/// Online correction of the camera's rotation against the body (T_I_C Exp(φ)), estimated from the
+/// photometric residuals against the LiDAR-anchored map with the LIO's pose as prior.
+struct CalibrationOptions {
+  double camera_rotation_std_deg = 0.0;   // prior 1-sigma of the rig's T_I_C rotation; 0: not estimated
+  double camera_rotation_walk_deg = 0.01; // random walk, deg per sqrt(s)
+};
+
 struct VioOptions {
   MapOptions map;
   SelectionOptions selection;
   PhotometricOptions photometric;
   UpdateOptions update;
   MaintenanceOptions maintenance;
+  CalibrationOptions calibration;
 };
 
 /// Throws std::invalid_argument naming the first option out of range.
