@@ -26,7 +26,7 @@ struct WheelOptions {
   double track_width = 0.5;            // m (rig; kept for a yaw-rate measurement)
   double speed_noise_std = 0.02;       // m/s, per wheel (rig)
   double lateral_noise_std = 0.05;     // m/s, the non-holonomic constraints
-  double vertical_noise_std = 0.05;    // m/s
+  double vertical_noise_std = 0.1;     // m/s: a car's suspension moves the body-fixed B up and down
   double max_sample_gap_s = 0.1;       // interpolate the speed only between samples this close
   double gate_chi2 = 16.27;            // 3 dof, 0.1 %: larger innovations (slip) are rejected
 };
