@@ -81,24 +81,30 @@ def read_tum(path):
 
 def revisit_drift(traj, gt, times, radius=10.0, min_path=100.0):
     """Drift at the last return to the start: the trajectory's displacement from its first pose to
-    its last pose within `radius` m (horizontally) of the true start, after `min_path` m of travel,
-    in the first pose's frame, against the ground truth's taken the same way. Relative, so the start
-    attitude (a few mrad of tilt from an IMU's errors) costs at most radius x angle, where a
-    first-pose alignment of the far end would turn it into metres; nan if the run never comes back."""
+    its pose nearest the true start (horizontally) during its last pass within `radius` m of it,
+    after `min_path` m of travel, in the first pose's frame, against the ground truth's taken the same
+    way. Relative, so the start attitude (a few mrad of tilt and heading from an IMU's errors) costs
+    only the closest approach's distance times that angle, where a first-pose alignment of a far end
+    would turn it into metres; nan if the run never comes back."""
     if not traj:
         return float('nan')
     t0, p0, q0 = traj[0]
     g0p, g0q, _ = interp(gt, times, t0)
-    path, last, end = 0.0, g0p, None
+    path, last, inside, end = 0.0, g0p, False, None
     for t, p, _ in traj:
         gp, _, _ = interp(gt, times, t)
         path += math.dist(gp, last)
         last = gp
-        if path >= min_path and math.dist(gp[:2], g0p[:2]) <= radius:
-            end = (p, gp)
+        d = math.dist(gp[:2], g0p[:2])
+        if path < min_path or d > radius:
+            inside = False
+            continue
+        if not inside or d < end[0]:  # a new pass starts, or a closer pose in this one
+            end = (d, p, gp)
+        inside = True
     if end is None:
         return float('nan')
-    p, gp = end
+    _, p, gp = end
     est = qrot(qconj(q0), tuple(p[i] - p0[i] for i in range(3)))
     true = qrot(qconj(g0q), tuple(gp[i] - g0p[i] for i in range(3)))
     return math.dist(est, true)
