@@ -47,9 +47,14 @@ synth::SequenceSpec roomSpec(int beams, double duration) {
 void BM_LioScan(benchmark::State& state) {
   const int beams = static_cast<int>(state.range(0));
   const int timed = static_cast<int>(state.range(1));
+  const bool map_upkeep = state.range(2) != 0;  // 0: the map of before issue 19 (no carving, no refresh)
   const synth::SyntheticSequence seq(roomSpec(beams, 1.0 + 0.1 * timed + 0.1));
   LioOptions opts;
   opts.imu_noise = seq.spec().imu_error.noise;
+  if (!map_upkeep) {
+    opts.seen_through.enabled = false;
+    opts.map.refresh_range_ratio = 0.0;
+  }
   LioEstimator lio(opts);
   size_t imu_index = 0;
   int k = 0;
@@ -85,8 +90,9 @@ void BM_LioScan(benchmark::State& state) {
   state.counters["points_per_sweep"] = static_cast<double>(points) / static_cast<double>(std::max<size_t>(1, ms.size()));
   state.counters["map_points"] = static_cast<double>(lio.map().numPoints());
 }
-BENCHMARK(BM_LioScan)->Args({16, 60})->Iterations(60)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_LioScan)->Args({64, 30})->Iterations(30)->UseManualTime()->Unit(benchmark::kMillisecond);
+// {beams, timed sweeps, map upkeep (seen-through carving and range refresh) on}
+BENCHMARK(BM_LioScan)->Args({16, 60, 1})->Args({16, 60, 0})->Iterations(60)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LioScan)->Args({64, 30, 1})->Args({64, 30, 0})->Iterations(30)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 // ---- map structures ----
 struct MapData {
