@@ -1,5 +1,7 @@
 #include "livo/esikf_update.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 namespace livo {
@@ -28,6 +30,20 @@ void informationStep(const FilterState& x, const FilterState& prior, const Mat18
   d += KH6 * Jinv_e0.head<6>();
   *delta = d;
   *P_post = Pn;
+}
+
+Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose) {
+  const Eigen::LLT<Mat6> llt(0.5 * (P_pose + P_pose.transpose()));
+  if (llt.info() != Eigen::Success) return S;  // no usable prior: all of it is new
+  const Mat6 L = llt.matrixL();
+  const Mat6 W = L.transpose() * S * L;
+  Eigen::SelfAdjointEigenSolver<Mat6> es(0.5 * (W + W.transpose()));
+  const Vec6 excess = (es.eigenvalues().array() - 1.0).max(0.0).matrix();
+  const Mat6 E = es.eigenvectors() * excess.asDiagonal() * es.eigenvectors().transpose();
+  // L^-T E L^-1
+  const Mat6 Linv = L.triangularView<Eigen::Lower>().solve(Mat6::Identity());
+  const Mat6 out = Linv.transpose() * E * Linv;
+  return 0.5 * (out + out.transpose());
 }
 
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,

@@ -1,4 +1,5 @@
 // livo-vio --config FILE: the direct photometric VIO (STATE_PRIOR in, STATE_POSTERIOR out).
+#include <cmath>
 #include <iostream>
 
 #include "livo/command_line.hpp"
@@ -25,7 +26,17 @@ int main(int argc, char** argv) {
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::vio::VioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
-    return livo::spin(*lcm, node.node());
+    const int status = livo::spin(*lcm, node.node());
+    if (!quiet && opts.vio.calibration.any()) {
+      // what the online calibration learnt: the extrinsic against the rig's, and the time offset
+      const livo::vio::VioEstimator& vio = node.estimator();
+      const livo::Pose3 T = opts.camera.T_I_C.inverse() * vio.cameraExtrinsic();
+      const livo::Vec3 phi = livo::so3::Log(T.linear()) * 180.0 / M_PI;
+      std::cerr << "[" << opts.name << "] online calibration: camera rotation [" << phi.transpose()
+                << "] deg, translation [" << T.translation().transpose() << "] m against the rig, image time offset "
+                << vio.timeOffset() * 1e3 << " ms\n";
+    }
+    return status;
   } catch (const std::exception& e) {
     std::cerr << "livo-vio: " << e.what() << "\n";
     return 1;

@@ -3,6 +3,8 @@
 // analysis on a corridor (two walls and a floor) against a room.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <random>
 
@@ -61,6 +63,36 @@ TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
   informationStep(x, prior, Phat, S, g, &delta, &Ppost);
   EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+TEST(EsikfUpdate, InformationBeyondPriorKeepsTheLargerInformationPerDirection) {
+  // diagonal case: per axis max(0, s_i - 1/p_i)
+  const Vec6 p = (Vec6() << 1e-4, 4e-4, 1e-2, 1e-6, 1.0, 0.25).finished();
+  const Vec6 si = (Vec6() << 5e3, 1e3, 1e3, 1e5, 10.0, 0.0).finished();
+  const Mat6 E = informationBeyondPrior(si.asDiagonal(), p.asDiagonal());
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(E(i, i), std::max(0.0, si[i] - 1.0 / p[i]), 1e-9 * (1.0 + si[i])) << i;
+  EXPECT_LT((E - Mat6(E.diagonal().asDiagonal())).cwiseAbs().maxCoeff(), 1e-9);
+  // general case: in the prior's whitened frame the posterior information is max(I, W) per
+  // eigendirection of W = L^T S L, so it is never below the prior's or the measurement's
+  const Mat6 P = randomCovariance(3).topLeftCorner<6, 6>();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n01;
+  Eigen::Matrix<double, 6, 3> H;
+  for (int i = 0; i < H.size(); ++i) H.data()[i] = 30.0 * n01(rng);
+  const Mat6 S = H * H.transpose();  // rank 3: three directions carry no measurement information
+  const Mat6 B = informationBeyondPrior(S, P);
+  const Mat6 post = P.inverse() + B;
+  const Eigen::SelfAdjointEigenSolver<Mat6> below_meas(post - S), below_prior(post - P.inverse()), b(B);
+  EXPECT_GT(below_meas.eigenvalues().minCoeff(), -1e-6 * S.norm());
+  EXPECT_GT(below_prior.eigenvalues().minCoeff(), -1e-6 * S.norm());
+  EXPECT_GT(b.eigenvalues().minCoeff(), -1e-6 * S.norm());
+  const Mat6 L = Eigen::LLT<Mat6>(P).matrixL();
+  const Eigen::SelfAdjointEigenSolver<Mat6> w(L.transpose() * S * L);
+  const Mat6 expected = w.eigenvectors() * w.eigenvalues().cwiseMax(1.0).asDiagonal() * w.eigenvectors().transpose();
+  EXPECT_LT((L.transpose() * post * L - expected).norm(), 1e-6 * expected.norm());
+  EXPECT_EQ(Eigen::FullPivLU<Mat6>(B).rank(), 3);  // nothing where the measurement says nothing
+  // a measurement weaker than the prior in every direction adds nothing
+  EXPECT_LT(informationBeyondPrior(1e-3 * P.inverse(), P).norm(), 1e-9 * P.inverse().norm());
 }
 
 TEST(EsikfUpdate, DirectPoseMeasurementConvergesToTheMapEstimate) {

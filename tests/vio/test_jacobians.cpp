@@ -266,17 +266,25 @@ TEST(VioRollingShutter, PixelJacobianWrtTheStampPoseMatchesNumeric) {
   }
 }
 
-TEST(VioJacobians, PixelJacobianWrtTheCameraRotationMatchesNumeric) {
-  // Bc = d pixel / d φ for the extrinsic T_I_C Exp(φ) (online camera-rotation calibration), with a
-  // rolling shutter, at every level
-  const CameraRig rig = distortedCamera();
-  const CameraProjection cam(rig);
-  const FilterState x = movingState();
-  const RollingShutter s = brisk(rig);
-  const cv::Mat img(rig.height, rig.width, CV_8UC1, cv::Scalar(100));
+/// A moving, turning body behind a distorted rolling-shutter camera, over a flat grey pyramid (the
+/// calibration Jacobians are about pixels, not intensities).
+struct MovingCameraScene {
+  CameraRig rig = distortedCamera();
+  CameraProjection cam{rig};
+  FilterState x = movingState();
+  RollingShutter s = brisk(rig);
   ImagePyramid pyr;
-  pyr.build(img, 3);
-  auto withRotation = [&](const Vec3& phi) { return rig.T_I_C * se3::fromRotationTranslation(so3::Exp(phi), Vec3::Zero()); };
+  MovingCameraScene() { pyr.build(cv::Mat(rig.height, rig.width, CV_8UC1, cv::Scalar(100)), 3); }
+};
+
+TEST(VioJacobians, PixelJacobianWrtTheCameraExtrinsicMatchesNumeric) {
+  // Bc = d pixel / d [φ ρ] for the extrinsic T_I_C (Exp(φ), ρ) (online calibration), with a
+  // rolling shutter, at every level
+  const MovingCameraScene scene;
+  const auto& [rig, cam, x, s, pyr] = scene;
+  auto withCorrection = [&](const Vec6& c) {
+    return scene.rig.T_I_C * se3::fromRotationTranslation(so3::Exp(c.head<3>()), c.tail<3>());
+  };
   for (int level = 0; level < 3; ++level)
     for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.3, 2.5), Vec3(-0.45, 0.3, 4.0)}) {
       TrackedPatch t;
@@ -284,16 +292,42 @@ TEST(VioJacobians, PixelJacobianWrtTheCameraRotationMatchesNumeric) {
       PatchResidual e;
       ASSERT_TRUE(evaluatePatch(pyr, level, cam, rig.T_I_C, x, t, PhotometricOptions(), &e, s));
       const double h = 1e-7;
-      for (int k = 0; k < 3; ++k) {
-        Vec3 d = Vec3::Zero();
+      for (int k = 0; k < 6; ++k) {
+        Vec6 d = Vec6::Zero();
         d[k] = h;
         PatchResidual ep, em;
-        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(d), x, t, PhotometricOptions(), &ep, s));
-        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withRotation(-d), x, t, PhotometricOptions(), &em, s));
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withCorrection(d), x, t, PhotometricOptions(), &ep, s));
+        ASSERT_TRUE(evaluatePatch(pyr, level, cam, withCorrection(-d), x, t, PhotometricOptions(), &em, s));
         const Eigen::Vector2d num = (ep.pixel - em.pixel) / (2 * h) / static_cast<double>(1 << level);
-        EXPECT_GT(num.norm(), 50.0 / (1 << level));  // a radian turns the view by hundreds of pixels
+        // a radian turns the view by hundreds of pixels, a metre at a few metres moves it by tens
+        EXPECT_GT(num.norm(), (k < 3 ? 50.0 : 10.0) / (1 << level));
         // the row time follows the pixel (a few per cent, as for the pose Jacobian)
         EXPECT_LT((e.Bc.col(k) - num).norm(), 0.05 * num.norm()) << "level " << level << " column " << k;
       }
     }
+}
+
+TEST(VioJacobians, PixelJacobianWrtTheImageTimeOffsetMatchesNumeric) {
+  // the image taken at its stamp + δt sees the body at R Exp(ω δt), p + v δt: d pixel / d δt is
+  // B [ω; v] (the δt column of the calibration information), checked against the pixel of the
+  // advanced state
+  const MovingCameraScene scene;
+  const auto& [rig, cam, x, s, pyr] = scene;
+  Vec6 motion;
+  motion << s.omega_I, x.vel;
+  ASSERT_GT(x.vel.norm(), 0.1);
+  for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.3, 2.5), Vec3(-0.45, 0.3, 4.0)}) {
+    TrackedPatch t;
+    t.p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());
+    PatchResidual e;
+    ASSERT_TRUE(evaluatePatch(pyr, 0, cam, rig.T_I_C, x, t, PhotometricOptions(), &e, s));
+    const double h = 1e-6;
+    PatchResidual ep, em;
+    ASSERT_TRUE(evaluatePatch(pyr, 0, cam, rig.T_I_C, advanced(x, s.omega_I, h), t, PhotometricOptions(), &ep, s));
+    ASSERT_TRUE(evaluatePatch(pyr, 0, cam, rig.T_I_C, advanced(x, s.omega_I, -h), t, PhotometricOptions(), &em, s));
+    const Eigen::Vector2d num = (ep.pixel - em.pixel) / (2 * h);
+    const Eigen::Vector2d analytic = e.B * motion;
+    EXPECT_GT(num.norm(), 20.0);  // pixels per second of the moving, turning view
+    EXPECT_LT((analytic - num).norm(), 0.05 * num.norm());
+  }
 }

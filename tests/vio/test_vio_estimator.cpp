@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include <Eigen/Cholesky>
 
@@ -195,4 +196,34 @@ TEST(VioEstimator, RollingShutterRowsArePlacedWithTheGyroRate) {
   global.addGyro(t, Vec3(1.0, 1.0, 1.0));
   EXPECT_FALSE(global.shutterAt(t, x).active());
   EXPECT_EQ(global.shutterAt(t, x).omega_I, Vec3::Zero());
+}
+
+TEST(VioEstimator, VoxelPointsSnapFlatVoxelsOntoTheirPlane) {
+  // one voxel (0.3 m) of a wall z = 0.15 seen with 3 cm range noise: its first point is moved
+  // onto the fitted plane; a voxel holding a corner and one with too few points keep theirs
+  MapOptions o;
+  o.plane_snap_max_rms = 0.05;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.03);
+  std::uniform_real_distribution<double> u(0.01, 0.29);
+  std::vector<float> x, y, z;
+  auto add = [&](double a, double b, double c) { x.push_back(a), y.push_back(b), z.push_back(c); };
+  add(0.15, 0.15, 0.15 + 0.06);  // the wall's first point, 2 sigma off
+  for (int i = 0; i < 60; ++i) add(u(rng), u(rng), std::clamp(0.15 + noise(rng), 0.001, 0.299));
+  add(std::nan(""), 0.1, 0.1);   // skipped
+  // corner voxel at x in [1.2, 1.5): half the points on z = 0.05, half on x = 1.25
+  add(1.4, 0.15, 0.12);
+  for (int i = 0; i < 30; ++i) add(1.2 + u(rng), u(rng), 0.05), add(1.25, u(rng), u(rng));
+  // a voxel with three points
+  add(3.1, 0.1, 0.1), add(3.2, 0.1, 0.2), add(3.15, 0.2, 0.15);
+  const std::vector<Vec3> snapped = voxelPoints(x.data(), y.data(), z.data(), x.size(), o);
+  ASSERT_EQ(snapped.size(), 3u);
+  EXPECT_LT(std::abs(snapped[0].z() - 0.15), 0.015);  // 6 cm off before
+  EXPECT_NEAR(snapped[0].x(), 0.15, 0.02);            // moved along the normal only
+  EXPECT_TRUE(snapped[1].isApprox(Vec3(1.4, 0.15, 0.12), 1e-6));
+  EXPECT_TRUE(snapped[2].isApprox(Vec3(3.1, 0.1, 0.1), 1e-6));
+  o.plane_snap_max_rms = 0.0;  // off: the raw first points
+  const std::vector<Vec3> raw = voxelPoints(x.data(), y.data(), z.data(), x.size(), o);
+  ASSERT_EQ(raw.size(), 3u);
+  EXPECT_NEAR(raw[0].z(), 0.21, 1e-6);
 }

@@ -41,6 +41,13 @@ struct EsikfResult {
 void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
                      const Vec6& g, Vec18* delta, Mat18* P_post);
 
+/// The part of a pose measurement's information S that exceeds the prior's, direction by
+/// direction: with P_pose = L L^T and L^T S L = V diag(λ) V^T (the measurement's information in
+/// units of the prior's), L^-T V diag(max(0, λ - 1)) V^T L^-1. A posterior that adds only this has
+/// the pose information max(prior, measurement) in every direction: the ellipsoidal intersection
+/// (Sijs & Lazar, 2012) of two estimates whose correlation is unknown.
+Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose);
+
 /// Iterates from the prior until the step is small or max_iterations; writes the posterior.
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
                            const EsikfOptions& options, FilterState* post, Mat18* P_post);

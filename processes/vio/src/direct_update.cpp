@@ -15,12 +15,15 @@ namespace {
 int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
             const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
             const PhotometricOptions& o, const RollingShutter& shutter, PoseInformation* info,
-            CameraRotationInformation* ci) {
+            const Vec6& motion, CalibrationInformation* ci) {
   PatchResidual e;
   int used = 0;
   for (size_t i = 0; i < patches.size(); ++i) {
     if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e, shutter)) continue;
-    accumulate(e, o, info, ci);
+    if (ci)
+      accumulate(e, o, info, motion, ci);
+    else
+      accumulate(e, o, info);
     ++used;
   }
   return used;
@@ -38,7 +41,7 @@ std::string fmt(double v) {
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
                                 const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io,
-                                const RollingShutter& shutter, const Mat3* cam_cov) {
+                                const RollingShutter& shutter, const CalibrationPrior* calib) {
   std::vector<TrackedPatch>& patches = *patches_io;
   DirectUpdateResult res;
   res.state = prior;
@@ -48,14 +51,31 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   std::vector<char> active(patches.size(), 0);
   PatchResidual e;
   bool stepped_at_finest = false;
-  // the camera-rotation correction φ (a nuisance with its own prior N(0, cam_cov), uncorrelated
-  // with the filter): eliminated from each step by its Schur complement, then solved for
-  Vec3 phi = Vec3::Zero();
-  Mat3 cam_info_prior = Mat3::Zero(), A = Mat3::Identity();
-  Eigen::Matrix<double, 6, 3> S_xc = Eigen::Matrix<double, 6, 3>::Zero();
+  // the calibration correction c: a nuisance with its own prior (CalibrationPrior)
+  CalibrationVector c = CalibrationVector::Zero();
+  CalibrationMatrix c_info_prior = CalibrationMatrix::Zero(), A = CalibrationMatrix::Identity();
+  Eigen::Matrix<double, 6, kCalibrationDim> S_xc = Eigen::Matrix<double, 6, kCalibrationDim>::Zero();
   Mat6 S_xx = Mat6::Zero();  // the pose's own information of the last step
-  if (cam_cov) cam_info_prior = cam_cov->inverse();
-  auto cameraAt = [&](const Vec3& f) { return cam_cov ? T_I_C * se3::fromRotationTranslation(so3::Exp(f), Vec3::Zero()) : T_I_C; };
+  Mat6 S_last = Mat6::Zero();  // the information of the last step (calibration eliminated) ...
+  FilterState x_lin = prior;   // ... and the iterate it was taken at
+  Eigen::Matrix<double, kCalibrationDim, 1> free = CalibrationVector::Zero();  // 1: estimated
+  if (calib)
+    for (int k = 0; k < kCalibrationDim; ++k)
+      if (calib->covariance(k, k) > 0.0) free[k] = 1.0;
+  if (calib) {
+    // the prior information of the free entries (the fixed ones are cut out below)
+    CalibrationMatrix cov = calib->covariance;
+    for (int k = 0; k < kCalibrationDim; ++k)
+      if (free[k] == 0.0) cov.row(k).setZero(), cov.col(k).setZero(), cov(k, k) = 1.0;
+    c_info_prior = cov.inverse();
+  }
+  auto cameraAt = [&](const CalibrationVector& f) {
+    return calib ? T_I_C * se3::fromRotationTranslation(so3::Exp(f.head<3>()), f.segment<3>(3)) : T_I_C;
+  };
+  // the state at the image's true time (stamp + δt)
+  auto stateAt = [&](const FilterState& xi, const CalibrationVector& f) {
+    return calib ? advanced(xi, calib->omega_I, calib->time_offset + f[6]) : xi;
+  };
   for (int level = pyramid.levels() - 1; level >= 0; --level) {
     // the measurement of this level: patches that project (and, once a coarser level has aligned
     // the image, correlate) at the current iterate; at the first level the prior may be off by more
@@ -63,7 +83,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     const bool gate = res.iterations > 0;
     int n_active = 0;
     for (size_t i = 0; i < patches.size(); ++i) {
-      active[i] = evaluatePatch(pyramid, level, camera, cameraAt(phi), x, patches[i], po, &e, shutter) && (!gate || e.ncc >= po.min_ncc);
+      active[i] = evaluatePatch(pyramid, level, camera, cameraAt(c), stateAt(x, c), patches[i], po, &e, shutter) &&
+                  (!gate || e.ncc >= po.min_ncc);
       n_active += active[i];
     }
     if (n_active < uo.min_patches) {
@@ -73,30 +94,36 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
       PoseInformation info;
-      CameraRotationInformation ci;
-      const int used = measure(patches, active, level, pyramid, camera, cameraAt(phi), x, po, shutter, &info,
-                               cam_cov ? &ci : nullptr);
+      CalibrationInformation ci;
+      const FilterState xs = stateAt(x, c);
+      Vec6 motion = Vec6::Zero();
+      if (calib) motion << calib->omega_I, xs.vel;
+      const int used = measure(patches, active, level, pyramid, camera, cameraAt(c), xs, po, shutter, &info, motion,
+                               calib ? &ci : nullptr);
       if (used < uo.min_patches) break;
       Vec18 delta;
       Mat6 S = info.HtRinvH;
       Vec6 g = info.HtRinvz;
       S_xx = S;
-      Vec3 r_c = Vec3::Zero();
-      if (cam_cov) {
-        A = ci.S_cc + cam_info_prior;
-        r_c = ci.g_c + cam_info_prior * phi;
-        S_xc = ci.S_xc;
-        const Eigen::LDLT<Mat3> Ainv(A);
+      CalibrationVector r_c = CalibrationVector::Zero();
+      if (calib) {
+        const CalibrationMatrix mask = free.asDiagonal();
+        A = mask * (ci.S_cc + c_info_prior) * mask + (CalibrationMatrix::Identity() - mask);
+        r_c = mask * (ci.g_c + c_info_prior * c);
+        S_xc = ci.S_xc * mask;
+        const Eigen::LDLT<CalibrationMatrix> Ainv(A);
         S -= S_xc * Ainv.solve(S_xc.transpose());
         g -= S_xc * Ainv.solve(r_c);
       }
       informationStep(x, prior, P_prior, S, g, &delta, &P);
+      S_last = S;
+      x_lin = x;
       if (!delta.allFinite() || !P.allFinite()) {
         res.why = "update diverged (non-finite step)";
         return res;
       }
       x = x.boxplus(delta);
-      if (cam_cov) phi -= A.ldlt().solve(r_c + S_xc.transpose() * delta.head<6>());
+      if (calib) c -= A.ldlt().solve(r_c + S_xc.transpose() * delta.head<6>());
       ++res.iterations;
       if (level == 0) {
         stepped_at_finest = true;
@@ -121,8 +148,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     t.active = false;
     if (!active[i]) continue;
     PatchResidual ep;
-    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior, t, po, &ep, shutter) ||
-        !evaluatePatch(pyramid, 0, camera, cameraAt(phi), x, t, po, &e, shutter))
+    if (!evaluatePatch(pyramid, 0, camera, T_I_C, stateAt(prior, CalibrationVector::Zero()), t, po, &ep, shutter) ||
+        !evaluatePatch(pyramid, 0, camera, cameraAt(c), stateAt(x, c), t, po, &e, shutter))
       continue;
     t.active = true;
     t.ncc = static_cast<float>(e.ncc);
@@ -151,11 +178,19 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     res.valid = true;
     res.state = x;
     res.covariance = P;
-    if (cam_cov) {
-      // φ's posterior: its information less what the pose (under its prior) explains of it
+    if (uo.covariance == CovarianceUpdate::kBeyondPrior) {
+      // the covariance counts only the photometric information beyond the prior's (UpdateOptions)
+      Vec18 unused;
+      informationStep(x_lin, prior, P_prior, informationBeyondPrior(S_last, P_prior.topLeftCorner<6, 6>()),
+                      Vec6::Zero(), &unused, &res.covariance);
+    }
+    if (calib) {
+      // c's posterior: its information less what the pose (under its prior) explains of it; the
+      // fixed entries keep a zero variance
       const Mat6 pose_info = S_xx + P_prior.topLeftCorner<6, 6>().inverse();
-      res.camera_rotation = phi;
-      res.camera_rotation_cov = (A - S_xc.transpose() * pose_info.ldlt().solve(S_xc)).inverse();
+      const CalibrationMatrix mask = free.asDiagonal();
+      res.calibration = c;
+      res.calibration_cov = mask * (A - S_xc.transpose() * pose_info.ldlt().solve(S_xc)).inverse() * mask;
     }
   }
   return res;

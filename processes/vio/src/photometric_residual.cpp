@@ -31,8 +31,10 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
   float w[kWindow * kWindow];
   if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
   out->B = pixelPoseJacobian(s, shutter, T_I_C) * (1.0 / static_cast<double>(1 << level));
-  // p_C = Exp(-φ) p_C0: d p_C / d φ = [p_C]x
-  out->Bc = s.J_proj * so3::hat(T_I_C.inverse() * s.p_I) * (1.0 / static_cast<double>(1 << level));
+  // p_C = Exp(-φ) (p_C0 - ρ): d p_C / d φ = [p_C]x, d p_C / d ρ = -I
+  const double scale = 1.0 / static_cast<double>(1 << level);
+  out->Bc.leftCols<3>() = s.J_proj * so3::hat(T_I_C.inverse() * s.p_I) * scale;
+  out->Bc.rightCols<3>() = -s.J_proj * scale;
 
   const float* Q = patch.reference.data() + static_cast<size_t>(level) * kPatchArea;
   // current intensities and gradients on the 8x8 interior of the 10x10 window
@@ -91,12 +93,9 @@ double huberCost(const PatchResidual& e, double d) {
   return cost;
 }
 
-double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info) {
-  return accumulate(e, o, info, nullptr);
-}
-
-double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info,
-                  CameraRotationInformation* ci) {
+namespace {
+double accumulateTerms(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info, const Vec6* motion,
+                       CalibrationInformation* ci) {
   const double d = o.huber_threshold;
   Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
   Eigen::Vector2d v = Eigen::Vector2d::Zero();
@@ -120,11 +119,24 @@ double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInfor
   info->geometry += H;
   info->count += kPatchArea;
   if (ci) {
-    ci->S_xc += inv_var * (e.B.transpose() * M * e.Bc);
-    ci->S_cc += inv_var * (e.Bc.transpose() * M * e.Bc);
-    ci->g_c += inv_var * (e.Bc.transpose() * v);
+    Eigen::Matrix<double, 2, kCalibrationDim> Bc;
+    Bc.leftCols<6>() = e.Bc;
+    Bc.col(6) = e.B * *motion;
+    ci->S_xc += inv_var * (e.B.transpose() * M * Bc);
+    ci->S_cc += inv_var * (Bc.transpose() * M * Bc);
+    ci->g_c += inv_var * (Bc.transpose() * v);
   }
   return cost;
+}
+}  // namespace
+
+double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info) {
+  return accumulateTerms(e, o, info, nullptr, nullptr);
+}
+
+double accumulate(const PatchResidual& e, const PhotometricOptions& o, PoseInformation* info, const Vec6& motion,
+                  CalibrationInformation* ci) {
+  return accumulateTerms(e, o, info, &motion, ci);
 }
 
 }  // namespace livo::vio

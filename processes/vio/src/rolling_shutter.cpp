@@ -35,6 +35,14 @@ bool projectThroughShutter(const CameraProjection& camera, const Pose3& T_I_C, c
   return u.x() >= border && u.y() >= border && u.x() <= w - 1.0 - border && u.y() <= h - 1.0 - border;
 }
 
+FilterState advanced(const FilterState& x, const Vec3& omega_I, double dt) {
+  if (dt == 0.0) return x;
+  FilterState y = x;
+  y.rot = x.rot * so3::Exp(omega_I * dt);
+  y.pos = x.pos + x.vel * dt;
+  return y;
+}
+
 Pose3 cameraPoseAt(const FilterState& x, const RollingShutter& shutter, double dt, const Pose3& T_I_C) {
   return se3::fromRotationTranslation(x.rot * shutter.rotationSince(dt), x.pos + x.vel * dt) * T_I_C;
 }

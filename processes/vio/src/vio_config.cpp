@@ -33,6 +33,8 @@ void readVio(const Config& c, VioNodeOptions* n) {
   map.readOptional("max_points", o.map.max_points);
   map.readOptional("max_observations", o.map.max_observations);
   map.readOptional("recent_scans", o.map.recent_scans);
+  map.readOptional("plane_snap_max_rms", o.map.plane_snap_max_rms);
+  map.readOptional("plane_snap_min_points", o.map.plane_snap_min_points);
 
   const Config sel = c.optionalSection("selection");
   sel.readOptional("grid_cell_px", o.selection.grid_cell_px);
@@ -66,6 +68,15 @@ void readVio(const Config& c, VioNodeOptions* n) {
   up.readOptional("max_mahalanobis", o.update.max_mahalanobis);
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
+  if (up.has("covariance")) {
+    const std::string c = up.get<std::string>("covariance");
+    if (c == "full")
+      o.update.covariance = CovarianceUpdate::kFull;
+    else if (c == "beyond_prior")
+      o.update.covariance = CovarianceUpdate::kBeyondPrior;
+    else
+      throw ConfigError(up.where("covariance") + ": '" + c + "' is neither full nor beyond_prior");
+  }
 
   const Config np = c.optionalSection("new_points");
   np.readOptional("cell_px", o.maintenance.new_point_cell_px);
@@ -81,6 +92,10 @@ void readVio(const Config& c, VioNodeOptions* n) {
   const Config cal = c.optionalSection("calibration");
   cal.readOptional("camera_rotation_std_deg", o.calibration.camera_rotation_std_deg);
   cal.readOptional("camera_rotation_walk_deg", o.calibration.camera_rotation_walk_deg);
+  cal.readOptional("camera_translation_std", o.calibration.camera_translation_std);
+  cal.readOptional("camera_translation_walk", o.calibration.camera_translation_walk);
+  cal.readOptional("time_offset_std", o.calibration.time_offset_std);
+  cal.readOptional("time_offset_walk", o.calibration.time_offset_walk);
 
   auto require = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
@@ -128,7 +143,8 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << c.distortion[3] << "], time offset " << n.camera_time_offset_s << " s (match within " << n.time_tolerance_s
      << " s)\n"
      << "  map: voxel " << o.map.voxel_size << " m, radius " << o.map.radius << " m, max " << o.map.max_points
-     << " points x " << o.map.max_observations << " patches, " << o.map.recent_scans << " recent scans\n"
+     << " points x " << o.map.max_observations << " patches, " << o.map.recent_scans << " recent scans, plane snap "
+     << o.map.plane_snap_max_rms << " m RMS from " << o.map.plane_snap_min_points << " points\n"
      << "  selection: grid " << o.selection.grid_cell_px << " px, depth " << o.selection.min_depth << ".."
      << o.selection.max_depth << " m, occlusion cell " << o.selection.depth_cell_px << " px, max view angle "
      << o.selection.max_view_angle_deg << " deg\n"
@@ -138,10 +154,19 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << o.photometric.min_ncc << "\n"
      << "  update: " << o.update.max_iterations << " iterations per level, min " << o.update.min_patches
      << " patches, Mahalanobis^2 <= " << o.update.max_mahalanobis << ", step <= " << o.update.max_step_pos << " m / "
-     << o.update.max_step_rot_deg << " deg\n"
+     << o.update.max_step_rot_deg << " deg, covariance counts "
+     << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
+     << "\n"
      << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
      << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"
-     << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << std::endl;
+     << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << "\n";
+  const CalibrationOptions& cal = o.calibration;
+  if (cal.any())
+    os << "  online calibration (1-sigma, walk per sqrt(s)): rotation " << cal.camera_rotation_std_deg << " deg ("
+       << cal.camera_rotation_walk_deg << "), translation " << cal.camera_translation_std << " m ("
+       << cal.camera_translation_walk << "), time offset " << cal.time_offset_std << " s (" << cal.time_offset_walk
+       << ")\n";
+  os << std::flush;
 }
 
 }  // namespace livo::vio

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_set>
+#include <unordered_map>
+
+#include "livo/plane.hpp"
 
 namespace livo::vio {
 
@@ -19,6 +21,43 @@ double angleDeg(const Vec3& a, const Vec3& b) {
 }
 }  // namespace
 
+std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& o) {
+  // group the finite points by voxel (CSR: first point of each voxel in arrival order)
+  const double inv = 1.0 / o.voxel_size;
+  std::unordered_map<uint64_t, uint32_t> voxel_of;
+  voxel_of.reserve(n / 4 + 16);
+  std::vector<uint32_t> group(n, UINT32_MAX), count;
+  std::vector<Vec3> first;
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 p(x[i], y[i], z[i]);
+    if (!p.allFinite()) continue;
+    const auto [it, added] = voxel_of.emplace(voxelKey(p, inv), static_cast<uint32_t>(first.size()));
+    if (added) {
+      first.push_back(p);
+      count.push_back(0);
+    }
+    group[i] = it->second;
+    ++count[it->second];
+  }
+  if (o.plane_snap_max_rms <= 0.0) return first;
+  std::vector<uint32_t> start(first.size() + 1, 0);
+  for (size_t g = 0; g < first.size(); ++g) start[g + 1] = start[g] + count[g];
+  std::vector<Vec3> members(start.back());
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < n; ++i)
+    if (group[i] != UINT32_MAX) members[fill[group[i]]++] = Vec3(x[i], y[i], z[i]);
+  // a flat voxel: its first point onto the plane of all its points (the range noise normal to the
+  // surface averages out; a position along the surface is as good as any for a patch)
+  const double max_ms = o.plane_snap_max_rms * o.plane_snap_max_rms;
+  PlaneFit fit;
+  for (size_t g = 0; g < first.size(); ++g) {
+    const int m = static_cast<int>(count[g]);
+    if (m < o.plane_snap_min_points || !fitPlane(members.data() + start[g], m, &fit)) continue;
+    if (fit.spread[0] <= max_ms && fit.spread[1] >= 4.0 * fit.spread[0]) first[g] = fit.plane.project(first[g]);
+  }
+  return first;
+}
+
 VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
     : options_(options),
       camera_(camera),
@@ -27,8 +66,12 @@ VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
       depth_(camera.width, camera.height, options.selection.depth_cell_px),
       shutter_(RollingShutter::fromReadout(camera.rolling_shutter_s, camera.height)) {
   validate(options_);
-  const double std = options_.calibration.camera_rotation_std_deg * M_PI / 180.0;
-  camera_rotation_cov_ = Mat3::Identity() * std * std;
+  const CalibrationOptions& cal = options_.calibration;
+  const double rot = cal.camera_rotation_std_deg * M_PI / 180.0;
+  CalibrationVector var;
+  var << Vec3::Constant(rot * rot), Vec3::Constant(cal.camera_translation_std * cal.camera_translation_std),
+      cal.time_offset_std * cal.time_offset_std;
+  calibration_cov_ = var.asDiagonal();
 }
 
 void VioEstimator::reset() {
@@ -38,39 +81,33 @@ void VioEstimator::reset() {
 }
 
 void VioEstimator::addGyro(int64_t utime, const Vec3& w) {
-  if (!shutter_.active() || !w.allFinite()) return;
+  if (!needsGyro() || !w.allFinite()) return;
   if (!gyro_.empty() && utime < gyro_.back().first) gyro_.clear();  // time went back: a new replay
   gyro_.emplace_back(utime, w);
   while (gyro_.front().first < utime - kGyroKept) gyro_.pop_front();
 }
 
-RollingShutter VioEstimator::shutterAt(int64_t utime, const FilterState& x) const {
-  RollingShutter s = shutter_;
+Vec3 VioEstimator::bodyRateAt(int64_t utime, const FilterState& x) const {
   Vec3 sum = Vec3::Zero();
   int n = 0;
   for (const auto& g : gyro_)
     if (std::abs(g.first - utime) <= kGyroWindow) sum += g.second, ++n;
-  if (s.active() && n > 0) {
-    s.omega_I = sum / n - x.gyro_bias;
-    return s;
-  }
+  if (n > 0) return sum / n - x.gyro_bias;
   const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
-  if (s.active() && last_utime_ >= 0 && dt > 0.0 && dt <= kMaxRateInterval)
-    s.omega_I = so3::Log(last_rot_.transpose() * x.rot) / dt;
+  if (last_utime_ >= 0 && dt > 0.0 && dt <= kMaxRateInterval) return so3::Log(last_rot_.transpose() * x.rot) / dt;
+  return Vec3::Zero();
+}
+
+RollingShutter VioEstimator::shutterAt(int64_t utime, const FilterState& x) const {
+  RollingShutter s = shutter_;
+  if (s.active()) s.omega_I = bodyRateAt(utime, x);
   return s;
 }
 
 void VioEstimator::addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n) {
   Scan s;
   s.utime = utime;
-  const double inv = 1.0 / options_.map.voxel_size;
-  std::unordered_set<uint64_t> seen;
-  seen.reserve(n / 2 + 16);
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3 p(x[i], y[i], z[i]);
-    if (!p.allFinite()) continue;
-    if (seen.insert(voxelKey(p, inv)).second) s.points.push_back(p);
-  }
+  s.points = voxelPoints(x, y, z, n, options_.map);
   // newest last; equal stamps keep arrival order
   auto it = std::upper_bound(scans_.begin(), scans_.end(), utime, [](int64_t t, const Scan& e) { return t < e.utime; });
   scans_.insert(it, std::move(s));
@@ -134,8 +171,10 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   r.covariance = P;
   const int levels = options_.photometric.pyramid_levels;
   pyramid_.build(image.pixels, levels);
-  const Pose3 T_W_C = prior.pose() * T_I_C_;
   const RollingShutter shutter = shutterAt(image.utime, prior);
+  // the state at the image's true time (the estimated offset; the update refines it)
+  const Vec3 omega = options_.calibration.time_offset_std > 0.0 ? bodyRateAt(image.utime, prior) : Vec3::Zero();
+  const Pose3 T_W_C = advanced(prior, omega, time_offset_).pose() * T_I_C_;
   fillDepth(T_W_C);
   std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, image.utime, image.exposure_time, depth_,
                                                     levels, options_.selection, &r.selection);
@@ -145,17 +184,26 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
                              : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
                                    std::to_string(options_.update.min_patches) + ")";
   } else {
-    const bool calibrate = options_.calibration.camera_rotation_std_deg > 0.0;
-    if (calibrate && last_utime_ >= 0 && image.utime > last_utime_) {
-      const double walk = options_.calibration.camera_rotation_walk_deg * M_PI / 180.0;
-      camera_rotation_cov_ += Mat3::Identity() * walk * walk * 1e-6 * static_cast<double>(image.utime - last_utime_);
+    const CalibrationOptions& cal = options_.calibration;
+    CalibrationPrior calibration;
+    if (cal.any() && last_utime_ >= 0 && image.utime > last_utime_) {
+      const double dt = 1e-6 * static_cast<double>(image.utime - last_utime_);
+      const double walk_rot = cal.camera_rotation_std_deg > 0.0 ? cal.camera_rotation_walk_deg * M_PI / 180.0 : 0.0;
+      const double walk_pos = cal.camera_translation_std > 0.0 ? cal.camera_translation_walk : 0.0;
+      const double walk_time = cal.time_offset_std > 0.0 ? cal.time_offset_walk : 0.0;
+      CalibrationVector walk;
+      walk << Vec3::Constant(walk_rot * walk_rot), Vec3::Constant(walk_pos * walk_pos), walk_time * walk_time;
+      calibration_cov_.diagonal() += walk * dt;
     }
+    calibration.covariance = calibration_cov_;
+    calibration.omega_I = omega;
+    calibration.time_offset = time_offset_;
     const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, T_I_C_, options_.photometric,
-                                              options_.update, &tracked, shutter,
-                                              calibrate ? &camera_rotation_cov_ : nullptr);
-    if (calibrate && u.valid) {
-      T_I_C_ = T_I_C_ * se3::fromRotationTranslation(so3::Exp(u.camera_rotation), Vec3::Zero());
-      camera_rotation_cov_ = 0.5 * (u.camera_rotation_cov + u.camera_rotation_cov.transpose());
+                                              options_.update, &tracked, shutter, cal.any() ? &calibration : nullptr);
+    if (cal.any() && u.valid) {
+      T_I_C_ = T_I_C_ * se3::fromRotationTranslation(so3::Exp(u.calibration.head<3>()), u.calibration.segment<3>(3));
+      time_offset_ += u.calibration[6];
+      calibration_cov_ = 0.5 * (u.calibration_cov + u.calibration_cov.transpose());
     }
     r.iterations = u.iterations;
     r.num_measurements = u.num_measurements;
@@ -170,7 +218,7 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
       r.covariance = u.covariance;
     }
   }
-  maintain(image, r.state, shutter, updated, tracked, &r);
+  maintain(image, advanced(r.state, omega, time_offset_), shutter, updated, tracked, &r);
   map_.prune((r.state.pose() * T_I_C_).translation());
   last_utime_ = image.utime;
   last_rot_ = r.state.rot;

@@ -35,8 +35,9 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
   node_.subscribe<registered_scan_t>(opts_.registered_scan_channel, [this](const registered_scan_t& m) { onScan(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onCorrection(m); });
-  // the body rate places a rolling shutter's rows; a global shutter does not need the IMU
-  if (opts_.camera.rolling_shutter_s > 0.0)
+  // the body rate places a rolling shutter's rows and moves the state by the image time offset
+  // being estimated; a global shutter with a known time offset does not need the IMU
+  if (vio_.needsGyro())
     node_.subscribe<imu_t>(opts_.imu_channel, [this](const imu_t& m) {
       vio_.addGyro(m.utime, Vec3(m.angular_velocity[0], m.angular_velocity[1], m.angular_velocity[2]));
     });

@@ -13,6 +13,8 @@ void validate(const VioOptions& o) {
   require(o.map.max_points >= 1, "map.max_points must be >= 1");
   require(o.map.max_observations >= 1, "map.max_observations must be >= 1");
   require(o.map.recent_scans >= 1, "map.recent_scans must be >= 1");
+  require(o.map.plane_snap_max_rms >= 0.0, "map.plane_snap_max_rms must be >= 0");
+  require(o.map.plane_snap_min_points >= 3, "map.plane_snap_min_points must be >= 3");
   require(o.selection.grid_cell_px >= 8, "selection.grid_cell_px must be >= 8");
   require(o.selection.min_depth > 0.0 && o.selection.max_depth > o.selection.min_depth,
           "selection: need 0 < min_depth < max_depth");
@@ -38,6 +40,12 @@ void validate(const VioOptions& o) {
   require(o.calibration.camera_rotation_std_deg >= 0.0 && o.calibration.camera_rotation_std_deg <= 10.0,
           "calibration.camera_rotation_std_deg must be in [0, 10]");
   require(o.calibration.camera_rotation_walk_deg >= 0.0, "calibration.camera_rotation_walk_deg must be >= 0");
+  require(o.calibration.camera_translation_std >= 0.0 && o.calibration.camera_translation_std <= 0.5,
+          "calibration.camera_translation_std must be in [0, 0.5]");
+  require(o.calibration.camera_translation_walk >= 0.0, "calibration.camera_translation_walk must be >= 0");
+  require(o.calibration.time_offset_std >= 0.0 && o.calibration.time_offset_std <= 0.1,
+          "calibration.time_offset_std must be in [0, 0.1]");
+  require(o.calibration.time_offset_walk >= 0.0, "calibration.time_offset_walk must be >= 0");
   require(o.maintenance.new_point_cell_px >= 8, "new_points.cell_px must be >= 8");
   require(o.maintenance.max_new_points >= 0, "new_points.max_per_image must be >= 0");
   require(o.maintenance.refresh_angle_deg > 0.0 && o.maintenance.refresh_distance_ratio >= 1.0,

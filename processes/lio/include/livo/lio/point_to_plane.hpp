@@ -2,17 +2,12 @@
 // n^T x + d = 0 fitted to its nearest map neighbours; r = n^T (R p + t) + d.
 #pragma once
 
+#include "livo/plane.hpp"
 #include "livo/so3.hpp"
 
 namespace livo::lio {
 
 using Row6 = Eigen::Matrix<double, 1, 6>;
-
-struct Plane {
-  Vec3 normal = Vec3::UnitZ();  // unit
-  double offset = 0.0;          // d in n^T x + d = 0
-  double distance(const Vec3& x) const { return normal.dot(x) + offset; }
-};
 
 struct PlaneFitOptions {
   int num_neighbors = 5;              // k of the kNN search
@@ -21,11 +16,6 @@ struct PlaneFitOptions {
   double min_planarity = 0.02;        // second over largest scatter eigenvalue: rejects the
                                       // nearly collinear neighbours of one far ring
 };
-
-/// Least-squares plane through n >= 3 points (smallest eigenvector of their scatter). Returns
-/// false if the points are (nearly) collinear — the scatter's second eigenvalue below
-/// min_planarity times the largest — or one lies farther than max_thickness.
-bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity = 1e-4);
 
 struct PointToPlaneResidual {
   Vec3 p_body;  // point in the body frame I

@@ -29,8 +29,18 @@ struct DirectUpdateResult {
   double cost_prior = 0.0;            // Huber cost per residual at level 0 over the final patches:
   double cost_post = 0.0;             //   at the prior and at the posterior
   double mahalanobis = 0.0;           // squared, of the pose step against the prior covariance
-  Vec3 camera_rotation = Vec3::Zero();  // estimated correction φ of T_I_C (when estimated)
-  Mat3 camera_rotation_cov = Mat3::Zero();
+  CalibrationVector calibration = CalibrationVector::Zero();  // the correction c (when estimated)
+  CalibrationMatrix calibration_cov = CalibrationMatrix::Zero(); // its posterior covariance
+};
+
+/// The camera calibration as a nuisance of the update (CalibrationInformation): eliminated from
+/// every Gauss-Newton step by its Schur complement against its own prior N(0, covariance),
+/// uncorrelated with the filter (Schmidt-like), then solved for. Only the entries with a positive
+/// prior variance are estimated; the others stay 0.
+struct CalibrationPrior {
+  CalibrationMatrix covariance = CalibrationMatrix::Zero();
+  Vec3 omega_I = Vec3::Zero();  // body rate at the image, rad/s (the δt column, with the state's velocity)
+  double time_offset = 0.0;     // s, the δt estimated so far: the state is moved by it before projecting
 };
 
 /// Runs the update; fills each patch's active / ncc / rms (level 0, at the posterior).
@@ -38,6 +48,6 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& photometric,
                                 const UpdateOptions& update, std::vector<TrackedPatch>* patches,
                                 const RollingShutter& shutter = RollingShutter(),
-                                const Mat3* camera_rotation_cov = nullptr);
+                                const CalibrationPrior* calibration = nullptr);
 
 }  // namespace livo::vio

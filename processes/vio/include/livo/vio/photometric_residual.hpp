@@ -49,7 +49,8 @@ struct PatchResidual {
   Eigen::Matrix<double, kPatchArea, 1> r;  // residuals, grey levels
   Eigen::Matrix<double, kPatchArea, 2> G;  // d r / d pixel (level pixels), brightness fit projected out
   Mat26 B;                                 // d pixel (level) / d pose
-  Eigen::Matrix<double, 2, 3> Bc;          // d pixel (level) / d camera rotation (T_I_C Exp(φ))
+  Eigen::Matrix<double, 2, 6> Bc;          // d pixel (level) / d [φ ρ], the camera extrinsic's
+                                           // correction T_I_C (Exp(φ), ρ) (CalibrationInformation)
   Eigen::Vector2d pixel;                   // level-0 projection
   double gain = 1.0, offset = 0.0, ncc = 0.0;
 
@@ -72,17 +73,25 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
 /// `info`; returns its Huber cost (sum over pixels, grey levels^2).
 double accumulate(const PatchResidual& e, const PhotometricOptions& options, PoseInformation* info);
 
-/// The information of the camera-rotation correction φ (T_I_C Exp(φ), camera frame) beside the
-/// pose's: S_xc = H_x^T R^-1 H_c, S_cc = H_c^T R^-1 H_c, g_c = H_c^T R^-1 z.
-struct CameraRotationInformation {
-  Eigen::Matrix<double, 6, 3> S_xc = Eigen::Matrix<double, 6, 3>::Zero();
-  Mat3 S_cc = Mat3::Zero();
-  Vec3 g_c = Vec3::Zero();
+/// The camera's calibration against the LiDAR-registered body, corrected online as a nuisance of
+/// the update: c = [φ ρ δt], the extrinsic T_I_C (Exp(φ), ρ) (camera frame) and the image taken at
+/// its stamp + δt (the body then at R Exp(ω δt), p + v δt).
+constexpr int kCalibrationDim = 7;
+using CalibrationVector = Eigen::Matrix<double, kCalibrationDim, 1>;
+using CalibrationMatrix = Eigen::Matrix<double, kCalibrationDim, kCalibrationDim>;
+
+/// The information of the correction c beside the pose's: S_xc = H_x^T R^-1 H_c,
+/// S_cc = H_c^T R^-1 H_c, g_c = H_c^T R^-1 z.
+struct CalibrationInformation {
+  Eigen::Matrix<double, 6, kCalibrationDim> S_xc = Eigen::Matrix<double, 6, kCalibrationDim>::Zero();
+  CalibrationMatrix S_cc = CalibrationMatrix::Zero();
+  CalibrationVector g_c = CalibrationVector::Zero();
 };
 
-/// accumulate() that also adds the camera-rotation terms of the same Huber-weighted residuals.
+/// accumulate() that also adds the calibration terms of the same Huber-weighted residuals;
+/// `motion` = [ω_I; v_W] at the image gives the δt column, d pixel / d δt = B motion.
 double accumulate(const PatchResidual& e, const PhotometricOptions& options, PoseInformation* info,
-                  CameraRotationInformation* camera_info);
+                  const Vec6& motion, CalibrationInformation* calibration_info);
 
 /// Huber cost of the residuals alone.
 double huberCost(const PatchResidual& e, double threshold);

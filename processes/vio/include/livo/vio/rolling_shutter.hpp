@@ -48,6 +48,10 @@ bool projectThroughShutter(const CameraProjection& camera, const Pose3& T_I_C, c
                            double border = 0.0);
 
 /// The camera pose W_T_C at which a point seen at row time dt was captured.
+/// The state moved forward by dt at the body rate omega_I and its velocity (dt of a few ms:
+/// constant rate and velocity): R Exp(ω dt), p + v dt.
+FilterState advanced(const FilterState& x, const Vec3& omega_I, double dt);
+
 Pose3 cameraPoseAt(const FilterState& x, const RollingShutter& shutter, double dt, const Pose3& T_I_C);
 
 }  // namespace livo::vio

@@ -30,6 +30,11 @@
 
 namespace livo::vio {
 
+/// One point per map voxel of a registered scan (world frame; non-finite points skipped): the
+/// voxel's first point, moved onto the plane of the voxel's points when they are flat
+/// (MapOptions::plane_snap_*).
+std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& options);
+
 struct ImageResult {
   bool valid = false;                // an update to adopt
   std::string why;                   // why not
@@ -54,12 +59,15 @@ class VioEstimator {
   VioEstimator(const VioOptions& options, const CameraRig& camera);
 
   /// A registered scan (world frame, `n` points); keeps the newest `recent_scans`, one point per
-  /// map voxel.
+  /// map voxel (voxelPoints).
   void addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n);
   void addScan(int64_t utime, const std::vector<Vec3>& points);
 
-  /// A gyro sample (IMU clock, body frame): the body rate a rolling shutter's rows are placed with.
+  /// A gyro sample (IMU clock, body frame): the body rate a rolling shutter's rows are placed with
+  /// and the time offset is estimated with (kept only if needsGyro()).
   void addGyro(int64_t utime, const Vec3& angular_velocity);
+  /// A rolling shutter or the online time-offset calibration use the body rate.
+  bool needsGyro() const { return shutter_.active() || options_.calibration.time_offset_std > 0.0; }
   /// Update at an image whose time the prior refers to (image.utime already on the IMU clock).
   ImageResult processImage(const GreyImage& image, const FilterState& prior, const Mat18& P);
 
@@ -78,6 +86,12 @@ class VioEstimator {
   /// sample within kGyroWindow of the image less the state's gyro bias; without samples the
   /// rotation since the last image's posterior (zero for the first image, after a gap or a correction).
   RollingShutter shutterAt(int64_t utime, const FilterState& x) const;
+  /// That body rate (whether or not the shutter rolls).
+  Vec3 bodyRateAt(int64_t utime, const FilterState& x) const;
+  /// The estimated image time offset against the LIO's clock (s; 0 unless estimated).
+  double timeOffset() const { return time_offset_; }
+  /// Covariance of the next correction c = [φ ρ δt] (photometric_residual.hpp).
+  const CalibrationMatrix& calibrationCovariance() const { return calibration_cov_; }
 
  private:
   struct Scan {
@@ -101,7 +115,9 @@ class VioEstimator {
   int64_t last_utime_ = -1;      // the last image's time and posterior rotation (body rate)
   Mat3 last_rot_ = Mat3::Identity();
   std::deque<std::pair<int64_t, Vec3>> gyro_;  // recent gyro samples, oldest first
-  Mat3 camera_rotation_cov_ = Mat3::Zero();  // of the correction folded into T_I_C_ (if estimated)
+  CalibrationMatrix calibration_cov_ = CalibrationMatrix::Zero();  // of the corrections folded into
+                                                                    // T_I_C_ and time_offset_
+  double time_offset_ = 0.0;     // s: an image stamped t was taken at t + time_offset_ (LIO clock)
 };
 
 }  // namespace livo::vio

@@ -14,6 +14,10 @@ struct MapOptions {
   int max_points = 10000;      // beyond this the least recently seen points are dropped
   int max_observations = 4;    // patches kept per point (the oldest goes first)
   int recent_scans = 2;        // REGISTERED_SCANs kept as the source of new points and occluders
+  double plane_snap_max_rms = 0.0;   // m: a scan's point for a voxel is moved onto the plane of all the
+                                     // scan's points in that voxel when they lie this close to it
+                                     // (RMS) and spread twice as wide as thick; 0: raw points
+  int plane_snap_min_points = 6;     // fewer points in the voxel: the raw point is kept
 };
 
 /// Which map points take part in an update.
@@ -47,6 +51,13 @@ struct PhotometricOptions {
   double min_ncc = 0.3;            // a patch correlating worse at the start of a level is dropped
 };
 
+/// What the posterior covariance of a photometric update counts (the step always uses all the
+/// photometric information): kFull, all of it, as for an independent measurement; kBeyondPrior,
+/// only what exceeds the prior direction by direction (livo::informationBeyondPrior), since the
+/// patches and map points are the filter's own past estimates and their errors are correlated
+/// with its state (README).
+enum class CovarianceUpdate { kFull, kBeyondPrior };
+
 /// The iterated ESIKF update and its acceptance tests.
 struct UpdateOptions {
   int max_iterations = 4;          // per pyramid level
@@ -56,6 +67,7 @@ struct UpdateOptions {
   double max_mahalanobis = 50.0;   // chi-square of the pose step against the prior covariance
   double max_step_pos = 0.3;       // m
   double max_step_rot_deg = 5.0;
+  CovarianceUpdate covariance = CovarianceUpdate::kBeyondPrior;  // "full" or "beyond_prior"
 };
 
 /// Map maintenance after each image (paper 2.3.2).
@@ -69,11 +81,18 @@ struct MaintenanceOptions {
   double outlier_ncc = 0.5;        // no new patch from a view correlating worse (occluded, moved)
 };
 
-/// Online correction of the camera's rotation against the body (T_I_C Exp(φ)), estimated from the
-/// photometric residuals against the LiDAR-anchored map with the LIO's pose as prior.
+/// Online correction of the camera's calibration against the LiDAR-registered body: its rotation
+/// and translation (T_I_C (Exp(φ), ρ)) and its time offset δt, estimated from the photometric
+/// residuals against the LiDAR-anchored map with the LIO's pose as prior (direct_update.hpp,
+/// CalibrationPrior). A 1-sigma of 0 leaves that part as the rig states it.
 struct CalibrationOptions {
-  double camera_rotation_std_deg = 0.0;   // prior 1-sigma of the rig's T_I_C rotation; 0: not estimated
+  double camera_rotation_std_deg = 0.0;   // prior 1-sigma of the rig's T_I_C rotation
   double camera_rotation_walk_deg = 0.01; // random walk, deg per sqrt(s)
+  double camera_translation_std = 0.0;    // m, prior 1-sigma of the rig's T_I_C translation
+  double camera_translation_walk = 0.001; // m per sqrt(s)
+  double time_offset_std = 0.0;           // s, prior 1-sigma of the image time against the LIO's
+  double time_offset_walk = 1e-4;         // s per sqrt(s)
+  bool any() const { return camera_rotation_std_deg > 0.0 || camera_translation_std > 0.0 || time_offset_std > 0.0; }
 };
 
 struct VioOptions {

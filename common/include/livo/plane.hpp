@@ -1,0 +1,33 @@
+// Planes in 3D: the least-squares plane of a point set (the smallest eigenvector of its scatter),
+// shared by the LIO's point-to-plane matching and the VIO's map-point denoising.
+#pragma once
+
+#include "livo/so3.hpp"
+
+namespace livo {
+
+struct Plane {
+  Vec3 normal = Vec3::UnitZ();  // unit
+  double offset = 0.0;          // d in n^T x + d = 0
+  double distance(const Vec3& x) const { return normal.dot(x) + offset; }
+  /// x moved along the normal onto the plane.
+  Vec3 project(const Vec3& x) const { return x - distance(x) * normal; }
+};
+
+/// The least-squares plane of a point set and the shape of the set around it.
+struct PlaneFit {
+  Plane plane;
+  Vec3 centroid = Vec3::Zero();
+  Vec3 spread = Vec3::Zero();  // eigenvalues of the scatter / n, ascending: spread[0] is the mean
+                               // squared distance to the plane, spread[1] the weaker in-plane one
+};
+
+/// Least-squares plane through n >= 3 points; false for fewer points or a non-finite result.
+bool fitPlane(const Vec3* points, int n, PlaneFit* out);
+
+/// Least-squares plane through n >= 3 points. Returns false if the points are (nearly) collinear
+/// — the scatter's second eigenvalue below min_planarity times the largest — or one lies farther
+/// than max_thickness.
+bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity = 1e-4);
+
+}  // namespace livo
