@@ -9,6 +9,7 @@
 #include <random>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "livo/vio/vio_estimator.hpp"
 #include "sim_fixture.hpp"
@@ -226,4 +227,37 @@ TEST(VioEstimator, VoxelPointsSnapFlatVoxelsOntoTheirPlane) {
   const std::vector<Vec3> raw = voxelPoints(x.data(), y.data(), z.data(), x.size(), o);
   ASSERT_EQ(raw.size(), 3u);
   EXPECT_NEAR(raw[0].z(), 0.21, 1e-6);
+}
+
+TEST(VioEstimator, CovarianceCountsOnlyTheInformationBeyondThePrior) {
+  // the same image and prior through both covariance rules: the state steps alike, but with a
+  // prior tighter than the image along some directions `beyond_prior` leaves those directions as
+  // the prior had them, while `full` adds the image's information everywhere
+  const livo_test::SimScene s;
+  const double t0 = 6.0, t1 = 6.05;
+  const FilterState truth = s.trueState(t1);
+  const FilterState prior = truth.boxplus(offsetOf(0.05, 0.003, 1));
+  Mat18 P = livo_test::priorCovariance(0.2 * M_PI / 180.0, 0.01);
+  P.block<3, 3>(0, 0) = Mat3::Identity() * std::pow(0.005 * M_PI / 180.0, 2);  // rotation: tighter than the image
+  ImageResult r[2];
+  for (int k = 0; k < 2; ++k) {
+    VioOptions o;
+    o.update.covariance = k == 0 ? CovarianceUpdate::kFull : CovarianceUpdate::kBeyondPrior;
+    VioEstimator vio(o, s.camera());
+    seed(s, &vio, t0);
+    r[k] = vio.processImage(s.image(t1, 2), prior, P);
+    ASSERT_TRUE(r[k].valid) << r[k].why;
+  }
+  EXPECT_LT(r[0].state.boxminus(r[1].state).norm(), 1e-12);  // the step does not depend on the rule
+  const Mat6 P0 = P.topLeftCorner<6, 6>(), full = r[0].covariance.topLeftCorner<6, 6>(),
+             beyond = r[1].covariance.topLeftCorner<6, 6>();
+  const double rot0 = P0.topLeftCorner(3, 3).trace(), pos0 = P0.bottomRightCorner(3, 3).trace();
+  // rotation: full still shrinks it a little, beyond_prior keeps it to within 1 %
+  EXPECT_LT(full.topLeftCorner(3, 3).trace(), 0.99 * rot0);
+  EXPECT_NEAR(beyond.topLeftCorner(3, 3).trace(), rot0, 0.01 * rot0);
+  // position (looser than the image): both shrink it, beyond_prior less, never below full
+  EXPECT_LT(beyond.bottomRightCorner(3, 3).trace(), 0.5 * pos0);
+  const Eigen::SelfAdjointEigenSolver<Mat6> diff(beyond - full);
+  EXPECT_GT(diff.eigenvalues().minCoeff(), -1e-15);
+  EXPECT_EQ(Eigen::LLT<Mat18>(r[1].covariance).info(), Eigen::Success);
 }
