@@ -46,23 +46,6 @@ Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose) {
   return 0.5 * (out + out.transpose());
 }
 
-Vec6 gradientBeyondPrior(const Mat6& S, const Vec6& g, const Mat6& P_pose) {
-  const Eigen::LLT<Mat6> llt(0.5 * (P_pose + P_pose.transpose()));
-  if (llt.info() != Eigen::Success) return g;
-  const Mat6 L = llt.matrixL();
-  const Mat6 W = L.transpose() * S * L;
-  Eigen::SelfAdjointEigenSolver<Mat6> es(0.5 * (W + W.transpose()));
-  Vec6 f;
-  for (int i = 0; i < 6; ++i) {
-    const double l = es.eigenvalues()[i];
-    f[i] = l > 1.0 ? (l - 1.0) / l : 0.0;
-  }
-  // g = L^-T (L^T g): in the whitened frame scale each eigendirection, then back
-  const Vec6 gw = L.transpose() * g;
-  const Vec6 kept = es.eigenvectors() * f.asDiagonal() * es.eigenvectors().transpose() * gw;
-  return L.transpose().triangularView<Eigen::Upper>().solve(kept);
-}
-
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
                            const EsikfOptions& opts, FilterState* post, Mat18* P_post) {
   EsikfResult res;

@@ -165,7 +165,7 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_EQ(d.vio.photometric.pyramid_levels, 3);
   const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
-      "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3, fusion: full}\n"
+      "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3, covariance: full}\n"
       "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n"
       "  calibration: {camera_rotation_std_deg: 0.3, camera_rotation_walk_deg: 0.002, camera_translation_std: 0.01,\n"
       "                time_offset_std: 0.002, time_offset_walk: 0.0002}\n")));
@@ -186,13 +186,10 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_DOUBLE_EQ(o.vio.calibration.time_offset_std, 0.002);
   EXPECT_DOUBLE_EQ(o.vio.calibration.time_offset_walk, 0.0002);
   EXPECT_FALSE(d.vio.calibration.any());
-  EXPECT_EQ(d.vio.update.fusion, PhotometricFusion::kBeyondPrior);
-  EXPECT_EQ(o.vio.update.fusion, PhotometricFusion::kFull);
-  EXPECT_EQ(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  update: {fusion: covariance_beyond_prior}\n")))
-                .vio.update.fusion,
-            PhotometricFusion::kCovarianceBeyondPrior);
+  EXPECT_EQ(d.vio.update.covariance, CovarianceUpdate::kBeyondPrior);
+  EXPECT_EQ(o.vio.update.covariance, CovarianceUpdate::kFull);
   EXPECT_DOUBLE_EQ(d.vio.map.plane_snap_max_rms, 0.0);  // off unless asked for
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  update: {fusion: half}\n"))), ConfigError);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  update: {covariance: half}\n"))), ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {time_offset_std: 0.5}\n"))),
                ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {camera_rotation_std_deg: -1}\n"))),

@@ -47,9 +47,6 @@ void informationStep(const FilterState& x, const FilterState& prior, const Mat18
 /// the pose information max(prior, measurement) in every direction: the ellipsoidal intersection
 /// (Sijs & Lazar, 2012) of two estimates whose correlation is unknown.
 Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose);
-/// The same split applied to the measurement's gradient g = H^T R^-1 z: each eigendirection keeps
-/// the fraction max(0, λ - 1) / λ of it (the step of the information beyond the prior).
-Vec6 gradientBeyondPrior(const Mat6& S, const Vec6& g, const Mat6& P_pose);
 
 /// Iterates from the prior until the step is small or max_iterations; writes the posterior.
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,

@@ -115,12 +115,6 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
         S -= S_xc * Ainv.solve(S_xc.transpose());
         g -= S_xc * Ainv.solve(r_c);
       }
-      if (uo.fusion == PhotometricFusion::kBeyondPrior) {
-        // only what the image knows beyond the prior, in the step and the covariance alike
-        const Mat6 P6 = P_prior.topLeftCorner<6, 6>();
-        g = gradientBeyondPrior(S, g, P6);
-        S = informationBeyondPrior(S, P6);
-      }
       informationStep(x, prior, P_prior, S, g, &delta, &P);
       S_last = S;
       x_lin = x;
@@ -184,7 +178,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     res.valid = true;
     res.state = x;
     res.covariance = P;
-    if (uo.fusion == PhotometricFusion::kCovarianceBeyondPrior) {
+    if (uo.covariance == CovarianceUpdate::kBeyondPrior) {
       // the covariance counts only the photometric information beyond the prior's (UpdateOptions)
       Vec18 unused;
       informationStep(x_lin, prior, P_prior, informationBeyondPrior(S_last, P_prior.topLeftCorner<6, 6>()),

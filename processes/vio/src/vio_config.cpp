@@ -68,16 +68,14 @@ void readVio(const Config& c, VioNodeOptions* n) {
   up.readOptional("max_mahalanobis", o.update.max_mahalanobis);
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
-  if (up.has("fusion")) {
-    const std::string f = up.get<std::string>("fusion");
-    if (f == "full")
-      o.update.fusion = PhotometricFusion::kFull;
-    else if (f == "covariance_beyond_prior")
-      o.update.fusion = PhotometricFusion::kCovarianceBeyondPrior;
-    else if (f == "beyond_prior")
-      o.update.fusion = PhotometricFusion::kBeyondPrior;
+  if (up.has("covariance")) {
+    const std::string c = up.get<std::string>("covariance");
+    if (c == "full")
+      o.update.covariance = CovarianceUpdate::kFull;
+    else if (c == "beyond_prior")
+      o.update.covariance = CovarianceUpdate::kBeyondPrior;
     else
-      throw ConfigError(up.where("fusion") + ": '" + f + "' is none of full, covariance_beyond_prior, beyond_prior");
+      throw ConfigError(up.where("covariance") + ": '" + c + "' is neither full nor beyond_prior");
   }
 
   const Config np = c.optionalSection("new_points");
@@ -156,10 +154,8 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << o.photometric.min_ncc << "\n"
      << "  update: " << o.update.max_iterations << " iterations per level, min " << o.update.min_patches
      << " patches, Mahalanobis^2 <= " << o.update.max_mahalanobis << ", step <= " << o.update.max_step_pos << " m / "
-     << o.update.max_step_rot_deg << " deg, fusion "
-     << (o.update.fusion == PhotometricFusion::kFull                     ? "full"
-         : o.update.fusion == PhotometricFusion::kCovarianceBeyondPrior ? "covariance_beyond_prior"
-                                                                         : "beyond_prior")
+     << o.update.max_step_rot_deg << " deg, covariance counts "
+     << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
      << "\n"
      << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
      << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"

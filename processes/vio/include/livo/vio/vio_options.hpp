@@ -51,14 +51,12 @@ struct PhotometricOptions {
   double min_ncc = 0.3;            // a patch correlating worse at the start of a level is dropped
 };
 
-/// How a photometric update is fused with the prior (README, "Fusion"). The patches and map points
-/// are the filter's own past estimates, so their errors are correlated with its state:
-///   kFull                   all of the photometric information, as for an independent sensor;
-///   kCovarianceBeyondPrior  the step with all of it, the covariance counting only the information
-///                           beyond the prior's, direction by direction (livo::informationBeyondPrior);
-///   kBeyondPrior            step and covariance with only that information (ellipsoidal
-///                           intersection): the camera adds what the prior does not already know.
-enum class PhotometricFusion { kFull, kCovarianceBeyondPrior, kBeyondPrior };
+/// What the posterior covariance of a photometric update counts (the step always uses all the
+/// photometric information): kFull, all of it, as for an independent measurement; kBeyondPrior,
+/// only what exceeds the prior direction by direction (livo::informationBeyondPrior), since the
+/// patches and map points are the filter's own past estimates and their errors are correlated
+/// with its state (README).
+enum class CovarianceUpdate { kFull, kBeyondPrior };
 
 /// The iterated ESIKF update and its acceptance tests.
 struct UpdateOptions {
@@ -69,7 +67,7 @@ struct UpdateOptions {
   double max_mahalanobis = 50.0;   // chi-square of the pose step against the prior covariance
   double max_step_pos = 0.3;       // m
   double max_step_rot_deg = 5.0;
-  PhotometricFusion fusion = PhotometricFusion::kBeyondPrior;  // full, covariance_beyond_prior, beyond_prior
+  CovarianceUpdate covariance = CovarianceUpdate::kBeyondPrior;  // "full" or "beyond_prior"
 };
 
 /// Map maintenance after each image (paper 2.3.2).
