@@ -42,7 +42,7 @@ struct SelectionOptions {
 /// The photometric residual (paper eq. 10) and its robust weighting.
 struct PhotometricOptions {
   int pyramid_levels = 3;          // 1..4; the update runs coarse to fine
-  double noise_std = 30.0;         // grey levels per pixel: R = noise_std^2 I (see README: far above
+  double noise_std = 120.0;        // grey levels per pixel: R = noise_std^2 I (see README: far above
                                    // the sensor noise, as the patch residuals are correlated)
   double huber_threshold = 10.0;   // grey levels: residuals beyond get weight threshold / |r|
   bool affine_brightness = true;   // per-patch gain and offset (else offset only)
