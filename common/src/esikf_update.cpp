@@ -46,6 +46,13 @@ Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose) {
   return 0.5 * (out + out.transpose());
 }
 
+void applyPoseMeasurementFloor(const Mat6& floor, Mat6* S, Vec6* g) {
+  const Eigen::PartialPivLU<Mat6> lu(Mat6::Identity() + *S * floor);
+  const Mat6 Sf = lu.solve(*S);
+  *S = 0.5 * (Sf + Sf.transpose());
+  *g = lu.solve(*g);
+}
+
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
                            const EsikfOptions& opts, FilterState* post, Mat18* P_post) {
   EsikfResult res;

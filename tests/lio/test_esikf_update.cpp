@@ -247,3 +247,37 @@ TEST(EsikfUpdate, CorridorIsFlaggedDegenerateAlongItsAxis) {
   const Mat3 Pp = Ppost.block<3, 3>(3, 3);
   EXPECT_GT(Pp(0, 0), 0.9 * P0(3, 3));
 }
+
+TEST(EsikfUpdate, PoseMeasurementFloorAddsItsCovarianceAndKeepsTheMeasuredPose) {
+  // a pose measurement of information S (gradient g) with a floor F behaves as one of covariance
+  // S^-1 + F around the same measured pose S^-1 g; a direction S knows nothing about stays empty
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix<double, 6, 9> J;
+  for (int i = 0; i < J.size(); ++i) J.data()[i] = n(rng);
+  const Mat6 S = 1e4 * J * J.transpose();
+  Vec6 g;
+  for (int i = 0; i < 6; ++i) g[i] = n(rng);
+  Mat6 F = Mat6::Zero();
+  F.diagonal() << 1e-6, 2e-6, 1e-6, 1e-4, 4e-4, 1e-4;
+  Mat6 Sf = S;
+  Vec6 gf = g;
+  applyPoseMeasurementFloor(F, &Sf, &gf);
+  const Mat6 expected = (S.inverse() + F).inverse();
+  EXPECT_LT((Sf - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_LT((Sf.ldlt().solve(gf) - S.ldlt().solve(g)).norm(), 1e-9 * S.ldlt().solve(g).norm());
+  EXPECT_LT((Sf - Sf.transpose()).cwiseAbs().maxCoeff(), 1e-12 * Sf.norm());
+  // the floor caps the information: no direction exceeds F^-1
+  const Eigen::SelfAdjointEigenSolver<Mat6> es(F.cwiseSqrt() * Sf * F.cwiseSqrt());
+  EXPECT_LT(es.eigenvalues().maxCoeff(), 1.0);
+  // a singular S (nothing along the last position axis) keeps that direction at zero
+  Mat6 S1 = S;
+  S1.row(5).setZero();
+  S1.col(5).setZero();
+  Vec6 g1 = g;
+  g1[5] = 0.0;
+  applyPoseMeasurementFloor(F, &S1, &g1);
+  EXPECT_TRUE(S1.allFinite());
+  EXPECT_LT(S1.row(5).cwiseAbs().maxCoeff(), 1e-12 * S1.norm());
+  EXPECT_NEAR(g1[5], 0.0, 1e-12);
+}

@@ -44,15 +44,6 @@ Vec18 offsetOf(double rot_deg, double pos_m, int k) {
   return d;
 }
 
-// The camera as the filter's only correction: the photometric noise a camera-only test is held
-// at. The default (120 grey levels) weighs the image for fusion with an LIO whose calibration to
-// the camera is uncertain (README, "Why noise_std is 120"); these tests check the update's
-// mechanics with the image as the sole, trusted sensor.
-VioOptions cameraOnlyOptions() {
-  VioOptions o;
-  o.photometric.noise_std = 30.0;
-  return o;
-}
 }  // namespace
 
 TEST(VioEstimator, SingleImageUpdateRecoversAKnownPoseOffset) {
@@ -93,7 +84,7 @@ TEST(VioEstimator, TracksASequenceAndMaintainsTheMap) {
   // 1.5 s of the walk at 20 Hz, sweeps at 10 Hz from the true poses, every prior 1 cm / 0.2 deg
   // off the truth with a matching covariance; the map is maintained from the posteriors.
   const livo_test::SimScene s;
-  VioEstimator vio(cameraOnlyOptions(), s.camera());
+  VioEstimator vio(VioOptions{}, s.camera());
   const double t0 = 8.0;
   seed(s, &vio, t0);
   const Mat18 P = livo_test::priorCovariance(0.2 * M_PI / 180.0, 0.01);
@@ -250,7 +241,7 @@ TEST(VioEstimator, CovarianceCountsOnlyTheInformationBeyondThePrior) {
   P.block<3, 3>(0, 0) = Mat3::Identity() * std::pow(0.005 * M_PI / 180.0, 2);  // rotation: tighter than the image
   ImageResult r[2];
   for (int k = 0; k < 2; ++k) {
-    VioOptions o = cameraOnlyOptions();
+    VioOptions o;
     o.update.covariance = k == 0 ? CovarianceUpdate::kFull : CovarianceUpdate::kBeyondPrior;
     VioEstimator vio(o, s.camera());
     seed(s, &vio, t0);
@@ -269,4 +260,33 @@ TEST(VioEstimator, CovarianceCountsOnlyTheInformationBeyondThePrior) {
   const Eigen::SelfAdjointEigenSolver<Mat6> diff(beyond - full);
   EXPECT_GT(diff.eigenvalues().minCoeff(), -1e-15);
   EXPECT_EQ(Eigen::LLT<Mat18>(r[1].covariance).info(), Eigen::Success);
+}
+
+TEST(VioEstimator, CalibrationFloorLiesAcrossTheBaselines) {
+  // a rotation error ε of the camera shifts a patch seen again a baseline b away as a move by ε × b:
+  // nothing along b, σ |b| across it; the image's floor averages its patches
+  const double sigma = 0.3 * M_PI / 180.0;
+  std::vector<TrackedPatch> patches(2);
+  const Vec3 c(1.0, 2.0, 0.5);
+  patches[0].reference_centre = c - Vec3(2.0, 0.0, 0.0);
+  patches[1].reference_centre = c - Vec3(2.0, 0.0, 0.0);
+  Mat3 F = calibrationFloor(patches, c, sigma);
+  EXPECT_LT((F - sigma * sigma * Vec3(0.0, 4.0, 4.0).asDiagonal().toDenseMatrix()).norm(), 1e-15);
+  patches[1].reference_centre = c - Vec3(0.0, 0.0, 1.0);  // a vertical baseline of 1 m
+  F = calibrationFloor(patches, c, sigma);
+  EXPECT_LT((F - sigma * sigma * Vec3(0.5, 2.5, 2.0).asDiagonal().toDenseMatrix()).norm(), 1e-15);
+  // a numeric check of the model: the mean squared displacement ε × b over sampled ε
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, sigma);
+  Mat3 M = Mat3::Zero();
+  const int N = 200000;
+  for (int k = 0; k < N; ++k) {
+    const Vec3 eps(n(rng), n(rng), n(rng));
+    for (const TrackedPatch& t : patches) {
+      const Vec3 d = eps.cross(c - t.reference_centre);
+      M += d * d.transpose() / (2.0 * N);
+    }
+  }
+  EXPECT_LT((M - F).norm(), 0.02 * F.norm());
+  EXPECT_TRUE(calibrationFloor({}, c, sigma).isZero());
 }

@@ -48,6 +48,13 @@ void informationStep(const FilterState& x, const FilterState& prior, const Mat18
 /// (Sijs & Lazar, 2012) of two estimates whose correlation is unknown.
 Mat6 informationBeyondPrior(const Mat6& S, const Mat6& P_pose);
 
+/// A pose measurement (information S, gradient g at the iterate) whose error has, besides the
+/// noise S models, a part of covariance `floor` that more data does not average away (a
+/// calibration bias, a map error): the measurement of covariance S^-1 + floor, i.e.
+/// S <- (I + S floor)^-1 S and g <- (I + S floor)^-1 g. The measurement's own minimiser
+/// (S^-1 g) is unchanged; S may be singular (no information stays no information).
+void applyPoseMeasurementFloor(const Mat6& floor, Mat6* S, Vec6* g);
+
 /// Iterates from the prior until the step is small or max_iterations; writes the posterior.
 EsikfResult iteratedUpdate(const FilterState& prior, const Mat18& P_prior, const PoseMeasurement& measure,
                            const EsikfOptions& options, FilterState* post, Mat18* P_post);

@@ -38,6 +38,16 @@ std::string fmt(double v) {
 
 }  // namespace
 
+Mat3 calibrationFloor(const std::vector<TrackedPatch>& patches, const Vec3& c_W, double rotation_std) {
+  Mat3 B = Mat3::Zero();
+  if (patches.empty()) return B;
+  for (const TrackedPatch& t : patches) {
+    const Vec3 b = c_W - t.reference_centre;
+    B += b.squaredNorm() * Mat3::Identity() - b * b.transpose();  // [b]x [b]x^T
+  }
+  return rotation_std * rotation_std * B / static_cast<double>(patches.size());
+}
+
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
                                 const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io,
@@ -69,6 +79,12 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
       if (free[k] == 0.0) cov.row(k).setZero(), cov.col(k).setZero(), cov(k, k) = 1.0;
     c_info_prior = cov.inverse();
   }
+  // the image's position measurement cannot beat what the camera's calibration allows
+  const bool floored = uo.calibration_rotation_std_deg > 0.0 && !patches.empty();
+  Mat6 pose_floor = Mat6::Zero();
+  if (floored)
+    pose_floor.bottomRightCorner<3, 3>() = calibrationFloor(patches, (prior.pose() * T_I_C).translation(),
+                                                            uo.calibration_rotation_std_deg * M_PI / 180.0);
   auto cameraAt = [&](const CalibrationVector& f) {
     return calib ? T_I_C * se3::fromRotationTranslation(so3::Exp(f.head<3>()), f.segment<3>(3)) : T_I_C;
   };
@@ -115,6 +131,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
         S -= S_xc * Ainv.solve(S_xc.transpose());
         g -= S_xc * Ainv.solve(r_c);
       }
+      if (floored) applyPoseMeasurementFloor(pose_floor, &S, &g);
       informationStep(x, prior, P_prior, S, g, &delta, &P);
       S_last = S;
       x_lin = x;

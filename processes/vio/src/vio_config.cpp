@@ -68,6 +68,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   up.readOptional("max_mahalanobis", o.update.max_mahalanobis);
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
+  up.readOptional("calibration_rotation_std_deg", o.update.calibration_rotation_std_deg);
   if (up.has("covariance")) {
     const std::string c = up.get<std::string>("covariance");
     if (c == "full")

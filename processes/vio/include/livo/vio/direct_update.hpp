@@ -43,6 +43,12 @@ struct CalibrationPrior {
   double time_offset = 0.0;     // s, the δt estimated so far: the state is moved by it before projecting
 };
 
+/// The position floor of an image seen from camera centre c_W (world, m²): a camera rotated by ε
+/// against the LiDAR-registered body sees a reference patch captured a baseline b away shifted as
+/// if it had moved by ε × b; with ε ~ N(0, rotation_std² I) that is σ² [b]× [b]×ᵀ, averaged over the
+/// patches. Nothing along the baselines (a corridor's axis keeps its information).
+Mat3 calibrationFloor(const std::vector<TrackedPatch>& patches, const Vec3& c_W, double rotation_std);
+
 /// Runs the update; fills each patch's active / ncc / rms (level 0, at the posterior).
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& photometric,

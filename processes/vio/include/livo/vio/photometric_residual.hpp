@@ -32,6 +32,7 @@ struct TrackedPatch {
   Vec3 p_W = Vec3::Zero();
   float gain0 = 1.0f;         // expected gain: exposure ratio current / reference, 1 if unknown
   float gradient = 0.0f;      // texture strength of the reference
+  Vec3 reference_centre = Vec3::Zero();  // W: the camera centre the reference was captured from
   std::array<float, kPatchArea * kMaxLevels> reference{};  // per level, row-major 8x8
   // filled by the update (level 0, at the posterior)
   bool active = false;

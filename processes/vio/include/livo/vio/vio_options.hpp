@@ -42,7 +42,7 @@ struct SelectionOptions {
 /// The photometric residual (paper eq. 10) and its robust weighting.
 struct PhotometricOptions {
   int pyramid_levels = 3;          // 1..4; the update runs coarse to fine
-  double noise_std = 120.0;        // grey levels per pixel: R = noise_std^2 I (see README: far above
+  double noise_std = 30.0;         // grey levels per pixel: R = noise_std^2 I (see README: far above
                                    // the sensor noise, as the patch residuals are correlated)
   double huber_threshold = 10.0;   // grey levels: residuals beyond get weight threshold / |r|
   bool affine_brightness = true;   // per-patch gain and offset (else offset only)
@@ -68,6 +68,12 @@ struct UpdateOptions {
   double max_step_pos = 0.3;       // m
   double max_step_rot_deg = 5.0;
   CovarianceUpdate covariance = CovarianceUpdate::kBeyondPrior;  // "full" or "beyond_prior"
+  // 1-sigma of the camera's rotation against the LiDAR-registered body, per axis (the rig
+  // calibration's accuracy; 0: taken as exact). A reference patch seen again after the camera
+  // moved by b is off by about ε × b, alike for every patch with that baseline, so more patches do
+  // not average it away: an image's position measurement gets the floor
+  // σ² mean_i([b_i]× [b_i]×ᵀ) over its patches (calibrationFloor, livo::applyPoseMeasurementFloor)
+  double calibration_rotation_std_deg = 0.3;
 };
 
 /// Map maintenance after each image (paper 2.3.2).
