@@ -157,7 +157,7 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << " patches, Mahalanobis^2 <= " << o.update.max_mahalanobis << ", step <= " << o.update.max_step_pos << " m / "
      << o.update.max_step_rot_deg << " deg, covariance counts "
      << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
-     << "\n"
+     << ", calibration floor " << o.update.calibration_rotation_std_deg << " deg x baseline\n"
      << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
      << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"
      << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << "\n";
