@@ -7,7 +7,7 @@
 namespace livo {
 
 void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
-                     const Vec6& g, Vec18* delta, Mat18* P_post) {
+                     const Vec6& g, Vec18* delta, Mat18* P_post, const Vec18* estimated) {
   using S18 = FilterState;
   // J^-1 of eq. (12): the right Jacobian on the rotation block, identity elsewhere.
   const Vec18 e0 = x.boxminus(prior);
@@ -28,6 +28,16 @@ void informationStep(const FilterState& x, const FilterState& prior, const Mat18
   const Eigen::Matrix<double, 18, 6> KH6 = Pn.leftCols<6>() * S;
   Vec18 d = -Pn.leftCols<6>() * g - Jinv_e0;
   d += KH6 * Jinv_e0.head<6>();
+  if (estimated) {
+    // K' = diag(estimated) K, with K H = Pn E S E^T and K R K^T = Pn E S E^T Pn in this form
+    const auto keep = estimated->asDiagonal();
+    d = keep * d;
+    Mat18 I_KH = Mat18::Identity();
+    I_KH.leftCols<6>() -= keep * KH6;
+    const Eigen::Matrix<double, 18, 6> KS = keep * Pn.leftCols<6>();
+    Pn = I_KH * P * I_KH.transpose() + KS * S * KS.transpose();
+    Pn = 0.5 * (Pn + Pn.transpose());
+  }
   *delta = d;
   *P_post = Pn;
 }

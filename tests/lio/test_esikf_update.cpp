@@ -65,6 +65,57 @@ TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
 }
 
+TEST(EsikfUpdate, ConsiderStepEqualsTheSchmidtKalmanFilter) {
+  // the gyro bias (and only it) considered: against the textbook Schmidt-Kalman filter, K' = M K
+  // with M zero on the considered rows and P+ = (I - K'H) P (I - K'H)^T + K' R K'^T
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  FilterState prior;
+  prior.rot = so3::Exp(Vec3(-0.1, 0.3, 0.2));
+  prior.pos = Vec3(-1, 0.5, 2);
+  Vec18 d0 = Vec18::Zero();
+  for (int i = 0; i < 9; ++i) d0[i] = 0.05 * n01(rng);  // the iterate moved the pose and velocity only
+  for (int i = 12; i < 18; ++i) d0[i] = 0.05 * n01(rng);
+  const FilterState x = prior.boxplus(d0);
+  const Mat18 Phat = randomCovariance(9);
+  Eigen::Matrix<double, 8, 18> H = Eigen::Matrix<double, 8, 18>::Zero();
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 6; ++j) H(i, j) = n01(rng);
+  Eigen::Matrix<double, 8, 1> z;
+  for (int i = 0; i < 8; ++i) z[i] = 0.1 * n01(rng);
+  Eigen::Matrix<double, 8, 8> R = Eigen::Matrix<double, 8, 8>::Zero();
+  for (int i = 0; i < 8; ++i) R(i, i) = 0.02 * (1 + i);
+
+  const Mat18 J = FilterState::boxminusJacobian(x, prior);
+  const Mat18 Jinv = J.inverse();
+  const Mat18 P = Jinv * Phat * Jinv.transpose();
+  const Eigen::Matrix<double, 8, 8> Rinv = R.inverse();
+  const Eigen::Matrix<double, 18, 8> K = (H.transpose() * Rinv * H + P.inverse()).inverse() * H.transpose() * Rinv;
+  Vec18 keep = Vec18::Ones();
+  keep.segment<3>(FilterState::kGyroBias).setZero();
+  const Eigen::Matrix<double, 18, 8> Ks = keep.asDiagonal() * K;
+  const Vec18 delta_ref = -Ks * z - (Mat18::Identity() - Ks * H) * Jinv * x.boxminus(prior);
+  const Mat18 I_KH = Mat18::Identity() - Ks * H;
+  const Mat18 Ppost_ref = I_KH * P * I_KH.transpose() + Ks * R * Ks.transpose();
+
+  const Mat6 S = H.leftCols<6>().transpose() * Rinv * H.leftCols<6>();
+  const Vec6 g = H.leftCols<6>().transpose() * Rinv * z;
+  Vec18 delta;
+  Mat18 Ppost;
+  informationStep(x, prior, Phat, S, g, &delta, &Ppost, &keep);
+  EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
+  EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
+  // the considered states keep their value and their variance; the rest steps as the full filter
+  EXPECT_TRUE(delta.segment<3>(FilterState::kGyroBias).isZero());
+  EXPECT_LT((Ppost.block<3, 3>(9, 9) - P.block<3, 3>(9, 9)).cwiseAbs().maxCoeff(), 1e-12);
+  Vec18 delta_full;
+  Mat18 Pfull;
+  informationStep(x, prior, Phat, S, g, &delta_full, &Pfull);
+  EXPECT_LT((delta - keep.asDiagonal() * delta_full).cwiseAbs().maxCoeff(), 1e-12);
+  // and it never claims more than the optimal filter: P+ - P_full is positive semi-definite
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat18>(Ppost - Pfull).eigenvalues().minCoeff(), -1e-12);
+}
+
 TEST(EsikfUpdate, InformationBeyondPriorKeepsTheLargerInformationPerDirection) {
   // diagonal case: per axis max(0, s_i - 1/p_i)
   const Vec6 p = (Vec6() << 1e-4, 4e-4, 1e-2, 1e-6, 1.0, 0.25).finished();

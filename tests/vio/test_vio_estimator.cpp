@@ -155,6 +155,37 @@ TEST(VioEstimator, LoopCorrectionMovesMapAndScans) {
   EXPECT_LT(poseError(r.state, truth).pos_m, 0.006);
 }
 
+TEST(VioEstimator, ConsidersTheGyroBiasOnceTheFilterKnowsIt) {
+  // a prior whose attitude error is correlated with the gyro bias (as after propagation): while
+  // the bias is uncertain the image corrects it through that correlation; once its 1-sigma is at
+  // most update.gyro_bias_std_to_update the image leaves it, and its variance, as the prior had them
+  const livo_test::SimScene s;
+  const FilterState truth = s.trueState(6.05);
+  const FilterState prior = truth.boxplus(offsetOf(0.3, 0.01, 3));
+  for (const double bias_std : {1e-3, 5e-5}) {
+    Mat18 P = livo_test::priorCovariance(0.3 * M_PI / 180.0, 0.02);
+    const double rot_std = 0.3 * M_PI / 180.0;
+    P.block<3, 3>(FilterState::kGyroBias, FilterState::kGyroBias) = Mat3::Identity() * bias_std * bias_std;
+    P.block<3, 3>(FilterState::kRot, FilterState::kGyroBias) = Mat3::Identity() * 0.8 * rot_std * bias_std;
+    P.block<3, 3>(FilterState::kGyroBias, FilterState::kRot) = Mat3::Identity() * 0.8 * rot_std * bias_std;
+    VioEstimator vio(VioOptions{}, s.camera());
+    seed(s, &vio, 6.0);
+    const ImageResult r = vio.processImage(s.image(6.05, 2), prior, P);
+    ASSERT_TRUE(r.valid) << r.why;
+    const Vec3 dbg = r.state.gyro_bias - prior.gyro_bias;
+    const Mat3 var_post = r.covariance.block<3, 3>(FilterState::kGyroBias, FilterState::kGyroBias);
+    if (bias_std > VioOptions{}.update.gyro_bias_std_to_update) {
+      EXPECT_GT(dbg.norm(), 0.1 * bias_std);
+      EXPECT_LT(var_post.trace(), 0.9 * 3.0 * bias_std * bias_std);
+    } else {
+      EXPECT_EQ(dbg.norm(), 0.0);
+      EXPECT_LT((var_post - Mat3::Identity() * bias_std * bias_std).cwiseAbs().maxCoeff(), 1e-6 * bias_std * bias_std);
+    }
+    EXPECT_LT(poseError(r.state, truth).rot_deg, 0.5 * poseError(prior, truth).rot_deg);
+    EXPECT_EQ(Eigen::LLT<Mat18>(r.covariance).info(), Eigen::Success);
+  }
+}
+
 TEST(VioEstimator, RejectsAnUpdateThatContradictsThePrior) {
   // a prior 2 cm off with a covariance claiming 2 mm: a confident photometric measurement
   // (low noise) moves the pose by far more than the prior allows

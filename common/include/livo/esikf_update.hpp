@@ -38,8 +38,12 @@ struct EsikfResult {
 };
 
 /// One information-form step: the Gauss-Newton increment and the updated covariance at iterate x.
+/// `estimated` (1 or 0 per error state; null: all 1) makes it a Schmidt "consider" step: the
+/// states marked 0 keep their prior value (their gain rows are zero), and the covariance is the
+/// Joseph form with that gain, (I - K'H) P (I - K'H)^T + K' R K'^T, which keeps their variance and
+/// updates their correlation with the rest. The iterate x must not have moved them from the prior.
 void informationStep(const FilterState& x, const FilterState& prior, const Mat18& P_prior, const Mat6& S,
-                     const Vec6& g, Vec18* delta, Mat18* P_post);
+                     const Vec6& g, Vec18* delta, Mat18* P_post, const Vec18* estimated = nullptr);
 
 /// The part of a pose measurement's information S that exceeds the prior's, direction by
 /// direction: with P_pose = L L^T and L^T S L = V diag(λ) V^T (the measurement's information in

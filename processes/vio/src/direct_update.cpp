@@ -85,6 +85,14 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   if (floored)
     pose_floor.bottomRightCorner<3, 3>() = calibrationFloor(patches, (prior.pose() * T_I_C).translation(),
                                                             uo.calibration_rotation_std_deg * M_PI / 180.0);
+  // once the filter knows the gyro bias, the image considers it instead of updating it
+  // (UpdateOptions::gyro_bias_std_to_update): a Schmidt step that leaves it at the prior
+  const bool consider_gyro_bias =
+      std::sqrt(P_prior.block<3, 3>(FilterState::kGyroBias, FilterState::kGyroBias).diagonal().maxCoeff()) <=
+      uo.gyro_bias_std_to_update;
+  Vec18 keep = Vec18::Ones();
+  keep.segment<3>(FilterState::kGyroBias).setZero();
+  const Vec18* estimated = consider_gyro_bias ? &keep : nullptr;
   auto cameraAt = [&](const CalibrationVector& f) {
     return calib ? T_I_C * se3::fromRotationTranslation(so3::Exp(f.head<3>()), f.segment<3>(3)) : T_I_C;
   };
@@ -132,7 +140,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
         g -= S_xc * Ainv.solve(r_c);
       }
       if (floored) applyPoseMeasurementFloor(pose_floor, &S, &g);
-      informationStep(x, prior, P_prior, S, g, &delta, &P);
+      informationStep(x, prior, P_prior, S, g, &delta, &P, estimated);
       S_last = S;
       x_lin = x;
       if (!delta.allFinite() || !P.allFinite()) {
@@ -199,7 +207,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
       // the covariance counts only the photometric information beyond the prior's (UpdateOptions)
       Vec18 unused;
       informationStep(x_lin, prior, P_prior, informationBeyondPrior(S_last, P_prior.topLeftCorner<6, 6>()),
-                      Vec6::Zero(), &unused, &res.covariance);
+                      Vec6::Zero(), &unused, &res.covariance, estimated);
     }
     if (calib) {
       // c's posterior: its information less what the pose (under its prior) explains of it; the

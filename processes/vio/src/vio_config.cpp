@@ -69,6 +69,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
   up.readOptional("calibration_rotation_std_deg", o.update.calibration_rotation_std_deg);
+  up.readOptional("gyro_bias_std_to_update", o.update.gyro_bias_std_to_update);
   if (up.has("covariance")) {
     const std::string c = up.get<std::string>("covariance");
     if (c == "full")
@@ -157,7 +158,8 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << " patches, Mahalanobis^2 <= " << o.update.max_mahalanobis << ", step <= " << o.update.max_step_pos << " m / "
      << o.update.max_step_rot_deg << " deg, covariance counts "
      << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
-     << ", calibration floor " << o.update.calibration_rotation_std_deg << " deg x baseline\n"
+     << ", calibration floor " << o.update.calibration_rotation_std_deg << " deg x baseline, gyro bias updated while its 1-sigma > "
+     << o.update.gyro_bias_std_to_update << " rad/s\n"
      << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
      << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"
      << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << "\n";
