@@ -25,42 +25,59 @@ Mat18 randomCovariance(unsigned seed) {
     for (int j = 0; j < 18; ++j) A(i, j) = 0.1 * n01(rng);
   return A * A.transpose() + Mat18::Identity() * 0.01;
 }
+
+// A linearised pose measurement z + H δ with H = [H6 0] (m rows), a prior covariance P̂ and an
+// iterate x̌ != x̂ (so J of eq. 12 is not the identity), with the textbook's P = J^-1 P̂ J^-T.
+struct LinearisedPoseMeasurement {
+  FilterState prior, x;
+  Mat18 Phat, P;
+  Eigen::MatrixXd H, R;
+  Eigen::VectorXd z;
+  Mat6 S() const { return H.leftCols<6>().transpose() * R.inverse() * H.leftCols<6>(); }
+  Vec6 g() const { return H.leftCols<6>().transpose() * R.inverse() * z; }
+  // the gain K = (H^T R^-1 H + P^-1)^-1 H^T R^-1 of eq. (17)
+  Eigen::MatrixXd gain() const {
+    const Eigen::MatrixXd Rinv = R.inverse();
+    return (H.transpose() * Rinv * H + P.inverse()).inverse() * H.transpose() * Rinv;
+  }
+};
+
+// `moved` marks the error states the iterate has moved from the prior.
+LinearisedPoseMeasurement randomPoseMeasurement(unsigned seed, int m, const Vec18& moved, const Vec3& rot,
+                                                const Vec3& pos) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01;
+  LinearisedPoseMeasurement lm;
+  lm.prior.rot = so3::Exp(rot);
+  lm.prior.pos = pos;
+  Vec18 d0;
+  for (int i = 0; i < 18; ++i) d0[i] = 0.05 * n01(rng) * moved[i];
+  lm.x = lm.prior.boxplus(d0);
+  lm.Phat = randomCovariance(seed - 4);
+  lm.H = Eigen::MatrixXd::Zero(m, 18);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < 6; ++j) lm.H(i, j) = n01(rng);
+  lm.z.resize(m);
+  for (int i = 0; i < m; ++i) lm.z[i] = 0.1 * n01(rng);
+  lm.R = Eigen::MatrixXd::Zero(m, m);
+  for (int i = 0; i < m; ++i) lm.R(i, i) = 0.01 * (1 + i);
+  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  lm.P = Jinv * lm.Phat * Jinv.transpose();
+  return lm;
+}
 }  // namespace
 
 TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
-  // A linearised pose measurement z + H δ with H = [H6 0] (m = 9 rows), prior covariance P̂,
-  // evaluated at an iterate x̌ != x̂ (so J of eq. 12 is not the identity).
-  std::mt19937 rng(7);
-  std::normal_distribution<double> n01;
-  FilterState prior;
-  prior.rot = so3::Exp(Vec3(0.2, 0.1, -0.4));
-  prior.pos = Vec3(1, 2, 3);
-  Vec18 d0;
-  for (int i = 0; i < 18; ++i) d0[i] = 0.05 * n01(rng);
-  const FilterState x = prior.boxplus(d0);
-  const Mat18 Phat = randomCovariance(3);
-  Eigen::Matrix<double, 9, 18> H = Eigen::Matrix<double, 9, 18>::Zero();
-  for (int i = 0; i < 9; ++i)
-    for (int j = 0; j < 6; ++j) H(i, j) = n01(rng);
-  Eigen::Matrix<double, 9, 1> z;
-  for (int i = 0; i < 9; ++i) z[i] = 0.1 * n01(rng);
-  Eigen::Matrix<double, 9, 9> R = Eigen::Matrix<double, 9, 9>::Zero();
-  for (int i = 0; i < 9; ++i) R(i, i) = 0.01 * (1 + i);
-
-  // textbook: P = J^-1 P̂ J^-T, K = (H^T R^-1 H + P^-1)^-1 H^T R^-1, eq. (17) and (18)
-  const Mat18 J = FilterState::boxminusJacobian(x, prior);
-  const Mat18 Jinv = J.inverse();
-  const Mat18 P = Jinv * Phat * Jinv.transpose();
-  const Eigen::Matrix<double, 9, 9> Rinv = R.inverse();
-  const Eigen::Matrix<double, 18, 9> K = (H.transpose() * Rinv * H + P.inverse()).inverse() * H.transpose() * Rinv;
-  const Vec18 delta_ref = -K * z - (Mat18::Identity() - K * H) * Jinv * x.boxminus(prior);
-  const Mat18 Ppost_ref = (Mat18::Identity() - K * H) * P;
-
-  const Mat6 S = H.leftCols<6>().transpose() * Rinv * H.leftCols<6>();
-  const Vec6 g = H.leftCols<6>().transpose() * Rinv * z;
+  const LinearisedPoseMeasurement lm =
+      randomPoseMeasurement(7, 9, Vec18::Ones(), Vec3(0.2, 0.1, -0.4), Vec3(1, 2, 3));
+  // textbook: K of eq. (17), the step and covariance of eqs. (17) and (18)
+  const Eigen::MatrixXd K = lm.gain();
+  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  const Vec18 delta_ref = -K * lm.z - (Mat18::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+  const Mat18 Ppost_ref = (Mat18::Identity() - K * lm.H) * lm.P;
   Vec18 delta;
   Mat18 Ppost;
-  informationStep(x, prior, Phat, S, g, &delta, &Ppost);
+  informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta, &Ppost);
   EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
 }
@@ -68,49 +85,26 @@ TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
 TEST(EsikfUpdate, ConsiderStepEqualsTheSchmidtKalmanFilter) {
   // the gyro bias (and only it) considered: against the textbook Schmidt-Kalman filter, K' = M K
   // with M zero on the considered rows and P+ = (I - K'H) P (I - K'H)^T + K' R K'^T
-  std::mt19937 rng(5);
-  std::normal_distribution<double> n01;
-  FilterState prior;
-  prior.rot = so3::Exp(Vec3(-0.1, 0.3, 0.2));
-  prior.pos = Vec3(-1, 0.5, 2);
-  Vec18 d0 = Vec18::Zero();
-  for (int i = 0; i < 9; ++i) d0[i] = 0.05 * n01(rng);  // the iterate moved the pose and velocity only
-  for (int i = 12; i < 18; ++i) d0[i] = 0.05 * n01(rng);
-  const FilterState x = prior.boxplus(d0);
-  const Mat18 Phat = randomCovariance(9);
-  Eigen::Matrix<double, 8, 18> H = Eigen::Matrix<double, 8, 18>::Zero();
-  for (int i = 0; i < 8; ++i)
-    for (int j = 0; j < 6; ++j) H(i, j) = n01(rng);
-  Eigen::Matrix<double, 8, 1> z;
-  for (int i = 0; i < 8; ++i) z[i] = 0.1 * n01(rng);
-  Eigen::Matrix<double, 8, 8> R = Eigen::Matrix<double, 8, 8>::Zero();
-  for (int i = 0; i < 8; ++i) R(i, i) = 0.02 * (1 + i);
-
-  const Mat18 J = FilterState::boxminusJacobian(x, prior);
-  const Mat18 Jinv = J.inverse();
-  const Mat18 P = Jinv * Phat * Jinv.transpose();
-  const Eigen::Matrix<double, 8, 8> Rinv = R.inverse();
-  const Eigen::Matrix<double, 18, 8> K = (H.transpose() * Rinv * H + P.inverse()).inverse() * H.transpose() * Rinv;
   Vec18 keep = Vec18::Ones();
   keep.segment<3>(FilterState::kGyroBias).setZero();
-  const Eigen::Matrix<double, 18, 8> Ks = keep.asDiagonal() * K;
-  const Vec18 delta_ref = -Ks * z - (Mat18::Identity() - Ks * H) * Jinv * x.boxminus(prior);
-  const Mat18 I_KH = Mat18::Identity() - Ks * H;
-  const Mat18 Ppost_ref = I_KH * P * I_KH.transpose() + Ks * R * Ks.transpose();
-
-  const Mat6 S = H.leftCols<6>().transpose() * Rinv * H.leftCols<6>();
-  const Vec6 g = H.leftCols<6>().transpose() * Rinv * z;
+  // the iterate has moved everything but the considered states
+  const LinearisedPoseMeasurement lm = randomPoseMeasurement(9, 8, keep, Vec3(-0.1, 0.3, 0.2), Vec3(-1, 0.5, 2));
+  const Eigen::MatrixXd Ks = keep.asDiagonal() * lm.gain();
+  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  const Vec18 delta_ref = -Ks * lm.z - (Mat18::Identity() - Ks * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+  const Mat18 I_KH = Mat18::Identity() - Ks * lm.H;
+  const Mat18 Ppost_ref = I_KH * lm.P * I_KH.transpose() + Ks * lm.R * Ks.transpose();
   Vec18 delta;
   Mat18 Ppost;
-  informationStep(x, prior, Phat, S, g, &delta, &Ppost, &keep);
+  informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta, &Ppost, &keep);
   EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
   // the considered states keep their value and their variance; the rest steps as the full filter
   EXPECT_TRUE(delta.segment<3>(FilterState::kGyroBias).isZero());
-  EXPECT_LT((Ppost.block<3, 3>(9, 9) - P.block<3, 3>(9, 9)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((Ppost.block<3, 3>(9, 9) - lm.P.block<3, 3>(9, 9)).cwiseAbs().maxCoeff(), 1e-12);
   Vec18 delta_full;
   Mat18 Pfull;
-  informationStep(x, prior, Phat, S, g, &delta_full, &Pfull);
+  informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta_full, &Pfull);
   EXPECT_LT((delta - keep.asDiagonal() * delta_full).cwiseAbs().maxCoeff(), 1e-12);
   // and it never claims more than the optimal filter: P+ - P_full is positive semi-definite
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat18>(Ppost - Pfull).eigenvalues().minCoeff(), -1e-12);
