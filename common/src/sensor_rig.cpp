@@ -25,12 +25,16 @@ ImuRig readImu(const Config& c) {
   c.read("gyro_random_walk", imu.gyro_random_walk);
   c.read("accel_noise_density", imu.accel_noise_density);
   c.read("accel_random_walk", imu.accel_random_walk);
+  c.readOptional("gyro_scale_std", imu.gyro_scale_std);
+  c.readOptional("gyro_misalignment_std", imu.gyro_misalignment_std);
   c.readOptional("gravity", imu.gravity);
   requirePositive(c, "rate_hz", imu.rate_hz);
   requireNonNegative(c, "gyro_noise_density", imu.gyro_noise_density);
   requireNonNegative(c, "gyro_random_walk", imu.gyro_random_walk);
   requireNonNegative(c, "accel_noise_density", imu.accel_noise_density);
   requireNonNegative(c, "accel_random_walk", imu.accel_random_walk);
+  requireNonNegative(c, "gyro_scale_std", imu.gyro_scale_std);
+  requireNonNegative(c, "gyro_misalignment_std", imu.gyro_misalignment_std);
   requirePositive(c, "gravity", imu.gravity);
   return imu;
 }

@@ -30,6 +30,8 @@ struct ImuRig {
   double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
   double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
   double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
+  double gyro_scale_std = 0.0;          // relative 1-sigma of the gyro's scale factors (datasheet tolerance)
+  double gyro_misalignment_std = 0.0;   // rad, 1-sigma of its axis misalignment / cross-axis sensitivity
   double gravity = 9.81;                // m/s^2, world z up
 };
 

@@ -34,10 +34,14 @@ void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& ac
   Fw->block<3, 3>(S::kAccelBias, 9) = Mat3::Identity() * dt;
 }
 
-Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt) {
+Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt, const Vec3& omega) {
   Mat12 Q = Mat12::Zero();
   const double inv = 1.0 / dt;
-  Q.diagonal().segment<3>(0).setConstant(n.gyro_noise_density * n.gyro_noise_density * inv);
+  // var((M w)_i) = s^2 w_i^2 + m^2 (|w|^2 - w_i^2) for M = I + scale + misalignment with independent entries
+  const Vec3 w2 = omega.cwiseAbs2();
+  const double s2 = n.gyro_scale_std * n.gyro_scale_std, m2 = n.gyro_misalignment_std * n.gyro_misalignment_std;
+  const Vec3 systematic = (s2 * w2 + m2 * (Vec3::Constant(w2.sum()) - w2)) * n.systematic_error_window_s;
+  Q.diagonal().segment<3>(0) = (Vec3::Constant(n.gyro_noise_density * n.gyro_noise_density) + systematic) * inv;
   Q.diagonal().segment<3>(3).setConstant(n.accel_noise_density * n.accel_noise_density * inv);
   Q.diagonal().segment<3>(6).setConstant(n.gyro_random_walk * n.gyro_random_walk * inv);
   Q.diagonal().segment<3>(9).setConstant(n.accel_random_walk * n.accel_random_walk * inv);
@@ -75,7 +79,7 @@ void ImuPropagator::step(const ImuSample& next) {
     Mat18x12 Fw;
     propagationJacobians(x_, gyro, accel, dt, &Fx, &Fw);
     x_ = propagateState(x_, gyro, accel, dt);
-    P_ = Fx * P_ * Fx.transpose() + Fw * discreteNoiseCovariance(noise_, dt) * Fw.transpose();
+    P_ = Fx * P_ * Fx.transpose() + Fw * discreteNoiseCovariance(noise_, dt, seg.omega) * Fw.transpose();
     P_ = 0.5 * (P_ + P_.transpose());
   }
   last_ = next;

@@ -20,11 +20,18 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   imu.read("gyro_random_walk", l.imu_noise.gyro_random_walk);
   imu.read("accel_noise_density", l.imu_noise.accel_noise_density);
   imu.read("accel_random_walk", l.imu_noise.accel_random_walk);
+  imu.readOptional("gyro_scale_std", l.imu_noise.gyro_scale_std);
+  imu.readOptional("gyro_misalignment_std", l.imu_noise.gyro_misalignment_std);
+  if (!(l.imu_noise.gyro_scale_std >= 0.0)) throw ConfigError(imu.where("gyro_scale_std") + ": must be >= 0");
+  if (!(l.imu_noise.gyro_misalignment_std >= 0.0))
+    throw ConfigError(imu.where("gyro_misalignment_std") + ": must be >= 0");
   imu.readOptional("gravity", l.init.gravity);
 
   const Config lidar = rig.section("lidar");
   lidar.ignore("model");
-  lidar.ignore("rate_hz");
+  double sweep_rate_hz = 0.0;
+  if (lidar.readOptional("rate_hz", sweep_rate_hz) && sweep_rate_hz > 0.0)
+    l.imu_noise.systematic_error_window_s = 1.0 / sweep_rate_hz;  // the attitude is corrected once a sweep
   lidar.ignore("dropout_probability");
   lidar.readOptional("min_range", l.min_range);
   lidar.readOptional("max_range", l.max_range);
@@ -206,7 +213,9 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << o.loop_correction_channel << "; outputs " << o.odometry_channel << ", " << o.registered_scan_channel << ", "
      << o.keyframe_channel << "\n"
      << "  imu noise: gyro " << l.imu_noise.gyro_noise_density << " / " << l.imu_noise.gyro_random_walk << ", accel "
-     << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gravity " << l.init.gravity
+     << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gyro scale "
+     << l.imu_noise.gyro_scale_std << " and misalignment " << l.imu_noise.gyro_misalignment_std << " rad per "
+     << l.imu_noise.systematic_error_window_s << " s sweep, gravity " << l.init.gravity
      << ", init window " << l.init.window_s << " s\n"
      << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["
      << l.min_range << ", " << l.max_range << "] m\n"

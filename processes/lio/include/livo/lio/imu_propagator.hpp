@@ -27,6 +27,14 @@ struct ImuNoise {
   double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
   double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
   double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
+  // The gyro's scale-factor and axis-misalignment errors (1-sigma; 0: not modelled). Unlike white noise
+  // they are an error in proportion to the rate, the same sign through a whole turn: M w with M's
+  // diagonal of gyro_scale_std and its off-diagonal of gyro_misalignment_std. Between two updates that
+  // correct the attitude (the LiDAR sweeps, systematic_error_window_s apart) it adds up to M w T, so the
+  // propagation adds a rate noise of density^2 = var(M w) T: the attitude spread grows by the turn.
+  double gyro_scale_std = 0.0;            // relative
+  double gyro_misalignment_std = 0.0;     // rad
+  double systematic_error_window_s = 0.1; // s, the LiDAR sweep period
 };
 
 /// Eq. (5): x ⊞ (dt f(x, u, 0)) with f of eq. (4).
@@ -36,8 +44,9 @@ FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& a
 void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx,
                           Mat18x12* Fw);
 
-/// Covariance of the discrete noise w_i over a step of dt: density^2 / dt per axis.
-Mat12 discreteNoiseCovariance(const ImuNoise& noise, double dt);
+/// Covariance of the discrete noise w_i over a step of dt: density^2 / dt per axis; the gyro's part
+/// grows with the bias-corrected rate `omega` when the scale or misalignment error is modelled.
+Mat12 discreteNoiseCovariance(const ImuNoise& noise, double dt, const Vec3& omega = Vec3::Zero());
 
 /// The IMU-rate trajectory over one step: state at `utime` and the constant input until the next.
 struct ImuSegment {
