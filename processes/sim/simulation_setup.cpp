@@ -201,6 +201,20 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   cam.readOptional("vignetting", e.vignetting);
   cam.readOptional("rolling_shutter_s", e.rolling_shutter_s);
   readAutoExposure(cam, &e);
+  std::string trigger = "free";
+  cam.readOptional("trigger", trigger);
+  if (trigger == "free") {
+    o->camera_trigger = CameraTrigger::kFree;
+  } else if (trigger == "sweep_start" || trigger == "sweep_end") {
+    o->camera_trigger = trigger == "sweep_start" ? CameraTrigger::kSweepStart : CameraTrigger::kSweepEnd;
+    if (!rig.lidar) throw ConfigError(cam.where("trigger") + ": " + trigger + " needs a LiDAR to trigger the camera");
+    if (rig.camera && std::abs(rig.camera->rate_hz - rig.lidar->rate_hz) > 1e-9)
+      throw ConfigError(cam.where("trigger") + ": " + trigger + " fires once per sweep, so rig.camera.rate_hz (" +
+                        std::to_string(rig.camera->rate_hz) + ") must equal rig.lidar.rate_hz (" +
+                        std::to_string(rig.lidar->rate_hz) + ")");
+  } else {
+    throw ConfigError(cam.where("trigger") + ": '" + trigger + "' is not free, sweep_start or sweep_end");
+  }
   if (!(e.exposure_time > 0.0)) throw ConfigError(cam.where("exposure_time") + ": must be > 0");
   if (!(e.exposure_variation >= 0.0 && e.exposure_variation < 1.0))
     throw ConfigError(cam.where("exposure_variation") + ": must be in [0, 1)");
@@ -368,7 +382,10 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
     os << "  camera: exposure " << o.camera.exposure_time * 1e3 << " ms +-" << o.camera.exposure_variation * 100
        << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples
        << ", noise " << o.camera.noise_std << " DN, brightness " << o.camera.brightness << ", vignetting "
-       << o.camera.vignetting;
+       << o.camera.vignetting << ", "
+       << (o.camera_trigger == CameraTrigger::kFree ? "free-running"
+           : o.camera_trigger == CameraTrigger::kSweepStart ? "triggered at each sweep's start"
+                                                            : "triggered at each sweep's end");
   if (s.rig.camera && o.camera.rolling_shutter_s > 0.0)
     os << ", rolling shutter readout " << o.camera.rolling_shutter_s * 1e3 << " ms";
   if (s.rig.camera) os << "\n";

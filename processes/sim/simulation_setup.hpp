@@ -23,6 +23,10 @@ namespace livo {
 namespace sim {
 
 /// The `sim:` options, with their defaults.
+/// When the camera exposes (sim.camera.trigger): free-running, its frames halfway between clock
+/// ticks, or hardware-triggered by the LiDAR at each sweep's start or end (then at the LiDAR's rate).
+enum class CameraTrigger { kFree, kSweepStart, kSweepEnd };
+
 struct SimOptions {
   double start_time_s = 1.7e9;        // stamp of t = 0 (procedural trajectories)
   double duration_s = 30.0;
@@ -34,6 +38,7 @@ struct SimOptions {
   LidarPatternOptions lidar;
   LidarEffects lidar_effects;         // sim.lidar receiver effects, all off by default
   CameraEffects camera;
+  CameraTrigger camera_trigger = CameraTrigger::kFree;
   double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;
   ImuErrors imu_errors;                 // sim.imu error model, as configured (1-sigmas if drawn)

@@ -163,7 +163,16 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     }
     if (renderer) {
       std::vector<std::function<void()>> frames;
-      for (int64_t u; (u = stampOf(start, frame_k, rig.camera->rate_hz, 0.5)) < c1; ++frame_k) {
+      // free-running: halfway between the clock's ticks; triggered: at the sweeps' starts or ends
+      auto frameStamp = [&](int64_t k) {
+        switch (o.camera_trigger) {
+          case CameraTrigger::kSweepStart: return stampOf(start, k, rig.lidar->rate_hz);
+          case CameraTrigger::kSweepEnd: return stampOf(start, k, rig.lidar->rate_hz) + sweep_us;
+          case CameraTrigger::kFree: break;
+        }
+        return stampOf(start, k, rig.camera->rate_hz, 0.5);
+      };
+      for (int64_t u; (u = frameStamp(frame_k)) < c1; ++frame_k) {
         pending.push_back({u, kCameraRank, images.size()});
         images.emplace_back();
         const size_t slot = images.size() - 1;

@@ -500,6 +500,57 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
   }
 }
 
+// A camera triggered by the LiDAR: every image stamped exactly at a sweep end (the next sweep's
+// start) and delivered before that sweep's message, as a driver publishing the image first does.
+// The sweep ending there is registered first and the image handed off at the same time: no sweep
+// is refused, every sweep gives its odometry, and every image after the map exists gets a prior.
+// The old order (the image first, as soon as the IMU passed it) refused the sweep at the same time.
+TEST(LioNode, ImagesAtTheSweepEndsCostNoSweep) {
+  const synth::SyntheticSequence seq = syntheticSequence();
+  image_t img;
+  img.frame = "C";
+  img.width = img.height = img.row_stride = 2;
+  img.encoding = image_t::ENCODING_GRAY8;
+  img.data = {10, 20, 30, 40};
+  img.size = 4;
+  std::vector<Message> in;
+  for (int k = 0; k < seq.numScans(); ++k) {
+    img.utime = seq.scanEndUtime(k);
+    in.push_back(encode(img.utime, "CAMERA", img));  // before the sweep on equal keys (stable sort)
+  }
+  const std::vector<Message> run = syntheticRun();
+  in.insert(in.end(), run.begin(), run.end());
+  std::stable_sort(in.begin(), in.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+
+  std::vector<int64_t> prior_times;
+  RunSetup setup;
+  setup.config = handoffConfig();
+  LioNode::HandoffCounts counts;
+  setup.handoff = &counts;
+  setup.attach = [&](Node& vio) {
+    vio.subscribe<filter_state_t>("STATE_PRIOR", [&vio, &prior_times](const filter_state_t& prior) {
+      prior_times.push_back(prior.utime);
+      filter_state_t post = prior;  // an answer that keeps the prior: the odometry stays LiDAR-only
+      post.valid = 0;
+      vio.publish("STATE_POSTERIOR", post);
+    });
+    vio.announce();
+  };
+  int64_t rejected = 0;
+  const Outputs out = runNode(in, &rejected, setup);
+  const Outputs lidar_only = runNode(syntheticRun());
+  EXPECT_EQ(rejected, 0);
+  ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
+  EXPECT_EQ(out.odometry_bytes, lidar_only.odometry_bytes);
+  // every image from the first tracked sweep on, at its own time
+  ASSERT_GE(prior_times.size(), 20u);
+  EXPECT_EQ(counts.kept_prior, counts.priors);
+  EXPECT_EQ(counts.missing, 0);
+  EXPECT_EQ(counts.priors + counts.images_skipped, seq.numScans());
+  EXPECT_EQ(prior_times.back(), seq.scanEndUtime(seq.numScans() - 1));
+  for (size_t i = 1; i < prior_times.size(); ++i) EXPECT_GT(prior_times[i], prior_times[i - 1]);
+}
+
 namespace {
 // Real-time orders around a reset: a loop correction of the current epoch is adopted (later
 // output says so in correction_id); an IMU clock jump back re-initialises lio in epoch 1; then a

@@ -3,6 +3,7 @@
 // and configuration mistakes are reported with the file and key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -219,6 +220,69 @@ TEST(Simulation, EveryWorldAndCameraEffectStaysByteIdenticalWhateverTheThreads) 
   ASSERT_GE(sink.images.size(), 10u);
   EXPECT_FLOAT_EQ(sink.images.front().exposure_time, 0.006f);
   EXPECT_NE(sink.images.back().exposure_time, sink.images.front().exposure_time);
+}
+
+// sim.camera.trigger: one image per sweep at its start or end stamp (room_triggered: 10 Hz camera
+// triggered at the sweep end); free-running images sit halfway between the camera clock's ticks.
+TEST(Simulation, TriggeredCameraFiresAtTheSweepStartsOrEnds) {
+  std::ifstream in(configPath("room_triggered"));
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string yaml = text.str();
+  ASSERT_NE(yaml.find("    trigger: sweep_end\n"), std::string::npos);
+  struct Stamps : SensorDataSink {
+    std::vector<int64_t> sweep_starts, sweep_ends, images;
+    void write(const ImuReading&) override {}
+    void write(const PoseReading&) override {}
+    void write(const WheelReading&) override {}
+    void write(const LidarSweep& m) override {
+      sweep_starts.push_back(m.utime);
+      sweep_ends.push_back(m.utime + std::llround(m.duration * 1e6));
+    }
+    void write(const CameraImage& m) override { images.push_back(m.utime); }
+  };
+  SimOverrides o;
+  o.duration_s = 0.65;
+  for (const std::string trigger : {"sweep_end", "sweep_start", "free"}) {
+    SCOPED_TRACE(trigger);
+    std::string y = yaml;
+    y.replace(y.find("trigger: sweep_end"), 18, "trigger: " + trigger);
+    const SimulationSetup setup =
+        loadSimulation(Config::fromString(y, "room_trigger.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+    Stamps s;
+    Simulator(setup).run(s);
+    ASSERT_EQ(s.sweep_starts.size(), 6u);
+    ASSERT_GE(s.images.size(), 6u);
+    if (trigger == "free") {
+      for (int64_t t : s.images) EXPECT_EQ((t - setup.start_utime) % 100'000, 50'000) << t;
+      continue;
+    }
+    // every image on a sweep's start (end), and every sweep's start (end) within the run imaged
+    const std::vector<int64_t>& at = trigger == "sweep_start" ? s.sweep_starts : s.sweep_ends;
+    for (int64_t t : s.images) {
+      if (t <= at.back()) {
+        EXPECT_NE(std::find(at.begin(), at.end(), t), at.end()) << t;
+      }
+    }
+    for (int64_t t : at) EXPECT_NE(std::find(s.images.begin(), s.images.end(), t), s.images.end()) << t;
+  }
+  // a trigger needs a LiDAR at the camera's rate, and a known name
+  std::string mismatched = yaml;
+  mismatched.replace(mismatched.find("rate_hz: 10   # one image per sweep"), 10, "rate_hz: 20");
+  try {
+    loadSimulation(Config::fromString(mismatched, "rates.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+    ADD_FAILURE() << "a 20 Hz camera triggered by a 10 Hz LiDAR was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("sim.camera.trigger: sweep_end fires once per sweep"), std::string::npos) << e.what();
+  }
+  std::string unknown = yaml;
+  unknown.replace(unknown.find("trigger: sweep_end"), 18, "trigger: strobe");
+  try {
+    loadSimulation(Config::fromString(unknown, "strobe.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+    ADD_FAILURE() << "an unknown trigger was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("'strobe' is not free, sweep_start or sweep_end"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {

@@ -69,6 +69,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("max_pending_scans", o->max_pending_scans);
   c.readOptional("camera_handoff", o->camera_handoff);
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
+  c.readOptional("image_lidar_wait_s", o->image_lidar_wait_s);
 
   const Config out = c.optionalSection("channels");
   out.readOptional("state_posterior", o->state_posterior_channel);
@@ -190,6 +191,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
   positive(l.init.window_s > 0, "init.window_s");
   positive(o->posterior_max_wait_s > 0, "posterior_max_wait_s");
+  positive(o->image_lidar_wait_s > 0, "image_lidar_wait_s");
   positive(l.max_imu_backlog_s > 0 && l.reseed_after_s > 0, "max_imu_backlog_s");
 }
 }  // namespace

@@ -64,6 +64,7 @@ void LioEstimator::reset() {
   last_registered_body_.clear();
   has_last_post_ = has_prev_post_ = false;
   has_registered_ = false;
+  last_sweep_end_utime_ = -1;
 }
 
 bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
@@ -317,12 +318,13 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   const double end_offset = scanEndOffset(scan);
   const int64_t t_end = scanEndUtime(scan);
   const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
-  if (t_end <= prop_.utime()) {
+  if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
     // before the first output this is a sweep recorded during the IMU initialisation window
     res.status = map_.empty() ? ScanResult::Status::kInitializing : ScanResult::Status::kRejected;
     res.message = map_.empty() ? "sweep ends before the IMU initialisation" : "sweep ends before the filter time";
     return res;
   }
+  last_sweep_end_utime_ = t_end;
 
   // 1. propagation to the sweep end (eqs. 5-6)
   if (!propagateThrough(t_end, note)) {

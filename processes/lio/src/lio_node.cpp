@@ -1,5 +1,6 @@
 #include "livo/lio/lio_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iomanip>
@@ -79,6 +80,7 @@ void LioNode::resetAll(const std::string& why) {
   wheel_.clear();
   scans_.clear();
   images_.clear();
+  newest_sweep_end_ = last_image_ = -1;
   pending_.reset();
   held_jump_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
@@ -151,7 +153,7 @@ void LioNode::onLidar(const point_cloud_t& m) {
   }
   p->msg = m;
   const int64_t t_end = lio_.scanEndUtime(p->scan);
-  if (lio_.initialized() && t_end <= lio_.utime()) {
+  if (!lio_.acceptsSweepEnding(t_end)) {
     node_.reject(opts_.lidar_channel, "sweep ends before the filter time (late or duplicate)");
     return;
   }
@@ -159,6 +161,7 @@ void LioNode::onLidar(const point_cloud_t& m) {
     node_.reject(opts_.lidar_channel, "sweep older than one already processed");
     return;
   }
+  newest_sweep_end_ = std::max(newest_sweep_end_, t_end);
   while (static_cast<int>(scans_.size()) > opts_.max_pending_scans) {
     node_.warn("no IMU past pending sweeps: dropping the oldest");
     scans_.popUntil(scans_.front().utime, [](const auto&) {});
@@ -176,7 +179,7 @@ void LioNode::onCamera(const void* data, int size) {
   }
   node_.noteSensorTime(utime);
   const int64_t t = utime + toUtime(opts_.camera_time_offset_s);
-  if ((lio_.initialized() && t <= lio_.utime()) || (pending_ && t <= pending_->utime)) {
+  if ((lio_.initialized() && t < lio_.utime()) || t <= last_image_ || (pending_ && t <= pending_->utime)) {
     ++handoff_.images_skipped;  // the filter is already past it
     return;
   }
@@ -224,10 +227,13 @@ void LioNode::advance() {
                  ": going on LiDAR-only (" + std::to_string(handoff_.missing) + " so far)");
       pending_.reset();
     }
-    // the earlier of the next image time and the next sweep end
-    if (!images_.empty() && (scans_.empty() || images_.front().utime <= scans_.front().utime)) {
+    // the earlier of the next image time and the next sweep end; a sweep ending at the image first
+    if (!images_.empty() && (scans_.empty() || images_.front().utime < scans_.front().utime)) {
       const int64_t t_image = images_.front().utime;
       if (fed_imu_ <= t_image) break;  // no IMU past the image yet
+      // every sweep ending at or before the image must have been processed (the LiDAR watermark)
+      const bool lidar_past = newest_sweep_end_ >= t_image;
+      if (!lidar_past && fed_imu_ <= t_image + toUtime(opts_.image_lidar_wait_s)) break;
       images_.popUntil(t_image, [](const auto&) {});
       handOff(t_image);
       continue;
@@ -313,7 +319,9 @@ std::string LioNode::wheelSummary() const {
 }
 
 void LioNode::handOff(int64_t utime) {
-  if (!lio_.tracking() || utime <= lio_.utime()) {
+  const bool repeated = utime <= last_image_;
+  last_image_ = std::max(last_image_, utime);
+  if (!lio_.tracking() || utime < lio_.utime() || repeated) {
     ++handoff_.images_skipped;
     return;
   }

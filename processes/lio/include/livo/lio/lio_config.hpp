@@ -50,6 +50,10 @@ struct LioNodeOptions {
   bool camera_handoff = false;
   double camera_time_offset_s = 0.0;   // rig.camera.time_offset_s: image utime + offset = IMU time
   double posterior_max_wait_s = 0.1;   // IMU time past an image after which lio goes on without its posterior
+  // An image is handed off once a sweep ending at or after it has arrived (so every sweep ending
+  // before it is registered first), or once the IMU has run this far past it (the LiDAR is late or
+  // gone). At least a sweep period plus the LiDAR driver's latency: a sweep arrives when it ends.
+  double image_lidar_wait_s = 0.25;
 
   LioOptions lio;
 };

@@ -94,6 +94,11 @@ class LioEstimator {
   bool tracking() const { return initialized_ && !map_.empty(); }
   /// Time of the filter state (IMU clock).
   int64_t utime() const { return prop_.utime(); }
+  /// False for a sweep ending before the filter time, or at it when a sweep already ended there. A
+  /// sweep may end exactly where an image hand-off moved the filter (a camera triggered by the LiDAR).
+  bool acceptsSweepEnding(int64_t t_end) const {
+    return !initialized_ || t_end > prop_.utime() || (t_end == prop_.utime() && t_end != last_sweep_end_utime_);
+  }
   const FilterState& state() const { return prop_.state(); }
   const Mat18& covariance() const { return prop_.covariance(); }
   const VoxelMap& map() const { return map_; }
@@ -192,6 +197,7 @@ class LioEstimator {
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
   int64_t last_registered_utime_ = 0;  // last sweep that seeded the map or registered
+  int64_t last_sweep_end_utime_ = -1;  // last sweep that reached the filter (any outcome)
   bool has_registered_ = false;
   Vec3 last_post_pos_ = Vec3::Zero(), prev_post_pos_ = Vec3::Zero();  // registered positions ...
   int64_t last_post_utime_ = 0, prev_post_utime_ = 0;                 // ... of the last two sweeps

@@ -8,7 +8,10 @@
 // of IMU beyond it).
 //
 // Camera hand-off (options.camera_handoff): image times from CAMERA are events like sweep ends.
-// When the IMU passes one, the filter is propagated to it and published on STATE_PRIOR; nothing
+// When the IMU passes one and every sweep ending at or before it has been processed (a sweep
+// ending at or after it has arrived, or image_lidar_wait_s of IMU beyond it), the filter is
+// propagated to it and published on STATE_PRIOR; a sweep ending exactly at an image comes first
+// (a camera triggered at the sweep end or start), then the image at the same time. Nothing
 // later is processed until the STATE_POSTERIOR with that request id has been adopted (valid = 0:
 // the prior is kept), or the IMU has run posterior_max_wait_s past the image: then lio goes on
 // LiDAR-only and counts the missing answer. While no live node subscribes to STATE_PRIOR (seen
@@ -100,6 +103,8 @@ class LioNode {
     int64_t utime;
   };
   TimeBuffer<bool> images_;             // image times (IMU clock) not yet handed off
+  int64_t newest_sweep_end_ = -1;       // the LiDAR's watermark: latest end of a sweep received (IMU clock)
+  int64_t last_image_ = -1;             // latest image time handed off or skipped (IMU clock)
   std::optional<PendingPrior> pending_;  // prior waiting for its posterior
   int64_t next_request_id_ = 1;
   HandoffCounts handoff_;
