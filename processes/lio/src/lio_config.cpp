@@ -43,8 +43,10 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   const Config cam = rig.optionalSection("camera");
   if (!cam.isNull()) {
     for (const std::string& key : cam.keys())
-      if (key != "time_offset_s") cam.ignore(key);  // the VIO and colouring read the camera model
+      if (key != "time_offset_s" && key != "rate_hz") cam.ignore(key);  // the VIO and colouring read the model
     cam.readOptional("time_offset_s", o->camera_time_offset_s);
+    cam.readOptional("rate_hz", o->camera_rate_hz);
+    if (!(o->camera_rate_hz > 0.0)) throw ConfigError(cam.where("rate_hz") + ": must be > 0");
   }
   const Config wheel = rig.optionalSection("wheel");
   if (!wheel.isNull()) {
@@ -70,6 +72,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("camera_handoff", o->camera_handoff);
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
   c.readOptional("image_lidar_wait_s", o->image_lidar_wait_s);
+  c.readOptional("image_max_wait_s", o->image_max_wait_s);
 
   const Config out = c.optionalSection("channels");
   out.readOptional("state_posterior", o->state_posterior_channel);
@@ -192,6 +195,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   positive(l.init.window_s > 0, "init.window_s");
   positive(o->posterior_max_wait_s > 0, "posterior_max_wait_s");
   positive(o->image_lidar_wait_s > 0, "image_lidar_wait_s");
+  positive(o->image_max_wait_s >= 0, "image_max_wait_s");
   positive(l.max_imu_backlog_s > 0 && l.reseed_after_s > 0, "max_imu_backlog_s");
 }
 }  // namespace

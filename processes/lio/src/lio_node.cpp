@@ -80,7 +80,7 @@ void LioNode::resetAll(const std::string& why) {
   wheel_.clear();
   scans_.clear();
   images_.clear();
-  newest_sweep_end_ = last_image_ = -1;
+  newest_sweep_end_ = last_image_ = newest_image_ = -1;
   pending_.reset();
   held_jump_.reset();
   has_imu_ = fed_any_imu_ = fed_any_wheel_ = false;
@@ -179,6 +179,7 @@ void LioNode::onCamera(const void* data, int size) {
   }
   node_.noteSensorTime(utime);
   const int64_t t = utime + toUtime(opts_.camera_time_offset_s);
+  newest_image_ = std::max(newest_image_, t);
   if ((lio_.initialized() && t < lio_.utime()) || t <= last_image_ || (pending_ && t <= pending_->utime)) {
     ++handoff_.images_skipped;  // the filter is already past it
     return;
@@ -241,6 +242,12 @@ void LioNode::advance() {
     if (scans_.empty()) break;
     const int64_t t_end = scans_.front().utime;
     if (fed_imu_ <= t_end) break;  // no IMU past the sweep end yet
+    if (opts_.camera_handoff && newest_image_ >= 0 && t_end - newest_image_ < toUtime(1.0) &&
+        node_.hasConsumers(opts_.state_prior_channel)) {
+      // the images before the sweep end come first: wait until the next one is due after it
+      const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > t_end;
+      if (!images_past && fed_imu_ <= t_end + toUtime(opts_.image_max_wait_s)) break;
+    }
     if (opts_.lio.wheel.enabled) {
       const bool wheel_past = !wheel_.empty() && wheel_.back().utime > t_end;
       const bool waited = fed_imu_ > t_end + toUtime(opts_.wheel_max_wait_s);

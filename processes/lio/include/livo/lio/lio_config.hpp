@@ -49,11 +49,16 @@ struct LioNodeOptions {
   // STATE_POSTERIOR that answers it; nothing later than the image is processed meanwhile.
   bool camera_handoff = false;
   double camera_time_offset_s = 0.0;   // rig.camera.time_offset_s: image utime + offset = IMU time
+  double camera_rate_hz = 20.0;        // rig.camera.rate_hz: when the next image is due
   double posterior_max_wait_s = 0.1;   // IMU time past an image after which lio goes on without its posterior
   // An image is handed off once a sweep ending at or after it has arrived (so every sweep ending
   // before it is registered first), or once the IMU has run this far past it (the LiDAR is late or
   // gone). At least a sweep period plus the LiDAR driver's latency: a sweep arrives when it ends.
   double image_lidar_wait_s = 0.25;
+  // A sweep waits for the images before its end (a camera driver that delivers later than the
+  // LiDAR's): until an image has arrived whose successor is due after the sweep end, or the IMU is
+  // this far past the end. Only while a VIO listens and the camera is live (an image within 1 s).
+  double image_max_wait_s = 0.1;
 
   LioOptions lio;
 };

@@ -11,7 +11,8 @@
 // When the IMU passes one and every sweep ending at or before it has been processed (a sweep
 // ending at or after it has arrived, or image_lidar_wait_s of IMU beyond it), the filter is
 // propagated to it and published on STATE_PRIOR; a sweep ending exactly at an image comes first
-// (a camera triggered at the sweep end or start), then the image at the same time. Nothing
+// (a camera triggered at the sweep end or start), then the image at the same time. A sweep in turn
+// waits for the images before its end (the camera's watermark, image_max_wait_s). Nothing
 // later is processed until the STATE_POSTERIOR with that request id has been adopted (valid = 0:
 // the prior is kept), or the IMU has run posterior_max_wait_s past the image: then lio goes on
 // LiDAR-only and counts the missing answer. While no live node subscribes to STATE_PRIOR (seen
@@ -105,6 +106,7 @@ class LioNode {
   TimeBuffer<bool> images_;             // image times (IMU clock) not yet handed off
   int64_t newest_sweep_end_ = -1;       // the LiDAR's watermark: latest end of a sweep received (IMU clock)
   int64_t last_image_ = -1;             // latest image time handed off or skipped (IMU clock)
+  int64_t newest_image_ = -1;           // the camera's watermark: latest image time received (IMU clock)
   std::optional<PendingPrior> pending_;  // prior waiting for its posterior
   int64_t next_request_id_ = 1;
   HandoffCounts handoff_;
