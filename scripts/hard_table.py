@@ -3,6 +3,11 @@
 
     scripts/hard_table.py --out DIR [--configs room_hard,corridor_hard,...] [--seeds 301,302,303]
                           [--duration 60] [--long-duration 300] [--keep-logs]
+                          [--without-loop] [--livo-tolerance 0.05]
+
+Issue 15's table (the camera never makes the estimate worse) is the same command on any sim configs
+with --without-loop --livo-tolerance 0.05 (LIVO within +5 % of the LIO, and at least 30 % below it
+where the LiDAR degenerates).
 
 For every config (config/sim/NAME.yaml) and seed: livo-sim writes the log (campus_loop_long*: the
 long duration), then scripts/run_pipeline.sh runs
@@ -81,6 +86,10 @@ def main():
     ap.add_argument('--duration', type=float, default=60.0)
     ap.add_argument('--long-duration', type=float, default=300.0, help='campus_loop_long*')
     ap.add_argument('--keep-logs', action='store_true')
+    ap.add_argument('--without-loop', action='store_true', help='skip the loop-closure runs')
+    ap.add_argument('--livo-tolerance', type=float, default=0.0,
+                    help='LIVO passes at most this fraction above the LIO (issue 15: 0.05); where the LiDAR '
+                         'degenerates LIVO must then also be at least 30 %% below it')
     a = ap.parse_args()
     build = os.environ.get('LIVO_BUILD_DIR', os.path.join(ROOT, 'build'))
     bin_dir = os.path.join(build, 'bin')
@@ -107,7 +116,7 @@ def main():
             variants = [('lio', 'lio')]
             if 'vio' in sections and has_camera(config):
                 variants.append(('livo', 'lio,vio'))
-            if 'loop' in sections:
+            if 'loop' in sections and not a.without_loop:
                 variants.append(('loop', 'lio,loop'))
             ok = {}
             for variant, processes in variants:
@@ -147,8 +156,13 @@ def main():
                         tag, judged, judged_ate['coverage'], judged_ate['max']))
             if name.startswith('corridor') and degenerate == 0:
                 failures.append('%s: no degenerate sweep flagged in the corridor' % tag)
-            if 'livo' in ok and not row['livo_ate'] <= row['lio_ate']:
-                failures.append('%s: LIVO ATE %.4f m worse than the LIO\'s %.4f m' % (tag, row['livo_ate'], row['lio_ate']))
+            if 'livo' in ok and not row['livo_ate'] <= (1.0 + a.livo_tolerance) * row['lio_ate']:
+                failures.append('%s: LIVO ATE %.4f m worse than the LIO\'s %.4f m%s' % (
+                    tag, row['livo_ate'], row['lio_ate'],
+                    ' (+%.0f %% allowed)' % (100 * a.livo_tolerance) if a.livo_tolerance else ''))
+            if 'livo' in ok and a.livo_tolerance and row.get('judged') == 'LIVO' and not row['livo_ate'] <= 0.7 * row['lio_ate']:
+                failures.append('%s: LIVO ATE %.4f m not 30 %% below the degenerate LIO\'s %.4f m' % (
+                    tag, row['livo_ate'], row['lio_ate']))
             if 'loop' in ok:
                 loops_json = os.path.join(base, 'loop', 'loops.json')
                 if not ok['loop'] or not os.path.exists(loops_json):

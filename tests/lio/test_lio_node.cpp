@@ -312,17 +312,22 @@ TEST(LioNode, CorruptedImuSamplesChangeNothing) {
 namespace {
 // The synthetic run with 20 Hz image times on CAMERA (tiny grey images: lio reads only the time).
 constexpr int64_t kBase = 1'000'000'000;
-std::vector<Message> withImages(std::vector<Message> msgs, int64_t* first_image, int64_t* last_image) {
+/// A 2x2 grey image: lio reads only its stamp.
+Message tinyImage(int64_t utime) {
   image_t img;
+  img.utime = utime;
   img.frame = "C";
   img.width = img.height = img.row_stride = 2;
   img.encoding = image_t::ENCODING_GRAY8;
   img.data = {10, 20, 30, 40};
   img.size = 4;
+  return encode(utime, "CAMERA", img);
+}
+
+std::vector<Message> withImages(std::vector<Message> msgs, int64_t* first_image, int64_t* last_image) {
   *first_image = kBase + 25'000;
   for (int64_t t = *first_image; t < kBase + 2'950'000; t += 50'000) {
-    img.utime = t;
-    msgs.push_back(encode(t, "CAMERA", img));
+    msgs.push_back(tinyImage(t));
     *last_image = t;
   }
   std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
@@ -507,17 +512,9 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
 // The old order (the image first, as soon as the IMU passed it) refused the sweep at the same time.
 TEST(LioNode, ImagesAtTheSweepEndsCostNoSweep) {
   const synth::SyntheticSequence seq = syntheticSequence();
-  image_t img;
-  img.frame = "C";
-  img.width = img.height = img.row_stride = 2;
-  img.encoding = image_t::ENCODING_GRAY8;
-  img.data = {10, 20, 30, 40};
-  img.size = 4;
   std::vector<Message> in;
-  for (int k = 0; k < seq.numScans(); ++k) {
-    img.utime = seq.scanEndUtime(k);
-    in.push_back(encode(img.utime, "CAMERA", img));  // before the sweep on equal keys (stable sort)
-  }
+  for (int k = 0; k < seq.numScans(); ++k)
+    in.push_back(tinyImage(seq.scanEndUtime(k)));  // before the sweep on equal keys (stable sort)
   const std::vector<Message> run = syntheticRun();
   in.insert(in.end(), run.begin(), run.end());
   std::stable_sort(in.begin(), in.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
