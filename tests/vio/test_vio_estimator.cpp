@@ -27,11 +27,12 @@ PoseError poseError(const FilterState& a, const FilterState& b) {
   return {d.head<3>().norm() * 180.0 / M_PI, d.segment<3>(3).norm()};
 }
 
-// Seeds the map at trajectory time t0 with the true pose (scans of the two sweeps before t0).
+// Seeds the map at trajectory time t0 with the true pose (scans of the two sweeps before t0) and a
+// covariance that says so (0.03 deg, 1 mm): the references carry it (UpdateOptions::reference_floor).
 void seed(const livo_test::SimScene& s, VioEstimator* vio, double t0, double sweep = 0.1) {
   vio->addScan(s.utime(t0 - sweep), s.sweep(t0 - 2 * sweep, 1));
   vio->addScan(s.utime(t0), s.sweep(t0 - sweep, 2));
-  const ImageResult r = vio->processImage(s.image(t0, 1), s.trueState(t0), livo_test::priorCovariance(0.01, 0.05));
+  const ImageResult r = vio->processImage(s.image(t0, 1), s.trueState(t0), livo_test::priorCovariance(5e-4, 0.001));
   EXPECT_FALSE(r.valid);  // nothing to align on yet
   EXPECT_EQ(r.why, "the point-patch map is empty");
   EXPECT_GT(r.new_points, 50);
@@ -192,6 +193,7 @@ TEST(VioEstimator, RejectsAnUpdateThatContradictsThePrior) {
   const livo_test::SimScene s;
   VioOptions o;
   o.photometric.noise_std = 10.0;
+  o.update.reference_floor = 0.0;  // the references as exact (the seed is the truth)
   VioEstimator vio(o, s.camera());
   seed(s, &vio, 6.0);
   const FilterState truth = s.trueState(6.05);
@@ -320,4 +322,67 @@ TEST(VioEstimator, CalibrationFloorLiesAcrossTheBaselines) {
   }
   EXPECT_LT((M - F).norm(), 0.02 * F.norm());
   EXPECT_TRUE(calibrationFloor({}, c, sigma).isZero());
+}
+
+TEST(VioEstimator, ReferencesCarryThePoseCovarianceTheyWereCutAt) {
+  // every observation keeps the pose covariance of the image it was cut in (rotation turned into
+  // the world frame); an image's reference floor is their mean, rotation back in its body frame
+  const livo_test::SimScene s;
+  VioEstimator vio(VioOptions{}, s.camera());
+  const double t0 = 6.0;
+  vio.addScan(s.utime(t0 - 0.1), s.sweep(t0 - 0.2, 1));
+  vio.addScan(s.utime(t0), s.sweep(t0 - 0.1, 2));
+  Mat18 P_seed = livo_test::priorCovariance(0.004, 0.02);
+  P_seed(0, 0) = 0.002 * 0.002;  // anisotropic, to see the rotation's frame
+  P_seed(3, 4) = P_seed(4, 3) = 1e-4;
+  const FilterState x0 = s.trueState(t0);
+  vio.processImage(s.image(t0, 1), x0, P_seed);
+  ASSERT_GT(vio.map().size(), 50u);
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = x0.rot;
+  const Mat6 expected_W = J * P_seed.topLeftCorner<6, 6>() * J.transpose();
+  const Mat6 stored = vio.map().point(0).observations[0].pose_cov_W.cast<double>();
+  EXPECT_LT((stored - expected_W).norm(), 1e-6 * expected_W.norm());
+
+  std::vector<TrackedPatch> patches(2);
+  patches[0].reference_cov_W = expected_W;
+  patches[1].reference_cov_W = Mat6::Identity() * 1e-4;
+  const Mat3 R = so3::Exp(Vec3(0.3, -0.2, 1.1));
+  const Mat6 F = referenceFloor(patches, R);
+  Mat6 Jb = Mat6::Identity();
+  Jb.topLeftCorner<3, 3>() = R.transpose();
+  EXPECT_LT((F - 0.5 * Jb * (expected_W + Mat6::Identity() * 1e-4) * Jb.transpose()).norm(), 1e-12);
+  // at the seed's own attitude the floor is the seed's pose covariance
+  EXPECT_LT((referenceFloor({patches[0]}, x0.rot) - P_seed.topLeftCorner<6, 6>()).norm(), 1e-6 * expected_W.norm());
+  EXPECT_TRUE(referenceFloor({}, R).isZero());
+}
+
+TEST(VioEstimator, AnImageMeasuresThePoseOnlyAsWellAsItsReferencesWereKnown) {
+  // the same rendered images and prior (3 cm, 0.5 deg off, 5 cm / 1 deg 1-sigma); the map seeded at
+  // the true pose, once with a covariance of 1 mm / 0.03 deg, once claiming the prior's own 5 cm /
+  // 1 deg. With references that uncertain the image is a pose measurement no better than the prior:
+  // the posterior goes about halfway; with exact references it goes nearly all the way.
+  const livo_test::SimScene s;
+  const double t0 = 6.0, t1 = 6.05;
+  const FilterState truth = s.trueState(t1);
+  Vec18 offset = Vec18::Zero();
+  offset.head<3>() = Vec3(0.3, -0.25, 0.2).normalized() * (0.5 * M_PI / 180.0);
+  offset.segment<3>(3) = Vec3(0.02, -0.015, 0.015).normalized() * 0.03;
+  const FilterState prior = truth.boxplus(offset);
+  const Mat18 P = livo_test::priorCovariance(1.0 * M_PI / 180.0, 0.05);
+  double remaining[2];
+  for (int k = 0; k < 2; ++k) {
+    VioEstimator vio(VioOptions{}, s.camera());
+    vio.addScan(s.utime(t0 - 0.1), s.sweep(t0 - 0.2, 1));
+    vio.addScan(s.utime(t0), s.sweep(t0 - 0.1, 2));
+    vio.processImage(s.image(t0, 1), s.trueState(t0), k == 0 ? livo_test::priorCovariance(5e-4, 0.001) : P);
+    const ImageResult r = vio.processImage(s.image(t1, 2), prior, P);
+    ASSERT_TRUE(r.valid) << r.why;
+    remaining[k] = poseError(r.state, truth).pos_m / poseError(prior, truth).pos_m;
+  }
+  std::printf("position error left: %.2f with exact references, %.2f with references as uncertain as the prior\n",
+              remaining[0], remaining[1]);
+  EXPECT_LT(remaining[0], 0.1);
+  EXPECT_GT(remaining[1], 0.35);
+  EXPECT_LT(remaining[1], 0.65);
 }

@@ -48,6 +48,15 @@ Mat3 calibrationFloor(const std::vector<TrackedPatch>& patches, const Vec3& c_W,
   return rotation_std * rotation_std * B / static_cast<double>(patches.size());
 }
 
+Mat6 referenceFloor(const std::vector<TrackedPatch>& patches, const Mat3& R_W_I) {
+  Mat6 F = Mat6::Zero();
+  if (patches.empty()) return F;
+  for (const TrackedPatch& t : patches) F += t.reference_cov_W;
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = R_W_I.transpose();
+  return J * (F / static_cast<double>(patches.size())) * J.transpose();
+}
+
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& po,
                                 const UpdateOptions& uo, std::vector<TrackedPatch>* patches_io,
@@ -80,11 +89,13 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     c_info_prior = cov.inverse();
   }
   // the image's position measurement cannot beat what the camera's calibration allows
-  const bool floored = uo.calibration_rotation_std_deg > 0.0 && !patches.empty();
+  // and than what the references' own poses allow
+  const bool floored = (uo.calibration_rotation_std_deg > 0.0 || uo.reference_floor > 0.0) && !patches.empty();
   Mat6 pose_floor = Mat6::Zero();
-  if (floored)
+  if (uo.calibration_rotation_std_deg > 0.0)
     pose_floor.bottomRightCorner<3, 3>() = calibrationFloor(patches, (prior.pose() * T_I_C).translation(),
                                                             uo.calibration_rotation_std_deg * M_PI / 180.0);
+  if (uo.reference_floor > 0.0) pose_floor += uo.reference_floor * referenceFloor(patches, prior.rot);
   // once the filter knows the gyro bias, the image considers it instead of updating it
   // (UpdateOptions::gyro_bias_std_to_update): a Schmidt step that leaves it at the prior
   const bool consider_gyro_bias =
@@ -99,6 +110,52 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   // the state at the image's true time (stamp + δt)
   auto stateAt = [&](const FilterState& xi, const CalibrationVector& f) {
     return calib ? advanced(xi, calib->omega_I, calib->time_offset + f[6]) : xi;
+  };
+  // one Gauss-Newton step at `level` from the iterate x (the floors applied if `with_floor`)
+  enum class Step { kStepped, kConverged, kTooFew, kDiverged };
+  auto gaussNewtonStep = [&](int level, bool with_floor) {
+    PoseInformation info;
+    CalibrationInformation ci;
+    const FilterState xs = stateAt(x, c);
+    Vec6 motion = Vec6::Zero();
+    if (calib) motion << calib->omega_I, xs.vel;
+    const int used = measure(patches, active, level, pyramid, camera, cameraAt(c), xs, po, shutter, &info, motion,
+                             calib ? &ci : nullptr);
+    if (used < uo.min_patches) return Step::kTooFew;
+    Vec18 delta;
+    Mat6 S = info.HtRinvH;
+    Vec6 g = info.HtRinvz;
+    S_xx = S;
+    CalibrationVector r_c = CalibrationVector::Zero();
+    if (calib) {
+      const CalibrationMatrix mask = free.asDiagonal();
+      A = mask * (ci.S_cc + c_info_prior) * mask + (CalibrationMatrix::Identity() - mask);
+      r_c = mask * (ci.g_c + c_info_prior * c);
+      S_xc = ci.S_xc * mask;
+      const Eigen::LDLT<CalibrationMatrix> Ainv(A);
+      S -= S_xc * Ainv.solve(S_xc.transpose());
+      g -= S_xc * Ainv.solve(r_c);
+    }
+    if (with_floor) applyPoseMeasurementFloor(pose_floor, &S, &g);
+    informationStep(x, prior, P_prior, S, g, &delta, &P, estimated);
+    S_last = S;
+    x_lin = x;
+    if (!delta.allFinite() || !P.allFinite()) {
+      res.why = "update diverged (non-finite step)";
+      return Step::kDiverged;
+    }
+    x = x.boxplus(delta);
+    if (calib) c -= A.ldlt().solve(r_c + S_xc.transpose() * delta.head<6>());
+    ++res.iterations;
+    if (level == 0) {
+      stepped_at_finest = true;
+      res.num_measurements = info.count;
+      res.patches = used;
+    }
+    return delta.segment<3>(FilterState::kRot).norm() < uo.convergence_rot &&
+                   delta.segment<3>(FilterState::kPos).norm() < uo.convergence_pos
+               ? Step::kConverged
+               : Step::kStepped;
   };
   for (int level = pyramid.levels() - 1; level >= 0; --level) {
     // the measurement of this level: patches that project (and, once a coarser level has aligned
@@ -117,53 +174,28 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
       return res;
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
-      PoseInformation info;
-      CalibrationInformation ci;
-      const FilterState xs = stateAt(x, c);
-      Vec6 motion = Vec6::Zero();
-      if (calib) motion << calib->omega_I, xs.vel;
-      const int used = measure(patches, active, level, pyramid, camera, cameraAt(c), xs, po, shutter, &info, motion,
-                               calib ? &ci : nullptr);
-      if (used < uo.min_patches) break;
-      Vec18 delta;
-      Mat6 S = info.HtRinvH;
-      Vec6 g = info.HtRinvz;
-      S_xx = S;
-      CalibrationVector r_c = CalibrationVector::Zero();
-      if (calib) {
-        const CalibrationMatrix mask = free.asDiagonal();
-        A = mask * (ci.S_cc + c_info_prior) * mask + (CalibrationMatrix::Identity() - mask);
-        r_c = mask * (ci.g_c + c_info_prior * c);
-        S_xc = ci.S_xc * mask;
-        const Eigen::LDLT<CalibrationMatrix> Ainv(A);
-        S -= S_xc * Ainv.solve(S_xc.transpose());
-        g -= S_xc * Ainv.solve(r_c);
-      }
-      if (floored) applyPoseMeasurementFloor(pose_floor, &S, &g);
-      informationStep(x, prior, P_prior, S, g, &delta, &P, estimated);
-      S_last = S;
-      x_lin = x;
-      if (!delta.allFinite() || !P.allFinite()) {
-        res.why = "update diverged (non-finite step)";
-        return res;
-      }
-      x = x.boxplus(delta);
-      if (calib) c -= A.ldlt().solve(r_c + S_xc.transpose() * delta.head<6>());
-      ++res.iterations;
-      if (level == 0) {
-        stepped_at_finest = true;
-        res.num_measurements = info.count;
-        res.patches = used;
-      }
-      if (delta.segment<3>(FilterState::kRot).norm() < uo.convergence_rot &&
-          delta.segment<3>(FilterState::kPos).norm() < uo.convergence_pos)
-        break;
+      const Step st = gaussNewtonStep(level, false);
+      if (st == Step::kTooFew) break;
+      if (st == Step::kDiverged) return res;
+      if (st == Step::kConverged) break;
     }
   }
   if (!stepped_at_finest) {
     res.why = "too few patches project at full resolution";
     return res;
   }
+  // the floors: the alignment above found where the image puts the pose; its measurement of the
+  // pose, though, is only as good as the calibration and the references' poses allow, so the
+  // fusion with the prior is one more step from there with the floored information
+  if (floored) {
+    const Step st = gaussNewtonStep(0, true);
+    if (st == Step::kDiverged) return res;
+    if (st == Step::kTooFew) {
+      res.why = "too few patches project at the aligned pose";
+      return res;
+    }
+  }
+
 
   // photometric quality at the posterior (for map maintenance) and the cost test
   double cost_prior = 0.0, cost_post = 0.0;

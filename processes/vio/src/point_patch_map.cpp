@@ -84,9 +84,15 @@ void PointPatchMap::prune(const Vec3& centre) {
 }
 
 void PointPatchMap::transform(const Pose3& T) {
+  Eigen::Matrix<float, 6, 6> J = Eigen::Matrix<float, 6, 6>::Zero();  // both blocks in the world frame
+  J.topLeftCorner<3, 3>() = T.linear().cast<float>();
+  J.bottomRightCorner<3, 3>() = T.linear().cast<float>();
   for (auto& m : points_) {
     m.position = T * m.position;
-    for (auto& o : m.observations) o.T_W_C = T * o.T_W_C;
+    for (auto& o : m.observations) {
+      o.T_W_C = T * o.T_W_C;
+      o.pose_cov_W = J * o.pose_cov_W * J.transpose();
+    }
   }
   // two points may now share a voxel: both stay, the older one is indexed
   reindex();

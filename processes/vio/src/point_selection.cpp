@@ -169,6 +169,7 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     t.p_W = m.position;
     t.gradient = c.gradient;
     t.reference_centre = obs.T_W_C.translation();
+    t.reference_cov_W = obs.pose_cov_W.cast<double>();
     t.gain0 = exposure_time > 0.0f && obs.exposure_time > 0.0f ? exposure_time / obs.exposure_time : 1.0f;
     bool ok = true;
     for (int l = 0; l < levels && ok; ++l)

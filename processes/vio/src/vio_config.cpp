@@ -69,6 +69,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
   up.readOptional("calibration_rotation_std_deg", o.update.calibration_rotation_std_deg);
+  up.readOptional("reference_floor", o.update.reference_floor);
   up.readOptional("gyro_bias_std_to_update", o.update.gyro_bias_std_to_update);
   if (up.has("covariance")) {
     const std::string c = up.get<std::string>("covariance");

@@ -152,13 +152,14 @@ void VioEstimator::fillDepth(const Pose3& T_W_C) {
 }
 
 bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
-                                   PatchObservation* obs) const {
+                                   const Mat6& pose_cov_W, PatchObservation* obs) const {
   const int levels = pyramid_.levels();
   obs->pixels.resize(static_cast<size_t>(levels) * kStoredArea);
   if (!extractStoredPatches(pyramid_, pixel, levels, obs->pixels.data())) return false;
   const int gl = std::min(1, levels - 1);
   obs->utime = image.utime;
   obs->T_W_C = T_W_C;
+  obs->pose_cov_W = pose_cov_W.cast<float>();
   obs->exposure_time = image.exposure_time;
   obs->gradient = patchGradient(pyramid_, gl, ImagePyramid::toLevel(pixel, gl));
   obs->error = 0.0f;
@@ -242,6 +243,11 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
   ShutterProjection sp;
   auto seen = [&](const Vec3& p_W) { return projectThroughShutter(camera_, T_I_C_, x, shutter, p_W, &sp, border); };
   auto rowCamera = [&](double dt) { return dt == 0.0 ? T_W_C : cameraPoseAt(x, shutter, dt, T_I_C_); };
+  // the pose covariance the references cut now carry, rotation in the world frame
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = x.rot;
+  const Mat6 P_pose = r->covariance.topLeftCorner<6, 6>();
+  const Mat6 pose_cov_W = J * (0.5 * (P_pose + P_pose.transpose())) * J.transpose();
   auto cellOf = [&](const Eigen::Vector2d& px) {
     return static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell);
   };
@@ -270,7 +276,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
     ratio = std::max(ratio, 1.0 / ratio);
     if (min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || t.rms > mo.refresh_error) {
       PatchObservation obs;
-      if (makeObservation(px, image, rowCamera(sp.dt), &obs)) {
+      if (makeObservation(px, image, rowCamera(sp.dt), pose_cov_W, &obs)) {
         map_.addObservation(t.point, std::move(obs));
         ++r->new_patches;
       }
@@ -318,7 +324,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
       continue;
     }
     PatchObservation obs;
-    if (!makeObservation(b.px, image, rowCamera(b.dt), &obs)) continue;
+    if (!makeObservation(b.px, image, rowCamera(b.dt), pose_cov_W, &obs)) continue;
     if (map_.add(b.p, image.utime, std::move(obs)) >= 0) ++r->new_points;
   }
 }

@@ -39,6 +39,7 @@ void validate(const VioOptions& o) {
   require(o.update.max_step_pos > 0.0 && o.update.max_step_rot_deg > 0.0, "update: step bounds must be > 0");
   require(o.update.calibration_rotation_std_deg >= 0.0 && o.update.calibration_rotation_std_deg <= 10.0,
           "update.calibration_rotation_std_deg must be in [0, 10]");
+  require(o.update.reference_floor >= 0.0, "update.reference_floor must be >= 0");
   require(o.update.gyro_bias_std_to_update >= 0.0, "update.gyro_bias_std_to_update must be >= 0");
   require(o.calibration.camera_rotation_std_deg >= 0.0 && o.calibration.camera_rotation_std_deg <= 10.0,
           "calibration.camera_rotation_std_deg must be in [0, 10]");

@@ -49,6 +49,11 @@ struct CalibrationPrior {
 /// patches. Nothing along the baselines (a corridor's axis keeps its information).
 Mat3 calibrationFloor(const std::vector<TrackedPatch>& patches, const Vec3& c_W, double rotation_std);
 
+/// The reference floor of an image at body attitude R_W_I: the mean of its patches' reference pose
+/// covariances (UpdateOptions::reference_floor), the rotation block turned into the body frame of
+/// the pose error [δθ δp] (right perturbation of R_W_I).
+Mat6 referenceFloor(const std::vector<TrackedPatch>& patches, const Mat3& R_W_I);
+
 /// Runs the update; fills each patch's active / ncc / rms (level 0, at the posterior).
 DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, const ImagePyramid& pyramid,
                                 const CameraProjection& camera, const Pose3& T_I_C, const PhotometricOptions& photometric,

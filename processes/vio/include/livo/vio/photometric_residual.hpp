@@ -33,6 +33,7 @@ struct TrackedPatch {
   float gain0 = 1.0f;         // expected gain: exposure ratio current / reference, 1 if unknown
   float gradient = 0.0f;      // texture strength of the reference
   Vec3 reference_centre = Vec3::Zero();  // W: the camera centre the reference was captured from
+  Mat6 reference_cov_W = Mat6::Zero();   // its pose covariance [rotation (world frame), position]
   std::array<float, kPatchArea * kMaxLevels> reference{};  // per level, row-major 8x8
   // filled by the update (level 0, at the posterior)
   bool active = false;

@@ -20,6 +20,8 @@ uint64_t voxelKey(const Vec3& p, double inv_voxel_size);
 struct PatchObservation {
   int64_t utime = 0;               // image time (IMU clock)
   Pose3 T_W_C = Pose3::Identity(); // camera pose it was seen from
+  // covariance of that pose's error [rotation (world frame), position] as the filter had it
+  Eigen::Matrix<float, 6, 6> pose_cov_W = Eigen::Matrix<float, 6, 6>::Zero();
   float exposure_time = 0.0f;      // s, 0 if unknown
   float gradient = 0.0f;           // texture strength at capture (patchGradient, level 1)
   float error = 0.0f;              // residual RMS (grey levels) when last used as the reference

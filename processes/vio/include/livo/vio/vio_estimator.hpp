@@ -101,7 +101,7 @@ class VioEstimator {
   void fillDepth(const Pose3& T_W_C);
   void maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh, const std::vector<TrackedPatch>& tracked,
                 ImageResult* result);
-  bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
+  bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C, const Mat6& pose_cov_W,
                        PatchObservation* obs) const;
 
   VioOptions options_;

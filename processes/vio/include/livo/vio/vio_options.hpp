@@ -74,6 +74,11 @@ struct UpdateOptions {
   // not average it away: an image's position measurement gets the floor
   // σ² mean_i([b_i]× [b_i]×ᵀ) over its patches (calibrationFloor, livo::applyPoseMeasurementFloor)
   double calibration_rotation_std_deg = 0.3;
+  // Scale of the reference floor: a reference patch was cut at the pose the filter had then, so
+  // the image measures the current pose only as well as its references' poses were known. Each
+  // observation keeps that pose covariance; an image's pose measurement gets the floor
+  // scale × mean_i(P_ref,i) over its patches (referenceFloor). 0: the references are taken as exact.
+  double reference_floor = 1.0;
   // rad/s: an image updates the gyro bias only while the prior's 1-sigma on it (largest axis) is
   // above this, i.e. while the filter is still finding it. The camera's rotation against the
   // LiDAR-registered body is known to a few tenths of a degree, and that offset pulls every image's
