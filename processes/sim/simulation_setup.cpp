@@ -73,7 +73,7 @@ void readCalibrationErrors(const Config& c, const SensorRig& rig, CalibrationErr
   c.checkAllUsed();
 }
 
-// The sim.imu keys of the IMU error model (refused for recorded IMU streams).
+// The sim.imu keys of the IMU error model.
 const std::vector<std::string> kImuErrorKeys = {"gyro_scale_ppm",     "accel_scale_ppm",  "gyro_misalignment_mrad",
                                                 "accel_misalignment_mrad", "gyro_g_sensitivity", "gyro_bias_per_c",
                                                 "accel_bias_per_c",   "temperature"};
@@ -98,11 +98,16 @@ void readImuErrors(const Config& imu, bool sigma, ImuErrors* e) {
   temp.checkAllUsed();
 }
 
-void refuseImuErrorsOnARecording(const Config& imu) {
-  for (const std::string& key : kImuErrorKeys)
+/// A replayed IMU stream is published as recorded: nothing of the IMU model (initial biases, error
+/// model) applies to it.
+void refuseImuModelOnARealImu(const Config& imu) {
+  std::vector<std::string> keys = kImuErrorKeys;
+  keys.insert(keys.end(), {"initial_gyro_bias", "initial_accel_bias"});
+  for (const std::string& key : keys)
     if (imu.has(key))
       throw ConfigError(imu.where(key) + ": a recorded trajectory publishes its real IMU samples unchanged; "
-                        "the IMU error model cannot be applied to them (remove the key)");
+                        "the IMU model cannot be applied to them (remove the key, or drop sim.trajectory.imu to "
+                        "synthesise the IMU from the recorded motion)");
 }
 
 /// The errors of this run: as configured, or drawn from the seed with the configured 1-sigmas.
@@ -303,14 +308,21 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   s.recorded_imu = std::move(traj.recorded_imu);
 
   if (s.recorded) {
-    refuseImuErrorsOnARecording(sim.optionalSection("imu"));
+    if (s.replaysRecordedImu()) refuseImuModelOnARealImu(sim.optionalSection("imu"));
     if (sim.has("start_time_s"))
       throw ConfigError(sim.where("start_time_s") + ": a recorded trajectory takes its start time from the recording");
-    // the span covered by both the ground truth and the IMU
+    // the span covered by the ground truth (and the IMU, when it is replayed), less the start offset
     const double gt0 = traj.recorded_start_stamp, gt1 = gt0 + s.trajectory->duration();
-    const double imu0 = s.recorded_imu.front().stamp_ns * 1e-9, imu1 = s.recorded_imu.back().stamp_ns * 1e-9;
-    const double t0 = std::max(gt0, imu0), t1 = std::min(gt1, imu1);
-    if (!(t1 > t0)) throw ConfigError(sim.where("trajectory") + ": the ground truth and the IMU do not overlap in time");
+    double t0 = gt0, t1 = gt1;
+    if (s.replaysRecordedImu()) {
+      t0 = std::max(gt0, s.recorded_imu.front().stamp_ns * 1e-9);
+      t1 = std::min(gt1, s.recorded_imu.back().stamp_ns * 1e-9);
+      if (!(t1 > t0)) throw ConfigError(sim.where("trajectory") + ": the ground truth and the IMU do not overlap in time");
+    }
+    t0 += traj.recorded_start_offset_s;
+    if (!(t1 > t0))
+      throw ConfigError(sim.section("trajectory").where("start_offset_s") + ": starts at or after the end of the recording (" +
+                        number(t1 - t0 + traj.recorded_start_offset_s) + " s available)");
     s.start_utime = static_cast<int64_t>(std::ceil(t0 * 1e6));
     s.trajectory_time_offset = static_cast<double>(s.start_utime) * 1e-6 - gt0;
     const double available = std::floor((t1 * 1e6 - static_cast<double>(s.start_utime))) * 1e-6;
@@ -370,7 +382,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
   if (s.scene->moverCount() > 0) os << ", " << s.scene->moverCount() << " moving objects";
   os << "\n";
   os << "  trajectory: " << s.trajectory_description << "\n";
-  if (s.recorded) os << "  IMU: the recording's own samples, unchanged\n";
+  if (s.replaysRecordedImu()) os << "  IMU: the recording's own samples, unchanged\n";
   else
     os << "  IMU initial bias: gyro [" << o.initial_gyro_bias.transpose() << "] rad/s, accel ["
        << o.initial_accel_bias.transpose() << "] m/s^2\n";

@@ -63,11 +63,13 @@ struct SimulationSetup {
   int64_t start_utime = 0;
   double trajectory_time_offset = 0.0;  // trajectory time at start_utime
   bool recorded = false;                // re-simulation along a recording:
-  std::vector<ImuSample> recorded_imu;  //   its real IMU stream, published untouched
+  std::vector<ImuSample> recorded_imu;  //   its real IMU stream, published untouched (none: synthesised)
   // The truth of this run (drawn from the seed when calibration_errors.draw is on): never in `rig`.
   CalibrationErrors calibration_errors;
   ImuErrors imu_errors;
 
+  /// The recording's real IMU samples are published instead of samples synthesised from the motion.
+  bool replaysRecordedImu() const { return !recorded_imu.empty(); }
   /// BodyTrajectory time of a stamp.
   double trajectoryTime(int64_t utime) const {
     return static_cast<double>(utime - start_utime) * 1e-6 + trajectory_time_offset;

@@ -100,7 +100,7 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
 
   int64_t imu_k = 0, gt_k = 0, wheel_k = 0, sweep_k = 0, frame_k = 0;
   size_t recorded_k = 0;
-  if (s.recorded) {
+  if (s.replaysRecordedImu()) {
     while (recorded_k < s.recorded_imu.size() && s.recorded_imu[recorded_k].stamp_ns < start * 1000) ++recorded_k;
   }
 
@@ -114,8 +114,8 @@ SimulationStats Simulator::run(SensorDataSink& sink, const Progress& progress) {
     std::vector<Pending> pending;
     std::vector<std::function<void()>> jobs;
 
-    // IMU: the recording's own samples, or exact readings plus noise
-    if (s.recorded) {
+    // IMU: the recording's own samples, or exact readings of the motion through the IMU model
+    if (s.replaysRecordedImu()) {
       for (; recorded_k < s.recorded_imu.size(); ++recorded_k) {
         const ImuSample& r = s.recorded_imu[recorded_k];
         const int64_t u = (r.stamp_ns + 500) / 1000;

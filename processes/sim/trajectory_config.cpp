@@ -35,24 +35,48 @@ double positive(const Config& c, const std::string& key, double value) {
 TrajectoryConfig readRecorded(const Config& c, const std::string& base_dir) {
   TrajectoryConfig out;
   const std::string gt_path = resolve(base_dir, c.get<std::string>("ground_truth"));
-  const std::string imu_path = resolve(base_dir, c.get<std::string>("imu"));
+  std::string imu_path;
+  if (c.readOptional("imu", imu_path)) imu_path = resolve(base_dir, imu_path);
+  RecordedMotionOptions motion;
+  c.readOptional("smoothing_s", motion.smoothing_s);
+  c.readOptional("placement", motion.placement);
+  c.readOptional("body_in_recorded", motion.body_in_recorded);
+  c.readOptional("start_offset_s", out.recorded_start_offset_s);
+  if (!(motion.smoothing_s >= 0.0)) throw ConfigError(c.where("smoothing_s") + ": must be >= 0");
+  if (!(out.recorded_start_offset_s >= 0.0)) throw ConfigError(c.where("start_offset_s") + ": must be >= 0");
   livo::Trajectory poses;
   try {
     poses = livo::readTrajectory(gt_path);
-    out.recorded_imu = readAslImuCsv(imu_path);
   } catch (const std::exception& e) {
     throw ConfigError(c.where("ground_truth") + ": " + e.what());
   }
+  if (!imu_path.empty()) {
+    try {
+      out.recorded_imu = readAslImuCsv(imu_path);
+    } catch (const std::exception& e) {
+      throw ConfigError(c.where("imu") + ": " + e.what());
+    }
+    if (out.recorded_imu.empty()) throw ConfigError(c.where("imu") + ": " + imu_path + " holds no samples");
+  }
   if (poses.size() < 4) throw ConfigError(c.where("ground_truth") + ": " + gt_path + " holds fewer than 4 poses");
-  if (out.recorded_imu.empty()) throw ConfigError(c.where("imu") + ": " + imu_path + " holds no samples");
+  // interpolation needs increasing stamps; a least-squares fit takes repeated ones
+  const bool smoothing = motion.smoothing_s > 0.0;
   for (size_t i = 1; i < poses.size(); ++i)
-    if (!(poses[i].stamp > poses[i - 1].stamp))
-      throw ConfigError(c.where("ground_truth") + ": " + gt_path + ": stamps do not increase at pose " + std::to_string(i));
-  auto rec = std::make_unique<RecordedTrajectory>(poses);
+    if (poses[i].stamp < poses[i - 1].stamp || (!smoothing && poses[i].stamp == poses[i - 1].stamp))
+      throw ConfigError(c.where("ground_truth") + ": " + gt_path + ": stamps do not increase at pose " + std::to_string(i) +
+                        (smoothing ? "" : " (smoothing_s > 0 accepts repeated stamps)"));
+  if (smoothing && !(motion.smoothing_s < poses.back().stamp - poses.front().stamp))
+    throw ConfigError(c.where("smoothing_s") + ": must be shorter than the recording");
+  auto rec = std::make_unique<RecordedTrajectory>(poses, motion);
   out.recorded_start_stamp = rec->startStamp();
   std::ostringstream os;
-  os << "recorded: " << poses.size() << " poses from " << gt_path << " (" << rec->duration() << " s), "
-     << out.recorded_imu.size() << " IMU samples from " << imu_path;
+  os << "recorded: " << poses.size() << " poses from " << gt_path << " (" << rec->duration() << " s), ";
+  if (smoothing) os << "least-squares cubic B-spline, knots every " << motion.smoothing_s << " s";
+  else os << "natural cubic splines through the poses";
+  if (!motion.placement.matrix().isIdentity(0.0) || !motion.body_in_recorded.matrix().isIdentity(0.0))
+    os << ", T_W_I = placement * T_recorded * body_in_recorded";
+  if (out.recorded_imu.empty()) os << "; IMU synthesised from the motion";
+  else os << "; " << out.recorded_imu.size() << " IMU samples from " << imu_path;
   out.description = os.str();
   out.trajectory = std::move(rec);
   out.recorded = true;

@@ -241,6 +241,42 @@ TEST(ImuErrors, SimulatorPublishesTheErroneousReadings) {
   }
 }
 
+// The IMU model applies to a recording only when its IMU is synthesised from the motion: with a
+// replayed real IMU every sim.imu key is refused, without one they reach the readings.
+TEST(ImuErrors, ApplyToARecordingOnlyWhenItsImuIsSynthesised) {
+  const std::string euroc = std::string(LIVO_SHARED_DATA) + "/euroc_v1_01";
+  const std::string replayed = test::noiseFreeImuRig() + "sim:\n" + test::boxRoomScene() +
+                               "  trajectory: {type: recorded, ground_truth: " + euroc + "/groundtruth.tum, imu: " + euroc +
+                               "/mav0/imu0/data.csv}\n";
+  for (const std::string key : {"gyro_scale_ppm: [100, 0, 0]", "accel_misalignment_mrad: [1, 0, 0]", "initial_gyro_bias: [0.01, 0, 0]",
+                                "temperature: {start_c: 20}"}) {
+    SCOPED_TRACE(key);
+    EXPECT_NE(configError(replayed + "  imu: {" + key + "}\n").find("a recorded trajectory publishes its real IMU samples unchanged"),
+              std::string::npos);
+  }
+
+  const std::string synthesised = test::noiseFreeImuRig() + "sim:\n  duration_s: 0.3\n" + test::boxRoomScene() +
+                                  "  trajectory: {type: recorded, ground_truth: " + std::string(LIVO_SHARED_DATA) +
+                                  "/trajectories/fr2_desk_groundtruth.txt, smoothing_s: 0.1, start_offset_s: 60}\n"
+                                  "  imu: {initial_gyro_bias: [0.01, -0.02, 0.03], initial_accel_bias: [0.1, 0.2, -0.3],\n"
+                                  "        gyro_scale_ppm: [1000, -2000, 3000], accel_misalignment_mrad: [-4, 5, -6],\n"
+                                  "        gyro_g_sensitivity: [1e-4, -2e-4, 3e-4]}\n";
+  const SimulationSetup s = load(synthesised);
+  ASSERT_FALSE(s.replaysRecordedImu());
+  EXPECT_EQ(s.imu_errors.gyro_scale_ppm, Vec3(1000, -2000, 3000));
+  const auto got = simulate(s);
+  ASSERT_EQ(got.imu.size(), 61u);  // 0.3 s at 200 Hz
+  for (const ImuReading& r : got.imu) {
+    const ImuReading ideal = idealImuReading(s.trajectory->at(s.trajectoryTime(r.utime)), 9.81, r.utime);
+    const Vec3 w = ideal.angular_velocity, f = ideal.linear_acceleration;
+    const Vec3 wm(1.001 * w.x() + 1e-4 * f.x() + 0.01, 0.998 * w.y() - 2e-4 * f.y() - 0.02, 1.003 * w.z() + 3e-4 * f.z() + 0.03);
+    const Vec3 fm(f.x() + 0.1, -0.004 * f.x() + f.y() + 0.2, 0.005 * f.x() - 0.006 * f.y() + f.z() - 0.3);
+    EXPECT_LT((r.angular_velocity - wm).norm(), 1e-12);
+    EXPECT_LT((r.linear_acceleration - fm).norm(), 1e-12);
+    EXPECT_GT(f.norm(), 9.0);  // gravity in the specific force: a real reading, not zeros
+  }
+}
+
 TEST(CalibrationErrors, DrawsDependOnTheSeedOnly) {
   const std::string yaml = movingRig(R"(  calibration_errors:
     draw: true
