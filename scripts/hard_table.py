@@ -30,7 +30,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'loop'))
 import check_loops as cl  # noqa: E402  (LCM log reading, ground truth, interpolation; pure Python)
 
-DEFAULT_CONFIGS = 'room_hard,corridor_hard,campus_loop_hard,campus_loop_long_hard,parking_hard,euroc_v1_01_hard'
+DEFAULT_CONFIGS = ('room_hard,corridor_hard,campus_loop_hard,campus_loop_long_hard,parking_hard,euroc_v1_01_hard,'
+                   'room_fr2_desk_hard')
 
 
 def degenerate_sweeps(outputs):
