@@ -187,6 +187,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   // the floors: the alignment above found where the image puts the pose; its measurement of the
   // pose, though, is only as good as the calibration and the references' poses allow, so the
   // fusion with the prior is one more step from there with the floored information
+  const FilterState x_aligned = x;
+  const CalibrationVector c_aligned = c;
   if (floored) {
     const Step st = gaussNewtonStep(0, true);
     if (st == Step::kDiverged) return res;
@@ -197,22 +199,26 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   }
 
 
-  // photometric quality at the posterior (for map maintenance) and the cost test
+  // photometric quality at the posterior (for map maintenance) and the cost test: the image must
+  // fit better at the pose it aligned to than at the prior (the fusion with floors may then give
+  // some of that back where the prior is surer)
   double cost_prior = 0.0, cost_post = 0.0;
   int n_cost = 0;
+  PatchResidual ep, ea;
   for (size_t i = 0; i < patches.size(); ++i) {
     TrackedPatch& t = patches[i];
     t.active = false;
     if (!active[i]) continue;
-    PatchResidual ep;
     if (!evaluatePatch(pyramid, 0, camera, T_I_C, stateAt(prior, CalibrationVector::Zero()), t, po, &ep, shutter) ||
-        !evaluatePatch(pyramid, 0, camera, cameraAt(c), stateAt(x, c), t, po, &e, shutter))
+        !evaluatePatch(pyramid, 0, camera, cameraAt(c), stateAt(x, c), t, po, &e, shutter) ||
+        (floored && !evaluatePatch(pyramid, 0, camera, cameraAt(c_aligned), stateAt(x_aligned, c_aligned), t, po,
+                                   &ea, shutter)))
       continue;
     t.active = true;
     t.ncc = static_cast<float>(e.ncc);
     t.rms = static_cast<float>(std::sqrt(e.r.squaredNorm() / kPatchArea));
     cost_prior += huberCost(ep, po.huber_threshold);
-    cost_post += huberCost(e, po.huber_threshold);
+    cost_post += huberCost(floored ? ea : e, po.huber_threshold);
     n_cost += kPatchArea;
   }
   if (n_cost > 0) {

@@ -27,7 +27,7 @@ struct DirectUpdateResult {
   int num_measurements = 0;           // scalar residuals of the last step
   int patches = 0;                    // patches of the last step
   double cost_prior = 0.0;            // Huber cost per residual at level 0 over the final patches:
-  double cost_post = 0.0;             //   at the prior and at the posterior
+  double cost_post = 0.0;             //   at the prior and at the aligned pose (the posterior without floors)
   double mahalanobis = 0.0;           // squared, of the pose step against the prior covariance
   CalibrationVector calibration = CalibrationVector::Zero();  // the correction c (when estimated)
   CalibrationMatrix calibration_cov = CalibrationMatrix::Zero(); // its posterior covariance
