@@ -49,6 +49,22 @@ Eigen::Matrix2d CameraProjection::distortJacobian(const Eigen::Vector2d& xy) con
   return J;
 }
 
+Eigen::Vector2d CameraProjection::undistort(const Eigen::Vector2d& distorted) const {
+  Eigen::Vector2d xy = distorted;
+  for (int it = 0; it < 20; ++it) {
+    const Eigen::Vector2d f = distort(xy) - distorted;
+    if (f.squaredNorm() < 1e-24) break;
+    xy -= distortJacobian(xy).inverse() * f;
+  }
+  return xy;
+}
+
+Eigen::Vector3d CameraProjection::pixelRay(const Eigen::Vector2d& pixel) const {
+  const Eigen::Vector2d d((pixel.x() - rig_.cx) / rig_.fx, (pixel.y() - rig_.cy) / rig_.fy);
+  const Eigen::Vector2d xy = undistort(d);
+  return Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
+}
+
 bool CameraProjection::projectWithJacobian(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel,
                                            Eigen::Matrix<double, 2, 3>* J, double border) const {
   if (!project(p_C, pixel, border)) return false;

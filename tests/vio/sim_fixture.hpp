@@ -40,6 +40,13 @@ class SimScene {
   }
 
   const livo::CameraRig& camera() const { return camera_; }
+  /// From now on the images are rendered through the camera mounted with an error,
+  /// T_I_C_true = T_I_C_rig * T_err; camera() stays the rig's (what an estimator believes).
+  void mountCameraWithError(const livo::Pose3& T_err) {
+    livo::CameraRig truth = camera_;
+    truth.T_I_C = camera_.T_I_C * T_err;
+    renderer_ = std::make_unique<livo::sim::CameraRenderer>(truth, setup_.options.camera);
+  }
   const livo::sim::SimulationSetup& setup() const { return setup_; }
   int64_t utime(double t) const { return setup_.start_utime + static_cast<int64_t>(std::llround(t * 1e6)); }
 

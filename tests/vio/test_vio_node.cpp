@@ -202,6 +202,22 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {camera_rotation_std_deg: -1}\n"))),
                ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
+  // the camera rotation from image pairs: off unless asked for, strict, and not beside the
+  // photometric rotation estimate
+  EXPECT_FALSE(d.vio.rotation_calibration.enabled);
+  const VioNodeOptions rc = readVioNodeOptions(Config::fromString(
+      roomConfig("vio:\n  rotation_calibration: {enabled: true, min_baseline: 0.2, window_pairs: 500, apply_std_deg: 0.04}\n")));
+  EXPECT_TRUE(rc.vio.rotation_calibration.enabled);
+  EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.min_baseline, 0.2);
+  EXPECT_EQ(rc.vio.rotation_calibration.window_pairs, 500);
+  EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.apply_std_deg, 0.04);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {min_pairs: 400}\n"))),
+               ConfigError);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig(
+                   "vio:\n  rotation_calibration: {enabled: true}\n  calibration: {camera_rotation_std_deg: 0.3}\n"))),
+               ConfigError);
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {enable: true}\n"))),
+               ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  photometric: {pyramid_levels: 7}\n"))),
                ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  image_buffer_s: -1\n"))), ConfigError);

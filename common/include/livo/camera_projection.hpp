@@ -21,6 +21,10 @@ class CameraProjection {
   Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
   /// d distort(xy) / d xy.
   Eigen::Matrix2d distortJacobian(const Eigen::Vector2d& xy) const;
+  /// The normalised image point xy whose distortion is `distorted` (Newton on distort(xy)).
+  Eigen::Vector2d undistort(const Eigen::Vector2d& distorted) const;
+  /// The unit ray of a pixel, camera frame (the inverse of project() up to scale).
+  Eigen::Vector3d pixelRay(const Eigen::Vector2d& pixel) const;
 
   /// Vignetting gain at a pixel for fall-off v (the simulator's and a common calibration model).
   double vignette(const Eigen::Vector2d& pixel, double v) const;

@@ -100,6 +100,25 @@ void readVio(const Config& c, VioNodeOptions* n) {
   cal.readOptional("time_offset_std", o.calibration.time_offset_std);
   cal.readOptional("time_offset_walk", o.calibration.time_offset_walk);
 
+  const Config rc = c.optionalSection("rotation_calibration");
+  RotationCalibrationOptions& r = o.rotation_calibration;
+  rc.readOptional("enabled", r.enabled);
+  rc.readOptional("max_corners", r.max_corners);
+  rc.readOptional("min_corner_distance_px", r.min_corner_distance_px);
+  rc.readOptional("corner_quality", r.corner_quality);
+  rc.readOptional("klt_window_px", r.klt_window_px);
+  rc.readOptional("klt_levels", r.klt_levels);
+  rc.readOptional("max_track_error_px", r.max_track_error_px);
+  rc.readOptional("min_baseline", r.min_baseline);
+  rc.readOptional("max_pair_time", r.max_pair_time);
+  rc.readOptional("min_tracks", r.min_tracks);
+  rc.readOptional("ransac_threshold_px", r.ransac_threshold_px);
+  rc.readOptional("cauchy_px", r.cauchy_px);
+  rc.readOptional("window_pairs", r.window_pairs);
+  rc.readOptional("min_pairs", r.min_pairs);
+  rc.readOptional("apply_std_deg", r.apply_std_deg);
+  rc.readOptional("reapply_deg", r.reapply_deg);
+
   auto require = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
@@ -170,6 +189,11 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
        << cal.camera_rotation_walk_deg << "), translation " << cal.camera_translation_std << " m ("
        << cal.camera_translation_walk << "), time offset " << cal.time_offset_std << " s (" << cal.time_offset_walk
        << ")\n";
+  const RotationCalibrationOptions& rc = o.rotation_calibration;
+  if (rc.enabled)
+    os << "  camera rotation from image pairs: " << rc.max_corners << " KLT corners, pairs " << rc.min_baseline
+       << " m apart, used once every axis is known to " << rc.apply_std_deg << " deg (" << rc.min_pairs << ".."
+       << rc.window_pairs << " pairs)\n";
   os << std::flush;
 }
 

@@ -72,12 +72,17 @@ VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
   var << Vec3::Constant(rot * rot), Vec3::Constant(cal.camera_translation_std * cal.camera_translation_std),
       cal.time_offset_std * cal.time_offset_std;
   calibration_cov_ = var.asDiagonal();
+  if (options_.rotation_calibration.enabled) rotation_calibration_.emplace(options_.rotation_calibration, camera_, camera.T_I_C);
 }
 
 void VioEstimator::reset() {
   map_.clear();
   scans_.clear();
   last_utime_ = -1;
+  if (rotation_calibration_) rotation_calibration_->reset();
+  T_I_C_ = camera_.rig().T_I_C;
+  adopted_rotation_.setZero();
+  rotation_adopted_ = false;
 }
 
 void VioEstimator::addGyro(int64_t utime, const Vec3& w) {
@@ -133,6 +138,7 @@ size_t VioEstimator::recentScanPoints() const {
 void VioEstimator::applyCorrection(const Pose3& T) {
   map_.transform(T);
   last_utime_ = -1;
+  if (rotation_calibration_) rotation_calibration_->applyCorrection(T);
   for (auto& s : scans_)
     for (auto& p : s.points) p = T * p;
 }
@@ -175,7 +181,22 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   const RollingShutter shutter = shutterAt(image.utime, prior);
   // the state at the image's true time (the estimated offset; the update refines it)
   const Vec3 omega = options_.calibration.time_offset_std > 0.0 ? bodyRateAt(image.utime, prior) : Vec3::Zero();
-  const Pose3 T_W_C = advanced(prior, omega, time_offset_).pose() * T_I_C_;
+  const FilterState at_image = advanced(prior, omega, time_offset_);
+  if (rotation_calibration_ && rotation_calibration_->addImage(image.pixels, image.utime, at_image.pose(), at_image.vel, shutter) &&
+      rotation_calibration_->converged()) {
+    // adopted, or moved far enough from what is in use: the references cut through the old
+    // rotation would pull the pose by it, so the map starts afresh from the recent scans
+    const Vec3 phi = rotation_calibration_->estimate().correction;
+    if (!rotation_adopted_ ||
+        (phi - adopted_rotation_).norm() * 180.0 / M_PI > options_.rotation_calibration.reapply_deg) {
+      T_I_C_ = rotation_calibration_->calibratedExtrinsic();
+      adopted_rotation_ = phi;
+      rotation_adopted_ = true;
+      map_.clear();
+      r.camera_rotation_changed = true;
+    }
+  }
+  const Pose3 T_W_C = at_image.pose() * T_I_C_;
   fillDepth(T_W_C);
   std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, image.utime, image.exposure_time, depth_,
                                                     levels, options_.selection, &r.selection);

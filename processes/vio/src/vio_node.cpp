@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <iomanip>
 #include <sstream>
 
 #include "livo/correction_frames.hpp"
@@ -155,6 +156,7 @@ void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
   const auto t0 = std::chrono::steady_clock::now();
   const ImageResult r = vio_.processImage(image.image, x, P);
   node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (const CameraRotationCalibration* cal = vio_.rotationCalibration()) reportRotationCalibration(*cal, r);
   if (!r.valid) {
     keep(prior, r.why);
     return;
@@ -165,6 +167,21 @@ void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
   if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
   ++counts_.priors;
   ++counts_.updated;
+}
+
+void VioNode::reportRotationCalibration(const CameraRotationCalibration& cal, const ImageResult& r) {
+  // a line when the estimate is adopted, and every 50 image pairs
+  const RotationEstimate& e = cal.estimate();
+  const int closed = cal.pairsClosed();
+  if (!r.camera_rotation_changed && closed < reported_pairs_ + 50 && closed >= reported_pairs_) return;
+  reported_pairs_ = closed;
+  const Vec3 deg = e.correction * 180.0 / M_PI;
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(3) << "camera rotation from the newest " << e.pairs << " of " << closed << " image pairs: the rig's turned by ("
+    << deg.x() << ", " << deg.y() << ", " << deg.z() << ") deg, 1-sigma <= " << e.maxStdDeg() << " deg, Sampson RMS "
+    << std::setprecision(2) << e.rms_px << " px"
+    << (r.camera_rotation_changed ? "; adopted, the point-patch map starts afresh" : "");
+  node_.info(s.str());
 }
 
 void VioNode::keep(const filter_state_t& prior, const std::string& why) {

@@ -50,6 +50,20 @@ void validate(const VioOptions& o) {
   require(o.calibration.time_offset_std >= 0.0 && o.calibration.time_offset_std <= 0.1,
           "calibration.time_offset_std must be in [0, 0.1]");
   require(o.calibration.time_offset_walk >= 0.0, "calibration.time_offset_walk must be >= 0");
+  const RotationCalibrationOptions& rc = o.rotation_calibration;
+  require(!(rc.enabled && o.calibration.camera_rotation_std_deg > 0.0),
+          "rotation_calibration and calibration.camera_rotation_std_deg both estimate the camera rotation: use one");
+  require(rc.max_corners >= 8 && rc.min_tracks >= 8 && rc.min_tracks <= rc.max_corners,
+          "rotation_calibration: need 8 <= min_tracks <= max_corners");
+  require(rc.min_corner_distance_px > 0.0 && rc.corner_quality > 0.0 && rc.corner_quality < 1.0,
+          "rotation_calibration: need min_corner_distance_px > 0 and corner_quality in (0, 1)");
+  require(rc.klt_window_px >= 5 && rc.klt_levels >= 0 && rc.max_track_error_px > 0.0,
+          "rotation_calibration: need klt_window_px >= 5, klt_levels >= 0, max_track_error_px > 0");
+  require(rc.min_baseline > 0.0 && rc.max_pair_time > 0.0, "rotation_calibration: need min_baseline, max_pair_time > 0");
+  require(rc.ransac_threshold_px > 0.0 && rc.cauchy_px > 0.0,
+          "rotation_calibration: need ransac_threshold_px, cauchy_px > 0");
+  require(rc.min_pairs >= 3 && rc.window_pairs >= rc.min_pairs, "rotation_calibration: need 3 <= min_pairs <= window_pairs");
+  require(rc.apply_std_deg > 0.0 && rc.reapply_deg >= 0.0, "rotation_calibration: need apply_std_deg > 0, reapply_deg >= 0");
   require(o.maintenance.new_point_cell_px >= 8, "new_points.cell_px must be >= 8");
   require(o.maintenance.max_new_points >= 0, "new_points.max_per_image must be >= 0");
   require(o.maintenance.refresh_angle_deg > 0.0 && o.maintenance.refresh_distance_ratio >= 1.0,

@@ -15,11 +15,13 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "livo/camera_projection.hpp"
 #include "livo/filter_state.hpp"
+#include "livo/vio/camera_rotation_calibration.hpp"
 #include "livo/vio/direct_update.hpp"
 #include "livo/vio/grey_image.hpp"
 #include "livo/vio/image_pyramid.hpp"
@@ -52,6 +54,8 @@ struct ImageResult {
   int candidates_weak = 0;           //   ... cells whose best candidate had too little texture
   int new_patches = 0;               // observations added to tracked points
   size_t map_points = 0;             // after maintenance
+  bool camera_rotation_changed = false;  // the rotation calibration was adopted before this image's
+                                         // update (the point-patch map started afresh)
 };
 
 class VioEstimator {
@@ -78,6 +82,10 @@ class VioEstimator {
   const PointPatchMap& map() const { return map_; }
   const VioOptions& options() const { return options_; }
   const CameraProjection& camera() const { return camera_; }
+  /// The rotation calibration from image pairs (null unless options.rotation_calibration.enabled).
+  const CameraRotationCalibration* rotationCalibration() const {
+    return rotation_calibration_ ? &*rotation_calibration_ : nullptr;
+  }
   /// The camera extrinsic in use (the rig's, corrected online if calibration is on).
   const Pose3& cameraExtrinsic() const { return T_I_C_; }
   const ImagePyramid& pyramid() const { return pyramid_; }  // of the last image
@@ -115,6 +123,9 @@ class VioEstimator {
   int64_t last_utime_ = -1;      // the last image's time and posterior rotation (body rate)
   Mat3 last_rot_ = Mat3::Identity();
   std::deque<std::pair<int64_t, Vec3>> gyro_;  // recent gyro samples, oldest first
+  std::optional<CameraRotationCalibration> rotation_calibration_;
+  Vec3 adopted_rotation_ = Vec3::Zero();  // the correction T_I_C_ has (rotation_calibration_)
+  bool rotation_adopted_ = false;
   CalibrationMatrix calibration_cov_ = CalibrationMatrix::Zero();  // of the corrections folded into
                                                                     // T_I_C_ and time_offset_
   double time_offset_ = 0.0;     // s: an image stamped t was taken at t + time_offset_ (LIO clock)

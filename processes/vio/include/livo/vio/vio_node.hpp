@@ -65,6 +65,7 @@ class VioNode {
   void resolve();
   void process(const filter_state_t& prior, const BufferedImage& image);
   void keep(const filter_state_t& prior, const std::string& why);
+  void reportRotationCalibration(const CameraRotationCalibration& calibration, const ImageResult& result);
   void trimImages();
   /// Where a pose of (epoch, correction) goes in the map; a newer epoch (a LIO reset) first drops
   /// the map, the waiting priors and the corrections of the old epoch.
@@ -82,6 +83,7 @@ class VioNode {
   MapFrame frame_;  // the map's odometry epoch and loop correction
   std::map<std::string, int64_t> kept_reasons_;
   std::map<std::string, int64_t> last_warned_;  // reason -> sensor time of its last warning
+  int reported_pairs_ = 0;  // image pairs of the rotation calibration at its last progress line
 };
 
 }  // namespace livo::vio

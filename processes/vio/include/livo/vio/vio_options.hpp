@@ -115,6 +115,31 @@ struct CalibrationOptions {
   bool any() const { return camera_rotation_std_deg > 0.0 || camera_translation_std > 0.0 || time_offset_std > 0.0; }
 };
 
+/// The camera's rotation against the body the LIO estimates, from the geometry of image pairs
+/// (camera_rotation_calibration.hpp): corners tracked with KLT between two images the LIO placed a
+/// baseline apart must satisfy the epipolar constraint of the LIO's relative pose seen through
+/// T_I_C. Unlike the photometric residuals, that does not depend on references cut through the
+/// same rotation. Once every axis is known to `apply_std_deg`, the VIO uses the estimated rotation
+/// (and starts its point-patch map afresh, the old references having been cut through the rig's).
+struct RotationCalibrationOptions {
+  bool enabled = false;
+  int max_corners = 150;              // tracked corners (Shi-Tomasi), topped up at every pair
+  double min_corner_distance_px = 20.0;
+  double corner_quality = 0.01;       // relative to the strongest corner
+  int klt_window_px = 21;
+  int klt_levels = 3;
+  double max_track_error_px = 0.5;    // forward-backward KLT disagreement beyond this: lost
+  double min_baseline = 0.1;          // m the LIO moved between the two images of a pair
+  double max_pair_time = 1.5;         // s: no baseline by then, the tracks start again
+  int min_tracks = 30;                // inliers a pair needs
+  double ransac_threshold_px = 1.0;   // essential-matrix RANSAC (moving objects, bad tracks)
+  double cauchy_px = 1.0;             // robust loss on the Sampson error
+  int window_pairs = 300;             // the estimate is over the newest pairs
+  int min_pairs = 30;
+  double apply_std_deg = 0.06;        // every axis this well known: used
+  double reapply_deg = 0.03;          // used again when it moved this far from the value in use
+};
+
 struct VioOptions {
   MapOptions map;
   SelectionOptions selection;
@@ -122,6 +147,7 @@ struct VioOptions {
   UpdateOptions update;
   MaintenanceOptions maintenance;
   CalibrationOptions calibration;
+  RotationCalibrationOptions rotation_calibration;
 };
 
 /// Throws std::invalid_argument naming the first option out of range.
