@@ -359,6 +359,54 @@ double alignedError(const Outputs& out, const synth::SyntheticSequence& seq) {
 
 }  // namespace
 
+// With lio.camera_free_state the LiDAR-inertial-only filter's state goes out at every hand-off
+// just before the prior, with its request id, and a VIO pulling the filter sideways at every image
+// does not move it.
+TEST(LioNode, CameraFreeStateGoesOutBeforeEachPriorAndIsNotPulled) {
+  const synth::SyntheticSequence seq = syntheticSequence();
+  int64_t first_image = 0, last_image = 0;
+  const std::vector<Message> in = withImages(syntheticRun(), &first_image, &last_image);
+  std::vector<filter_state_t> priors, free_states;
+  std::vector<int64_t> order;  // request ids as they arrive, negated for the camera-free states
+  RunSetup setup;
+  setup.config = handoffConfig() + "  camera_free_state: true\n";
+  setup.attach = [&](Node& vio) {
+    vio.subscribe<filter_state_t>("STATE_CAMERA_FREE", [&](const filter_state_t& m) {
+      free_states.push_back(m);
+      order.push_back(-m.request_id);
+    });
+    vio.subscribe<filter_state_t>("STATE_PRIOR", [&](const filter_state_t& prior) {
+      priors.push_back(prior);
+      order.push_back(prior.request_id);
+      filter_state_t post = prior;  // the prior moved 2 cm sideways, as sure as it was
+      post.position[1] += 0.02;
+      post.valid = 1;
+      post.source = "fake_vio";
+      vio.publish("STATE_POSTERIOR", post);
+    });
+    vio.announce();
+  };
+  runNode(in, nullptr, setup);
+  ASSERT_GE(priors.size(), 40u);
+  ASSERT_EQ(free_states.size(), priors.size());
+  for (size_t i = 0; i < priors.size(); ++i) {
+    EXPECT_EQ(order[2 * i], -priors[i].request_id);
+    EXPECT_EQ(order[2 * i + 1], priors[i].request_id);
+    EXPECT_EQ(free_states[i].utime, priors[i].utime);
+  }
+  auto error = [&](const std::vector<filter_state_t>& states) {
+    std::vector<Vec3> est, gt;
+    for (const auto& m : states) {
+      est.emplace_back(m.position[0], m.position[1], m.position[2]);
+      gt.push_back(seq.truth(m.utime).translation());
+    }
+    return synth::alignedRmse(est, gt);
+  };
+  const double pulled = error(priors), free = error(free_states);
+  EXPECT_LT(free, 0.01) << "pulled " << pulled;
+  EXPECT_GT(pulled, 2.0 * free + 0.005) << "camera-free " << free;
+}
+
 // At every image time after the map is seeded lio publishes the propagated filter on STATE_PRIOR
 // and waits for the answer; a VIO that answers with the true pose and a tight covariance pulls the
 // state onto the truth, and every sweep still gets its ODOMETRY.

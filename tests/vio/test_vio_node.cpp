@@ -211,6 +211,16 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.min_baseline, 0.2);
   EXPECT_EQ(rc.vio.rotation_calibration.window_pairs, 500);
   EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.apply_std_deg, 0.04);
+  EXPECT_EQ(rc.vio.rotation_calibration.against, RotationCalibrationOptions::Against::kCameraFree);
+  EXPECT_FALSE(rc.vio.rotation_calibration.adopt);  // reported, not used, unless asked for
+  EXPECT_EQ(rc.camera_free_state_channel, "STATE_CAMERA_FREE");
+  const VioNodeOptions rf = readVioNodeOptions(Config::fromString(
+      roomConfig("vio:\n  channels: {camera_free_state: FREE2}\n  rotation_calibration: {against: filter, adopt: true}\n")));
+  EXPECT_EQ(rf.vio.rotation_calibration.against, RotationCalibrationOptions::Against::kFilter);
+  EXPECT_TRUE(rf.vio.rotation_calibration.adopt);
+  EXPECT_EQ(rf.camera_free_state_channel, "FREE2");
+  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {against: lidar}\n"))),
+               ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {min_pairs: 400}\n"))),
                ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig(

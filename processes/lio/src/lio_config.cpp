@@ -70,6 +70,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("imu_max_acceleration", o->imu_max_acceleration);
   c.readOptional("max_pending_scans", o->max_pending_scans);
   c.readOptional("camera_handoff", o->camera_handoff);
+  c.readOptional("camera_free_state", o->camera_free_state);
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
   c.readOptional("image_lidar_wait_s", o->image_lidar_wait_s);
   c.readOptional("image_max_wait_s", o->image_max_wait_s);
@@ -81,6 +82,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   out.readOptional("registered_scan", o->registered_scan_channel);
   out.readOptional("keyframe", o->keyframe_channel);
   out.readOptional("state_prior", o->state_prior_channel);
+  out.readOptional("camera_free_state", o->camera_free_state_channel);
 
   const Config init = c.optionalSection("init");
   std::string mode;
@@ -232,6 +234,7 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "\n"
      << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
+     << (o.camera_handoff && o.camera_free_state ? "; camera-free filter beside it -> " + o.camera_free_state_channel : std::string())
      << "\n"
      << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
      << (l.wheel.enabled ? "on" : "off");

@@ -41,6 +41,10 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
   if (opts_.lio.wheel.enabled)
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   if (opts_.camera_handoff) {
+    if (opts_.camera_free_state) {
+      camera_free_.emplace(opts_.lio);
+      node_.declareOutput(opts_.camera_free_state_channel);
+    }
     node_.declareOutput(opts_.state_prior_channel);
     node_.watchConsumers(opts_.state_prior_channel);
     node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
@@ -75,6 +79,7 @@ void LioNode::saveNumbering() {
 
 void LioNode::resetAll(const std::string& why) {
   lio_.reset();
+  if (camera_free_) camera_free_->reset();
   announceReset(why);
   imu_.clear();
   wheel_.clear();
@@ -212,6 +217,7 @@ void LioNode::advance() {
     imu_.popUntil(settled, [&](const TimeBuffer<ImuSample>::Entry& e) {
       std::string why;
       if (!lio_.addImu(e.value, &why)) node_.warn("IMU sample refused by the filter: " + why);
+      if (camera_free_) camera_free_->addImu(e.value);
       fed_imu_ = e.utime;
       fed_any_imu_ = true;
     });
@@ -261,6 +267,7 @@ void LioNode::advance() {
         }
       wheel_.popUntil(upto, [&](const TimeBuffer<WheelSample>::Entry& e) {
         lio_.addWheel(e.value);
+        if (camera_free_) camera_free_->addWheel(e.value);
         fed_wheel_ = e.utime;
         fed_any_wheel_ = true;
       });
@@ -282,6 +289,7 @@ void LioNode::process(const PendingScan& p) {
   const auto t0 = std::chrono::steady_clock::now();
   const int32_t epoch_before = lio_.frame().epoch;
   ScanResult r = lio_.addScan(p.scan);
+  if (camera_free_ && camera_free_->acceptsSweepEnding(camera_free_->scanEndUtime(p.scan))) camera_free_->addScan(p.scan);
   if (lio_.frame().epoch != epoch_before) announceReset(r.message.empty() ? "the filter re-initialised" : r.message);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ++sweeps_;
@@ -343,6 +351,12 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
+  if (camera_free_ && camera_free_->tracking() && utime >= camera_free_->utime() && camera_free_->propagateTo(utime)) {
+    filter_state_t free = toFilterState(utime, camera_free_->state(), camera_free_->covariance(), id, opts_.name);
+    free.epoch = camera_free_->frame().epoch;
+    free.correction_id = camera_free_->frame().correction_id;
+    node_.publish(opts_.camera_free_state_channel, free);
+  }
   filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name);
   prior.epoch = lio_.frame().epoch;
   prior.correction_id = lio_.frame().correction_id;

@@ -118,16 +118,20 @@ CameraRotationCalibration::CameraRotationCalibration(const RotationCalibrationOp
     : options_(options), camera_(camera), T_I_C_rig_(T_I_C_rig) {}
 
 void CameraRotationCalibration::reset() {
+  restartTracks();
+  pairs_.clear();
+  pairs_since_solve_ = 0;
+  pairs_closed_ = 0;
+  estimate_ = RotationEstimate();
+}
+
+void CameraRotationCalibration::restartTracks() {
   key_utime_ = -1;
   key_ray_.clear();
   key_dt_.clear();
   key_px_.clear();
   cur_px_.clear();
   prev_pyramid_.clear();
-  pairs_.clear();
-  pairs_since_solve_ = 0;
-  pairs_closed_ = 0;
-  estimate_ = RotationEstimate();
 }
 
 void CameraRotationCalibration::applyCorrection(const Pose3& T_corrected_odom) {

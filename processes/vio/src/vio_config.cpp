@@ -17,6 +17,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   ch.readOptional("state_posterior", n->state_posterior_channel);
   ch.readOptional("registered_scan", n->registered_scan_channel);
   ch.readOptional("loop_correction", n->loop_correction_channel);
+  ch.readOptional("camera_free_state", n->camera_free_state_channel);
   c.readOptional("time_tolerance_s", n->time_tolerance_s);
   c.readOptional("image_buffer_s", n->image_buffer_s);
   c.readOptional("max_buffered_images", n->max_buffered_images);
@@ -103,6 +104,16 @@ void readVio(const Config& c, VioNodeOptions* n) {
   const Config rc = c.optionalSection("rotation_calibration");
   RotationCalibrationOptions& r = o.rotation_calibration;
   rc.readOptional("enabled", r.enabled);
+  rc.readOptional("adopt", r.adopt);
+  if (rc.has("against")) {
+    const std::string a = rc.get<std::string>("against");
+    if (a == "camera_free")
+      r.against = RotationCalibrationOptions::Against::kCameraFree;
+    else if (a == "filter")
+      r.against = RotationCalibrationOptions::Against::kFilter;
+    else
+      throw ConfigError(rc.where("against") + ": '" + a + "' is neither camera_free nor filter");
+  }
   rc.readOptional("max_corners", r.max_corners);
   rc.readOptional("min_corner_distance_px", r.min_corner_distance_px);
   rc.readOptional("corner_quality", r.corner_quality);

@@ -138,7 +138,9 @@ size_t VioEstimator::recentScanPoints() const {
 void VioEstimator::applyCorrection(const Pose3& T) {
   map_.transform(T);
   last_utime_ = -1;
-  if (rotation_calibration_) rotation_calibration_->applyCorrection(T);
+  // (lio's camera-free filter takes no loop corrections: its pairs need none)
+  if (rotation_calibration_ && options_.rotation_calibration.against == RotationCalibrationOptions::Against::kFilter)
+    rotation_calibration_->applyCorrection(T);
   for (auto& s : scans_)
     for (auto& p : s.points) p = T * p;
 }
@@ -172,7 +174,8 @@ bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage
   return true;
 }
 
-ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState& prior, const Mat18& P) {
+ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState& prior, const Mat18& P,
+                                       const FilterState* camera_free) {
   ImageResult r;
   r.state = prior;
   r.covariance = P;
@@ -182,8 +185,13 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   // the state at the image's true time (the estimated offset; the update refines it)
   const Vec3 omega = options_.calibration.time_offset_std > 0.0 ? bodyRateAt(image.utime, prior) : Vec3::Zero();
   const FilterState at_image = advanced(prior, omega, time_offset_);
-  if (rotation_calibration_ && rotation_calibration_->addImage(image.pixels, image.utime, at_image.pose(), at_image.vel, shutter) &&
-      rotation_calibration_->converged()) {
+  // the body the image pairs are measured against (RotationCalibrationOptions::against)
+  const bool against_filter = options_.rotation_calibration.against == RotationCalibrationOptions::Against::kFilter;
+  const FilterState* body = against_filter ? &at_image : camera_free;
+  if (rotation_calibration_ && !body) rotation_calibration_->restartTracks();
+  if (rotation_calibration_ && body &&
+      rotation_calibration_->addImage(image.pixels, image.utime, body->pose(), body->vel, shutter) &&
+      options_.rotation_calibration.adopt && rotation_calibration_->converged()) {
     // adopted, or moved far enough from what is in use: the references cut through the old
     // rotation would pull the pose by it, so the map starts afresh from the recent scans
     const Vec3 phi = rotation_calibration_->estimate().correction;

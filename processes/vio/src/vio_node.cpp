@@ -34,6 +34,10 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
   node_.subscribe<image_t>(opts_.camera_channel, [this](const image_t& m) { onImage(m); });
   node_.subscribe<filter_state_t>(opts_.state_prior_channel, [this](const filter_state_t& m) { onPrior(m); });
   node_.subscribe<registered_scan_t>(opts_.registered_scan_channel, [this](const registered_scan_t& m) { onScan(m); });
+  const RotationCalibrationOptions& rc = opts_.vio.rotation_calibration;
+  if (rc.enabled && rc.against == RotationCalibrationOptions::Against::kCameraFree)
+    node_.subscribe<filter_state_t>(opts_.camera_free_state_channel,
+                                    [this](const filter_state_t& m) { onCameraFreeState(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onCorrection(m); });
   // the body rate places a rolling shutter's rows and moves the state by the image time offset
@@ -153,8 +157,25 @@ void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
     keep(prior, why);
     return;
   }
+  // lio's camera-free state for this image (published just before the prior, same request id)
+  FilterState free_x;
+  bool have_free = false;
+  for (const filter_state_t& m : camera_free_)
+    if (m.request_id == prior.request_id && m.utime == prior.utime) {
+      Mat18 free_P;
+      std::string free_why;
+      have_free = priorFromMessage(m, &free_x, &free_P, &free_why);
+      break;
+    }
+  const RotationCalibrationOptions& rc = opts_.vio.rotation_calibration;
+  if (rc.enabled && rc.against == RotationCalibrationOptions::Against::kCameraFree && !have_free &&
+      !warned_no_camera_free_ && counts_.priors >= 50) {
+    warned_no_camera_free_ = true;
+    node_.warn("no " + opts_.camera_free_state_channel + " for the images so far: the camera rotation calibration "
+               "waits for lio's camera-free filter (lio.camera_free_state: true)");
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  const ImageResult r = vio_.processImage(image.image, x, P);
+  const ImageResult r = vio_.processImage(image.image, x, P, have_free ? &free_x : nullptr);
   node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (const CameraRotationCalibration* cal = vio_.rotationCalibration()) reportRotationCalibration(*cal, r);
   if (!r.valid) {
@@ -181,6 +202,13 @@ void VioNode::reportRotationCalibration(const CameraRotationCalibration& cal, co
     << deg.x() << ", " << deg.y() << ", " << deg.z() << ") deg, 1-sigma <= " << e.maxStdDeg() << " deg, Sampson RMS "
     << std::setprecision(2) << e.rms_px << " px"
     << (r.camera_rotation_changed ? "; adopted, the point-patch map starts afresh" : "");
+  if (cal.hasEstimate()) {
+    const Pose3 T = cal.calibratedExtrinsic();
+    const Eigen::Quaterniond q(T.linear());
+    s << std::setprecision(6) << "; the rig as estimated: camera T_I_C {translation: [" << T.translation().x() << ", "
+      << T.translation().y() << ", " << T.translation().z() << "], rotation: [" << q.w() << ", " << q.x() << ", " << q.y()
+      << ", " << q.z() << "]}";
+  }
   node_.info(s.str());
 }
 
@@ -220,6 +248,11 @@ void VioNode::onScan(const registered_scan_t& m) {
     vio_.addScan(m.utime, c.x.data(), c.y.data(), c.z.data(), static_cast<size_t>(c.num_points));
   }
   ++counts_.scans;
+}
+
+void VioNode::onCameraFreeState(const filter_state_t& m) {
+  camera_free_.push_back(m);
+  while (camera_free_.size() > kAnsweredIds) camera_free_.pop_front();
 }
 
 void VioNode::onCorrection(const loop_correction_t& m) {

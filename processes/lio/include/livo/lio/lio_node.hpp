@@ -86,6 +86,7 @@ class LioNode {
   LioNodeOptions opts_;
   Node node_;
   LioEstimator lio_;
+  std::optional<LioEstimator> camera_free_;  // options.camera_free_state: never takes a posterior
   TimeBuffer<ImuSample> imu_;
   TimeBuffer<WheelSample> wheel_;
   TimeBuffer<std::shared_ptr<PendingScan>> scans_;  // keyed by the sweep end (IMU clock)

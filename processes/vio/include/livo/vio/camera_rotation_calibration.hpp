@@ -74,10 +74,14 @@ class CameraRotationCalibration {
   /// A loop correction T_corrected_odom: the open pair's first pose moves with the map.
   void applyCorrection(const Pose3& T_corrected_odom);
   void reset();
+  /// Drops the tracks and the open pair (an image without a body pose); the estimate stays.
+  void restartTracks();
 
   const RotationEstimate& estimate() const { return estimate_; }
   /// Enough pairs and every axis known to options.apply_std_deg.
   bool converged() const;
+  /// Solved on at least options.min_pairs pairs (converged or not).
+  bool hasEstimate() const { return estimate_.pairs >= options_.min_pairs; }
   /// T_I_C with the estimated rotation.
   Pose3 calibratedExtrinsic() const;
   size_t tracks() const { return key_px_.size(); }

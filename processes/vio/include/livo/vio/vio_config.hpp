@@ -22,6 +22,7 @@ struct VioNodeOptions {
   std::string state_posterior_channel = "STATE_POSTERIOR";
   std::string registered_scan_channel = "REGISTERED_SCAN";
   std::string loop_correction_channel = "LOOP_CORRECTION";
+  std::string camera_free_state_channel = "STATE_CAMERA_FREE";  // rotation_calibration against camera_free
   // time
   double camera_time_offset_s = 0.0;  // rig.camera.time_offset_s: image utime + offset = IMU time
   double time_tolerance_s = 0.0005;   // a prior and an image this close in time belong together

@@ -73,7 +73,10 @@ class VioEstimator {
   /// A rolling shutter or the online time-offset calibration use the body rate.
   bool needsGyro() const { return shutter_.active() || options_.calibration.time_offset_std > 0.0; }
   /// Update at an image whose time the prior refers to (image.utime already on the IMU clock).
-  ImageResult processImage(const GreyImage& image, const FilterState& prior, const Mat18& P);
+  /// `camera_free`: lio's LiDAR-inertial-only state at the image (rotation calibration against
+  /// camera_free; null if there is none for this image).
+  ImageResult processImage(const GreyImage& image, const FilterState& prior, const Mat18& P,
+                           const FilterState* camera_free = nullptr);
 
   /// A loop correction: moves the map and the recent scans by T_corrected_odom.
   void applyCorrection(const Pose3& T_corrected_odom);

@@ -61,6 +61,7 @@ class VioNode {
   void onPrior(const filter_state_t& m);
   void onScan(const registered_scan_t& m);
   void onCorrection(const loop_correction_t& m);
+  void onCameraFreeState(const filter_state_t& m);
   /// Answers every waiting prior that can be answered now, then trims the image buffer.
   void resolve();
   void process(const filter_state_t& prior, const BufferedImage& image);
@@ -83,6 +84,8 @@ class VioNode {
   MapFrame frame_;  // the map's odometry epoch and loop correction
   std::map<std::string, int64_t> kept_reasons_;
   std::map<std::string, int64_t> last_warned_;  // reason -> sensor time of its last warning
+  std::deque<filter_state_t> camera_free_;  // lio's camera-free states, newest last (by request id)
+  bool warned_no_camera_free_ = false;
   int reported_pairs_ = 0;  // image pairs of the rotation calibration at its last progress line
 };
 

@@ -123,6 +123,15 @@ struct CalibrationOptions {
 /// (and starts its point-patch map afresh, the old references having been cut through the rig's).
 struct RotationCalibrationOptions {
   bool enabled = false;
+  // The body poses the pairs are measured against. kCameraFree: lio's LiDAR-inertial-only filter
+  // (lio.camera_free_state, STATE_CAMERA_FREE); kFilter: the prior, which the camera's own
+  // updates have already turned toward the camera's view (README: it then misses the tilt).
+  enum class Against { kCameraFree, kFilter };
+  Against against = Against::kCameraFree;
+  // Use the estimate in the VIO once known (true), or only report it (false: the log gives the
+  // rig's T_I_C to write into the config). Adopting it mid-run starts the point-patch map afresh,
+  // which has cost more than the better rotation gained (README).
+  bool adopt = false;
   int max_corners = 150;              // tracked corners (Shi-Tomasi), topped up at every pair
   double min_corner_distance_px = 20.0;
   double corner_quality = 0.01;       // relative to the strongest corner
