@@ -13,22 +13,28 @@
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
-#                           [--stop-grace S]
+#                           [--stop-grace S] [--overlay FILE,...] [--calibrate-camera]
 # Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
 # every restart. Without it a process that dies stops the run. --kill P:SIG:AT_S sends SIG to
 # process P AT_S seconds of wall time after the replay starts (for supervision tests). At the end
 # every process gets SIGINT and --stop-grace seconds (60) to write its files before SIGKILL.
+# --overlay FILE,...: YAML files merged over the config in order (livo-config merge: maps key by
+# key, other values replaced) into DIR/config.yaml, which every process then reads.
+# --calibrate-camera: a first pass (lio + vio, config/overlays/camera_rotation_calibration.yaml, in
+# DIR/camera_calibration) measures the camera's rotation against the LiDAR-inertial body from image
+# pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
+# the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio loop colour octomap)
 
-usage() { sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -47,6 +53,8 @@ while [ $# -gt 0 ]; do
     --max-restarts) max_restarts="$2"; shift 2 ;;
     --kill) kills="$2"; shift 2 ;;
     --stop-grace) stop_grace="$2"; shift 2 ;;
+    --overlay) overlays+="${overlays:+,}$2"; shift 2 ;;
+    --calibrate-camera) calibrate=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"; swap["${2%%=*}"]="${2#*=}"; shift 2 ;;
     --inside-bus) inside=1; shift ;;
     -h|--help) usage 0 ;;
@@ -66,6 +74,28 @@ out="$(cd "$out" && pwd)"
 for tool in livo-playback livo-record livo-report; do
   [ -x "$bin/$tool" ] || die "$bin/$tool missing: run scripts/build.sh"
 done
+
+# The config the processes read: the file with the overlays merged over it (outside the bus only;
+# inside, --config is already the merged file).
+if [ "$inside" = 0 ] && [ "$calibrate" = 1 ]; then
+  grep -Eq '^vio:' "$config" || die "--calibrate-camera needs a vio: section (and a camera in the rig) in $config"
+  echo "run_pipeline.sh: calibration pass: the camera's rotation from image pairs -> $out/camera_calibration" >&2
+  "$0" --log "$log" --config "$config" --out "$out/camera_calibration" --processes lio,vio \
+    --overlay "${overlays:+$overlays,}$root/config/overlays/camera_rotation_calibration.yaml" \
+    --record ODOMETRY,HEALTH,GROUND_TRUTH --stop-grace "$stop_grace" >/dev/null \
+    || die "the calibration pass failed (see $out/camera_calibration/logs/)"
+  if [ -f "$out/camera_calibration/camera_rotation.yaml" ]; then
+    overlays+="${overlays:+,}$out/camera_calibration/camera_rotation.yaml"
+    grep -E '^# (The pairs|fused)' "$out/camera_calibration/camera_rotation.yaml" | sed 's/^# /run_pipeline.sh: /' >&2
+  else
+    echo "run_pipeline.sh: warning: the calibration pass found no camera rotation (too few image pairs); the rig's is used" >&2
+  fi
+fi
+if [ "$inside" = 0 ] && [ -n "$overlays" ]; then
+  [ -x "$bin/livo-config" ] || die "$bin/livo-config missing: run scripts/build.sh"
+  "$bin/livo-config" merge "$config" --overlay "$overlays" --out "$out/config.yaml" || die "cannot merge $overlays over $config"
+  config="$out/config.yaml"
+fi
 
 # Which processes: --processes, else every known one with a section in the config.
 if [ -z "$processes" ]; then

@@ -34,15 +34,17 @@ std::string describe(const YAML::Node& n) {
 
 }  // namespace
 
-Config Config::load(const std::string& file) {
+namespace {
+
+std::string readFile(const std::string& file) {
   std::ifstream in(file);
   if (!in) throw ConfigError(file + ": cannot open config file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return fromString(ss.str(), file);
+  return ss.str();
 }
 
-Config Config::fromString(const std::string& yaml, const std::string& name) {
+YAML::Node parseRoot(const std::string& yaml, const std::string& name) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml);
@@ -51,9 +53,55 @@ Config Config::fromString(const std::string& yaml, const std::string& name) {
                       std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   if (!root.IsNull() && !root.IsMap()) throw ConfigError(name + ": the top level must be a map of sections");
+  return root;
+}
+
+/// `over` merged into a copy of `base` (Config::load with overlays).
+YAML::Node merged(const YAML::Node& base, const YAML::Node& over) {
+  if (!base.IsDefined() || !base.IsMap() || !over.IsMap()) return YAML::Clone(over);
+  YAML::Node out = YAML::Clone(base);
+  for (const auto& kv : over) {
+    const std::string key = kv.first.as<std::string>();
+    out[key] = merged(base[key], kv.second);
+  }
+  return out;
+}
+
+/// The root of `file` with `overlays` merged over it; *name gets "file + overlay + ...".
+YAML::Node loadMerged(const std::string& file, const std::vector<std::string>& overlays, std::string* name) {
+  YAML::Node root = parseRoot(readFile(file), file);
+  *name = file;
+  for (const std::string& overlay : overlays) {
+    const YAML::Node over = parseRoot(readFile(overlay), overlay);
+    if (!over.IsNull()) root = merged(root, over);  // an empty overlay changes nothing
+    *name += " + " + overlay;
+  }
+  return root;
+}
+
+}  // namespace
+
+Config Config::load(const std::string& file) { return load(file, {}); }
+
+Config Config::load(const std::string& file, const std::vector<std::string>& overlays) {
+  auto state = std::make_shared<State>();
+  YAML::Node root = loadMerged(file, overlays, &state->file);
+  return Config(root, state, "");
+}
+
+std::string Config::mergedText(const std::string& file, const std::vector<std::string>& overlays) {
+  std::string name;
+  const YAML::Node root = loadMerged(file, overlays, &name);
+  YAML::Emitter out;
+  out.SetSeqFormat(YAML::Flow);
+  out << root;
+  return std::string(out.c_str()) + "\n";
+}
+
+Config Config::fromString(const std::string& yaml, const std::string& name) {
   auto state = std::make_shared<State>();
   state->file = name;
-  return Config(root, state, "");
+  return Config(parseRoot(yaml, name), state, "");
 }
 
 std::string Config::where(const std::string& key) const { return state_->file + ": " + keyPath(key); }

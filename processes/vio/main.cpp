@@ -3,7 +3,34 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/file_output.hpp"
+#include "livo/vio/camera_rotation_calibration.hpp"
 #include "livo/vio/vio_node.hpp"
+
+namespace {
+
+/// The camera rotation the image pairs found, fused with the rig's, as a config overlay for the
+/// next run (rotation_calibration.overlay_file); nothing before min_pairs pairs.
+void writeRotationOverlay(const livo::vio::VioNodeOptions& opts, const livo::vio::VioEstimator& vio, bool quiet) {
+  const livo::vio::CameraRotationCalibration* cal = vio.rotationCalibration();
+  const std::string& file = opts.vio.rotation_calibration.overlay_file;
+  if (!cal || file.empty()) return;
+  if (!cal->hasEstimate()) {
+    std::cerr << "[" << opts.name << "] camera rotation: " << cal->pairsClosed() << " image pairs, too few for an estimate; "
+              << file << " not written\n";
+    return;
+  }
+  const double rig_std = opts.vio.update.calibration_rotation_std_deg * M_PI / 180.0;
+  const livo::vio::FusedCameraRotation fused = livo::vio::fuseWithRig(opts.camera.T_I_C, cal->estimate(), rig_std);
+  std::string error;
+  if (!livo::writeFileAtomically(file, {livo::vio::cameraRotationOverlay(fused, cal->estimate(), cal->pairsClosed(), rig_std)},
+                                 &error))
+    std::cerr << "[" << opts.name << "] camera rotation: " << error << "\n";
+  else if (!quiet)
+    std::cerr << "[" << opts.name << "] camera rotation written to " << file << " (a config overlay)\n";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-vio", "Sparse direct photometric update: CAMERA, STATE_PRIOR, REGISTERED_SCAN (and "
@@ -27,6 +54,7 @@ int main(int argc, char** argv) {
     livo::vio::VioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
     const int status = livo::spin(*lcm, node.node());
+    writeRotationOverlay(opts, node.estimator(), quiet);
     if (!quiet && opts.vio.calibration.any()) {
       // what the online calibration learnt: the extrinsic against the rig's, and the time offset
       const livo::vio::VioEstimator& vio = node.estimator();

@@ -1,9 +1,11 @@
 // Config: values, and the errors for missing, mistyped and unknown keys name file and key.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "livo/config.hpp"
+#include "../temp_path.hpp"
 
 using livo::Config;
 using livo::ConfigError;
@@ -126,4 +128,50 @@ TEST(Config, BadFilesAndRigidTransforms) {
   EXPECT_NE(errorOf([&] { c.get<Eigen::Isometry3d>("qbad"); }).find("unit norm"), std::string::npos);
   EXPECT_FALSE(errorOf([&] { c.get<Eigen::Isometry3d>("both"); }).empty());
   EXPECT_NE(errorOf([&] { c.get<double>("nan"); }).find("finite"), std::string::npos);
+}
+
+TEST(Config, OverlaysMergeMapsKeyByKeyAndReplaceEverythingElse) {
+  const std::string base = livo_test::tempPath("base.yaml"), over1 = livo_test::tempPath("over1.yaml"),
+                    over2 = livo_test::tempPath("over2.yaml");
+  std::ofstream(base) << kYaml;
+  // a new key, a changed scalar, a list replaced whole, a map over a map merged, a section added
+  std::ofstream(over1) << "lio: {voxel_size: 0.25, noise: [1.0], extrinsic: {rpy_deg: [0, 0, 45]}, extra: 3}\n"
+                          "loop: {radius: 10}\n";
+  // a later overlay wins; a matrix replaces a map; null removes a value
+  std::ofstream(over2) << "lio: {voxel_size: 0.125, nested: [1, 2], name: ~}\n";
+
+  const Config c = Config::load(base, {over1, over2});
+  const Config lio = c.section("lio");
+  EXPECT_EQ(lio.get<int>("max_iterations"), 4);
+  EXPECT_DOUBLE_EQ(lio.get<double>("voxel_size"), 0.125);
+  EXPECT_EQ(lio.get<std::vector<double>>("noise"), std::vector<double>{1.0});
+  EXPECT_EQ(lio.get<std::vector<int>>("nested"), (std::vector<int>{1, 2}));
+  EXPECT_FALSE(lio.has("name"));
+  EXPECT_EQ(lio.get<int>("extra"), 3);
+  const Eigen::Isometry3d T = lio.get<Eigen::Isometry3d>("extrinsic");
+  EXPECT_TRUE(T.translation().isApprox(Eigen::Vector3d(0.1, 0.0, -0.05)));
+  EXPECT_NEAR(std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI, 45.0, 1e-9);
+  EXPECT_EQ(c.section("loop").get<int>("radius"), 10);
+  EXPECT_EQ(c.section("vio").get<int>("patch"), 8);
+  // messages name every file; the base alone is unchanged
+  EXPECT_EQ(c.file(), base + " + " + over1 + " + " + over2);
+  EXPECT_DOUBLE_EQ(Config::load(base).section("lio").get<double>("voxel_size"), 0.5);
+
+  // the merged text reads back to the same values
+  const std::string text = Config::mergedText(base, {over1, over2});
+  const Config back = Config::fromString(text);
+  EXPECT_DOUBLE_EQ(back.section("lio").get<double>("voxel_size"), 0.125);
+  EXPECT_EQ(back.section("lio").get<std::vector<int>>("nested"), (std::vector<int>{1, 2}));
+  EXPECT_TRUE(back.section("lio").get<Eigen::Isometry3d>("extrinsic").isApprox(T));
+
+  // an empty overlay changes nothing
+  const std::string empty = livo_test::tempPath("empty.yaml");
+  std::ofstream(empty) << "# nothing\n";
+  EXPECT_EQ(Config::load(base, {empty}).section("lio").get<int>("max_iterations"), 4);
+
+  // a broken overlay is named
+  std::ofstream(over2) << "lio: [1, 2\n";
+  EXPECT_NE(errorOf([&] { Config::load(base, {over1, over2}); }).find(over2 + ": invalid YAML"), std::string::npos);
+  EXPECT_NE(errorOf([&] { Config::load(base, {livo_test::tempPath("none.yaml")}); }).find("cannot open"),
+            std::string::npos);
 }

@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
+#include "../temp_path.hpp"
 #include "livo/camera_projection.hpp"
+#include "livo/config.hpp"
+#include "livo/so3.hpp"
 #include "livo/vio/camera_rotation_calibration.hpp"
 #include "sim_fixture.hpp"
 
@@ -162,4 +166,41 @@ TEST(CameraRotationCalibration, FindsTheMountingErrorThroughARollingShutter) {
   ASSERT_GE(pairs, 100);
   EXPECT_TRUE(converged) << "1-sigma " << e.maxStdDeg() << " deg";
   expectRotation(e, rpy_err, 0.06);
+}
+
+TEST(CameraRotationOverlay, FusesThePairsWithTheRigAndMergesOverTheConfig) {
+  const Pose3 rig = rigExtrinsic();
+  RotationEstimate e;
+  e.correction = Vec3(-0.12, -0.08, 0.24) * kDeg;
+  e.covariance = Vec3(0.03, 0.06, 0.3).cwiseAbs2().asDiagonal();
+  e.covariance *= kDeg * kDeg;
+  e.pairs = 300;
+  const double rig_std = 0.3 * kDeg;
+
+  // per axis (diagonal covariances): the precision-weighted mean of the pairs and the rig (0)
+  const livo::vio::FusedCameraRotation f = livo::vio::fuseWithRig(rig, e, rig_std);
+  for (int k = 0; k < 3; ++k) {
+    const double v = e.covariance(k, k), v0 = rig_std * rig_std;
+    EXPECT_NEAR(f.correction(k), e.correction(k) * v0 / (v0 + v), 1e-12);
+    EXPECT_NEAR(f.covariance(k, k), v * v0 / (v + v0), 1e-18);
+  }
+  EXPECT_NEAR(f.correction.x() / e.correction.x(), 0.99, 0.005);  // a sure axis: nearly whole
+  EXPECT_NEAR(f.correction.z() / e.correction.z(), 0.5, 1e-9);    // as vague as the rig: half
+  EXPECT_TRUE(f.T_I_C.translation().isApprox(rig.translation()));
+  EXPECT_LT(livo::so3::Log(f.T_I_C.linear().transpose() * rig.linear() * livo::so3::Exp(f.correction)).norm(), 1e-12);
+  // no stated rig uncertainty: the pairs' estimate whole
+  EXPECT_TRUE(livo::vio::fuseWithRig(rig, e, 0.0).correction.isApprox(e.correction, 1e-12));
+
+  // the overlay replaces the rig's T_I_C whatever form it had, and nothing else
+  const std::string config = livo_test::tempPath("rig.yaml"), overlay = livo_test::tempPath("camera_rotation.yaml");
+  std::ofstream(config) << "rig:\n  camera: {width: 640, T_I_C: {translation: [0.08, 0, 0.02], rpy_deg: [-90, 0, -90]}}\n"
+                           "vio: {update: {noise_std: 30}}\n";
+  std::ofstream(overlay) << livo::vio::cameraRotationOverlay(f, e, 432, rig_std);
+  const livo::Config merged = livo::Config::load(config, {overlay});
+  const livo::Config camera = merged.section("rig").section("camera");
+  const Pose3 T = camera.get<Eigen::Isometry3d>("T_I_C");
+  EXPECT_LT((T.matrix() - f.T_I_C.matrix()).cwiseAbs().maxCoeff(), 1e-8);  // 9 decimals
+  EXPECT_EQ(camera.get<int>("width"), 640);
+  EXPECT_EQ(merged.section("vio").section("update").get<int>("noise_std"), 30);
+  EXPECT_EQ(camera.keys(), (std::vector<std::string>{"width", "T_I_C"}));
 }

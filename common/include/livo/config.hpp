@@ -29,6 +29,12 @@ class Config {
  public:
   /// Parses a YAML file; throws ConfigError if it is missing or malformed.
   static Config load(const std::string& file);
+  /// A file with overlay files merged over it in order: where both hold a map, the overlay's keys
+  /// are merged into it one by one (recursively); any other value of the overlay (a number, a
+  /// string, a list, null) replaces what was there. Messages name "file + overlay + ...".
+  static Config load(const std::string& file, const std::vector<std::string>& overlays);
+  /// The YAML text of `file` with `overlays` merged over it as load() does (livo-config merge).
+  static std::string mergedText(const std::string& file, const std::vector<std::string>& overlays);
   /// Parses YAML text (tests, embedded defaults); `name` stands for the file in messages.
   static Config fromString(const std::string& yaml, const std::string& name = "<string>");
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -137,6 +139,49 @@ void CameraRotationCalibration::restartTracks() {
 void CameraRotationCalibration::applyCorrection(const Pose3& T_corrected_odom) {
   key_T_W_I_ = T_corrected_odom * key_T_W_I_;
   key_v_W_ = T_corrected_odom.linear() * key_v_W_;
+}
+
+FusedCameraRotation fuseWithRig(const Pose3& T_I_C_rig, const RotationEstimate& estimate, double rig_std) {
+  FusedCameraRotation f;
+  const Mat3 info_pairs = estimate.covariance.inverse();
+  // rig_std 0: no stated uncertainty, the estimate is taken whole
+  const Mat3 info = info_pairs + (rig_std > 0.0 ? Mat3(Mat3::Identity() / (rig_std * rig_std)) : Mat3(Mat3::Zero()));
+  f.covariance = info.inverse();
+  f.correction = f.covariance * (info_pairs * estimate.correction);
+  f.T_I_C = T_I_C_rig;
+  f.T_I_C.linear() = T_I_C_rig.linear() * so3::Exp(f.correction);
+  return f;
+}
+
+std::string cameraRotationOverlay(const FusedCameraRotation& fused, const RotationEstimate& estimate, int pairs_closed,
+                                  double rig_std) {
+  constexpr double kDeg = 180.0 / M_PI;
+  const auto stds = [&](const Mat3& P) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(3) << std::sqrt(P(0, 0)) * kDeg << " / " << std::sqrt(P(1, 1)) * kDeg << " / "
+      << std::sqrt(P(2, 2)) * kDeg;
+    return s.str();
+  };
+  const Vec3 e = estimate.correction * kDeg, c = fused.correction * kDeg;
+  const Eigen::Quaterniond q(fused.T_I_C.linear());
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(4);
+  s << "# livo-vio: the camera's rotation against the LiDAR-inertial body, from " << estimate.pairs << " image pairs (the newest of "
+    << pairs_closed << "), Sampson RMS " << std::setprecision(2) << estimate.rms_px << " px.\n"
+    << std::setprecision(4) << "# The pairs turn the rig's camera by (" << e.x() << ", " << e.y() << ", " << e.z()
+    << ") deg in its own frame, 1-sigma " << stds(estimate.covariance) << " deg;\n"
+    << "# fused with the rig's rotation at 1-sigma " << rig_std * kDeg << " deg: (" << c.x() << ", " << c.y() << ", "
+    << c.z() << ") deg, 1-sigma " << stds(fused.covariance) << " deg.\n"
+    << "# Merge it over the config (livo-config merge CONFIG --overlay THIS, scripts/run_pipeline.sh --overlay THIS).\n"
+    << std::setprecision(9) << "# As a rig entry: T_I_C: {translation: [" << fused.T_I_C.translation().x() << ", "
+    << fused.T_I_C.translation().y() << ", " << fused.T_I_C.translation().z() << "], rotation: [" << q.w() << ", "
+    << q.x() << ", " << q.y() << ", " << q.z() << "]}\n";
+  s << "rig:\n  camera:\n    T_I_C: [";
+  const Eigen::Matrix4d M = fused.T_I_C.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int col = 0; col < 4; ++col) s << (r || col ? (col ? ", " : ",\n            ") : "") << M(r, col);
+  s << "]\n";
+  return s.str();
 }
 
 bool CameraRotationCalibration::converged() const {

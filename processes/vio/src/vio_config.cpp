@@ -128,6 +128,7 @@ void readVio(const Config& c, VioNodeOptions* n) {
   rc.readOptional("window_pairs", r.window_pairs);
   rc.readOptional("min_pairs", r.min_pairs);
   rc.readOptional("apply_std_deg", r.apply_std_deg);
+  rc.readOptional("overlay_file", r.overlay_file);
   rc.readOptional("reapply_deg", r.reapply_deg);
 
   auto require = [&](bool ok, const std::string& key, const char* what) {

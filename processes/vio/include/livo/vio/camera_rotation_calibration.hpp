@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -62,6 +63,24 @@ double sampsonError(const Vec3& x0, const Vec3& x1, const Mat3& E);
 /// `cauchy` in normalised image units, `focal` (px) only for rms_px.
 RotationEstimate solveCameraRotation(const std::deque<TrackPair>& pairs, const Pose3& T_I_C_rig, const Vec3& initial,
                                      double cauchy, double focal);
+
+/// The pairs' estimate fused with the rig's own rotation, taken as a prior of `rig_std` rad per
+/// axis about the rig's (the stated 1-sigma of the camera's rotation against the LiDAR,
+/// update.calibration_rotation_std_deg): φ = (P0⁻¹ + P⁻¹)⁻¹ P⁻¹ φ_pairs. What a later run over the
+/// same rig should use: an estimate much surer than the rig is taken nearly whole, a vague one
+/// barely moves it. rig_std 0: the estimate whole.
+struct FusedCameraRotation {
+  Vec3 correction = Vec3::Zero();      // rad: R_I_C = R_I_C,rig Exp(correction)
+  Mat3 covariance = Mat3::Identity();  // rad²
+  Pose3 T_I_C = Pose3::Identity();     // the rig's translation, the fused rotation
+};
+FusedCameraRotation fuseWithRig(const Pose3& T_I_C_rig, const RotationEstimate& estimate, double rig_std);
+
+/// A project-config overlay (livo::Config::load with overlays, livo-config merge) that sets
+/// rig.camera.T_I_C to `fused` (a 16-number row-major matrix, so it replaces the rig's entry
+/// whatever form that has), with comments giving the estimate, the fusion and the quaternion.
+std::string cameraRotationOverlay(const FusedCameraRotation& fused, const RotationEstimate& estimate, int pairs_closed,
+                                  double rig_std);
 
 class CameraRotationCalibration {
  public:

@@ -147,6 +147,10 @@ struct RotationCalibrationOptions {
   int min_pairs = 30;
   double apply_std_deg = 0.06;        // every axis this well known: used
   double reapply_deg = 0.03;          // used again when it moved this far from the value in use
+  // At exit: the rig's camera extrinsic with the estimate fused in, as a config overlay
+  // (cameraRotationOverlay; scripts/run_pipeline.sh --calibrate-camera), relative to the working
+  // directory ("": none). Written once the estimate has min_pairs pairs.
+  std::string overlay_file = "camera_rotation.yaml";
 };
 
 struct VioOptions {
