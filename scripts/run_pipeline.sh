@@ -27,6 +27,9 @@
 # pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
 # the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
 set -euo pipefail
+# One brace group: bash reads all of it before running any of it, so editing this file during a
+# long run (a 30 min soak) cannot break that run.
+{
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio loop colour octomap)
@@ -328,3 +331,5 @@ sleep 0.3
 kill -INT "$logger" 2>/dev/null || true
 wait "$logger" 2>/dev/null || true
 [ "$rc" = 0 ] && [ "$failed" = 0 ] || exit 1
+exit 0
+}

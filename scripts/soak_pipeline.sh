@@ -12,6 +12,9 @@
 # logs/soak_<config name>_<S>s, checkpoints 300,900,1800 (those beyond the duration print '-').
 # Bar (issue 16): each process's RSS at 30 min within 20 % of its value at 5 min, none above 1 GB.
 set -euo pipefail
+# One brace group: bash reads all of it before running any of it, so editing this file during a
+# long run (a 30 min soak) cannot break that run.
+{
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 config="$root/config/sim/campus_loop_long_soak.yaml" duration=1800 log="" out="" at="300,900,1800" without=()
@@ -63,3 +66,4 @@ wall=$(( $(date +%s) - t0 ))
   done
   [ -f "$out/octomap.bt" ] && echo "octomap.bt: $(du -h "$out/octomap.bt" | cut -f1)"
 } | tee "$out/soak.md"
+}
