@@ -171,6 +171,24 @@ uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* cre
   return id;
 }
 
+size_t ColourMap::removeUncoloured(const std::function<bool(uint32_t)>& drop) {
+  size_t removed = 0;
+  for (uint32_t id = 0; id < points_.size(); ++id) {  // in id order: free_ is the same whatever the tiles' hash order
+    MapPoint& p = points_[id];
+    if (!p.live() || p.coloured() || !drop(id)) continue;
+    index_.erase(key(p.position));
+    p.rejected = -1;
+    free_.push_back(id);
+    ++removed;
+  }
+  if (removed == 0) return 0;
+  for (auto& [k, t] : tiles_)
+    if (!t.spilled)
+      t.ids.erase(std::remove_if(t.ids.begin(), t.ids.end(), [this](uint32_t id) { return !points_[id].live(); }),
+                  t.ids.end());
+  return removed;
+}
+
 bool ColourMap::accumulate(uint32_t id, const Eigen::Vector3f& c, const AccumulationOptions& o) {
   MapPoint& mp = points_[id];
   if (mp.count >= o.outlier_min_count && (c - mp.colour).cwiseAbs().maxCoeff() > o.outlier_threshold) {

@@ -65,6 +65,10 @@ class ColourMap {
   /// The point of the voxel containing p (created at p if the voxel is empty); a tile on disk
   /// comes back first.
   uint32_t addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created = nullptr);
+  /// Removes the resident points never coloured for which `drop(id)` is true (their voxels become
+  /// empty: a scan that measures one again creates its point anew); returns how many. One pass
+  /// over the resident points and tiles: call it now and then, not per scan.
+  size_t removeUncoloured(const std::function<bool(uint32_t id)>& drop);
   /// Robust running mean; false if the observation was refused as an outlier.
   bool accumulate(uint32_t id, const Eigen::Vector3f& colour, const AccumulationOptions& options);
 

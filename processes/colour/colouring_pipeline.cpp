@@ -9,6 +9,10 @@ namespace livo {
 namespace colour {
 
 namespace {
+// How often the points no image can colour any more leave the map (sensor time): one pass over the
+// resident points each time, so not per scan; in between they are at most this much older.
+constexpr int64_t kPrunePeriodUs = 1000000;
+
 DepthBufferOptions depthOptions(const ColourOptions& o) {
   DepthBufferOptions d;
   d.cell_px = o.depth_cell_px;
@@ -49,7 +53,7 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   ++stats_.scans;
   const int64_t anchor = keyframes_.empty() ? -1 : keyframes_.rbegin()->first;
   map_.setTime(scan.utime);
-  ActiveScan active{INT64_MAX, INT64_MIN, {}};
+  ActiveScan active{++scan_seq_, INT64_MAX, INT64_MIN, {}};
   active.points.reserve(scan.num_points);
   const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
   const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
@@ -66,6 +70,8 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
     }
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));
     const uint32_t id = map_.addPoint(p, anchor);
+    if (id >= last_scan_.size()) last_scan_.resize(map_.size(), 0);
+    last_scan_[id] = active.seq;
     active.points.emplace_back(id, t);
     active.t_min = std::min(active.t_min, t);
     active.t_max = std::max(active.t_max, t);
@@ -76,6 +82,12 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   const int64_t keep_from = newest_scan_end_ - 2 * windowUs() - 1000000;
   while (!active_.empty() && active_.front().t_max < keep_from) active_.pop_front();
   poses_.dropBefore(keep_from);
+  if (last_prune_utime_ == INT64_MIN) {
+    last_prune_utime_ = scan.utime;
+  } else if (scan.utime - last_prune_utime_ >= kPrunePeriodUs) {
+    pruneUncolourable();
+    last_prune_utime_ = scan.utime;
+  }
   processReady(false);
   afterTileChanges(map_.evictIdle(scan.utime));
   return true;
@@ -207,6 +219,12 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   return true;
 }
 
+void ColouringPipeline::pruneUncolourable() {
+  const uint32_t oldest_kept = active_.empty() ? scan_seq_ + 1 : active_.front().seq;
+  stats_.points_pruned += static_cast<int64_t>(
+      map_.removeUncoloured([&](uint32_t id) { return id >= last_scan_.size() || last_scan_[id] < oldest_kept; }));
+}
+
 void ColouringPipeline::markRecoloured(uint32_t id) {
   if (recoloured_flag_.size() < map_.size()) recoloured_flag_.resize(map_.size(), 0);
   if (!recoloured_flag_[id]) {
@@ -269,6 +287,10 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
   // points that went to a tile on disk leave the scans (no image can colour them there) and are
   // published when their tile comes back
   const auto& remap = map_.lastRemap();
+  std::vector<uint32_t> last_scan(map_.size(), 0);
+  for (size_t old = 0; old < std::min(last_scan_.size(), remap.size()); ++old)
+    if (remap[old] != ColourMap::kGone) last_scan[remap[old]] = std::max(last_scan[remap[old]], last_scan_[old]);
+  last_scan_.swap(last_scan);
   for (ActiveScan& s : active_) {
     for (auto& pt : s.points) pt.first = remap[pt.first];
     s.points.erase(std::remove_if(s.points.begin(), s.points.end(),

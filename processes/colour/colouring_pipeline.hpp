@@ -42,6 +42,7 @@ struct Observation {
 struct ColouringStats {
   int64_t scans = 0, points_in = 0, points_rejected = 0;
   int64_t points_out_of_reach = 0;  // beyond max_depth + map_margin from the body: not mapped
+  int64_t points_pruned = 0;  // left the map uncoloured once no image could colour them any more
   int64_t images = 0, images_without_pose = 0, images_dropped = 0;  // dropped: waited beyond max_pending_images
   int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
   int64_t gain_estimates = 0;
@@ -86,6 +87,7 @@ class ColouringPipeline {
 
  private:
   struct ActiveScan {
+    uint32_t seq;  // scans added before it, plus one
     int64_t t_min, t_max;
     std::vector<std::pair<uint32_t, int64_t>> points;  // map point, measurement time
   };
@@ -95,6 +97,9 @@ class ColouringPipeline {
   /// Forgets ids the map freed (tiles written to disk) and adds the points that came back moved.
   void afterTileChanges(std::vector<uint32_t> freed);
   void markRecoloured(uint32_t id);
+  /// Removes the map points no kept scan refers to and no image has coloured: no image can colour
+  /// them any more (their time windows have passed), so they would only hold memory.
+  void pruneUncolourable();
 
   ColourOptions options_;
   CameraProjection camera_;
@@ -108,6 +113,9 @@ class ColouringPipeline {
   int64_t newest_scan_end_ = INT64_MIN;
   double reference_exposure_ = 0.0;
   uint32_t visit_ = 0;
+  uint32_t scan_seq_ = 0;
+  std::vector<uint32_t> last_scan_;  // per map point: seq of the newest scan that measured it (0: none)
+  int64_t last_prune_utime_ = INT64_MIN;
   std::vector<uint32_t> visited_;  // per map point: the last visit_ that looked at it (dense: cache-friendly)
   std::vector<uint8_t> recoloured_flag_;
   std::vector<uint32_t> recoloured_;

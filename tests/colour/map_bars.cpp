@@ -96,15 +96,22 @@ class BarSink : public sim::SensorDataSink {
     cv.T_W_I = T_end;
     cv.num_points = static_cast<int>(s.size());
     cv.x = x.data(), cv.y = y.data(), cv.z = z.data(), cv.time_offset = s.time_offset.data();
-    const size_t before = colour_.map().size();
     std::string error;
     double c0 = cpuSeconds();
     colour_.addScan(cv, &error);
     colour_cpu_ += cpuSeconds() - c0;
-    for (size_t id = before; id < colour_.map().size(); ++id) {
-      const Eigen::Vector3f& p = colour_.map().point(id).position;
-      auto it = origin_of.find(bitsOf(p));
-      if (it != origin_of.end()) truth_[id] = trueColour(it->second, p.cast<double>());
+    // the points this scan created: new slots, and freed ones (points that left the map
+    // uncoloured) taken again, which hold another position now
+    truth_.resize(colour_.map().size());
+    for (size_t id = 0; id < colour_.map().size(); ++id) {
+      const colour::MapPoint& mp = colour_.map().point(id);
+      const uint64_t bits = bitsOf(mp.position);
+      if (!mp.live() || (truth_[id].set && truth_[id].bits == bits)) continue;
+      auto it = origin_of.find(bits);
+      truth_[id].set = true;
+      truth_[id].known = it != origin_of.end();
+      truth_[id].bits = bits;
+      if (truth_[id].known) truth_[id].colour = trueColour(it->second, mp.position.cast<double>());
     }
     c0 = cpuSeconds();
     octo_.addScan(cv, &error);  // the same view
@@ -127,10 +134,10 @@ class BarSink : public sim::SensorDataSink {
     colour_.flush();
     double err = 0.0;
     size_t n = 0, occluded = 0;
-    for (const auto& [id, truth] : truth_) {
+    for (size_t id = 0; id < truth_.size(); ++id) {
       const colour::MapPoint& p = colour_.map().point(id);
-      if (!p.coloured()) continue;
-      err += (p.colour - truth).cwiseAbs().mean();
+      if (!truth_[id].known || !p.live() || !p.coloured()) continue;
+      err += (p.colour - truth_[id].colour).cwiseAbs().mean();
       ++n;
       occluded += occluded_.count(id);
     }
@@ -263,7 +270,12 @@ class BarSink : public sim::SensorDataSink {
   colour::ColouringPipeline colour_;
   octomap_export::OctomapBuilder octo_;
   double res_;
-  std::unordered_map<uint32_t, Eigen::Vector3f> truth_;
+  struct Truth {
+    bool set = false, known = false;  // known: the point came from a beam of a scan
+    uint64_t bits = 0;  // of the position it was computed for
+    Eigen::Vector3f colour;
+  };
+  std::vector<Truth> truth_;  // per map point id
   std::unordered_set<uint32_t> occluded_;
   std::unordered_set<uint64_t> truth_voxels_;
   std::unordered_map<uint64_t, bool> closed_cache_, open_cache_;

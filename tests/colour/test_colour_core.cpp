@@ -275,6 +275,62 @@ TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
   EXPECT_EQ(all.map().size(), 4u);
 }
 
+// A point no image of its time window coloured leaves the map once no kept scan refers to it (it
+// could only be coloured by an image within max_time_difference of a measurement of it): a 360 deg
+// LiDAR under one camera would otherwise keep most of every resident tile uncoloured, more with
+// every pass (see the colour README, Memory). A later measurement of the voxel creates it anew.
+TEST(ColouringPipeline, PointsNoImageCanColourLeaveTheMap) {
+  const CameraRig rig = livo_test::testCamera(false);
+  ColourOptions o;
+  o.estimate_gain = false;  // window 0.3 s: scans are kept 2 * 0.3 + 1 s past their last point
+  ColouringPipeline pipe(o, rig);
+  std::string error;
+  // in front of the camera (coloured by the image at 1.0 s) and behind it (seen by no image)
+  std::vector<float> x{0.f, 0.f}, y{0.f, 0.f}, z{5.f, -5.f}, dt{0.1f, 0.1f};
+  ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 1000000), &error)) << error;
+  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error)) << error;
+  int64_t t = 1000000;
+  auto emptyScansUntil = [&](int64_t until) {
+    while (t + 100000 <= until) {
+      t += 100000;
+      ASSERT_TRUE(pipe.addScan(viewOf(t, {}, {}, {}, {}), &error)) << error;
+    }
+  };
+  emptyScansUntil(2500000);  // the first scan is still kept: nothing leaves
+  EXPECT_EQ(pipe.stats().images, 1);
+  EXPECT_EQ(pipe.map().residentPoints(), 2u);
+  EXPECT_EQ(pipe.stats().points_pruned, 0);
+  emptyScansUntil(3100000);  // dropped at 2.7 s (its points at 1.0 s); the next pass is at 3.0 s
+  ASSERT_EQ(pipe.map().residentPoints(), 1u);
+  EXPECT_EQ(pipe.stats().points_pruned, 1);
+  uint32_t kept = 0;
+  for (uint32_t id = 0; id < pipe.map().size(); ++id)
+    if (pipe.map().point(id).live()) kept = id;
+  EXPECT_TRUE(pipe.map().point(kept).coloured());
+  EXPECT_FLOAT_EQ(pipe.map().point(kept).position.z(), 5.f);
+  // the voxel behind the camera measured again, 2 cm over: a new point, at the new measurement
+  std::vector<float> x2{0.02f}, y2{0.f}, z2{-5.f}, dt2{0.f};
+  t += 100000;
+  ASSERT_TRUE(pipe.addScan(viewOf(t, x2, y2, z2, dt2), &error)) << error;
+  ASSERT_EQ(pipe.map().residentPoints(), 2u);
+  bool found = false;
+  for (uint32_t id = 0; id < pipe.map().size(); ++id) {
+    const MapPoint& p = pipe.map().point(id);
+    if (p.live() && p.position.z() < 0) {
+      found = true;
+      EXPECT_FLOAT_EQ(p.position.x(), 0.02f);
+      EXPECT_FALSE(p.coloured());
+    }
+  }
+  EXPECT_TRUE(found);
+  // a point measured again and again stays while it is measured
+  for (int k = 0; k < 30; ++k) {
+    t += 100000;
+    ASSERT_TRUE(pipe.addScan(viewOf(t, x2, y2, z2, dt2), &error)) << error;
+    ASSERT_EQ(pipe.map().residentPoints(), 2u) << "scan " << k;
+  }
+}
+
 TEST(ColouringPipeline, RefusesStaleStampsAndSkipsNonFinitePoints) {
   const CameraRig rig = livo_test::testCamera(false);
   ColouringPipeline pipe(ColourOptions{}, rig);
