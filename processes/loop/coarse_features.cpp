@@ -7,7 +7,7 @@
 namespace livo::loop {
 
 CoarseFeatures computeCoarseFeatures(const Points& cloud, const CoarseFeatureOptions& options) {
-  const Points points = voxelDownsample(cloud, options.voxel_size);
+  const Points points = centroidPerVoxel(cloud, options.voxel_size);
   CoarseFeatures out;
   if (points.empty()) return out;
   const PointTree tree(points);

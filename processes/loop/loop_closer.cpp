@@ -79,7 +79,7 @@ std::shared_ptr<const LoopCloser::Features> LoopCloser::deriveFeatures(const Poi
   auto f = std::make_shared<Features>();
   const Points levelled = transformed(cloud_I, rotationOnly(G_R_I));
   f->coarse = computeCoarseFeatures(levelled, options_.coarse);
-  f->fine = GicpCloud::build(voxelDownsample(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
+  f->fine = GicpCloud::build(centroidPerVoxel(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
   return f;
 }
 
@@ -109,7 +109,7 @@ std::shared_ptr<const LoopCloser::Features> LoopCloser::features(int64_t id) {
 Points LoopCloser::mapCloud(int64_t id) const {
   Points cloud_I;
   for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
-  Points map = voxelDownsample(cloud_I, options_.map_voxel_size);
+  Points map = centroidPerVoxel(cloud_I, options_.map_voxel_size);
   for (Vec3& p : map) p = p.cast<float>().cast<double>();  // float, as the global map has always kept them
   return map;
 }

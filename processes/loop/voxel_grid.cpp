@@ -14,7 +14,7 @@ Points transformed(const Points& points, const Pose3& T) {
   return out;
 }
 
-Points voxelDownsample(const Points& points, double voxel_size) {
+Points centroidPerVoxel(const Points& points, double voxel_size) {
   Points finite;
   finite.reserve(points.size());
   for (const Vec3& p : points)

@@ -8,7 +8,7 @@ namespace livo::loop {
 /// Drops non-finite points and replaces the points of each cubic voxel of edge `voxel_size` by
 /// their centroid. Output is ordered by voxel index (independent of input order).
 /// voxel_size <= 0 only removes non-finite points.
-Points voxelDownsample(const Points& points, double voxel_size);
+Points centroidPerVoxel(const Points& points, double voxel_size);
 
 }  // namespace livo::loop
 
@@ -17,9 +17,9 @@ Points voxelDownsample(const Points& points, double voxel_size);
 
 namespace livo::loop {
 
-/// voxelDownsample over a stream: points are added one at a time (non-finite ones dropped) and
+/// centroidPerVoxel over a stream: points are added one at a time (non-finite ones dropped) and
 /// only per-voxel sums are kept, so memory grows with the voxels, not the points. centroids()
-/// equals voxelDownsample of every point added, in the order added.
+/// equals centroidPerVoxel of every point added, in the order added.
 class VoxelCentroids {
  public:
   explicit VoxelCentroids(double voxel_size) : voxel_(voxel_size) {}

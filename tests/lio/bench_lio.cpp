@@ -124,7 +124,7 @@ const MapData& roomMapData() {
       std::vector<Vec3> world;
       for (const auto& p : s.points) world.push_back(T * p);
       std::vector<Vec3> reg;
-      for (size_t i : voxelDownsample(world, 0.5)) reg.push_back(world[i]);
+      for (size_t i : firstPointPerVoxel(world, 0.5)) reg.push_back(world[i]);
       map.insert(reg);
       if (k == 29) d.sweep = reg;
     }

@@ -194,7 +194,7 @@ RegistrationSetup makeRegistration(const synth::Scene& scene, const synth::Traje
     const LidarScan scan = synth::simulateSweep(scene, still, model, 0, 0, Pose3::Identity(), &rng);
     std::vector<Vec3> world;
     for (const auto& p : scan.points) world.push_back(traj.pose(t + dt) * p);
-    const auto idx = voxelDownsample(world, 0.5);
+    const auto idx = firstPointPerVoxel(world, 0.5);
     for (size_t i : idx) s.map.insert(world[i]);
   }
   synth::Trajectory still = traj;
@@ -203,7 +203,7 @@ RegistrationSetup makeRegistration(const synth::Scene& scene, const synth::Traje
   still.phi0 = so3::Log(traj.pose(t + 0.3).linear());
   s.truth = traj.pose(t + 0.3);
   const LidarScan scan = synth::simulateSweep(scene, still, model, 0, 0, Pose3::Identity(), &rng);
-  for (size_t i : voxelDownsample(scan.points, 0.5)) s.body.push_back(scan.points[i]);
+  for (size_t i : firstPointPerVoxel(scan.points, 0.5)) s.body.push_back(scan.points[i]);
   return s;
 }
 

@@ -9,6 +9,9 @@
 using namespace livo;
 using namespace livo::lio;
 
+// min_planarity for these tests: refuses only (nearly) collinear points
+constexpr double kCollinearOnly = 1e-4;
+
 TEST(PointToPlane, FitRecoversAPlane) {
   const Vec3 n = Vec3(0.3, -0.2, 0.9).normalized();
   const double d = -1.7;
@@ -19,7 +22,7 @@ TEST(PointToPlane, FitRecoversAPlane) {
   const double uv[5][2] = {{0, 0}, {0.4, 0.1}, {-0.3, 0.5}, {0.2, -0.6}, {-0.5, -0.2}};
   for (const auto& q : uv) pts.push_back(c + q[0] * u + q[1] * v);
   Plane p;
-  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.01, &p));
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.01, &p, kCollinearOnly));
   EXPECT_NEAR(std::abs(p.normal.dot(n)), 1.0, 1e-12);
   for (const auto& x : pts) EXPECT_NEAR(p.distance(x), 0.0, 1e-12);
   // a point 0.5 m off the plane on the normal's side
@@ -27,8 +30,8 @@ TEST(PointToPlane, FitRecoversAPlane) {
 
   // thickness check: one point 20 cm off; the fit leans towards it, but it stays > 5 cm away
   pts[2] += 0.2 * n;
-  EXPECT_FALSE(fitPlane(pts.data(), 5, 0.05, &p));
-  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.2, &p));
+  EXPECT_FALSE(fitPlane(pts.data(), 5, 0.05, &p, kCollinearOnly));
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.2, &p, kCollinearOnly));
   double worst = 0.0;
   for (const auto& x : pts) worst = std::max(worst, std::abs(p.distance(x)));
   EXPECT_GT(worst, 0.05);
@@ -39,8 +42,8 @@ TEST(PointToPlane, RejectsCollinearAndTooFewPoints) {
   std::vector<Vec3> line;
   for (int i = 0; i < 5; ++i) line.emplace_back(0.1 * i, 0.2 * i, 0.0);
   Plane p;
-  EXPECT_FALSE(fitPlane(line.data(), 5, 0.1, &p));
-  EXPECT_FALSE(fitPlane(line.data(), 2, 0.1, &p));
+  EXPECT_FALSE(fitPlane(line.data(), 5, 0.1, &p, kCollinearOnly));
+  EXPECT_FALSE(fitPlane(line.data(), 2, 0.1, &p, kCollinearOnly));
 }
 
 TEST(PointToPlane, JacobianMatchesNumericDifferentiation) {

@@ -150,9 +150,9 @@ TEST(VoxelMap, BoundedMemoryOverALongPath) {
 TEST(VoxelMap, ScanDownsamplingKeepsTheFirstPointPerVoxel) {
   const std::vector<Vec3> pts = {Vec3(0.1, 0.1, 0.1), Vec3(0.2, 0.2, 0.2), Vec3(0.6, 0.1, 0.1), Vec3(-0.1, 0, 0),
                                  Vec3(0.3, 0.4, 0.1)};
-  const auto idx = voxelDownsample(pts, 0.5);
+  const auto idx = firstPointPerVoxel(pts, 0.5);
   EXPECT_EQ(idx, (std::vector<size_t>{0, 2, 3}));
-  const auto sub = voxelDownsample(pts, std::vector<size_t>{1, 4, 2}, 0.5);
+  const auto sub = firstPointPerVoxel(pts, std::vector<size_t>{1, 4, 2}, 0.5);
   EXPECT_EQ(sub, (std::vector<size_t>{1, 2}));
 }
 

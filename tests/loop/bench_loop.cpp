@@ -40,7 +40,7 @@ Keyframe load(int i) {
   kf.levelled = readXyzBin(kDump + name);  // KITTI velodyne frames are close to level
   const LoopCloserOptions defaults;
   kf.coarse = computeCoarseFeatures(kf.levelled, defaults.coarse);
-  kf.fine = GicpCloud::build(voxelDownsample(kf.levelled, defaults.fine_voxel_size), defaults.covariance_neighbors);
+  kf.fine = GicpCloud::build(centroidPerVoxel(kf.levelled, defaults.fine_voxel_size), defaults.covariance_neighbors);
   return kf;
 }
 

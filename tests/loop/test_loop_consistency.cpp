@@ -107,8 +107,8 @@ TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
   const Points scene = makeScene(41, 0.15);
   const DriftingLaps laps(2 * DriftingLaps::kPerLap + 6);
   // the information a real registration of two keyframes 2.4 m apart claims
-  const GicpCloud a = GicpCloud::build(voxelDownsample(viewFrom(scene, laps.truth[0].translation(), M_PI / 2, 20.0, 0.02, 1), 0.4));
-  const GicpCloud b = GicpCloud::build(voxelDownsample(viewFrom(scene, laps.truth[1].translation(), M_PI / 2 + M_PI / 18, 20.0, 0.02, 2), 0.4));
+  const GicpCloud a = GicpCloud::build(centroidPerVoxel(viewFrom(scene, laps.truth[0].translation(), M_PI / 2, 20.0, 0.02, 1), 0.4));
+  const GicpCloud b = GicpCloud::build(centroidPerVoxel(viewFrom(scene, laps.truth[1].translation(), M_PI / 2 + M_PI / 18, 20.0, 0.02, 2), 0.4));
   const GicpResult realistic = gicpRegister(b, a, laps.truth[0].inverse() * laps.truth[1], {});
   ASSERT_TRUE(realistic.converged);
 

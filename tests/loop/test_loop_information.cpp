@@ -55,9 +55,9 @@ TEST(LoopInformation, CovariancePredictsTheSpreadOfTheRegistrationError) {
     Mat6 predicted = Mat6::Zero();
     for (int k = 0; k < draws; ++k) {
       const GicpCloud target =
-          GicpCloud::build(voxelDownsample(viewFrom(scene, W_T_t.translation(), 0.1, 25, noise, 1000 + 2 * k), 0.4));
+          GicpCloud::build(centroidPerVoxel(viewFrom(scene, W_T_t.translation(), 0.1, 25, noise, 1000 + 2 * k), 0.4));
       const GicpCloud source =
-          GicpCloud::build(voxelDownsample(viewFrom(scene, W_T_s.translation(), 0.9, 25, noise, 1001 + 2 * k), 0.4));
+          GicpCloud::build(centroidPerVoxel(viewFrom(scene, W_T_s.translation(), 0.9, 25, noise, 1001 + 2 * k), 0.4));
       Pose3 init = truth;
       init.translation() += Vec3(0.1, -0.05, 0.02);
       const GicpResult r = gicpRegister(source, target, init, {});
@@ -91,8 +91,8 @@ TEST(LoopInformation, CovariancePredictsTheSpreadOfTheRegistrationError) {
 // the same residual variance, would claim millimetres along the axis from its in-plane
 // regularisation terms.
 TEST(LoopInformation, CorridorAxisKeepsOnlyTheCapsInformation) {
-  const GicpCloud target = GicpCloud::build(voxelDownsample(corridorView(0.0, 1), 0.4));
-  const GicpCloud source = GicpCloud::build(voxelDownsample(corridorView(5.0, 2), 0.4));
+  const GicpCloud target = GicpCloud::build(centroidPerVoxel(corridorView(0.0, 1), 0.4));
+  const GicpCloud source = GicpCloud::build(centroidPerVoxel(corridorView(5.0, 2), 0.4));
   Pose3 truth = Pose3::Identity();
   truth.translation() = Vec3(5.0, 0, 0);
   const GicpResult r = gicpRegister(source, target, truth, {});

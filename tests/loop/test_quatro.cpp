@@ -20,7 +20,7 @@ struct Matched {
 };
 Matched makeMatched(const Pose3& T, int n, double outlier_ratio, double noise, uint32_t seed) {
   std::mt19937 rng(seed);
-  const Points scene = voxelDownsample(makeScene(seed), 0.5);
+  const Points scene = centroidPerVoxel(makeScene(seed), 0.5);
   Matched m;
   std::uniform_int_distribution<size_t> pick(0, scene.size() - 1);
   std::normal_distribution<double> nd(0, noise);

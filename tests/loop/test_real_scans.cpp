@@ -25,7 +25,7 @@ struct Prepared {
 // With the options livo-loop runs with (the fine voxel size unless given).
 Prepared prepare(const Points& raw, double fine_voxel = LoopCloserOptions{}.fine_voxel_size) {
   const LoopCloserOptions o;
-  return {computeCoarseFeatures(raw, o.coarse), GicpCloud::build(voxelDownsample(raw, fine_voxel), o.covariance_neighbors)};
+  return {computeCoarseFeatures(raw, o.coarse), GicpCloud::build(centroidPerVoxel(raw, fine_voxel), o.covariance_neighbors)};
 }
 
 LoopRegistrationResult registerPair(const Prepared& source, const Prepared& target) {

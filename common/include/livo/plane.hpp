@@ -27,7 +27,8 @@ bool fitPlane(const Vec3* points, int n, PlaneFit* out);
 
 /// Least-squares plane through n >= 3 points. Returns false if the points are (nearly) collinear
 /// — the scatter's second eigenvalue below min_planarity times the largest — or one lies farther
-/// than max_thickness.
-bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity = 1e-4);
+/// than max_thickness. No default: the callers' options say how planar (the LIO's
+/// `matching.plane.min_planarity`).
+bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity);
 
 }  // namespace livo

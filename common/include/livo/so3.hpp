@@ -6,6 +6,9 @@
 //  - SE(3) tangent vectors are ordered [rotation; translation] and perturb on the right.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -17,6 +20,13 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Quat = Eigen::Quaterniond;
 using Pose3 = Eigen::Isometry3d;
+
+/// The angle between two vectors in degrees (0 if either is zero), accurate to rounding for
+/// angles away from 0 and 180 degrees.
+inline double angleBetweenDeg(const Vec3& a, const Vec3& b) {
+  const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
+}
 
 namespace so3 {
 

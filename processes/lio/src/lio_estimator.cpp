@@ -6,9 +6,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "livo/lio/scan_to_map.hpp"
+#include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/lio/undistorter.hpp"
 
@@ -21,13 +21,6 @@ void appendNote(std::string* note, const std::string& what) {
   if (!note) return;
   if (!note->empty()) *note += "; ";
   *note += what;
-}
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(3);
-  os << v;
-  return os.str();
 }
 }  // namespace
 
@@ -165,7 +158,7 @@ void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note
   const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * skipped);
   P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
   prop_.reset(x, P, s);
-  appendNote(note, "IMU gap of " + fmt(gap_s) + " s: velocity re-initialised");
+  appendNote(note, "IMU gap of " + formatSignificant(gap_s) + " s: velocity re-initialised");
 }
 
 void LioEstimator::widenForGap(double gap_s) {
@@ -236,7 +229,7 @@ bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
     const ImuSample next = has_next ? imu_.front() : prop_.lastSample();
     const double gap = static_cast<double>((has_next ? next.utime : t_end) - prop_.utime()) * 1e-6;
     const double step = static_cast<double>(t_end - prop_.utime()) * 1e-6;
-    if (!has_next) appendNote(note, "IMU data ends " + fmt(gap) + " s before the sweep end: last sample held");
+    if (!has_next) appendNote(note, "IMU data ends " + formatSignificant(gap) + " s before the sweep end: last sample held");
     if (gap > reset_gap) {
       ImuSample at = next;
       at.utime = t_end;
@@ -251,7 +244,7 @@ bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
       worst_gap = std::max(worst_gap, gap);
     }
   }
-  if (worst_gap > max_gap) appendNote(note, "IMU gap of " + fmt(worst_gap) + " s bridged");
+  if (worst_gap > max_gap) appendNote(note, "IMU gap of " + formatSignificant(worst_gap) + " s bridged");
   return prop_.state().rot.allFinite() && prop_.state().pos.allFinite() && prop_.state().vel.allFinite() &&
          prop_.covariance().allFinite();
 }
@@ -367,7 +360,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   std::vector<size_t> subset;
   const size_t stride = static_cast<size_t>(std::max(1, opts_.point_stride));
   for (size_t i = 0; i < body.size(); i += stride) subset.push_back(i);
-  subset = voxelDownsample(body, subset, opts_.scan_voxel_size);
+  subset = firstPointPerVoxel(body, subset, opts_.scan_voxel_size);
   std::vector<Vec3> reg;
   reg.reserve(subset.size());
   for (size_t i : subset) reg.push_back(body[i]);
@@ -390,9 +383,9 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
           wheelVelocityUpdate(&x, &P, prop_.lastSample().gyro, speed, opts_.wheel, scale_variance);
       ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
       if (!w.applied)
-        appendNote(note, "wheel speed rejected (chi2 " + fmt(w.chi2) + "; filter minus wheels forward " +
-                             fmt(w.innovation.x()) + ", lateral " + fmt(w.innovation.y()) + ", vertical " +
-                             fmt(w.innovation.z()) + " m/s)");
+        appendNote(note, "wheel speed rejected (chi2 " + formatSignificant(w.chi2) + "; filter minus wheels forward " +
+                             formatSignificant(w.innovation.x()) + ", lateral " + formatSignificant(w.innovation.y()) + ", vertical " +
+                             formatSignificant(w.innovation.z()) + " m/s)");
     } else {
       ++wheel_counts_.no_reading;
       appendNote(note, "no wheel reading around the sweep end");
@@ -413,7 +406,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     P.middleRows<3>(FilterState::kVel).setZero();
     P.middleCols<3>(FilterState::kVel).setZero();
     P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
-    appendNote(note, "no registration for " + fmt(lost_s) + " s: map re-seeded at the predicted pose");
+    appendNote(note, "no registration for " + formatSignificant(lost_s) + " s: map re-seeded at the predicted pose");
   }
   if (map_.empty()) {
     if (static_cast<int>(valid.size()) < opts_.min_points) {
@@ -531,7 +524,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     kf.utime = t_end;
     kf.pose = x.pose();
     kf.pose_covariance = P.topLeftCorner<6, 6>();
-    for (size_t i : voxelDownsample(body, opts_.keyframe.cloud_voxel)) {
+    for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
       kf.cloud.push_back(body[i]);
       kf.intensity.push_back(res.intensity[i]);
     }

@@ -288,7 +288,7 @@ std::vector<Vec3> VoxelMap::points() const {
   return out;
 }
 
-std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
                                     double voxel_size) {
   const double inv = 1.0 / voxel_size;
   FlatKeyIndex seen(subset.size());
@@ -302,10 +302,10 @@ std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, const std::
   return out;
 }
 
-std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, double voxel_size) {
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, double voxel_size) {
   std::vector<size_t> all(points.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = i;
-  return voxelDownsample(points, all, voxel_size);
+  return firstPointPerVoxel(points, all, voxel_size);
 }
 
 }  // namespace livo::lio

@@ -1,11 +1,11 @@
 #include "livo/vio/direct_update.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include <Eigen/Cholesky>
 
 #include "livo/esikf_update.hpp"
+#include "livo/text_format.hpp"
 
 namespace livo::vio {
 
@@ -29,12 +29,6 @@ int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& a
   return used;
 }
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
 
 }  // namespace
 
@@ -231,12 +225,12 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   res.mahalanobis = ldlt.info() == Eigen::Success ? dpose.dot(ldlt.solve(dpose)) : INFINITY;
   const double step_rot_deg = dpose.head<3>().norm() * 180.0 / M_PI, step_pos = dpose.tail<3>().norm();
   if (!(res.cost_post <= 1.05 * res.cost_prior + 1e-9)) {
-    res.why = "photometric cost grew (" + fmt(res.cost_prior) + " -> " + fmt(res.cost_post) + ")";
+    res.why = "photometric cost grew (" + formatSignificant(res.cost_prior) + " -> " + formatSignificant(res.cost_post) + ")";
   } else if (!(res.mahalanobis <= uo.max_mahalanobis)) {
-    res.why = "step inconsistent with the prior (Mahalanobis^2 " + fmt(res.mahalanobis) + " > " +
-              fmt(uo.max_mahalanobis) + ")";
+    res.why = "step inconsistent with the prior (Mahalanobis^2 " + formatSignificant(res.mahalanobis) + " > " +
+              formatSignificant(uo.max_mahalanobis) + ")";
   } else if (step_pos > uo.max_step_pos || step_rot_deg > uo.max_step_rot_deg) {
-    res.why = "step too large (" + fmt(step_pos) + " m, " + fmt(step_rot_deg) + " deg)";
+    res.why = "step too large (" + formatSignificant(step_pos) + " m, " + formatSignificant(step_rot_deg) + " deg)";
   } else {
     res.valid = true;
     res.state = x;

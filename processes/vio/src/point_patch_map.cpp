@@ -7,16 +7,7 @@ namespace livo::vio {
 
 PointPatchMap::PointPatchMap(const MapOptions& options) : options_(options), inv_voxel_(1.0 / options.voxel_size) {}
 
-uint64_t voxelKey(const Vec3& p, double inv_voxel_size) {
-  constexpr int64_t off = int64_t{1} << 20;
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  const auto c = [&](double v) {
-    return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v * inv_voxel_size)) + off) & mask;
-  };
-  return c(p.x()) | (c(p.y()) << 21) | (c(p.z()) << 42);
-}
-
-uint64_t PointPatchMap::keyOf(const Vec3& p) const { return voxelKey(p, inv_voxel_); }
+uint64_t PointPatchMap::keyOf(const Vec3& p) const { return voxelKeyOf(p, inv_voxel_); }
 
 int PointPatchMap::find(const Vec3& p) const {
   const auto it = index_.find(keyOf(p));

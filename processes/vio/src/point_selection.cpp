@@ -80,20 +80,13 @@ bool DepthGrid::depthEdge(const Eigen::Vector2d& pixel, double z, double radius_
   return false;
 }
 
-namespace {
-double angleDeg(const Vec3& a, const Vec3& b) {
-  const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
-  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
-}
-}  // namespace
-
 int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const SelectionOptions& o) {
   const Vec3 ray = m.position - c_W;
   int best = -1;
   double best_score = std::numeric_limits<double>::infinity();
   for (size_t j = 0; j < m.observations.size(); ++j) {
     const PatchObservation& obs = m.observations[j];
-    const double angle = angleDeg(ray, m.position - obs.T_W_C.translation());
+    const double angle = angleBetweenDeg(ray, m.position - obs.T_W_C.translation());
     if (angle > o.max_view_angle_deg) continue;
     const double age = std::max(0.0, toSeconds(utime - obs.utime));
     const double score = o.view_angle_weight * angle + o.error_weight * obs.error + o.age_weight * age;

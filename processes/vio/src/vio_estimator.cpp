@@ -15,10 +15,6 @@ constexpr double kMaxRateInterval = 0.25; // s: the body rate from two images fa
 constexpr int64_t kGyroWindow = 15000;    // us: gyro samples this close to the image give its body rate
 constexpr int64_t kGyroKept = 200000;     // us: samples kept behind the newest
 
-double angleDeg(const Vec3& a, const Vec3& b) {
-  const double c = a.dot(b) / std::max(1e-12, a.norm() * b.norm());
-  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
-}
 }  // namespace
 
 std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& o) {
@@ -31,7 +27,7 @@ std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, si
   for (size_t i = 0; i < n; ++i) {
     const Vec3 p(x[i], y[i], z[i]);
     if (!p.allFinite()) continue;
-    const auto [it, added] = voxel_of.emplace(voxelKey(p, inv), static_cast<uint32_t>(first.size()));
+    const auto [it, added] = voxel_of.emplace(voxelKeyOf(p, inv), static_cast<uint32_t>(first.size()));
     if (added) {
       first.push_back(p);
       count.push_back(0);
@@ -296,7 +292,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
     double min_angle = std::numeric_limits<double>::infinity(), ratio = 1.0;
     for (const auto& obs : m.observations) {
       const Vec3 ray_obs = m.position - obs.T_W_C.translation();
-      const double a = angleDeg(ray, ray_obs);
+      const double a = angleBetweenDeg(ray, ray_obs);
       if (a < min_angle) {
         min_angle = a;
         ratio = ray.norm() / std::max(1e-9, ray_obs.norm());

@@ -40,7 +40,7 @@ struct LioOptions {
   double reset_imu_gap_s = 1.0;        // larger gaps reset the velocity (soft re-initialisation)
   double gap_rate_std = 1.0;           // rad/s: rotation uncertainty added per second of such a gap
                                        // (the position gets init.moving_vel_std per second)
-  double max_position_jump = 5.0;      // m per scan: a larger update step re-initialises
+  double max_position_jump = 5.0;      // m per scan: a larger update step is rejected (the sweep is only predicted)
   double max_imu_backlog_s = 1.0;      // IMU waiting for a sweep beyond this is propagated at once
                                        // (a LiDAR outage must not grow the buffer)
   double reseed_after_s = 1.0;         // no registration for this long (LiDAR outage, lost

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "livo/lio/voxel_key.hpp"
+#include "livo/lio/flat_key_index.hpp"
 
 namespace livo::lio {
 
@@ -105,9 +105,9 @@ class VoxelMap {
 };
 
 /// Indices of the first point falling in each voxel of the given size, in input order.
-std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, double voxel_size);
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, double voxel_size);
 /// Same on a subset of indices.
-std::vector<size_t> voxelDownsample(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
                                     double voxel_size);
 
 }  // namespace livo::lio

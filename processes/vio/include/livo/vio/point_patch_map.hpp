@@ -10,12 +10,10 @@
 
 #include "livo/so3.hpp"
 #include "livo/vio/patch.hpp"
+#include "livo/voxel_key.hpp"
 #include "livo/vio/vio_options.hpp"
 
 namespace livo::vio {
-
-/// Packs the voxel of p (21 bits per axis, +-2^20 voxels) into one key.
-uint64_t voxelKey(const Vec3& p, double inv_voxel_size);
 
 struct PatchObservation {
   int64_t utime = 0;               // image time (IMU clock)

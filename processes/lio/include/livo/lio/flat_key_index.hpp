@@ -1,32 +1,15 @@
-// Integer voxel coordinates packed into one 64-bit key, and a flat open-addressing hash table
-// from keys to dense indices (faster than std::unordered_map for the per-point lookups of the
-// map and the scan downsampling; deterministic: no dependence on addresses).
+// A flat open-addressing hash table from voxel keys (livo/voxel_key.hpp) to dense indices
+// (faster than std::unordered_map for the per-point lookups of the map and the scan
+// downsampling; deterministic: no dependence on addresses).
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
-#include "livo/so3.hpp"
+#include "livo/voxel_key.hpp"
 
 namespace livo::lio {
-
-using VoxelKey = uint64_t;
-constexpr VoxelKey kNoVoxel = ~VoxelKey{0};
-
-/// Packs three signed voxel coordinates (21 bits each, |c| < 2^20) into a key.
-inline VoxelKey packVoxel(int64_t x, int64_t y, int64_t z) {
-  constexpr int64_t off = int64_t{1} << 20;
-  constexpr uint64_t mask = (uint64_t{1} << 21) - 1;
-  return (static_cast<uint64_t>(x + off) & mask) | ((static_cast<uint64_t>(y + off) & mask) << 21) |
-         ((static_cast<uint64_t>(z + off) & mask) << 42);
-}
-
-inline VoxelKey voxelKeyOf(const Vec3& p, double inv_size) {
-  return packVoxel(static_cast<int64_t>(std::floor(p.x() * inv_size)),
-                   static_cast<int64_t>(std::floor(p.y() * inv_size)),
-                   static_cast<int64_t>(std::floor(p.z() * inv_size)));
-}
 
 /// Key -> int32 index, linear probing, grows at 50 % load. No single-key erase: callers rebuild.
 class FlatKeyIndex {

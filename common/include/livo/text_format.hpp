@@ -1,0 +1,17 @@
+// Numbers in log lines and notes.
+#pragma once
+
+#include <sstream>
+#include <string>
+
+namespace livo {
+
+/// `v` with `digits` significant digits, as an ostream prints it (0.0123, 1.5e+03).
+inline std::string formatSignificant(double v, int digits = 3) {
+  std::ostringstream os;
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
+}  // namespace livo
