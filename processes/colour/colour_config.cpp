@@ -12,6 +12,8 @@ ColourNodeOptions readColourOptions(const Config& c) {
     c.readOptional("tile_idle_s", o.tile_idle_s);
     c.readOptional("max_resident_points", o.max_resident_points);
     c.readOptional("map_margin", o.map_margin);
+    c.readOptional("map_only_in_view", o.map_only_in_view);
+    c.readOptional("view_margin_deg", o.view_margin_deg);
     c.readOptional("max_time_difference", o.max_time_difference);
     c.readOptional("max_depth", o.max_depth);
     c.readOptional("min_depth", o.min_depth);
@@ -49,6 +51,7 @@ ColourNodeOptions readColourOptions(const Config& c) {
   if (!(o.tile_idle_s >= 0.0)) fail("tile_idle_s", "must be >= 0");
   if (o.max_resident_points < 0) fail("max_resident_points", "must be >= 0 (0: no limit)");
   if (!(o.map_margin >= 0.0)) fail("map_margin", "must be >= 0");
+  if (!(o.view_margin_deg >= 0.0 && o.view_margin_deg <= 180.0)) fail("view_margin_deg", "must be in [0, 180]");
   if (!(o.max_time_difference >= 0.0)) fail("max_time_difference", "must be >= 0");
   if (!(o.min_depth > 0.0 && o.max_depth > o.min_depth)) fail("max_depth", "need 0 < min_depth < max_depth");
   if (o.depth_cell_px < 1) fail("depth_cell_px", "must be >= 1");

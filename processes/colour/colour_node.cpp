@@ -212,7 +212,9 @@ bool ColourNode::saveMap(const std::string& name) {
     << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.tilesEvictedForMemory()
     << " sent to disk early for memory, " << map.spilledTiles()
     << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB live of "
-    << map.spillWrittenBytes() / 1e6 << " MB written)";
+    << map.spillWrittenBytes() / 1e6 << " MB written; scan points left out: " << pipeline_.stats().points_out_of_reach
+    << " out of reach, " << pipeline_.stats().points_out_of_view << " outside the view cone, "
+    << pipeline_.stats().points_pruned << " left the map uncoloured)";
   node_.info(s.str());
   return true;
 }

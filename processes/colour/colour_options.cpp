@@ -8,7 +8,9 @@ namespace colour {
 void printColourOptions(const ColourOptions& o, std::ostream& os) {
   os << "colour: voxel_size " << o.voxel_size << " m, tiles " << o.tile_size << " m to disk after " << o.tile_idle_s
      << " s idle or beyond " << o.max_resident_points << " points in memory, points within max_depth + " << o.map_margin
-     << " m of the body, max_time_difference " << o.max_time_difference
+     << " m of the body"
+     << (o.map_only_in_view ? " and in the camera's view cone (+ " : " (view cone off: ")
+     << o.view_margin_deg << " deg), max_time_difference " << o.max_time_difference
      << " s, depth " << o.min_depth << ".." << o.max_depth << " m, border " << o.border_px << " px, at most "
      << o.max_pending_images << " images waiting\n"
      << "  occlusion: cell " << o.depth_cell_px << " px, occluder_radius " << o.occluder_radius

@@ -21,6 +21,13 @@ struct ColourOptions {
                                        // max_time_difference can colour them (body speed below
                                        // map_margin / max_time_difference, 33 m/s), and with a long-range
                                        // LiDAR they would keep every tile in reach in memory
+  bool map_only_in_view = true;        // scan points outside the camera's widened view cone (below)
+                                       // are not put in the map: no image of their time window sees them
+  double view_margin_deg = 15.0;       // the cone: the camera's field (half-angle to the farthest
+                                       // image corner) + this + the body's rotation over the window
+                                       // (1.5 x the fastest rate of the last 2 s), from the camera at
+                                       // the scan pose; points nearer than the camera's travel over
+                                       // the window always pass, farther ones by asin(travel / range) more
   // Which images a point may take colour from
   double max_time_difference = 0.3;    // s: |t_point - t_image| at most (point = when last measured)
   double max_depth = 30.0;             // m in front of the camera

@@ -34,7 +34,54 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
                        options.tile_idle_s > 0 ? std::max(options.tile_idle_s, 2 * options.max_time_difference + 2.0) : 0.0,
                        "", static_cast<size_t>(std::max(0, options.max_resident_points)),
                        2 * options.max_time_difference + 2.0}),
-      reference_exposure_(options.reference_exposure_s) {}
+      reference_exposure_(options.reference_exposure_s) {
+  // the camera's field: its axis to the farthest ray through the image border
+  const CameraRig& rig = camera_.rig();
+  double widest = 0.0;
+  auto look = [&](double u, double v) {
+    const Eigen::Vector3d ray = camera_.pixelRay(Eigen::Vector2d(u, v));
+    if (ray.allFinite()) widest = std::max(widest, std::atan2(ray.head<2>().norm(), ray.z()));
+  };
+  for (int u = 0; u < rig.width; u += 8) look(u, 0), look(u, rig.height - 1);
+  for (int v = 0; v < rig.height; v += 8) look(0, v), look(rig.width - 1, v);
+  look(rig.width - 1, rig.height - 1);
+  field_half_angle_ = widest > 0.0 ? widest : M_PI_2;
+}
+
+bool ColouringPipeline::ViewCone::contains(const Eigen::Vector3d& p) const {
+  if (half_angle >= M_PI) return true;
+  const Eigen::Vector3d v = p - centre;
+  const double r = v.norm();
+  if (r <= travel) return true;
+  const double angle = std::atan2(v.cross(axis).norm(), v.dot(axis));
+  return angle <= half_angle + std::asin(std::min(1.0, travel / r));
+}
+
+ColouringPipeline::ViewCone ColouringPipeline::viewCone(const RegisteredScanView& scan) {
+  // the body's motion from the scan poses of the last 2 s (a loop correction's jump only widens it)
+  if (last_scan_pose_) {
+    const double dt = (scan.utime - last_scan_pose_->first) * 1e-6;
+    const Pose3& last = last_scan_pose_->second;
+    if (dt > 0.0)
+      motion_.push_back({scan.utime, so3::Log(Mat3(last.linear().transpose() * scan.T_W_I.linear())).norm() / dt,
+                         (scan.T_W_I.translation() - last.translation()).norm() / dt});
+  }
+  last_scan_pose_ = std::make_pair(scan.utime, scan.T_W_I);
+  while (!motion_.empty() && motion_.front().utime < scan.utime - 2000000) motion_.pop_front();
+  double rate = 0.0, speed = 0.0;
+  for (const Motion& m : motion_) rate = std::max(rate, m.rate), speed = std::max(speed, m.speed);
+
+  ViewCone cone;
+  const Pose3 T_W_C = scan.T_W_I * camera_.rig().T_I_C;
+  cone.centre = T_W_C.translation();
+  cone.axis = T_W_C.linear().col(2);
+  // images of the window lie within max_time_difference of a point, which lies within the sweep
+  const double window = options_.max_time_difference + std::max(0.0, (scan.utime - scan.cloud_utime) * 1e-6);
+  const double turn = 1.5 * rate * window;
+  cone.half_angle = field_half_angle_ + options_.view_margin_deg * M_PI / 180.0 + turn;
+  cone.travel = 1.5 * speed * window + camera_.rig().T_I_C.translation().norm() * turn + 0.2;
+  return cone;
+}
 
 void ColouringPipeline::addPose(int64_t utime, const Pose3& T_W_I) { poses_.add(utime, T_W_I); }
 
@@ -57,6 +104,7 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   active.points.reserve(scan.num_points);
   const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
   const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
+  const ViewCone cone = viewCone(scan);
   for (int j = 0; j < scan.num_points; ++j) {
     const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
@@ -66,6 +114,10 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
     }
     if ((p - body).squaredNorm() > reach * reach) {
       ++stats_.points_out_of_reach;
+      continue;
+    }
+    if (options_.map_only_in_view && !cone.contains(p.cast<double>())) {
+      ++stats_.points_out_of_view;
       continue;
     }
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));

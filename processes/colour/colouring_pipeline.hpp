@@ -12,10 +12,12 @@
 // poses bracket t_img, or at flush(); so the result depends on the stamps, not on arrival order.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +44,7 @@ struct Observation {
 struct ColouringStats {
   int64_t scans = 0, points_in = 0, points_rejected = 0;
   int64_t points_out_of_reach = 0;  // beyond max_depth + map_margin from the body: not mapped
+  int64_t points_out_of_view = 0;   // outside the widened view cone (map_only_in_view): not mapped
   int64_t points_pruned = 0;  // left the map uncoloured once no image could colour them any more
   int64_t images = 0, images_without_pose = 0, images_dropped = 0;  // dropped: waited beyond max_pending_images
   int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
@@ -56,7 +59,8 @@ class ColouringPipeline {
   /// Body pose samples (ODOMETRY, REGISTERED_SCAN).
   void addPose(int64_t utime, const Pose3& T_W_I);
   /// Adds a scan's points to the map (non-finite points are skipped and counted, points farther
-  /// than max_depth + map_margin from the body counted and left out) and processes
+  /// than max_depth + map_margin from the body and, with map_only_in_view, points outside the
+  /// camera's widened view cone counted and left out) and processes
   /// the images it makes ready. False (and nothing changes) for a scan older than the last one.
   bool addScan(const RegisteredScanView& scan, std::string* error);
   /// Queues an image; processes it at once if it is ready. False if older than the last image.
@@ -91,6 +95,15 @@ class ColouringPipeline {
     int64_t t_min, t_max;
     std::vector<std::pair<uint32_t, int64_t>> points;  // map point, measurement time
   };
+  /// The cone around the camera's axis at the scan pose within which an image of the scan's time
+  /// window may see a point (see ColourOptions::view_margin_deg).
+  struct ViewCone {
+    Eigen::Vector3d centre, axis;
+    double half_angle = M_PI;  // rad, before the travel term
+    double travel = 0.0;       // m: how far the camera may move over the window
+    bool contains(const Eigen::Vector3d& p) const;
+  };
+  ViewCone viewCone(const RegisteredScanView& scan);
   void processReady(bool flushing);
   bool processImage(const ColourImage& image);
   int64_t windowUs() const { return static_cast<int64_t>(options_.max_time_difference * 1e6); }
@@ -116,6 +129,13 @@ class ColouringPipeline {
   uint32_t scan_seq_ = 0;
   std::vector<uint32_t> last_scan_;  // per map point: seq of the newest scan that measured it (0: none)
   int64_t last_prune_utime_ = INT64_MIN;
+  double field_half_angle_ = M_PI_2;  // rad: the camera's axis to its farthest image corner
+  struct Motion {
+    int64_t utime;
+    double rate, speed;  // rad/s, m/s between this scan pose and the previous
+  };
+  std::deque<Motion> motion_;  // the last 2 s of scan poses
+  std::optional<std::pair<int64_t, Pose3>> last_scan_pose_;
   std::vector<uint32_t> visited_;  // per map point: the last visit_ that looked at it (dense: cache-friendly)
   std::vector<uint8_t> recoloured_flag_;
   std::vector<uint32_t> recoloured_;

@@ -258,7 +258,9 @@ TEST(ColouringPipeline, LoopCorrectionMovesPointsWithTheirKeyframe) {
 // they would otherwise keep every tile in reach in memory; see the colour README, Memory).
 TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
   const CameraRig rig = livo_test::testCamera(false);
-  ColouringPipeline pipe(ColourOptions{}, rig);
+  ColourOptions o;
+  o.map_only_in_view = false;  // the points lie to the side: only the reach is tested here
+  ColouringPipeline pipe(o, rig);
   Pose3 B = Pose3::Identity();
   B.translation() = Vec3(100.0, -50.0, 2.0);
   std::vector<float> x{139.9f, 140.1f, 100.f, 59.9f}, y{-50.f, -50.f, -10.5f, -50.f}, z{2.f, 2.f, 2.f, 2.f},
@@ -268,7 +270,7 @@ TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
   EXPECT_EQ(pipe.map().size(), 2u);  // 39.9 m and 39.5 m away; the two 40.1 m away left out
   EXPECT_EQ(pipe.stats().points_out_of_reach, 2);
   EXPECT_EQ(pipe.stats().points_in, 2);
-  ColourOptions wide;
+  ColourOptions wide = o;
   wide.map_margin = 100.0;
   ColouringPipeline all(wide, rig);
   ASSERT_TRUE(all.addScan(viewOf(2000000, x, y, z, dt, B), &error)) << error;
@@ -283,6 +285,7 @@ TEST(ColouringPipeline, PointsNoImageCanColourLeaveTheMap) {
   const CameraRig rig = livo_test::testCamera(false);
   ColourOptions o;
   o.estimate_gain = false;  // window 0.3 s: scans are kept 2 * 0.3 + 1 s past their last point
+  o.map_only_in_view = false;  // the point behind the camera must enter the map first
   ColouringPipeline pipe(o, rig);
   std::string error;
   // in front of the camera (coloured by the image at 1.0 s) and behind it (seen by no image)
@@ -328,6 +331,50 @@ TEST(ColouringPipeline, PointsNoImageCanColourLeaveTheMap) {
     t += 100000;
     ASSERT_TRUE(pipe.addScan(viewOf(t, x2, y2, z2, dt2), &error)) << error;
     ASSERT_EQ(pipe.map().residentPoints(), 2u) << "scan " << k;
+  }
+}
+
+// A spinning LiDAR sees all around; one camera sees a cone. Points no image of their time window
+// can see are not mapped (they would only fill the tiles in use): the cone is the camera's field
+// (45 deg to the corners of the test camera) + view_margin_deg (15) + 1.5 x the body's rotation
+// over the window, and points nearer than the camera's travel pass whatever their direction.
+TEST(ColouringPipeline, PointsOutsideTheWidenedViewConeAreNotMapped) {
+  const CameraRig rig = livo_test::testCamera(false);
+  auto deg = [](double a) { return a * M_PI / 180.0; };
+  auto at = [](double angle, double r) {  // in the camera's x-z plane, `angle` from its axis (+z)
+    return Eigen::Vector3f(float(r * std::sin(angle)), 0.f, float(r * std::cos(angle)));
+  };
+  std::vector<Eigen::Vector3f> pts{at(deg(0), 5), at(deg(55), 5), at(deg(65), 5), at(deg(90), 5),
+                                   at(deg(180), 5), at(deg(120), 0.15)};
+  auto scanOf = [&](int64_t utime, const Pose3& T, std::vector<float>* x, std::vector<float>* y, std::vector<float>* z,
+                    std::vector<float>* dt) {
+    x->clear(), y->clear(), z->clear(), dt->clear();
+    for (const Eigen::Vector3f& p : pts) {
+      const Eigen::Vector3f w = (T * p.cast<double>()).cast<float>();
+      x->push_back(w.x()), y->push_back(w.y()), z->push_back(w.z()), dt->push_back(0.05f);
+    }
+    return viewOf(utime, *x, *y, *z, *dt, T);
+  };
+  std::vector<float> x, y, z, dt;
+  std::string error;
+  {  // at rest: 0, 55 deg and the point 0.15 m away (within the 0.2 m travel margin) are mapped
+    ColouringPipeline pipe(ColourOptions{}, rig);
+    ASSERT_TRUE(pipe.addScan(scanOf(1000000, Pose3::Identity(), &x, &y, &z, &dt), &error)) << error;
+    EXPECT_EQ(pipe.map().residentPoints(), 3u);
+    EXPECT_EQ(pipe.stats().points_out_of_view, 3);
+    ColourOptions all;
+    all.map_only_in_view = false;
+    ColouringPipeline every(all, rig);
+    ASSERT_TRUE(every.addScan(scanOf(1000000, Pose3::Identity(), &x, &y, &z, &dt), &error)) << error;
+    EXPECT_EQ(every.map().residentPoints(), pts.size());
+  }
+  {  // turning at 1 rad/s about the camera's y axis: the cone widens by 1.5 * 1 * (0.3 + 0.1) s = 34 deg
+    ColouringPipeline pipe(ColourOptions{}, rig);
+    ASSERT_TRUE(pipe.addScan(viewOf(900000, {}, {}, {}, {}, Pose3::Identity()), &error)) << error;
+    Pose3 turned = Pose3::Identity();
+    turned.linear() = so3::Exp(Vec3(0, 0.1, 0));
+    ASSERT_TRUE(pipe.addScan(scanOf(1000000, turned, &x, &y, &z, &dt), &error)) << error;
+    EXPECT_EQ(pipe.map().residentPoints(), 5u);  // 65 and 90 deg now too (< 45 + 15 + 34 + 2); not 180
   }
 }
 
