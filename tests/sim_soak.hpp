@@ -32,9 +32,9 @@
 #include "livo/lio/lio_estimator.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/point_cloud_t.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
-#include "umeyama.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
+#include "livo/evaluate/umeyama.hpp"
 
 namespace livo_soak {
 
@@ -302,7 +302,7 @@ inline void printMemoryRatios(double early_s, const Memory& a, double last_s, co
 /// Position RMSE of `est` against `gt` after SE(3) Umeyama alignment; NaN with fewer than 3 poses.
 inline double ateRmse(const std::vector<livo::Vec3>& est, const std::vector<livo::Vec3>& gt) {
   if (est.size() < 3) return std::numeric_limits<double>::quiet_NaN();
-  const auto align = livo::evaluation::umeyamaAlignment(est, gt, false);
+  const auto align = livo::evaluate::umeyamaAlignment(est, gt, false);
   double sq = 0.0;
   for (size_t i = 0; i < est.size(); ++i) sq += (align.apply(est[i]) - gt[i]).squaredNorm();
   return std::sqrt(sq / static_cast<double>(est.size()));

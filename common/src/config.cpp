@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 namespace livo {
 
 const std::vector<std::string> kConfigSections = {
@@ -104,12 +106,17 @@ Config Config::fromString(const std::string& yaml, const std::string& name) {
   return Config(parseRoot(yaml, name), state, "");
 }
 
+Config::Config(const YAML::Node& node, std::shared_ptr<State> state, std::string path)
+    : node_(std::make_shared<const YAML::Node>(node)), state_(std::move(state)), path_(std::move(path)) {}
+
+bool Config::isNull() const { return !*node_ || node_->IsNull(); }
+
 std::string Config::where(const std::string& key) const { return state_->file + ": " + keyPath(key); }
 
 YAML::Node Config::child(const std::string& key, bool required) const {
   state_->asked.insert(keyPath(key));
-  if (node_ && node_.IsMap()) {
-    YAML::Node n = node_[key];
+  if (*node_ && node_->IsMap()) {
+    YAML::Node n = (*node_)[key];
     if (n && !n.IsNull()) {
       state_->used.insert(keyPath(key));
       return n;
@@ -120,13 +127,13 @@ YAML::Node Config::child(const std::string& key, bool required) const {
 }
 
 bool Config::has(const std::string& key) const {
-  return node_ && node_.IsMap() && node_[key] && !node_[key].IsNull();
+  return *node_ && node_->IsMap() && (*node_)[key] && !(*node_)[key].IsNull();
 }
 
 std::vector<std::string> Config::keys() const {
   std::vector<std::string> out;
-  if (node_ && node_.IsMap())
-    for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  if (*node_ && node_->IsMap())
+    for (const auto& kv : *node_) out.push_back(kv.first.as<std::string>());
   return out;
 }
 
@@ -172,7 +179,7 @@ void Config::collectUnused(const YAML::Node& n, const std::string& path, std::ve
 void Config::checkAllUsed() const {
   if (isNull()) return;
   std::vector<std::string> unused;
-  collectUnused(node_, path_, &unused);
+  collectUnused(*node_, path_, &unused);
   if (unused.empty()) return;
   std::string msg = state_->file + ": unknown key" + (unused.size() > 1 ? "s" : "") + ":";
   for (const auto& u : unused) {
@@ -334,5 +341,28 @@ Eigen::Isometry3d Config::convert<Eigen::Isometry3d>(const YAML::Node& n, const 
   sub.checkAllUsed();
   return T;
 }
+
+#define LIVO_CONFIG_FETCH(T)                                                 \
+  bool Config::fetch(const std::string& key, bool required, T& out) const { \
+    const YAML::Node n = child(key, required);                               \
+    if (!n) return false;                                                    \
+    out = convert<T>(n, key);                                                \
+    return true;                                                             \
+  }
+LIVO_CONFIG_FETCH(bool)
+LIVO_CONFIG_FETCH(int)
+LIVO_CONFIG_FETCH(int64_t)
+LIVO_CONFIG_FETCH(double)
+LIVO_CONFIG_FETCH(float)
+LIVO_CONFIG_FETCH(std::string)
+LIVO_CONFIG_FETCH(std::vector<double>)
+LIVO_CONFIG_FETCH(std::vector<int>)
+LIVO_CONFIG_FETCH(std::vector<std::string>)
+LIVO_CONFIG_FETCH(Eigen::Vector3d)
+LIVO_CONFIG_FETCH(Eigen::Matrix3d)
+LIVO_CONFIG_FETCH(Eigen::Matrix4d)
+LIVO_CONFIG_FETCH(Eigen::Quaterniond)
+LIVO_CONFIG_FETCH(Eigen::Isometry3d)
+#undef LIVO_CONFIG_FETCH
 
 }  // namespace livo

@@ -1,7 +1,7 @@
 // livo-colour --config FILE [--name N] [--output-dir DIR] [--lcm-url URL]: the RGB point-cloud map.
 #include <iostream>
 
-#include "colour_node.hpp"
+#include "livo/colour/colour_node.hpp"
 #include "livo/command_line.hpp"
 
 int main(int argc, char** argv) {
@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   try {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
     const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
-    const livo::colour::ColourNodeOptions options = livo::colour::readColourOptions(cfg.optionalSection("colour"));
+    const livo::colour::ColourNodeOptions options = livo::colour::readColourNodeOptions(cfg);
     if (!cli.has("--quiet")) livo::colour::printColourOptions(options.core, std::cerr);
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");

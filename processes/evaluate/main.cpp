@@ -1,6 +1,6 @@
 // livo-evaluate --est E --gt G [--align se3|sim3|none] [--max-dt S] [--gt-offset x,y,z] [--json F] [--plot F]
 #include <iostream>
 
-#include "evaluate_command.hpp"
+#include "livo/evaluate/evaluate_command.hpp"
 
-int main(int argc, char** argv) { return livo::evaluation::runEvaluateCommand(argc, argv, std::cout, std::cerr); }
+int main(int argc, char** argv) { return livo::evaluate::runEvaluateCommand(argc, argv, std::cout, std::cerr); }

@@ -1,23 +1,23 @@
 // livo-import FORMAT INPUT --out LOG [--preset NAME]: dataset formats -> the project's LCM log.
 #include <iostream>
 
-#include "file_utils.hpp"
-#include "import_job.hpp"
+#include "livo/import/file_utils.hpp"
+#include "livo/import/import_job.hpp"
 #include "livo/command_line.hpp"
-#include "rosbag_presets.hpp"
+#include "livo/import/rosbag_presets.hpp"
 
 namespace {
 
-livo::LidarStampConvention stampConvention(const std::string& s) {
-  if (s == "start") return livo::LidarStampConvention::kStart;
-  if (s == "end") return livo::LidarStampConvention::kEnd;
+livo::import::LidarStampConvention stampConvention(const std::string& s) {
+  if (s == "start") return livo::import::LidarStampConvention::kStart;
+  if (s == "end") return livo::import::LidarStampConvention::kEnd;
   throw std::invalid_argument("--lidar-stamp: expected start or end, got '" + s + "'");
 }
 
-livo::KittiPointFields pointFields(const std::string& s) {
-  if (s == "auto") return livo::KittiPointFields::kAuto;
-  if (s == "xyzi") return livo::KittiPointFields::kXyzi;
-  if (s == "xyz") return livo::KittiPointFields::kXyz;
+livo::import::KittiPointFields pointFields(const std::string& s) {
+  if (s == "auto") return livo::import::KittiPointFields::kAuto;
+  if (s == "xyzi") return livo::import::KittiPointFields::kXyzi;
+  if (s == "xyz") return livo::import::KittiPointFields::kXyz;
   throw std::invalid_argument("--point-fields: expected auto, xyzi or xyz, got '" + s + "'");
 }
 
@@ -68,16 +68,16 @@ int main(int argc, char** argv) {
   if (!cli.parse(argc, argv)) return cli.exitCode();
 
   if (cli.has("--list-presets")) {
-    for (const livo::RosbagPreset& p : livo::rosbagPresets()) std::cout << p.name << ": " << p.description << "\n";
+    for (const livo::import::RosbagPreset& p : livo::import::rosbagPresets()) std::cout << p.name << ": " << p.description << "\n";
     return 0;
   }
-  livo::ImportJob job;
+  livo::import::ImportJob job;
   try {
     job.format = cli.get("FORMAT");
     job.input = cli.get("INPUT");
     if (cli.has("--list-topics")) {
       if (job.format != "rosbag") throw std::invalid_argument("--list-topics is for the rosbag format");
-      for (const livo::BagTopic& t : livo::listBagTopics(job.input))
+      for (const livo::import::BagTopic& t : livo::import::listBagTopics(job.input))
         std::cout << t.topic << "  " << t.type << "  " << t.messages << "\n";
       return 0;
     }
@@ -92,14 +92,14 @@ int main(int argc, char** argv) {
     job.max_buffer_mb = cli.getInt("--max-buffer-mb");
     job.quiet = cli.has("--quiet");
 
-    livo::RosbagImportOptions& r = job.rosbag;
+    livo::import::RosbagImportOptions& r = job.rosbag;
     r.imu_topic = cli.get("--imu");
     r.lidar_topic = cli.get("--lidar");
     r.camera_topic = cli.get("--camera");
     r.camera_right_topic = cli.get("--camera-right");
     if (cli.has("--ground-truth")) {
       const std::string gt = cli.get("--ground-truth");
-      if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::isFile(gt))
+      if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::import::isFile(gt))
         r.ground_truth_topic = gt;
       else
         r.ground_truth_file = gt;
@@ -131,6 +131,6 @@ int main(int argc, char** argv) {
     std::cerr << "livo-import: " << e.what() << "\n";
     return 2;
   }
-  const livo::ImportOutcome outcome = livo::runImport(job, &std::cout);
+  const livo::import::ImportOutcome outcome = livo::import::runImport(job, &std::cout);
   return outcome.ok() ? 0 : 1;
 }

@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
-#include "log_summary.hpp"
+#include "livo/loginfo/log_summary.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-loginfo", "Prints duration and, per channel, type, count, rate and bytes of an LCM log.");
@@ -11,8 +11,8 @@ int main(int argc, char** argv) {
   cli.flag("--nonfinite", "add the number of messages holding a NaN or an infinity; exit 3 if there is any");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   try {
-    const livo::LogSummary summary = livo::summarizeLog(cli.get("LOG"));
-    livo::printLogSummary(summary, std::cout, cli.has("--digest"), cli.has("--nonfinite"));
+    const livo::loginfo::LogSummary summary = livo::loginfo::summarizeLog(cli.get("LOG"));
+    livo::loginfo::printLogSummary(summary, std::cout, cli.has("--digest"), cli.has("--nonfinite"));
     if (cli.has("--nonfinite")) {
       int64_t bad = 0;
       for (const auto& [name, c] : summary.channels) bad += c.non_finite_messages;

@@ -5,7 +5,7 @@
 #include "livo/command_line.hpp"
 #include "livo/config.hpp"
 #include "livo/node.hpp"
-#include "loop_node.hpp"
+#include "livo/loop/loop_node.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-loop", "Loop closure: Quatro + Nano-GICP registration and pose-graph correction.");

@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
-#include "octomap_node.hpp"
+#include "livo/octomap/octomap_node.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-octomap",
@@ -20,13 +20,13 @@ int main(int argc, char** argv) {
   try {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
     const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
-    const auto options = livo::octomap_export::readOctomapOptions(cfg.optionalSection("octomap"));
-    if (!cli.has("--quiet")) livo::octomap_export::printOctomapOptions(options.core, std::cerr);
+    const auto options = livo::octomap::readOctomapNodeOptions(cfg);
+    if (!cli.has("--quiet")) livo::octomap::printOctomapOptions(options.core, std::cerr);
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;
     node_options.name = cli.get("--name");
-    livo::octomap_export::OctomapNode node(*lcm, node_options, options, rig, cli.get("--output-dir"));
+    livo::octomap::OctomapNode node(*lcm, node_options, options, rig, cli.get("--output-dir"));
     return livo::spin(*lcm, node.node(), [&] { node.finish(); });
   } catch (const std::exception& e) {
     std::cerr << "livo-octomap: " << e.what() << std::endl;

@@ -6,7 +6,7 @@
 
 #include "livo/command_line.hpp"
 #include "livo/node.hpp"
-#include "playback.hpp"
+#include "livo/playback/playback.hpp"
 
 namespace {
 std::vector<std::string> splitList(const std::string& s) {
@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   if (!cli.parse(argc, argv)) return cli.exitCode();
 
   try {
-    livo::PlaybackOptions o;
+    livo::playback::PlaybackOptions o;
     o.log = cli.get("LOG");
     o.speed = cli.getDouble("--speed");
     o.lockstep = cli.has("--lockstep");
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     o.source.channels = cli.get("--channels");
     o.source.start_s = cli.getDouble("--start");
     o.source.duration_s = cli.getDouble("--duration");
-    for (const auto& f : splitList(cli.get("--faults"))) o.faults.push_back(livo::parseFault(f));
+    for (const auto& f : splitList(cli.get("--faults"))) o.faults.push_back(livo::playback::parseFault(f));
     o.seed = static_cast<uint64_t>(cli.getInt("--seed"));
     o.out_log = cli.get("--out");
     o.progress_channel = cli.get("--progress-channel");
@@ -65,12 +65,12 @@ int main(int argc, char** argv) {
     o.quiet = cli.has("--quiet");
     if (o.speed < 0) throw std::invalid_argument("--speed must be >= 0");
     if (!o.quiet)
-      for (const auto& f : o.faults) std::cerr << "[playback] fault: " << livo::describe(f) << "\n";
+      for (const auto& f : o.faults) std::cerr << "[playback] fault: " << livo::playback::describe(f) << "\n";
 
     std::unique_ptr<lcm::LCM> lcm;
     if (o.out_log.empty()) lcm = livo::makeLcm(cli.get("--lcm-url"));
     livo::installSignalHandlers();
-    const livo::PlaybackResult r = livo::runPlayback(o, lcm.get());
+    const livo::playback::PlaybackResult r = livo::playback::runPlayback(o, lcm.get());
     if (!o.quiet)
       std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
                 << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())

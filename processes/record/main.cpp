@@ -3,7 +3,7 @@
 #include <sstream>
 
 #include "livo/command_line.hpp"
-#include "recorder.hpp"
+#include "livo/record/recorder.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-record",
@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
     o.name = cli.get("--name");
     o.quiet = true;
     livo::Node node(*lcm, o);
-    livo::Recorder recorder(node, cli.get("--out"), channels);
+    livo::record::Recorder recorder(node, cli.get("--out"), channels);
     const int rc = livo::spin(*lcm, node, [&] { recorder.finish(o.health_channel); });
     std::cerr << "[" << o.name << "] wrote " << recorder.written() << " messages to " << cli.get("--out") << std::endl;
     return rc;

@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "livo/command_line.hpp"
-#include "memory_profile.hpp"
-#include "pipeline_outputs.hpp"
-#include "run_report.hpp"
+#include "livo/report/memory_profile.hpp"
+#include "livo/report/pipeline_outputs.hpp"
+#include "livo/report/run_report.hpp"
 
 namespace {
 
@@ -37,17 +37,17 @@ int extract(int argc, char** argv) {
       .option("--loop-channel", "CH", "loop corrections", "LOOP_CORRECTION")
       .option("--health-channel", "CH", "node health", "HEALTH");
   if (!cli.parse(argc, argv)) return cli.exitCode();
-  livo::PipelineChannels ch;
+  livo::report::PipelineChannels ch;
   ch.odometry = cli.get("--odometry-channel");
   ch.keyframe = cli.get("--keyframe-channel");
   ch.loop_correction = cli.get("--loop-channel");
   ch.health = cli.get("--health-channel");
-  const livo::PipelineOutputs out = livo::readPipelineOutputs(cli.get("OUTPUTS"), ch);
+  const livo::report::PipelineOutputs out = livo::report::readPipelineOutputs(cli.get("OUTPUTS"), ch);
   const std::string dir = cli.get("--dir");
   livo::writeTum(dir + "/odometry.tum", out.odometry);
-  livo::writeTum(dir + "/trajectory.tum", livo::loopCorrectedTrajectory(out));
-  writeText(dir + "/timing.json", livo::timingJson(out.final_health).dump(2) + "\n");
-  writeText(dir + "/resets.json", livo::resetsJson(out.resets));
+  livo::writeTum(dir + "/trajectory.tum", livo::report::loopCorrectedTrajectory(out));
+  writeText(dir + "/timing.json", livo::report::timingJson(out.final_health).dump(2) + "\n");
+  writeText(dir + "/resets.json", livo::report::resetsJson(out.resets));
   std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
             << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes\n";
   if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
@@ -76,7 +76,7 @@ int markdown(int argc, char** argv) {
       .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   const std::string dir = cli.get("--dir");
-  livo::ReportInputs in;
+  livo::report::ReportInputs in;
   in.run.log = cli.get("--log");
   in.run.config = cli.get("--config");
   in.run.processes = splitList(cli.get("--processes"));
@@ -108,7 +108,7 @@ int markdown(int argc, char** argv) {
   for (const auto& f : splitList(cli.get("--sensor-use"), ';')) in.sensor_use.push_back(f);
   if (!cli.get("--restarts").empty()) {
     in.supervised = true;
-    in.restarts = livo::readRestarts(cli.get("--restarts"));
+    in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
   for (const auto& [node, p] : in.timing.items()) {
@@ -121,7 +121,7 @@ int markdown(int argc, char** argv) {
                               " were rejected (see its log)");
     }
   }
-  writeText(dir + "/report.md", livo::reportMarkdown(in));
+  writeText(dir + "/report.md", livo::report::reportMarkdown(in));
   std::cout << dir << "/report.md\n";
   return 0;
 }
@@ -134,12 +134,12 @@ int memory(int argc, char** argv) {
   if (!cli.parse(argc, argv)) return cli.exitCode();
   std::vector<double> at;
   for (const std::string& s : splitList(cli.get("--at"))) at.push_back(std::stod(s));
-  const livo::MemoryProfile p = livo::readMemoryProfile(cli.get("OUTPUTS"), cli.get("--health-channel"));
+  const livo::report::MemoryProfile p = livo::report::readMemoryProfile(cli.get("OUTPUTS"), cli.get("--health-channel"));
   if (p.samples.empty()) {
     std::cerr << "livo-report: no HEALTH messages with a sensor time in " << cli.get("OUTPUTS") << "\n";
     return 1;
   }
-  std::cout << livo::memoryTable(p, at);
+  std::cout << livo::report::memoryTable(p, at);
   return 0;
 }
 

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
-#include "log_writer.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/log_writer.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-sim",

@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "colouring_pipeline.hpp"
+#include "livo/colour/colouring_pipeline.hpp"
 #include "../octomap/sim_recording.hpp"
 
 namespace {

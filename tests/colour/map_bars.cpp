@@ -23,13 +23,13 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "colour_config.hpp"
-#include "colouring_pipeline.hpp"
+#include "livo/colour/colour_config.hpp"
+#include "livo/colour/colouring_pipeline.hpp"
 #include "livo/command_line.hpp"
-#include "octomap_builder.hpp"
-#include "octomap_config.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/octomap/octomap_builder.hpp"
+#include "livo/octomap/octomap_config.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 using namespace livo;
 
@@ -56,7 +56,7 @@ double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
 class BarSink : public sim::SensorDataSink {
  public:
-  BarSink(const sim::SimulationSetup& setup, const colour::ColourOptions& co, const octomap_export::OctomapOptions& oo)
+  BarSink(const sim::SimulationSetup& setup, const colour::ColourOptions& co, const livo::octomap::OctomapOptions& oo)
       : setup_(setup), colour_(co, *setup.rig.camera), octo_(oo, setup.rig.lidar->T_I_L), res_(oo.resolution) {
     colour_.setObserver([this](const colour::Observation& o) {
       const Eigen::Vector3d p = colour_.map().point(o.point).position.cast<double>();
@@ -268,7 +268,7 @@ class BarSink : public sim::SensorDataSink {
 
   const sim::SimulationSetup& setup_;
   colour::ColouringPipeline colour_;
-  octomap_export::OctomapBuilder octo_;
+  livo::octomap::OctomapBuilder octo_;
   double res_;
   struct Truth {
     bool set = false, known = false;  // known: the point came from a beam of a scan
@@ -296,15 +296,15 @@ int main(int argc, char** argv) {
     const Config cfg = Config::load(cli.get("--config"));
     // the config's colour: section (defaults if absent) with the bar's photometric calibration:
     // the simulator's camera model
-    colour::ColourOptions co = colour::readColourOptions(cfg.optionalSection("colour")).core;
+    colour::ColourOptions co = colour::readColourNodeOptions(cfg).core;
     co.vignetting = setup.options.camera.vignetting;
     co.reference_exposure_s = setup.options.camera.exposure_time;
     // the config's octomap: section (defaults if absent), at the bar's resolution and the sensor's range
-    octomap_export::OctomapOptions oo = octomap_export::readOctomapOptions(cfg.optionalSection("octomap")).core;
+    livo::octomap::OctomapOptions oo = livo::octomap::readOctomapNodeOptions(cfg).core;
     oo.resolution = 0.1;
     oo.max_range = setup.rig.lidar->max_range;
     colour::printColourOptions(co, std::cout);
-    octomap_export::printOctomapOptions(oo, std::cout);
+    livo::octomap::printOctomapOptions(oo, std::cout);
     BarSink sink(setup, co, oo);
     sim::Simulator(setup).run(sink);
     sink.report();

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "colour_image.hpp"
+#include "livo/colour/colour_image.hpp"
 #include "livo/sensor_rig.hpp"
 
 namespace livo_test {

@@ -9,10 +9,10 @@
 #include <opencv2/calib3d.hpp>
 
 #include "livo/camera_projection.hpp"
-#include "colour_map.hpp"
-#include "colouring_pipeline.hpp"
-#include "exposure_gain.hpp"
-#include "map_files.hpp"
+#include "livo/colour/colour_map.hpp"
+#include "livo/colour/colouring_pipeline.hpp"
+#include "livo/colour/exposure_gain.hpp"
+#include "livo/colour/map_files.hpp"
 #include "scene_fixtures.hpp"
 #include "temp_path.hpp"
 

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "colour_node.hpp"
+#include "livo/colour/colour_node.hpp"
 #include "livo/colored_cloud_t.hpp"
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
@@ -16,7 +16,7 @@
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "map_files.hpp"
+#include "livo/colour/map_files.hpp"
 #include "scene_fixtures.hpp"
 #include "temp_path.hpp"
 
@@ -420,15 +420,15 @@ TEST(ColourNode, RefusesARigWithoutCamera) {
 
 TEST(ColourConfig, ReadsKeysStrictly) {
   const Config ok = Config::fromString("colour: {voxel_size: 0.1, vignetting: 0.25, map_name: room}");
-  const colour::ColourNodeOptions o = colour::readColourOptions(ok.section("colour"));
+  const colour::ColourNodeOptions o = colour::readColourNodeOptions(ok);
   EXPECT_DOUBLE_EQ(o.core.voxel_size, 0.1);
   EXPECT_DOUBLE_EQ(o.core.vignetting, 0.25);
   EXPECT_EQ(o.map_name, "room");
-  EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {voxel_sise: 0.1}").section("colour")), ConfigError);
-  EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {voxel_size: -1}").section("colour")), ConfigError);
-  EXPECT_EQ(colour::readColourOptions(Config::fromString("colour: {max_pending_images: 8}").section("colour"))
+  EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {voxel_sise: 0.1}")), ConfigError);
+  EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {voxel_size: -1}")), ConfigError);
+  EXPECT_EQ(colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 8}"))
                 .core.max_pending_images,
             8);
-  EXPECT_THROW(colour::readColourOptions(Config::fromString("colour: {max_pending_images: 0}").section("colour")),
+  EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 0}")),
                ConfigError);
 }

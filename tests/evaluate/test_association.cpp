@@ -4,11 +4,11 @@
 #include <cmath>
 #include <random>
 
-#include "association.hpp"
+#include "livo/evaluate/association.hpp"
 #include "synthetic_trajectory.hpp"
 
 using namespace livo;
-using namespace livo::evaluation;
+using namespace livo::evaluate;
 
 namespace {
 Trajectory stamped(const std::vector<double>& stamps) {

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "evaluate_command.hpp"
+#include "livo/evaluate/evaluate_command.hpp"
 #include "livo/trajectory_io.hpp"
 #include "synthetic_trajectory.hpp"
 #include "temp_path.hpp"
@@ -30,7 +30,7 @@ CommandResult run(std::vector<std::string> args) {
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   std::ostringstream out, err;
-  const int code = evaluation::runEvaluateCommand(static_cast<int>(argv.size()), argv.data(), out, err);
+  const int code = evaluate::runEvaluateCommand(static_cast<int>(argv.size()), argv.data(), out, err);
   return {code, out.str(), err.str()};
 }
 

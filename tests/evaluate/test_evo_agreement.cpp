@@ -11,10 +11,10 @@
 #include <map>
 #include <string>
 
-#include "evaluation.hpp"
+#include "livo/evaluate/evaluation.hpp"
 
 using namespace livo;
-using namespace livo::evaluation;
+using namespace livo::evaluate;
 
 namespace {
 
@@ -173,7 +173,7 @@ const Evaluation& evaluationOf(const EvoReference& ref) {
     options.alignment = parseAlignment(ref.align);
     options.rpe.delta = ref.delta;
     options.rpe.all_pairs = ref.all_pairs;
-    it = cache.emplace(key, evaluate(input(ref.est), input(ref.gt), options)).first;
+    it = cache.emplace(key, evaluateTrajectory(input(ref.est), input(ref.gt), options)).first;
   }
   return it->second;
 }

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <random>
 
-#include "evaluation.hpp"
+#include "livo/evaluate/evaluation.hpp"
 #include "synthetic_trajectory.hpp"
 
 using namespace livo;
-using namespace livo::evaluation;
+using namespace livo::evaluate;
 
 namespace {
 TrajectoryInput timed(const Trajectory& t, const std::string& name = "synthetic") {
@@ -61,7 +61,7 @@ TEST(Evaluate, AlignmentUndoesAKnownTransformAndScale) {
   const Trajectory gt = fixtures::wigglyTrajectory(600);
   EvaluationOptions options;
   // Rigid change of world frame: SE(3) alignment removes it entirely.
-  Evaluation ev = evaluate(timed(fixtures::transformed(gt, fixtures::somePose())), timed(gt), options);
+  Evaluation ev = evaluateTrajectory(timed(fixtures::transformed(gt, fixtures::somePose())), timed(gt), options);
   EXPECT_EQ(ev.pairs.size(), 600u);
   EXPECT_LT(ev.ate.max, 1e-9);
   EXPECT_LT(ev.rpe_translation_m.max, 1e-9);
@@ -71,10 +71,10 @@ TEST(Evaluate, AlignmentUndoesAKnownTransformAndScale) {
 
   // Scaled by 0.5 as well: SE(3) leaves an error, Sim(3) recovers the scale 2.
   const Trajectory scaled = fixtures::transformed(gt, fixtures::somePose(), 0.5);
-  ev = evaluate(timed(scaled), timed(gt), options);
+  ev = evaluateTrajectory(timed(scaled), timed(gt), options);
   EXPECT_GT(ev.ate.rmse, 1.0);
   options.alignment = Alignment::kSim3;
-  ev = evaluate(timed(scaled), timed(gt), options);
+  ev = evaluateTrajectory(timed(scaled), timed(gt), options);
   EXPECT_NEAR(ev.alignment.scale, 2.0, 1e-12);
   EXPECT_LT(ev.ate.max, 1e-9);
   EXPECT_LT(ev.rpe_translation_m.max, 1e-9);
@@ -83,7 +83,7 @@ TEST(Evaluate, AlignmentUndoesAKnownTransformAndScale) {
   options.alignment = Alignment::kNone;
   Pose3 shift = Pose3::Identity();
   shift.translation() = Vec3(0.3, -0.4, 0.0);
-  ev = evaluate(timed(fixtures::transformed(gt, shift)), timed(gt), options);
+  ev = evaluateTrajectory(timed(fixtures::transformed(gt, shift)), timed(gt), options);
   EXPECT_NEAR(ev.ate.min, 0.5, 1e-12);
   EXPECT_NEAR(ev.ate.max, 0.5, 1e-12);
   EXPECT_LT(ev.rpe_translation_m.max, 1e-12);  // relative poses do not see it
@@ -96,7 +96,7 @@ TEST(Evaluate, AteOfIsotropicNoiseIsItsExpectedSize) {
   const double sigma = 0.02;
   std::normal_distribution<double> noise(0.0, sigma);
   for (auto& s : est) s.pose.translation() += Vec3(noise(rng), noise(rng), noise(rng));
-  const Evaluation ev = evaluate(timed(est), timed(gt), EvaluationOptions{});
+  const Evaluation ev = evaluateTrajectory(timed(est), timed(gt), EvaluationOptions{});
   // |n| for n ~ N(0, sigma^2 I3): rms sqrt(3) sigma, mean 2 sqrt(2/pi) sigma, median 1.5382 sigma.
   // Over 5000 samples their standard errors are below 1 %; the bounds are about four of them.
   EXPECT_NEAR(ev.ate.rmse, std::sqrt(3.0) * sigma, 0.04 * std::sqrt(3.0) * sigma);
@@ -118,7 +118,7 @@ TEST(Evaluate, RpeSeesAConstantPerStepError) {
     est[i].pose = est[i - 1].pose * (gt[i - 1].pose.inverse() * gt[i].pose) * step_error;
   EvaluationOptions options;
   options.alignment = Alignment::kNone;
-  Evaluation ev = evaluate(timed(est), timed(gt), options);
+  Evaluation ev = evaluateTrajectory(timed(est), timed(gt), options);
   ASSERT_EQ(ev.rpe_translation_m.count, 399u);
   EXPECT_NEAR(ev.rpe_translation_m.min, step_error.translation().norm(), 1e-9);
   EXPECT_NEAR(ev.rpe_translation_m.max, step_error.translation().norm(), 1e-9);
@@ -127,11 +127,11 @@ TEST(Evaluate, RpeSeesAConstantPerStepError) {
 
   // Over 4 frames, consecutive (0-4, 4-8, ...) or every pair (0-4, 1-5, ...).
   options.rpe.delta = 4;
-  ev = evaluate(timed(est), timed(gt), options);
+  ev = evaluateTrajectory(timed(est), timed(gt), options);
   EXPECT_EQ(ev.rpe.from.size(), 99u);
   EXPECT_EQ(ev.rpe.from[1], 4u);
   options.rpe.all_pairs = true;
-  ev = evaluate(timed(est), timed(gt), options);
+  ev = evaluateTrajectory(timed(est), timed(gt), options);
   EXPECT_EQ(ev.rpe.from.size(), 396u);
   EXPECT_EQ(ev.rpe.from[1], 1u);
   EXPECT_EQ(ev.rpe.to[1], 5u);
@@ -207,7 +207,7 @@ TEST(Evaluate, CoverageOfAnEstimateThatLosesTrack) {
   Trajectory est;
   for (size_t i = 0; i < gt.size(); i += 2)  // 10 Hz, lost between 20 s and 30 s
     if (gt[i].stamp - gt.front().stamp < 20.0 || gt[i].stamp - gt.front().stamp >= 30.0) est.push_back(gt[i]);
-  const Evaluation ev = evaluate(timed(est), timed(gt), EvaluationOptions{});
+  const Evaluation ev = evaluateTrajectory(timed(est), timed(gt), EvaluationOptions{});
   EXPECT_NEAR(ev.coverage.gap, 0.3, 1e-9);
   // Covered: 0 .. 19.9 and 30 .. 49.9 of a 49.95 s span.
   EXPECT_NEAR(ev.coverage.fraction, (19.9 + 19.9) / 49.95, 1e-9);
@@ -221,16 +221,16 @@ TEST(Evaluate, GtOffsetMovesTheEstimateToThePrism) {
   EXPECT_NEAR((prism_track[10].pose.translation() - body[10].pose.translation()).norm(), prism.norm(), 1e-12);
   EvaluationOptions options;
   options.alignment = Alignment::kNone;
-  EXPECT_NEAR(evaluate(timed(body), timed(prism_track), options).ate.max, prism.norm(), 1e-12);
+  EXPECT_NEAR(evaluateTrajectory(timed(body), timed(prism_track), options).ate.max, prism.norm(), 1e-12);
   options.gt_offset = prism;
-  EXPECT_LT(evaluate(timed(body), timed(prism_track), options).ate.max, 1e-12);
+  EXPECT_LT(evaluateTrajectory(timed(body), timed(prism_track), options).ate.max, 1e-12);
 }
 
 TEST(Evaluate, ClearErrorsWhenNothingPairsOrAlignmentIsImpossible) {
   const Trajectory gt = fixtures::wigglyTrajectory(100, 10.0, 1000.0);
   const Trajectory est = fixtures::wigglyTrajectory(100, 10.0, 0.0);
   try {
-    evaluate(timed(est, "est.tum"), timed(gt, "gt.tum"), EvaluationOptions{});
+    evaluateTrajectory(timed(est, "est.tum"), timed(gt, "gt.tum"), EvaluationOptions{});
     FAIL() << "nothing associates";
   } catch (const EvaluationError& e) {
     const std::string m = e.what();
@@ -240,14 +240,14 @@ TEST(Evaluate, ClearErrorsWhenNothingPairsOrAlignmentIsImpossible) {
   }
   // Two pairs cannot be aligned; without alignment they can be evaluated.
   const Trajectory two(gt.begin(), gt.begin() + 2);
-  EXPECT_THROW(evaluate(timed(two), timed(gt), EvaluationOptions{}), EvaluationError);
+  EXPECT_THROW(evaluateTrajectory(timed(two), timed(gt), EvaluationOptions{}), EvaluationError);
   EvaluationOptions none;
   none.alignment = Alignment::kNone;
-  EXPECT_EQ(evaluate(timed(two), timed(gt), none).ate.count, 2u);
+  EXPECT_EQ(evaluateTrajectory(timed(two), timed(gt), none).ate.count, 2u);
 
   EvaluationOptions bad;
   bad.rpe.delta = 0;
-  EXPECT_THROW(evaluate(timed(gt), timed(gt), bad), std::invalid_argument);
+  EXPECT_THROW(evaluateTrajectory(timed(gt), timed(gt), bad), std::invalid_argument);
   EXPECT_THROW(parseAlignment("affine"), std::invalid_argument);
 }
 
@@ -256,7 +256,7 @@ TEST(Evaluate, ClearErrorsWhenNothingPairsOrAlignmentIsImpossible) {
 TEST(Evaluate, EndPointDriftAnchorsAtTheFirstPose) {
   const Trajectory gt = fixtures::wigglyTrajectory(600);
   EvaluationOptions options;
-  Evaluation ev = evaluate(timed(fixtures::transformed(gt, fixtures::somePose())), timed(gt), options);
+  Evaluation ev = evaluateTrajectory(timed(fixtures::transformed(gt, fixtures::somePose())), timed(gt), options);
   EXPECT_LT(ev.end_point.translation_m, 1e-9);
   EXPECT_LT(ev.end_point.rotation_deg, 1e-9);
   double length = 0.0;
@@ -270,7 +270,7 @@ TEST(Evaluate, EndPointDriftAnchorsAtTheFirstPose) {
   yaw.linear() = Eigen::AngleAxisd(M_PI / 180.0, Vec3::UnitZ()).toRotationMatrix();
   yaw.translation() = p0 - yaw.linear() * p0;
   for (size_t i = 1; i < est.size(); ++i) est[i].pose = yaw * est[i].pose;
-  ev = evaluate(timed(est), timed(gt), options);
+  ev = evaluateTrajectory(timed(est), timed(gt), options);
   const Vec3 pn = gt.back().pose.translation();
   const Vec3 d = pn - p0;
   const double expected = 2.0 * std::sin(M_PI / 360.0) * std::hypot(d.x(), d.y());

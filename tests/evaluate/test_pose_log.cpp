@@ -4,18 +4,18 @@
 #include <cmath>
 #include <functional>
 
-#include "evaluation.hpp"
+#include "livo/evaluate/evaluation.hpp"
 #include "lcm_log_writer.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/pose_t.hpp"
-#include "pose_log.hpp"
+#include "livo/evaluate/pose_log.hpp"
 #include "synthetic_trajectory.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
-using namespace livo::evaluation;
+using namespace livo::evaluate;
 
 namespace {
 
@@ -98,7 +98,7 @@ TEST(PoseLog, ReadsDefaultAndNamedChannelsOfBothTypes) {
   EXPECT_EQ(readTrajectoryInput(log + ":GROUND_TRUTH", "ODOMETRY").poses.size(), 200u);
 
   // Estimate and ground truth from the same log: the world change is undone by the alignment.
-  const Evaluation ev = evaluate(o, g, EvaluationOptions{});
+  const Evaluation ev = evaluateTrajectory(o, g, EvaluationOptions{});
   EXPECT_EQ(ev.pairs.size(), 100u);
   EXPECT_LT(ev.ate.max, 1e-9);
 }

@@ -3,10 +3,10 @@
 
 #include <random>
 
-#include "umeyama.hpp"
+#include "livo/evaluate/umeyama.hpp"
 
 using namespace livo;
-using namespace livo::evaluation;
+using namespace livo::evaluate;
 
 namespace {
 std::vector<Vec3> randomPoints(size_t n, unsigned seed) {

@@ -1,14 +1,14 @@
 // The shared EuRoC V1_01 sample (ASL folder + groundtruth.tum) against its own files.
 #include <gtest/gtest.h>
 
-#include "file_utils.hpp"
-#include "import_job.hpp"
+#include "livo/import/file_utils.hpp"
+#include "livo/import/import_job.hpp"
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/pose_t.hpp"
 #include "log_reading.hpp"
 
-namespace livo {
+namespace livo::import {
 namespace {
 
 const std::string kEuroc = std::string(LIVO_SHARED_DATA) + "/euroc_v1_01";
@@ -107,4 +107,4 @@ TEST(EurocImport, NotAnAslFolderIsAClearError) {
 }
 
 }  // namespace
-}  // namespace livo
+}  // namespace livo::import

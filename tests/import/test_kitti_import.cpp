@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "file_utils.hpp"
-#include "import_job.hpp"
-#include "kitti_velodyne.hpp"
+#include "livo/import/file_utils.hpp"
+#include "livo/import/import_job.hpp"
+#include "livo/import/kitti_velodyne.hpp"
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
@@ -18,7 +18,7 @@
 #include "livo/pose_t.hpp"
 #include "log_reading.hpp"
 
-namespace livo {
+namespace livo::import {
 namespace {
 
 const std::string kData = LIVO_SHARED_DATA;
@@ -224,4 +224,4 @@ TEST(KittiImport, TruncatedScanIsSkippedNamingTheFile) {
 }
 
 }  // namespace
-}  // namespace livo
+}  // namespace livo::import

@@ -9,16 +9,16 @@
 
 #include <gtest/gtest.h>
 
-#include "file_utils.hpp"
-#include "import_job.hpp"
+#include "livo/import/file_utils.hpp"
+#include "livo/import/import_job.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/trajectory_io.hpp"
 #include "log_reading.hpp"
-#include "ouster_metadata.hpp"
-#include "pcap_reader.hpp"
+#include "livo/import/ouster_metadata.hpp"
+#include "livo/import/pcap_reader.hpp"
 
-namespace livo {
+namespace livo::import {
 namespace {
 
 const std::string kOuster = std::string(LIVO_SHARED_DATA) + "/ouster";
@@ -279,4 +279,4 @@ TEST(OusterImport, MetadataErrorsNameTheKey) {
 }
 
 }  // namespace
-}  // namespace livo
+}  // namespace livo::import

@@ -5,9 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "point_cloud2_conversion.hpp"
+#include "livo/import/point_cloud2_conversion.hpp"
 
 using namespace livo;
+using namespace livo::import;
 
 namespace {
 constexpr uint8_t kUint16 = 4, kFloat32 = 7;  // sensor_msgs/PointField datatypes

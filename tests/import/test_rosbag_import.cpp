@@ -6,15 +6,15 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "file_utils.hpp"
-#include "import_job.hpp"
+#include "livo/import/file_utils.hpp"
+#include "livo/import/import_job.hpp"
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/pose_t.hpp"
 #include "log_reading.hpp"
 
-namespace livo {
+namespace livo::import {
 namespace {
 
 using nlohmann::json;
@@ -252,4 +252,4 @@ TEST(RosbagImport, NotABagIsAClearError) {
 }
 
 }  // namespace
-}  // namespace livo
+}  // namespace livo::import

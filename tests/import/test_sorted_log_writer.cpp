@@ -3,9 +3,9 @@
 
 #include "livo/imu_t.hpp"
 #include "log_reading.hpp"
-#include "sorted_log_writer.hpp"
+#include "livo/import/sorted_log_writer.hpp"
 
-namespace livo {
+namespace livo::import {
 namespace {
 
 void writeShuffled(SortedLogWriter& w) {
@@ -52,4 +52,4 @@ TEST(SortedLogWriter, SortsThroughSpilledRuns) {
 }
 
 }  // namespace
-}  // namespace livo
+}  // namespace livo::import

@@ -69,7 +69,7 @@ RunLog run(LioEstimator& lio, const SyntheticSequence& seq, int first, int last,
       log.degenerate += r.degeneracy.degenerate;
     }
     r.world_points.clear();
-    r.intensity.clear();
+    r.input_index.clear();
     log.results.push_back(std::move(r));
   }
   return log;

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "point_types.hpp"
+#include "livo/loop/point_types.hpp"
 
 namespace livo::loop::testing {
 

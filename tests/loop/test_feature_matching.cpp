@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "coarse_features.hpp"
-#include "feature_matching.hpp"
+#include "livo/loop/coarse_features.hpp"
+#include "livo/loop/feature_matching.hpp"
 #include "synthetic_scenes.hpp"
 
 namespace livo::loop {

@@ -2,10 +2,10 @@
 
 #include <random>
 
-#include "gicp.hpp"
-#include "loop_registration.hpp"
+#include "livo/loop/gicp.hpp"
+#include "livo/loop/loop_registration.hpp"
 #include "synthetic_scenes.hpp"
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "loop_closer.hpp"
-#include "loop_consistency.hpp"
+#include "livo/loop/loop_closer.hpp"
+#include "livo/loop/loop_consistency.hpp"
 #include "synthetic_scenes.hpp"
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

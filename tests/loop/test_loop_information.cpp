@@ -8,10 +8,10 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "gicp.hpp"
-#include "loop_information.hpp"
+#include "livo/loop/gicp.hpp"
+#include "livo/loop/loop_information.hpp"
 #include "synthetic_scenes.hpp"
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

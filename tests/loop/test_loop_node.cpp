@@ -13,8 +13,8 @@
 
 #include "livo/loop_correction_t.hpp"
 #include "livo/messages.hpp"
-#include "loop_node.hpp"
-#include "pose_graph.hpp"
+#include "livo/loop/loop_node.hpp"
+#include "livo/loop/pose_graph.hpp"
 #include "synthetic_scenes.hpp"
 #include "temp_path.hpp"
 

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "max_clique.hpp"
+#include "livo/loop/max_clique.hpp"
 
 namespace livo::loop {
 namespace {

@@ -4,7 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "pose_graph.hpp"
+#include "livo/loop/pose_graph.hpp"
 #include "synthetic_scenes.hpp"
 
 namespace livo::loop {

@@ -2,11 +2,11 @@
 
 #include <gtest/gtest.h>
 
-#include "coarse_features.hpp"
-#include "feature_matching.hpp"
-#include "quatro.hpp"
+#include "livo/loop/coarse_features.hpp"
+#include "livo/loop/feature_matching.hpp"
+#include "livo/loop/quatro.hpp"
 #include "synthetic_scenes.hpp"
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

@@ -6,11 +6,11 @@
 
 #include <gtest/gtest.h>
 
-#include "loop_closer.hpp"
-#include "loop_registration.hpp"
+#include "livo/loop/loop_closer.hpp"
+#include "livo/loop/loop_registration.hpp"
 #include "real_scans.hpp"
 #include "synthetic_scenes.hpp"
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "voxel_grid.hpp"
+#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {

@@ -13,7 +13,7 @@
 #include <set>
 #include <string>
 
-#include "octomap_builder.hpp"
+#include "livo/octomap/octomap_builder.hpp"
 #include "sim_recording.hpp"
 
 namespace {
@@ -29,16 +29,16 @@ double cpuSeconds() {
 void sweeps(benchmark::State& state, int origin_segments) {
   const livo_bench::SimRecording& rec = livo_bench::roomRecording();
   const auto& setup = livo_bench::roomSetup();
-  livo::octomap_export::OctomapOptions o;
+  livo::octomap::OctomapOptions o;
   o.resolution = 0.1;
   o.max_range = setup.rig.lidar->max_range;
   o.origin_segments = origin_segments;
-  std::unique_ptr<livo::octomap_export::OctomapBuilder> builder;
+  std::unique_ptr<livo::octomap::OctomapBuilder> builder;
   size_t next = rec.sweeps.size(), points = 0;
   std::string error;
   for (auto _ : state) {
     if (next == rec.sweeps.size()) {
-      builder = std::make_unique<livo::octomap_export::OctomapBuilder>(o, setup.rig.lidar->T_I_L);
+      builder = std::make_unique<livo::octomap::OctomapBuilder>(o, setup.rig.lidar->T_I_L);
       next = 0;
     }
     const livo_bench::WorldSweep& s = rec.sweeps[next++];
@@ -63,10 +63,10 @@ BENCHMARK(BM_OctomapSweep)->Arg(8)->Arg(1)->UseManualTime()->Unit(benchmark::kMi
 void BM_OctomapRebuild(benchmark::State& state) {
   const livo_bench::SimRecording& rec = livo_bench::roomRecording();
   const auto& setup = livo_bench::roomSetup();
-  livo::octomap_export::OctomapOptions o;
+  livo::octomap::OctomapOptions o;
   o.resolution = 0.1;
   o.max_range = setup.rig.lidar->max_range;
-  livo::octomap_export::OctomapBuilder builder(o, setup.rig.lidar->T_I_L);
+  livo::octomap::OctomapBuilder builder(o, setup.rig.lidar->T_I_L);
   std::map<int64_t, livo::Pose3> poses;
   size_t keyframe_points = 0;
   std::string error;
@@ -78,7 +78,7 @@ void BM_OctomapRebuild(benchmark::State& state) {
     v.x = s.x.data(), v.y = s.y.data(), v.z = s.z.data(), v.time_offset = s.time_offset.data();
     builder.addScan(v, &error);
     if (k % 10 != 5) continue;
-    livo::octomap_export::Keyframe kf;
+    livo::octomap::Keyframe kf;
     kf.utime = s.utime;
     kf.T_W_I = s.T_W_I;
     const livo::Pose3 T_I_W = s.T_W_I.inverse();

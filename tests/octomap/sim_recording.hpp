@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 namespace livo_bench {
 

@@ -15,12 +15,12 @@
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
-#include "octomap_builder.hpp"
-#include "octomap_config.hpp"
+#include "livo/octomap/octomap_builder.hpp"
+#include "livo/octomap/octomap_config.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
-using namespace livo::octomap_export;
+using namespace livo::octomap;
 
 namespace {
 
@@ -114,7 +114,7 @@ TEST(OccupancyMap, BtAndOtFilesLoadBackWithOctomapsReaders) {
     ASSERT_TRUE(map.writeFull(ot));
     const size_t occupied = map.occupiedVoxels().size();
 
-    octomap::OcTree from_bt(0.1);
+    ::octomap::OcTree from_bt(0.1);
     ASSERT_TRUE(from_bt.readBinary(bt));
     EXPECT_DOUBLE_EQ(from_bt.getResolution(), 0.1);
     size_t bt_occupied = 0;
@@ -124,13 +124,13 @@ TEST(OccupancyMap, BtAndOtFilesLoadBackWithOctomapsReaders) {
     ASSERT_NE(from_bt.search(-2.05, 0.0, 1.0), nullptr);
     EXPECT_TRUE(from_bt.isNodeOccupied(from_bt.search(-2.05, 0.0, 1.0)));
 
-    std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(ot));
+    std::unique_ptr<::octomap::AbstractOcTree> any(::octomap::AbstractOcTree::read(ot));
     ASSERT_NE(any, nullptr);
     EXPECT_EQ(any->getTreeType(), colour ? "ColorOcTree" : "OcTree");
     if (colour) {
-      auto* t = dynamic_cast<octomap::ColorOcTree*>(any.get());
+      auto* t = dynamic_cast<::octomap::ColorOcTree*>(any.get());
       ASSERT_NE(t, nullptr);
-      const octomap::ColorOcTreeNode* n = t->search(-2.05, 0.05, 1.05);
+      const ::octomap::ColorOcTreeNode* n = t->search(-2.05, 0.05, 1.05);
       ASSERT_NE(n, nullptr);
       EXPECT_EQ(n->getColor().r, 200);
       EXPECT_EQ(n->getColor().g, 10);
@@ -362,11 +362,11 @@ TEST(OctomapBuilder, RebuildsOnlyWhenPointsMoveBeyondTheTolerance) {
 }
 
 TEST(OctomapConfig, ReadsKeysStrictly) {
-  const auto o = readOctomapOptions(Config::fromString("octomap: {resolution: 0.2, colour: true}").section("octomap"));
+  const auto o = readOctomapNodeOptions(Config::fromString("octomap: {resolution: 0.2, colour: true}"));
   EXPECT_DOUBLE_EQ(o.core.resolution, 0.2);
   EXPECT_TRUE(o.core.colour);
-  EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {resolutoin: 0.2}").section("octomap")), ConfigError);
-  EXPECT_THROW(readOctomapOptions(Config::fromString("octomap: {prob_hit: 0.3}").section("octomap")), ConfigError);
+  EXPECT_THROW(readOctomapNodeOptions(Config::fromString("octomap: {resolutoin: 0.2}")), ConfigError);
+  EXPECT_THROW(readOctomapNodeOptions(Config::fromString("octomap: {prob_hit: 0.3}")), ConfigError);
 }
 
 namespace {
@@ -412,27 +412,27 @@ TEST(OccupancyMap, SweepSlicesAreOneUpdate) {
   EXPECT_EQ(map.classify(Eigen::Vector3d(3.05, 0.05, 0.05)), 1);
   EXPECT_EQ(map.classify(Eigen::Vector3d(0.55, 0.05, 0.05)), 0);
   // one miss per sweep: the log-odds of a voxel both rays crossed is that of a single miss
-  const float one_miss = octomap::logodds(o.prob_miss);
+  const float one_miss = ::octomap::logodds(o.prob_miss);
   std::istringstream in(map.fullBytes());
-  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(in));
-  auto* tree = dynamic_cast<octomap::OcTree*>(read.get());
+  std::unique_ptr<::octomap::AbstractOcTree> read(::octomap::AbstractOcTree::read(in));
+  auto* tree = dynamic_cast<::octomap::OcTree*>(read.get());
   ASSERT_NE(tree, nullptr);
-  const octomap::OcTreeNode* n = tree->search(0.55, 0.05, 0.05);
+  const ::octomap::OcTreeNode* n = tree->search(0.55, 0.05, 0.05);
   ASSERT_NE(n, nullptr);
   EXPECT_NEAR(n->getLogOdds(), one_miss, 1e-4);
 }
 
 TEST(OctomapConfig, FreeMarginAndRebuildToleranceAreReadAndChecked) {
-  EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("free_margin: 0.3")).core.free_margin, 0.3);
-  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("free_margin: -0.1")), livo::ConfigError);
-  EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("rebuild_tolerance: 0")).core.rebuild_tolerance, 0.0);
-  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("rebuild_tolerance: -0.01")), livo::ConfigError);
-  const OctomapOptions tiles = readOctomapOptions(livo::Config::fromString("{tile_size: 12.8, tile_idle_s: 2}")).core;
+  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {free_margin: 0.3}")).core.free_margin, 0.3);
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {free_margin: -0.1}")), livo::ConfigError);
+  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: 0}")).core.rebuild_tolerance, 0.0);
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: -0.01}")), livo::ConfigError);
+  const OctomapOptions tiles = readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 12.8, tile_idle_s: 2}")).core;
   EXPECT_DOUBLE_EQ(tiles.tile_size, 12.8);
   EXPECT_DOUBLE_EQ(tiles.tile_idle_s, 2.0);
-  EXPECT_DOUBLE_EQ(readOctomapOptions(livo::Config::fromString("tile_size: 0")).core.tile_size, 0.0);
-  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("tile_size: 0.1")), livo::ConfigError);  // one voxel
-  EXPECT_THROW(readOctomapOptions(livo::Config::fromString("tile_idle_s: -1")), livo::ConfigError);
+  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 0}")).core.tile_size, 0.0);
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 0.1}")), livo::ConfigError);  // one voxel
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_idle_s: -1}")), livo::ConfigError);
 }
 
 // The keyframe clouds are kept on disk quantised to keyframe_step (1 cm): a rebuild from them
@@ -544,7 +544,7 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
     // tree has its value (and colour) in the tiled one
     auto readFull = [](const std::string& bytes) {
       std::istringstream in(bytes);
-      return std::unique_ptr<octomap::AbstractOcTree>(octomap::AbstractOcTree::read(in));
+      return std::unique_ptr<::octomap::AbstractOcTree>(::octomap::AbstractOcTree::read(in));
     };
     const std::string single_ot = single.fullBytes(), tiled_ot = tiled.fullBytes();
     auto single_tree = readFull(single_ot), tiled_tree = readFull(tiled_ot);
@@ -556,29 +556,29 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
     }
     size_t compared = 0;
     if (colour) {
-      auto* a = dynamic_cast<octomap::ColorOcTree*>(single_tree.get());
-      auto* b = dynamic_cast<octomap::ColorOcTree*>(tiled_tree.get());
+      auto* a = dynamic_cast<::octomap::ColorOcTree*>(single_tree.get());
+      auto* b = dynamic_cast<::octomap::ColorOcTree*>(tiled_tree.get());
       ASSERT_TRUE(a && b);
       for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
-        const octomap::ColorOcTreeNode* n = b->search(it.getKey());
+        const ::octomap::ColorOcTreeNode* n = b->search(it.getKey());
         ASSERT_NE(n, nullptr);
         ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
         ASSERT_TRUE(n->getColor() == it->getColor());
       }
       EXPECT_EQ(b->getNumLeafNodes(), a->getNumLeafNodes());  // a colour tree is not pruned
     } else {
-      auto* a = dynamic_cast<octomap::OcTree*>(single_tree.get());
-      auto* b = dynamic_cast<octomap::OcTree*>(tiled_tree.get());
+      auto* a = dynamic_cast<::octomap::OcTree*>(single_tree.get());
+      auto* b = dynamic_cast<::octomap::OcTree*>(tiled_tree.get());
       ASSERT_TRUE(a && b);
       for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
-        const octomap::OcTreeNode* n = b->search(it.getKey());
+        const ::octomap::OcTreeNode* n = b->search(it.getKey());
         ASSERT_NE(n, nullptr);
         ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
       }
       // both are pruned (at different times, and never across tiles): the leaves differ, the
       // voxels they cover do not
       for (auto it = b->begin_leafs(); it != b->end_leafs(); ++it) {
-        const octomap::OcTreeNode* n = a->search(it.getKey());
+        const ::octomap::OcTreeNode* n = a->search(it.getKey());
         ASSERT_NE(n, nullptr);
         ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
       }
@@ -587,7 +587,7 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
 
     // .bt: octomap reads it and writes it back unchanged; the occupancy of every voxel agrees
     const std::string single_bt = single.binaryBytes(), tiled_bt = tiled.binaryBytes();
-    octomap::OcTree single_bin(0.1), tiled_bin(0.1);
+    ::octomap::OcTree single_bin(0.1), tiled_bin(0.1);
     {
       std::istringstream a(single_bt), b(tiled_bt);
       ASSERT_TRUE(single_bin.readBinary(a));
@@ -597,13 +597,13 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
       EXPECT_TRUE(again.str() == tiled_bt) << "colour " << colour;
     }
     for (auto it = single_bin.begin_leafs(); it != single_bin.end_leafs(); ++it) {
-      const octomap::OcTreeNode* n = tiled_bin.search(it.getCoordinate());
+      const ::octomap::OcTreeNode* n = tiled_bin.search(it.getCoordinate());
       ASSERT_NE(n, nullptr);
       ASSERT_EQ(tiled_bin.isNodeOccupied(n), single_bin.isNodeOccupied(*it));
     }
     EXPECT_EQ(tiled_bin.getNumLeafNodes(), single_bin.getNumLeafNodes()) << "colour " << colour;
     // the message: the resident tiles only, a valid tree of fewer nodes
-    octomap::OcTree resident(0.1);
+    ::octomap::OcTree resident(0.1);
     std::istringstream r(tiled.binaryBytes(true));
     ASSERT_TRUE(resident.readBinary(r));
     EXPECT_GT(resident.size(), 0u);

@@ -12,7 +12,7 @@
 #include "livo/messages.hpp"
 #include "livo/octomap_t.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "octomap_node.hpp"
+#include "livo/octomap/octomap_node.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -62,10 +62,10 @@ void drain(lcm::LCM& lcm) {
 TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  octomap_export::OctomapNodeOptions options;
+  livo::octomap::OctomapNodeOptions options;
   options.publish_period_s = 0.5;
   options.write_period_s = 0;
-  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo"));
+  livo::octomap::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo"));
   std::vector<octomap_t> received;
   collect(lcm, &received);
   for (int k = 0; k < 10; ++k) {
@@ -83,15 +83,15 @@ TEST(OctomapNode, PublishesTheTreeAndWritesFiles) {
   EXPECT_EQ(node.builder().scans(), 10);
   ASSERT_EQ(received.size(), 2u);  // at 1.0 s and 1.5 s
   std::istringstream in(std::string(received.back().data.begin(), received.back().data.end()));
-  octomap::OcTree tree(0.1);
+  ::octomap::OcTree tree(0.1);
   ASSERT_TRUE(tree.readBinary(in));
-  const octomap::OcTreeNode* n = tree.search(2.05, 0.05, 0.05);
+  const ::octomap::OcTreeNode* n = tree.search(2.05, 0.05, 0.05);
   ASSERT_NE(n, nullptr);
   EXPECT_TRUE(tree.isNodeOccupied(n));
   node.finish();
-  octomap::OcTree from_file(0.1);
+  ::octomap::OcTree from_file(0.1);
   EXPECT_TRUE(from_file.readBinary(node.btPath()));
-  std::unique_ptr<octomap::AbstractOcTree> ot(octomap::AbstractOcTree::read(node.otPath()));
+  std::unique_ptr<::octomap::AbstractOcTree> ot(::octomap::AbstractOcTree::read(node.otPath()));
   EXPECT_NE(ot, nullptr);
 }
 
@@ -129,9 +129,9 @@ loop_correction_t correction(int64_t utime, const std::vector<std::pair<int64_t,
 
 bool occupiedIn(const octomap_t& m, double x, double y, double z) {
   std::istringstream in(std::string(m.data.begin(), m.data.end()));
-  octomap::OcTree tree(0.1);
+  ::octomap::OcTree tree(0.1);
   if (!tree.readBinary(in)) return false;
-  const octomap::OcTreeNode* n = tree.search(x, y, z);
+  const ::octomap::OcTreeNode* n = tree.search(x, y, z);
   return n && tree.isNodeOccupied(n);
 }
 }  // namespace
@@ -141,10 +141,10 @@ bool occupiedIn(const octomap_t& m, double x, double y, double z) {
 TEST(OctomapNode, RebuildsFromCorrectedKeyframesAndPublishes) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  octomap_export::OctomapNodeOptions options;
+  livo::octomap::OctomapNodeOptions options;
   options.publish_period_s = 100.0;  // the first scan's tree, then only after corrections
   options.write_period_s = 0;
-  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo_loop"));
+  livo::octomap::OctomapNode node(lcm, quiet(), options, SensorRig{}, livo_test::tempPath("octo_loop"));
   std::vector<octomap_t> received;
   collect(lcm, &received);
   const registered_scan_t scan = wallScan(1000000);
@@ -218,12 +218,12 @@ loop_correction_t shiftCorrection(int64_t id, int32_t epoch, int64_t previous, c
 TEST(OctomapNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  octomap_export::OctomapNodeOptions options;
+  livo::octomap::OctomapNodeOptions options;
   options.publish_period_s = 0;
   options.write_period_s = 0;
   options.map_name = "epochs";
   const std::string dir = livo_test::tempPath("octo_epochs");
-  octomap_export::OctomapNode node(lcm, quiet(), options, SensorRig{}, dir);
+  livo::octomap::OctomapNode node(lcm, quiet(), options, SensorRig{}, dir);
   auto tree = [&]() {
     octomap_t m;
     const std::string bytes = node.builder().map().binaryBytes();
@@ -274,14 +274,14 @@ TEST(OctomapNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
   EXPECT_EQ(node.builder().keyframes(), 0u);
   EXPECT_TRUE(occupiedIn(tree(), 6.05, 0.05, 0.05));
   EXPECT_FALSE(occupiedIn(tree(), 2.05, 0.05, 2.05));
-  octomap::OcTree old(0.1);
+  ::octomap::OcTree old(0.1);
   ASSERT_TRUE(old.readBinary(dir + "/epochs_epoch0.bt"));
   for (double x : {2.05, 3.05, 4.05}) {
-    const octomap::OcTreeNode* n = old.search(x, 0.05, 2.05);
+    const ::octomap::OcTreeNode* n = old.search(x, 0.05, 2.05);
     ASSERT_NE(n, nullptr) << x;
     EXPECT_TRUE(old.isNodeOccupied(n)) << x;
   }
-  std::unique_ptr<octomap::AbstractOcTree> old_full(octomap::AbstractOcTree::read(dir + "/epochs_epoch0.ot"));
+  std::unique_ptr<::octomap::AbstractOcTree> old_full(::octomap::AbstractOcTree::read(dir + "/epochs_epoch0.ot"));
   EXPECT_NE(old_full, nullptr);
 
   // the old epoch afterwards: its scans and corrections are refused, the new map does not move

@@ -4,11 +4,12 @@
 #include <cmath>
 #include <map>
 
-#include "fault_injector.hpp"
+#include "livo/playback/fault_injector.hpp"
 #include "livo/imu_t.hpp"
 #include "test_log.hpp"
 
 using namespace livo;
+using namespace livo::playback;
 using playback_test::kT0;
 
 namespace {

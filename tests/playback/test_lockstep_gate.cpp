@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
-#include "lockstep_gate.hpp"
+#include "livo/playback/lockstep_gate.hpp"
 
-using livo::LockstepGate;
-using livo::LockstepGateOptions;
+using livo::playback::LockstepGate;
+using livo::playback::LockstepGateOptions;
 using livo::progress_t;
 
 namespace {

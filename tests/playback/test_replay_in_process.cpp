@@ -2,10 +2,11 @@
 #include <gtest/gtest.h>
 
 #include "livo/node.hpp"
-#include "playback.hpp"
+#include "livo/playback/playback.hpp"
 #include "test_log.hpp"
 
 using namespace livo;
+using namespace livo::playback;
 
 TEST(ReplayInProcess, DeliversEverythingInLogOrderThroughNodes) {
   const std::string path = playback_test::makeLog("inproc", 3.0);

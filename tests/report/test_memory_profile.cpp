@@ -3,9 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include "memory_profile.hpp"
+#include "livo/report/memory_profile.hpp"
 
-using livo::MemoryProfile;
+using livo::report::MemoryProfile;
 
 TEST(MemoryProfile, PeakAtCheckpointsAndTheRunsEnd) {
   MemoryProfile p;
@@ -19,7 +19,7 @@ TEST(MemoryProfile, PeakAtCheckpointsAndTheRunsEnd) {
   EXPECT_DOUBLE_EQ(p.peakAt("colour", 300.0), 40.0);  // the checkpoint at the log's end counts
   EXPECT_TRUE(std::isnan(p.peakAt("colour", 900.0)));  // beyond the run
   EXPECT_TRUE(std::isnan(p.peakAt("vio", 60.0)));      // no such node
-  const std::string table = livo::memoryTable(p, {60.0, 300.0, 900.0});
+  const std::string table = livo::report::memoryTable(p, {60.0, 300.0, 900.0});
   EXPECT_NE(table.find("| colour | 20.0 | 40.0 | - | - | 40.0 |"), std::string::npos) << table;
   EXPECT_NE(table.find("| lio | 5.0 | 5.5 | - | - | 5.5 |"), std::string::npos) << table;
 }

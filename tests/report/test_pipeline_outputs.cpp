@@ -6,11 +6,12 @@
 #include "livo/keyframe_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
-#include "pipeline_outputs.hpp"
-#include "run_report.hpp"
+#include "livo/report/pipeline_outputs.hpp"
+#include "livo/report/run_report.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
+using namespace livo::report;
 
 namespace {
 

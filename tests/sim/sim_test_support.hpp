@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "sensor_data.hpp"
-#include "trajectory.hpp"
+#include "livo/sim/sensor_data.hpp"
+#include "livo/sim/trajectory.hpp"
 
 namespace livo {
 namespace sim {

@@ -6,14 +6,14 @@
 
 #include <cmath>
 
-#include "calibration_errors.hpp"
-#include "camera_renderer.hpp"
-#include "imu_model.hpp"
-#include "lidar_scanner.hpp"
+#include "livo/sim/calibration_errors.hpp"
+#include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/imu_model.hpp"
+#include "livo/sim/lidar_scanner.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
-#include "wheel_model.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
+#include "livo/sim/wheel_model.hpp"
 
 using namespace livo;
 using namespace livo::sim;

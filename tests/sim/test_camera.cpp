@@ -2,8 +2,8 @@
 // landing on the pixels the model predicts, exposure changes and motion blur.
 #include <gtest/gtest.h>
 
-#include "camera_renderer.hpp"
-#include "random.hpp"
+#include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/random.hpp"
 #include "sim_test_support.hpp"
 
 #ifdef LIVO_HAVE_OPENCV

@@ -4,8 +4,8 @@
 // within the stated number of frames, exposure first, then gain.
 #include <gtest/gtest.h>
 
-#include "auto_exposure.hpp"
-#include "camera_renderer.hpp"
+#include "livo/sim/auto_exposure.hpp"
+#include "livo/sim/camera_renderer.hpp"
 #include "sim_test_support.hpp"
 
 using namespace livo;

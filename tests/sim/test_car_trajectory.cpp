@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "car_trajectory.hpp"
+#include "livo/sim/car_trajectory.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 using namespace livo;
 using namespace livo::sim;

@@ -2,11 +2,11 @@
 // distances and brute force.
 #include <gtest/gtest.h>
 
-#include "height_field.hpp"
-#include "random.hpp"
-#include "scene.hpp"
-#include "shapes.hpp"
-#include "texture.hpp"
+#include "livo/sim/height_field.hpp"
+#include "livo/sim/random.hpp"
+#include "livo/sim/scene.hpp"
+#include "livo/sim/shapes.hpp"
+#include "livo/sim/texture.hpp"
 
 using namespace livo;
 using namespace livo::sim;

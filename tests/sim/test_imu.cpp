@@ -2,9 +2,9 @@
 // continuous-time parameters.
 #include <gtest/gtest.h>
 
-#include "imu_model.hpp"
+#include "livo/sim/imu_model.hpp"
 #include "sim_test_support.hpp"
-#include "wheel_model.hpp"
+#include "livo/sim/wheel_model.hpp"
 
 using namespace livo;
 using namespace livo::sim;

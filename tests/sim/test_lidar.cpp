@@ -5,7 +5,7 @@
 
 #include <set>
 
-#include "lidar_scanner.hpp"
+#include "livo/sim/lidar_scanner.hpp"
 #include "sim_test_support.hpp"
 
 using namespace livo;

@@ -5,10 +5,10 @@
 
 #include <cstring>
 
-#include "lidar_scanner.hpp"
+#include "livo/sim/lidar_scanner.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 using namespace livo;
 using namespace livo::sim;

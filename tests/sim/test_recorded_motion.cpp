@@ -7,13 +7,13 @@
 #include <gtest/gtest.h>
 
 #include "livo/trajectory_io.hpp"
-#include "paths.hpp"
-#include "procedural_trajectory.hpp"
-#include "random.hpp"
-#include "recorded_trajectory.hpp"
-#include "sample_curves.hpp"
+#include "livo/sim/paths.hpp"
+#include "livo/sim/procedural_trajectory.hpp"
+#include "livo/sim/random.hpp"
+#include "livo/sim/recorded_trajectory.hpp"
+#include "livo/sim/sample_curves.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
+#include "livo/sim/simulation_setup.hpp"
 
 using namespace livo;
 using namespace livo::sim;

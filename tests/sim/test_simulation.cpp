@@ -16,10 +16,10 @@
 #include "livo/pose_t.hpp"
 #include "livo/trajectory_io.hpp"
 #include "livo/wheel_odometry_t.hpp"
-#include "log_writer.hpp"
+#include "livo/sim/log_writer.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;

@@ -3,14 +3,14 @@
 // the simulator reproduces the ground-truth trajectory.
 #include <gtest/gtest.h>
 
-#include "car_trajectory.hpp"
+#include "livo/sim/car_trajectory.hpp"
 #include "livo/trajectory_io.hpp"
-#include "paths.hpp"
-#include "procedural_trajectory.hpp"
-#include "recorded_trajectory.hpp"
+#include "livo/sim/paths.hpp"
+#include "livo/sim/procedural_trajectory.hpp"
+#include "livo/sim/recorded_trajectory.hpp"
 #include "sim_test_support.hpp"
-#include "simulation_setup.hpp"
-#include "simulator.hpp"
+#include "livo/sim/simulation_setup.hpp"
+#include "livo/sim/simulator.hpp"
 
 using namespace livo;
 using namespace livo::sim;

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 
-#include "camera_renderer.hpp"
-#include "lidar_scanner.hpp"
+#include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/lidar_scanner.hpp"
 #include "sim_test_support.hpp"
 
 using namespace livo;

@@ -8,7 +8,7 @@
 
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
-#include "log_summary.hpp"
+#include "livo/loginfo/log_summary.hpp"
 #include "temp_path.hpp"
 
 namespace {
@@ -54,7 +54,7 @@ std::string makeLog() {
 }  // namespace
 
 TEST(LogInfo, CountsRatesAndTypes) {
-  const livo::LogSummary s = livo::summarizeLog(makeLog());
+  const livo::loginfo::LogSummary s = livo::loginfo::summarizeLog(makeLog());
   EXPECT_EQ(s.events, 201 + 21 + 1);
   EXPECT_NEAR(s.durationS(), 2.0, 1e-9);
   EXPECT_EQ(s.trailing_bytes, 0);
@@ -69,7 +69,7 @@ TEST(LogInfo, CountsRatesAndTypes) {
   EXPECT_NEAR(lidar.rateHz(), 10.0, 1e-9);
   EXPECT_EQ(s.channels.at("OTHER").type.rfind("unknown", 0), 0u);
   std::ostringstream os;
-  livo::printLogSummary(s, os);
+  livo::loginfo::printLogSummary(s, os);
   EXPECT_NE(os.str().find("livo.point_cloud_t"), std::string::npos);
 }
 
@@ -79,9 +79,9 @@ TEST(LogInfo, TruncatedLogKeepsWhatIsReadable) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string cut = livo_test::tempPath("loginfo_cut.lcmlog");
   std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
-  const livo::LogSummary s = livo::summarizeLog(cut);
+  const livo::loginfo::LogSummary s = livo::loginfo::summarizeLog(cut);
   EXPECT_GT(s.events, 50);
   EXPECT_LT(s.events, 223);
   EXPECT_GT(s.trailing_bytes, 0);
-  EXPECT_THROW(livo::summarizeLog("/nonexistent.lcmlog"), std::runtime_error);
+  EXPECT_THROW(livo::loginfo::summarizeLog("/nonexistent.lcmlog"), std::runtime_error);
 }

@@ -11,11 +11,11 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "camera_renderer.hpp"
-#include "lidar_scanner.hpp"
+#include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/lidar_scanner.hpp"
 #include "livo/filter_state.hpp"
 #include "livo/vio/grey_image.hpp"
-#include "simulation_setup.hpp"
+#include "livo/sim/simulation_setup.hpp"
 
 namespace livo_test {
 

@@ -16,7 +16,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <yaml-cpp/yaml.h>
+
+namespace YAML {
+class Node;  // yaml-cpp stays inside config.cpp
+}  // namespace YAML
 
 namespace livo {
 
@@ -43,20 +46,17 @@ class Config {
   /// An optional nested map; an empty (null) config if absent.
   Config optionalSection(const std::string& key) const;
   bool has(const std::string& key) const;
-  bool isNull() const { return !node_ || node_.IsNull(); }
+  bool isNull() const;
   /// Keys of this map in file order.
   std::vector<std::string> keys() const;
 
   template <class T>
   void read(const std::string& key, T& value) const {
-    value = convert<T>(child(key, true), key);
+    fetch(key, /*required=*/true, value);
   }
   template <class T>
   bool readOptional(const std::string& key, T& value) const {
-    YAML::Node n = child(key, false);
-    if (!n) return false;
-    value = convert<T>(n, key);
-    return true;
+    return fetch(key, /*required=*/false, value);
   }
   template <class T>
   T get(const std::string& key) const {
@@ -86,37 +86,37 @@ class Config {
     std::set<std::string> opened; // sections opened with section()/optionalSection()
     std::set<std::string> asked;  // every key path asked for, present or not (for suggestions)
   };
-  Config(YAML::Node node, std::shared_ptr<State> state, std::string path)
-      : node_(std::move(node)), state_(std::move(state)), path_(std::move(path)) {}
+  Config(const YAML::Node& node, std::shared_ptr<State> state, std::string path);
+
+  // One overload per supported value type (config.cpp): reads `key` into `out` if present; a
+  // missing required key throws. Returns whether the key was present.
+#define LIVO_CONFIG_FETCH(T) bool fetch(const std::string& key, bool required, T& out) const;
+  LIVO_CONFIG_FETCH(bool)
+  LIVO_CONFIG_FETCH(int)
+  LIVO_CONFIG_FETCH(int64_t)
+  LIVO_CONFIG_FETCH(double)
+  LIVO_CONFIG_FETCH(float)
+  LIVO_CONFIG_FETCH(std::string)
+  LIVO_CONFIG_FETCH(std::vector<double>)
+  LIVO_CONFIG_FETCH(std::vector<int>)
+  LIVO_CONFIG_FETCH(std::vector<std::string>)
+  LIVO_CONFIG_FETCH(Eigen::Vector3d)
+  LIVO_CONFIG_FETCH(Eigen::Matrix3d)
+  LIVO_CONFIG_FETCH(Eigen::Matrix4d)
+  LIVO_CONFIG_FETCH(Eigen::Quaterniond)
+  LIVO_CONFIG_FETCH(Eigen::Isometry3d)
+#undef LIVO_CONFIG_FETCH
 
   YAML::Node child(const std::string& key, bool required) const;
   template <class T>
   T convert(const YAML::Node& n, const std::string& key) const;
   void collectUnused(const YAML::Node& n, const std::string& path, std::vector<std::string>* out) const;
 
-  YAML::Node node_;
+  std::shared_ptr<const YAML::Node> node_;  // never null
   std::shared_ptr<State> state_;
   std::string path_;
 };
 
-
-// Explicit specialisations of Config::convert, defined in config.cpp.
-#define LIVO_CONFIG_TYPE(T) template <> T Config::convert<T>(const YAML::Node&, const std::string&) const;
-LIVO_CONFIG_TYPE(bool)
-LIVO_CONFIG_TYPE(int)
-LIVO_CONFIG_TYPE(int64_t)
-LIVO_CONFIG_TYPE(double)
-LIVO_CONFIG_TYPE(float)
-LIVO_CONFIG_TYPE(std::string)
-LIVO_CONFIG_TYPE(std::vector<double>)
-LIVO_CONFIG_TYPE(std::vector<int>)
-LIVO_CONFIG_TYPE(std::vector<std::string>)
-LIVO_CONFIG_TYPE(Eigen::Vector3d)
-LIVO_CONFIG_TYPE(Eigen::Matrix3d)
-LIVO_CONFIG_TYPE(Eigen::Matrix4d)
-LIVO_CONFIG_TYPE(Eigen::Quaterniond)
-LIVO_CONFIG_TYPE(Eigen::Isometry3d)
-#undef LIVO_CONFIG_TYPE
 
 // Supported value types (defined in config.cpp): bool, int, int64_t, double, float,
 // std::string, std::vector<double|int|std::string>, Eigen::Vector3d, Eigen::Matrix3d (9 numbers,

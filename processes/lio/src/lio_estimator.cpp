@@ -308,7 +308,6 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     res.message = "waiting for the IMU initialisation";
     return res;
   }
-  const double end_offset = scanEndOffset(scan);
   const int64_t t_end = scanEndUtime(scan);
   const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
   if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
@@ -326,10 +325,58 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     res.status = ScanResult::Status::kRejected;
     return res;
   }
-  const FilterState prior = prop_.state();
-  const Mat18 P_prior = prop_.covariance();
+  FilterState x = prop_.state();
+  Mat18 P = prop_.covariance();
 
   // 2. valid points, undistorted into the body frame at the end
+  const std::vector<size_t> valid = validPoints(scan, note);
+  res.num_points = static_cast<int>(valid.size());
+  const std::vector<Vec3> body = undistortToSweepEnd(scan, valid, x, t_first, t_end);
+
+  // 3. registration subset: stride, then voxel downsampling
+  const std::vector<Vec3> reg = registrationSubset(body);
+  res.num_registered = static_cast<int>(reg.size());
+
+  // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
+  // wheel-scale anchor (learnt from after the LiDAR update)
+  WheelTravel travel;
+  const bool has_travel = opts_.wheel.enabled && wheelVelocityStage(t_end, &x, &P, &travel, note);
+
+  // 5. LiDAR update or map seeding
+  reseedAfterOutage(t_end, &x, &P, note);
+  res.status = lidarStage(reg, valid.size(), &x, &P, &res);
+  noteRegistration(res.status, x, t_end);
+  prop_.setState(x, P);
+  res.utime = t_end;
+  if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
+
+  // 6. map insertion and the local window
+  if (res.status != ScanResult::Status::kPredicted) {
+    res.map_points_seen_through = insertIntoMap(reg, x);
+    last_registered_body_ = reg;
+    pruneMap(x.pos);
+  }
+
+  // 7. outputs
+  res.sweep_start_utime = t_first;
+  res.state = x;
+  res.covariance = P;
+  res.angular_velocity = prop_.lastSample().gyro - x.gyro_bias;
+  res.world_points.resize(body.size());
+  res.input_index.resize(body.size());
+  for (size_t i = 0; i < body.size(); ++i) {
+    res.input_index[i] = static_cast<uint32_t>(valid[i]);
+    res.world_points[i] = x.rot * body[i] + x.pos;
+  }
+  if (res.status != ScanResult::Status::kPredicted && keyframe_selector_.check(x.pose())) {
+    res.is_keyframe = true;
+    res.keyframe = makeKeyframe(scan, valid, body, x, P, t_end);
+  }
+  return res;
+}
+
+std::vector<size_t> LioEstimator::validPoints(const LidarScan& scan, std::string* note) const {
+  const double end_offset = scanEndOffset(scan);
   std::vector<size_t> valid;
   valid.reserve(scan.points.size());
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
@@ -345,18 +392,24 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     valid.push_back(j);
   }
   if (scan.points.size() != scan.time_offset.size()) appendNote(note, "points and time offsets differ in number");
-  res.num_points = static_cast<int>(valid.size());
+  return valid;
+}
+
+std::vector<Vec3> LioEstimator::undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
+                                                    const FilterState& at_end, int64_t t_first, int64_t t_end) {
   std::vector<Vec3> body;
   if (!prop_.segments().empty()) {
-    const Undistorter und(prop_.segments(), prior.rot, prior.pos, t_end, opts_.extrinsics.T_I_L);
+    const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, opts_.extrinsics.T_I_L);
     und.undistort(scan, t_first, valid, &body);
   } else {
     body.reserve(valid.size());
     for (size_t j : valid) body.push_back(opts_.extrinsics.T_I_L * scan.points[j]);
   }
   prop_.clearSegments();
+  return body;
+}
 
-  // 3. registration subset: stride, then voxel downsampling
+std::vector<Vec3> LioEstimator::registrationSubset(const std::vector<Vec3>& body) const {
   std::vector<size_t> subset;
   const size_t stride = static_cast<size_t>(std::max(1, opts_.point_stride));
   for (size_t i = 0; i < body.size(); i += stride) subset.push_back(i);
@@ -364,123 +417,134 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   std::vector<Vec3> reg;
   reg.reserve(subset.size());
   for (size_t i : subset) reg.push_back(body[i]);
-  res.num_registered = static_cast<int>(reg.size());
+  return reg;
+}
 
-  FilterState x = prior;
-  Mat18 P = P_prior;
-
-  // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
-  // wheel-scale anchor (learnt from after the LiDAR update)
-  WheelTravel travel;
+bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel,
+                                      std::string* note) {
   bool has_travel = false;
-  if (opts_.wheel.enabled) {
-    if (opts_.wheel_scale.enabled && has_scale_anchor_)
-      has_travel = integrateWheelSpeeds(wheel_, scale_anchor_utime_, t_end, opts_.wheel.max_sample_gap_s,
-                                        &travel.measured, &travel.measured_noise_gain);
-    double speed = 0.0, scale_variance = 0.0;
-    if (wheelSpeedAt(t_end, &speed, &scale_variance)) {
-      const WheelUpdateResult w =
-          wheelVelocityUpdate(&x, &P, prop_.lastSample().gyro, speed, opts_.wheel, scale_variance);
-      ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
-      if (!w.applied)
-        appendNote(note, "wheel speed rejected (chi2 " + formatSignificant(w.chi2) + "; filter minus wheels forward " +
-                             formatSignificant(w.innovation.x()) + ", lateral " + formatSignificant(w.innovation.y()) + ", vertical " +
-                             formatSignificant(w.innovation.z()) + " m/s)");
-    } else {
-      ++wheel_counts_.no_reading;
-      appendNote(note, "no wheel reading around the sweep end");
-    }
-    while (wheel_.size() > 2 && wheel_[1].utime <= t_end) wheel_.pop_front();
-  }
-
-  // 5. LiDAR update or map seeding. After reseed_after_s without a registration (a LiDAR outage,
-  // lost track) the map no longer fits the predicted pose: a new one is seeded there, so the
-  // trajectory goes on from the prediction instead of restarting at the origin.
-  if (!map_.empty() && has_registered_ &&
-      static_cast<double>(t_end - last_registered_utime_) * 1e-6 > opts_.reseed_after_s) {
-    const double lost_s = static_cast<double>(t_end - last_registered_utime_) * 1e-6;
-    map_.clear();
-    // the IMU-only velocity of a long outage is worthless: keep it only after a short one
-    if (lost_s > 3.0 * opts_.reseed_after_s) x.vel.setZero();
-    const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
-    P.middleRows<3>(FilterState::kVel).setZero();
-    P.middleCols<3>(FilterState::kVel).setZero();
-    P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
-    appendNote(note, "no registration for " + formatSignificant(lost_s) + " s: map re-seeded at the predicted pose");
-  }
-  if (map_.empty()) {
-    if (static_cast<int>(valid.size()) < opts_.min_points) {
-      res.status = ScanResult::Status::kPredicted;
-      appendNote(note, "too few valid points to seed the map (" + std::to_string(valid.size()) + ")");
-    } else {
-      res.status = ScanResult::Status::kMapInitialized;
-    }
-  } else if (static_cast<int>(valid.size()) < opts_.min_points) {
-    res.status = ScanResult::Status::kPredicted;
-    appendNote(note, "too few valid points (" + std::to_string(valid.size()) + "): prediction only");
+  if (opts_.wheel_scale.enabled && has_scale_anchor_)
+    has_travel = integrateWheelSpeeds(wheel_, scale_anchor_utime_, t_end, opts_.wheel.max_sample_gap_s,
+                                      &travel->measured, &travel->measured_noise_gain);
+  double speed = 0.0, scale_variance = 0.0;
+  if (wheelSpeedAt(t_end, &speed, &scale_variance)) {
+    const WheelUpdateResult w = wheelVelocityUpdate(x, P, prop_.lastSample().gyro, speed, opts_.wheel, scale_variance);
+    ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
+    if (!w.applied)
+      appendNote(note, "wheel speed rejected (chi2 " + formatSignificant(w.chi2) + "; filter minus wheels forward " +
+                           formatSignificant(w.innovation.x()) + ", lateral " + formatSignificant(w.innovation.y()) +
+                           ", vertical " + formatSignificant(w.innovation.z()) + " m/s)");
   } else {
-    ScanToMap s2m(map_, reg, opts_.matching);
-    FilterState post;
-    Mat18 P_post;
-    EsikfResult er = iteratedUpdate(
-        x, P, [&](const FilterState& xi, int it, PoseInformation* info) { return s2m.evaluate(xi, it, info); },
-        opts_.esikf, &post, &P_post);
-    const ScanToMap* fitted = &s2m;
-    std::optional<ScanToMap> s2m_still;
-    if (gap_bridged_) {
-      // After a bridged IMU gap the prediction assumed the gap's time really passed. If it did not
-      // (every sensor's clock stepped ahead), the body stood still meanwhile: try that too and keep
-      // the registration that finds more of the map.
-      FilterState still = x;
-      still.rot = gap_undo_rot_ * x.rot;
-      still.pos = x.pos + gap_undo_pos_;
-      still.vel = x.vel + gap_undo_vel_;
-      s2m_still.emplace(map_, reg, opts_.matching);
-      FilterState post_still;
-      Mat18 P_still;
-      const EsikfResult er_still = iteratedUpdate(
-          still, P,
-          [&](const FilterState& xi, int it, PoseInformation* info) { return s2m_still->evaluate(xi, it, info); },
-          opts_.esikf, &post_still, &P_still);
-      if (er_still.valid && er_still.info.count > (er.valid ? er.info.count : 0) * 11 / 10) {
-        appendNote(note, "after the IMU gap the sweep fits the map better as if no time had passed (" +
-                             std::to_string(er_still.info.count) + " against " + std::to_string(er.info.count) +
-                             " matches): the clock stepped");
-        x = still;
-        fitted = &*s2m_still;
-        er = er_still;
-        post = post_still;
-        P_post = P_still;
-      }
-    }
-    res.num_residuals = er.info.count;
-    res.iterations = er.iterations;
-    res.converged = er.converged;
-    res.degeneracy = fitted->degeneracy();
-    res.min_information_eigenvalue = fitted->minInformationEigenvalue();
-    const bool enough = er.valid && er.info.count >= opts_.min_residuals;
-    const bool sane = enough && post.rot.allFinite() && post.pos.allFinite() && P_post.allFinite() &&
-                      (post.pos - x.pos).norm() <= opts_.max_position_jump;
-    if (sane) {
-      x = post;
-      P = P_post;
-      res.status = ScanResult::Status::kTracked;
+    ++wheel_counts_.no_reading;
+    appendNote(note, "no wheel reading around the sweep end");
+  }
+  while (wheel_.size() > 2 && wheel_[1].utime <= t_end) wheel_.pop_front();
+  return has_travel;
+}
+
+void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, Mat18* P, std::string* note) {
+  // After reseed_after_s without a registration (a LiDAR outage, lost track) the map no longer
+  // fits the predicted pose: a new one is seeded there, so the trajectory goes on from the
+  // prediction instead of restarting at the origin.
+  if (map_.empty() || !has_registered_) return;
+  const double lost_s = static_cast<double>(t_end - last_registered_utime_) * 1e-6;
+  if (lost_s <= opts_.reseed_after_s) return;
+  map_.clear();
+  // the IMU-only velocity of a long outage is worthless: keep it only after a short one
+  if (lost_s > 3.0 * opts_.reseed_after_s) x->vel.setZero();
+  const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
+  P->middleRows<3>(FilterState::kVel).setZero();
+  P->middleCols<3>(FilterState::kVel).setZero();
+  P->block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
+  appendNote(note, "no registration for " + formatSignificant(lost_s) + " s: map re-seeded at the predicted pose");
+}
+
+ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, Mat18* P,
+                                            ScanResult* res) {
+  std::string* note = &res->message;
+  ScanResult::Status status;
+  if (map_.empty()) {
+    if (static_cast<int>(num_valid) < opts_.min_points) {
+      status = ScanResult::Status::kPredicted;
+      appendNote(note, "too few valid points to seed the map (" + std::to_string(num_valid) + ")");
     } else {
-      res.status = ScanResult::Status::kPredicted;
-      res.degeneracy.degenerate = true;
-      appendNote(note, enough ? "update rejected (diverged)"
-                              : "too few point-to-plane matches (" + std::to_string(er.info.count) + ")");
+      status = ScanResult::Status::kMapInitialized;
     }
+  } else if (static_cast<int>(num_valid) < opts_.min_points) {
+    status = ScanResult::Status::kPredicted;
+    appendNote(note, "too few valid points (" + std::to_string(num_valid) + "): prediction only");
+  } else {
+    status = registerSweep(reg, x, P, res);
   }
   gap_bridged_ = false;
   gap_undo_rot_.setIdentity();
   gap_undo_pos_.setZero();
   gap_undo_vel_.setZero();
-  if (res.status == ScanResult::Status::kTracked || res.status == ScanResult::Status::kMapInitialized) {
+  return status;
+}
+
+ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, Mat18* P,
+                                               ScanResult* res) {
+  std::string* note = &res->message;
+  ScanToMap s2m(map_, reg, opts_.matching);
+  FilterState post;
+  Mat18 P_post;
+  EsikfResult er = iteratedUpdate(
+      *x, *P, [&](const FilterState& xi, int it, PoseInformation* info) { return s2m.evaluate(xi, it, info); },
+      opts_.esikf, &post, &P_post);
+  const ScanToMap* fitted = &s2m;
+  std::optional<ScanToMap> s2m_still;
+  if (gap_bridged_) {
+    // After a bridged IMU gap the prediction assumed the gap's time really passed. If it did not
+    // (every sensor's clock stepped ahead), the body stood still meanwhile: try that too and keep
+    // the registration that finds more of the map.
+    FilterState still = *x;
+    still.rot = gap_undo_rot_ * x->rot;
+    still.pos = x->pos + gap_undo_pos_;
+    still.vel = x->vel + gap_undo_vel_;
+    s2m_still.emplace(map_, reg, opts_.matching);
+    FilterState post_still;
+    Mat18 P_still;
+    const EsikfResult er_still = iteratedUpdate(
+        still, *P,
+        [&](const FilterState& xi, int it, PoseInformation* info) { return s2m_still->evaluate(xi, it, info); },
+        opts_.esikf, &post_still, &P_still);
+    if (er_still.valid && er_still.info.count > (er.valid ? er.info.count : 0) * 11 / 10) {
+      appendNote(note, "after the IMU gap the sweep fits the map better as if no time had passed (" +
+                           std::to_string(er_still.info.count) + " against " + std::to_string(er.info.count) +
+                           " matches): the clock stepped");
+      *x = still;
+      fitted = &*s2m_still;
+      er = er_still;
+      post = post_still;
+      P_post = P_still;
+    }
+  }
+  res->num_residuals = er.info.count;
+  res->iterations = er.iterations;
+  res->converged = er.converged;
+  res->degeneracy = fitted->degeneracy();
+  res->min_information_eigenvalue = fitted->minInformationEigenvalue();
+  const bool enough = er.valid && er.info.count >= opts_.min_residuals;
+  const bool sane = enough && post.rot.allFinite() && post.pos.allFinite() && P_post.allFinite() &&
+                    (post.pos - x->pos).norm() <= opts_.max_position_jump;
+  if (!sane) {
+    res->degeneracy.degenerate = true;
+    appendNote(note, enough ? "update rejected (diverged)"
+                            : "too few point-to-plane matches (" + std::to_string(er.info.count) + ")");
+    return ScanResult::Status::kPredicted;
+  }
+  *x = post;
+  *P = P_post;
+  return ScanResult::Status::kTracked;
+}
+
+void LioEstimator::noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end) {
+  if (status == ScanResult::Status::kTracked || status == ScanResult::Status::kMapInitialized) {
     last_registered_utime_ = t_end;
     has_registered_ = true;
   }
-  if (res.status == ScanResult::Status::kTracked) {
+  if (status == ScanResult::Status::kTracked) {
     // remember the previous registered position (velocity after IMU gaps)
     if (has_last_post_) {
       prev_post_pos_ = last_post_pos_;
@@ -491,49 +555,23 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     last_post_utime_ = t_end;
     has_last_post_ = true;
   }
-  prop_.setState(x, P);
-  res.utime = t_end;
-  if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
+}
 
-  // 6. map insertion and the local window
-  if (res.status != ScanResult::Status::kPredicted) {
-    res.map_points_seen_through = insertIntoMap(reg, x);
-    last_registered_body_ = reg;
-    pruneMap(x.pos);
+Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid,
+                                    const std::vector<Vec3>& body, const FilterState& x, const Mat18& P, int64_t t_end) {
+  Keyframe kf;
+  kf.id = next_keyframe_id_++;
+  kf.utime = t_end;
+  kf.pose = x.pose();
+  kf.pose_covariance = P.topLeftCorner<6, 6>();
+  const bool has_intensity = scan.intensity.size() == scan.points.size();
+  for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
+    kf.cloud.push_back(body[i]);
+    kf.intensity.push_back(has_intensity ? scan.intensity[valid[i]] : 0.0f);
   }
-
-  // 7. outputs
-  res.utime = t_end;
-  res.sweep_start_utime = t_first;
-  res.state = x;
-  res.covariance = P;
-  res.angular_velocity = prop_.lastSample().gyro - x.gyro_bias;
-  res.world_points.resize(body.size());
-  res.intensity.resize(body.size());
-  res.point_index.resize(body.size());
-  res.time_offset.resize(body.size());
-  for (size_t i = 0; i < body.size(); ++i) {
-    res.point_index[i] = static_cast<uint32_t>(valid[i]);
-    res.world_points[i] = x.rot * body[i] + x.pos;
-    res.intensity[i] = scan.intensity.size() == scan.points.size() ? scan.intensity[valid[i]] : 0.0f;
-    res.time_offset[i] = scan.time_offset[valid[i]];
-  }
-  if (res.status != ScanResult::Status::kPredicted && keyframe_selector_.check(x.pose())) {
-    Keyframe kf;
-    kf.id = next_keyframe_id_++;
-    kf.utime = t_end;
-    kf.pose = x.pose();
-    kf.pose_covariance = P.topLeftCorner<6, 6>();
-    for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
-      kf.cloud.push_back(body[i]);
-      kf.intensity.push_back(res.intensity[i]);
-    }
-    keyframes_.push_back(kf);
-    while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
-    res.is_keyframe = true;
-    res.keyframe = kf;
-  }
-  return res;
+  keyframes_.push_back(kf);
+  while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+  return kf;
 }
 
 bool LioEstimator::propagateTo(int64_t utime, std::string* why) {

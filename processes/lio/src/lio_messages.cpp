@@ -84,13 +84,15 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in,
   c.time_offset.resize(n);
   c.ring.resize(n);
   const bool has_ring = in.ring.size() == static_cast<size_t>(in.num_points);
+  const bool has_intensity = in.intensity.size() == static_cast<size_t>(in.num_points);
   for (size_t i = 0; i < n; ++i) {
+    const uint32_t j = r.input_index[i];
     c.x[i] = static_cast<float>(r.world_points[i].x());
     c.y[i] = static_cast<float>(r.world_points[i].y());
     c.z[i] = static_cast<float>(r.world_points[i].z());
-    c.intensity[i] = r.intensity[i];
-    c.time_offset[i] = r.time_offset[i];
-    c.ring[i] = has_ring ? in.ring[r.point_index[i]] : int16_t{-1};
+    c.intensity[i] = has_intensity ? in.intensity[j] : 0.0f;
+    c.time_offset[i] = in.time_offset[j];
+    c.ring[i] = has_ring ? in.ring[j] : int16_t{-1};
   }
   return m;
 }

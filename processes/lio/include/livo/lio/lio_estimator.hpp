@@ -51,10 +51,10 @@ struct ScanResult {
   DegeneracyReport degeneracy;
   double min_information_eigenvalue = 0.0;  // of H^T R^-1 H (6x6)
 
-  std::vector<Vec3> world_points;  // undistorted to utime, world frame
-  std::vector<float> intensity;    // one per world point
-  std::vector<uint32_t> point_index;  // index of each world point in the input sweep
-  std::vector<float> time_offset;  // per world point: its input time offset, s after sweep_start_utime
+  // The sweep's valid points, undistorted to utime, in the world frame; input_index[i] is the
+  // index of world_points[i] in the input sweep (its intensity, time offset and ring are there).
+  std::vector<Vec3> world_points;
+  std::vector<uint32_t> input_index;
 
   bool is_keyframe = false;
   Keyframe keyframe;
@@ -153,6 +153,30 @@ class LioEstimator {
 
  private:
   double scanEndOffset(const LidarScan& scan) const;
+  // The stages of addScan, in order.
+  /// Indices of the sweep's usable points (finite, inside the sweep and the range limits).
+  std::vector<size_t> validPoints(const LidarScan& scan, std::string* note) const;
+  /// The valid points in the body frame at t_end (IMU-propagated motion undistortion); consumes
+  /// the propagation segments.
+  std::vector<Vec3> undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
+                                        const FilterState& at_end, int64_t t_first, int64_t t_end);
+  /// The points registered against the map: every point_stride-th, then one per scan voxel.
+  std::vector<Vec3> registrationSubset(const std::vector<Vec3>& body) const;
+  /// Wheel speed update at the sweep end; returns whether `travel` holds the wheels' travel since
+  /// the wheel-scale anchor.
+  bool wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel, std::string* note);
+  /// After reseed_after_s without a registration: drops the map (seeded anew at the prediction).
+  void reseedAfterOutage(int64_t t_end, FilterState* x, Mat18* P, std::string* note);
+  /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis.
+  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, Mat18* P,
+                                ScanResult* res);
+  /// The iterated point-to-plane update (and the no-time-passed hypothesis after a bridged gap).
+  ScanResult::Status registerSweep(const std::vector<Vec3>& reg, FilterState* x, Mat18* P, ScanResult* res);
+  /// Remembers the last registration (re-seeding, velocity after IMU gaps).
+  void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
+  /// A new keyframe from the sweep (kept in the bounded keyframe store).
+  Keyframe makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid, const std::vector<Vec3>& body,
+                        const FilterState& x, const Mat18& P, int64_t t_end);
   void tryInitialize(std::string* note);
   bool propagateThrough(int64_t t_end, std::string* note);
   /// One IMU sample into the propagation (gaps bridged or soft-reset).

@@ -1,0 +1,21 @@
+// Decompression of ROS bag chunks: "none", "bz2" (libbz2) and "lz4" (ROS writes LZ4 frames, read
+// with liblz4's frame API). A damaged or truncated chunk yields what could be decompressed.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace livo::import {
+
+struct DecompressedChunk {
+  std::vector<uint8_t> data;
+  bool complete = false;  // false: `error` says why, `data` holds what came out before
+  std::string error;
+};
+
+/// `expected_size` is the chunk record's uncompressed size.
+DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size,
+                                  size_t expected_size);
+
+}  // namespace livo::import

@@ -1,0 +1,103 @@
+// ROS 1 messages read from their serialised form (the wire format of the message definitions:
+// little-endian primitives, uint32-length strings and arrays, fixed arrays inline). Only the
+// types the importer needs; each decoder throws DecodeError naming the field that does not fit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "livo/import/byte_reader.hpp"
+
+namespace livo::import {
+
+/// std_msgs/Header.
+struct RosHeader {
+  uint32_t seq = 0;
+  uint32_t sec = 0, nsec = 0;
+  std::string frame_id;
+  int64_t stampNs() const { return static_cast<int64_t>(sec) * 1000000000LL + nsec; }
+};
+RosHeader decodeRosHeader(ByteReader& r);
+
+/// sensor_msgs/Imu.
+struct RosImu {
+  RosHeader header;
+  std::array<double, 4> orientation_xyzw{};
+  std::array<double, 3> angular_velocity{};
+  std::array<double, 3> linear_acceleration{};
+};
+RosImu decodeRosImu(ByteReader& r);
+
+/// sensor_msgs/PointField datatypes.
+enum class PointFieldType : uint8_t { kInt8 = 1, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+int pointFieldSize(uint8_t datatype);  // bytes, 0 if unknown
+
+struct RosPointField {
+  std::string name;
+  uint32_t offset = 0;
+  uint8_t datatype = 0;
+  uint32_t count = 0;
+};
+/// sensor_msgs/PointCloud2 (the point data stays in the bag's buffer).
+struct RosPointCloud2 {
+  RosHeader header;
+  uint32_t height = 0, width = 0;
+  std::vector<RosPointField> fields;
+  bool is_bigendian = false;
+  uint32_t point_step = 0, row_step = 0;
+  const uint8_t* data = nullptr;
+  size_t data_size = 0;
+  bool is_dense = false;
+};
+RosPointCloud2 decodeRosPointCloud2(ByteReader& r);
+
+/// sensor_msgs/Image.
+struct RosImage {
+  RosHeader header;
+  uint32_t height = 0, width = 0;
+  std::string encoding;
+  bool is_bigendian = false;
+  uint32_t step = 0;
+  const uint8_t* data = nullptr;
+  size_t data_size = 0;
+};
+RosImage decodeRosImage(ByteReader& r);
+
+/// sensor_msgs/CompressedImage.
+struct RosCompressedImage {
+  RosHeader header;
+  std::string format;
+  const uint8_t* data = nullptr;
+  size_t data_size = 0;
+};
+RosCompressedImage decodeRosCompressedImage(ByteReader& r);
+
+/// A stamped position with an optional orientation: nav_msgs/Odometry, geometry_msgs/PoseStamped,
+/// PoseWithCovarianceStamped, TransformStamped (orientation) and PointStamped (position only).
+struct RosStampedPose {
+  RosHeader header;
+  std::string child_frame_id;  // Odometry, TransformStamped
+  std::array<double, 3> position{};
+  std::array<double, 4> orientation_xyzw{0.0, 0.0, 0.0, 1.0};
+  bool has_orientation = true;
+};
+RosStampedPose decodeRosOdometry(ByteReader& r);
+RosStampedPose decodeRosPoseStamped(ByteReader& r);
+RosStampedPose decodeRosPoseWithCovarianceStamped(ByteReader& r);
+RosStampedPose decodeRosTransformStamped(ByteReader& r);
+RosStampedPose decodeRosPointStamped(ByteReader& r);
+
+/// The message kinds the importer reads, chosen by type name and checked against the md5sum the
+/// connection record carries (a bag with a different definition under the same name is refused).
+enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kPose };
+struct RosTypeInfo {
+  RosMessageKind kind = RosMessageKind::kUnsupported;
+  const char* md5 = "";
+  RosStampedPose (*decode_pose)(ByteReader&) = nullptr;
+};
+/// Info for a type name, kind kUnsupported if the importer has no decoder for it.
+RosTypeInfo rosTypeInfo(const std::string& type);
+
+}  // namespace livo::import

@@ -1,0 +1,44 @@
+// ROS 1 bag -> LCM log: each mapped topic's messages converted to the project's types
+// (sensor_msgs/Imu -> imu_t, PointCloud2 -> point_cloud_t, Image / CompressedImage -> image_t,
+// Odometry / PoseStamped / PoseWithCovarianceStamped / TransformStamped / PointStamped -> pose_t),
+// stamped by their header stamps. Other topics are counted, never decoded.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "livo/import/channel_names.hpp"
+#include "livo/import/import_report.hpp"
+#include "livo/import/imu_units.hpp"
+#include "livo/import/point_cloud2_conversion.hpp"
+#include "livo/import/sorted_log_writer.hpp"
+
+namespace livo::import {
+
+struct RosbagImportOptions {
+  // Topics; empty ones are chosen automatically when the bag has exactly one topic of the type
+  // (IMU, PointCloud2, image) and `auto_map` is set.
+  std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, ground_truth_topic;
+  bool auto_map = true;
+  std::string ground_truth_file;              // TUM / EuRoC csv instead of a topic
+  std::string ground_truth_child_frame = "I";
+  ChannelNames channels;
+  PointCloudConversionOptions lidar;
+  ImuUnitOptions imu_units;
+  bool use_bag_time = false;                  // stamp by the bag's receive time, not header.stamp
+  bool progress = true;
+};
+
+/// Reads the whole bag (all bags, in order). A read error stops that bag; what was read is kept
+/// and the error is in the report.
+void importRosbag(const std::vector<std::string>& bags, const RosbagImportOptions& options, SortedLogWriter& writer,
+                  ImportReport& report);
+
+/// Topics of a bag with type and message count (reads the whole bag), for --list-topics.
+struct BagTopic {
+  std::string topic, type;
+  int64_t messages = 0;
+};
+std::vector<BagTopic> listBagTopics(const std::string& bag);
+
+}  // namespace livo::import

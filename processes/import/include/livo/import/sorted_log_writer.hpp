@@ -1,0 +1,59 @@
+// Writes an LCM log whose events are in time order (event timestamp = message utime), whatever
+// order the importer produces them in. Ties keep insertion order. Memory is bounded: past
+// `max_buffer_bytes` the buffered events are sorted and spilled to a temporary run file next to
+// the output, and finish() merges the runs.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace livo::import {
+
+struct SortedLogWriterOptions {
+  int64_t max_buffer_bytes = 512LL << 20;  // spill to a run file beyond this
+};
+
+class SortedLogWriter {
+ public:
+  explicit SortedLogWriter(std::string path, SortedLogWriterOptions options = {});
+  ~SortedLogWriter();  // removes run files if finish() was not called
+  SortedLogWriter(const SortedLogWriter&) = delete;
+  SortedLogWriter& operator=(const SortedLogWriter&) = delete;
+
+  /// Adds an LCM message (any generated type with utime and encode()).
+  template <class Msg>
+  void add(const std::string& channel, const Msg& msg) {
+    std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
+    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    addEncoded(channel, msg.utime, std::move(bytes));
+  }
+  void addEncoded(const std::string& channel, int64_t utime, std::vector<uint8_t> bytes);
+
+  /// Sorts, merges and writes the log. Throws std::runtime_error if it cannot be written.
+  void finish();
+
+  /// Messages added per channel.
+  const std::map<std::string, int64_t>& counts() const { return counts_; }
+  int64_t runFiles() const { return static_cast<int64_t>(runs_.size()); }
+
+ private:
+  struct Event {
+    int64_t utime;
+    std::string channel;
+    std::vector<uint8_t> data;
+  };
+  void spill();
+  void removeRuns();
+
+  std::string path_;
+  SortedLogWriterOptions options_;
+  std::vector<Event> buffer_;
+  int64_t buffer_bytes_ = 0;
+  std::vector<std::string> runs_;
+  std::map<std::string, int64_t> counts_;
+  bool finished_ = false;
+};
+
+}  // namespace livo::import

@@ -1,0 +1,92 @@
+#include "livo/import/chunk_decompression.hpp"
+
+#include <bzlib.h>
+#include <lz4frame.h>
+
+namespace livo::import {
+
+namespace {
+
+DecompressedChunk bz2(const uint8_t* in, size_t size, size_t expected) {
+  DecompressedChunk out;
+  out.data.resize(expected);
+  bz_stream s{};
+  if (BZ2_bzDecompressInit(&s, 0, 0) != BZ_OK) {
+    out.data.clear();
+    out.error = "bz2: cannot initialise the decompressor";
+    return out;
+  }
+  s.next_in = const_cast<char*>(reinterpret_cast<const char*>(in));
+  s.avail_in = static_cast<unsigned>(size);
+  s.next_out = reinterpret_cast<char*>(out.data.data());
+  s.avail_out = static_cast<unsigned>(expected);
+  const int rc = BZ2_bzDecompress(&s);
+  const size_t produced = expected - s.avail_out;
+  BZ2_bzDecompressEnd(&s);
+  out.data.resize(produced);
+  if (rc == BZ_STREAM_END && produced == expected) {
+    out.complete = true;
+  } else if (rc == BZ_STREAM_END || rc == BZ_OK) {
+    out.error = "bz2: stream gave " + std::to_string(produced) + " of " + std::to_string(expected) +
+                " bytes (truncated chunk?)";
+  } else {
+    out.error = "bz2: corrupt data (error " + std::to_string(rc) + ") after " + std::to_string(produced) + " bytes";
+  }
+  return out;
+}
+
+DecompressedChunk lz4(const uint8_t* in, size_t size, size_t expected) {
+  DecompressedChunk out;
+  out.data.resize(expected);
+  LZ4F_dctx* ctx = nullptr;
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
+    out.data.clear();
+    out.error = "lz4: cannot initialise the decompressor";
+    return out;
+  }
+  size_t in_pos = 0, out_pos = 0;
+  size_t hint = 1;
+  while (in_pos < size && out_pos < expected && hint != 0) {
+    size_t in_len = size - in_pos, out_len = expected - out_pos;
+    hint = LZ4F_decompress(ctx, out.data.data() + out_pos, &out_len, in + in_pos, &in_len, nullptr);
+    if (LZ4F_isError(hint)) {
+      out.error = std::string("lz4: ") + LZ4F_getErrorName(hint) + " after " + std::to_string(out_pos) + " bytes";
+      break;
+    }
+    in_pos += in_len;
+    out_pos += out_len;
+    if (in_len == 0 && out_len == 0) break;
+  }
+  LZ4F_freeDecompressionContext(ctx);
+  out.data.resize(out_pos);
+  if (out.error.empty()) {
+    if (out_pos == expected)
+      out.complete = true;
+    else
+      out.error = "lz4: frame gave " + std::to_string(out_pos) + " of " + std::to_string(expected) +
+                  " bytes (truncated chunk?)";
+  }
+  return out;
+}
+
+}  // namespace
+
+DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size,
+                                  size_t expected_size) {
+  if (compression == "none") {
+    DecompressedChunk out;
+    out.data.assign(in, in + std::min(size, expected_size));
+    out.complete = size == expected_size;
+    if (!out.complete)
+      out.error = "uncompressed chunk holds " + std::to_string(size) + " bytes, its header says " +
+                  std::to_string(expected_size) + " (truncated?)";
+    return out;
+  }
+  if (compression == "bz2") return bz2(in, size, expected_size);
+  if (compression == "lz4") return lz4(in, size, expected_size);
+  DecompressedChunk out;
+  out.error = "unknown chunk compression '" + compression + "'";
+  return out;
+}
+
+}  // namespace livo::import

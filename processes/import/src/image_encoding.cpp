@@ -1,0 +1,93 @@
+#include "livo/import/image_encoding.hpp"
+
+#include <cstring>
+
+#include "livo/import/stamp_conversion.hpp"
+
+namespace livo::import {
+
+namespace {
+uint32_t be32(const uint8_t* p) { return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3]; }
+uint16_t be16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
+}  // namespace
+
+CompressedImageInfo sniffCompressedImage(const uint8_t* d, size_t n) {
+  CompressedImageInfo info;
+  static const uint8_t png[8] = {0x89, 'P', 'N', 'G', 0x0d, 0x0a, 0x1a, 0x0a};
+  if (n >= 8 && std::memcmp(d, png, 8) == 0) {
+    info.encoding = image_t::ENCODING_PNG;
+    if (n >= 24 && std::memcmp(d + 12, "IHDR", 4) == 0) {
+      info.width = static_cast<int>(be32(d + 16));
+      info.height = static_cast<int>(be32(d + 20));
+    }
+    return info;
+  }
+  if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) {
+    info.encoding = image_t::ENCODING_JPEG;
+    size_t i = 2;
+    while (i + 4 <= n) {
+      if (d[i] != 0xff) break;
+      const uint8_t marker = d[i + 1];
+      if (marker == 0xff) { ++i; continue; }
+      if (marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7) || marker == 0x01) { i += 2; continue; }
+      const uint16_t len = be16(d + i + 2);
+      const bool sof = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+      if (sof && i + 9 <= n) {
+        info.height = be16(d + i + 5);
+        info.width = be16(d + i + 7);
+        break;
+      }
+      if (marker == 0xda || len < 2) break;  // start of scan: no frame header before it
+      i += 2 + len;
+    }
+  }
+  return info;
+}
+
+image_t convertRosImage(const RosImage& m, const std::string& frame, const std::string& where) {
+  image_t img;
+  img.utime = nsToUtime(m.header.stampNs());
+  img.frame = frame;
+  img.width = static_cast<int32_t>(m.width);
+  img.height = static_cast<int32_t>(m.height);
+  img.row_stride = static_cast<int32_t>(m.step);
+  img.exposure_time = 0.0f;
+  int channels = 0;
+  if (m.encoding == "mono8" || m.encoding == "8UC1") {
+    img.encoding = image_t::ENCODING_GRAY8, channels = 1;
+  } else if (m.encoding == "rgb8") {
+    img.encoding = image_t::ENCODING_RGB8, channels = 3;
+  } else if (m.encoding == "bgr8" || m.encoding == "8UC3") {
+    img.encoding = image_t::ENCODING_BGR8, channels = 3;
+  } else {
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
+  }
+  if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * channels)
+    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " + std::to_string(channels));
+  if (static_cast<uint64_t>(m.step) * m.height > m.data_size)
+    throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
+                      std::to_string(static_cast<uint64_t>(m.step) * m.height));
+  const size_t size = static_cast<size_t>(m.step) * m.height;
+  img.size = static_cast<int32_t>(size);
+  img.data.assign(m.data, m.data + size);
+  return img;
+}
+
+image_t convertRosCompressedImage(const RosCompressedImage& m, const std::string& frame, const std::string& where) {
+  const CompressedImageInfo info = sniffCompressedImage(m.data, m.data_size);
+  if (info.encoding < 0)
+    throw DecodeError(where + ": field 'data': neither JPEG nor PNG (format '" + m.format + "')");
+  image_t img;
+  img.utime = nsToUtime(m.header.stampNs());
+  img.frame = frame;
+  img.width = info.width;
+  img.height = info.height;
+  img.row_stride = 0;
+  img.encoding = info.encoding;
+  img.exposure_time = 0.0f;
+  img.size = static_cast<int32_t>(m.data_size);
+  img.data.assign(m.data, m.data + m.data_size);
+  return img;
+}
+
+}  // namespace livo::import

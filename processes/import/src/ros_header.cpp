@@ -1,0 +1,33 @@
+#include "livo/import/ros_messages.hpp"
+
+namespace livo::import {
+
+RosHeader decodeRosHeader(ByteReader& r) {
+  RosHeader h;
+  h.seq = r.u32("header.seq");
+  h.sec = r.u32("header.stamp.sec");
+  h.nsec = r.u32("header.stamp.nsec");
+  h.frame_id = r.string("header.frame_id");
+  return h;
+}
+
+RosTypeInfo rosTypeInfo(const std::string& type) {
+  RosTypeInfo t;
+  if (type == "sensor_msgs/Imu") t = {RosMessageKind::kImu, "6a62c6daae103f4ff57a132d6f95cec2", nullptr};
+  if (type == "sensor_msgs/PointCloud2") t = {RosMessageKind::kPointCloud2, "1158d486dd51d683ce2f1be655c3c181", nullptr};
+  if (type == "sensor_msgs/Image") t = {RosMessageKind::kImage, "060021388200f6f0f447d0fcd9c64743", nullptr};
+  if (type == "sensor_msgs/CompressedImage")
+    t = {RosMessageKind::kCompressedImage, "8f7a12909da2c9d3332d540a0977563f", nullptr};
+  if (type == "nav_msgs/Odometry") t = {RosMessageKind::kPose, "cd5e73d190d741a2f92e81eda573aca7", decodeRosOdometry};
+  if (type == "geometry_msgs/PoseStamped")
+    t = {RosMessageKind::kPose, "d3812c3cbc69362b77dc0b19b345f8f5", decodeRosPoseStamped};
+  if (type == "geometry_msgs/PoseWithCovarianceStamped")
+    t = {RosMessageKind::kPose, "953b798c0f514ff060a53a3498ce6246", decodeRosPoseWithCovarianceStamped};
+  if (type == "geometry_msgs/TransformStamped")
+    t = {RosMessageKind::kPose, "b5764a33bfeb3588febc2682852579b0", decodeRosTransformStamped};
+  if (type == "geometry_msgs/PointStamped")
+    t = {RosMessageKind::kPose, "c63aecb41bfdfd6b7e1fac37c7cbe7bf", decodeRosPointStamped};
+  return t;
+}
+
+}  // namespace livo::import

@@ -1,0 +1,63 @@
+#include "livo/import/rosbag_presets.hpp"
+
+namespace livo::import {
+
+const std::vector<RosbagPreset>& rosbagPresets() {
+  static const std::vector<RosbagPreset> presets = [] {
+    std::vector<RosbagPreset> v;
+
+    // NTU VIRAL (ntu-aris): VN100 IMU, two Ouster OS1-16 (horizontal node1, vertical node2), two
+    // uEye mono cameras, Leica MS60 tracking a prism. The OS1 clouds are stamped at the end of the
+    // sweep with `t` counted from its start; the ground truth is the prism's position only.
+    RosbagPreset ntu;
+    ntu.name = "ntu_viral";
+    ntu.description = "NTU VIRAL: /imu/imu, /os1_cloud_node1/points (end-of-sweep stamps), /left|right/image_raw, "
+                      "/leica/pose/relative (prism position)";
+    ntu.imu_topic = "/imu/imu";
+    ntu.lidar_topic = "/os1_cloud_node1/points";
+    ntu.camera_topic = "/left/image_raw";
+    ntu.camera_right_topic = "/right/image_raw";
+    ntu.ground_truth_topic = "/leica/pose/relative";
+    ntu.ground_truth_child_frame = "prism";
+    ntu.lidar_stamp = LidarStampConvention::kEnd;
+    ntu.sweep_duration = 0.1;
+    ntu.num_rings = 16;
+    ntu.metadata = {
+        {"ground_truth_point", "\"Leica prism position in W (geometry_msgs/PointStamped): no orientation\""},
+        {"prism_offset_body", "[-0.293656, -0.012288, -0.273095]"},
+        {"prism_offset_note", "\"p_W_prism = p_W_I + R_W_I * prism_offset_body; pass it to livo-evaluate --gt-offset\""},
+        {"lidar_stamp", "\"end of sweep in the bag; converted to start (stamp - 0.1 s)\""},
+        {"extrinsic_body_lidar_horizontal", "{translation: [-0.05, 0.0, 0.055], rotation: [1.0, 0.0, 0.0, 0.0]}"},
+        {"frames_note", "\"the IMU and horizontal LiDAR z axes point down (dataset calibration)\""},
+    };
+    v.push_back(ntu);
+
+    // M2DGR (SJTU): Velodyne VLP-32C, Handsfree 9-axis IMU, RealSense colour camera (compressed);
+    // ground truth comes as separate TUM files (pass with --ground-truth FILE).
+    RosbagPreset m2dgr;
+    m2dgr.name = "m2dgr";
+    m2dgr.description = "M2DGR: /handsfree/imu, /velodyne_points (VLP-32C), /camera/color/image_raw/compressed; "
+                        "ground truth from the sequence's TUM file";
+    m2dgr.imu_topic = "/handsfree/imu";
+    m2dgr.lidar_topic = "/velodyne_points";
+    m2dgr.camera_topic = "/camera/color/image_raw/compressed";
+    m2dgr.lidar_stamp = LidarStampConvention::kStart;
+    m2dgr.sweep_duration = 0.1;
+    m2dgr.num_rings = 32;
+    m2dgr.metadata = {
+        {"lidar_model", "\"Velodyne VLP-32C, 10 Hz\""},
+        {"ground_truth_note", "\"M2DGR ships ground truth as TUM text files: --ground-truth SEQUENCE.txt\""},
+    };
+    v.push_back(m2dgr);
+    return v;
+  }();
+  return presets;
+}
+
+const RosbagPreset* findRosbagPreset(const std::string& name) {
+  for (const RosbagPreset& p : rosbagPresets())
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+}  // namespace livo::import

@@ -1,0 +1,418 @@
+#include "livo/loop/loop_closer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "livo/loop/voxel_grid.hpp"
+
+namespace livo::loop {
+
+namespace {
+// Rotation that levels the body frame: R_rp with W_R_I = Rz(yaw) * R_rp.
+Mat3 rollPitch(const Mat3& W_R_I) {
+  const Vec3 x = W_R_I.col(0);
+  const double yaw = std::atan2(x.y(), x.x());
+  return Eigen::AngleAxisd(-yaw, Vec3::UnitZ()).toRotationMatrix() * W_R_I;
+}
+Pose3 rotationOnly(const Mat3& R) {
+  Pose3 T = Pose3::Identity();
+  T.linear() = R;
+  return T;
+}
+}  // namespace
+
+std::string LoopCloser::problem(const KeyframeInput& input) const {
+  if (!placements_.empty()) {
+    const int64_t newest_id = placements_.back().id;
+    if (input.id <= newest_id)
+      return "keyframe id " + std::to_string(input.id) + " is not after " + std::to_string(newest_id);
+    if (input.epoch < newest_.epoch)
+      return "keyframe " + std::to_string(input.id) + " is of odometry epoch " + std::to_string(input.epoch) +
+             ", before the newest keyframe's (" + std::to_string(newest_.epoch) + ")";
+  }
+  if (!published_.odometryToCorrected(input.epoch, input.correction_id))
+    return "keyframe " + std::to_string(input.id) + " includes loop correction " +
+           std::to_string(input.correction_id) + ", which this process did not publish for odometry epoch " +
+           std::to_string(input.epoch);
+  return "";
+}
+
+const LoopCloser::Placement& LoopCloser::placement(int64_t id) const {
+  const auto it = std::lower_bound(placements_.begin(), placements_.end(), id,
+                                   [](const Placement& p, int64_t i) { return p.id < i; });
+  if (it == placements_.end() || it->id != id) throw std::out_of_range("unknown keyframe " + std::to_string(id));
+  return *it;
+}
+
+size_t LoopCloser::odometryEdgesAcrossEpochs() const {
+  size_t n = 0;
+  for (const PoseEdge& e : graph_.edges()) n += !e.is_loop && nodes_.at(e.from).epoch != nodes_.at(e.to).epoch;
+  return n;
+}
+
+std::vector<std::pair<double, int64_t>> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
+                                                                   double radius) const {
+  const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+  std::vector<std::pair<double, int64_t>> near;
+  for (const auto& [id, node] : nodes_) {
+    if (id >= kf_id) break;
+    if (node.epoch != kf.epoch || kf.utime - node.utime < recent || !node.has_keypoints) continue;
+    const double d2 = (graph_.pose(id).translation() - p).squaredNorm();
+    if (d2 <= radius * radius) near.push_back({d2, id});
+  }
+  std::sort(near.begin(), near.end());
+  return near;
+}
+
+std::vector<int64_t> LoopCloser::candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
+  // graph nodes only: a keyframe that joined one is represented by it
+  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.candidates.search_radius);
+  std::vector<int64_t> out;
+  for (size_t i = 0; i < near.size() && static_cast<int>(i) < options_.candidates.max_candidates; ++i)
+    out.push_back(near[i].second);
+  return out;
+}
+
+std::shared_ptr<const LoopCloser::Features> LoopCloser::deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const {
+  auto f = std::make_shared<Features>();
+  const Points levelled = transformed(cloud_I, rotationOnly(G_R_I));
+  f->coarse = computeCoarseFeatures(levelled, options_.coarse);
+  f->fine = GicpCloud::build(centroidPerVoxel(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
+  return f;
+}
+
+void LoopCloser::cacheFeatures(int64_t id, std::shared_ptr<const Features> f) {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it)
+    if (it->first == id) {
+      cache_.erase(it);
+      break;
+    }
+  cache_.emplace_front(id, std::move(f));
+  while (cache_.size() > static_cast<size_t>(std::max(1, options_.feature_cache_keyframes))) cache_.pop_back();
+}
+
+std::shared_ptr<const LoopCloser::Features> LoopCloser::features(int64_t id) {
+  for (auto it = cache_.begin(); it != cache_.end(); ++it)
+    if (it->first == id) {
+      cache_.splice(cache_.begin(), cache_, it);
+      return it->second;
+    }
+  Points cloud_I;
+  for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
+  std::shared_ptr<const Features> f = deriveFeatures(cloud_I, nodes_.at(id).G_R_I);
+  cacheFeatures(id, f);
+  return f;
+}
+
+Points LoopCloser::mapCloud(int64_t id) const {
+  Points cloud_I;
+  for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
+  Points map = centroidPerVoxel(cloud_I, options_.map_voxel_size);
+  for (Vec3& p : map) p = p.cast<float>().cast<double>();  // float, as the global map has always kept them
+  return map;
+}
+
+AcceptedLoop LoopCloser::acceptedLoop(int64_t from_id, const Keyframe& from, int64_t to_id, const Keyframe& to,
+                                      const LoopRegistrationResult& r) const {
+  AcceptedLoop loop;
+  loop.from_id = from_id;
+  loop.to_id = to_id;
+  loop.from_utime = from.utime;
+  loop.to_utime = to.utime;
+  // registration works in the levelled frames G; the loop is between the body frames I
+  loop.T_to_from = rotationOnly(to.G_R_I).inverse() * r.T_target_source * rotationOnly(from.G_R_I);
+  loop.covariance = loopCovariance(r, from);
+  loop.coarse_inliers = r.coarse.num_inliers;
+  loop.fitness = r.fine.fitness;
+  loop.overlap = r.fine.overlap;
+  return loop;
+}
+
+Pose3 LoopCloser::pose(int64_t id) const {
+  const Placement& k = placement(id);
+  return k.node == id ? graph_.pose(id) : graph_.pose(k.node) * k.T_node_kf;
+}
+
+void LoopCloser::forEachPose(const std::function<void(int64_t, const Pose3&)>& visit) const {
+  for (const Placement& k : placements_) visit(k.id, k.node == k.id ? graph_.pose(k.id) : graph_.pose(k.node) * k.T_node_kf);
+}
+
+std::optional<int64_t> LoopCloser::mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
+  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.merge_distance);
+  if (near.empty()) return std::nullopt;
+  return near.front().second;
+}
+
+Mat6 LoopCloser::loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const {
+  if (!options_.registration_information) {
+    Vec6 sigma;
+    sigma << Vec3::Constant(options_.loop_rotation_sigma), Vec3::Constant(options_.loop_translation_sigma);
+    return sigma.cwiseAbs2().asDiagonal();
+  }
+  // registered between the levelled frames: T_I = Q_to^-1 T_G Q_from, so T_I Exp(xi_I) =
+  // Q_to^-1 T_G Exp(xi_G) Q_from gives xi_I = Ad(Q_from^-1) xi_G (a rotation: both blocks rotated)
+  const Mat6 cov_G = registrationCovariance(r.fine, r.T_target_source, options_.loop_information);
+  Mat6 A = Mat6::Zero();
+  A.topLeftCorner<3, 3>() = A.bottomRightCorner<3, 3>() = from.G_R_I.transpose();
+  return A * cov_G * A.transpose();
+}
+
+DriftModel LoopCloser::driftModel() const {
+  return {options_.odometry_rotation_floor, options_.odometry_translation_floor, options_.odometry_rotation_per_m,
+          options_.odometry_translation_per_m};
+}
+
+std::optional<RefusedLoop> LoopCloser::inconsistency(const AcceptedLoop& loop, const Keyframe& from,
+                                                     const Pose3& W_T_from) const {
+  if (!options_.consistency_check) return std::nullopt;
+  const Keyframe& to = nodes_.at(loop.to_id);
+  const DriftModel drift = driftModel();
+  RefusedLoop refusal;
+  refusal.from_id = loop.from_id;
+  refusal.to_id = loop.to_id;
+  refusal.merged = loop.merged;
+  refusal.T_to_from = loop.T_to_from;
+  std::ostringstream why;
+  // the graph's relative pose of the two, uncertain by the odometry's drift over the path between them
+  const double path = std::abs(from.path - to.path);
+  const Pose3 graph_T = graph_.pose(loop.to_id).inverse() * W_T_from;
+  const double chi2 = poseChi2(graph_T, driftCovariance(path, drift), loop.T_to_from, loop.covariance);
+  if (chi2 > options_.consistency_chi2) {
+    refusal.against = "odometry";
+    refusal.chi2 = chi2;
+    refusal.path = path;
+    why << "inconsistent with the odometry: chi2 " << chi2 << " > " << options_.consistency_chi2 << " over " << path
+        << " m (" << (graph_T.inverse() * loop.T_to_from).translation().norm() << " m apart)";
+    refusal.reason = why.str();
+    return refusal;
+  }
+  // the cycle through the earlier loop with the least odometry on either side (C <- D), if any has
+  // less than the path above: T_to_from = odo(to -> C) T_C_D odo(D -> from)
+  long best = -1;
+  double best_path = path, best_1 = 0.0, best_3 = 0.0;
+  for (size_t k = 0; k < loops_.size(); ++k) {
+    if (anchors_[k].epoch != from.epoch) continue;
+    const double l1 = std::abs(to.path - nodes_.at(loops_[k].to_id).path);
+    const double l3 = std::abs(anchors_[k].from_path - from.path);
+    if (l1 + l3 < best_path) {
+      best = static_cast<long>(k);
+      best_path = l1 + l3;
+      best_1 = l1;
+      best_3 = l3;
+    }
+  }
+  if (best < 0) return std::nullopt;
+  const AcceptedLoop& earlier = loops_[best];
+  const Pose3 T1 = to.odometry.inverse() * nodes_.at(earlier.to_id).odometry;
+  const Pose3 T3 = anchors_[best].from_odometry.inverse() * from.odometry;
+  const Mat6 cov12 = composedCovariance(driftCovariance(best_1, drift), earlier.T_to_from, earlier.covariance);
+  const Mat6 cov = composedCovariance(cov12, T3, driftCovariance(best_3, drift));
+  const double cycle_chi2 = poseChi2(T1 * earlier.T_to_from * T3, cov, loop.T_to_from, loop.covariance);
+  if (cycle_chi2 <= options_.consistency_chi2) return std::nullopt;
+  refusal.against = "loop";
+  refusal.against_from_id = earlier.from_id;
+  refusal.against_to_id = earlier.to_id;
+  refusal.chi2 = cycle_chi2;
+  refusal.path = best_path;
+  why << "inconsistent with loop " << earlier.from_id << " -> " << earlier.to_id << ": chi2 " << cycle_chi2 << " > "
+      << options_.consistency_chi2 << " over a cycle with " << best_path << " m of odometry";
+  refusal.reason = why.str();
+  return refusal;
+}
+
+void LoopCloser::accept(const AcceptedLoop& loop, const Keyframe& from, AddResult& result) {
+  loops_.push_back(loop);
+  anchors_.push_back(LoopAnchor{from.epoch, from.odometry, from.path});
+  result.loop = loop;
+  keyframes_since_loop_ = 0;
+}
+
+LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, int64_t to_id,
+                                                const Features& to) const {
+  LoopRegistrationResult r = registerLoop(from.coarse, to.coarse, from.fine, to.fine, options_.registration);
+  if (options_.registration_hook) options_.registration_hook(from_id, to_id, r);
+  return r;
+}
+
+Mat6 LoopCloser::chainCovariance(const Keyframe& to) const {
+  // the odometry part: the increment's covariance from the absolute ones, floored by the drift
+  // model over the path; the loop part (if the chain starts with one) adds its covariance
+  // (carried to the end of the chain)
+  const Mat6 odometry =
+      relativeInformation(chain_.start_keyframe.covariance, to.covariance,
+                          std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+                          std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
+          .inverse();
+  if (!chain_.via_loop) return odometry;
+  // T_node_to = T_node_start (the loop) * the odometry increment from start to `to`
+  return composedCovariance(chain_.loop_covariance, chain_.start_keyframe.odometry.inverse() * to.odometry, odometry);
+}
+
+std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t current, const Keyframe& cur,
+                                                  AcceptedLoop* loop) {
+  // where the loop puts the keyframe (the joined or loop node's pose and the measured offset)
+  // against where the odometry has it now (in the newest correction it was sent)
+  const Pose3 implied = graph_.pose(loop->to_id) * loop->T_to_from;
+  const Pose3 odometry = *published_.odometryToCorrected(cur.epoch, published_.newest(cur.epoch)) * cur.odometry;
+  const Pose3 discrepancy = implied.inverse() * odometry;
+  loop->residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
+  loop->residual_translation = discrepancy.translation().norm();
+  loop->corrected = loop->residual_translation >= options_.min_correction_translation ||
+                    loop->residual_rotation >= options_.min_correction_rotation;
+  if (edge) graph_.addEdge(*edge);
+  if (!loop->corrected) return std::nullopt;
+  graph_.optimize();
+  // The odometry adopts T_Ck_O = corrected * raw^-1 of this keyframe (the whole epoch's raw frame
+  // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
+  Correction c;
+  c.id = next_correction_id_++;
+  c.epoch = cur.epoch;
+  c.previous_id = published_.newest(cur.epoch);
+  c.T_Ck_O = pose(current) * cur.odometry.inverse();
+  c.T_Ck_Cj = c.T_Ck_O * published_.odometryToCorrected(cur.epoch, c.previous_id)->inverse();
+  published_.add(c.id, c.epoch, c.T_Ck_O);
+  return c;
+}
+
+void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate,
+                         const std::vector<Eigen::Vector3f>& cloud) {
+  graph_.addNode(id, estimate);
+  nodes_.emplace(id, kf);
+  clouds_.put(id, cloud);
+  placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity()});
+}
+
+AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
+  if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
+  Keyframe kf;
+  kf.utime = input.utime;
+  kf.epoch = input.epoch;
+  kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
+  kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
+  kf.G_R_I = rollPitch(input.pose.linear());
+  // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
+  std::vector<Eigen::Vector3f> cloud_f;
+  cloud_f.reserve(input.cloud.size());
+  for (const Vec3& p : input.cloud) cloud_f.push_back(p.cast<float>());
+  const auto deriveCurrent = [&] {
+    Points cloud_I;
+    cloud_I.reserve(cloud_f.size());
+    for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
+    std::shared_ptr<const Features> f = deriveFeatures(cloud_I, kf.G_R_I);
+    kf.has_keypoints = !f->coarse.points.empty();
+    return f;
+  };
+  const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
+  const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
+  const Pose3 previous_odometry = newest_.odometry;
+  kf.path = first_of_epoch ? 0.0 : newest_.path + (previous_odometry.inverse() * kf.odometry).translation().norm();
+  newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
+
+  AddResult result;
+  std::shared_ptr<const Features> cur_features;
+  if (first_of_epoch) {
+    // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
+    // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
+    const bool first = placements_.empty();
+    cur_features = deriveCurrent();
+    addNode(input.id, kf, kf.odometry, cloud_f);
+    if (!first) graph_.holdFixed(input.id);
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
+  } else {
+    chain_.path += (previous_odometry.inverse() * kf.odometry).translation().norm();
+    // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
+    const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
+    const Pose3 estimate = graph_.pose(chain_.node) * T_node_kf;
+    const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+    const bool older_node = kf.utime - nodes_.at(chain_.node).utime >= recent;
+    if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
+      // passing again near the older node the odometry hangs from: the keyframe joins it (its
+      // cloud and features are not needed: the node represents it)
+      placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf});
+      return result;
+    }
+    cur_features = deriveCurrent();
+    if (options_.merge_distance > 0 && kf.has_keypoints) {
+      if (const std::optional<int64_t> near = mergeCandidate(input.id, kf, estimate.translation())) {
+        const Keyframe& target = nodes_.at(*near);
+        const std::shared_ptr<const Features> target_features = features(*near);
+        LoopRegistrationResult r = registerPair(input.id, *cur_features, *near, *target_features);
+        result.attempts.push_back(r);
+        std::optional<AcceptedLoop> loop;
+        if (r.accepted) {
+          loop = acceptedLoop(input.id, kf, *near, target, r);
+          loop->merged = true;
+          if (std::optional<RefusedLoop> refusal = inconsistency(*loop, kf, estimate)) {
+            refused_.push_back(*refusal);
+            result.refused.push_back(*refusal);
+            loop.reset();  // it becomes a node of its own (below)
+          }
+        }
+        if (loop) {
+          // the keyframe joins the older node; the graph gets the edge chain node -> that node
+          placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from});
+          PoseEdge e;  // none if the chain's node is the joined one (no new relation)
+          e.from = chain_.node;
+          e.to = *near;
+          e.T_from_to = T_node_kf * loop->T_to_from.inverse();
+          e.is_loop = true;
+          const Mat6 cov = composedCovariance(chainCovariance(kf), loop->T_to_from.inverse(),
+                                              inverseCovariance(loop->T_to_from, loop->covariance));
+          e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
+          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &*loop);
+          accept(*loop, kf, result);
+          chain_ = Chain{*near, input.id, kf, loop->T_to_from, true, 0.0, loop->covariance};
+          return result;
+        }
+      }
+    }
+    // a node of its own, with the chain's measurement from the node before
+    PoseEdge e;
+    e.from = chain_.node;
+    e.to = input.id;
+    e.T_from_to = T_node_kf;
+    e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
+    e.information = chain_.via_loop
+                        ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
+                        : relativeInformation(chain_.start_keyframe.covariance, kf.covariance,
+                                              std::hypot(options_.odometry_rotation_floor,
+                                                         options_.odometry_rotation_per_m * chain_.path),
+                                              std::hypot(options_.odometry_translation_floor,
+                                                         options_.odometry_translation_per_m * chain_.path));
+    addNode(input.id, kf, estimate, cloud_f);
+    graph_.addEdge(e);
+    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
+    if (!result.attempts.empty()) return result;  // the nearest older node did not register: no second try
+  }
+
+  if (cooling) return result;
+  cacheFeatures(input.id, cur_features);
+  if (!kf.has_keypoints) return result;
+  for (int64_t cand : candidates(input.id, kf, graph_.pose(input.id).translation())) {
+    const Keyframe& target = nodes_.at(cand);
+    const std::shared_ptr<const Features> target_features = features(cand);
+    LoopRegistrationResult r = registerPair(input.id, *cur_features, cand, *target_features);
+    result.attempts.push_back(r);
+    if (!r.accepted) continue;
+    AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);
+    if (std::optional<RefusedLoop> refusal = inconsistency(loop, kf, graph_.pose(input.id))) {
+      refused_.push_back(*refusal);
+      result.refused.push_back(*refusal);
+      continue;
+    }
+    PoseEdge e;
+    e.from = cand;
+    e.to = input.id;
+    e.T_from_to = loop.T_to_from;
+    e.is_loop = true;
+    e.information = informationFromCovariance(edgeCovarianceFromRight(loop.T_to_from, loop.covariance));
+    result.correction = addLoopEdge(&e, input.id, kf, &loop);
+    accept(loop, kf, result);
+    break;
+  }
+  return result;
+}
+
+}  // namespace livo::loop

@@ -1,0 +1,755 @@
+#include "livo/octomap/occupancy_map.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <functional>
+#include <limits>
+#include <type_traits>
+
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
+#include "livo/file_output.hpp"
+#include "livo/spill_file.hpp"
+
+namespace livo::octomap {
+
+namespace {
+template <class Tree>
+void configure(Tree* t, const OctomapOptions& o) {
+  t->setProbHit(o.prob_hit);
+  t->setProbMiss(o.prob_miss);
+  t->setClampingThresMin(o.clamping_min);
+  t->setClampingThresMax(o.clamping_max);
+  t->setOccupancyThres(o.occupancy_threshold);
+}
+}  // namespace
+
+// Open-addressing set of packed voxel keys (3 x 16 bits), reused across sweeps: the ray casting's
+// inner loop, several times faster than octomap's KeySet (an unordered_set).
+class FlatKeySet {
+ public:
+  void clear() {
+    if (size_ == 0) return;
+    std::fill(slots_.begin(), slots_.end(), 0);
+    size_ = 0;
+    order_.clear();
+  }
+  // true if newly inserted
+  bool insert(uint64_t packed) {
+    if ((size_ + 1) * 2 > slots_.size()) grow();
+    const uint64_t v = packed + 1;
+    size_t i = hash(v) & (slots_.size() - 1);
+    while (slots_[i]) {
+      if (slots_[i] == v) return false;
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    slots_[i] = v;
+    ++size_;
+    order_.push_back(packed);
+    return true;
+  }
+  bool contains(uint64_t packed) const {
+    if (slots_.empty()) return false;
+    const uint64_t v = packed + 1;
+    size_t i = hash(v) & (slots_.size() - 1);
+    while (slots_[i]) {
+      if (slots_[i] == v) return true;
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    return false;
+  }
+  const std::vector<uint64_t>& keys() const { return order_; }  // insertion order
+
+ private:
+  static size_t hash(uint64_t v) { return static_cast<size_t>((v * 0x9E3779B97F4A7C15ull) >> 20); }
+  void grow() {
+    std::vector<uint64_t> old = std::move(order_);
+    slots_.assign(std::max<size_t>(1 << 14, slots_.size() * 2), 0);
+    size_ = 0;
+    order_.clear();
+    order_.reserve(slots_.size() / 2);
+    for (uint64_t k : old) insert(k);
+  }
+  std::vector<uint64_t> slots_;
+  std::vector<uint64_t> order_;
+  size_t size_ = 0;
+};
+
+struct OccupancyMap::Scratch {
+  FlatKeySet free, hit, endpoints;
+  ::octomap::KeyRay ray;
+};
+
+// What the levels above the tiles need of a tile's root (the node at the tiles' depth), and the
+// size of its subtree in the format being written.
+struct OccupancyMap::TileSummary {
+  uint64_t index = 0;
+  uint64_t morton = 0;     // the tile's place in the tree's depth-first order
+  float log_odds = 0.f;    // full format: the root's value and colour
+  std::array<uint8_t, 3> rgb{{255, 255, 255}};
+  bool leaf = false;       // binary: the root is a (maximum-likelihood) leaf ...
+  bool occupied = false;   // ... and occupied
+  uint64_t nodes = 0;      // nodes of its subtree in this format
+  bool present = false;    // the tile holds a node at all
+};
+
+struct OccupancyMap::Tile {
+  std::unique_ptr<::octomap::AbstractOccupancyOcTree> tree;  // resident
+  bool spilled = false;
+  int64_t last_used = INT64_MIN;
+  bool dirty = false;        // inner nodes not refreshed since the last update
+  // on disk: the tree's node stream (octomap's full format from the root: after the levels above
+  // the tile's root it is the tile's part of a .ot as it is) and the tile's part of a .bt, with
+  // what the levels above need of each, so a file is written without decoding a tile on disk
+  SpillFile::Record record;
+  uint64_t full_offset = 0;  // bytes of `record` before the tile's root
+  SpillFile::Record binary;
+  TileSummary full_summary, binary_summary;
+  size_t leaves = 0;         // on disk: its leaf count
+};
+
+namespace {
+uint64_t pack(const ::octomap::OcTreeKey& k) { return (uint64_t(k[0]) << 32) | (uint64_t(k[1]) << 16) | uint64_t(k[2]); }
+::octomap::OcTreeKey unpack(uint64_t v) {
+  return ::octomap::OcTreeKey(uint16_t(v >> 32), uint16_t(v >> 16), uint16_t(v));
+}
+constexpr int kTreeDepth = 16;  // octomap's key depth
+
+// Log-odds updates of finest-level leaves, as octomap's updateNode(key, log_odds, lazy_eval = true)
+// makes them (same clamping and early abort, so the tree is the same), but walking down only from
+// the deepest node the key shares with the previous one: keys in ray or sweep order share most of
+// their path, so most updates cost a few pointer steps instead of two full descents (octomap's
+// search, then updateNodeRecurs). Missing nodes are created by octomap's updateNode.
+template <class Tree>
+class LeafUpdater {
+ public:
+  explicit LeafUpdater(Tree& t) : t_(t), depth_(static_cast<int>(t.getTreeDepth())) {}
+
+  void update(const ::octomap::OcTreeKey& key, float log_odds) {
+    using Node = typename Tree::NodeType;
+    path_[0] = t_.getRoot();
+    if (!path_[0]) {
+      fallback(key, log_odds, 0);
+      return;
+    }
+    // the node at depth d is fixed by the key bits above depth_ - 1 - d: shared up to the highest
+    // bit in which the keys differ
+    int d = 0;
+    if (valid_ > 0) {
+      const unsigned diff = unsigned(key[0] ^ prev_[0]) | unsigned(key[1] ^ prev_[1]) | unsigned(key[2] ^ prev_[2]);
+      const int highest = diff ? 31 - __builtin_clz(diff) : -1;
+      d = std::min(valid_, depth_ - 1 - highest);
+    }
+    for (; d < depth_; ++d) {
+      const unsigned pos = ::octomap::computeChildIdx(key, depth_ - 1 - d);
+      if (!t_.nodeChildExists(path_[d], pos)) {
+        fallback(key, log_odds, d);
+        return;
+      }
+      path_[d + 1] = t_.getNodeChild(path_[d], pos);
+    }
+    Node* leaf = path_[depth_];
+    const float v = leaf->getLogOdds();
+    if (!((log_odds >= 0 && v >= t_.getClampingThresMaxLog()) || (log_odds <= 0 && v <= t_.getClampingThresMinLog())))
+      t_.updateNodeLogOdds(leaf, log_odds);
+    prev_ = key;
+    valid_ = depth_;
+  }
+
+ private:
+  void fallback(const ::octomap::OcTreeKey& key, float log_odds, int valid) {
+    t_.updateNode(key, log_odds, true);  // creates the missing nodes below path_[valid]
+    prev_ = key;
+    valid_ = valid;  // path_[0 .. valid] still hold (nodes are never moved or freed by an update)
+  }
+
+  Tree& t_;
+  const int depth_;
+  std::array<typename Tree::NodeType*, 17> path_{};  // path_[d]: node at depth d (tree depth <= 16)
+  ::octomap::OcTreeKey prev_;
+  int valid_ = 0;  // path_[0 .. valid_] matches prev_
+};
+
+// Casts the sweep into key sets (on the key arithmetic of `keys`), then updates the leaves in the
+// trees of their tiles (`tree_of(tile index)`).
+template <class Tree, class TreeOf, class TileOf>
+size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::Slice>& slices, const OctomapOptions& o,
+                 OccupancyMap::Scratch& s, TreeOf tree_of, TileOf tile_of) {
+  s.free.clear();
+  s.hit.clear();
+  const double min2 = o.min_range * o.min_range;
+  size_t rays = 0;
+  for (const OccupancyMap::Slice& slice : slices) {
+    if (!slice.points || !slice.origin.allFinite()) continue;
+    const ::octomap::point3d origin(slice.origin.x(), slice.origin.y(), slice.origin.z());
+    s.endpoints.clear();
+    for (const Eigen::Vector3f& p : *slice.points) {
+      if (!p.allFinite()) continue;
+      const Eigen::Vector3d d = p.cast<double>() - slice.origin;
+      const double r2 = d.squaredNorm();
+      if (r2 < min2) continue;
+      ::octomap::OcTreeKey key;
+      if (!keys.coordToKeyChecked(::octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+      ++rays;
+      if (!s.endpoints.insert(pack(key))) continue;  // one ray per endpoint voxel and slice
+      // discretised: the ray ends at the endpoint voxel's centre
+      ::octomap::point3d end = keys.keyToCoord(key);
+      bool hit = true;
+      const double r = std::sqrt(r2);
+      if (o.max_range > 0.0 && r > o.max_range) {
+        end = origin + (end - origin).normalized() * float(o.max_range);
+        hit = false;
+      } else if (o.free_margin > 0.0) {
+        // clear only up to free_margin before the endpoint (nothing if the ray is shorter)
+        const double length = (end - origin).norm();
+        end = origin + (end - origin) * float(std::max(0.0, length - o.free_margin) / std::max(length, 1e-9));
+      }
+      if (hit) s.hit.insert(pack(key));
+      if (keys.computeRayKeys(origin, end, s.ray))
+        for (const ::octomap::OcTreeKey& k : s.ray) s.free.insert(pack(k));
+    }
+  }
+  // one updater per tile (each keeps its own path), the last one cached: keys in ray order stay
+  // in a tile for long runs
+  std::map<uint64_t, std::unique_ptr<LeafUpdater<Tree>>> updaters;
+  uint64_t last_tile = ~uint64_t{0};
+  LeafUpdater<Tree>* updater = nullptr;
+  auto update = [&](uint64_t packed, float log_odds) {
+    const ::octomap::OcTreeKey key = unpack(packed);
+    const uint64_t tile = tile_of(key);
+    if (tile != last_tile || !updater) {
+      auto& u = updaters[tile];
+      if (!u) u = std::make_unique<LeafUpdater<Tree>>(*tree_of(tile));
+      updater = u.get();
+      last_tile = tile;
+    }
+    updater->update(key, log_odds);
+  };
+  const float miss = keys.getProbMissLog(), hit = keys.getProbHitLog();
+  for (uint64_t k : s.free.keys())
+    if (!s.hit.contains(k)) update(k, miss);
+  for (uint64_t k : s.hit.keys()) update(k, hit);
+  return rays;
+}
+
+// Calls f with the tree as the type it is (an OcTree or a ColorOcTree).
+template <class F>
+decltype(auto) withTree(bool colour, ::octomap::AbstractOccupancyOcTree& t, F&& f) {
+  if (colour) return f(static_cast<::octomap::ColorOcTree&>(t));
+  return f(static_cast<::octomap::OcTree&>(t));
+}
+
+// The node at `depth` on the tile's one path down (the levels above a tile hold one child each).
+template <class Tree>
+const typename Tree::NodeType* tileRoot(const Tree& t, int depth) {
+  const auto* node = t.getRoot();
+  for (int d = 0; node && d < depth; ++d) {
+    const typename Tree::NodeType* next = nullptr;
+    for (unsigned i = 0; i < 8; ++i) {
+      if (!t.nodeChildExists(node, i)) continue;
+      if (next) throw std::logic_error("octomap tile: more than one path above the tile's root");
+      next = t.getNodeChild(node, i);
+    }
+    node = next;
+  }
+  return node;
+}
+
+// octomap's full format (writeNodesRecurs): the node's data, a byte of the children that exist,
+// the children. Returns the nodes written (out null: only counted).
+template <class Tree>
+uint64_t writeFullNode(const Tree& t, const typename Tree::NodeType* node, std::ostream* out) {
+  uint8_t children = 0;
+  for (unsigned i = 0; i < 8; ++i)
+    if (t.nodeChildExists(node, i)) children |= uint8_t(1u << i);
+  if (out) {
+    node->writeData(*out);
+    out->write(reinterpret_cast<const char*>(&children), 1);
+  }
+  uint64_t n = 1;
+  for (unsigned i = 0; i < 8; ++i)
+    if (children & (1u << i)) n += writeFullNode(t, t.getNodeChild(node, i), out);
+  return n;
+}
+
+// octomap's binary format of the maximum-likelihood tree, pruned (what OcTree::writeBinary
+// writes after toMaxLikelihood() and prune()): a node whose eight children are leaves of one
+// occupancy is a leaf. encode() appends a node's content (two bytes of 2-bit child codes, then the
+// children's contents) to *out unless the node is a leaf.
+struct BinaryNode {
+  bool leaf = false;
+  bool occupied = false;
+  uint64_t nodes = 1;
+};
+inline void putChildCode(uint8_t codes[2], unsigned i, const BinaryNode& c) {
+  // 10 free leaf, 01 occupied leaf, 11 inner (bit 2i is the first of the pair)
+  const unsigned bits = !c.leaf ? 3u : (c.occupied ? 2u : 1u);
+  codes[i / 4] |= uint8_t(bits << (2 * (i % 4)));
+}
+template <class Tree>
+BinaryNode encodeBinary(const Tree& t, const typename Tree::NodeType* node, std::string* out, bool may_be_leaf = true) {
+  BinaryNode me;
+  if (!t.nodeHasChildren(node)) {
+    if (may_be_leaf) {
+      me.leaf = true;
+      me.occupied = t.isNodeOccupied(node);
+      return me;
+    }
+    out->append(2, '\0');  // the root of the tree: an inner node without children
+    return me;
+  }
+  std::array<BinaryNode, 8> child{};
+  std::array<bool, 8> exists{};
+  std::string below;
+  bool uniform = true;
+  for (unsigned i = 0; i < 8; ++i) {
+    exists[i] = t.nodeChildExists(node, i);
+    if (!exists[i]) {
+      uniform = false;
+      continue;
+    }
+    child[i] = encodeBinary(t, t.getNodeChild(node, i), &below);
+    uniform = uniform && child[i].leaf && child[i].occupied == child[0].occupied;
+  }
+  if (uniform && may_be_leaf) {
+    me.leaf = true;
+    me.occupied = child[0].occupied;
+    return me;
+  }
+  uint8_t codes[2] = {0, 0};
+  for (unsigned i = 0; i < 8; ++i) {
+    if (!exists[i]) continue;
+    putChildCode(codes, i, child[i]);
+    me.nodes += child[i].nodes;
+  }
+  out->append(reinterpret_cast<const char*>(codes), 2);
+  out->append(below);
+  return me;
+}
+
+std::string header(bool colour, double resolution, bool binary, uint64_t nodes) {
+  // octomap's headers (AbstractOcTree::write, OcTree::writeBinaryConst), written here: octomap's
+  // own writers print to the console
+  std::ostringstream s;
+  s << (binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file")
+    << "\n# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+    << "id " << (colour && !binary ? "ColorOcTree" : "OcTree") << "\nsize " << nodes << "\nres " << resolution
+    << "\ndata\n";
+  return s.str();
+}
+}  // namespace
+
+OccupancyMap::OccupancyMap(const OctomapOptions& options)
+    : options_(options), keys_(std::make_unique<::octomap::OcTree>(options.resolution)), scratch_(std::make_unique<Scratch>()) {
+  configure(keys_.get(), options_);
+  if (options_.tile_size > 0.0) {
+    const double voxels = options_.tile_size / options_.resolution;
+    tile_bits_ = std::clamp(static_cast<int>(std::lround(std::log2(std::max(voxels, 2.0)))), 1, kTreeDepth);
+  }
+}
+OccupancyMap::~OccupancyMap() = default;
+OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
+OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
+
+void OccupancyMap::clear() {
+  tiles_.clear();
+  spill_.reset();
+}
+
+std::unique_ptr<::octomap::AbstractOccupancyOcTree> OccupancyMap::newTree() const {
+  if (options_.colour) {
+    auto t = std::make_unique<::octomap::ColorOcTree>(options_.resolution);
+    configure(t.get(), options_);
+    return t;
+  }
+  auto t = std::make_unique<::octomap::OcTree>(options_.resolution);
+  configure(t.get(), options_);
+  return t;
+}
+
+OccupancyMap::Tile& OccupancyMap::residentTile(uint64_t tile_index) {
+  std::unique_ptr<Tile>& slot = tiles_[tile_index];
+  if (!slot) slot = std::make_unique<Tile>();
+  Tile& t = *slot;
+  if (t.spilled) {
+    std::unique_ptr<::octomap::AbstractOccupancyOcTree> back;
+    treeOf(t, &back);
+    t.tree = std::move(back);
+    spill_->release(t.record);  // the disk space goes back (written again when it goes)
+    spill_->release(t.binary);
+    t.spilled = false;
+    t.leaves = 0;
+  } else if (!t.tree) {
+    t.tree = newTree();
+  }
+  t.last_used = now_;
+  t.dirty = true;
+  return t;
+}
+
+::octomap::AbstractOccupancyOcTree& OccupancyMap::treeOf(const Tile& tile,
+                                                      std::unique_ptr<::octomap::AbstractOccupancyOcTree>* holder) const {
+  if (!tile.spilled) return *tile.tree;
+  std::vector<uint8_t> bytes;
+  spill_->read(tile.record, &bytes);
+  std::istringstream in(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  *holder = newTree();
+  withTree(options_.colour, **holder, [&](auto& t) {
+    t.readData(in);
+    return 0;
+  });
+  if (!in) throw std::runtime_error("octomap: a tile read back from the scratch file is incomplete");
+  return **holder;
+}
+
+OccupancyMap::TileSummary OccupancyMap::summarize(const ::octomap::AbstractOccupancyOcTree& tree, Format format,
+                                                   std::string* payload) const {
+  const int depth = kTreeDepth - tile_bits_;
+  TileSummary s;
+  withTree(options_.colour, const_cast<::octomap::AbstractOccupancyOcTree&>(tree), [&](auto& t) {
+    const auto* root = tileRoot(t, depth);
+    if (!root) return 0;
+    s.present = true;
+    s.log_odds = root->getLogOdds();
+    if constexpr (std::is_same_v<std::decay_t<decltype(t)>, ::octomap::ColorOcTree>) {
+      const auto c = root->getColor();
+      s.rgb = {c.r, c.g, c.b};
+    }
+    if (format == Format::kBinary) {
+      std::string scratch;
+      const BinaryNode b = encodeBinary(t, root, payload ? payload : &scratch, depth > 0);
+      s.leaf = b.leaf;
+      s.occupied = b.occupied;
+      s.nodes = b.nodes;
+    } else if (payload) {
+      std::ostringstream out;
+      s.nodes = writeFullNode(t, root, &out);
+      *payload = out.str();
+    } else {
+      s.nodes = writeFullNode(t, root, nullptr);
+    }
+    return 0;
+  });
+  return s;
+}
+
+void OccupancyMap::spill(Tile* tile) {
+  std::ostringstream out;
+  withTree(options_.colour, *tile->tree, [&](auto& t) {
+    t.updateInnerOccupancy();
+    // lossless for an OcTree (eight equal leaves); a ColorOcTree would average their colours
+    if (!options_.colour) t.prune();
+    tile->leaves = t.getNumLeafNodes();
+    t.writeData(out);  // no header: read back into a tree of the type (octomap's read() prints)
+    // the levels above the tile's root hold one node each: its data and a byte of children
+    using Node = typename std::decay_t<decltype(t)>::NodeType;
+    std::ostringstream one;
+    Node().writeData(one);
+    tile->full_offset = static_cast<uint64_t>(kTreeDepth - tile_bits_) * (one.str().size() + 1);
+    return 0;
+  });
+  const std::string bytes = out.str();
+  std::string binary_bytes;
+  tile->full_summary = summarize(*tile->tree, Format::kFull, nullptr);
+  tile->binary_summary = summarize(*tile->tree, Format::kBinary, &binary_bytes);
+  if (!spill_) spill_ = std::make_unique<SpillFile>();
+  tile->record = spill_->append(bytes.data(), bytes.size());
+  tile->binary = spill_->append(binary_bytes.data(), binary_bytes.size());
+  tile->tree.reset();
+  tile->spilled = true;
+  tile->dirty = false;
+}
+
+size_t OccupancyMap::evictIdle() {
+  // pruning is lossless for an OcTree (eight equal leaves become their parent; an update below
+  // expands it again) and keeps the free space a sweep clears to a few nodes once it is clamped
+  if (!options_.colour && !tiles_.empty()) {
+    auto it = tiles_.lower_bound(prune_next_);
+    for (size_t tried = 0; tried < tiles_.size(); ++tried, ++it) {
+      if (it == tiles_.end()) it = tiles_.begin();
+      if (it->second->spilled) continue;
+      static_cast<::octomap::OcTree&>(*it->second->tree).prune();
+      prune_next_ = it->first + 1;
+      break;
+    }
+  }
+  if (options_.tile_idle_s <= 0.0 || now_ == INT64_MIN) return 0;
+  const int64_t before = now_ - static_cast<int64_t>(options_.tile_idle_s * 1e6);
+  size_t n = 0;
+  for (auto& [index, tile] : tiles_) {
+    if (tile->spilled || tile->last_used >= before) continue;
+    spill(tile.get());
+    ++n;
+  }
+  return n;
+}
+
+size_t OccupancyMap::residentTiles() const {
+  return static_cast<size_t>(std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return !t.second->spilled; }));
+}
+size_t OccupancyMap::spilledTiles() const { return tiles_.size() - residentTiles(); }
+uint64_t OccupancyMap::spilledBytes() const { return spill_ ? spill_->liveBytes() : 0; }
+
+void OccupancyMap::refreshResident() const {
+  for (const auto& [index, tile] : tiles_) {
+    if (tile->spilled || !tile->dirty) continue;
+    withTree(options_.colour, *tile->tree, [](auto& t) {
+      t.updateInnerOccupancy();
+      return 0;
+    });
+    tile->dirty = false;
+  }
+}
+
+size_t OccupancyMap::insertRays(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& origin) {
+  Slice s;
+  s.origin = origin;
+  s.points = &points;
+  return insertSweep({s});
+}
+
+size_t OccupancyMap::insertSweep(const std::vector<Slice>& slices) {
+  const int b = tile_bits_;
+  auto tile_of = [b](const ::octomap::OcTreeKey& k) {
+    return (uint64_t(k[0] >> b) << 32) | (uint64_t(k[1] >> b) << 16) | uint64_t(k[2] >> b);
+  };
+  if (options_.colour) {
+    return integrate<::octomap::ColorOcTree>(
+        *keys_, slices, options_, *scratch_,
+        [&](uint64_t i) { return static_cast<::octomap::ColorOcTree*>(residentTile(i).tree.get()); }, tile_of);
+  }
+  return integrate<::octomap::OcTree>(
+      *keys_, slices, options_, *scratch_,
+      [&](uint64_t i) { return static_cast<::octomap::OcTree*>(residentTile(i).tree.get()); }, tile_of);
+}
+
+size_t OccupancyMap::setColours(const std::vector<Eigen::Vector3f>& points, const std::vector<std::array<uint8_t, 3>>& rgb) {
+  if (!options_.colour) return 0;
+  size_t n = 0;
+  for (size_t i = 0; i < points.size() && i < rgb.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (!p.allFinite()) continue;
+    ::octomap::OcTreeKey key;
+    if (!keys_->coordToKeyChecked(::octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+    const uint64_t index = (uint64_t(key[0] >> tile_bits_) << 32) | (uint64_t(key[1] >> tile_bits_) << 16) |
+                           uint64_t(key[2] >> tile_bits_);
+    if (!tiles_.count(index)) continue;  // nothing mapped there
+    auto& tree = static_cast<::octomap::ColorOcTree&>(*residentTile(index).tree);
+    ::octomap::ColorOcTreeNode* node = tree.search(key);
+    if (!node || !tree.isNodeOccupied(node)) continue;
+    tree.averageNodeColor(key, rgb[i][0], rgb[i][1], rgb[i][2]);
+    ++n;
+  }
+  return n;
+}
+
+int OccupancyMap::classify(const Eigen::Vector3d& p) const {
+  refreshResident();
+  ::octomap::OcTreeKey key;
+  if (!keys_->coordToKeyChecked(::octomap::point3d(p.x(), p.y(), p.z()), key)) return -1;
+  const uint64_t index =
+      (uint64_t(key[0] >> tile_bits_) << 32) | (uint64_t(key[1] >> tile_bits_) << 16) | uint64_t(key[2] >> tile_bits_);
+  auto it = tiles_.find(index);
+  if (it == tiles_.end()) return -1;
+  std::unique_ptr<::octomap::AbstractOccupancyOcTree> holder;
+  return withTree(options_.colour, treeOf(*it->second, &holder), [&](auto& t) {
+    const auto* n = t.search(key);
+    return n ? (t.isNodeOccupied(n) ? 1 : 0) : -1;
+  });
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupiedVoxels() const {
+  refreshResident();
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& [index, tile] : tiles_) {
+    std::unique_ptr<::octomap::AbstractOccupancyOcTree> holder;
+    withTree(options_.colour, treeOf(*tile, &holder), [&](auto& t) {
+      const double res = t.getResolution();
+      for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it) {
+        if (!t.isNodeOccupied(*it)) continue;
+        const double size = it.getSize();
+        const int n = std::max(1, static_cast<int>(std::lround(size / res)));
+        const ::octomap::point3d c = it.getCoordinate();
+        const double start = -0.5 * size + 0.5 * res;
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j)
+            for (int k = 0; k < n; ++k)
+              out.emplace_back(c.x() + start + i * res, c.y() + start + j * res, c.z() + start + k * res);
+      }
+      return 0;
+    });
+  }
+  return out;
+}
+
+size_t OccupancyMap::leafCount() const {
+  refreshResident();
+  size_t n = 0;
+  for (const auto& [index, tile] : tiles_)
+    n += tile->spilled ? tile->leaves : withTree(options_.colour, *tile->tree, [](auto& t) { return t.getNumLeafNodes(); });
+  return n;
+}
+
+// The one octree the tiles make, in octomap's full (.ot) or binary (.bt) format, streamed: first
+// every tile's root and subtree size (the header needs the node count), then the levels above the
+// tiles, each tile's subtree in its place. A tile on disk is not decoded: what the file needs of it
+// was written beside it when it went there.
+bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_only) const {
+  refreshResident();
+  const int depth = kTreeDepth - tile_bits_;  // of the tiles' roots
+  const bool binary = format == Format::kBinary;
+  std::vector<TileSummary> tiles;
+  for (const auto& [index, tile] : tiles_) {
+    if (resident_only && tile->spilled) continue;
+    TileSummary s = tile->spilled ? (binary ? tile->binary_summary : tile->full_summary)
+                                  : summarize(*tile->tree, format, nullptr);
+    if (!s.present) continue;
+    s.index = index;
+    // depth-first order: at every level the child index (x bit 1, y bit 2, z bit 4)
+    const uint64_t x = index >> 32, y = (index >> 16) & 0xFFFF, z = index & 0xFFFF;
+    s.morton = 0;
+    for (int d = depth - 1; d >= 0; --d)
+      s.morton = (s.morton << 3) | (((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2));
+    tiles.push_back(s);
+  }
+  std::sort(tiles.begin(), tiles.end(), [](const TileSummary& a, const TileSummary& b) { return a.morton < b.morton; });
+
+  // the levels above the tiles: node (d, range of tiles); child i holds the tiles whose code at
+  // level d is i
+  auto childCode = [&](const TileSummary& t, int d) { return unsigned(t.morton >> (3 * (depth - 1 - d))) & 7u; };
+  struct Synth {
+    float log_odds = 0.f;
+    std::array<uint8_t, 3> rgb{{255, 255, 255}};
+    uint64_t nodes = 0;
+  };
+  // value and colour as octomap's updateInnerOccupancy makes them (maximum child log-odds; the
+  // integer mean of the children's colours that are set, else white)
+  std::function<Synth(size_t, size_t, int)> synth = [&](size_t lo, size_t hi, int d) -> Synth {
+    if (d == depth) return Synth{tiles[lo].log_odds, tiles[lo].rgb, tiles[lo].nodes};
+    Synth me;
+    me.nodes = 1;
+    me.log_odds = -std::numeric_limits<float>::max();
+    int sum[3] = {0, 0, 0}, coloured = 0;
+    for (size_t a = lo; a < hi;) {
+      size_t b = a;
+      while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
+      const Synth c = synth(a, b, d + 1);
+      me.nodes += c.nodes;
+      me.log_odds = std::max(me.log_odds, c.log_odds);
+      if (!(c.rgb[0] == 255 && c.rgb[1] == 255 && c.rgb[2] == 255)) {
+        for (int k = 0; k < 3; ++k) sum[k] += c.rgb[k];
+        ++coloured;
+      }
+      a = b;
+    }
+    if (coloured > 0)
+      for (int k = 0; k < 3; ++k) me.rgb[k] = static_cast<uint8_t>(sum[k] / coloured);
+    return me;
+  };
+  auto tilePayload = [&](const TileSummary& s) {
+    const Tile& tile = *tiles_.at(s.index);
+    if (tile.spilled) {  // as written when it went to disk
+      std::vector<uint8_t> bytes;
+      spill_->read(binary ? tile.binary : tile.record, &bytes);
+      const size_t skip = binary ? 0 : tile.full_offset;
+      out.write(reinterpret_cast<const char*>(bytes.data()) + skip, static_cast<std::streamsize>(bytes.size() - skip));
+      return;
+    }
+    std::string bytes;
+    summarize(*tile.tree, format, &bytes);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  };
+  std::function<void(size_t, size_t, int)> write = [&](size_t lo, size_t hi, int d) {
+    if (d == depth) {
+      tilePayload(tiles[lo]);
+      return;
+    }
+    std::vector<std::pair<size_t, size_t>> children(8, {0, 0});
+    for (size_t a = lo; a < hi;) {
+      size_t b = a;
+      while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
+      children[childCode(tiles[a], d)] = {a, b};
+      a = b;
+    }
+    if (binary) {
+      uint8_t codes[2] = {0, 0};
+      for (unsigned i = 0; i < 8; ++i) {
+        const auto [a, b] = children[i];
+        if (a == b) continue;
+        BinaryNode c;  // a level above the tiles is inner; a tile's root may be a leaf
+        if (d + 1 == depth) c.leaf = tiles[a].leaf, c.occupied = tiles[a].occupied;
+        putChildCode(codes, i, c);
+      }
+      out.write(reinterpret_cast<const char*>(codes), 2);
+      for (unsigned i = 0; i < 8; ++i) {
+        const auto [a, b] = children[i];
+        if (a == b || (d + 1 == depth && tiles[a].leaf)) continue;
+        write(a, b, d + 1);
+      }
+      return;
+    }
+    const Synth me = synth(lo, hi, d);
+    out.write(reinterpret_cast<const char*>(&me.log_odds), sizeof(float));
+    if (options_.colour) out.write(reinterpret_cast<const char*>(me.rgb.data()), 3);
+    uint8_t exists = 0;
+    for (unsigned i = 0; i < 8; ++i)
+      if (children[i].first != children[i].second) exists |= uint8_t(1u << i);
+    out.write(reinterpret_cast<const char*>(&exists), 1);
+    for (unsigned i = 0; i < 8; ++i)
+      if (children[i].first != children[i].second) write(children[i].first, children[i].second, d + 1);
+  };
+
+  if (tiles.empty()) {
+    out << header(options_.colour, options_.resolution, binary, 0);
+    return bool(out);
+  }
+  uint64_t nodes = 0;
+  if (binary) {
+    // the levels above the tiles are inner nodes (one per distinct prefix); tiles' roots that are
+    // leaves count one node each (their BinaryNode says so)
+    std::function<uint64_t(size_t, size_t, int)> count = [&](size_t lo, size_t hi, int d) -> uint64_t {
+      if (d == depth) return tiles[lo].nodes;
+      uint64_t n = 1;
+      for (size_t a = lo; a < hi;) {
+        size_t b = a;
+        while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
+        n += count(a, b, d + 1);
+        a = b;
+      }
+      return n;
+    };
+    nodes = count(0, tiles.size(), 0);
+  } else {
+    nodes = synth(0, tiles.size(), 0).nodes;
+  }
+  out << header(options_.colour, options_.resolution, binary, nodes);
+  write(0, tiles.size(), 0);
+  return bool(out);
+}
+
+std::string OccupancyMap::binaryBytes(bool resident_only) const {
+  std::ostringstream s;
+  writeTree(s, Format::kBinary, resident_only);
+  return s.str();
+}
+
+std::string OccupancyMap::fullBytes(bool resident_only) const {
+  std::ostringstream s;
+  writeTree(s, Format::kFull, resident_only);
+  return s.str();
+}
+
+std::string OccupancyMap::treeType() const { return options_.colour ? "ColorOcTree" : "OcTree"; }
+
+bool OccupancyMap::writeBinary(const std::string& path) const {
+  return writeFileAtomically(path, [&](std::ostream& out) { return writeTree(out, Format::kBinary, false); });
+}
+bool OccupancyMap::writeFull(const std::string& path) const {
+  return writeFileAtomically(path, [&](std::ostream& out) { return writeTree(out, Format::kFull, false); });
+}
+
+}  // namespace livo::octomap

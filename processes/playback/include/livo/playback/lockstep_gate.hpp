@@ -1,0 +1,112 @@
+// Decides when the pipeline is idle, from the PROGRESS messages of its nodes: for every channel,
+// each listed consumer has taken as many messages as were published on it by playback and by
+// every node. Knows nothing of LCM or clocks: the caller feeds it progress with the wall time
+// (seconds, any origin) and asks.
+//
+// Three things a UDP bus and real processes add to that count:
+// - A lost message: a consumer that reports itself idle (nothing waiting in its queue) while it
+//   still lacks messages published more than `loss_grace_s` ago never got them. They are counted
+//   as lost for it (and reported), so the replay goes on instead of waiting for ever.
+// - A stall: a (consumer, channel) whose handled count has not moved for a while although it is
+//   behind; heartbeats and traffic on other channels do not hide it (stalledFor()).
+// - A restart (tolerate_restarts): a consumer that exits or goes silent is not waited for until a
+//   new instance of it reports; messages published while it was away are lost to it.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "livo/progress_t.hpp"
+
+namespace livo::playback {
+
+struct LockstepGateOptions {
+  double loss_grace_s = 3.0;        // an idle consumer still lacking a message this old lost it
+  bool tolerate_restarts = false;   // consumers may exit and come back (supervised runs)
+  double silent_after_s = 5.0;      // tolerate_restarts: a consumer not heard for this long is away
+  double restart_wait_s = 30.0;     // tolerate_restarts: how long a consumer away is waited for
+};
+
+class LockstepGate {
+ public:
+  explicit LockstepGate(std::vector<std::string> consumers, LockstepGateOptions options = {});
+
+  /// Records a node's PROGRESS received at `now_s` (only the newest sequence of each instance
+  /// counts). `idle_checked_s` is when the node checked its queue (progress_t.idle_checked_us on the
+  /// caller's clock; NaN: unknown, taken as now_s): a report checked before a message was published
+  /// says nothing about that message, however late it is received. Returns true if it moved
+  /// anything on (a count changed, or the node is new, restarted or finished), false for a
+  /// heartbeat that repeats what was known.
+  bool onProgress(const progress_t& p, double now_s = 0.0, double idle_checked_s = std::nan(""));
+  /// Playback published one more message on `channel` at `now_s`.
+  void onPublished(const std::string& channel, double now_s = 0.0);
+  /// tolerate_restarts: marks consumers not heard for silent_after_s as away (call periodically).
+  void checkSilent(double now_s);
+
+  /// Every consumer has reported at least once.
+  bool allPresent() const;
+  std::vector<std::string> missing() const;
+  /// Consumers that reported `finished` (they exited) and have not come back.
+  std::vector<std::string> finished() const;
+  /// The pipeline has handled everything published so far (consumers away are not waited for).
+  bool idle() const;
+  /// tolerate_restarts: a consumer went away less than restart_wait_s ago and has not come back
+  /// (lockstep holds the replay so that it misses as little as possible).
+  bool awaitingRestart(double now_s) const;
+  /// What the pipeline is still waiting for, e.g. "lio: LIDAR 41/42" (for stall reports).
+  std::string pendingDescription() const;
+  /// The longest time a consumer has been behind on a channel without its count moving.
+  double stalledFor(double now_s) const;
+
+  /// Events worth telling the user (losses, consumers away and back), oldest first; taking them
+  /// empties the list.
+  std::vector<std::string> takeEvents();
+  /// Messages counted as lost, per "consumer: channel".
+  const std::map<std::string, int64_t>& lost() const { return lost_total_; }
+  int64_t lostMessages() const;
+  int restarts() const { return restarts_; }
+
+ private:
+  struct NodeState {
+    int64_t instance = 0;
+    int64_t sequence = -1;
+    bool finished = false;
+    bool away = false;                      // exited or silent, waiting for a new instance
+    double away_since_s = 0.0;
+    double last_heard_s = 0.0;
+    std::map<std::string, int64_t> handled;
+    std::map<std::string, int64_t> published;
+    std::map<std::string, int64_t> published_before;  // by earlier instances of this node
+    std::map<std::string, int64_t> offset;  // counted as handled: lost, or published while away
+  };
+  struct Waiting {
+    int64_t handled = 0;
+    double since_s = 0.0;
+  };
+  int64_t totalPublished(const std::string& channel) const;
+  /// Messages on `channel` published at or before `t_s`.
+  int64_t publishedBy(const std::string& channel, double t_s) const;
+  int64_t deficit(const NodeState& n, const std::string& channel) const;
+  void notePublished(const std::string& channel, double now_s);
+  void detectLosses(const std::string& node, NodeState& n, double idle_at_s);
+  void updateWaiting(double now_s);
+  bool isConsumer(const std::string& node) const;
+
+  std::vector<std::string> consumers_;
+  LockstepGateOptions options_;
+  std::map<std::string, NodeState> nodes_;  // every node seen, listed or not
+  std::map<std::string, int64_t> playback_published_;
+  std::map<std::string, int64_t> known_total_;                       // channel -> total seen so far
+  std::map<std::string, std::deque<std::pair<int64_t, double>>> reached_at_;  // channel -> (total, time)
+  std::map<std::pair<std::string, std::string>, Waiting> waiting_;   // (consumer, channel)
+  std::map<std::string, int64_t> lost_total_;
+  std::vector<std::string> events_;
+  int restarts_ = 0;
+};
+
+}  // namespace livo::playback

@@ -1,0 +1,263 @@
+#include "livo/playback/lockstep_gate.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+
+namespace livo::playback {
+
+namespace {
+constexpr double kPublishHistoryS = 60.0;  // how far back publish times are kept (>> loss_grace_s)
+}  // namespace
+
+LockstepGate::LockstepGate(std::vector<std::string> consumers, LockstepGateOptions options)
+    : consumers_(std::move(consumers)), options_(options) {}
+
+bool LockstepGate::isConsumer(const std::string& node) const {
+  return std::find(consumers_.begin(), consumers_.end(), node) != consumers_.end();
+}
+
+bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_checked_s) {
+  const bool is_new = !nodes_.count(p.node);
+  NodeState& n = nodes_[p.node];
+  bool changed = is_new;
+  if (is_new) {
+    n.instance = p.instance;
+  } else if (p.instance != n.instance) {
+    // A new process under the same name: its counts start again from zero. What the old instance
+    // published stays published; what was published before the new one reported is lost to it.
+    for (const auto& [channel, count] : n.published) n.published_before[channel] += count;
+    n.published.clear();
+    std::ostringstream lost;
+    int64_t lost_total = 0;
+    for (int i = 0; i < p.num_inputs; ++i) {
+      const std::string& channel = p.input_channel[i];
+      const int64_t missed = totalPublished(channel) - n.handled[channel] - n.offset[channel];
+      if (missed > 0) {
+        lost << (lost_total ? ", " : "") << missed << " " << channel;
+        lost_total += missed;
+      }
+    }
+    n.handled.clear();
+    n.offset.clear();
+    for (int i = 0; i < p.num_inputs; ++i)
+      n.offset[p.input_channel[i]] = totalPublished(p.input_channel[i]) - p.handled[i];
+    n.instance = p.instance;
+    n.sequence = -1;
+    n.finished = false;
+    n.away = false;
+    changed = true;
+    if (isConsumer(p.node)) {
+      ++restarts_;
+      events_.push_back("consumer " + p.node + " restarted" +
+                        (lost_total ? "; missed while it was away: " + lost.str() : std::string()));
+    }
+  }
+  if (p.sequence <= n.sequence && !p.finished) return false;  // stale or reordered
+  n.last_heard_s = now_s;
+  if (n.away && !n.finished && !p.finished) {
+    n.away = false;
+    events_.push_back("consumer " + p.node + " is heard again");
+  }
+  n.sequence = p.sequence;
+  for (int i = 0; i < p.num_inputs; ++i) {
+    int64_t& v = n.handled[p.input_channel[i]];
+    changed = changed || v != p.handled[i];
+    v = p.handled[i];
+  }
+  for (int i = 0; i < p.num_outputs; ++i) {
+    int64_t& v = n.published[p.output_channel[i]];
+    if (v != p.published[i]) {
+      changed = true;
+      v = p.published[i];
+      notePublished(p.output_channel[i], now_s);
+    }
+  }
+  if (p.finished && !n.finished) {
+    n.finished = true;
+    changed = true;
+    if (options_.tolerate_restarts && isConsumer(p.node)) {
+      n.away = true;
+      n.away_since_s = now_s;
+      events_.push_back("consumer " + p.node + " exited; not waited for until it restarts");
+    }
+  }
+  if (p.idle && !p.finished && isConsumer(p.node))
+    detectLosses(p.node, n, std::isfinite(idle_checked_s) ? std::min(idle_checked_s, now_s) : now_s);
+  updateWaiting(now_s);
+  return changed;
+}
+
+void LockstepGate::onPublished(const std::string& channel, double now_s) {
+  ++playback_published_[channel];
+  notePublished(channel, now_s);
+  updateWaiting(now_s);
+}
+
+void LockstepGate::notePublished(const std::string& channel, double now_s) {
+  const int64_t total = totalPublished(channel);
+  int64_t& known = known_total_[channel];
+  if (total <= known) return;
+  known = total;
+  auto& history = reached_at_[channel];
+  history.emplace_back(total, now_s);
+  while (history.size() > 2 && history[1].second < now_s - kPublishHistoryS) history.pop_front();
+}
+
+int64_t LockstepGate::publishedBy(const std::string& channel, double t_s) const {
+  auto it = reached_at_.find(channel);
+  if (it == reached_at_.end()) return 0;
+  const auto& history = it->second;
+  // the last entry reached at or before t_s (times do not decrease along the history)
+  auto after = std::upper_bound(history.begin(), history.end(), t_s,
+                                [](double t, const std::pair<int64_t, double>& e) { return t < e.second; });
+  return after == history.begin() ? 0 : std::prev(after)->first;
+}
+
+int64_t LockstepGate::deficit(const NodeState& n, const std::string& channel) const {
+  auto h = n.handled.find(channel);
+  auto o = n.offset.find(channel);
+  return totalPublished(channel) - (h == n.handled.end() ? 0 : h->second) - (o == n.offset.end() ? 0 : o->second);
+}
+
+void LockstepGate::detectLosses(const std::string& node, NodeState& n, double idle_at_s) {
+  for (const auto& [channel, handled] : n.handled) {
+    if (deficit(n, channel) <= 0) continue;
+    const int64_t old = publishedBy(channel, idle_at_s - options_.loss_grace_s) - handled - n.offset[channel];
+    if (old <= 0) continue;
+    n.offset[channel] += old;
+    lost_total_[node + ": " + channel] += old;
+    std::ostringstream os;
+    os << "lost on the bus: " << node << " never received " << old << " " << channel << " message"
+       << (old > 1 ? "s" : "") << " (it is idle and has handled " << handled << " of " << totalPublished(channel)
+       << ", the missing ones published more than " << options_.loss_grace_s << " s ago); going on without "
+       << (old > 1 ? "them" : "it");
+    events_.push_back(os.str());
+  }
+}
+
+void LockstepGate::updateWaiting(double now_s) {
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end()) continue;
+    const NodeState& n = it->second;
+    for (const auto& [channel, handled] : n.handled) {
+      const auto key = std::make_pair(c, channel);
+      if (n.away || deficit(n, channel) <= 0) {
+        waiting_.erase(key);
+        continue;
+      }
+      auto o = n.offset.find(channel);
+      const int64_t counted = handled + (o == n.offset.end() ? 0 : o->second);
+      auto w = waiting_.find(key);
+      if (w == waiting_.end() || w->second.handled != counted) waiting_[key] = Waiting{counted, now_s};
+    }
+  }
+}
+
+void LockstepGate::checkSilent(double now_s) {
+  if (!options_.tolerate_restarts) return;
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end() || it->second.away) continue;
+    if (now_s - it->second.last_heard_s > options_.silent_after_s) {
+      it->second.away = true;
+      it->second.away_since_s = now_s;
+      std::ostringstream os;
+      os << "consumer " << c << " silent for " << std::fixed << std::setprecision(1)
+         << now_s - it->second.last_heard_s << " s; not waited for until it reports again";
+      events_.push_back(os.str());
+    }
+  }
+  updateWaiting(now_s);
+}
+
+bool LockstepGate::allPresent() const { return missing().empty(); }
+
+std::vector<std::string> LockstepGate::missing() const {
+  std::vector<std::string> out;
+  for (const auto& c : consumers_)
+    if (!nodes_.count(c)) out.push_back(c);
+  return out;
+}
+
+std::vector<std::string> LockstepGate::finished() const {
+  std::vector<std::string> out;
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it != nodes_.end() && it->second.finished) out.push_back(c);
+  }
+  return out;
+}
+
+int64_t LockstepGate::totalPublished(const std::string& channel) const {
+  int64_t n = 0;
+  auto it = playback_published_.find(channel);
+  if (it != playback_published_.end()) n += it->second;
+  for (const auto& [name, node] : nodes_) {
+    auto p = node.published.find(channel);
+    if (p != node.published.end()) n += p->second;
+    auto b = node.published_before.find(channel);
+    if (b != node.published_before.end()) n += b->second;
+  }
+  return n;
+}
+
+bool LockstepGate::idle() const {
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end()) return false;
+    if (it->second.away) continue;
+    for (const auto& [channel, handled] : it->second.handled)
+      if (deficit(it->second, channel) > 0) return false;
+  }
+  return true;
+}
+
+bool LockstepGate::awaitingRestart(double now_s) const {
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it != nodes_.end() && it->second.away && now_s - it->second.away_since_s < options_.restart_wait_s) return true;
+  }
+  return false;
+}
+
+double LockstepGate::stalledFor(double now_s) const {
+  double longest = 0.0;
+  for (const auto& [key, w] : waiting_) longest = std::max(longest, now_s - w.since_s);
+  return longest;
+}
+
+std::string LockstepGate::pendingDescription() const {
+  std::ostringstream os;
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end()) {
+      os << c << ": never reported; ";
+      continue;
+    }
+    if (it->second.away) continue;
+    for (const auto& [channel, handled] : it->second.handled) {
+      if (deficit(it->second, channel) <= 0) continue;
+      const int64_t total = totalPublished(channel);
+      os << c << ": " << channel << " " << total - deficit(it->second, channel) << "/" << total << "; ";
+    }
+  }
+  std::string s = os.str();
+  if (s.size() >= 2) s.resize(s.size() - 2);
+  return s;
+}
+
+std::vector<std::string> LockstepGate::takeEvents() {
+  std::vector<std::string> out;
+  out.swap(events_);
+  return out;
+}
+
+int64_t LockstepGate::lostMessages() const {
+  int64_t n = 0;
+  for (const auto& [key, count] : lost_total_) n += count;
+  return n;
+}
+
+}  // namespace livo::playback

@@ -1,0 +1,165 @@
+#include "livo/report/pipeline_outputs.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <map>
+#include <stdexcept>
+
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "livo/correction_frames.hpp"
+#include "livo/keyframe_t.hpp"
+#include "livo/map_inputs.hpp"
+#include "livo/messages.hpp"
+#include "livo/odometry_t.hpp"
+#include "livo/time.hpp"
+
+namespace livo::report {
+
+namespace {
+template <class T>
+bool decodeInto(const lcm::LogEvent* ev, T& msg) {
+  return msg.decode(ev->data, 0, ev->datalen) == ev->datalen;
+}
+}  // namespace
+
+PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineChannels& ch) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::runtime_error(log_path + ": cannot open as an LCM log");
+  PipelineOutputs out;
+  std::map<int32_t, std::string> reasons;  // epoch -> why lio was reset
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    if (ev->channel == ch.odometry) {
+      odometry_t m;
+      if (!decodeInto(ev, m)) {
+        ++out.undecodable;
+        continue;
+      }
+      if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+        ++out.non_finite;
+        continue;
+      }
+      out.odometry.push_back({toSeconds(m.utime), poseFrom(m.position, m.orientation)});
+      out.odometry_frames.push_back({m.epoch, m.correction_id});
+    } else if (ev->channel == ch.keyframe) {
+      keyframe_t m;
+      if (!decodeInto(ev, m)) {
+        ++out.undecodable;
+        continue;
+      }
+      out.keyframes.push_back({m.id, toSeconds(m.utime), poseFrom(m.position, m.orientation), {m.epoch, m.correction_id}});
+    } else if (ev->channel == ch.loop_correction) {
+      loop_correction_t m;
+      if (!decodeInto(ev, m)) {
+        ++out.undecodable;
+        continue;
+      }
+      Pose3 T_Ck_O;
+      if (!correctionTransform(m, &T_Ck_O).empty()) {
+        ++out.undecodable;
+        continue;
+      }
+      out.corrections[m.correction_id] = {m.epoch, T_Ck_O};
+      auto last = out.last_loop.find(m.epoch);
+      if (last == out.last_loop.end() || last->second.correction_id < m.correction_id) out.last_loop[m.epoch] = m;
+      ++out.loop_corrections;
+    } else if (ev->channel == ch.health) {
+      health_t m;
+      if (!decodeInto(ev, m)) {
+        ++out.undecodable;
+        continue;
+      }
+      out.final_health[m.node] = m;
+      const std::string tag = "odometry reset to epoch ";
+      if (m.message.rfind(tag, 0) == 0) {
+        const size_t colon = m.message.find(": ", tag.size());
+        if (colon != std::string::npos)
+          reasons[std::atoi(m.message.c_str() + tag.size())] = m.message.substr(colon + 2);
+      }
+    }
+  }
+  // odometry in stamp order with its frames
+  std::vector<size_t> order(out.odometry.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return out.odometry[a].stamp < out.odometry[b].stamp; });
+  Trajectory odometry;
+  std::vector<PublishedFrame> frames;
+  for (size_t i : order) {
+    odometry.push_back(out.odometry[i]);
+    frames.push_back(out.odometry_frames[i]);
+  }
+  out.odometry = std::move(odometry);
+  out.odometry_frames = std::move(frames);
+  // the stamp order of a reset's first odometry (in log order, a new epoch's stamps may be earlier)
+  int32_t epoch = 0;
+  for (size_t i = 0; i < out.odometry.size(); ++i) {
+    if (out.odometry_frames[i].epoch <= epoch) continue;
+    epoch = out.odometry_frames[i].epoch;
+    auto r = reasons.find(epoch);
+    out.resets.push_back({out.odometry[i].stamp, epoch, r == reasons.end() ? std::string() : r->second});
+  }
+  std::stable_sort(out.keyframes.begin(), out.keyframes.end(),
+                   [](const KeyframePose& a, const KeyframePose& b) { return a.id < b.id; });
+  return out;
+}
+
+Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
+  if (outputs.last_loop.empty()) return outputs.odometry;
+  auto rawPose = [&](const Pose3& published, const PublishedFrame& f) {
+    if (f.correction_id == 0) return published;
+    auto it = outputs.corrections.find(f.correction_id);
+    if (it == outputs.corrections.end() || it->second.first != f.epoch)
+      throw std::runtime_error("a pose of epoch " + std::to_string(f.epoch) + " includes loop correction " +
+                               std::to_string(f.correction_id) + ", which is not in the log");
+    return Pose3(it->second.second.inverse() * published);
+  };
+
+  // Per epoch, per keyframe (by stamp): the correction that maps its raw pose to its optimised one.
+  struct Anchor {
+    double stamp;
+    Pose3 correction;
+  };
+  std::map<int32_t, std::vector<Anchor>> anchors;
+  for (const auto& [epoch, lc] : outputs.last_loop) {
+    std::map<int64_t, Pose3> corrected;
+    if (const std::string why = correctedKeyframePoses(lc, &corrected); !why.empty())
+      throw std::runtime_error("loop correction " + std::to_string(lc.correction_id) + ": " + why);
+    const Pose3 overall = outputs.corrections.at(lc.correction_id).second;
+    std::vector<Anchor>& a = anchors[epoch];
+    for (const KeyframePose& k : outputs.keyframes) {
+      if (k.frame.epoch != epoch) continue;
+      auto it = corrected.find(k.id);
+      a.push_back({k.stamp, it != corrected.end() ? Pose3(it->second * rawPose(k.pose, k.frame).inverse()) : overall});
+    }
+    std::stable_sort(a.begin(), a.end(), [](const Anchor& x, const Anchor& y) { return x.stamp < y.stamp; });
+    if (a.empty()) a.push_back({0.0, overall});
+  }
+
+  Trajectory out;
+  out.reserve(outputs.odometry.size());
+  std::map<int32_t, size_t> next;  // per epoch: the anchor in use
+  for (size_t i = 0; i < outputs.odometry.size(); ++i) {
+    const StampedPose& p = outputs.odometry[i];
+    const PublishedFrame& f = outputs.odometry_frames[i];
+    auto a = anchors.find(f.epoch);
+    if (a == anchors.end()) {  // no loop in this epoch: the odometry is final (it adopted none)
+      out.push_back(p);
+      continue;
+    }
+    // before the first keyframe the first keyframe's correction applies (it is the map origin)
+    size_t& k = next[f.epoch];
+    while (k + 1 < a->second.size() && a->second[k + 1].stamp <= p.stamp) ++k;
+    out.push_back({p.stamp, a->second[k].correction * rawPose(p.pose, f)});
+  }
+  return out;
+}
+
+std::string resetsJson(const std::vector<OdometryReset>& resets) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const OdometryReset& r : resets) j.push_back({{"time", r.stamp}, {"epoch", r.epoch}, {"reason", r.reason}});
+  return j.dump(2) + "\n";
+}
+
+}  // namespace livo::report

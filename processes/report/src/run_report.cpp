@@ -1,0 +1,180 @@
+#include "livo/report/run_report.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace livo::report {
+
+nlohmann::json timingJson(const std::map<std::string, health_t>& final_health) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [node, h] : final_health) {
+    nlohmann::json channels = nlohmann::json::object();
+    const channel_stats_t* busiest = nullptr;
+    int64_t total = 0;
+    for (const auto& c : h.channels) {
+      channels[c.channel] = {{"messages", c.messages},   {"median_ms", c.median_ms},
+                             {"p90_ms", c.p90_ms},       {"max_ms", c.max_ms},
+                             {"decode_failures", c.decode_failures}, {"rejected", c.rejected}};
+      total += c.messages;
+      if (!busiest || c.median_ms * c.messages > busiest->median_ms * busiest->messages) busiest = &c;
+    }
+    nlohmann::json p = {{"messages", busiest ? busiest->messages : 0},
+                        {"median_ms", busiest ? busiest->median_ms : 0.0},
+                        {"p90_ms", busiest ? busiest->p90_ms : 0.0},
+                        {"max_ms", busiest ? busiest->max_ms : 0.0},
+                        {"peak_rss_mb", h.peak_rss_mb},
+                        {"busiest_channel", busiest ? busiest->channel : ""},
+                        {"messages_all_channels", total},
+                        {"channels", channels}};
+    out[node] = p;
+  }
+  return out;
+}
+
+namespace {
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "n/a";
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(digits) << v;
+  return os.str();
+}
+// j[a][b][c...] as a number, NaN when absent or null (a metric with no data).
+double num(const nlohmann::json& j, std::initializer_list<const char*> path) {
+  const nlohmann::json* node = &j;
+  for (const char* key : path) {
+    if (!node->is_object() || !node->contains(key)) return std::nan("");
+    node = &(*node)[key];
+  }
+  return node->is_number() ? node->get<double>() : std::nan("");
+}
+}  // namespace
+
+std::vector<ProcessRestart> readRestarts(const std::string& path) {
+  std::vector<ProcessRestart> out;
+  std::ifstream f(path);
+  if (!f) return out;
+  std::string line;
+  int number = 0;
+  while (std::getline(f, line)) {
+    ++number;
+    if (line.empty()) continue;
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, '\t')) fields.push_back(field);
+    if (fields.size() != 7)
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected 7 tab-separated fields, got " +
+                               std::to_string(fields.size()));
+    out.push_back({fields[0], fields[1], fields[2], fields[3], fields[4], fields[5], fields[6]});
+  }
+  return out;
+}
+
+std::string reportMarkdown(const ReportInputs& in) {
+  std::ostringstream md;
+  md << "# Pipeline run\n\n";
+  md << "| | |\n| --- | --- |\n";
+  md << "| log | `" << in.run.log << "` |\n";
+  md << "| config | `" << in.run.config << "` |\n";
+  md << "| processes | ";
+  for (size_t i = 0; i < in.run.processes.size(); ++i) md << (i ? ", " : "") << in.run.processes[i];
+  md << " |\n";
+  md << "| replay | " << in.run.mode << ": " << fixed(in.run.log_seconds, 1) << " s of log in "
+     << fixed(in.run.wall_seconds, 1) << " s wall";
+  if (in.run.wall_seconds > 0) md << " (" << fixed(in.run.log_seconds / in.run.wall_seconds, 2) << "x real time)";
+  md << " |\n";
+  if (in.outputs) {
+    md << "| odometry poses | " << in.outputs->odometry.size() << " |\n";
+    md << "| keyframes | " << in.outputs->keyframes.size() << " |\n";
+    md << "| loop corrections | " << in.outputs->loop_corrections << " |\n";
+  }
+  md << "| odometry resets | " << in.resets.size() << " (epochs 0.." << in.resets.size() << ") |\n";
+  md << "\n";
+
+  if (!in.resets.empty()) {
+    md << "## Odometry resets\n\n";
+    md << "livo-lio re-initialised: the odometry restarted at the origin in a new epoch, and every consumer "
+          "started over in it (loop: a new graph segment; vio, colour, octomap: a new map; the old maps are "
+          "written as `*_epoch<N>.*`). Trajectories of different epochs are in unrelated frames.\n\n";
+    md << "| time s | new epoch | reason |\n| --- | --- | --- |\n";
+    for (const auto& r : in.resets) {
+      const std::string reason = r.value("reason", std::string());
+      md << "| " << fixed(r.value("time", 0.0), 3) << " | " << r.value("epoch", 0) << " | "
+         << (reason.empty() ? "(not in HEALTH; see logs/lio.log)" : reason) << " |\n";
+    }
+    md << "\n";
+  }
+
+  if (!in.evaluations.empty()) {
+    md << "## Accuracy\n\n";
+    md << "| trajectory | ATE RMSE m | mean m | median m | max m | coverage | RPE trans RMSE m | RPE rot RMSE deg |\n";
+    md << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const auto& [title, j] : in.evaluations) {
+      md << "| " << title << " | " << fixed(num(j, {"ate", "rmse"}), 4) << " | " << fixed(num(j, {"ate", "mean"}), 4)
+         << " | " << fixed(num(j, {"ate", "median"}), 4) << " | " << fixed(num(j, {"ate", "max"}), 4) << " | "
+         << fixed(100.0 * num(j, {"ate", "coverage"}), 1) << " % | " << fixed(num(j, {"rpe", "translation", "rmse"}), 4)
+         << " | " << fixed(num(j, {"rpe", "rotation", "rmse"}), 3) << " |\n";
+    }
+    const nlohmann::json& first = in.evaluations.front().second;
+    const std::string mode = first.contains("alignment") && first["alignment"].contains("mode") &&
+                                     first["alignment"]["mode"].is_string()
+                                 ? first["alignment"]["mode"].get<std::string>()
+                                 : std::string("?");
+    md << "\nATE: translation error after `" << mode << "` Umeyama alignment (`livo-evaluate`, as evo's `evo_ape`); "
+       << "RPE between consecutive poses.\n\n";
+  } else {
+    md << "## Accuracy\n\nNo ground truth in the log: no accuracy figures.\n\n";
+  }
+
+  for (const auto& [caption, path] : in.figures) md << "![" << caption << "](" << path << ")\n\n";
+
+  md << "## Processing time\n\n";
+  md << "Per process, its busiest input (median x messages); `timing.json` lists every channel.\n\n";
+  md << "| process | input | messages | median ms | p90 ms | max ms | peak RSS MB |\n";
+  md << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& [node, p] : in.timing.items()) {
+    md << "| " << node << " | " << p.value("busiest_channel", std::string()) << " | " << p.value("messages", 0) << " | "
+       << fixed(p.value("median_ms", 0.0), 2) << " | " << fixed(p.value("p90_ms", 0.0), 2) << " | "
+       << fixed(p.value("max_ms", 0.0), 2) << " | " << fixed(p.value("peak_rss_mb", 0.0), 1) << " |\n";
+  }
+  md << "\n";
+
+  if (!in.sensor_use.empty()) {
+    md << "## Sensor use\n\n";
+    md << "What the estimators did with their inputs, from their summaries at exit:\n\n";
+    for (const auto& f : in.sensor_use) md << "- " << f << "\n";
+    md << "\n";
+  }
+
+  if (!in.injected_faults.empty()) {
+    md << "## Injected faults\n\n";
+    md << "Faults injected by `livo-playback --faults` (seeded), per channel:\n\n";
+    for (const auto& f : in.injected_faults) md << "- " << f << "\n";
+    md << "\n";
+  }
+
+  if (in.supervised || !in.restarts.empty()) {
+    md << "## Restarts\n\n";
+    if (in.restarts.empty()) {
+      md << "None: no process exited during the run.\n\n";
+    } else {
+      md << "| process | ended at (wall s) | log s | how | restart | down s | lost |\n";
+      md << "| --- | --- | --- | --- | --- | --- | --- |\n";
+      for (const auto& r : in.restarts)
+        md << "| " << r.process << " | " << r.wall_s << " | " << (r.log_s.empty() ? "?" : r.log_s) << " | " << r.ended
+           << " | " << r.restart << " | " << r.down_s << " | " << r.lost << " |\n";
+      md << "\n";
+    }
+  }
+
+  md << "## Warnings\n\n";
+  if (in.warnings.empty()) md << "None.\n";
+  for (const auto& w : in.warnings) md << "- " << w << "\n";
+  return md.str();
+}
+
+}  // namespace livo::report

@@ -1,0 +1,45 @@
+// Height-field ground: z = base + relief(x, y) over a rectangle, sampled on a regular grid and
+// ray-cast cell by cell (2-D DDA with per-cell height bounds, two triangles per cell).
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "livo/sim/geometry.hpp"
+
+namespace livo::sim {
+
+struct HeightFieldOptions {
+  Vec3 center = Vec3::Zero();          // centre of the rectangle; z is the base height
+  double size_x = 20.0, size_y = 20.0; // m
+  double resolution = 0.5;             // grid spacing, m
+  /// Relief as octaves of gradient noise: (amplitude m, wavelength m) pairs.
+  std::vector<std::pair<double, double>> relief = {{0.3, 10.0}, {0.05, 1.0}};
+  uint64_t seed = 1;
+};
+
+class HeightField {
+ public:
+  explicit HeightField(const HeightFieldOptions& options);
+
+  /// Height of the triangulated surface at (x, y) (base height outside the rectangle).
+  double heightAt(double x, double y) const;
+  const Aabb& bounds() const { return bounds_; }
+
+  bool intersect(const PreparedRay& ray, double t_min, double t_max, double* t, int* face) const;
+  SurfacePoint surface(const Ray& ray, double t, int face) const;
+
+ private:
+  double vertex(int i, int j) const { return heights_[static_cast<size_t>(j) * (nx_ + 1) + i]; }
+  Vec3 vertexPoint(int i, int j) const { return Vec3(x0_ + i * cell_, y0_ + j * cell_, vertex(i, j)); }
+  bool intersectCell(int i, int j, const Ray& ray, double t_lo, double t_hi, double* t, int* tri) const;
+
+  int nx_ = 0, ny_ = 0;
+  double x0_ = 0.0, y0_ = 0.0, cell_ = 1.0;
+  std::vector<double> heights_;               // (nx+1) x (ny+1), absolute z
+  std::vector<std::pair<float, float>> cell_range_;  // min/max z per cell
+  Aabb bounds_;
+};
+
+}  // namespace livo::sim

@@ -1,0 +1,321 @@
+#include "livo/sim/scene_config.hpp"
+
+#include <map>
+#include <stdexcept>
+
+#include "livo/sim/random.hpp"
+
+namespace livo::sim {
+
+namespace {
+
+Mat3 rotationFromRpyDeg(const Vec3& rpy_deg) {
+  const Vec3 r = rpy_deg * M_PI / 180.0;
+  return (Eigen::AngleAxisd(r.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
+          Eigen::AngleAxisd(r.x(), Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+/// A rotation whose z axis is `normal`.
+Mat3 rotationFromNormal(const Vec3& normal) {
+  const Vec3 z = normal.normalized();
+  const Vec3 helper = std::abs(z.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitX();
+  const Vec3 x = helper.cross(z).normalized();
+  Mat3 R;
+  R.col(0) = x;
+  R.col(1) = z.cross(x);
+  R.col(2) = z;
+  return R;
+}
+
+double positive(const Config& c, const std::string& key) {
+  const double v = c.get<double>(key);
+  if (!(v > 0.0)) throw ConfigError(c.where(key) + ": must be > 0");
+  return v;
+}
+
+Eigen::Vector3d colour(const Config& c, const std::string& key) {
+  const Eigen::Vector3d v = c.get<Eigen::Vector3d>(key);
+  if ((v.array() < 0.0).any() || (v.array() > 1.0).any())
+    throw ConfigError(c.where(key) + ": colour components must be in [0, 1]");
+  return v;
+}
+
+TextureOptions readTexture(const Config& c, uint64_t seed) {
+  TextureOptions t;
+  t.seed = seed;
+  const std::string pattern = c.get<std::string>("pattern");
+  if (!parseTexturePattern(pattern, &t.pattern))
+    throw ConfigError(c.where("pattern") + ": unknown pattern '" + pattern +
+                      "' (known: uniform, noise, bricks, checker, stripes)");
+  t.color_a = colour(c, "color");
+  if (c.has("color2")) t.color_b = colour(c, "color2");
+  else t.color_b = 0.5 * t.color_a;
+  if (t.pattern != TexturePattern::kUniform) t.scale = positive(c, "scale");
+  if (t.pattern == TexturePattern::kBricks) {
+    t.brick_height = positive(c, "brick_height");
+    c.readOptional("mortar", t.mortar);
+  }
+  if (t.pattern == TexturePattern::kNoise) {
+    c.readOptional("octaves", t.octaves);
+    if (t.octaves < 1 || t.octaves > 6) throw ConfigError(c.where("octaves") + ": must be in 1..6");
+  }
+  c.readOptional("grain", t.grain);
+  c.readOptional("variation", t.variation);
+  if (t.grain < 0.0 || t.grain > 1.0) throw ConfigError(c.where("grain") + ": must be in [0, 1]");
+  if (t.variation < 0.0 || t.variation > 1.0) throw ConfigError(c.where("variation") + ": must be in [0, 1]");
+  c.checkAllUsed();
+  return t;
+}
+
+struct Placement {
+  int count = 1, rows = 1;
+  Vec3 step = Vec3::Zero(), row_step = Vec3::Zero(), jitter = Vec3::Zero();
+  int seed = 0;
+};
+
+Placement readRepeat(const Config& c) {
+  Placement p;
+  if (!c.has("repeat")) return p;
+  const Config r = c.section("repeat");
+  r.read("count", p.count);
+  r.read("step", p.step);
+  r.readOptional("rows", p.rows);
+  if (p.rows > 1) r.read("row_step", p.row_step);
+  r.readOptional("jitter", p.jitter);
+  r.readOptional("seed", p.seed);
+  if (p.count < 1 || p.count > 100000) throw ConfigError(r.where("count") + ": must be in 1..100000");
+  if (p.rows < 1 || p.rows > 100000) throw ConfigError(r.where("rows") + ": must be in 1..100000");
+  r.checkAllUsed();
+  return p;
+}
+
+double unitInterval(const Config& c, const std::string& key, double value) {
+  c.readOptional(key, value);
+  if (!(value >= 0.0 && value <= 1.0)) throw ConfigError(c.where(key) + ": must be in [0, 1]");
+  return value;
+}
+
+/// texture, reflectivity, and `material: opaque | glass` with glass's return_probability, transmission.
+Material readMaterial(const Config& c, const std::map<std::string, int>& textures) {
+  const std::string tex = c.get<std::string>("texture");
+  const auto it = textures.find(tex);
+  if (it == textures.end()) throw ConfigError(c.where("texture") + ": unknown texture '" + tex + "'");
+  Material m;
+  m.texture = it->second;
+  m.reflectivity = unitInterval(c, "reflectivity", m.reflectivity);
+  std::string kind = "opaque";
+  c.readOptional("material", kind);
+  if (kind == "glass") {
+    m.kind = MaterialKind::kGlass;
+    m.glass_return_probability = unitInterval(c, "return_probability", m.glass_return_probability);
+    m.glass_transmission = unitInterval(c, "transmission", m.glass_transmission);
+  } else if (kind != "opaque") {
+    throw ConfigError(c.where("material") + ": unknown material '" + kind + "' (known: opaque, glass)");
+  }
+  return m;
+}
+
+/// A box or cylinder crown of leaves (`shape`, its size keys, `leaf_density` in 1/m).
+Shape readVegetation(const Config& c, Material* m) {
+  if (m->kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": vegetation has no material key");
+  m->kind = MaterialKind::kVegetation;
+  m->leaf_density = positive(c, "leaf_density");
+  std::string form = "cylinder";
+  c.readOptional("shape", form);
+  Shape shape;
+  if (form == "box") {
+    shape.type = ShapeType::kBox;
+    const Vec3 size = c.get<Vec3>("size");
+    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
+    shape.half_size = 0.5 * size;
+  } else if (form == "cylinder") {
+    shape.type = ShapeType::kCylinder;
+    const double radius = positive(c, "radius"), height = positive(c, "height");
+    shape.half_size = Vec3(radius, radius, 0.5 * height);
+  } else {
+    throw ConfigError(c.where("shape") + ": unknown vegetation shape '" + form + "' (known: box, cylinder)");
+  }
+  return shape;
+}
+
+void readObject(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
+  const std::string type = c.get<std::string>("type");
+  Material m = readMaterial(c, textures);
+  const Vec3 center = c.get<Vec3>("center");
+  const Placement placement = readRepeat(c);
+
+  Shape shape;
+  HeightFieldOptions hf;
+  bool is_height_field = false;
+  Vec3 rpy = Vec3::Zero();
+  const bool has_rpy = c.readOptional("rpy_deg", rpy);
+  shape.rotation = rotationFromRpyDeg(rpy);
+  if (type == "vegetation") {
+    shape = readVegetation(c, &m);
+    shape.rotation = rotationFromRpyDeg(rpy);
+  } else if (type == "plane") {
+    shape.type = ShapeType::kPlane;
+    if (c.has("normal")) {
+      if (has_rpy) throw ConfigError(c.where("normal") + ": give normal or rpy_deg, not both");
+      shape.rotation = rotationFromNormal(c.get<Vec3>("normal"));
+    }
+    shape.half_size = Vec3(kInfinity, kInfinity, 0.0);
+    std::vector<double> size;
+    if (c.readOptional("size", size)) {
+      if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+        throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0 (omit for an infinite plane)");
+      shape.half_size = Vec3(0.5 * size[0], 0.5 * size[1], 0.0);
+    }
+  } else if (type == "box") {
+    shape.type = ShapeType::kBox;
+    const Vec3 size = c.get<Vec3>("size");
+    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
+    shape.half_size = 0.5 * size;
+  } else if (type == "cylinder") {
+    shape.type = ShapeType::kCylinder;
+    const double radius = positive(c, "radius"), height = positive(c, "height");
+    shape.half_size = Vec3(radius, radius, 0.5 * height);
+  } else if (type == "sphere") {
+    shape.type = ShapeType::kSphere;
+    shape.half_size = Vec3::Constant(positive(c, "radius"));
+  } else if (type == "heightfield") {
+    if (m.kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": a height field is opaque");
+    if (has_rpy) throw ConfigError(c.where("rpy_deg") + ": a height field is axis-aligned");
+    is_height_field = true;
+    const std::vector<double> size = c.get<std::vector<double>>("size");
+    if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+      throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0");
+    hf.size_x = size[0];
+    hf.size_y = size[1];
+    hf.resolution = positive(c, "resolution");
+    if (hf.size_x / hf.resolution * hf.size_y / hf.resolution > 2e7)
+      throw ConfigError(c.where("resolution") + ": too fine for this size (more than 2e7 cells)");
+    const Config relief = c.section("relief");
+    const auto amplitude = relief.get<std::vector<double>>("amplitude");
+    const auto wavelength = relief.get<std::vector<double>>("wavelength");
+    if (amplitude.size() != wavelength.size())
+      throw ConfigError(relief.where("wavelength") + ": needs as many entries as amplitude");
+    hf.relief.clear();
+    for (size_t i = 0; i < amplitude.size(); ++i) {
+      if (!(wavelength[i] > 0.0)) throw ConfigError(relief.where("wavelength") + ": must be > 0");
+      hf.relief.emplace_back(amplitude[i], wavelength[i]);
+    }
+    relief.checkAllUsed();
+    int seed = 1;
+    c.readOptional("seed", seed);
+    hf.seed = static_cast<uint64_t>(seed);
+  } else {
+    throw ConfigError(c.where("type") + ": unknown object type '" + type +
+                      "' (known: plane, box, cylinder, sphere, heightfield, vegetation)");
+  }
+  c.checkAllUsed();
+
+  const Texture& texture = scene.texture(m.texture);
+  int index = 0;
+  for (int row = 0; row < placement.rows; ++row) {
+    for (int k = 0; k < placement.count; ++k, ++index) {
+      const std::string full = placement.count * placement.rows > 1 ? name + "[" + std::to_string(index) + "]" : name;
+      Random jitter(static_cast<uint64_t>(placement.seed), 0x6a177e5ULL, static_cast<uint64_t>(index));
+      Vec3 offset = placement.step * k + placement.row_step * row;
+      for (int i = 0; i < 3; ++i) offset[i] += placement.jitter[i] * (2.0 * jitter.uniform() - 1.0);
+      Random shift(hashString(full.c_str()), 0x7e47ULL);
+      Material mi = m;
+      mi.u_offset = shift.uniform() * texture.periodU();
+      mi.v_offset = shift.uniform() * texture.periodV();
+      if (is_height_field) {
+        HeightFieldOptions h = hf;
+        h.center = center + offset;
+        scene.addHeightField(full, h, mi);
+      } else {
+        Shape s = shape;
+        s.center = center + offset;
+        scene.addShape(full, s, mi);
+      }
+    }
+  }
+}
+
+std::vector<Vec3> readPath(const Config& c) {
+  const auto flat = c.get<std::vector<double>>("path");
+  if (flat.size() % 3 != 0 || flat.size() < 6)
+    throw ConfigError(c.where("path") + ": expected x, y, z triples of at least 2 ground points");
+  std::vector<Vec3> points;
+  for (size_t i = 0; i < flat.size(); i += 3) points.emplace_back(flat[i], flat[i + 1], flat[i + 2]);
+  return points;
+}
+
+/// A pedestrian (upright cylinder, 0.5 m across, 1.75 m tall) or a car (box 4.5 x 1.8 x 1.5 m)
+/// walking a closed path; `size` overrides the body.
+void readMover(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
+  const std::string type = c.get<std::string>("type");
+  const Material m = readMaterial(c, textures);
+  Shape body;
+  std::vector<double> size;
+  const bool has_size = c.readOptional("size", size);
+  if (type == "pedestrian") {
+    body.type = ShapeType::kCylinder;
+    if (!has_size) size = {0.5, 1.75};
+    if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+      throw ConfigError(c.where("size") + ": a pedestrian's size is [diameter, height] > 0");
+    body.half_size = Vec3(0.5 * size[0], 0.5 * size[0], 0.5 * size[1]);
+  } else if (type == "car") {
+    body.type = ShapeType::kBox;
+    if (!has_size) size = {4.5, 1.8, 1.5};
+    if (size.size() != 3 || !(size[0] > 0.0) || !(size[1] > 0.0) || !(size[2] > 0.0))
+      throw ConfigError(c.where("size") + ": a car's size is [length, width, height] > 0");
+    body.half_size = 0.5 * Vec3(size[0], size[1], size[2]);
+  } else {
+    throw ConfigError(c.where("type") + ": unknown mover type '" + type + "' (known: pedestrian, car)");
+  }
+  MoverPath path;
+  path.waypoints = readPath(c);
+  c.read("speed", path.speed);
+  if (!(path.speed >= 0.0 && path.speed <= 100.0)) throw ConfigError(c.where("speed") + ": must be in [0, 100] m/s");
+  c.readOptional("phase", path.phase);
+  if (!(path.phase >= 0.0 && path.phase < 1.0)) throw ConfigError(c.where("phase") + ": must be in [0, 1)");
+  c.checkAllUsed();
+  try {
+    scene.addMover(name, MovingObject(body, path), m);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(c.where("path") + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Scene> readScene(const Config& c) {
+  auto scene = std::make_unique<Scene>();
+  if (c.has("sky")) {
+    const Config sky = c.section("sky");
+    scene->sky.horizon = colour(sky, "horizon");
+    scene->sky.zenith = colour(sky, "zenith");
+    sky.checkAllUsed();
+  }
+  if (c.has("light")) {
+    const Config light = c.section("light");
+    const Vec3 d = light.get<Vec3>("direction");
+    if (d.norm() < 1e-9) throw ConfigError(light.where("direction") + ": must not be zero");
+    scene->lighting.direction = d.normalized();
+    light.read("ambient", scene->lighting.ambient);
+    light.read("diffuse", scene->lighting.diffuse);
+    light.checkAllUsed();
+  }
+  std::map<std::string, int> textures;
+  const Config tex = c.section("textures");
+  for (const std::string& name : tex.keys()) {
+    textures[name] = scene->addTexture(readTexture(tex.section(name), hashString(name.c_str())));
+  }
+  const Config objects = c.section("objects");
+  if (objects.keys().empty()) throw ConfigError(c.where("objects") + ": the scene has no objects");
+  for (const std::string& name : objects.keys()) readObject(*scene, objects.section(name), name, textures);
+  if (c.has("movers")) {
+    const Config movers = c.section("movers");
+    for (const std::string& name : movers.keys()) readMover(*scene, movers.section(name), name, textures);
+  }
+  c.checkAllUsed();
+  scene->build();
+  return scene;
+}
+
+}  // namespace livo::sim
