@@ -115,7 +115,7 @@ class SimLioDriver : public livo::sim::SensorDataSink {
   }
 
   void write(const livo::sim::ImuReading& m) override {
-    livo::lio::ImuSample s;
+    livo::ImuSample s;
     s.utime = m.utime;
     s.gyro = m.angular_velocity;
     s.accel = m.linear_acceleration;
@@ -126,7 +126,7 @@ class SimLioDriver : public livo::sim::SensorDataSink {
   }
   void write(const livo::sim::WheelReading& m) override {
     if (!wheel_enabled_) return;  // the node does not subscribe to WHEEL then
-    livo::lio::WheelSample w;
+    livo::WheelSample w;
     w.utime = m.utime;
     w.left_speed = m.left_speed;
     w.right_speed = m.right_speed;
@@ -151,7 +151,7 @@ class SimLioDriver : public livo::sim::SensorDataSink {
     Pending p;
     p.msg = toPointCloud(m);  // the node's own conversion
     std::string why;
-    if (!livo::lio::fromMessage(p.msg, &p.scan, &why)) throw std::runtime_error("sweep conversion: " + why);
+    if (!livo::fromMessage(p.msg, &p.scan, &why)) throw std::runtime_error("sweep conversion: " + why);
     p.t_end = lio_.scanEndUtime(p.scan);
     pending_.push_back(std::move(p));
     processReady();
@@ -190,7 +190,7 @@ class SimLioDriver : public livo::sim::SensorDataSink {
  private:
   struct Pending {
     livo::point_cloud_t msg;
-    livo::lio::LidarScan scan;
+    livo::LidarScan scan;
     int64_t t_end = 0;
   };
 

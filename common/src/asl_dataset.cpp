@@ -11,8 +11,8 @@
 
 namespace livo {
 
-std::vector<ImuSample> readAslImuCsv(const std::string& path) {
-  std::vector<ImuSample> out;
+std::vector<AslImuSample> readAslImuCsv(const std::string& path) {
+  std::vector<AslImuSample> out;
   // The nanosecond stamp does not survive a double: read it as an integer from the line itself.
   std::ifstream in(path);
   if (!in) throw TrajectoryError(path + ": cannot open");
@@ -28,7 +28,7 @@ std::vector<ImuSample> readAslImuCsv(const std::string& path) {
     while (std::getline(ss, field, ',')) fields.push_back(field);
     if (fields.size() < 7)
       throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 7 columns (t[ns], w xyz, a xyz), got " + std::to_string(fields.size()));
-    ImuSample s;
+    AslImuSample s;
     try {
       size_t used = 0;
       s.stamp_ns = std::stoll(fields[0], &used);

@@ -10,7 +10,7 @@
 namespace livo {
 
 const std::vector<std::string> kConfigSections = {
-    "rig", "sim", "bus", "playback", "lio", "vio", "loop", "colour", "octomap", "pipeline", "evaluate"};
+    "rig", "sim", "bus", "playback", "lio", "lio_graph", "vio", "loop", "colour", "octomap", "pipeline", "evaluate"};
 
 namespace {
 
@@ -349,20 +349,7 @@ Eigen::Isometry3d Config::convert<Eigen::Isometry3d>(const YAML::Node& n, const 
     out = convert<T>(n, key);                                                \
     return true;                                                             \
   }
-LIVO_CONFIG_FETCH(bool)
-LIVO_CONFIG_FETCH(int)
-LIVO_CONFIG_FETCH(int64_t)
-LIVO_CONFIG_FETCH(double)
-LIVO_CONFIG_FETCH(float)
-LIVO_CONFIG_FETCH(std::string)
-LIVO_CONFIG_FETCH(std::vector<double>)
-LIVO_CONFIG_FETCH(std::vector<int>)
-LIVO_CONFIG_FETCH(std::vector<std::string>)
-LIVO_CONFIG_FETCH(Eigen::Vector3d)
-LIVO_CONFIG_FETCH(Eigen::Matrix3d)
-LIVO_CONFIG_FETCH(Eigen::Matrix4d)
-LIVO_CONFIG_FETCH(Eigen::Quaterniond)
-LIVO_CONFIG_FETCH(Eigen::Isometry3d)
+LIVO_CONFIG_VALUE_TYPES(LIVO_CONFIG_FETCH)
 #undef LIVO_CONFIG_FETCH
 
 }  // namespace livo

@@ -68,4 +68,23 @@ std::string correctedKeyframePoses(const loop_correction_t& m, std::map<int64_t,
   return "";
 }
 
+std::string viewRegisteredScanInMap(const registered_scan_t& m, const MapFrame::Placed& placed,
+                                    registered_scan_t* moved, RegisteredScanView* view) {
+  if (placed.placement != MapFrame::Placement::kUse) return placed.why;
+  if (!placed.moved) return viewRegisteredScan(m, view);
+  // published before the LIO adopted the map's loop correction (or after one not here yet)
+  *moved = m;
+  moveRegisteredScan(placed.to_map, moved);
+  return viewRegisteredScan(*moved, view);
+}
+
+MapCorrection readMapCorrection(const loop_correction_t& m, MapFrame* frame) {
+  MapCorrection c;
+  Pose3 T_Ck_O;
+  c.problem = correctedKeyframePoses(m, &c.corrected);
+  if (c.problem.empty()) c.problem = correctionTransform(m, &T_Ck_O);
+  if (c.problem.empty()) c.step = frame->addCorrection(m.correction_id, m.epoch, T_Ck_O);
+  return c;
+}
+
 }  // namespace livo

@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
     const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
     const livo::colour::ColourNodeOptions options = livo::colour::readColourNodeOptions(cfg);
-    if (!cli.has("--quiet")) livo::colour::printColourOptions(options.core, std::cerr);
+    if (!cli.has("--quiet")) livo::colour::printOptions(options, std::cerr);
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;

@@ -13,13 +13,17 @@ int main(int argc, char** argv) {
       .option("--name", "N", "node name on the bus", "loop")
       .option("--output-dir", "DIR", "write keyframes.tum, loops.json and global_map.ply here (overrides loop.output_dir)")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
-      .flag("--quiet", "no summary at shutdown");
+      .flag("--quiet", "no option summary at start, no summary at shutdown");
   if (!cli.parse(argc, argv)) return cli.exitCode();
+  if (!cli.has("--config")) {
+    std::cerr << "livo-loop: --config FILE is required\n" << cli.usage();
+    return 2;
+  }
   try {
-    if (!cli.has("--config")) throw livo::ConfigError("--config FILE is required");
     const livo::Config config = livo::Config::load(cli.get("--config"));
     livo::loop::LoopNodeOptions options = livo::loop::readLoopNodeOptions(config);
     if (cli.has("--output-dir")) options.output_dir = cli.get("--output-dir");
+    if (!cli.has("--quiet")) livo::loop::printOptions(options, std::cerr);
     livo::NodeOptions node_options;
     node_options.name = cli.get("--name");
     node_options.quiet = cli.has("--quiet");

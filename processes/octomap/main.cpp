@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
     const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
     const auto options = livo::octomap::readOctomapNodeOptions(cfg);
-    if (!cli.has("--quiet")) livo::octomap::printOctomapOptions(options.core, std::cerr);
+    if (!cli.has("--quiet")) livo::octomap::printOptions(options, std::cerr);
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;

@@ -303,8 +303,8 @@ int main(int argc, char** argv) {
     livo::octomap::OctomapOptions oo = livo::octomap::readOctomapNodeOptions(cfg).core;
     oo.resolution = 0.1;
     oo.max_range = setup.rig.lidar->max_range;
-    colour::printColourOptions(co, std::cout);
-    livo::octomap::printOctomapOptions(oo, std::cout);
+    colour::printOptions(co, std::cout);
+    livo::octomap::printOptions(oo, std::cout);
     BarSink sink(setup, co, oo);
     sim::Simulator(setup).run(sink);
     sink.report();

@@ -150,6 +150,7 @@ LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarM
   scan.points.reserve(n);
   scan.time_offset.reserve(n);
   scan.intensity.reserve(n);
+  scan.ring.reserve(n);
   std::normal_distribution<double> noise(0.0, 1.0);
   const double t0 = static_cast<double>(utime - base_utime) * 1e-6;
   std::vector<Vec3> dirs(static_cast<size_t>(m.rings));
@@ -167,6 +168,7 @@ LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarM
       scan.points.push_back(d_L * range);
       scan.time_offset.push_back(static_cast<float>(dt));
       scan.intensity.push_back(static_cast<float>(r));
+      scan.ring.push_back(static_cast<int16_t>(r));
     }
   }
   return scan;

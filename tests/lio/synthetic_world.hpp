@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "livo/lio/imu_propagator.hpp"
-#include "livo/lio/lidar_scan.hpp"
+#include "livo/sensor_samples.hpp"
 
 namespace livo::lio::synth {
 

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "livo/lio/imu_initializer.hpp"
+#include "livo/imu_initializer.hpp"
 #include "synthetic_world.hpp"
 
 using namespace livo;

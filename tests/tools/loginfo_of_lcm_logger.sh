@@ -14,7 +14,8 @@ sleep 0.5
 kill -INT "$logger"
 wait "$logger" || true
 "$loginfo" "$dir/bus.lcmlog" | tee "$dir/info.txt"
-grep -Eq '^BUS_TEST +livo\.point_cloud_t +50 +10\.[0-9]+ ' "$dir/info.txt" || {
+# the publisher paces itself with sleeps: on a loaded machine 50 messages span a little more than 4.9 s
+grep -Eq '^BUS_TEST +livo\.point_cloud_t +50 +(9\.[5-9]|10\.[0-4])[0-9]* ' "$dir/info.txt" || {
   echo "FAIL: expected 50 livo.point_cloud_t messages at ~10 Hz on BUS_TEST" >&2
   exit 1
 }

@@ -9,14 +9,14 @@
 
 namespace livo {
 
-struct ImuSample {
+struct AslImuSample {
   int64_t stamp_ns = 0;
   Vec3 gyro = Vec3::Zero();   // rad/s
   Vec3 accel = Vec3::Zero();  // m/s^2
 };
 
 /// imu0/data.csv: "#timestamp [ns], w_x, w_y, w_z, a_x, a_y, a_z". Errors name file and line.
-std::vector<ImuSample> readAslImuCsv(const std::string& path);
+std::vector<AslImuSample> readAslImuCsv(const std::string& path);
 
 struct AslImage {
   int64_t stamp_ns = 0;

@@ -23,6 +23,12 @@ class Node;  // yaml-cpp stays inside config.cpp
 
 namespace livo {
 
+// The value types Config reads (see the end of this file), as an X-macro: X(T) for each.
+#define LIVO_CONFIG_VALUE_TYPES(X)                                                              \
+  X(bool) X(int) X(int64_t) X(double) X(float) X(std::string) X(std::vector<double>) X(std::vector<int>) \
+  X(std::vector<std::string>) X(Eigen::Vector3d) X(Eigen::Matrix3d) X(Eigen::Matrix4d) X(Eigen::Quaterniond) \
+  X(Eigen::Isometry3d)
+
 class ConfigError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -88,23 +94,10 @@ class Config {
   };
   Config(const YAML::Node& node, std::shared_ptr<State> state, std::string path);
 
-  // One overload per supported value type (config.cpp): reads `key` into `out` if present; a
-  // missing required key throws. Returns whether the key was present.
+  // One overload per supported value type (LIVO_CONFIG_VALUE_TYPES, defined in config.cpp): reads
+  // `key` into `out` if present; a missing required key throws. Returns whether the key was present.
 #define LIVO_CONFIG_FETCH(T) bool fetch(const std::string& key, bool required, T& out) const;
-  LIVO_CONFIG_FETCH(bool)
-  LIVO_CONFIG_FETCH(int)
-  LIVO_CONFIG_FETCH(int64_t)
-  LIVO_CONFIG_FETCH(double)
-  LIVO_CONFIG_FETCH(float)
-  LIVO_CONFIG_FETCH(std::string)
-  LIVO_CONFIG_FETCH(std::vector<double>)
-  LIVO_CONFIG_FETCH(std::vector<int>)
-  LIVO_CONFIG_FETCH(std::vector<std::string>)
-  LIVO_CONFIG_FETCH(Eigen::Vector3d)
-  LIVO_CONFIG_FETCH(Eigen::Matrix3d)
-  LIVO_CONFIG_FETCH(Eigen::Matrix4d)
-  LIVO_CONFIG_FETCH(Eigen::Quaterniond)
-  LIVO_CONFIG_FETCH(Eigen::Isometry3d)
+  LIVO_CONFIG_VALUE_TYPES(LIVO_CONFIG_FETCH)
 #undef LIVO_CONFIG_FETCH
 
   YAML::Node child(const std::string& key, bool required) const;

@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 
+#include "livo/correction_frames.hpp"
 #include "livo/so3.hpp"
 
 namespace livo {
@@ -46,5 +47,22 @@ std::string keyframeProblem(const keyframe_t& m);
 /// The corrected keyframe poses of a LOOP_CORRECTION (id -> W_T_I), or why it cannot be used
 /// (arrays that disagree with num_keyframes, a bad pose); "" when `poses` was filled.
 std::string correctedKeyframePoses(const loop_correction_t& m, std::map<int64_t, Pose3>* poses);
+
+/// The view of a registered scan in a map's frame, `placed` being MapFrame::place() of its epoch
+/// and correction: a scan made in another correction's frame is first moved into `*moved` (the view
+/// then points into it). "" when `view` was filled, else why the scan is not used (placement,
+/// viewRegisteredScan()).
+std::string viewRegisteredScanInMap(const registered_scan_t& m, const MapFrame::Placed& placed,
+                                    registered_scan_t* moved, RegisteredScanView* view);
+
+/// A LOOP_CORRECTION as a map builder takes it: `problem` says why the message is refused
+/// (correctedKeyframePoses(), correctionTransform()); otherwise it was recorded in the MapFrame and
+/// `step` says whether the map moves to it, `corrected` holding the corrected keyframe poses.
+struct MapCorrection {
+  std::string problem;
+  std::map<int64_t, Pose3> corrected;  // keyframe id -> W_T_I in the corrected frame
+  MapFrame::CorrectionStep step;
+};
+MapCorrection readMapCorrection(const loop_correction_t& m, MapFrame* frame);
 
 }  // namespace livo

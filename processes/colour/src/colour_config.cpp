@@ -1,5 +1,7 @@
 #include "livo/colour/colour_config.hpp"
 
+#include <ostream>
+
 namespace livo::colour {
 
 ColourNodeOptions readColourNodeOptions(const Config& root) {
@@ -64,6 +66,15 @@ ColourNodeOptions readColourNodeOptions(const Config& root) {
   if (n.max_points_per_message < 1) fail("max_points_per_message", "must be >= 1");
   if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");
   return n;
+}
+
+void printOptions(const ColourNodeOptions& o, std::ostream& os) {
+  os << "colour: inputs " << o.registered_scan_channel << ", " << o.odometry_channel << ", "
+     << (o.camera_channel.empty() ? std::string("the rig's camera channel") : o.camera_channel) << ", "
+     << o.keyframe_channel << ", " << o.loop_correction_channel << ", " << o.colour_save_channel << "; output "
+     << o.colored_cloud_channel << " (at most " << o.max_points_per_message << " points a message); files "
+     << o.map_name << ".ply/.pcd\n";
+  printOptions(o.core, os);
 }
 
 }  // namespace livo::colour

@@ -35,18 +35,10 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
   node_.declareOutput(options_.colored_cloud_channel);
 
   node_.subscribe<registered_scan_t>(options_.registered_scan_channel, [this](const registered_scan_t& m) {
-    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
-    if (placed.placement != MapFrame::Placement::kUse) {
-      node_.reject(options_.registered_scan_channel, placed.why);
-      return;
-    }
     registered_scan_t moved;
-    if (placed.moved) {  // published before the LIO adopted the map's loop correction (or after one not here yet)
-      moved = m;
-      moveRegisteredScan(placed.to_map, &moved);
-    }
     RegisteredScanView v;
-    if (const std::string why = viewRegisteredScan(placed.moved ? moved : m, &v); !why.empty()) {
+    if (const std::string why = viewRegisteredScanInMap(m, placeInMap(m.epoch, m.correction_id), &moved, &v);
+        !why.empty()) {
       node_.reject(options_.registered_scan_channel, why);
       return;
     }
@@ -110,20 +102,16 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
     pipeline_.addKeyframe(m.id, m.utime, placed.to_map * poseFrom(m.position, m.orientation));
   });
   node_.subscribe<loop_correction_t>(options_.loop_correction_channel, [this](const loop_correction_t& m) {
-    std::map<int64_t, Pose3> corrected;
-    Pose3 T_Ck_O;
-    std::string why = correctedKeyframePoses(m, &corrected);
-    if (why.empty()) why = correctionTransform(m, &T_Ck_O);
-    if (!why.empty()) {
-      node_.reject(options_.loop_correction_channel, why);
+    const MapCorrection c = readMapCorrection(m, &frame_);
+    if (!c.problem.empty()) {
+      node_.reject(options_.loop_correction_channel, c.problem);
       return;
     }
-    const MapFrame::CorrectionStep step = frame_.addCorrection(m.correction_id, m.epoch, T_Ck_O);
-    if (!step.apply) {
-      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + step.why);
+    if (!c.step.apply) {
+      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + c.step.why);
       return;
     }
-    const int moved = pipeline_.applyCorrection(corrected, step.unlisted);
+    const int moved = pipeline_.applyCorrection(c.corrected, c.step.unlisted);
     std::ostringstream s;
     s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved the map";
     node_.info(s.str());

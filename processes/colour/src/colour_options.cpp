@@ -4,7 +4,7 @@
 
 namespace livo::colour {
 
-void printColourOptions(const ColourOptions& o, std::ostream& os) {
+void printOptions(const ColourOptions& o, std::ostream& os) {
   os << "colour: voxel_size " << o.voxel_size << " m, tiles " << o.tile_size << " m to disk after " << o.tile_idle_s
      << " s idle or beyond " << o.max_resident_points << " points in memory, points within max_depth + " << o.map_margin
      << " m of the body"

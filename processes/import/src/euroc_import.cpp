@@ -100,7 +100,7 @@ void importEuroc(const std::string& root, const EurocImportOptions& o, SortedLog
   const std::string imu_csv = joinPath(mav0, "imu0/data.csv");
   if (isFile(imu_csv)) {
     try {
-      for (const ImuSample& s : readAslImuCsv(imu_csv)) {
+      for (const AslImuSample& s : readAslImuCsv(imu_csv)) {
         imu_t m;
         m.utime = nsToUtime(s.stamp_ns);
         for (int i = 0; i < 3; ++i) {

@@ -1,5 +1,7 @@
 #include "livo/loop/loop_config.hpp"
 
+#include <ostream>
+
 namespace livo::loop {
 
 LoopNodeOptions readLoopNodeOptions(const Config& root) {
@@ -65,6 +67,23 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
     throw ConfigError(s.where("loop_rotation_sigma") + ": loop_rotation_sigma and loop_translation_sigma must be > 0");
   if (!(c.consistency_chi2 > 0)) throw ConfigError(s.where("consistency_chi2") + ": consistency_chi2 must be > 0");
   return o;
+}
+
+void printOptions(const LoopNodeOptions& o, std::ostream& os) {
+  const LoopCloserOptions& c = o.closer;
+  const AcceptanceOptions& a = c.registration.acceptance;
+  os << "loop: input " << o.keyframe_channel << "; output " << o.loop_correction_channel << "; files "
+     << (o.output_dir.empty() ? std::string("none") : o.output_dir + "/{keyframes.tum,loops.json,global_map.ply}")
+     << "\n  candidates within " << c.candidates.search_radius << " m, older than " << c.candidates.exclude_recent_s
+     << " s, at most " << c.candidates.max_candidates << " per keyframe, " << c.candidates.cooldown_keyframes
+     << " keyframes of cooldown\n  coarse: voxel " << c.coarse.voxel_size << " m, FPFH radius "
+     << c.coarse.feature_radius << " m, at most " << c.coarse.max_keypoints << " keypoints, noise bound "
+     << c.registration.quatro.noise_bound << " m; fine: voxel " << c.fine_voxel_size << " m, GICP max distance "
+     << c.registration.gicp.max_correspondence_distance << " m\n  accepted with at least "
+     << a.min_coarse_inliers << " coarse inliers, fitness <= " << a.max_fitness << ", overlap >= " << a.min_overlap
+     << "; consistency check " << (c.consistency_check ? "on" : "off") << " (chi2 " << c.consistency_chi2
+     << "); a correction only beyond " << c.min_correction_translation << " m / " << c.min_correction_rotation
+     << " rad\n";
 }
 
 }  // namespace livo::loop

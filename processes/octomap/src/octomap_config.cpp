@@ -1,5 +1,7 @@
 #include "livo/octomap/octomap_config.hpp"
 
+#include <ostream>
+
 namespace livo::octomap {
 
 OctomapNodeOptions readOctomapNodeOptions(const Config& root) {
@@ -55,6 +57,14 @@ OctomapNodeOptions readOctomapNodeOptions(const Config& root) {
   if (n.write_period_s < 0.0) fail("write_period_s", "must be >= 0");
   if (n.map_name.empty() || n.map_name.find('/') != std::string::npos) fail("map_name", "must be a plain file name");
   return n;
+}
+
+void printOptions(const OctomapNodeOptions& o, std::ostream& os) {
+  os << "octomap: inputs " << o.registered_scan_channel << ", " << o.keyframe_channel << ", "
+     << o.loop_correction_channel << (o.core.colour ? ", " + o.colored_cloud_channel : std::string()) << "; output "
+     << o.octomap_channel << " every " << o.publish_period_s << " s; files " << o.map_name << ".bt/.ot every "
+     << o.write_period_s << " s\n";
+  printOptions(o.core, os);
 }
 
 }  // namespace livo::octomap

@@ -4,7 +4,7 @@
 
 namespace livo::octomap {
 
-void printOctomapOptions(const OctomapOptions& o, std::ostream& os) {
+void printOptions(const OctomapOptions& o, std::ostream& os) {
   os << "octomap: resolution " << o.resolution << " m, range " << o.min_range << ".." << o.max_range
      << " m, prob_hit " << o.prob_hit << ", prob_miss " << o.prob_miss << ", clamping " << o.clamping_min << ".."
      << o.clamping_max << ", threshold " << o.occupancy_threshold << ", " << (o.colour ? "ColorOcTree" : "OcTree")

@@ -109,7 +109,7 @@ class SimulationRun {
   void addImu(Chunk* c) {
     if (s_.replaysRecordedImu()) {
       for (; recorded_k_ < s_.recorded_imu.size(); ++recorded_k_) {
-        const ImuSample& r = s_.recorded_imu[recorded_k_];
+        const AslImuSample& r = s_.recorded_imu[recorded_k_];
         const int64_t u = (r.stamp_ns + 500) / 1000;
         if (u >= c->end) break;
         c->imus.push_back({u, r.gyro, r.accel});

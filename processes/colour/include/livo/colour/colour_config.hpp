@@ -2,6 +2,7 @@
 // unknown keys are errors).
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 #include "livo/colour/colour_options.hpp"
@@ -26,5 +27,8 @@ struct ColourNodeOptions {
 };
 
 ColourNodeOptions readColourNodeOptions(const Config& root);
+
+/// The channels and options, for the log at start-up.
+void printOptions(const ColourNodeOptions& o, std::ostream& os);
 
 }  // namespace livo::colour

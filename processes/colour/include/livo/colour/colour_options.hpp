@@ -53,6 +53,6 @@ struct ColourOptions {
   int max_count = 50;                  // the running mean's weight saturates (slow drift allowed)
 };
 
-void printColourOptions(const ColourOptions& o, std::ostream& os);
+void printOptions(const ColourOptions& o, std::ostream& os);
 
 }  // namespace livo::colour

@@ -8,18 +8,12 @@
 #include <vector>
 
 #include "livo/filter_state.hpp"
+#include "livo/sensor_samples.hpp"
 
 namespace livo::lio {
 
 using Mat18x12 = Eigen::Matrix<double, 18, 12>;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
-
-/// One IMU sample in the body frame I: angular rate (rad/s) and specific force (m/s^2).
-struct ImuSample {
-  int64_t utime = 0;
-  Vec3 gyro = Vec3::Zero();
-  Vec3 accel = Vec3::Zero();
-};
 
 /// Continuous-time noise densities of the IMU (the rig's imu section).
 struct ImuNoise {

@@ -11,16 +11,13 @@
 #include "livo/odometry_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "livo/sensor_messages.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
 namespace livo::lio {
 
-ImuSample fromMessage(const imu_t& m);
-WheelSample fromMessage(const wheel_odometry_t& m);
-/// A sweep in frame "L" (or "I": then the points are taken as already in the body frame by the
-/// caller). False with the reason for inconsistent array sizes, an unknown frame or a pattern
-/// without time offsets.
-bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why);
+// The sensor messages: livo/sensor_messages.hpp (fromMessage for imu_t, wheel_odometry_t and
+// point_cloud_t).
 
 /// The output messages carry the frame they are in (epoch, correction_id).
 odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame);

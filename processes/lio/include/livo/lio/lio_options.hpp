@@ -4,9 +4,10 @@
 #include <cstddef>
 
 #include "livo/esikf_update.hpp"
-#include "livo/lio/imu_initializer.hpp"
-#include "livo/lio/keyframe_selector.hpp"
-#include "livo/lio/lidar_scan.hpp"
+#include "livo/imu_initializer.hpp"
+#include "livo/keyframe_selector.hpp"
+#include "livo/lio/imu_propagator.hpp"
+#include "livo/sensor_samples.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "livo/lio/voxel_map.hpp"
 #include "livo/lio/wheel_scale.hpp"

@@ -7,7 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "livo/lio/flat_key_index.hpp"
+#include "livo/flat_key_index.hpp"
+#include "livo/voxel_downsample.hpp"
 
 namespace livo::lio {
 
@@ -103,11 +104,5 @@ class VoxelMap {
   FlatKeyIndex index_;
   std::vector<int> offsets_; // 27 neighbour offsets as (dx, dy, dz) triples, search radius 1
 };
-
-/// Indices of the first point falling in each voxel of the given size, in input order.
-std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, double voxel_size);
-/// Same on a subset of indices.
-std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
-                                    double voxel_size);
 
 }  // namespace livo::lio

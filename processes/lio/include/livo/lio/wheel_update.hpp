@@ -9,16 +9,11 @@
 #include <cstdint>
 
 #include "livo/filter_state.hpp"
+#include "livo/sensor_samples.hpp"
 
 namespace livo::lio {
 
 using Mat3x18 = Eigen::Matrix<double, 3, 18>;
-
-struct WheelSample {
-  int64_t utime = 0;
-  double left_speed = 0.0;   // m/s
-  double right_speed = 0.0;  // m/s
-};
 
 struct WheelOptions {
   bool enabled = false;

@@ -2,7 +2,7 @@
 // plane-regularised covariances of GICP (Segal et al.; as Nano-GICP/fast_gicp compute them).
 #pragma once
 
-#include "livo/loop/kdtree.hpp"
+#include "livo/kdtree.hpp"
 #include "livo/loop/point_types.hpp"
 
 namespace livo::loop {

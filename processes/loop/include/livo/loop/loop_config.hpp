@@ -2,6 +2,7 @@
 // (every key optional, unknown keys are errors).
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 #include "livo/config.hpp"
@@ -20,5 +21,8 @@ struct LoopNodeOptions {
 /// Reads the optional `loop:` section of a project config (absent keys keep the defaults) and
 /// the channel names from `loop.channels` (strict: unknown keys are errors).
 LoopNodeOptions readLoopNodeOptions(const Config& root);
+
+/// The channels and options, for the log at start-up.
+void printOptions(const LoopNodeOptions& o, std::ostream& os);
 
 }  // namespace livo::loop

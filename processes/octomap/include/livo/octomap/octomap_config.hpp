@@ -1,6 +1,7 @@
 // Reads the `octomap:` section of a project config (strict: unknown keys are errors).
 #pragma once
 
+#include <iosfwd>
 #include <string>
 
 #include "livo/config.hpp"
@@ -21,5 +22,8 @@ struct OctomapNodeOptions {
 };
 
 OctomapNodeOptions readOctomapNodeOptions(const Config& root);
+
+/// The channels and options, for the log at start-up.
+void printOptions(const OctomapNodeOptions& o, std::ostream& os);
 
 }  // namespace livo::octomap

@@ -37,6 +37,6 @@ struct OctomapOptions {
                                   // cost what the area costs, not the drive (0: keep every one)
 };
 
-void printOctomapOptions(const OctomapOptions& o, std::ostream& os);
+void printOptions(const OctomapOptions& o, std::ostream& os);
 
 }  // namespace livo::octomap

@@ -62,7 +62,7 @@ struct SimulationSetup {
   int64_t start_utime = 0;
   double trajectory_time_offset = 0.0;  // trajectory time at start_utime
   bool recorded = false;                // re-simulation along a recording:
-  std::vector<ImuSample> recorded_imu;  //   its real IMU stream, published untouched (none: synthesised)
+  std::vector<AslImuSample> recorded_imu;  //   its real IMU stream, published untouched (none: synthesised)
   // The truth of this run (drawn from the seed when calibration_errors.draw is on): never in `rig`.
   CalibrationErrors calibration_errors;
   ImuErrors imu_errors;

@@ -17,7 +17,7 @@ struct TrajectoryConfig {
   bool recorded = false;
   double recorded_start_stamp = 0.0;      // s, first ground-truth stamp
   double recorded_start_offset_s = 0.0;   // recorded: the run starts this long after the default start
-  std::vector<ImuSample> recorded_imu;    // recorded: the real IMU samples (none: synthesised from the motion)
+  std::vector<AslImuSample> recorded_imu;    // recorded: the real IMU samples (none: synthesised from the motion)
 };
 
 /// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths;

@@ -3,7 +3,7 @@
 
 #include "livo/so3.hpp"
 
-namespace livo::lio {
+namespace livo {
 
 struct KeyframeOptions {
   double min_distance = 1.0;   // m
@@ -31,4 +31,4 @@ class KeyframeSelector {
   bool has_last_ = false;
 };
 
-}  // namespace livo::lio
+}  // namespace livo

@@ -10,7 +10,7 @@
 
 #include <nanoflann.hpp>
 
-namespace livo::loop {
+namespace livo {
 
 template <class Vector, class Container = std::vector<Vector>>
 class KdTree {
@@ -85,4 +85,4 @@ class KdTree {
   Index index_;
 };
 
-}  // namespace livo::loop
+}  // namespace livo

@@ -9,7 +9,7 @@
 
 #include "livo/voxel_key.hpp"
 
-namespace livo::lio {
+namespace livo {
 
 /// Key -> int32 index, linear probing, grows at 50 % load. No single-key erase: callers rebuild.
 class FlatKeyIndex {
@@ -90,4 +90,4 @@ class FlatKeyIndex {
   size_t size_ = 0;
 };
 
-}  // namespace livo::lio
+}  // namespace livo

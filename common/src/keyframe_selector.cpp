@@ -1,8 +1,8 @@
-#include "livo/lio/keyframe_selector.hpp"
+#include "livo/keyframe_selector.hpp"
 
 #include <cmath>
 
-namespace livo::lio {
+namespace livo {
 
 bool KeyframeSelector::check(const Pose3& pose) {
   if (has_last_) {
@@ -14,4 +14,4 @@ bool KeyframeSelector::check(const Pose3& pose) {
   return true;
 }
 
-}  // namespace livo::lio
+}  // namespace livo

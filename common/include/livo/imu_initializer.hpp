@@ -9,9 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "livo/lio/imu_propagator.hpp"
+#include "livo/filter_state.hpp"
+#include "livo/sensor_samples.hpp"
 
-namespace livo::lio {
+namespace livo {
 
 struct ImuInitOptions {
   enum class Mode { kAuto, kStatic, kMoving };
@@ -52,4 +53,4 @@ bool isStill(const std::vector<ImuSample>& window, const ImuInitOptions& opts);
 /// request on a moving window or a degenerate specific force.
 ImuInitResult initializeImu(const std::vector<ImuSample>& window, const ImuInitOptions& opts);
 
-}  // namespace livo::lio
+}  // namespace livo

@@ -1,8 +1,8 @@
-#include "livo/lio/imu_initializer.hpp"
+#include "livo/imu_initializer.hpp"
 
 #include <cmath>
 
-namespace livo::lio {
+namespace livo {
 
 namespace {
 struct Moments {
@@ -94,4 +94,4 @@ ImuInitResult initializeImu(const std::vector<ImuSample>& window, const ImuInitO
   return r;
 }
 
-}  // namespace livo::lio
+}  // namespace livo

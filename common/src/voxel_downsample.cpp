@@ -1,0 +1,28 @@
+#include "livo/voxel_downsample.hpp"
+
+#include "livo/flat_key_index.hpp"
+#include "livo/voxel_key.hpp"
+
+namespace livo {
+
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
+                                    double voxel_size) {
+  const double inv = 1.0 / voxel_size;
+  FlatKeyIndex seen(subset.size());
+  std::vector<size_t> out;
+  out.reserve(subset.size() / 4 + 16);
+  for (size_t j : subset) {
+    const VoxelKey key = voxelKeyOf(points[j], inv);
+    const int32_t next = static_cast<int32_t>(out.size());
+    if (seen.insert(key, next) == next) out.push_back(j);
+  }
+  return out;
+}
+
+std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, double voxel_size) {
+  std::vector<size_t> all(points.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return firstPointPerVoxel(points, all, voxel_size);
+}
+
+}  // namespace livo
