@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
               << writer.bytesWritten() / 1e6 << " MB\n";
     for (const auto& [channel, count] : stats.messages) std::cerr << "  " << std::left << std::setw(14) << channel << count << " messages\n";
     if (setup.rig.lidar) std::cerr << "  LiDAR points: " << stats.lidar_points << "\n";
+    if (setup.rig.wheel && setup.options.wheel_slip.enabled())
+      std::cerr << "  wheel slip episodes: " << stats.wheel_slip_episodes << "\n";
   } catch (const std::exception& e) {
     std::cerr << "livo-sim: " << e.what() << "\n";
     return 1;

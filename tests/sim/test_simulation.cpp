@@ -288,7 +288,7 @@ TEST(Simulation, TriggeredCameraFiresAtTheSweepStartsOrEnds) {
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
   for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking", "hall_noisy", "room_hard",
                                   "corridor_hard", "campus_loop_hard", "campus_loop_long_hard", "parking_hard", "room_fr2_desk",
-                                  "room_fr2_desk_hard"}) {
+                                  "room_fr2_desk_hard", "bridge_deck", "tree_campus"}) {
     SCOPED_TRACE(name);
     const double duration = 0.5;
     const SimulationSetup setup = loadSimulation(configPath(name));

@@ -116,7 +116,7 @@ Material readMaterial(const Config& c, const std::map<std::string, int>& texture
   return m;
 }
 
-/// A box or cylinder crown of leaves (`shape`, its size keys, `leaf_density` in 1/m).
+/// A box, cylinder or sphere crown of leaves (`shape`, its size keys, `leaf_density` in 1/m).
 Shape readVegetation(const Config& c, Material* m) {
   if (m->kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": vegetation has no material key");
   m->kind = MaterialKind::kVegetation;
@@ -133,8 +133,11 @@ Shape readVegetation(const Config& c, Material* m) {
     shape.type = ShapeType::kCylinder;
     const double radius = positive(c, "radius"), height = positive(c, "height");
     shape.half_size = Vec3(radius, radius, 0.5 * height);
+  } else if (form == "sphere") {
+    shape.type = ShapeType::kSphere;
+    shape.half_size = Vec3::Constant(positive(c, "radius"));
   } else {
-    throw ConfigError(c.where("shape") + ": unknown vegetation shape '" + form + "' (known: box, cylinder)");
+    throw ConfigError(c.where("shape") + ": unknown vegetation shape '" + form + "' (known: box, cylinder, sphere)");
   }
   return shape;
 }

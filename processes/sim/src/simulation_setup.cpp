@@ -163,6 +163,32 @@ void readAutoExposure(const Config& cam, CameraEffects* e) {
   ae.checkAllUsed();
 }
 
+/// A [min, max] pair with lo <= min <= max <= hi.
+void readRange(const Config& c, const std::string& key, double lo, double hi, double* min, double* max) {
+  std::vector<double> v;
+  if (!c.readOptional(key, v)) return;
+  if (v.size() != 2 || !(lo <= v[0] && v[0] <= v[1] && v[1] <= hi))
+    throw ConfigError(c.where(key) + ": must be [min, max] with " + number(lo) + " <= min <= max <= " + number(hi));
+  *min = v[0];
+  *max = v[1];
+}
+
+/// sim.wheel.slip: absent or rate_per_min 0 = off.
+void readWheelSlip(const Config& slip, WheelSlipOptions* w) {
+  slip.readOptional("rate_per_min", w->rate_per_min);
+  if (!(w->rate_per_min >= 0.0 && w->rate_per_min <= 600.0))
+    throw ConfigError(slip.where("rate_per_min") + ": must be in [0, 600] (0 = off)");
+  readRange(slip, "duration_s", 1e-3, 60.0, &w->min_duration_s, &w->max_duration_s);
+  readRange(slip, "spin", 0.0, 10.0, &w->min_spin, &w->max_spin);
+  slip.readOptional("lock_probability", w->lock_probability);
+  slip.readOptional("both_probability", w->both_probability);
+  if (!(w->lock_probability >= 0.0 && w->lock_probability <= 1.0))
+    throw ConfigError(slip.where("lock_probability") + ": must be in [0, 1]");
+  if (!(w->both_probability >= 0.0 && w->both_probability <= 1.0))
+    throw ConfigError(slip.where("both_probability") + ": must be in [0, 1]");
+  slip.checkAllUsed();
+}
+
 void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   sim.readOptional("start_time_s", o->start_time_s);
   sim.readOptional("duration_s", o->duration_s);
@@ -238,6 +264,7 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   wheel.readOptional("right_scale", o->wheel_right_scale);
   if (!(o->wheel_left_scale > 0.0)) throw ConfigError(wheel.where("left_scale") + ": must be > 0");
   if (!(o->wheel_right_scale > 0.0)) throw ConfigError(wheel.where("right_scale") + ": must be > 0");
+  readWheelSlip(wheel.optionalSection("slip"), &o->wheel_slip);
   wheel.checkAllUsed();
 }
 
@@ -408,6 +435,12 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
   }
   if (s.rig.wheel)
     os << "  wheel: scale errors left " << o.wheel_left_scale << ", right " << o.wheel_right_scale << "\n";
+  if (s.rig.wheel && o.wheel_slip.enabled()) {
+    const WheelSlipOptions& w = o.wheel_slip;
+    os << "  wheel slip: " << w.rate_per_min << " episodes per minute, " << w.min_duration_s << ".." << w.max_duration_s
+       << " s each, " << w.both_probability * 100 << " % on both wheels, " << w.lock_probability * 100
+       << " % locked (reads 0), else spinning +" << w.min_spin * 100 << ".." << w.max_spin * 100 << " %\n";
+  }
   if (s.imu_errors.any()) printImuErrors(s, os);
   if (s.calibration_errors.any()) printCalibrationErrors(s, os);
 }

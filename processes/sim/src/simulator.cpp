@@ -20,7 +20,7 @@ namespace livo::sim {
 namespace {
 
 // Random stream ids, one per sensor.
-enum Stream : uint64_t { kImuStream = 1, kWheelStream = 2, kLidarStream = 3, kCameraStream = 4 };
+enum Stream : uint64_t { kImuStream = 1, kWheelStream = 2, kLidarStream = 3, kCameraStream = 4, kWheelSlipStream = 5 };
 // Order of messages that share a stamp.
 enum Rank : int { kImuRank = 0, kWheelRank = 1, kGroundTruthRank = 2, kLidarRank = 3, kCameraRank = 4 };
 
@@ -84,6 +84,8 @@ class SimulationRun {
     if (rig_.wheel) {
       stats_.messages[rig_.channels.wheel] = 0;
       wheel_noise_.emplace(*rig_.wheel, o_.wheel_left_scale, o_.wheel_right_scale, Random(o_.seed, kWheelStream));
+      // a stream of its own: with slip on, the readings outside its episodes are those without it
+      if (o_.wheel_slip.enabled()) wheel_slip_.emplace(o_.wheel_slip, Random(o_.seed, kWheelSlipStream));
     }
     if (rig_.lidar) {
       stats_.messages[rig_.channels.lidar] = 0;
@@ -138,9 +140,17 @@ class SimulationRun {
       // stamped u, measured at IMU time u + the wheel's time offset error
       const double t = s_.trajectoryTime(u) + errors_.wheel_time_offset_s;
       WheelReading r = idealWheelReading(s_.trajectory->at(t), *mounted_.wheel, u);
+      if (wheel_slip_) wheel_slip_->apply((u - start_) * 1e-6, &r);  // the wheels' own rotation, then scale and noise
       wheel_noise_->apply(&r);
       c->wheels.push_back(r);
       c->pending.push_back({u, kWheelRank, c->wheels.size() - 1});
+    }
+    if (wheel_slip_ && !c->wheels.empty()) {
+      // episodes begun up to the chunk's last sample
+      const double last = (c->wheels.back().utime - start_) * 1e-6;
+      const auto& episodes = wheel_slip_->episodes();
+      stats_.wheel_slip_episodes = std::count_if(episodes.begin(), episodes.end(),
+                                                 [last](const WheelSlipEpisode& e) { return e.start_s <= last; });
     }
   }
 
@@ -230,6 +240,7 @@ class SimulationRun {
   SimulationStats stats_;
   ImuNoise imu_noise_;
   std::optional<WheelNoise> wheel_noise_;
+  std::optional<WheelSlip> wheel_slip_;
   std::unique_ptr<LidarScanner> scanner_;
   int64_t sweep_us_ = 0;
   std::unique_ptr<CameraRenderer> renderer_;

@@ -22,7 +22,7 @@ namespace livo::sim {
 enum class MaterialKind {
   kOpaque,
   kGlass,       // a surface the camera sees through and a LiDAR beam mostly passes
-  kVegetation,  // a volume (box or cylinder) of leaves: hit at an exponentially distributed depth
+  kVegetation,  // a volume (box, cylinder or sphere) of leaves: hit at an exponentially distributed depth
 };
 
 struct Material {

@@ -18,6 +18,7 @@
 #include "livo/sensor_rig.hpp"
 #include "livo/sim/scene.hpp"
 #include "livo/sim/trajectory.hpp"
+#include "livo/sim/wheel_model.hpp"
 
 namespace livo::sim {
 
@@ -40,6 +41,7 @@ struct SimOptions {
   CameraTrigger camera_trigger = CameraTrigger::kFree;
   double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;
+  WheelSlipOptions wheel_slip;        // sim.wheel.slip, off by default
   ImuErrors imu_errors;                 // sim.imu error model, as configured (1-sigmas if drawn)
   CalibrationErrors calibration_errors; // sim.calibration_errors, as configured (1-sigmas if drawn)
 };
