@@ -58,7 +58,11 @@ while [ $# -gt 0 ]; do
     --stop-grace) stop_grace="$2"; shift 2 ;;
     --overlay) overlays+="${overlays:+,}$2"; shift 2 ;;
     --calibrate-camera) calibrate=1; shift ;;
-    --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"; swap["${2%%=*}"]="${2#*=}"; shift 2 ;;
+    --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
+            exe="${2#*=}"
+            # a path relative to where the script was called from (the processes run inside --out)
+            [[ "$exe" == */* && "$exe" != /* ]] && exe="$PWD/$exe"
+            swap["${2%%=*}"]="$exe"; shift 2 ;;
     --inside-bus) inside=1; shift ;;
     -h|--help) usage 0 ;;
     *) echo "run_pipeline.sh: unknown argument '$1'" >&2; usage ;;

@@ -1,0 +1,133 @@
+// livo-lio-graph's estimator (APGC-LVIW's LiDAR subsystem on LIO-SAM's structure, GTSAM replaced by
+// Ceres). Every sweep:
+//   1. the IMU is preintegrated from the newest state to the sweep end (Forster et al.), which
+//      also predicts the pose at every IMU sample: the sweep is deskewed to its end with them;
+//   2. roughness features (edges, surfaces) of the deskewed sweep;
+//   3. scan-to-local-map matching from the predicted pose (the LiDAR odometry measurement);
+//   4. a new state (pose, velocity, biases) joins a fixed-lag window with an IMU preintegration
+//      factor, a bias random walk, the LiDAR pose factor (its information from the matching, so a
+//      degenerate direction is left to the other sensors) and, with wheels, a wheel
+//      preintegration factor; the window is optimised and its oldest state marginalised into a
+//      linear prior, so the cost per sweep does not grow with the run;
+//   5. every keyframe_distance / keyframe_angle a keyframe: its features enter the local map.
+// Deterministic: the output depends only on the inputs.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "livo/keyframe_selector.hpp"
+#include "livo/lio_graph/lio_graph_options.hpp"
+#include "livo/lio_graph/marginalization.hpp"
+
+namespace livo::lio_graph {
+
+struct GraphKeyframe {
+  int64_t id = 0;
+  int64_t utime = 0;
+  Pose3 pose = Pose3::Identity();       // W_T_I
+  Mat6 pose_covariance = Mat6::Identity() * 1e-4;  // [rotation, position]
+  std::vector<Vec3> cloud;              // the deskewed sweep, body frame, downsampled
+  std::vector<float> intensity;         // one per cloud point
+};
+
+struct GraphScanResult {
+  enum class Status { kInitializing, kRejected, kMapInitialized, kTracked, kPredicted };
+  Status status = Status::kRejected;
+  std::string message;
+  int64_t utime = 0;              // sweep end, IMU clock
+  int64_t sweep_start_utime = 0;  // IMU clock
+  Pose3 pose = Pose3::Identity(); // W_T_I at utime (after the window's optimisation)
+  Vec3 velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
+  Vec3 gyro_bias = Vec3::Zero(), accel_bias = Vec3::Zero();
+  Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
+  bool degenerate = false;
+  Vec6 weakest_direction = Vec6::Zero();    // of the scan matching, [rotation, translation]
+  int edge_residuals = 0, surface_residuals = 0;
+  int planes = 0;                 // planes observed in the sweep (planar factors)
+  int ground_planes = 0;
+  int num_points = 0;
+  // the sweep's valid points deskewed to utime, world frame, and their indices in the input
+  std::vector<Vec3> world_points;
+  std::vector<uint32_t> input_index;
+  bool is_keyframe = false;
+  GraphKeyframe keyframe;
+  bool hasOutput() const {
+    return status == Status::kMapInitialized || status == Status::kTracked || status == Status::kPredicted;
+  }
+};
+
+const char* toString(GraphScanResult::Status s);
+
+class LioGraphEstimator {
+ public:
+  explicit LioGraphEstimator(LioGraphOptions options);
+  ~LioGraphEstimator();
+  LioGraphEstimator(const LioGraphEstimator&) = delete;
+  LioGraphEstimator& operator=(const LioGraphEstimator&) = delete;
+
+  /// False (with the reason) for non-finite values or a sample not later than the previous one.
+  bool addImu(const ImuSample& s, std::string* why = nullptr);
+  bool addWheel(const WheelSample& s, std::string* why = nullptr);
+  /// End of the sweep in the IMU clock: the IMU must have passed it before addScan.
+  int64_t scanEndUtime(const LidarScan& scan) const;
+  GraphScanResult addScan(const LidarScan& scan);
+
+  bool initialized() const { return !window_.empty(); }
+  size_t windowSize() const { return window_.size(); }
+  size_t planeLandmarks() const { return landmarks_.size(); }
+  size_t storedKeyframes() const { return keyframes_.size(); }
+  const LioGraphOptions& options() const { return opts_; }
+  const LocalMap& localMap() const { return map_; }
+  /// Forgets everything; the next sweeps initialise again.
+  void reset();
+
+ private:
+  struct Node;
+  struct PlaneLandmark;
+  struct ImuStep {
+    int64_t utime;
+    Pose3 pose;  // predicted W_T_I
+  };
+
+  bool initialize(int64_t t_end, std::string* note);
+  /// The IMU preintegration from the newest state to t_end and the predicted poses at every sample.
+  bool preintegrate(int64_t t_end, ImuPreintegration* pre, std::vector<ImuStep>* steps, Vec3* last_gyro) const;
+  std::unique_ptr<WheelPreintegration> wheelBetween(int64_t t0, int64_t t1) const;
+  /// Valid points deskewed to the sweep end, body frame (and their indices).
+  void deskew(const LidarScan& scan, int64_t t_first, const std::vector<ImuStep>& steps, std::vector<Vec3>* body,
+              std::vector<uint32_t>* index, std::vector<int16_t>* ring, std::vector<float>* time) const;
+  /// Planes of the sweep (body frame) associated with the window's landmarks or new ones; their
+  /// factors go to the node.
+  void observePlanes(const std::vector<Vec3>& body, Node* node, GraphScanResult* res);
+  void optimize();
+  void marginalizeOldest();
+  void updateKeyframePoses();
+  void rebuildLocalMap();
+  Mat6 newestPoseCovariance();
+  void dropImuBefore(int64_t utime);
+
+  LioGraphOptions opts_;
+  std::deque<ImuSample> imu_;
+  std::deque<WheelSample> wheel_;
+  std::deque<std::unique_ptr<Node>> window_;
+  std::deque<std::unique_ptr<PlaneLandmark>> landmarks_;
+  std::shared_ptr<MarginalPrior> prior_;
+  std::unique_ptr<MarginalPriorFactor> prior_factor_;
+  struct StoredKeyframe {
+    GraphKeyframe kf;
+    std::vector<Vec3> edges, surfaces;  // features, body frame
+    const Node* node = nullptr;         // while its state is in the window
+  };
+  std::deque<StoredKeyframe> keyframes_;
+  LocalMap map_;
+  KeyframeSelector keyframe_selector_;
+  int64_t next_keyframe_id_ = 0;
+  int64_t last_sweep_end_ = -1;
+};
+
+}  // namespace livo::lio_graph

@@ -1,0 +1,52 @@
+// The livo-lio-graph node: IMU, LIDAR (and WHEEL) in; ODOMETRY, REGISTERED_SCAN and KEYFRAME out,
+// as livo-lio publishes them, so it can stand in for livo-lio in the pipeline
+// (scripts/run_pipeline.sh --swap lio=build/bin/livo-lio-graph).
+//
+// Determinism: sweeps wait in a queue and are processed once the IMU has passed their end (and,
+// with wheels, a wheel reading has, or wheel_max_wait_s of IMU beyond it), so the output depends
+// only on the messages' contents and stamps, not on how the channels interleave.
+#pragma once
+
+#include <deque>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "livo/imu_t.hpp"
+#include "livo/lio_graph/lio_graph_config.hpp"
+#include "livo/lio_graph/lio_graph_estimator.hpp"
+#include "livo/node.hpp"
+#include "livo/point_cloud_t.hpp"
+#include "livo/wheel_odometry_t.hpp"
+
+namespace livo::lio_graph {
+
+class LioGraphNode {
+ public:
+  LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNodeOptions options);
+  Node& node() { return node_; }
+  const LioGraphEstimator& estimator() const { return estimator_; }
+  /// Sweeps processed, tracked, predicted only and degenerate.
+  std::string summary() const;
+
+ private:
+  struct PendingSweep {
+    point_cloud_t msg;
+    LidarScan scan;
+    int64_t end_utime;
+  };
+  void onImu(const imu_t& m);
+  void onWheel(const wheel_odometry_t& m);
+  void onLidar(const point_cloud_t& m);
+  void processReady();
+  void process(const PendingSweep& p);
+
+  Node node_;
+  LioGraphNodeOptions opts_;
+  LioGraphEstimator estimator_;
+  std::deque<PendingSweep> pending_;
+  int64_t imu_watermark_ = INT64_MIN;
+  int64_t wheel_watermark_ = INT64_MIN;
+  int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0;
+};
+
+}  // namespace livo::lio_graph

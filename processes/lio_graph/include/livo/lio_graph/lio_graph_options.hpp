@@ -1,0 +1,58 @@
+// Options of livo-lio-graph's core (the `lio_graph:` config section and the rig).
+#pragma once
+
+#include "livo/imu_initializer.hpp"
+#include "livo/keyframe_selector.hpp"
+#include "livo/imu_preintegration.hpp"
+#include "livo/lio_graph/feature_extraction.hpp"
+#include "livo/lio_graph/plane_extraction.hpp"
+#include "livo/lio_graph/scan_matching.hpp"
+#include "livo/sensor_rig.hpp"
+#include "livo/sensor_samples.hpp"
+#include "livo/wheel_preintegration.hpp"
+
+namespace livo::lio_graph {
+
+struct LioGraphOptions {
+  LidarExtrinsics extrinsics;           // rig.lidar
+  double min_range = 1.0;               // m (rig.lidar.min_range, at least features.min_range)
+  double max_range = 100.0;             // m
+  ImuPreintegrationNoise imu_noise;     // rig.imu
+  double gravity = 9.81;                // m/s^2 (rig.imu.gravity)
+  ImuInitOptions init;
+  FeatureOptions features;
+  ScanMatchingOptions matching;
+
+  bool use_wheel = false;               // rig.wheel present and lio_graph.wheel not false
+  WheelRig wheel_rig;
+  WheelPreintegrationNoise wheel_noise;
+  double wheel_huber = 3.0;             // robust loss on the whitened wheel residual (slip)
+  double max_wheel_gap_s = 0.2;         // a longer gap between readings: no wheel factor there
+
+  // Adaptive planar factors (the paper's contribution): planes extracted from every sweep
+  // (plane_extraction.hpp) become landmarks of the window, each observation a factor.
+  bool planar_factors = true;
+  PlaneExtractionOptions planes;
+  double plane_cloud_voxel = 0.2;       // m: the sweep is downsampled to this before extraction
+  double plane_sigma_angle_deg = 1.0;   // an observed plane's normal
+  double plane_sigma_distance = 0.02;   // m, at least; its offset (at least its quality)
+  double plane_match_angle_deg = 10.0;  // an observation joins a landmark this close in normal ...
+  double plane_match_distance = 0.2;    // ... whose plane passes this close to its centroid (m)
+
+  int window_states = 10;               // sweeps in the fixed-lag smoother
+  int solver_iterations = 10;
+  KeyframeOptions keyframe;             // a new keyframe (local map, KEYFRAME) after 1 m or 10 deg
+  int local_map_keyframes = 30;         // the newest keyframes within local_map_radius form the map
+  double local_map_radius = 50.0;       // m
+  double map_edge_voxel = 0.2;          // m
+  double map_surface_voxel = 0.4;       // m
+  // The scan-matching result as a pose measurement: information = scale * J^T J / sigma^2. The
+  // residuals of neighbouring points are far from independent (the map's own noise is shared),
+  // so the scale is well below one.
+  double lidar_point_sigma = 0.05;      // m
+  double lidar_information_scale = 0.05;
+  double max_imu_gap_s = 0.5;           // s without IMU: the state is re-initialised
+  size_t max_stored_keyframes = 200;    // keyframes kept for the local map (older ones dropped)
+};
+
+}  // namespace livo::lio_graph

@@ -1,0 +1,62 @@
+// Marginalisation for the fixed-lag smoother: the factors that touch the states leaving the window
+// are linearised at the current estimate and the leaving blocks eliminated (Schur complement);
+// what they said about the blocks that stay becomes one linear prior on those (MarginalPrior),
+// a factor like any other in the next windows (the scheme of OKVIS and VINS-Mono). Blocks are
+// Euclidean or quaternions on RightQuaternionManifold.
+#pragma once
+
+#include <memory>
+#include <set>
+#include <vector>
+
+#include <Eigen/Core>
+#include <ceres/ceres.h>
+
+namespace livo::lio_graph {
+
+/// A linear prior r(x) = r0 + J (x [-] x0) on parameter blocks, [-] per block (Euclidean
+/// difference; Log(q0^-1 q) for quaternions).
+struct MarginalPrior {
+  std::vector<double*> blocks;
+  std::vector<int> sizes;         // ambient
+  std::vector<bool> quaternion;
+  std::vector<Eigen::VectorXd> x0;
+  Eigen::MatrixXd J;              // rows: rank, columns: sum of tangent sizes
+  Eigen::VectorXd r0;
+  int tangentSize() const { return static_cast<int>(J.cols()); }
+};
+
+class MarginalPriorFactor : public ceres::CostFunction {
+ public:
+  explicit MarginalPriorFactor(std::shared_ptr<const MarginalPrior> prior);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+  const MarginalPrior& prior() const { return *prior_; }
+
+ private:
+  std::shared_ptr<const MarginalPrior> prior_;
+};
+
+class Marginalizer {
+ public:
+  /// Marks a block as a quaternion (x y z w, tangent size 3); any other block is Euclidean.
+  void setQuaternion(const double* block) { quaternions_.insert(block); }
+  /// A factor touching a block to be eliminated; `cost` (and `loss`, which may be null) are not
+  /// owned and must live until marginalize() returns. Blocks in the cost function's order. A robust
+  /// loss is linearised as its weight at the current residual (its first derivative).
+  void addFactor(const ceres::CostFunction* cost, std::vector<double*> blocks,
+                 const ceres::LossFunction* loss = nullptr);
+  /// Linearises every factor at the blocks' current values and eliminates `drop`. Null if no
+  /// block stays (nothing to keep). Eigenvalues below `eps` (relative to the largest) are dropped.
+  std::shared_ptr<MarginalPrior> marginalize(const std::set<const double*>& drop, double eps = 1e-10) const;
+
+ private:
+  struct Factor {
+    const ceres::CostFunction* cost;
+    std::vector<double*> blocks;
+    const ceres::LossFunction* loss;
+  };
+  std::vector<Factor> factors_;
+  std::set<const double*> quaternions_;
+};
+
+}  // namespace livo::lio_graph

@@ -1,0 +1,135 @@
+#include "livo/lio_graph/graph_factors.hpp"
+
+namespace livo::lio_graph {
+
+namespace {
+
+using Quatd = Eigen::Quaterniond;
+
+struct ImuCost {
+  ImuPreintegration pre;
+  Vec3 gravity;
+  Eigen::Matrix<double, 9, 9> sqrt_info;
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* v_i, const T* bg_i, const T* ba_i, const T* q_j, const T* p_j,
+                  const T* v_j, T* r) const {
+    T raw[9];
+    pre.residual(q_i, p_i, v_i, bg_i, ba_i, q_j, p_j, v_j, gravity, raw);
+    Eigen::Map<Eigen::Matrix<T, 9, 1>> out(r);
+    out = sqrt_info.cast<T>() * Eigen::Map<const Eigen::Matrix<T, 9, 1>>(raw);
+    return true;
+  }
+};
+
+struct BiasWalkCost {
+  Eigen::Matrix<double, 6, 1> sqrt_info;  // diagonal
+  template <class T>
+  bool operator()(const T* bg_i, const T* ba_i, const T* bg_j, const T* ba_j, T* r) const {
+    for (int k = 0; k < 3; ++k) {
+      r[k] = T(sqrt_info(k)) * (bg_j[k] - bg_i[k]);
+      r[3 + k] = T(sqrt_info(3 + k)) * (ba_j[k] - ba_i[k]);
+    }
+    return true;
+  }
+};
+
+struct PoseCost {
+  Quatd q_measured_inverse;
+  Vec3 p_measured;
+  Mat6 sqrt_info;
+  template <class T>
+  bool operator()(const T* q, const T* p, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qq(q);
+    Eigen::Matrix<T, 6, 1> e;
+    e.template head<3>() = quaternionLog(Eigen::Quaternion<T>(q_measured_inverse.cast<T>() * qq));
+    for (int k = 0; k < 3; ++k) e(3 + k) = p[k] - T(p_measured(k));
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> out_map(r);
+    out_map = sqrt_info.cast<T>() * e;
+    return true;
+  }
+};
+
+struct VectorPriorCost {
+  Vec3 mean, inv_sigma;
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma(k)) * (x[k] - T(mean(k)));
+    return true;
+  }
+};
+
+struct PlaneCost {
+  Vec3 anchor, t1, t2;  // t1, t2: orthonormal, orthogonal to the measured normal
+  double offset;        // measured d_m
+  double w_angle, w_distance;
+  template <class T>
+  bool operator()(const T* q, const T* p, const T* c, T* r) const {
+    using std::sqrt;
+    const Eigen::Map<const Eigen::Quaternion<T>> Q(q);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> P(p), C(c);
+    const T len = sqrt(C.squaredNorm());
+    const Eigen::Matrix<T, 3, 1> n_w = C / len;
+    // world plane n_w.x + d_w = 0 with d_w = -(n_w.a) - |c|: the anchor on its negative side;
+    // seen from the body (the same side as the anchor) the sensor-positive plane is its negative
+    const T d_w = -n_w.dot(anchor.cast<T>()) - len;
+    const Eigen::Matrix<T, 3, 1> n_b = -(Q.conjugate() * n_w);
+    const T d_b = -(d_w + n_w.dot(P));
+    r[0] = T(w_angle) * n_b.dot(t1.cast<T>());
+    r[1] = T(w_angle) * n_b.dot(t2.cast<T>());
+    r[2] = T(w_distance) * (d_b - T(offset));
+    return true;
+  }
+};
+
+struct WheelCost {
+  WheelPreintegration pre;
+  Mat6 sqrt_info;
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, T* r) const {
+    T raw[6];
+    pre.residual(q_i, p_i, q_j, p_j, raw);
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> out_map(r);
+    out_map = sqrt_info.cast<T>() * Eigen::Map<const Eigen::Matrix<T, 6, 1>>(raw);
+    return true;
+  }
+};
+
+}  // namespace
+
+ceres::CostFunction* makeImuFactor(const ImuPreintegration& preintegration, const Vec3& gravity_W) {
+  return new ceres::AutoDiffCostFunction<ImuCost, 9, 4, 3, 3, 3, 3, 4, 3, 3>(
+      new ImuCost{preintegration, gravity_W, preintegration.sqrtInformation()});
+}
+
+ceres::CostFunction* makeBiasWalkFactor(double gyro_random_walk, double accel_random_walk, double dt) {
+  const double dt_s = std::max(dt, 1e-6);
+  Eigen::Matrix<double, 6, 1> s;
+  s.head<3>().setConstant(1.0 / (gyro_random_walk * std::sqrt(dt_s)));
+  s.tail<3>().setConstant(1.0 / (accel_random_walk * std::sqrt(dt_s)));
+  return new ceres::AutoDiffCostFunction<BiasWalkCost, 6, 3, 3, 3, 3>(new BiasWalkCost{s});
+}
+
+ceres::CostFunction* makePoseFactor(const Pose3& measured, const Mat6& information) {
+  return new ceres::AutoDiffCostFunction<PoseCost, 6, 4, 3>(new PoseCost{
+      Quatd(measured.linear()).normalized().inverse(), measured.translation(), Mat6(sqrtInformation(information))});
+}
+
+ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma) {
+  return new ceres::AutoDiffCostFunction<VectorPriorCost, 3, 3>(new VectorPriorCost{mean, sigma.cwiseInverse()});
+}
+
+ceres::CostFunction* makePlaneFactor(const Vec3& anchor, const Vec3& measured_normal, double measured_offset,
+                                     double sigma_angle, double sigma_distance) {
+  const Vec3 n = measured_normal.normalized();
+  const Vec3 t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  const Vec3 t2 = n.cross(t1);
+  return new ceres::AutoDiffCostFunction<PlaneCost, 3, 4, 3, 3>(
+      new PlaneCost{anchor, t1, t2, measured_offset, 1.0 / sigma_angle, 1.0 / sigma_distance});
+}
+
+ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration) {
+  return new ceres::AutoDiffCostFunction<WheelCost, 6, 4, 3, 4, 3>(
+      new WheelCost{preintegration, preintegration.sqrtInformation()});
+}
+
+}  // namespace livo::lio_graph

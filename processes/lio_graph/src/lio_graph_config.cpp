@@ -1,0 +1,83 @@
+#include "livo/lio_graph/lio_graph_config.hpp"
+
+#include <ostream>
+
+#include "livo/sensor_rig.hpp"
+
+namespace livo::lio_graph {
+
+LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
+  LioGraphNodeOptions n;
+  LioGraphOptions& o = n.core;
+  const SensorRig rig = readSensorRig(root.section("rig"));
+  n.imu_channel = rig.channels.imu;
+  n.lidar_channel = rig.channels.lidar;
+  n.wheel_channel = rig.channels.wheel;
+  o.imu_noise = ImuPreintegrationNoise::fromRig(rig.imu);
+  o.gravity = rig.imu.gravity;
+  if (!rig.lidar) throw ConfigError(root.where("rig") + ": livo-lio-graph needs a rig.lidar");
+  o.extrinsics.T_I_L = rig.lidar->T_I_L;
+  o.min_range = std::max(rig.lidar->min_range, o.features.min_range);
+  o.max_range = rig.lidar->max_range;
+  if (rig.wheel) {
+    o.use_wheel = true;
+    o.wheel_rig = *rig.wheel;
+    o.wheel_noise = WheelPreintegrationNoise::fromRig(*rig.wheel);
+  }
+
+  const Config c = root.optionalSection("lio_graph");
+  if (!c.isNull()) {
+    c.readOptional("name", n.name);
+    const Config ch = c.optionalSection("channels");
+    ch.readOptional("odometry", n.odometry_channel);
+    ch.readOptional("registered_scan", n.registered_scan_channel);
+    ch.readOptional("keyframe", n.keyframe_channel);
+    bool wheel = o.use_wheel;
+    if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
+    c.readOptional("wheel_huber", o.wheel_huber);
+    c.readOptional("wheel_max_wait_s", n.wheel_max_wait_s);
+    c.readOptional("window_states", o.window_states);
+    c.readOptional("solver_iterations", o.solver_iterations);
+    c.readOptional("keyframe_distance", o.keyframe.min_distance);
+    c.readOptional("keyframe_angle_deg", o.keyframe.min_angle_deg);
+    c.readOptional("local_map_keyframes", o.local_map_keyframes);
+    c.readOptional("local_map_radius", o.local_map_radius);
+    c.readOptional("map_edge_voxel", o.map_edge_voxel);
+    c.readOptional("map_surface_voxel", o.map_surface_voxel);
+    c.readOptional("lidar_point_sigma", o.lidar_point_sigma);
+    c.readOptional("lidar_information_scale", o.lidar_information_scale);
+    c.readOptional("edge_threshold", o.features.edge_threshold);
+    c.readOptional("surface_threshold", o.features.surface_threshold);
+    c.readOptional("surface_voxel", o.features.surface_voxel);
+    c.readOptional("degenerate_eigenvalue", o.matching.degenerate_eigenvalue);
+    c.checkAllUsed();
+  }
+  auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
+  if (o.window_states < 2) fail("window_states", "must be >= 2");
+  if (o.solver_iterations < 1) fail("solver_iterations", "must be >= 1");
+  if (!(o.keyframe.min_distance > 0.0)) fail("keyframe_distance", "must be > 0");
+  if (!(o.keyframe.min_angle_deg > 0.0)) fail("keyframe_angle_deg", "must be > 0");
+  if (o.local_map_keyframes < 1) fail("local_map_keyframes", "must be >= 1");
+  if (!(o.local_map_radius > 0.0)) fail("local_map_radius", "must be > 0");
+  if (!(o.map_edge_voxel > 0.0 && o.map_surface_voxel > 0.0 && o.features.surface_voxel > 0.0))
+    fail("map_surface_voxel", "voxel sizes must be > 0");
+  if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
+    fail("lidar_information_scale", "lidar_point_sigma and lidar_information_scale must be > 0");
+  if (!(o.wheel_huber > 0.0)) fail("wheel_huber", "must be > 0");
+  if (!(n.wheel_max_wait_s >= 0.0)) fail("wheel_max_wait_s", "must be >= 0");
+  return n;
+}
+
+void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
+  const LioGraphOptions& o = n.core;
+  os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.lidar_channel
+     << (o.use_wheel ? ", " + n.wheel_channel : std::string()) << "; outputs " << n.odometry_channel << ", "
+     << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
+     << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
+     << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
+     << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "") << "\n"
+     << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
+     << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";
+}
+
+}  // namespace livo::lio_graph

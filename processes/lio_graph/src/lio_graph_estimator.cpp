@@ -1,0 +1,611 @@
+#include "livo/lio_graph/lio_graph_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <Eigen/Eigenvalues>
+
+#include "livo/lio_graph/graph_factors.hpp"
+#include "livo/plane.hpp"
+#include "livo/time.hpp"
+#include "livo/voxel_downsample.hpp"
+
+namespace livo::lio_graph {
+
+namespace {
+
+constexpr double kMaxSweepS = 1.0;      // time offsets beyond this are garbage
+
+void appendNote(std::string* note, const std::string& what) {
+  if (!note->empty()) *note += "; ";
+  *note += what;
+}
+
+/// IMU reading at t between two samples (linear).
+ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t) {
+  if (b.utime <= a.utime) return ImuSample{t, b.gyro, b.accel};
+  const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
+  return ImuSample{t, a.gyro + s * (b.gyro - a.gyro), a.accel + s * (b.accel - a.accel)};
+}
+
+WheelSample interpolate(const WheelSample& a, const WheelSample& b, int64_t t) {
+  if (b.utime <= a.utime) return WheelSample{t, b.left_speed, b.right_speed};
+  const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
+  return WheelSample{t, a.left_speed + s * (b.left_speed - a.left_speed),
+                     a.right_speed + s * (b.right_speed - a.right_speed)};
+}
+
+/// Samples of a time-ordered buffer covering [t0, t1]: the readings at t0 and t1 (interpolated)
+/// and every sample strictly between. False if the buffer does not reach t1.
+template <class Sample>
+bool samplesOver(const std::deque<Sample>& buf, int64_t t0, int64_t t1, std::vector<Sample>* out) {
+  out->clear();
+  if (buf.empty() || buf.back().utime < t1) return false;
+  size_t i = 0;
+  while (i + 1 < buf.size() && buf[i + 1].utime <= t0) ++i;
+  // the reading at t0 (held before the first sample)
+  if (buf[i].utime >= t0 || i + 1 >= buf.size()) {
+    Sample s = buf[i];
+    s.utime = t0;
+    out->push_back(s);
+  } else {
+    out->push_back(interpolate(buf[i], buf[i + 1], t0));
+  }
+  for (size_t k = i; k < buf.size() && buf[k].utime < t1; ++k)
+    if (buf[k].utime > t0) out->push_back(buf[k]);
+  size_t j = 0;
+  while (j < buf.size() && buf[j].utime < t1) ++j;
+  out->push_back(j == 0 ? buf[0] : interpolate(buf[j - 1], buf[j], t1));
+  out->back().utime = t1;
+  return true;
+}
+
+Pose3 poseOf(const double* q, const double* p) {
+  return se3::fromRotationTranslation(Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix(),
+                                      Vec3(p[0], p[1], p[2]));
+}
+
+}  // namespace
+
+const char* toString(GraphScanResult::Status s) {
+  switch (s) {
+    case GraphScanResult::Status::kInitializing: return "initializing";
+    case GraphScanResult::Status::kRejected: return "rejected";
+    case GraphScanResult::Status::kMapInitialized: return "map initialized";
+    case GraphScanResult::Status::kTracked: return "tracked";
+    case GraphScanResult::Status::kPredicted: return "predicted";
+  }
+  return "?";
+}
+
+/// A plane of the scene: c is the vector from `anchor` to its closest point (graph_factors.hpp).
+struct LioGraphEstimator::PlaneLandmark {
+  double c[3] = {0, 0, 1};
+  Vec3 anchor = Vec3::Zero();
+  int observers = 0;  // window states that observe it
+  /// The plane with `from` (a point on the anchor's side) on its positive side.
+  Plane seenFrom() const {
+    const Vec3 cv(c[0], c[1], c[2]);
+    const double len = cv.norm();
+    Plane pl;
+    pl.normal = -cv / len;
+    pl.offset = pl.normal.dot(-anchor) + len;  // n'.x + d' = 0, n' = -c/|c|, d' = n.a + |c|
+    return pl;
+  }
+};
+
+/// One state of the window and the factors that end at it (owned here; the problem is rebuilt for
+/// every optimisation, so nothing else owns them).
+struct LioGraphEstimator::Node {
+  int64_t utime = 0;
+  double q[4] = {0, 0, 0, 1};
+  double p[3] = {0, 0, 0};
+  double v[3] = {0, 0, 0};
+  double bg[3] = {0, 0, 0};
+  double ba[3] = {0, 0, 0};
+  Vec3 last_gyro = Vec3::Zero();
+  std::unique_ptr<ceres::CostFunction> imu, bias_walk, wheel, lidar;
+  std::unique_ptr<ceres::LossFunction> wheel_loss;
+  struct Unary {
+    std::unique_ptr<ceres::CostFunction> cost;
+    std::vector<double*> blocks;
+  };
+  std::vector<Unary> priors;  // the first state's
+  struct PlaneObservation {
+    PlaneLandmark* landmark;
+    std::unique_ptr<ceres::CostFunction> cost;
+  };
+  std::vector<PlaneObservation> planes;
+
+  Pose3 pose() const { return poseOf(q, p); }
+  void setPose(const Pose3& T) {
+    const Eigen::Quaterniond r = Eigen::Quaterniond(T.linear()).normalized();
+    std::copy(r.coeffs().data(), r.coeffs().data() + 4, q);
+    const Vec3 t = T.translation();
+    std::copy(t.data(), t.data() + 3, p);
+  }
+  std::vector<double*> blocks() { return {q, p, v, bg, ba}; }
+};
+
+LioGraphEstimator::LioGraphEstimator(LioGraphOptions options)
+    : opts_(std::move(options)), keyframe_selector_(opts_.keyframe) {}
+LioGraphEstimator::~LioGraphEstimator() = default;
+
+void LioGraphEstimator::reset() {
+  window_.clear();
+  landmarks_.clear();
+  prior_.reset();
+  prior_factor_.reset();
+  keyframes_.clear();
+  map_.rebuild({}, {});
+  keyframe_selector_.reset();
+  last_sweep_end_ = -1;
+}
+
+bool LioGraphEstimator::addImu(const ImuSample& s, std::string* why) {
+  if (!s.gyro.allFinite() || !s.accel.allFinite()) {
+    if (why) *why = "non-finite IMU sample";
+    return false;
+  }
+  if (!imu_.empty() && s.utime <= imu_.back().utime) {
+    if (why) *why = "IMU sample not later than the previous one";
+    return false;
+  }
+  if (!imu_.empty() && toSeconds(s.utime - imu_.back().utime) > opts_.max_imu_gap_s && initialized()) {
+    reset();  // the propagation across such a gap is worthless
+    if (why) *why = "IMU gap: re-initialising";
+  }
+  imu_.push_back(s);
+  // keep what the newest state and the initialisation window need
+  const int64_t keep_from = initialized() ? window_.back()->utime : s.utime - toUtime(opts_.init.window_s + 1.0);
+  dropImuBefore(keep_from);
+  return true;
+}
+
+bool LioGraphEstimator::addWheel(const WheelSample& s, std::string* why) {
+  if (!std::isfinite(s.left_speed) || !std::isfinite(s.right_speed)) {
+    if (why) *why = "non-finite wheel speed";
+    return false;
+  }
+  if (!wheel_.empty() && s.utime <= wheel_.back().utime) {
+    if (why) *why = "wheel reading not later than the previous one";
+    return false;
+  }
+  wheel_.push_back(s);
+  const int64_t keep_from = initialized() ? window_.back()->utime : s.utime - toUtime(1.0);
+  while (wheel_.size() > 2 && wheel_[1].utime <= keep_from) wheel_.pop_front();
+  return true;
+}
+
+void LioGraphEstimator::dropImuBefore(int64_t utime) {
+  while (imu_.size() > 2 && imu_[1].utime <= utime) imu_.pop_front();
+}
+
+int64_t LioGraphEstimator::scanEndUtime(const LidarScan& scan) const {
+  double end = std::isfinite(scan.sweep_duration) && scan.sweep_duration > 0.0 ? scan.sweep_duration : 0.0;
+  for (float t : scan.time_offset)
+    if (std::isfinite(t) && t <= kMaxSweepS) end = std::max(end, static_cast<double>(t));
+  return scan.utime + toUtime(opts_.extrinsics.time_offset_s) + toUtime(end);
+}
+
+bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
+  std::vector<ImuSample> window;
+  for (const ImuSample& s : imu_)
+    if (s.utime <= t_end && s.utime >= t_end - toUtime(opts_.init.window_s)) window.push_back(s);
+  if (window.size() < 2 || toSeconds(window.back().utime - window.front().utime) < 0.8 * opts_.init.window_s) {
+    *note = "waiting for the IMU initialisation window";
+    return false;
+  }
+  ImuInitOptions init = opts_.init;
+  init.gravity = opts_.gravity;
+  const ImuInitResult r = initializeImu(window, init);
+  if (!r.ok) {
+    *note = "IMU initialisation failed: " + r.message;
+    return false;
+  }
+  auto n = std::make_unique<Node>();
+  n->utime = t_end;
+  n->setPose(se3::fromRotationTranslation(r.state.rot, Vec3::Zero()));
+  Eigen::Map<Vec3>(n->bg) = r.state.gyro_bias;
+  Eigen::Map<Vec3>(n->ba) = r.state.accel_bias;
+  n->last_gyro = window.back().gyro;
+  // the gauge (yaw, position) held firmly, roll and pitch, velocity and biases as initialised
+  Mat6 info = Mat6::Zero();
+  const double rot_std = r.static_start ? init.static_rot_std : init.moving_rot_std;
+  info(0, 0) = info(1, 1) = 1.0 / (rot_std * rot_std);
+  info(2, 2) = 1.0 / (init.yaw_std * init.yaw_std);
+  info.bottomRightCorner<3, 3>() = Mat3::Identity() / (init.pos_std * init.pos_std);
+  // information on the body-frame rotation: roll/pitch/yaw are world-frame angles; for a level
+  // start they coincide, otherwise this is the usual approximation
+  const double vel_std = r.static_start ? init.static_vel_std : init.moving_vel_std;
+  const double bg_std = r.static_start ? 0.002 : init.moving_gyro_bias_std;
+  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makePoseFactor(n->pose(), info)), {n->q, n->p}});
+  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeVectorPriorFactor(Vec3::Zero(), Vec3::Constant(vel_std))), {n->v}});
+  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeVectorPriorFactor(r.state.gyro_bias, Vec3::Constant(bg_std))), {n->bg}});
+  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(
+                           makeVectorPriorFactor(r.state.accel_bias, Vec3::Constant(init.accel_bias_std))), {n->ba}});
+  window_.push_back(std::move(n));
+  *note = r.static_start ? "initialised at rest" : "initialised in motion";
+  return true;
+}
+
+bool LioGraphEstimator::preintegrate(int64_t t_end, ImuPreintegration* pre, std::vector<ImuStep>* steps,
+                                     Vec3* last_gyro) const {
+  const Node& n = *window_.back();
+  std::vector<ImuSample> s;
+  if (!samplesOver(imu_, n.utime, t_end, &s)) return false;
+  const Mat3 R0 = n.pose().linear();
+  const Vec3 p0(n.p[0], n.p[1], n.p[2]), v0(n.v[0], n.v[1], n.v[2]);
+  const Vec3 bg(n.bg[0], n.bg[1], n.bg[2]), ba(n.ba[0], n.ba[1], n.ba[2]);
+  const Vec3 g(0.0, 0.0, -opts_.gravity);
+  *pre = ImuPreintegration(bg, ba, opts_.imu_noise);
+  steps->clear();
+  steps->push_back({n.utime, n.pose()});
+  for (size_t k = 0; k + 1 < s.size(); ++k) {
+    const double dt = toSeconds(s[k + 1].utime - s[k].utime);
+    if (dt <= 0.0) continue;
+    pre->integrate(0.5 * (s[k].gyro + s[k + 1].gyro), 0.5 * (s[k].accel + s[k + 1].accel), dt);
+    Mat3 R;
+    Vec3 p, v;
+    pre->predict(R0, p0, v0, bg, ba, g, &R, &p, &v);
+    steps->push_back({s[k + 1].utime, se3::fromRotationTranslation(R, p)});
+  }
+  *last_gyro = s.back().gyro;
+  return true;
+}
+
+std::unique_ptr<WheelPreintegration> LioGraphEstimator::wheelBetween(int64_t t0, int64_t t1) const {
+  std::vector<WheelSample> s;
+  if (!samplesOver(wheel_, t0, t1, &s)) return nullptr;
+  if (wheel_.front().utime > t0) return nullptr;  // the readings do not reach back to t0
+  auto pre = std::make_unique<WheelPreintegration>(opts_.wheel_rig, opts_.wheel_noise);
+  for (size_t k = 0; k + 1 < s.size(); ++k) {
+    const double dt = toSeconds(s[k + 1].utime - s[k].utime);
+    if (dt > opts_.max_wheel_gap_s) return nullptr;
+    pre->integrate(s[k].left_speed, s[k].right_speed, s[k + 1].left_speed, s[k + 1].right_speed, dt);
+  }
+  return pre->duration() > 0.0 ? std::move(pre) : nullptr;
+}
+
+void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std::vector<ImuStep>& steps,
+                               std::vector<Vec3>* body, std::vector<uint32_t>* index, std::vector<int16_t>* ring,
+                               std::vector<float>* time) const {
+  const Pose3 T_end_inv = steps.back().pose.inverse();
+  const Pose3& T_I_L = opts_.extrinsics.T_I_L;
+  const double end_offset = toSeconds(steps.back().utime - t_first);
+  const size_t n = std::min(scan.points.size(), scan.time_offset.size());
+  const bool has_ring = scan.ring.size() == scan.points.size();
+  const double min2 = opts_.min_range * opts_.min_range, max2 = opts_.max_range * opts_.max_range;
+  size_t seg = 0;
+  for (size_t j = 0; j < n; ++j) {
+    const Vec3& pl = scan.points[j];
+    const float off = scan.time_offset[j];
+    if (!pl.allFinite() || !std::isfinite(off) || off < 0.0f || off > end_offset + 1e-6) continue;
+    const double r2 = pl.squaredNorm();
+    if (r2 < min2 || r2 > max2) continue;
+    const int64_t t = t_first + toUtime(off);
+    // the predicted pose at t (held before the first step), between two IMU steps
+    Pose3 T_W_I;
+    if (t <= steps.front().utime) {
+      T_W_I = steps.front().pose;
+    } else {
+      if (seg >= steps.size() - 1 || steps[seg].utime > t) seg = 0;
+      while (seg + 1 < steps.size() - 1 && steps[seg + 1].utime < t) ++seg;
+      const ImuStep& a = steps[seg];
+      const ImuStep& b = steps[std::min(seg + 1, steps.size() - 1)];
+      const double s = b.utime > a.utime ? std::clamp(static_cast<double>(t - a.utime) / (b.utime - a.utime), 0.0, 1.0) : 1.0;
+      T_W_I = se3::interpolate(a.pose, b.pose, s);
+    }
+    body->push_back(T_end_inv * (T_W_I * (T_I_L * pl)));
+    index->push_back(static_cast<uint32_t>(j));
+    ring->push_back(has_ring ? scan.ring[j] : int16_t{-1});
+    time->push_back(off);
+  }
+}
+
+GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
+  GraphScanResult res;
+  std::string* note = &res.message;
+  const int64_t t_end = scanEndUtime(scan);
+  const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
+  res.utime = t_end;
+  res.sweep_start_utime = t_first;
+  if (t_end <= last_sweep_end_) {
+    res.status = GraphScanResult::Status::kRejected;
+    *note = "sweep ends before the previous one";
+    return res;
+  }
+  const bool seeding = !initialized();
+  if (seeding) {
+    if (!initialize(t_end, note)) {
+      res.status = GraphScanResult::Status::kInitializing;
+      return res;
+    }
+  }
+  last_sweep_end_ = t_end;
+
+  // 1. preintegration to the sweep end and the predicted poses (deskewing)
+  ImuPreintegration pre(Vec3::Zero(), Vec3::Zero(), opts_.imu_noise);
+  std::vector<ImuStep> steps;
+  Vec3 last_gyro = window_.back()->last_gyro;
+  if (seeding) {
+    steps = {{t_end, window_.back()->pose()}};
+  } else if (!preintegrate(t_end, &pre, &steps, &last_gyro)) {
+    res.status = GraphScanResult::Status::kRejected;
+    *note = "the IMU does not reach the sweep end";
+    return res;
+  }
+
+  // 2. deskewed points and their features
+  std::vector<Vec3> body;
+  RingCloud cloud;
+  deskew(scan, t_first, steps, &body, &res.input_index, &cloud.ring, &cloud.time_offset);
+  res.num_points = static_cast<int>(body.size());
+  const Pose3 T_L_I = opts_.extrinsics.T_I_L.inverse();
+  cloud.points.reserve(body.size());
+  for (const Vec3& b : body) cloud.points.push_back(T_L_I * b);
+  ScanFeatures features = extractFeatures(cloud, opts_.features);
+  for (Vec3& e : features.edges) e = opts_.extrinsics.T_I_L * e;
+  for (Vec3& s : features.surfaces) s = opts_.extrinsics.T_I_L * s;
+
+  Node* newest = nullptr;
+  if (seeding) {
+    newest = window_.back().get();
+    res.status = GraphScanResult::Status::kMapInitialized;
+    observePlanes(body, newest, &res);
+  } else {
+    // 3. scan-to-map matching from the prediction
+    const Node& prev = *window_.back();
+    auto n = std::make_unique<Node>();
+    n->utime = t_end;
+    Mat3 R;
+    Vec3 p, v;
+    pre.predict(prev.pose().linear(), Vec3(prev.p[0], prev.p[1], prev.p[2]), Vec3(prev.v[0], prev.v[1], prev.v[2]),
+                pre.gyroBias(), pre.accelBias(), Vec3(0, 0, -opts_.gravity), &R, &p, &v);
+    n->setPose(se3::fromRotationTranslation(R, p));
+    Eigen::Map<Vec3>(n->v) = v;
+    std::copy(prev.bg, prev.bg + 3, n->bg);
+    std::copy(prev.ba, prev.ba + 3, n->ba);
+    n->last_gyro = last_gyro;
+    const ScanMatchResult match = matchScan(map_, features, n->pose(), opts_.matching);
+    res.edge_residuals = match.edge_residuals;
+    res.surface_residuals = match.surface_residuals;
+    res.degenerate = match.degenerate;
+    res.weakest_direction = match.weakest;
+    if (match.valid) {
+      n->setPose(match.T_W_I);
+      const Mat6 info = match.hessian * (opts_.lidar_information_scale /
+                                         (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
+      n->lidar.reset(makePoseFactor(match.T_W_I, info));
+      res.status = GraphScanResult::Status::kTracked;
+    } else {
+      res.status = GraphScanResult::Status::kPredicted;
+      res.degenerate = true;
+      appendNote(note, "too few matches with the local map (" + std::to_string(match.edge_residuals) + " edge, " +
+                           std::to_string(match.surface_residuals) + " surface): IMU prediction");
+    }
+    // 4. the new state's factors, the window optimised, the oldest state marginalised
+    n->imu.reset(makeImuFactor(pre, Vec3(0, 0, -opts_.gravity)));
+    n->bias_walk.reset(makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk,
+                                          pre.duration()));
+    if (opts_.use_wheel) {
+      if (auto w = wheelBetween(prev.utime, t_end)) {
+        n->wheel.reset(makeWheelFactor(*w));
+        n->wheel_loss = std::make_unique<ceres::HuberLoss>(opts_.wheel_huber);
+      } else {
+        appendNote(note, "no wheel readings over the sweep");
+      }
+    }
+    observePlanes(body, n.get(), &res);
+    window_.push_back(std::move(n));
+    newest = window_.back().get();
+    optimize();
+    while (static_cast<int>(window_.size()) > std::max(2, opts_.window_states)) marginalizeOldest();
+    updateKeyframePoses();
+    dropImuBefore(newest->utime);
+  }
+
+  res.pose = newest->pose();
+  res.velocity = Vec3(newest->v[0], newest->v[1], newest->v[2]);
+  res.gyro_bias = Vec3(newest->bg[0], newest->bg[1], newest->bg[2]);
+  res.accel_bias = Vec3(newest->ba[0], newest->ba[1], newest->ba[2]);
+  res.angular_velocity = newest->last_gyro - res.gyro_bias;
+  res.pose_covariance = newestPoseCovariance();
+  res.world_points.reserve(body.size());
+  for (const Vec3& b : body) res.world_points.push_back(res.pose * b);
+
+  // 5. keyframes: the local map grows where the body has moved
+  if (res.status != GraphScanResult::Status::kPredicted && keyframe_selector_.check(res.pose)) {
+    StoredKeyframe s;
+    s.kf.id = next_keyframe_id_++;
+    s.kf.utime = t_end;
+    s.kf.pose = res.pose;
+    s.kf.pose_covariance = res.pose_covariance;
+    const bool has_intensity = scan.intensity.size() == scan.points.size();
+    for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
+      s.kf.cloud.push_back(body[i]);
+      s.kf.intensity.push_back(has_intensity ? scan.intensity[res.input_index[i]] : 0.0f);
+    }
+    s.edges = std::move(features.edges);
+    s.surfaces = std::move(features.surfaces);
+    s.node = newest;
+    keyframes_.push_back(std::move(s));
+    while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+    rebuildLocalMap();
+    res.is_keyframe = true;
+    res.keyframe = keyframes_.back().kf;
+  }
+  return res;
+}
+
+void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node, GraphScanResult* res) {
+  if (!opts_.planar_factors) return;
+  std::vector<Vec3> cloud;
+  for (size_t i : firstPointPerVoxel(body, opts_.plane_cloud_voxel)) cloud.push_back(body[i]);
+  const Pose3 T = node->pose();
+  const Mat3 R = T.linear();
+  const Vec3 p = T.translation();
+  PlaneExtractionOptions po = opts_.planes;
+  po.up = R.transpose() * Vec3::UnitZ();  // the world is gravity-aligned
+  const double cos_match = std::cos(opts_.plane_match_angle_deg * M_PI / 180.0);
+  std::vector<const PlaneLandmark*> used;
+  for (const ExtractedPlane& e : extractPlanes(cloud, po)) {
+    // the observation in the world, the sensor on its positive side
+    Plane w;
+    w.normal = R * e.plane.normal;
+    w.offset = e.plane.offset - w.normal.dot(p);
+    const Vec3 centroid = T * e.centroid;
+    PlaneLandmark* best = nullptr;
+    double best_distance = opts_.plane_match_distance;
+    for (auto& l : landmarks_) {
+      if (std::find(used.begin(), used.end(), l.get()) != used.end()) continue;
+      const Plane lp = l->seenFrom();
+      if (lp.normal.dot(w.normal) < cos_match) continue;
+      const double d = std::abs(lp.distance(centroid));
+      if (d < best_distance) best_distance = d, best = l.get();
+    }
+    if (!best) {
+      auto l = std::make_unique<PlaneLandmark>();
+      l->anchor = p;
+      const Vec3 c = -w.distance(p) * w.normal;  // from the anchor to the plane's closest point
+      std::copy(c.data(), c.data() + 3, l->c);
+      landmarks_.push_back(std::move(l));
+      best = landmarks_.back().get();
+    }
+    used.push_back(best);
+    ++best->observers;
+    node->planes.push_back(
+        {best, std::unique_ptr<ceres::CostFunction>(makePlaneFactor(
+                   best->anchor, e.plane.normal, e.plane.offset, opts_.plane_sigma_angle_deg * M_PI / 180.0,
+                   std::max(opts_.plane_sigma_distance, e.quality)))});
+    ++res->planes;
+    res->ground_planes += e.ground;
+  }
+}
+
+void LioGraphEstimator::optimize() {
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  static RightQuaternionManifold manifold;
+  for (auto& n : window_) {
+    problem.AddParameterBlock(n->q, 4, &manifold);
+    for (double* b : {n->p, n->v, n->bg, n->ba}) problem.AddParameterBlock(b, 3);
+  }
+  for (auto& l : landmarks_) problem.AddParameterBlock(l->c, 3);
+  if (prior_factor_) problem.AddResidualBlock(prior_factor_.get(), nullptr, prior_->blocks);
+  for (size_t k = 0; k < window_.size(); ++k) {
+    Node& n = *window_[k];
+    for (auto& u : n.priors) problem.AddResidualBlock(u.cost.get(), nullptr, u.blocks);
+    if (n.lidar) problem.AddResidualBlock(n.lidar.get(), nullptr, n.q, n.p);
+    for (auto& o : n.planes) problem.AddResidualBlock(o.cost.get(), nullptr, n.q, n.p, o.landmark->c);
+    if (k == 0) continue;
+    Node& m = *window_[k - 1];
+    if (n.imu) problem.AddResidualBlock(n.imu.get(), nullptr, {m.q, m.p, m.v, m.bg, m.ba, n.q, n.p, n.v});
+    if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, m.bg, m.ba, n.bg, n.ba);
+    if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), m.q, m.p, n.q, n.p);
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.max_num_iterations = opts_.solver_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+}
+
+void LioGraphEstimator::marginalizeOldest() {
+  Node& a = *window_[0];
+  Node& b = *window_[1];
+  Marginalizer m;
+  for (auto& n : window_) m.setQuaternion(n->q);
+  if (prior_factor_) m.addFactor(prior_factor_.get(), prior_->blocks);
+  for (auto& u : a.priors) m.addFactor(u.cost.get(), u.blocks);
+  if (a.lidar) m.addFactor(a.lidar.get(), {a.q, a.p});
+  if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
+  if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
+  if (b.wheel) m.addFactor(b.wheel.get(), {a.q, a.p, b.q, b.p}, b.wheel_loss.get());
+  std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
+  for (auto& o : a.planes) {
+    m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
+    if (--o.landmark->observers == 0) drop.insert(o.landmark->c);  // seen by no state that stays
+  }
+  prior_ = m.marginalize(drop);
+  prior_factor_ = prior_ ? std::make_unique<MarginalPriorFactor>(prior_) : nullptr;
+  b.imu.reset();
+  b.bias_walk.reset();
+  b.wheel.reset();
+  b.wheel_loss.reset();
+  for (StoredKeyframe& k : keyframes_)
+    if (k.node == &a) k.node = nullptr;
+  window_.pop_front();
+  landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
+                                  [](const std::unique_ptr<PlaneLandmark>& l) { return l->observers == 0; }),
+                   landmarks_.end());
+}
+
+void LioGraphEstimator::updateKeyframePoses() {
+  // keyframes whose state is still in the window follow its optimisation (the local map follows at
+  // the next keyframe); older ones keep the pose they left the window with
+  for (StoredKeyframe& k : keyframes_)
+    if (k.node) k.kf.pose = k.node->pose();
+}
+
+void LioGraphEstimator::rebuildLocalMap() {
+  const Vec3 here = keyframes_.back().kf.pose.translation();
+  std::vector<Vec3> edges, surfaces;
+  int used = 0;
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend() && used < opts_.local_map_keyframes; ++it) {
+    if ((it->kf.pose.translation() - here).norm() > opts_.local_map_radius) continue;
+    ++used;
+    for (const Vec3& e : it->edges) edges.push_back(it->kf.pose * e);
+    for (const Vec3& s : it->surfaces) surfaces.push_back(it->kf.pose * s);
+  }
+  std::vector<Vec3> e_ds, s_ds;
+  for (size_t i : firstPointPerVoxel(edges, opts_.map_edge_voxel)) e_ds.push_back(edges[i]);
+  for (size_t i : firstPointPerVoxel(surfaces, opts_.map_surface_voxel)) s_ds.push_back(surfaces[i]);
+  map_.rebuild(std::move(e_ds), std::move(s_ds));
+}
+
+Mat6 LioGraphEstimator::newestPoseCovariance() {
+  // the marginal of the newest pose from the window's information (ceres::Covariance would rebuild
+  // the problem; the window is small, so the dense route is simple and exact)
+  Node& n = *window_.back();
+  Marginalizer m;
+  for (auto& w : window_) m.setQuaternion(w->q);
+  if (prior_factor_) m.addFactor(prior_factor_.get(), prior_->blocks);
+  for (size_t k = 0; k < window_.size(); ++k) {
+    Node& a = *window_[k];
+    for (auto& u : a.priors) m.addFactor(u.cost.get(), u.blocks);
+    if (a.lidar) m.addFactor(a.lidar.get(), {a.q, a.p});
+    for (auto& o : a.planes) m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
+    if (k == 0) continue;
+    Node& b = *window_[k - 1];
+    if (a.imu) m.addFactor(a.imu.get(), {b.q, b.p, b.v, b.bg, b.ba, a.q, a.p, a.v});
+    if (a.bias_walk) m.addFactor(a.bias_walk.get(), {b.bg, b.ba, a.bg, a.ba});
+    if (a.wheel) m.addFactor(a.wheel.get(), {b.q, b.p, a.q, a.p}, a.wheel_loss.get());
+  }
+  std::set<const double*> drop;
+  for (auto& w : window_)
+    for (double* b : w->blocks())
+      if (b != n.q && b != n.p) drop.insert(b);
+  for (auto& l : landmarks_) drop.insert(l->c);
+  const auto marginal = m.marginalize(drop, 1e-12);
+  if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();
+  // blocks in first-seen order: make it [q, p]
+  Eigen::MatrixXd J = marginal->J;
+  if (marginal->blocks[0] != n.q) {
+    Eigen::MatrixXd swapped(J.rows(), 6);
+    swapped << J.rightCols(3), J.leftCols(3);
+    J = swapped;
+  }
+  const Mat6 info = J.transpose() * J;
+  const Eigen::SelfAdjointEigenSolver<Mat6> es(info);
+  const Vec6 inv = es.eigenvalues().cwiseMax(1e-9).cwiseInverse();
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+}
+
+}  // namespace livo::lio_graph

@@ -1,0 +1,129 @@
+#include "livo/lio_graph/lio_graph_node.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include "livo/keyframe_t.hpp"
+#include "livo/messages.hpp"
+#include "livo/odometry_t.hpp"
+#include "livo/output_messages.hpp"
+#include "livo/registered_scan_t.hpp"
+#include "livo/sensor_messages.hpp"
+#include "livo/time.hpp"
+
+namespace livo::lio_graph {
+
+namespace {
+
+odometry_t toOdometry(const GraphScanResult& r) {
+  odometry_t o;
+  o.utime = r.utime;
+  o.parent_frame = "W";
+  o.child_frame = "I";
+  poseTo(r.pose, o.position, o.orientation);
+  vec3To(r.velocity, o.velocity);
+  vec3To(r.angular_velocity, o.angular_velocity);
+  matrixTo<6>(r.pose_covariance, o.pose_covariance);
+  matrixTo<3>(Mat3(Mat3::Identity() * 1e-2), o.velocity_covariance);
+  o.num_residuals = r.edge_residuals + r.surface_residuals;
+  o.degenerate = r.degenerate ? 1 : 0;
+  o.min_information_eigenvalue = 0.0;
+  o.epoch = 0;
+  o.correction_id = 0;
+  return o;
+}
+
+}  // namespace
+
+LioGraphNode::LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNodeOptions options)
+    : node_(lcm, std::move(node_options)), opts_(std::move(options)), estimator_(opts_.core) {
+  node_.declareOutput(opts_.odometry_channel);
+  node_.declareOutput(opts_.registered_scan_channel);
+  node_.declareOutput(opts_.keyframe_channel);
+  node_.subscribe<imu_t>(opts_.imu_channel, [this](const imu_t& m) { onImu(m); });
+  node_.subscribe<point_cloud_t>(opts_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
+  if (opts_.core.use_wheel)
+    node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
+}
+
+void LioGraphNode::onImu(const imu_t& m) {
+  std::string why;
+  if (!estimator_.addImu(fromMessage(m), &why)) {
+    node_.reject(opts_.imu_channel, why);
+    return;
+  }
+  if (!why.empty()) node_.warn(why);
+  imu_watermark_ = m.utime;
+  processReady();
+}
+
+void LioGraphNode::onWheel(const wheel_odometry_t& m) {
+  std::string why;
+  if (!estimator_.addWheel(fromMessage(m), &why)) {
+    node_.reject(opts_.wheel_channel, why);
+    return;
+  }
+  wheel_watermark_ = m.utime;
+  processReady();
+}
+
+void LioGraphNode::onLidar(const point_cloud_t& m) {
+  PendingSweep p;
+  std::string why;
+  if (!fromMessage(m, &p.scan, &why)) {
+    node_.reject(opts_.lidar_channel, why);
+    return;
+  }
+  p.msg = m;
+  p.end_utime = estimator_.scanEndUtime(p.scan);
+  if (!pending_.empty() && p.end_utime <= pending_.back().end_utime) {
+    node_.reject(opts_.lidar_channel, "sweep does not end after the previous one");
+    return;
+  }
+  pending_.push_back(std::move(p));
+  processReady();
+}
+
+void LioGraphNode::processReady() {
+  while (!pending_.empty()) {
+    const PendingSweep& p = pending_.front();
+    if (imu_watermark_ < p.end_utime) return;
+    if (opts_.core.use_wheel && wheel_watermark_ < p.end_utime &&
+        imu_watermark_ < p.end_utime + toUtime(opts_.wheel_max_wait_s))
+      return;
+    process(p);
+    pending_.pop_front();
+  }
+}
+
+void LioGraphNode::process(const PendingSweep& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const GraphScanResult r = estimator_.addScan(p.scan);
+  node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (!r.hasOutput()) {
+    if (r.status == GraphScanResult::Status::kRejected) node_.reject(opts_.lidar_channel, r.message);
+    return;
+  }
+  ++processed_;
+  tracked_ += r.status == GraphScanResult::Status::kTracked;
+  predicted_ += r.status == GraphScanResult::Status::kPredicted;
+  degenerate_ += r.degenerate;
+  if (!r.message.empty()) node_.info(r.message);
+  const OutputFrame frame{0, 0};
+  node_.publish(opts_.odometry_channel, toOdometry(r));
+  node_.publish(opts_.registered_scan_channel,
+                registeredScanMessage(r.utime, r.sweep_start_utime, r.pose, r.world_points, r.input_index, p.msg, frame));
+  if (r.is_keyframe)
+    node_.publish(opts_.keyframe_channel,
+                  keyframeMessage(r.keyframe.id, r.keyframe.utime, r.keyframe.pose, r.keyframe.pose_covariance,
+                                  r.keyframe.cloud, r.keyframe.intensity, p.msg.num_rings, frame));
+}
+
+std::string LioGraphNode::summary() const {
+  std::ostringstream s;
+  s << processed_ << " sweeps: " << tracked_ << " tracked, " << predicted_ << " predicted only, " << degenerate_
+    << " degenerate";
+  return s.str();
+}
+
+}  // namespace livo::lio_graph
