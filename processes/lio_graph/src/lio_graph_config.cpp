@@ -50,6 +50,14 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     c.readOptional("surface_threshold", o.features.surface_threshold);
     c.readOptional("surface_voxel", o.features.surface_voxel);
     c.readOptional("degenerate_eigenvalue", o.matching.degenerate_eigenvalue);
+    c.readOptional("planar_factors", o.planar_factors);
+    c.readOptional("plane_sigma_angle_deg", o.plane_sigma_angle_deg);
+    c.readOptional("plane_sigma_distance", o.plane_sigma_distance);
+    c.readOptional("plane_match_angle_deg", o.plane_match_angle_deg);
+    c.readOptional("plane_match_distance", o.plane_match_distance);
+    c.readOptional("plane_threshold_base", o.planes.threshold_base);
+    c.readOptional("plane_threshold_per_metre", o.planes.threshold_per_metre);
+    c.readOptional("plane_max_quality_ratio", o.planes.max_quality_ratio);
     c.checkAllUsed();
   }
   auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
@@ -64,6 +72,13 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
     fail("lidar_information_scale", "lidar_point_sigma and lidar_information_scale must be > 0");
   if (!(o.wheel_huber > 0.0)) fail("wheel_huber", "must be > 0");
+  if (!(o.plane_sigma_angle_deg > 0.0 && o.plane_sigma_distance > 0.0))
+    fail("plane_sigma_distance", "plane_sigma_angle_deg and plane_sigma_distance must be > 0");
+  if (!(o.plane_match_angle_deg > 0.0 && o.plane_match_distance > 0.0))
+    fail("plane_match_distance", "plane_match_angle_deg and plane_match_distance must be > 0");
+  if (!(o.planes.threshold_base > 0.0 && o.planes.threshold_per_metre >= 0.0))
+    fail("plane_threshold_base", "plane_threshold_base must be > 0 and plane_threshold_per_metre >= 0");
+  if (!(o.planes.max_quality_ratio > 0.0)) fail("plane_max_quality_ratio", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0)) fail("wheel_max_wait_s", "must be >= 0");
   return n;
 }
@@ -75,7 +90,8 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
-     << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "") << "\n"
+     << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
+     << (o.planar_factors ? ", adaptive planar factors" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
      << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";
 }
