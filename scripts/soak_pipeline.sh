@@ -6,7 +6,7 @@
 # sizes of the maps.
 #
 #   scripts/soak_pipeline.sh [--config FILE] [--duration S] [--log LOG] [--out DIR] [--at S,S,...]
-#                            [--without P,...]   (passed to run_pipeline.sh)
+#                            [--without P,...] [--swap P=EXE]   (passed to run_pipeline.sh)
 #
 # Defaults: config/sim/campus_loop_long_soak.yaml, 1800 s, logs/campus_loop_long_soak_<S>s.lcmlog,
 # logs/soak_<config name>_<S>s, checkpoints 300,900,1800 (those beyond the duration print '-').
@@ -17,7 +17,7 @@ set -euo pipefail
 {
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
-config="$root/config/sim/campus_loop_long_soak.yaml" duration=1800 log="" out="" at="300,900,1800" without=()
+config="$root/config/sim/campus_loop_long_soak.yaml" duration=1800 log="" out="" at="300,900,1800" without=() swap=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --config) config="$2"; shift 2 ;;
@@ -26,6 +26,7 @@ while [ $# -gt 0 ]; do
     --out) out="$2"; shift 2 ;;
     --at) at="$2"; shift 2 ;;
     --without) without=(--without "$2"); shift 2 ;;
+    --swap) swap+=(--swap "$2"); shift 2 ;;
     -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "soak_pipeline.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
@@ -48,7 +49,7 @@ t0=$(date +%s)
 # the clouds and images stay out of outputs.lcmlog (the maps are files): a 30 min log would
 # otherwise need another ~15 GB
 "$root/scripts/run_pipeline.sh" --log "$log" --config "$config" --out "$out" \
-  --record ODOMETRY,KEYFRAME,LOOP_CORRECTION,HEALTH,GROUND_TRUTH "${without[@]}" >&2
+  --record ODOMETRY,KEYFRAME,LOOP_CORRECTION,HEALTH,GROUND_TRUTH ${without[@]+"${without[@]}"} ${swap[@]+"${swap[@]}"} >&2
 wall=$(( $(date +%s) - t0 ))
 {
   echo "# Soak: $name, $duration s of sensor time"

@@ -48,6 +48,16 @@ void WheelPreintegration::integrate(double v_left0, double v_right0, double v_le
   covariance_ = A * covariance_ * A.transpose() + B * (scale * q).asDiagonal() * B.transpose();
   covariance_ = 0.5 * (covariance_ + covariance_.transpose());
 
+  // Scale Jacobians: v = v0 + [v_l, v_r]/2 δs and w = w0 + [-v_l, v_r]/b δs about z; the step
+  // ΔR_k Exp(J_R δs) Exp(½θ + ½ dθ) (u + du) moves Δp by -mid_R [u]x (half_R^T J_R δs + Jr(½θ) ½ dθ) + mid_R du.
+  Eigen::Matrix<double, 3, 2> dtheta_ds = Eigen::Matrix<double, 3, 2>::Zero();
+  dtheta_ds.row(2) << -v_left / track_width_ * dt, v_right / track_width_ * dt;
+  Eigen::Matrix<double, 3, 2> du_ds = Eigen::Matrix<double, 3, 2>::Zero();
+  du_ds.row(0) << 0.5 * v_left * dt, 0.5 * v_right * dt;
+  dp_ds_ += -mid_R * so3::hat(step_p) * (half_R.transpose() * dR_ds_ + 0.5 * so3::rightJacobian(0.5 * theta) * dtheta_ds) +
+            mid_R * du_ds;
+  dR_ds_ = step_R.transpose() * dR_ds_ + so3::rightJacobian(theta) * dtheta_ds;
+
   delta_p_ += mid_R * step_p;
   delta_q_ = (delta_q_ * so3::ExpQuat(theta)).normalized();
   delta_R_ = delta_q_.toRotationMatrix();

@@ -16,6 +16,11 @@
 // the encoder's rate (white noise: an interval of dt seconds has the variance sigma² / (rate_hz dt),
 // so the variance of a distance grows with its duration whatever the readings' spacing). Errors
 // follow the IMU preintegration: ΔR̃ = ΔR Exp(δθ), Δp̃ = Δp + δp, covariance() = Cov([δθ, δp]).
+//
+// Wheel scales. Real tyres are not the nominal radius (pressure, load, wear: about 1 %), which a
+// planar-motion prior cannot absorb. With true speeds s_l v_l and s_r v_r, the preintegrated motion
+// depends on s = [s_l, s_r] (1 at the nominal radius); like the IMU biases it is corrected to first
+// order, ΔR(s) = ΔR Exp(J_R (s - 1)), Δp(s) = Δp + J_p (s - 1), with J_R, J_p integrated alongside.
 #pragma once
 
 #include "livo/imu_preintegration.hpp"  // quaternionExp/Log for the templated residual, upperSqrtInformation
@@ -54,6 +59,9 @@ class WheelPreintegration {
   const Mat6& covariance() const { return covariance_; }
   /// Upper-triangular U with U^T U = covariance()^-1 (upperSqrtInformation, imu_preintegration.hpp).
   Mat6 sqrtInformation() const;
+  /// d(δθ)/ds and d(Δp)/ds at s = [1, 1] (wheel scales, above).
+  const Eigen::Matrix<double, 3, 2>& rotationScaleJacobian() const { return dR_ds_; }
+  const Eigen::Matrix<double, 3, 2>& positionScaleJacobian() const { return dp_ds_; }
 
   /// [r_R, r_p] for the IMU poses W_T_I at i and j, with T_W_O = T_W_I T_I_B:
   ///   r_R = Log(ΔR^T R_Oi^T R_Oj),  r_p = R_Oi^T (p_Oj - p_Oi) - Δp.
@@ -63,6 +71,9 @@ class WheelPreintegration {
   /// [x, y, z, w], positions W_p_I; r has 6 entries.
   template <class T>
   void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, T* r) const;
+  /// The same with the wheel scales s = [s_l, s_r] (the preintegration corrected to first order).
+  template <class T>
+  void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, T* r) const;
 
  private:
   double track_width_;
@@ -75,10 +86,19 @@ class WheelPreintegration {
   Mat3 delta_R_ = Mat3::Identity();
   Vec3 delta_p_ = Vec3::Zero();
   Mat6 covariance_ = Mat6::Zero();
+  Eigen::Matrix<double, 3, 2> dR_ds_ = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Matrix<double, 3, 2> dp_ds_ = Eigen::Matrix<double, 3, 2>::Zero();
 };
 
 template <class T>
 void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, T* r) const {
+  const T unit[2] = {T(1.0), T(1.0)};
+  residual(q_i, p_i, q_j, p_j, unit, r);
+}
+
+template <class T>
+void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale,
+                                   T* r) const {
   using Vec3T = Eigen::Matrix<T, 3, 1>;
   using QuatT = Eigen::Quaternion<T>;
   const Eigen::Map<const QuatT> Q_i(q_i), Q_j(q_j);
@@ -88,9 +108,11 @@ void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, con
   const QuatT Q_Oi = Q_i * q_IB, Q_Oj = Q_j * q_IB;
   const Vec3T P_Oi = P_i + Q_i * t_IB, P_Oj = P_j + Q_j * t_IB;
   const QuatT Q_Oi_inv = Q_Oi.conjugate();
+  const Eigen::Matrix<T, 2, 1> ds(scale[0] - T(1.0), scale[1] - T(1.0));
+  const QuatT dq = delta_q_.cast<T>() * quaternionExp<T>(Vec3T(dR_ds_.cast<T>() * ds));
   Eigen::Map<Eigen::Matrix<T, 6, 1>> res(r);
-  res.template head<3>() = quaternionLog<T>(delta_q_.cast<T>().conjugate() * (Q_Oi_inv * Q_Oj));
-  res.template tail<3>() = Q_Oi_inv * Vec3T(P_Oj - P_Oi) - delta_p_.cast<T>();
+  res.template head<3>() = quaternionLog<T>(dq.conjugate() * (Q_Oi_inv * Q_Oj));
+  res.template tail<3>() = Q_Oi_inv * Vec3T(P_Oj - P_Oi) - (delta_p_.cast<T>() + dp_ds_.cast<T>() * ds);
 }
 
 }  // namespace livo

@@ -49,11 +49,12 @@ struct PoseCost {
   }
 };
 
+template <int N>
 struct VectorPriorCost {
-  Vec3 mean, inv_sigma;
+  Eigen::Matrix<double, N, 1> mean, inv_sigma;
   template <class T>
   bool operator()(const T* x, T* r) const {
-    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma(k)) * (x[k] - T(mean(k)));
+    for (int k = 0; k < N; ++k) r[k] = T(inv_sigma(k)) * (x[k] - T(mean(k)));
     return true;
   }
 };
@@ -86,8 +87,13 @@ struct WheelCost {
   Mat6 sqrt_info;
   template <class T>
   bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, T* r) const {
+    const T unit[2] = {T(1.0), T(1.0)};
+    return (*this)(q_i, p_i, q_j, p_j, unit, r);
+  }
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, T* r) const {
     T raw[6];
-    pre.residual(q_i, p_i, q_j, p_j, raw);
+    pre.residual(q_i, p_i, q_j, p_j, scale, raw);
     Eigen::Map<Eigen::Matrix<T, 6, 1>> out_map(r);
     out_map = sqrt_info.cast<T>() * Eigen::Map<const Eigen::Matrix<T, 6, 1>>(raw);
     return true;
@@ -115,7 +121,11 @@ ceres::CostFunction* makePoseFactor(const Pose3& measured, const Mat6& informati
 }
 
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma) {
-  return new ceres::AutoDiffCostFunction<VectorPriorCost, 3, 3>(new VectorPriorCost{mean, sigma.cwiseInverse()});
+  return new ceres::AutoDiffCostFunction<VectorPriorCost<3>, 3, 3>(new VectorPriorCost<3>{mean, sigma.cwiseInverse()});
+}
+
+ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma) {
+  return new ceres::AutoDiffCostFunction<VectorPriorCost<2>, 2, 2>(new VectorPriorCost<2>{mean, Vec2::Constant(1.0 / sigma)});
 }
 
 ceres::CostFunction* makePlaneFactor(const Vec3& anchor, const Vec3& measured_normal, double measured_offset,
@@ -129,6 +139,11 @@ ceres::CostFunction* makePlaneFactor(const Vec3& anchor, const Vec3& measured_no
 
 ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration) {
   return new ceres::AutoDiffCostFunction<WheelCost, 6, 4, 3, 4, 3>(
+      new WheelCost{preintegration, preintegration.sqrtInformation()});
+}
+
+ceres::CostFunction* makeScaledWheelFactor(const WheelPreintegration& preintegration) {
+  return new ceres::AutoDiffCostFunction<WheelCost, 6, 4, 3, 4, 3, 2>(
       new WheelCost{preintegration, preintegration.sqrtInformation()});
 }
 

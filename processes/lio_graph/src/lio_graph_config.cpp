@@ -34,7 +34,8 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     ch.readOptional("keyframe", n.keyframe_channel);
     bool wheel = o.use_wheel;
     if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
-    c.readOptional("wheel_huber", o.wheel_huber);
+    c.readOptional("wheel_cauchy", o.wheel_cauchy);
+    c.readOptional("wheel_scale_std", o.wheel_scale_std);
     c.readOptional("wheel_max_wait_s", n.wheel_max_wait_s);
     c.readOptional("window_states", o.window_states);
     c.readOptional("solver_iterations", o.solver_iterations);
@@ -71,7 +72,8 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     fail("map_surface_voxel", "voxel sizes must be > 0");
   if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
     fail("lidar_information_scale", "lidar_point_sigma and lidar_information_scale must be > 0");
-  if (!(o.wheel_huber > 0.0)) fail("wheel_huber", "must be > 0");
+  if (!(o.wheel_cauchy > 0.0)) fail("wheel_cauchy", "must be > 0");
+  if (!(o.wheel_scale_std >= 0.0 && o.wheel_scale_std <= 0.2)) fail("wheel_scale_std", "must be in [0, 0.2]");
   if (!(o.plane_sigma_angle_deg > 0.0 && o.plane_sigma_distance > 0.0))
     fail("plane_sigma_distance", "plane_sigma_angle_deg and plane_sigma_distance must be > 0");
   if (!(o.plane_match_angle_deg > 0.0 && o.plane_match_distance > 0.0))
@@ -91,6 +93,7 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
      << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
+     << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
      << (o.planar_factors ? ", adaptive planar factors" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
      << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";

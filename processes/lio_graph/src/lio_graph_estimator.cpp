@@ -225,6 +225,10 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
   n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeVectorPriorFactor(r.state.gyro_bias, Vec3::Constant(bg_std))), {n->bg}});
   n->priors.push_back({std::unique_ptr<ceres::CostFunction>(
                            makeVectorPriorFactor(r.state.accel_bias, Vec3::Constant(init.accel_bias_std))), {n->ba}});
+  // the wheel scales keep what an earlier epoch learned, held with the prior's sigma
+  if (estimatesWheelScale())
+    n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeWheelScalePrior(wheelScale(), opts_.wheel_scale_std)),
+                         {wheel_scale_}});
   window_.push_back(std::move(n));
   *note = r.static_start ? "initialised at rest" : "initialised in motion";
   return true;
@@ -391,8 +395,8 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
                                           pre.duration()));
     if (opts_.use_wheel) {
       if (auto w = wheelBetween(prev.utime, t_end)) {
-        n->wheel.reset(makeWheelFactor(*w));
-        n->wheel_loss = std::make_unique<ceres::HuberLoss>(opts_.wheel_huber);
+        n->wheel.reset(estimatesWheelScale() ? makeScaledWheelFactor(*w) : makeWheelFactor(*w));
+        n->wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
       } else {
         appendNote(note, "no wheel readings over the sweep");
       }
@@ -411,6 +415,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
   res.gyro_bias = Vec3(newest->bg[0], newest->bg[1], newest->bg[2]);
   res.accel_bias = Vec3(newest->ba[0], newest->ba[1], newest->ba[2]);
   res.angular_velocity = newest->last_gyro - res.gyro_bias;
+  res.wheel_scale = wheelScale();
   res.pose_covariance = newestPoseCovariance();
   res.world_points.reserve(body.size());
   for (const Vec3& b : body) res.world_points.push_back(res.pose * b);
@@ -506,7 +511,7 @@ void LioGraphEstimator::optimize() {
     Node& m = *window_[k - 1];
     if (n.imu) problem.AddResidualBlock(n.imu.get(), nullptr, {m.q, m.p, m.v, m.bg, m.ba, n.q, n.p, n.v});
     if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, m.bg, m.ba, n.bg, n.ba);
-    if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), m.q, m.p, n.q, n.p);
+    if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), wheelBlocks(m, n));
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_SCHUR;
@@ -527,7 +532,7 @@ void LioGraphEstimator::marginalizeOldest() {
   if (a.lidar) m.addFactor(a.lidar.get(), {a.q, a.p});
   if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
   if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
-  if (b.wheel) m.addFactor(b.wheel.get(), {a.q, a.p, b.q, b.p}, b.wheel_loss.get());
+  if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
   std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   for (auto& o : a.planes) {
     m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
@@ -545,6 +550,11 @@ void LioGraphEstimator::marginalizeOldest() {
   landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
                                   [](const std::unique_ptr<PlaneLandmark>& l) { return l->observers == 0; }),
                    landmarks_.end());
+}
+
+std::vector<double*> LioGraphEstimator::wheelBlocks(Node& a, Node& b) {
+  if (estimatesWheelScale()) return {a.q, a.p, b.q, b.p, wheel_scale_};
+  return {a.q, a.p, b.q, b.p};
 }
 
 void LioGraphEstimator::updateKeyframePoses() {
@@ -586,13 +596,14 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
     Node& b = *window_[k - 1];
     if (a.imu) m.addFactor(a.imu.get(), {b.q, b.p, b.v, b.bg, b.ba, a.q, a.p, a.v});
     if (a.bias_walk) m.addFactor(a.bias_walk.get(), {b.bg, b.ba, a.bg, a.ba});
-    if (a.wheel) m.addFactor(a.wheel.get(), {b.q, b.p, a.q, a.p}, a.wheel_loss.get());
+    if (a.wheel) m.addFactor(a.wheel.get(), wheelBlocks(b, a), a.wheel_loss.get());
   }
   std::set<const double*> drop;
   for (auto& w : window_)
     for (double* b : w->blocks())
       if (b != n.q && b != n.p) drop.insert(b);
   for (auto& l : landmarks_) drop.insert(l->c);
+  drop.insert(wheel_scale_);
   const auto marginal = m.marginalize(drop, 1e-12);
   if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();
   // blocks in first-seen order: make it [q, p]

@@ -123,6 +123,8 @@ std::string LioGraphNode::summary() const {
   std::ostringstream s;
   s << processed_ << " sweeps: " << tracked_ << " tracked, " << predicted_ << " predicted only, " << degenerate_
     << " degenerate";
+  if (opts_.core.use_wheel && opts_.core.wheel_scale_std > 0.0)
+    s << "; tyre scales " << estimator_.wheelScale().x() << " (left), " << estimator_.wheelScale().y() << " (right)";
   return s.str();
 }
 

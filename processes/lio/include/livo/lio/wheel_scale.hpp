@@ -16,7 +16,6 @@
 
 namespace livo::lio {
 
-using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
 
 struct WheelScaleOptions {

@@ -24,6 +24,8 @@ ceres::CostFunction* makePoseFactor(const Pose3& measured, const Mat6& informati
 
 /// A Gaussian prior on a 3-vector block (velocity, a bias): per-axis sigmas.
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma);
+/// The wheel scales' prior (2 residuals; block s).
+ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma);
 
 /// A plane landmark seen from a state (3 residuals; blocks q p c). The landmark is the vector c
 /// from its anchor a (the position it was first seen from) to the plane's closest point: plane
@@ -36,5 +38,8 @@ ceres::CostFunction* makePlaneFactor(const Vec3& anchor, const Vec3& measured_no
 
 /// The wheel preintegration between i and j (6 residuals; blocks q_i p_i q_j p_j).
 ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration);
+/// The same with the wheel scales [s_l, s_r] as a block (wheel_preintegration.hpp; blocks q_i p_i
+/// q_j p_j s): the tyres' true radii over the nominal, estimated with the trajectory.
+ceres::CostFunction* makeScaledWheelFactor(const WheelPreintegration& preintegration);
 
 }  // namespace livo::lio_graph

@@ -44,6 +44,7 @@ struct GraphScanResult {
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
   Vec3 gyro_bias = Vec3::Zero(), accel_bias = Vec3::Zero();
+  Vec2 wheel_scale = Vec2::Ones();          // [left, right] tyre radius over the nominal
   Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
   bool degenerate = false;
   Vec6 weakest_direction = Vec6::Zero();    // of the scan matching, [rotation, translation]
@@ -81,6 +82,7 @@ class LioGraphEstimator {
   size_t windowSize() const { return window_.size(); }
   size_t planeLandmarks() const { return landmarks_.size(); }
   size_t storedKeyframes() const { return keyframes_.size(); }
+  Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
   const LioGraphOptions& options() const { return opts_; }
   const LocalMap& localMap() const { return map_; }
   /// Forgets everything; the next sweeps initialise again.
@@ -110,6 +112,9 @@ class LioGraphEstimator {
   void rebuildLocalMap();
   Mat6 newestPoseCovariance();
   void dropImuBefore(int64_t utime);
+  bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
+  /// The parameter blocks of the wheel factor that ends at state b.
+  std::vector<double*> wheelBlocks(Node& a, Node& b);
 
   LioGraphOptions opts_;
   std::deque<ImuSample> imu_;
@@ -128,6 +133,7 @@ class LioGraphEstimator {
   KeyframeSelector keyframe_selector_;
   int64_t next_keyframe_id_ = 0;
   int64_t last_sweep_end_ = -1;
+  double wheel_scale_[2] = {1.0, 1.0};  // a block of the graph for as long as it runs (never marginalised)
 };
 
 }  // namespace livo::lio_graph

@@ -26,8 +26,13 @@ struct LioGraphOptions {
   bool use_wheel = false;               // rig.wheel present and lio_graph.wheel not false
   WheelRig wheel_rig;
   WheelPreintegrationNoise wheel_noise;
-  double wheel_huber = 3.0;             // robust loss on the whitened wheel residual (slip)
+  // Cauchy loss on the whitened wheel residual: a slipping wheel (tens of sigmas off the IMU) loses
+  // its influence instead of pulling with a bounded one, as a Huber loss would.
+  double wheel_cauchy = 3.0;
   double max_wheel_gap_s = 0.2;         // a longer gap between readings: no wheel factor there
+  // The tyres' radii over the nominal ([s_l, s_r], wheel_preintegration.hpp) as a parameter of the
+  // graph with this prior sigma around 1; 0 keeps them at the nominal.
+  double wheel_scale_std = 0.02;
 
   // Adaptive planar factors (the paper's contribution): planes extracted from every sweep
   // (plane_extraction.hpp) become landmarks of the window, each observation a factor.
