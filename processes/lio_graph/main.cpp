@@ -7,7 +7,7 @@
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-lio-graph",
                         "LIO-SAM-style LiDAR-inertial(-wheel) odometry on a fixed-lag factor graph: IMU + LIDAR (+ WHEEL) "
-                        "in, ODOMETRY, REGISTERED_SCAN and KEYFRAME out (a stand-in for livo-lio).");
+                        "and LOOP_CORRECTION in, ODOMETRY, REGISTERED_SCAN and KEYFRAME out (a stand-in for livo-lio).");
   cli.option("--config", "FILE", "project config with rig: and (optional) lio_graph: sections")
       .option("--name", "NAME", "node name on the bus (overrides lio_graph.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")

@@ -1,9 +1,12 @@
 // Marginalisation against the full problem: eliminating a block and keeping its linear prior gives
 // the full problem's estimate and covariance of the blocks that stay (exactly for a linear problem,
-// to first order on quaternions); the quaternion manifold's Jacobians against numeric ones.
+// to first order on quaternions); the quaternion manifold's Jacobians against numeric ones; the
+// prior moved with a rigid correction of the world (a loop correction).
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "livo/lio_graph/graph_factors.hpp"
 #include "livo/lio_graph/marginalization.hpp"
@@ -228,4 +231,212 @@ TEST(GraphFactors, RightQuaternionManifoldJacobiansAgainstNumeric) {
     m.Minus(b.coeffs().data(), q.coeffs().data(), lb.data());
     EXPECT_LT(((la - lb) / (2 * h) - (D * Py).col(k)).norm(), 1e-7);
   }
+}
+
+namespace {
+
+/// A state of the window as the estimator holds it: orientation (x y z w), position, velocity, biases.
+struct State {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  Vec3 p = Vec3::Zero(), v = Vec3::Zero(), bg = Vec3::Zero(), ba = Vec3::Zero();
+  Pose3 pose() const { return se3::fromRotationTranslation(q.toRotationMatrix(), p); }
+};
+
+/// The state in the world moved by T: orientation and position by T, velocity turned, biases kept.
+State movedState(const State& s, const Pose3& T) {
+  State m = s;
+  m.q = (Eigen::Quaterniond(T.linear()) * s.q).normalized();
+  m.p = T * s.p;
+  m.v = T.linear() * s.v;
+  return m;
+}
+
+/// A pose factor's information in a world turned by R (the position error turns with it).
+Mat6 turned(const Mat6& information, const Mat3& R) {
+  Mat6 A = Mat6::Identity();
+  A.bottomRightCorner<3, 3>() = R;
+  return A * information * A.transpose();
+}
+
+Mat6 randomInformation(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  Mat6 A;
+  for (int i = 0; i < 36; ++i) A(i) = g(rng);
+  return A * A.transpose() + 10.0 * Mat6::Identity();
+}
+
+Eigen::VectorXd evaluate(const ceres::CostFunction& f, const std::vector<double*>& blocks) {
+  Eigen::VectorXd r(f.num_residuals());
+  EXPECT_TRUE(f.Evaluate(blocks.data(), r.data(), nullptr));
+  return r;
+}
+
+/// The two states, the landmark's c and its anchor, and the factors of a small window, made in a
+/// world frame (gravity, anchor and measured poses given in it).
+struct SmallWindow {
+  State a, b;
+  Vec3 c = Vec3::Zero(), anchor = Vec3::Zero();
+  std::unique_ptr<ceres::CostFunction> prior_a, imu, walk, plane_a, plane_b, lidar_b;
+
+  /// Marginalises state a: the prior on b's blocks and c.
+  std::shared_ptr<MarginalPrior> marginalizeA() {
+    Marginalizer m;
+    m.setQuaternion(a.q.coeffs().data());
+    m.setQuaternion(b.q.coeffs().data());
+    m.addFactor(prior_a.get(), {a.q.coeffs().data(), a.p.data()});
+    m.addFactor(imu.get(), {a.q.coeffs().data(), a.p.data(), a.v.data(), a.bg.data(), a.ba.data(), b.q.coeffs().data(),
+                            b.p.data(), b.v.data()});
+    m.addFactor(walk.get(), {a.bg.data(), a.ba.data(), b.bg.data(), b.ba.data()});
+    m.addFactor(plane_a.get(), {a.q.coeffs().data(), a.p.data(), c.data()});
+    m.addFactor(plane_b.get(), {b.q.coeffs().data(), b.p.data(), c.data()});
+    m.addFactor(lidar_b.get(), {b.q.coeffs().data(), b.p.data()});
+    return m.marginalize({a.q.coeffs().data(), a.p.data(), a.v.data(), a.bg.data(), a.ba.data()});
+  }
+  /// The prior's blocks as the estimator tells them apart.
+  std::vector<WorldMotion> motions(const MarginalPrior& prior) {
+    std::vector<WorldMotion> m;
+    for (const double* blk : prior.blocks) {
+      if (blk == b.q.coeffs().data()) m.push_back(WorldMotion::kRotation);
+      else if (blk == b.p.data()) m.push_back(WorldMotion::kPoint);
+      else if (blk == b.v.data() || blk == c.data()) m.push_back(WorldMotion::kDirection);
+      else m.push_back(WorldMotion::kNone);
+    }
+    return m;
+  }
+};
+
+}  // namespace
+
+// A loop correction moves the window rigidly: the marginal prior moved with it (linearisation
+// points moved, the columns of world-frame tangents turned) gives the same residual at the moved
+// state as before at the old one, its Jacobians are right, and it is the prior the same
+// marginalisation would have produced in the moved world.
+TEST(Marginalization, PriorMovesWithARigidCorrectionOfTheWorld) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  auto rv = [&](double s) { return Vec3(s * g(rng), s * g(rng), s * g(rng)); };
+  const Vec3 gravity(0.0, 0.0, -9.81);
+  ImuPreintegration pre(Vec3(0.01, -0.02, 0.005), Vec3(0.05, 0.02, -0.03), ImuPreintegrationNoise{});
+  for (int k = 0; k < 20; ++k) pre.integrate(Vec3(0.1, -0.2, 0.3) + rv(0.01), Vec3(0.5, 0.2, 9.9) + rv(0.05), 0.005);
+
+  SmallWindow w;
+  w.a.q = so3::ExpQuat(rv(0.3));
+  w.a.p = rv(1.0);
+  w.a.v = rv(0.5);
+  w.a.bg = rv(0.01);
+  w.a.ba = rv(0.05);
+  w.b.q = w.a.q * so3::ExpQuat(Vec3(0.01, -0.02, 0.03) + rv(0.01));
+  w.b.p = w.a.p + 0.1 * w.a.v + rv(0.02);
+  w.b.v = w.a.v + rv(0.05);
+  w.b.bg = w.a.bg + rv(0.001);
+  w.b.ba = w.a.ba + rv(0.005);
+  w.anchor = w.a.p;
+  w.c = Vec3(0.3, -0.2, 2.0) + rv(0.05);
+  const Vec3 n_a = Vec3(0.1, 0.05, -1.0).normalized(), n_b = Vec3(0.12, 0.03, -1.0).normalized();
+  const Pose3 measured_a = se3::boxplus(w.a.pose(), (Vec6() << rv(0.01), rv(0.02)).finished());
+  const Pose3 measured_b = se3::boxplus(w.b.pose(), (Vec6() << rv(0.01), rv(0.02)).finished());
+  const Mat6 info_a = randomInformation(rng), info_b = randomInformation(rng);
+  auto makeFactors = [&](SmallWindow& win, const Pose3& T) {
+    win.prior_a.reset(makePoseFactor(T * measured_a, turned(info_a, T.linear())));
+    win.imu.reset(makeImuFactor(pre, T.linear() * gravity));
+    win.walk.reset(makeBiasWalkFactor(1e-4, 1e-3, 0.1));
+    win.plane_a.reset(makePlaneFactor(win.anchor, n_a, 2.05, 0.02, 0.05));
+    win.plane_b.reset(makePlaneFactor(win.anchor, n_b, 1.98, 0.02, 0.05));
+    win.lidar_b.reset(makePoseFactor(T * measured_b, turned(info_b, T.linear())));
+  };
+  makeFactors(w, Pose3::Identity());
+  const auto prior = w.marginalizeA();
+  ASSERT_TRUE(prior);
+  auto blocksOf = [](State& s, Vec3& c) {
+    return std::vector<double*>{s.q.coeffs().data(), s.p.data(), s.v.data(), s.bg.data(), s.ba.data(), c.data()};
+  };
+  ASSERT_EQ(prior->blocks, blocksOf(w.b, w.c));  // b's five blocks and c, in the order they were first seen
+  const std::vector<WorldMotion> motion = w.motions(*prior);
+
+  // a 5 deg yaw, a little roll and pitch, and a translation
+  const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.02, -0.015, 5.0 * M_PI / 180.0)), Vec3(3.0, -2.0, 0.5));
+  const auto moved = std::make_shared<MarginalPrior>(movedPrior(*prior, motion, T));
+  EXPECT_EQ(moved->blocks, prior->blocks);
+  MarginalPriorFactor before(prior), after(moved);
+
+  // the moved world: the same window remade there and marginalised again
+  SmallWindow mw;
+  mw.a = movedState(w.a, T);
+  mw.b = movedState(w.b, T);
+  mw.c = T.linear() * w.c;
+  mw.anchor = T * w.anchor;
+  makeFactors(mw, T);
+  const auto remade = mw.marginalizeA();
+  ASSERT_TRUE(remade);
+  MarginalPriorFactor again(remade);
+
+  ASSERT_EQ(remade->blocks, blocksOf(mw.b, mw.c));
+  for (int trial = 0; trial < 4; ++trial) {
+    // at the linearisation point, then at states away from it
+    State x = w.b;
+    Vec3 c = w.c;
+    if (trial > 0) {
+      x.q = x.q * so3::ExpQuat(rv(0.05));
+      x.p += rv(0.1);
+      x.v += rv(0.1);
+      x.bg += rv(0.001);
+      x.ba += rv(0.01);
+      c += rv(0.05);
+    }
+    State xm = movedState(x, T);
+    Vec3 cm = T.linear() * c;
+    const Eigen::VectorXd r_old = evaluate(before, blocksOf(x, c));
+    const Eigen::VectorXd r_new = evaluate(after, blocksOf(xm, cm));
+    EXPECT_LT((r_new - r_old).norm(), 1e-9) << trial << ": " << r_old.norm();
+    // the prior marginalised in the moved world: the same cost (its rows may be another basis)
+    const Eigen::VectorXd r_again = evaluate(again, blocksOf(xm, cm));
+    EXPECT_NEAR(r_again.squaredNorm(), r_new.squaredNorm(), 1e-8 * (1.0 + r_new.squaredNorm())) << trial;
+
+    // analytic Jacobians of the moved prior against numeric ones, in each block's tangent space
+    std::vector<double*> blocks = blocksOf(xm, cm);
+    const int rows = after.num_residuals();
+    std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(blocks.size());
+    std::vector<double*> jac(blocks.size());
+    for (size_t k = 0; k < blocks.size(); ++k) {
+      J[k].resize(rows, k == 0 ? 4 : 3);
+      jac[k] = J[k].data();
+    }
+    Eigen::VectorXd r(rows);
+    ASSERT_TRUE(after.Evaluate(blocks.data(), r.data(), jac.data()));
+    const RightQuaternionManifold manifold;
+    const double h = 1e-6;
+    for (size_t k = 0; k < blocks.size(); ++k) {
+      Eigen::MatrixXd analytic = J[k];
+      if (k == 0) {
+        Eigen::Matrix<double, 4, 3, Eigen::RowMajor> P;
+        manifold.PlusJacobian(blocks[0], P.data());
+        analytic = J[0] * P;
+      }
+      for (int d = 0; d < 3; ++d) {
+        std::vector<double> plus(blocks[k], blocks[k] + (k == 0 ? 4 : 3)), minus = plus;
+        if (k == 0) {
+          Vec3 e = Vec3::Zero();
+          e(d) = h;
+          manifold.Plus(blocks[0], e.data(), plus.data());
+          e(d) = -h;
+          manifold.Plus(blocks[0], e.data(), minus.data());
+        } else {
+          plus[d] += h;
+          minus[d] -= h;
+        }
+        std::vector<double*> bp = blocks, bm = blocks;
+        bp[k] = plus.data();
+        bm[k] = minus.data();
+        const Eigen::VectorXd numeric = (evaluate(after, bp) - evaluate(after, bm)) / (2.0 * h);
+        EXPECT_LT((numeric - analytic.col(d)).norm(), 1e-6 * (1.0 + analytic.col(d).norm()))
+            << "trial " << trial << ", block " << k << ", direction " << d;
+      }
+    }
+  }
+
+  // a motion that does not fit its block is refused
+  std::vector<WorldMotion> wrong = motion;
+  wrong[1] = WorldMotion::kRotation;  // b.p is Euclidean
+  EXPECT_THROW(movedPrior(*prior, wrong, T), std::invalid_argument);
+  EXPECT_THROW(movedPrior(*prior, {WorldMotion::kNone}, T), std::invalid_argument);
 }

@@ -613,8 +613,7 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat
 }
 
 void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const std::vector<KeyframePose>& corrected) {
-  const Pose3 T = correction.previous_id == frame_.correction_id ? correction.T_Ck_Cj
-                                                                  : Pose3(correction.T_Ck_O * frame_.T_C_O.inverse());
+  const Pose3 T = correctionStep(frame_, correction);
   frame_.correction_id = correction.id;
   frame_.T_C_O = correction.T_Ck_O;
   has_scale_anchor_ = false;  // its pose is in the frame before the correction

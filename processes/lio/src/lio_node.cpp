@@ -402,17 +402,8 @@ void LioNode::onLoopCorrection(const loop_correction_t& m) {
     node_.reject(opts_.loop_correction_channel, why);
     return;
   }
-  const OdometryFrame& frame = lio_.frame();
-  if (m.epoch != frame.epoch) {
-    node_.reject(opts_.loop_correction_channel,
-                 "loop correction " + std::to_string(m.correction_id) + " is for odometry epoch " +
-                     std::to_string(m.epoch) + ", the filter is in epoch " + std::to_string(frame.epoch) + ": ignored");
-    return;
-  }
-  if (m.correction_id <= frame.correction_id) {
-    node_.reject(opts_.loop_correction_channel, "loop correction " + std::to_string(m.correction_id) +
-                                                    " is not after the adopted one (" +
-                                                    std::to_string(frame.correction_id) + "): ignored");
+  if (const std::string refusal = adoptionRefusal(m, lio_.frame()); !refusal.empty()) {
+    node_.reject(opts_.loop_correction_channel, refusal);
     return;
   }
   if (pending_) {

@@ -32,6 +32,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     ch.readOptional("odometry", n.odometry_channel);
     ch.readOptional("registered_scan", n.registered_scan_channel);
     ch.readOptional("keyframe", n.keyframe_channel);
+    ch.readOptional("loop_correction", n.loop_correction_channel);
     bool wheel = o.use_wheel;
     if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
     c.readOptional("wheel_cauchy", o.wheel_cauchy);
@@ -88,7 +89,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
 void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
   const LioGraphOptions& o = n.core;
   os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.lidar_channel
-     << (o.use_wheel ? ", " + n.wheel_channel : std::string()) << "; outputs " << n.odometry_channel << ", "
+     << (o.use_wheel ? ", " + n.wheel_channel : std::string()) << ", " << n.loop_correction_channel << "; outputs " << n.odometry_channel << ", "
      << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "

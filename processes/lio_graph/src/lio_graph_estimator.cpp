@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
 #include "livo/lio_graph/graph_factors.hpp"
 #include "livo/plane.hpp"
+#include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/voxel_downsample.hpp"
 
@@ -66,6 +69,14 @@ Pose3 poseOf(const double* q, const double* p) {
                                       Vec3(p[0], p[1], p[2]));
 }
 
+/// A pose's information [dtheta (right), dp] in a world turned by R: the rotation error is
+/// body-frame and stays, the position error turns with the world.
+Mat6 turnedInformation(const Mat6& information, const Mat3& R) {
+  Mat6 A = Mat6::Identity();
+  A.bottomRightCorner<3, 3>() = R;
+  return A * information * A.transpose();
+}
+
 }  // namespace
 
 const char* toString(GraphScanResult::Status s) {
@@ -107,14 +118,38 @@ struct LioGraphEstimator::Node {
   Vec3 last_gyro = Vec3::Zero();
   std::unique_ptr<ceres::CostFunction> imu, bias_walk, wheel, lidar;
   std::unique_ptr<ceres::LossFunction> wheel_loss;
+  // What the factors holding world-frame quantities were made from, to remake them when a loop
+  // correction moves the world (the wheel and bias factors are relative: they never move).
+  std::optional<ImuPreintegration> imu_preintegration;  // its factor holds the world gravity
+  Pose3 lidar_pose = Pose3::Identity();   // the matched W_T_I ...
+  Mat6 lidar_information = Mat6::Zero();  // ... and its information [dtheta (right), dp]
+  /// A prior of the first state (the initialisation).
   struct Unary {
-    std::unique_ptr<ceres::CostFunction> cost;
+    enum class Kind { kPose, kVelocity, kBias, kWheelScale } kind;
     std::vector<double*> blocks;
+    Pose3 pose = Pose3::Identity();   // kPose: W_T_I and its information
+    Mat6 information = Mat6::Zero();
+    Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();  // kVelocity (world frame), kBias; kWheelScale: head<2>, sigma(0)
+    std::unique_ptr<ceres::CostFunction> cost;
+    void remake() {
+      switch (kind) {
+        case Kind::kPose: cost.reset(makePoseFactor(pose, information)); break;
+        case Kind::kWheelScale: cost.reset(makeWheelScalePrior(mean.head<2>(), sigma(0))); break;
+        default: cost.reset(makeVectorPriorFactor(mean, sigma));
+      }
+    }
   };
   std::vector<Unary> priors;  // the first state's
   struct PlaneObservation {
     PlaneLandmark* landmark;
+    Vec3 normal;     // the measured plane, body frame (n.x + offset = 0) ...
+    double offset;
+    double sigma_angle, sigma_distance;  // ... and its sigmas
     std::unique_ptr<ceres::CostFunction> cost;
+    /// The factor against the landmark's current anchor.
+    void remake() {
+      cost.reset(makePlaneFactor(landmark->anchor, normal, offset, sigma_angle, sigma_distance));
+    }
   };
   std::vector<PlaneObservation> planes;
 
@@ -129,10 +164,12 @@ struct LioGraphEstimator::Node {
 };
 
 LioGraphEstimator::LioGraphEstimator(LioGraphOptions options)
-    : opts_(std::move(options)), keyframe_selector_(opts_.keyframe) {}
+    : opts_(std::move(options)), keyframe_selector_(opts_.keyframe), gravity_W_(0.0, 0.0, -opts_.gravity) {}
 LioGraphEstimator::~LioGraphEstimator() = default;
 
 void LioGraphEstimator::reset() {
+  frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
+  gravity_W_ = Vec3(0.0, 0.0, -opts_.gravity);
   window_.clear();
   landmarks_.clear();
   prior_.reset();
@@ -153,8 +190,9 @@ bool LioGraphEstimator::addImu(const ImuSample& s, std::string* why) {
     return false;
   }
   if (!imu_.empty() && toSeconds(s.utime - imu_.back().utime) > opts_.max_imu_gap_s && initialized()) {
-    reset();  // the propagation across such a gap is worthless
-    if (why) *why = "IMU gap: re-initialising";
+    const double gap = toSeconds(s.utime - imu_.back().utime);
+    reset();  // the propagation across such a gap is worthless: a new epoch
+    if (why) *why = "IMU gap of " + formatSignificant(gap) + " s";
   }
   imu_.push_back(s);
   // keep what the newest state and the initialisation window need
@@ -220,15 +258,34 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
   // start they coincide, otherwise this is the usual approximation
   const double vel_std = r.static_start ? init.static_vel_std : init.moving_vel_std;
   const double bg_std = r.static_start ? 0.002 : init.moving_gyro_bias_std;
-  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makePoseFactor(n->pose(), info)), {n->q, n->p}});
-  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeVectorPriorFactor(Vec3::Zero(), Vec3::Constant(vel_std))), {n->v}});
-  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeVectorPriorFactor(r.state.gyro_bias, Vec3::Constant(bg_std))), {n->bg}});
-  n->priors.push_back({std::unique_ptr<ceres::CostFunction>(
-                           makeVectorPriorFactor(r.state.accel_bias, Vec3::Constant(init.accel_bias_std))), {n->ba}});
+  using Unary = Node::Unary;
+  n->priors.resize(4);
+  n->priors[0].kind = Unary::Kind::kPose;
+  n->priors[0].blocks = {n->q, n->p};
+  n->priors[0].pose = n->pose();
+  n->priors[0].information = info;
+  // isotropic: a loop correction turns the mean only
+  n->priors[1].kind = Unary::Kind::kVelocity;
+  n->priors[1].blocks = {n->v};
+  n->priors[1].sigma = Vec3::Constant(vel_std);
+  n->priors[2].kind = Unary::Kind::kBias;
+  n->priors[2].blocks = {n->bg};
+  n->priors[2].mean = r.state.gyro_bias;
+  n->priors[2].sigma = Vec3::Constant(bg_std);
+  n->priors[3].kind = Unary::Kind::kBias;
+  n->priors[3].blocks = {n->ba};
+  n->priors[3].mean = r.state.accel_bias;
+  n->priors[3].sigma = Vec3::Constant(init.accel_bias_std);
   // the wheel scales keep what an earlier epoch learned, held with the prior's sigma
-  if (estimatesWheelScale())
-    n->priors.push_back({std::unique_ptr<ceres::CostFunction>(makeWheelScalePrior(wheelScale(), opts_.wheel_scale_std)),
-                         {wheel_scale_}});
+  if (estimatesWheelScale()) {
+    n->priors.emplace_back();
+    Unary& u = n->priors.back();
+    u.kind = Unary::Kind::kWheelScale;
+    u.blocks = {wheel_scale_};
+    u.mean.head<2>() = wheelScale();
+    u.sigma.setConstant(opts_.wheel_scale_std);
+  }
+  for (Unary& u : n->priors) u.remake();
   window_.push_back(std::move(n));
   *note = r.static_start ? "initialised at rest" : "initialised in motion";
   return true;
@@ -242,7 +299,7 @@ bool LioGraphEstimator::preintegrate(int64_t t_end, ImuPreintegration* pre, std:
   const Mat3 R0 = n.pose().linear();
   const Vec3 p0(n.p[0], n.p[1], n.p[2]), v0(n.v[0], n.v[1], n.v[2]);
   const Vec3 bg(n.bg[0], n.bg[1], n.bg[2]), ba(n.ba[0], n.ba[1], n.ba[2]);
-  const Vec3 g(0.0, 0.0, -opts_.gravity);
+  const Vec3& g = gravity_W_;
   *pre = ImuPreintegration(bg, ba, opts_.imu_noise);
   steps->clear();
   steps->push_back({n.utime, n.pose()});
@@ -366,7 +423,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     Mat3 R;
     Vec3 p, v;
     pre.predict(prev.pose().linear(), Vec3(prev.p[0], prev.p[1], prev.p[2]), Vec3(prev.v[0], prev.v[1], prev.v[2]),
-                pre.gyroBias(), pre.accelBias(), Vec3(0, 0, -opts_.gravity), &R, &p, &v);
+                pre.gyroBias(), pre.accelBias(), gravity_W_, &R, &p, &v);
     n->setPose(se3::fromRotationTranslation(R, p));
     Eigen::Map<Vec3>(n->v) = v;
     std::copy(prev.bg, prev.bg + 3, n->bg);
@@ -379,9 +436,10 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     res.weakest_direction = match.weakest;
     if (match.valid) {
       n->setPose(match.T_W_I);
-      const Mat6 info = match.hessian * (opts_.lidar_information_scale /
-                                         (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
-      n->lidar.reset(makePoseFactor(match.T_W_I, info));
+      n->lidar_pose = match.T_W_I;
+      n->lidar_information = match.hessian * (opts_.lidar_information_scale /
+                                              (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
+      n->lidar.reset(makePoseFactor(n->lidar_pose, n->lidar_information));
       res.status = GraphScanResult::Status::kTracked;
     } else {
       res.status = GraphScanResult::Status::kPredicted;
@@ -390,7 +448,8 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
                            std::to_string(match.surface_residuals) + " surface): IMU prediction");
     }
     // 4. the new state's factors, the window optimised, the oldest state marginalised
-    n->imu.reset(makeImuFactor(pre, Vec3(0, 0, -opts_.gravity)));
+    n->imu_preintegration = pre;
+    n->imu.reset(makeImuFactor(pre, gravity_W_));
     n->bias_walk.reset(makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk,
                                           pre.duration()));
     if (opts_.use_wheel) {
@@ -437,7 +496,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     s.node = newest;
     keyframes_.push_back(std::move(s));
     while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
-    rebuildLocalMap();
+    rebuildLocalMap(keyframes_.back().kf.pose.translation());
     res.is_keyframe = true;
     res.keyframe = keyframes_.back().kf;
   }
@@ -452,7 +511,7 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
   const Mat3 R = T.linear();
   const Vec3 p = T.translation();
   PlaneExtractionOptions po = opts_.planes;
-  po.up = R.transpose() * Vec3::UnitZ();  // the world is gravity-aligned
+  po.up = R.transpose() * (-gravity_W_).normalized();  // a loop correction may have tilted the world
   const double cos_match = std::cos(opts_.plane_match_angle_deg * M_PI / 180.0);
   std::vector<const PlaneLandmark*> used;
   for (const ExtractedPlane& e : extractPlanes(cloud, po)) {
@@ -480,10 +539,10 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
     }
     used.push_back(best);
     ++best->observers;
-    node->planes.push_back(
-        {best, std::unique_ptr<ceres::CostFunction>(makePlaneFactor(
-                   best->anchor, e.plane.normal, e.plane.offset, opts_.plane_sigma_angle_deg * M_PI / 180.0,
-                   std::max(opts_.plane_sigma_distance, e.quality)))});
+    Node::PlaneObservation o{best, e.plane.normal, e.plane.offset, opts_.plane_sigma_angle_deg * M_PI / 180.0,
+                             std::max(opts_.plane_sigma_distance, e.quality), nullptr};
+    o.remake();
+    node->planes.push_back(std::move(o));
     ++res->planes;
     res->ground_planes += e.ground;
   }
@@ -541,6 +600,7 @@ void LioGraphEstimator::marginalizeOldest() {
   prior_ = m.marginalize(drop);
   prior_factor_ = prior_ ? std::make_unique<MarginalPriorFactor>(prior_) : nullptr;
   b.imu.reset();
+  b.imu_preintegration.reset();
   b.bias_walk.reset();
   b.wheel.reset();
   b.wheel_loss.reset();
@@ -564,8 +624,7 @@ void LioGraphEstimator::updateKeyframePoses() {
     if (k.node) k.kf.pose = k.node->pose();
 }
 
-void LioGraphEstimator::rebuildLocalMap() {
-  const Vec3 here = keyframes_.back().kf.pose.translation();
+void LioGraphEstimator::rebuildLocalMap(const Vec3& here) {
   std::vector<Vec3> edges, surfaces;
   int used = 0;
   for (auto it = keyframes_.rbegin(); it != keyframes_.rend() && used < opts_.local_map_keyframes; ++it) {
@@ -578,6 +637,80 @@ void LioGraphEstimator::rebuildLocalMap() {
   for (size_t i : firstPointPerVoxel(edges, opts_.map_edge_voxel)) e_ds.push_back(edges[i]);
   for (size_t i : firstPointPerVoxel(surfaces, opts_.map_surface_voxel)) s_ds.push_back(surfaces[i]);
   map_.rebuild(std::move(e_ds), std::move(s_ds));
+}
+
+WorldMotion LioGraphEstimator::motionOf(const double* block) const {
+  for (const auto& n : window_) {
+    if (block == n->q) return WorldMotion::kRotation;
+    if (block == n->p) return WorldMotion::kPoint;
+    if (block == n->v) return WorldMotion::kDirection;
+    if (block == n->bg || block == n->ba) return WorldMotion::kNone;
+  }
+  if (block == wheel_scale_) return WorldMotion::kNone;
+  for (const auto& l : landmarks_)
+    if (block == l->c) return WorldMotion::kDirection;
+  throw std::logic_error("the marginal prior holds a block that is neither a window state's nor a landmark's");
+}
+
+void LioGraphEstimator::applyLoopCorrection(const LoopCorrection& correction,
+                                            const std::vector<KeyframePose>& corrected) {
+  const Pose3 T = correctionStep(frame_, correction);
+  frame_.correction_id = correction.id;
+  frame_.T_C_O = correction.T_Ck_O;
+  const Mat3 R = T.linear();
+  // keyframes: corrected poses where given, the rigid correction elsewhere
+  for (StoredKeyframe& k : keyframes_) {
+    auto it = std::find_if(corrected.begin(), corrected.end(), [&](const KeyframePose& c) { return c.id == k.kf.id; });
+    k.kf.pose = it != corrected.end() ? it->pose : T * k.kf.pose;
+  }
+  if (initialized()) {
+    // The whole window moves rigidly, so every factor keeps its residual: the prior first (its
+    // blocks are looked up in the window), then the states, the landmarks, and the factors that
+    // hold world-frame quantities, remade from what they were made of.
+    if (prior_) {
+      std::vector<WorldMotion> motion;
+      for (const double* b : prior_->blocks) motion.push_back(motionOf(b));
+      prior_ = std::make_shared<MarginalPrior>(movedPrior(*prior_, motion, T));
+      prior_factor_ = std::make_unique<MarginalPriorFactor>(prior_);
+    }
+    // the world gravity is the state's: it tilts with the frame (with no state yet, the
+    // initialisation is gravity-aligned, as livo-lio's)
+    gravity_W_ = R * gravity_W_;
+    const Eigen::Quaterniond qR(R);
+    for (auto& n : window_) {
+      Eigen::Map<Eigen::Quaterniond> q(n->q);
+      q = (qR * q).normalized();
+      Eigen::Map<Vec3> p(n->p), v(n->v);
+      p = Vec3(R * p + T.translation());
+      v = Vec3(R * v);
+    }
+    for (auto& l : landmarks_) {
+      l->anchor = T * l->anchor;
+      Eigen::Map<Vec3> c(l->c);
+      c = Vec3(R * c);
+    }
+    for (auto& n : window_) {
+      if (n->imu_preintegration) n->imu.reset(makeImuFactor(*n->imu_preintegration, gravity_W_));
+      if (n->lidar) {
+        n->lidar_pose = T * n->lidar_pose;
+        n->lidar_information = turnedInformation(n->lidar_information, R);
+        n->lidar.reset(makePoseFactor(n->lidar_pose, n->lidar_information));
+      }
+      for (Node::Unary& u : n->priors) {
+        if (u.kind == Node::Unary::Kind::kPose) {
+          u.pose = T * u.pose;
+          u.information = turnedInformation(u.information, R);
+        } else if (u.kind == Node::Unary::Kind::kVelocity) {
+          u.mean = R * u.mean;
+        }
+        u.remake();
+      }
+      for (Node::PlaneObservation& o : n->planes) o.remake();
+    }
+    keyframe_selector_.setReference(window_.back()->pose());
+  }
+  // the local map from the corrected keyframes around the new position
+  rebuildLocalMap(initialized() ? window_.back()->pose().translation() : Vec3(T.translation()));
 }
 
 Mat6 LioGraphEstimator::newestPoseCovariance() {

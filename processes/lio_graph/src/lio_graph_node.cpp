@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "livo/keyframe_t.hpp"
+#include "livo/loop_correction_message.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/output_messages.hpp"
@@ -15,7 +16,7 @@ namespace livo::lio_graph {
 
 namespace {
 
-odometry_t toOdometry(const GraphScanResult& r) {
+odometry_t toOdometry(const GraphScanResult& r, const OdometryFrame& frame) {
   odometry_t o;
   o.utime = r.utime;
   o.parent_frame = "W";
@@ -28,8 +29,8 @@ odometry_t toOdometry(const GraphScanResult& r) {
   o.num_residuals = r.edge_residuals + r.surface_residuals;
   o.degenerate = r.degenerate ? 1 : 0;
   o.min_information_eigenvalue = 0.0;
-  o.epoch = 0;
-  o.correction_id = 0;
+  o.epoch = frame.epoch;
+  o.correction_id = frame.correction_id;
   return o;
 }
 
@@ -44,15 +45,28 @@ LioGraphNode::LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNode
   node_.subscribe<point_cloud_t>(opts_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
   if (opts_.core.use_wheel)
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
+  node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
+                                     [this](const loop_correction_t& m) { onLoopCorrection(m); });
+}
+
+void LioGraphNode::announceReset(const std::string& why) {
+  ++resets_;
+  node_.warn("odometry reset to epoch " + std::to_string(estimator_.frame().epoch) + ": " + why + ": re-initialising");
+  node_.publishHealthNow();  // the reason reaches resets.json / report.md even if a warning follows
 }
 
 void LioGraphNode::onImu(const imu_t& m) {
   std::string why;
+  const int32_t epoch_before = estimator_.frame().epoch;
   if (!estimator_.addImu(fromMessage(m), &why)) {
     node_.reject(opts_.imu_channel, why);
     return;
   }
-  if (!why.empty()) node_.warn(why);
+  if (estimator_.frame().epoch != epoch_before) {
+    announceReset(why);
+  } else if (!why.empty()) {
+    node_.warn(why);
+  }
   imu_watermark_ = m.utime;
   processReady();
 }
@@ -84,6 +98,24 @@ void LioGraphNode::onLidar(const point_cloud_t& m) {
   processReady();
 }
 
+void LioGraphNode::onLoopCorrection(const loop_correction_t& m) {
+  LoopCorrection correction;
+  std::vector<KeyframePose> poses;
+  std::string why;
+  if (!fromMessage(m, &correction, &poses, &why)) {
+    node_.reject(opts_.loop_correction_channel, why);
+    return;
+  }
+  if (const std::string refusal = adoptionRefusal(m, estimator_.frame()); !refusal.empty()) {
+    node_.reject(opts_.loop_correction_channel, refusal);
+    return;
+  }
+  // between sweeps: the ones still waiting for the IMU are processed in the corrected frame
+  estimator_.applyLoopCorrection(correction, poses);
+  node_.info("loop correction " + std::to_string(m.correction_id) + " applied (" + std::to_string(poses.size()) +
+             " keyframes)");
+}
+
 void LioGraphNode::processReady() {
   while (!pending_.empty()) {
     const PendingSweep& p = pending_.front();
@@ -109,8 +141,8 @@ void LioGraphNode::process(const PendingSweep& p) {
   predicted_ += r.status == GraphScanResult::Status::kPredicted;
   degenerate_ += r.degenerate;
   if (!r.message.empty()) node_.info(r.message);
-  const OutputFrame frame{0, 0};
-  node_.publish(opts_.odometry_channel, toOdometry(r));
+  const OutputFrame frame{estimator_.frame().epoch, estimator_.frame().correction_id};
+  node_.publish(opts_.odometry_channel, toOdometry(r, estimator_.frame()));
   node_.publish(opts_.registered_scan_channel,
                 registeredScanMessage(r.utime, r.sweep_start_utime, r.pose, r.world_points, r.input_index, p.msg, frame));
   if (r.is_keyframe)

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <map>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Eigenvalues>
 
@@ -51,6 +53,41 @@ bool MarginalPriorFactor::Evaluate(double const* const* parameters, double* resi
     offset += local;
   }
   return true;
+}
+
+MarginalPrior movedPrior(const MarginalPrior& prior, const std::vector<WorldMotion>& motion, const Pose3& T) {
+  if (motion.size() != prior.blocks.size())
+    throw std::invalid_argument("movedPrior: " + std::to_string(motion.size()) + " motions for " +
+                                std::to_string(prior.blocks.size()) + " blocks");
+  const Mat3 R = T.linear();
+  const Eigen::Quaterniond qR(R);
+  MarginalPrior moved = prior;
+  int offset = 0;
+  for (size_t b = 0; b < prior.blocks.size(); ++b) {
+    const int local = prior.quaternion[b] ? 3 : prior.sizes[b];
+    const bool three = !prior.quaternion[b] && prior.sizes[b] == 3;
+    switch (motion[b]) {
+      case WorldMotion::kNone:
+        break;
+      case WorldMotion::kRotation: {
+        if (!prior.quaternion[b]) throw std::invalid_argument("movedPrior: a rotation on a Euclidean block");
+        const Eigen::Map<const Eigen::Quaterniond> q0(prior.x0[b].data());
+        Eigen::Map<Eigen::Quaterniond> q0_moved(moved.x0[b].data());
+        q0_moved = (qR * q0).normalized();
+        break;
+      }
+      case WorldMotion::kPoint:
+      case WorldMotion::kDirection: {
+        if (!three) throw std::invalid_argument("movedPrior: a point or direction on a block not of size 3");
+        const Vec3 x0 = prior.x0[b];
+        moved.x0[b] = motion[b] == WorldMotion::kPoint ? Vec3(R * x0 + T.translation()) : Vec3(R * x0);
+        moved.J.middleCols(offset, 3) = prior.J.middleCols(offset, 3) * R.transpose();
+        break;
+      }
+    }
+    offset += local;
+  }
+  return moved;
 }
 
 void Marginalizer::addFactor(const ceres::CostFunction* cost, std::vector<double*> blocks,

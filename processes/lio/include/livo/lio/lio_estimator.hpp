@@ -13,6 +13,7 @@
 #include "livo/lio/degeneracy.hpp"
 #include "livo/lio/imu_propagator.hpp"
 #include "livo/lio/lio_options.hpp"
+#include "livo/odometry_frame.hpp"
 
 namespace livo::lio {
 
@@ -66,14 +67,6 @@ struct ScanResult {
 
 const char* toString(ScanResult::Status s);
 
-/// The frame the estimator's poses are in (lcmtypes/loop_correction_t.lcm): its odometry epoch
-/// (+1 at every reset) and the newest loop correction adopted in it.
-struct OdometryFrame {
-  int32_t epoch = 0;
-  int64_t correction_id = 0;             // 0: the raw odometry frame O of the epoch
-  Pose3 T_C_O = Pose3::Identity();       // odometry_to_corrected of that correction
-};
-
 class LioEstimator {
  public:
   explicit LioEstimator(LioOptions options = {});
@@ -113,17 +106,9 @@ class LioEstimator {
   /// Adopts an external update of the state at the filter's current time (STATE_POSTERIOR).
   bool adoptPosterior(int64_t utime, const FilterState& x, const Mat18& P, std::string* why = nullptr);
 
-  struct KeyframePose {
-    int64_t id;
-    Pose3 pose;  // corrected W_T_I
-  };
-  /// A loop correction to adopt: its id, T_Ck_O, and T_Ck_Cj from the previous correction j.
-  struct LoopCorrection {
-    int64_t id = 0;
-    int64_t previous_id = 0;
-    Pose3 T_Ck_O = Pose3::Identity();
-    Pose3 T_Ck_Cj = Pose3::Identity();
-  };
+  // livo/odometry_frame.hpp (livo-lio-graph adopts corrections the same way)
+  using KeyframePose = livo::KeyframePose;
+  using LoopCorrection = livo::LoopCorrection;
   /// Loop correction: moves the state from the current frame onto C_k (by T_Ck_Cj when the
   /// estimator is in j, by T_Ck_O * T_C_O^-1 when it missed corrections), replaces the poses of
   /// the listed keyframes (the others move likewise) and rebuilds the local map from them. The

@@ -7,7 +7,7 @@
 #include "livo/imu_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/lio/lio_estimator.hpp"
-#include "livo/loop_correction_t.hpp"
+#include "livo/loop_correction_message.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/registered_scan_t.hpp"
@@ -17,7 +17,7 @@
 namespace livo::lio {
 
 // The sensor messages: livo/sensor_messages.hpp (fromMessage for imu_t, wheel_odometry_t and
-// point_cloud_t).
+// point_cloud_t); LOOP_CORRECTION: livo/loop_correction_message.hpp (shared with livo-lio-graph).
 
 /// The output messages carry the frame they are in (epoch, correction_id).
 odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame);
@@ -30,9 +30,5 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& inp
 /// The keyframe's downsampled body-frame cloud with the input intensities; time offsets zero
 /// (the cloud is undistorted to the keyframe's utime).
 keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings, const OdometryFrame& frame);
-
-/// The loop correction (id, transforms) and the corrected keyframe poses.
-bool fromMessage(const loop_correction_t& m, LioEstimator::LoopCorrection* correction,
-                 std::vector<LioEstimator::KeyframePose>* poses, std::string* why);
 
 }  // namespace livo::lio

@@ -21,6 +21,7 @@ struct LioGraphNodeOptions {
   std::string odometry_channel = "ODOMETRY";
   std::string registered_scan_channel = "REGISTERED_SCAN";
   std::string keyframe_channel = "KEYFRAME";
+  std::string loop_correction_channel = "LOOP_CORRECTION";  // in: adopted as livo-lio adopts it
   /// A sweep waits for a wheel reading past its end, or for this much IMU beyond it (a dead
   /// encoder must not stall the odometry).
   double wheel_max_wait_s = 0.1;

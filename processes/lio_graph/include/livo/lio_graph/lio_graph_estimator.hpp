@@ -10,6 +10,8 @@
 //      preintegration factor; the window is optimised and its oldest state marginalised into a
 //      linear prior, so the cost per sweep does not grow with the run;
 //   5. every keyframe_distance / keyframe_angle a keyframe: its features enter the local map.
+// A LOOP_CORRECTION is adopted as livo-lio adopts it (applyLoopCorrection): the poses are then in
+// the corrected frame C_k that frame() names.
 // Deterministic: the output depends only on the inputs.
 #pragma once
 
@@ -22,6 +24,7 @@
 #include "livo/keyframe_selector.hpp"
 #include "livo/lio_graph/lio_graph_options.hpp"
 #include "livo/lio_graph/marginalization.hpp"
+#include "livo/odometry_frame.hpp"
 
 namespace livo::lio_graph {
 
@@ -83,10 +86,25 @@ class LioGraphEstimator {
   size_t planeLandmarks() const { return landmarks_.size(); }
   size_t storedKeyframes() const { return keyframes_.size(); }
   Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
+  /// Stored keyframe i, oldest first (i < storedKeyframes()).
+  const GraphKeyframe& storedKeyframe(size_t i) const { return keyframes_.at(i).kf; }
   const LioGraphOptions& options() const { return opts_; }
   const LocalMap& localMap() const { return map_; }
-  /// Forgets everything; the next sweeps initialise again.
+  /// Gravity in the world frame: (0, 0, -gravity) until a loop correction tilts the frame.
+  const Vec3& gravity() const { return gravity_W_; }
+  /// Forgets everything (state, map, keyframes); the next sweeps initialise again in a new odometry
+  /// epoch (frame().epoch + 1, no correction).
   void reset();
+
+  /// Loop correction (lcmtypes/loop_correction_t.lcm), adopted as livo-lio adopts it: everything
+  /// moves from the current frame onto C_k by correctionStep() (T_Ck_Cj when the estimator is in
+  /// j, T_Ck_O * T_C_O^-1 when it missed corrections): the window's states and plane landmarks,
+  /// the factors made from world-frame measurements, the marginal prior and the world gravity (the
+  /// correction may tilt the frame). The listed keyframes take their corrected poses, the others
+  /// move likewise, and the local map is rebuilt from them. The caller checks the epoch and that
+  /// the id is newer than frame().correction_id.
+  void applyLoopCorrection(const LoopCorrection& correction, const std::vector<KeyframePose>& corrected);
+  const OdometryFrame& frame() const { return frame_; }
 
  private:
   struct Node;
@@ -109,7 +127,10 @@ class LioGraphEstimator {
   void optimize();
   void marginalizeOldest();
   void updateKeyframePoses();
-  void rebuildLocalMap();
+  /// The local map from the newest keyframes within local_map_radius of `here`.
+  void rebuildLocalMap(const Vec3& here);
+  /// What a loop correction does to a block of the marginal prior (a window state's or landmark's).
+  WorldMotion motionOf(const double* block) const;
   Mat6 newestPoseCovariance();
   void dropImuBefore(int64_t utime);
   bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
@@ -134,6 +155,8 @@ class LioGraphEstimator {
   int64_t next_keyframe_id_ = 0;
   int64_t last_sweep_end_ = -1;
   double wheel_scale_[2] = {1.0, 1.0};  // a block of the graph for as long as it runs (never marginalised)
+  OdometryFrame frame_;
+  Vec3 gravity_W_;  // what the IMU factors, the prediction and the plane extraction's "up" use
 };
 
 }  // namespace livo::lio_graph

@@ -1,6 +1,9 @@
 // The livo-lio-graph node: IMU, LIDAR (and WHEEL) in; ODOMETRY, REGISTERED_SCAN and KEYFRAME out,
 // as livo-lio publishes them, so it can stand in for livo-lio in the pipeline
-// (scripts/run_pipeline.sh --swap lio=build/bin/livo-lio-graph).
+// (scripts/run_pipeline.sh --swap lio=build/bin/livo-lio-graph). LOOP_CORRECTION is adopted as
+// livo-lio adopts it: a correction of the current odometry epoch newer than the adopted one moves
+// the estimator when it arrives (between sweeps), and the outputs say which frame they are in
+// (epoch, correction_id). An estimator reset (an IMU gap) starts a new epoch.
 //
 // Determinism: sweeps wait in a queue and are processed once the IMU has passed their end (and,
 // with wheels, a wheel reading has, or wheel_max_wait_s of IMU beyond it), so the output depends
@@ -14,6 +17,7 @@
 #include "livo/imu_t.hpp"
 #include "livo/lio_graph/lio_graph_config.hpp"
 #include "livo/lio_graph/lio_graph_estimator.hpp"
+#include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
@@ -25,6 +29,9 @@ class LioGraphNode {
   LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNodeOptions options);
   Node& node() { return node_; }
   const LioGraphEstimator& estimator() const { return estimator_; }
+  const OdometryFrame& frame() const { return estimator_.frame(); }
+  /// Odometry resets so far (= the current epoch).
+  int64_t resets() const { return resets_; }
   /// Sweeps processed, tracked, predicted only and degenerate.
   std::string summary() const;
 
@@ -37,6 +44,10 @@ class LioGraphNode {
   void onImu(const imu_t& m);
   void onWheel(const wheel_odometry_t& m);
   void onLidar(const point_cloud_t& m);
+  void onLoopCorrection(const loop_correction_t& m);
+  /// Warns (HEALTH, stderr) "odometry reset to epoch N: why: re-initialising" after the estimator
+  /// was reset.
+  void announceReset(const std::string& why);
   void processReady();
   void process(const PendingSweep& p);
 
@@ -47,6 +58,7 @@ class LioGraphNode {
   int64_t imu_watermark_ = INT64_MIN;
   int64_t wheel_watermark_ = INT64_MIN;
   int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0;
+  int64_t resets_ = 0;
 };
 
 }  // namespace livo::lio_graph

@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <ceres/ceres.h>
 
+#include "livo/so3.hpp"
+
 namespace livo::lio_graph {
 
 /// A linear prior r(x) = r0 + J (x [-] x0) on parameter blocks, [-] per block (Euclidean
@@ -25,6 +27,22 @@ struct MarginalPrior {
   Eigen::VectorXd r0;
   int tangentSize() const { return static_cast<int>(J.cols()); }
 };
+
+/// How a block changes when the world frame moves rigidly by T = (R, t) (a loop correction).
+enum class WorldMotion {
+  kNone,       // body-frame quantities (biases)
+  kRotation,   // an orientation W_R_I (quaternion): R q; its right-perturbation tangent is body-frame
+  kPoint,      // a world point (a position): R p + t
+  kDirection,  // a world vector (a velocity, a plane landmark's c): R v
+};
+
+/// The prior on the blocks moved by T: r'(x') = r(x) for every x, x' being x moved
+/// (motion[b] for blocks[b]). The linearisation points move with their blocks; the Jacobian
+/// columns of points and directions turn by R^T, as their tangent (x - x0) is a world-frame
+/// difference; quaternion tangents (Log(q0^-1 q)) and body-frame blocks stay. The blocks keep their
+/// pointers (the state moves in place). Throws std::invalid_argument for a motion that does not fit
+/// its block (a rotation on a Euclidean block, a point or direction on a block not of size 3).
+MarginalPrior movedPrior(const MarginalPrior& prior, const std::vector<WorldMotion>& motion, const Pose3& T);
 
 class MarginalPriorFactor : public ceres::CostFunction {
  public:
