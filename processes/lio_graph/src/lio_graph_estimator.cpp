@@ -625,13 +625,15 @@ void LioGraphEstimator::updateKeyframePoses() {
 }
 
 void LioGraphEstimator::rebuildLocalMap(const Vec3& here) {
+  std::vector<const StoredKeyframe*> chosen;  // the newest local_map_keyframes within the radius
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend() && static_cast<int>(chosen.size()) < opts_.local_map_keyframes; ++it)
+    if ((it->kf.pose.translation() - here).norm() <= opts_.local_map_radius) chosen.push_back(&*it);
+  // Oldest first, so a voxel keeps an older keyframe's point: the newest sweep's rings, which the
+  // next sweep's rings resemble wherever the body moves, would pull the match towards standing still.
   std::vector<Vec3> edges, surfaces;
-  int used = 0;
-  for (auto it = keyframes_.rbegin(); it != keyframes_.rend() && used < opts_.local_map_keyframes; ++it) {
-    if ((it->kf.pose.translation() - here).norm() > opts_.local_map_radius) continue;
-    ++used;
-    for (const Vec3& e : it->edges) edges.push_back(it->kf.pose * e);
-    for (const Vec3& s : it->surfaces) surfaces.push_back(it->kf.pose * s);
+  for (auto it = chosen.rbegin(); it != chosen.rend(); ++it) {
+    for (const Vec3& e : (*it)->edges) edges.push_back((*it)->kf.pose * e);
+    for (const Vec3& s : (*it)->surfaces) surfaces.push_back((*it)->kf.pose * s);
   }
   std::vector<Vec3> e_ds, s_ds;
   for (size_t i : firstPointPerVoxel(edges, opts_.map_edge_voxel)) e_ds.push_back(edges[i]);
