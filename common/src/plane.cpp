@@ -10,11 +10,15 @@ bool fitPlane(const Vec3* pts, int n, PlaneFit* out) {
   Vec3 c = Vec3::Zero();
   for (int i = 0; i < n; ++i) c += pts[i];
   c /= n;
-  Mat3 S = Mat3::Zero();
+  // the scatter's six distinct sums (as S += d d^T would add them, without its 3x3 temporaries)
+  double sxx = 0.0, sxy = 0.0, sxz = 0.0, syy = 0.0, syz = 0.0, szz = 0.0;
   for (int i = 0; i < n; ++i) {
     const Vec3 d = pts[i] - c;
-    S += d * d.transpose();
+    sxx += d.x() * d.x(), sxy += d.x() * d.y(), sxz += d.x() * d.z();
+    syy += d.y() * d.y(), syz += d.y() * d.z(), szz += d.z() * d.z();
   }
+  Mat3 S;
+  S << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   es.computeDirect(S);
   PlaneFit f;

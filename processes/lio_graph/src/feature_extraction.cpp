@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "livo/voxel_downsample.hpp"
 
@@ -51,9 +50,11 @@ void ringFeatures(const std::vector<RingPoint>& ring, const FeatureOptions& o,
   for (int s = 0; s < sectors; ++s) {
     const int a = k + (n - 2 * k) * s / sectors, b = k + (n - 2 * k) * (s + 1) / sectors;
     if (b <= a) continue;
-    order.resize(b - a);
-    std::iota(order.begin(), order.end(), a);
-    // roughest first; ties by position, so the result does not depend on the sort's stability
+    // the edge candidates, roughest first; ties by position, so the result does not depend on the
+    // sort's stability (the smoother points come after them and would end the loop below)
+    order.clear();
+    for (int i = a; i < b; ++i)
+      if (roughness[i] > o.edge_threshold) order.push_back(i);
     std::sort(order.begin(), order.end(), [&](int x, int y) {
       return roughness[x] > roughness[y] || (roughness[x] == roughness[y] && x < y);
     });

@@ -733,22 +733,36 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
     if (a.bias_walk) m.addFactor(a.bias_walk.get(), {b.bg, b.ba, a.bg, a.ba});
     if (a.wheel) m.addFactor(a.wheel.get(), wheelBlocks(b, a), a.wheel_loss.get());
   }
-  std::set<const double*> drop;
-  for (auto& w : window_)
-    for (double* b : w->blocks())
-      if (b != n.q && b != n.p) drop.insert(b);
-  for (auto& l : landmarks_) drop.insert(l->c);
-  drop.insert(wheel_scale_);
-  const auto marginal = m.marginalize(drop, 1e-12);
-  if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();
-  // blocks in first-seen order: make it [q, p]
-  Eigen::MatrixXd J = marginal->J;
-  if (marginal->blocks[0] != n.q) {
-    Eigen::MatrixXd swapped(J.rows(), 6);
-    swapped << J.rightCols(3), J.leftCols(3);
-    J = swapped;
+  // by a Cholesky factorisation of the rest; the eigen-decomposition (which also copes with a rank
+  // deficient rest) only where that fails
+  Eigen::MatrixXd marginal_info;
+  Mat6 info;
+  if (m.marginalInformation({n.q, n.p}, &marginal_info) && marginal_info.rows() == 6) {
+    // as marginalize() has it: directions with no information (relative to the strongest) carry none
+    const Eigen::SelfAdjointEigenSolver<Mat6> ei{Mat6(marginal_info)};
+    const double top = std::max(ei.eigenvalues().maxCoeff(), 0.0);
+    const Vec6 kept = (ei.eigenvalues().array() > 1e-12 * top && ei.eigenvalues().array() > 0.0)
+                          .select(ei.eigenvalues().array(), 0.0)
+                          .matrix();
+    info = ei.eigenvectors() * kept.asDiagonal() * ei.eigenvectors().transpose();
+  } else {
+    std::set<const double*> drop;
+    for (auto& w : window_)
+      for (double* b : w->blocks())
+        if (b != n.q && b != n.p) drop.insert(b);
+    for (auto& l : landmarks_) drop.insert(l->c);
+    drop.insert(wheel_scale_);
+    const auto marginal = m.marginalize(drop, 1e-12);
+    if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();
+    // blocks in first-seen order: make it [q, p]
+    Eigen::MatrixXd J = marginal->J;
+    if (marginal->blocks[0] != n.q) {
+      Eigen::MatrixXd swapped(J.rows(), 6);
+      swapped << J.rightCols(3), J.leftCols(3);
+      J = swapped;
+    }
+    info = J.transpose() * J;
   }
-  const Mat6 info = J.transpose() * J;
   const Eigen::SelfAdjointEigenSolver<Mat6> es(info);
   const Vec6 inv = es.eigenvalues().cwiseMax(1e-9).cwiseInverse();
   return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();

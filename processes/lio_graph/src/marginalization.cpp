@@ -1,10 +1,12 @@
 #include "livo/lio_graph/marginalization.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "livo/lio_graph/quaternion_manifold.hpp"
@@ -95,30 +97,18 @@ void Marginalizer::addFactor(const ceres::CostFunction* cost, std::vector<double
   factors_.push_back({cost, std::move(blocks), loss});
 }
 
-std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const double*>& drop, double eps) const {
-  // every block the factors touch: the dropped ones first, then the kept ones, in first-seen order
-  std::vector<double*> order;
-  std::map<const double*, int> ambient;
-  for (int pass = 0; pass < 2; ++pass)
-    for (const Factor& f : factors_)
-      for (size_t k = 0; k < f.blocks.size(); ++k) {
-        double* b = f.blocks[k];
-        if ((drop.count(b) > 0) != (pass == 0) || ambient.count(b)) continue;
-        ambient[b] = f.cost->parameter_block_sizes()[k];
-        order.push_back(b);
-      }
+void Marginalizer::linearize(const std::vector<double*>& order, std::map<const double*, int>* ambient,
+                             Eigen::MatrixXd* H_out, Eigen::VectorXd* g_out) const {
   std::map<const double*, int> offset;
-  int total = 0, dropped = 0;
+  int total = 0;
   for (double* b : order) {
     offset[b] = total;
-    const int local = quaternions_.count(b) ? 3 : ambient[b];
-    total += local;
-    if (drop.count(b)) dropped += local;
+    total += quaternions_.count(b) ? 3 : (*ambient)[b];
   }
-  if (total == dropped) return nullptr;
-
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(total, total);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(total);
+  Eigen::MatrixXd& H = *H_out;
+  Eigen::VectorXd& g = *g_out;
+  H = Eigen::MatrixXd::Zero(total, total);
+  g = Eigen::VectorXd::Zero(total);
   const RightQuaternionManifold manifold;
   for (const Factor& f : factors_) {
     const int rows = f.cost->num_residuals();
@@ -155,6 +145,71 @@ std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const do
         H.block(oa, offset[f.blocks[b]], Jloc[a].cols(), Jloc[b].cols()) += Jloc[a].transpose() * Jloc[b];
     }
   }
+}
+
+std::vector<double*> Marginalizer::blockOrder(const std::set<const double*>& first,
+                                              std::map<const double*, int>* ambient) const {
+  // every block the factors touch: those of `first`, then the others, in first-seen order
+  std::vector<double*> order;
+  for (int pass = 0; pass < 2; ++pass)
+    for (const Factor& f : factors_)
+      for (size_t k = 0; k < f.blocks.size(); ++k) {
+        double* b = f.blocks[k];
+        if ((first.count(b) > 0) != (pass == 0) || ambient->count(b)) continue;
+        (*ambient)[b] = f.cost->parameter_block_sizes()[k];
+        order.push_back(b);
+      }
+  return order;
+}
+
+bool Marginalizer::marginalInformation(const std::vector<const double*>& keep, Eigen::MatrixXd* info) const {
+  std::set<const double*> drop;
+  for (const Factor& f : factors_)
+    for (double* b : f.blocks)
+      if (std::find(keep.begin(), keep.end(), b) == keep.end()) drop.insert(b);
+  std::map<const double*, int> ambient;
+  std::vector<double*> order = blockOrder(drop, &ambient);
+  // the kept blocks last, in the order asked for
+  order.resize(static_cast<size_t>(
+      std::count_if(order.begin(), order.end(), [&](double* b) { return drop.count(b) > 0; })));
+  int k = 0;
+  for (const double* b : keep) {
+    if (!ambient.count(b)) return false;  // touched by no factor: no information
+    order.push_back(const_cast<double*>(b));
+    k += quaternions_.count(b) ? 3 : ambient[b];
+  }
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  linearize(order, &ambient, &H, &g);
+  const Eigen::Index m = H.rows() - k;
+  if (m == 0) {
+    *info = H;
+    return true;
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(H.topLeftCorner(m, m));  // reads the lower triangle
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd Hmr = H.topRightCorner(m, k);
+  const Eigen::MatrixXd L_inv_Hmr = llt.matrixL().solve(Hmr);
+  Eigen::MatrixXd Hp = H.bottomRightCorner(k, k) - L_inv_Hmr.transpose() * L_inv_Hmr;
+  *info = 0.5 * (Hp + Hp.transpose());
+  return info->allFinite();
+}
+
+std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const double*>& drop, double eps) const {
+  // every block the factors touch: the dropped ones first, then the kept ones, in first-seen order
+  std::map<const double*, int> ambient;
+  const std::vector<double*> order = blockOrder(drop, &ambient);
+  int total = 0, dropped = 0;
+  for (double* b : order) {
+    const int local = quaternions_.count(b) ? 3 : ambient[b];
+    total += local;
+    if (drop.count(b)) dropped += local;
+  }
+  if (total == dropped) return nullptr;
+
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  linearize(order, &ambient, &H, &g);
 
   // Schur complement of the dropped block
   const int m = dropped, k = total - dropped;

@@ -5,6 +5,7 @@
 // Euclidean or quaternions on RightQuaternionManifold.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <set>
 #include <vector>
@@ -66,6 +67,12 @@ class Marginalizer {
   /// Linearises every factor at the blocks' current values and eliminates `drop`. Null if no
   /// block stays (nothing to keep). Eigenvalues below `eps` (relative to the largest) are dropped.
   std::shared_ptr<MarginalPrior> marginalize(const std::set<const double*>& drop, double eps = 1e-10) const;
+  /// The information on `keep` (tangent coordinates, blocks in this order) once every other block
+  /// the factors touch is eliminated (Schur complement), linearised as marginalize() does. By a
+  /// Cholesky factorisation of the eliminated blocks' information, far cheaper than marginalize()'s
+  /// eigen-decompositions; false if that is not positive definite (marginalize() then handles the
+  /// rank deficiency) or a kept block is touched by no factor.
+  bool marginalInformation(const std::vector<const double*>& keep, Eigen::MatrixXd* info) const;
 
  private:
   struct Factor {
@@ -73,6 +80,14 @@ class Marginalizer {
     std::vector<double*> blocks;
     const ceres::LossFunction* loss;
   };
+  /// Every block the factors touch, those in `first` first, each group in first-seen order; their
+  /// ambient sizes into `ambient`.
+  std::vector<double*> blockOrder(const std::set<const double*>& first, std::map<const double*, int>* ambient) const;
+  /// H = J^T J and g = J^T r of every factor at the blocks' current values, the blocks' tangent
+  /// coordinates in `order`.
+  void linearize(const std::vector<double*>& order, std::map<const double*, int>* ambient, Eigen::MatrixXd* H,
+                 Eigen::VectorXd* g) const;
+
   std::vector<Factor> factors_;
   std::set<const double*> quaternions_;
 };
