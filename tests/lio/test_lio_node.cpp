@@ -13,6 +13,7 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/lio/lio_node.hpp"
 #include "livo/messages.hpp"
+#include "synthetic_messages.hpp"
 #include "synthetic_world.hpp"
 
 using namespace livo;
@@ -30,33 +31,6 @@ lio:
   init: {window_s: 0.5}
   keyframe: {min_distance: 0.5}
 )";
-
-imu_t toImuMsg(const ImuSample& s) {
-  imu_t m;
-  m.utime = s.utime;
-  vec3To(s.gyro, m.angular_velocity);
-  vec3To(s.accel, m.linear_acceleration);
-  return m;
-}
-
-point_cloud_t toCloudMsg(const LidarScan& s) {
-  point_cloud_t m;
-  m.utime = s.utime;
-  m.frame = "L";
-  m.pattern = point_cloud_t::PATTERN_SPINNING;
-  m.num_rings = 16;
-  m.sweep_duration = static_cast<float>(s.sweep_duration);
-  m.num_points = static_cast<int32_t>(s.points.size());
-  for (size_t i = 0; i < s.points.size(); ++i) {
-    m.x.push_back(static_cast<float>(s.points[i].x()));
-    m.y.push_back(static_cast<float>(s.points[i].y()));
-    m.z.push_back(static_cast<float>(s.points[i].z()));
-    m.intensity.push_back(s.intensity[i]);
-    m.time_offset.push_back(s.time_offset[i]);
-    m.ring.push_back(static_cast<int16_t>(s.intensity[i]));
-  }
-  return m;
-}
 
 struct Outputs {
   std::vector<std::vector<uint8_t>> odometry_bytes;
@@ -143,8 +117,8 @@ synth::SyntheticSequence syntheticSequence() {
 std::vector<Message> syntheticRun() {
   const synth::SyntheticSequence seq = syntheticSequence();
   std::vector<Message> msgs;
-  for (const auto& s : seq.imu()) msgs.push_back(encode(s.utime, "IMU", toImuMsg(s)));
-  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", toCloudMsg(seq.scan(k))));
+  for (const auto& s : seq.imu()) msgs.push_back(encode(s.utime, "IMU", synth::imuMessage(s)));
+  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
   std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
   return msgs;
 }
@@ -610,7 +584,7 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
   poseTo(T, lc.correction_position, lc.correction_orientation);
   poseTo(T, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
   msgs.push_back(encode(kBase + 1'000'001, "LOOP_CORRECTION", lc));
-  imu_t jumped = toImuMsg(syntheticSequence().imu().front());
+  imu_t jumped = synth::imuMessage(syntheticSequence().imu().front());
   jumped.utime = kBase - 2'000'000;  // 3.5 s back from 1.5 s: more than clock_reset_s
   msgs.push_back(encode(kBase + 1'500'001, "IMU", jumped));
   jumped.utime += 5'000;  // the next sample confirms the new clock (a lone one would be dropped)

@@ -13,6 +13,7 @@
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "synthetic_messages.hpp"
 #include "synthetic_world.hpp"
 
 using namespace livo;
@@ -30,33 +31,6 @@ rig:
 )";
 
 constexpr int64_t kBase = 1'000'000'000;  // the synthetic sequence's first stamp
-
-imu_t toImuMsg(const ImuSample& s) {
-  imu_t m;
-  m.utime = s.utime;
-  vec3To(s.gyro, m.angular_velocity);
-  vec3To(s.accel, m.linear_acceleration);
-  return m;
-}
-
-point_cloud_t toCloudMsg(const LidarScan& s) {
-  point_cloud_t m;
-  m.utime = s.utime;
-  m.frame = "L";
-  m.pattern = point_cloud_t::PATTERN_SPINNING;
-  m.num_rings = 16;
-  m.sweep_duration = static_cast<float>(s.sweep_duration);
-  m.num_points = static_cast<int32_t>(s.points.size());
-  for (size_t i = 0; i < s.points.size(); ++i) {
-    m.x.push_back(static_cast<float>(s.points[i].x()));
-    m.y.push_back(static_cast<float>(s.points[i].y()));
-    m.z.push_back(static_cast<float>(s.points[i].z()));
-    m.intensity.push_back(s.intensity[i]);
-    m.time_offset.push_back(s.time_offset[i]);
-    m.ring.push_back(static_cast<int16_t>(s.intensity[i]));
-  }
-  return m;
-}
 
 struct Message {
   int64_t order_key;
@@ -121,9 +95,9 @@ std::vector<Message> syntheticRun(double duration, double gap_from = -1.0, doubl
   for (const auto& s : seq.imu()) {
     const double t = static_cast<double>(s.utime - kBase) * 1e-6;
     if (t > gap_from && t < gap_to) continue;
-    msgs.push_back(encode(s.utime, "IMU", toImuMsg(s)));
+    msgs.push_back(encode(s.utime, "IMU", synth::imuMessage(s)));
   }
-  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", toCloudMsg(seq.scan(k))));
+  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
   return msgs;
 }
 
