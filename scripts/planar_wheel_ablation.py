@@ -95,8 +95,9 @@ def main():
                     continue
                 print('%s: %s' % (tag, variant), file=sys.stderr, flush=True)
                 run_dir = os.path.join(base, variant)
+                # only what the evaluation reads: 24 runs of every output would fill a disk
                 cmd = [os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
-                       '--out', run_dir, '--processes', 'lio']
+                       '--out', run_dir, '--processes', 'lio', '--record', 'ODOMETRY,GROUND_TRUTH,HEALTH']
                 if exe:
                     cmd += ['--swap', 'lio=' + os.path.join(bin_dir, exe)]
                 if overlay:
