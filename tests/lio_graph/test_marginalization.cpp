@@ -8,8 +8,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "livo/lio_graph/graph_factors.hpp"
-#include "livo/lio_graph/marginalization.hpp"
+#include "livo/graph_factors.hpp"
+#include "livo/lio_graph/plane_factor.hpp"
+#include "livo/marginalization.hpp"
 
 using namespace livo;
 using namespace livo::lio_graph;

@@ -8,7 +8,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "livo/lio_graph/graph_factors.hpp"
+#include "livo/graph_factors.hpp"
+#include "livo/lio_graph/plane_factor.hpp"
 #include "livo/plane.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"

@@ -23,7 +23,7 @@
 
 #include "livo/keyframe_selector.hpp"
 #include "livo/lio_graph/lio_graph_options.hpp"
-#include "livo/lio_graph/marginalization.hpp"
+#include "livo/marginalization.hpp"
 #include "livo/odometry_frame.hpp"
 
 namespace livo::lio_graph {

@@ -1,4 +1,4 @@
-#include "livo/lio_graph/marginalization.hpp"
+#include "livo/marginalization.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +9,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "livo/lio_graph/quaternion_manifold.hpp"
+#include "livo/quaternion_manifold.hpp"
 #include "livo/so3.hpp"
 
-namespace livo::lio_graph {
+namespace livo {
 
 MarginalPriorFactor::MarginalPriorFactor(std::shared_ptr<const MarginalPrior> prior) : prior_(std::move(prior)) {
   set_num_residuals(static_cast<int>(prior_->J.rows()));
@@ -249,4 +249,4 @@ std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const do
   return prior;
 }
 
-}  // namespace livo::lio_graph
+}  // namespace livo

@@ -15,7 +15,7 @@
 
 #include "livo/so3.hpp"
 
-namespace livo::lio_graph {
+namespace livo {
 
 /// A linear prior r(x) = r0 + J (x [-] x0) on parameter blocks, [-] per block (Euclidean
 /// difference; Log(q0^-1 q) for quaternions).
@@ -92,4 +92,4 @@ class Marginalizer {
   std::set<const double*> quaternions_;
 };
 
-}  // namespace livo::lio_graph
+}  // namespace livo

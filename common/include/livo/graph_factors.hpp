@@ -1,17 +1,18 @@
-// The factors of the sliding-window graph (Ceres). A state is five parameter blocks: the
-// orientation q_W_I (quaternion, Eigen order x y z w, on RightQuaternionManifold: perturbed on the
-// right, q Exp(dtheta), the convention of every information matrix here), the position p_W,
-// the velocity v_W and the gyro and accelerometer biases.
+// The factors of the sliding-window graphs (Ceres) of livo-lio-graph and livo-vio-feature. A
+// state is five parameter blocks: the orientation q_W_I (quaternion, Eigen order x y z w, on
+// RightQuaternionManifold: perturbed on the right, q Exp(dtheta), the convention of every
+// information matrix here), the position p_W, the velocity v_W and the gyro and accelerometer
+// biases.
 #pragma once
 
 #include <ceres/ceres.h>
 
 #include "livo/imu_preintegration.hpp"
-#include "livo/lio_graph/quaternion_manifold.hpp"
+#include "livo/quaternion_manifold.hpp"
 #include "livo/so3.hpp"
 #include "livo/wheel_preintegration.hpp"
 
-namespace livo::lio_graph {
+namespace livo {
 
 /// The IMU preintegration between states i and j (9 residuals; blocks q_i p_i v_i bg_i ba_i q_j p_j v_j).
 ceres::CostFunction* makeImuFactor(const ImuPreintegration& preintegration, const Vec3& gravity_W);
@@ -27,19 +28,10 @@ ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma);
 /// The wheel scales' prior (2 residuals; block s).
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma);
 
-/// A plane landmark seen from a state (3 residuals; blocks q p c). The landmark is the vector c
-/// from its anchor a (the position it was first seen from) to the plane's closest point: plane
-/// n.(x - a) = |c| with n = c / |c|; never near c = 0, since no plane is seen at zero range. The
-/// measurement is the plane in the body frame (n_m.x + d_m = 0, the sensor on its positive side):
-/// residuals are the predicted normal along two directions orthogonal to n_m, over sigma_angle
-/// (rad), and the predicted offset minus d_m, over sigma_distance (m).
-ceres::CostFunction* makePlaneFactor(const Vec3& anchor, const Vec3& measured_normal, double measured_offset,
-                                     double sigma_angle, double sigma_distance);
-
 /// The wheel preintegration between i and j (6 residuals; blocks q_i p_i q_j p_j).
 ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration);
 /// The same with the wheel scales [s_l, s_r] as a block (wheel_preintegration.hpp; blocks q_i p_i
 /// q_j p_j s): the tyres' true radii over the nominal, estimated with the trajectory.
 ceres::CostFunction* makeScaledWheelFactor(const WheelPreintegration& preintegration);
 
-}  // namespace livo::lio_graph
+}  // namespace livo

@@ -1,11 +1,11 @@
-#include "livo/lio_graph/quaternion_manifold.hpp"
+#include "livo/quaternion_manifold.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "livo/so3.hpp"
 
-namespace livo::lio_graph {
+namespace livo {
 
 namespace {
 
@@ -63,4 +63,4 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& information) {
   return s.asDiagonal() * es.eigenvectors().transpose();
 }
 
-}  // namespace livo::lio_graph
+}  // namespace livo

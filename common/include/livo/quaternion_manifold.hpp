@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <ceres/manifold.h>
 
-namespace livo::lio_graph {
+namespace livo {
 
 /// Unit quaternions (x, y, z, w) with Plus(q, d) = q * Exp(d) and Minus(y, x) = Log(x^-1 * y).
 class RightQuaternionManifold : public ceres::Manifold {
@@ -26,4 +26,4 @@ void minusAmbientJacobian(const double* q0, const double* q, double* jacobian);
 /// information, eigenvalues below zero clipped.
 Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& information);
 
-}  // namespace livo::lio_graph
+}  // namespace livo
