@@ -14,6 +14,12 @@
 
 namespace livo {
 
+/// The pose W_T_I of a state's orientation block q (x y z w, normalised here) and position block p.
+inline Pose3 poseFromBlocks(const double* q, const double* p) {
+  return se3::fromRotationTranslation(Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix(),
+                                      Vec3(p[0], p[1], p[2]));
+}
+
 /// The IMU preintegration between states i and j (9 residuals; blocks q_i p_i v_i bg_i ba_i q_j p_j v_j).
 ceres::CostFunction* makeImuFactor(const ImuPreintegration& preintegration, const Vec3& gravity_W);
 

@@ -11,6 +11,7 @@
 #include "livo/graph_factors.hpp"
 #include "livo/lio_graph/plane_factor.hpp"
 #include "livo/plane.hpp"
+#include "livo/sample_interval.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/voxel_downsample.hpp"
@@ -24,50 +25,6 @@ constexpr double kMaxSweepS = 1.0;      // time offsets beyond this are garbage
 void appendNote(std::string* note, const std::string& what) {
   if (!note->empty()) *note += "; ";
   *note += what;
-}
-
-/// IMU reading at t between two samples (linear).
-ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t) {
-  if (b.utime <= a.utime) return ImuSample{t, b.gyro, b.accel};
-  const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
-  return ImuSample{t, a.gyro + s * (b.gyro - a.gyro), a.accel + s * (b.accel - a.accel)};
-}
-
-WheelSample interpolate(const WheelSample& a, const WheelSample& b, int64_t t) {
-  if (b.utime <= a.utime) return WheelSample{t, b.left_speed, b.right_speed};
-  const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
-  return WheelSample{t, a.left_speed + s * (b.left_speed - a.left_speed),
-                     a.right_speed + s * (b.right_speed - a.right_speed)};
-}
-
-/// Samples of a time-ordered buffer covering [t0, t1]: the readings at t0 and t1 (interpolated)
-/// and every sample strictly between. False if the buffer does not reach t1.
-template <class Sample>
-bool samplesOver(const std::deque<Sample>& buf, int64_t t0, int64_t t1, std::vector<Sample>* out) {
-  out->clear();
-  if (buf.empty() || buf.back().utime < t1) return false;
-  size_t i = 0;
-  while (i + 1 < buf.size() && buf[i + 1].utime <= t0) ++i;
-  // the reading at t0 (held before the first sample)
-  if (buf[i].utime >= t0 || i + 1 >= buf.size()) {
-    Sample s = buf[i];
-    s.utime = t0;
-    out->push_back(s);
-  } else {
-    out->push_back(interpolate(buf[i], buf[i + 1], t0));
-  }
-  for (size_t k = i; k < buf.size() && buf[k].utime < t1; ++k)
-    if (buf[k].utime > t0) out->push_back(buf[k]);
-  size_t j = 0;
-  while (j < buf.size() && buf[j].utime < t1) ++j;
-  out->push_back(j == 0 ? buf[0] : interpolate(buf[j - 1], buf[j], t1));
-  out->back().utime = t1;
-  return true;
-}
-
-Pose3 poseOf(const double* q, const double* p) {
-  return se3::fromRotationTranslation(Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix(),
-                                      Vec3(p[0], p[1], p[2]));
 }
 
 /// A pose's information [dtheta (right), dp] in a world turned by R: the rotation error is
@@ -154,7 +111,7 @@ struct LioGraphEstimator::Node {
   };
   std::vector<PlaneObservation> planes;
 
-  Pose3 pose() const { return poseOf(q, p); }
+  Pose3 pose() const { return poseFromBlocks(q, p); }
   void setPose(const Pose3& T) {
     const Eigen::Quaterniond r = Eigen::Quaterniond(T.linear()).normalized();
     std::copy(r.coeffs().data(), r.coeffs().data() + 4, q);
