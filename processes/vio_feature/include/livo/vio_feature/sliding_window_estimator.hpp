@@ -1,0 +1,135 @@
+// livo-vio-feature's back end: a sliding window of camera-rate states (pose, velocity, biases)
+// optimised with Ceres over
+//   - reprojection factors of tracked features (inverse depth in their first frame, Cauchy loss),
+//   - inverse-depth priors where a depth was measured (RGB-D depth image or LiDAR),
+//   - IMU preintegration and bias random-walk factors between consecutive states,
+//   - wheel preintegration factors (Cauchy loss) when the rig has a wheel encoder,
+//   - the marginal prior of the states and features that left the window
+// (VINS-Mono's scheme, the wheel as in Ground-Fusion, from common/'s preintegration and factors).
+// When the window is full, a new keyframe pushes the oldest state out (marginalised: its factors
+// become the prior); a new frame that is not a keyframe replaces the previous newest, whose
+// observations are dropped and whose IMU and wheel intervals merge into the new one's.
+//
+// Initialisation: at rest from the IMU (gravity, gyro bias), or in motion from the wheels (the
+// body velocity from the wheel speeds, gravity from the specific force over a short window less
+// the acceleration the wheels and the gyro account for). The world is gravity-aligned, z up, with
+// the first state at the origin and zero yaw.
+//
+// The core knows nothing of LCM or images: features arrive tracked and undistorted (the front end,
+// feature_tracker.hpp), IMU and wheel samples on the IMU clock.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "livo/marginalization.hpp"
+#include "livo/sensor_samples.hpp"
+#include "livo/vio_feature/vio_feature_options.hpp"
+
+namespace livo::vio_feature {
+
+/// One tracked feature in one image: its track's id, its undistorted normalised point (z = 1) and
+/// its measured depth along the camera's z (0: none).
+struct FeatureMeasurement {
+  uint64_t id = 0;
+  Vec2 xy = Vec2::Zero();
+  double depth = 0.0;
+};
+
+/// The features of one image, stamped on the camera clock.
+struct FrameFeatures {
+  int64_t utime = 0;
+  bool keyframe = true;   // the front end's decision (parallax, tracked count)
+  std::vector<FeatureMeasurement> features;
+};
+
+/// The estimate at an image's time (IMU clock).
+struct VisualState {
+  int64_t utime = 0;
+  Pose3 pose = Pose3::Identity();   // W_T_I
+  Vec3 velocity = Vec3::Zero();     // W
+  Vec3 gyro_bias = Vec3::Zero();
+  Vec3 accel_bias = Vec3::Zero();
+  Mat6 pose_covariance = Mat6::Identity();  // [dtheta (right), dp]
+};
+
+struct FrameResult {
+  enum class Status { kRejected, kInitializing, kInitialized, kTracked };
+  Status status = Status::kRejected;
+  std::string note;
+  VisualState state;          // kInitialized, kTracked
+  int features_in_graph = 0;  // with an inverse depth and two observations or more
+  int features_with_depth = 0;// of those, with a measured depth
+  int outliers = 0;           // dropped after this optimisation
+  bool static_start = false;  // kInitialized: at rest, else in motion (wheels)
+};
+
+const char* statusName(FrameResult::Status s);
+
+class SlidingWindowEstimator {
+ public:
+  explicit SlidingWindowEstimator(const SlidingWindowOptions& options);
+  ~SlidingWindowEstimator();
+  SlidingWindowEstimator(const SlidingWindowEstimator&) = delete;
+  SlidingWindowEstimator& operator=(const SlidingWindowEstimator&) = delete;
+
+  /// Buffers an IMU sample (IMU clock); false with `why` for a non-finite or non-increasing one.
+  bool addImu(const ImuSample& s, std::string* why = nullptr);
+  /// Buffers a wheel reading (IMU clock); the same checks.
+  bool addWheel(const WheelSample& s, std::string* why = nullptr);
+  /// Processes an image's features. The IMU (and the wheels) must already be buffered up to the
+  /// image's time on the IMU clock (utime + camera_time_offset_s), else the frame is refused.
+  FrameResult addFrame(const FrameFeatures& frame);
+
+  bool initialized() const { return !window_.empty(); }
+  /// Drops the window, the features and the prior (the buffers stay): the next frames initialise.
+  void reset();
+  /// The newest IMU sample's time (0 before any).
+  int64_t imuWatermark() const { return imu_.empty() ? 0 : imu_.back().utime; }
+  int64_t wheelWatermark() const { return wheel_.empty() ? 0 : wheel_.back().utime; }
+  const SlidingWindowOptions& options() const { return opts_; }
+
+ private:
+  struct Frame;
+  struct Feature;
+
+  bool initialize(int64_t t, FrameResult* res);
+  bool initializeAtRest(int64_t t, FrameResult* res);
+  bool initializeMoving(int64_t t, FrameResult* res);
+  void startWindow(int64_t t, const Mat3& R, const Vec3& v, const Vec3& bg, const Vec3& ba, double rot_std,
+                   double vel_std, double bg_std);
+  /// The IMU (and wheel) factors of `to` from `from`'s time, linearised at from's biases; false if
+  /// the IMU does not cover the interval or has a gap.
+  /// `predict`: the new state's first guess is the IMU's prediction (else it keeps its estimate).
+  bool connect(Frame& from, Frame& to, bool predict, std::string* why);
+  void addObservations(Frame& frame, const FrameFeatures& features);
+  void triangulate();
+  /// The features that enter the optimisation (inverse depth known, two frames or more).
+  std::vector<Feature*> graphFeatures();
+  void optimize(const std::vector<Feature*>& features);
+  /// Drops the features of the last optimisation that are off by more than outlier_px anywhere.
+  int rejectOutliers();
+  void marginalizeOldest();
+  void dropSecondNewest();
+  void eraseFeature(uint64_t id);
+  Mat6 newestPoseCovariance(const std::vector<Feature*>& features) const;
+  VisualState stateOf(const Frame& f) const;
+
+  SlidingWindowOptions opts_;
+  Vec3 gravity_W_;
+  std::deque<ImuSample> imu_;
+  std::deque<WheelSample> wheel_;
+  std::deque<std::unique_ptr<Frame>> window_;
+  std::map<uint64_t, std::unique_ptr<Feature>> features_;
+  std::set<uint64_t> rejected_;  // outlier tracks: their later observations are ignored
+  std::shared_ptr<MarginalPrior> prior_;
+  std::unique_ptr<ceres::CostFunction> prior_factor_;
+  std::unique_ptr<ceres::LossFunction> reprojection_loss_;
+};
+
+}  // namespace livo::vio_feature

@@ -1,0 +1,316 @@
+// livo-vio-feature's back end: the reprojection factor's Jacobians against central differences,
+// and the sliding window on synthetic feature tracks of the room walk (exact trajectory, realistic
+// IMU errors, pixel noise) against ground truth.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "livo/so3.hpp"
+#include "livo/vio_feature/reprojection_factor.hpp"
+#include "livo/vio_feature/sliding_window_estimator.hpp"
+#include "synthetic_world.hpp"
+
+using namespace livo;
+using namespace livo::vio_feature;
+namespace synth = livo::lio::synth;
+
+namespace {
+
+/// The camera looking forward along the body's x, a little above and ahead of the IMU.
+Pose3 forwardCamera() {
+  Mat3 R_IC;
+  R_IC << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // camera z = body x, camera x = -body y, camera y = -body z
+  return se3::fromRotationTranslation(R_IC, Vec3(0.1, 0.02, 0.05));
+}
+
+std::vector<double> quaternionBlock(const Mat3& R) {
+  const Eigen::Quaterniond q(R);
+  return {q.x(), q.y(), q.z(), q.w()};
+}
+
+}  // namespace
+
+TEST(ReprojectionFactor, JacobiansMatchCentralDifferences) {
+  const Pose3 T_I_C = forwardCamera();
+  const Pose3 T_a = se3::fromRotationTranslation(so3::Exp(Vec3(0.1, -0.2, 0.4)), Vec3(1.0, 2.0, 0.5));
+  const Pose3 T_j = se3::fromRotationTranslation(so3::Exp(Vec3(0.15, -0.1, 0.6)), Vec3(1.4, 2.3, 0.45));
+  const Vec2 xy_a(0.12, -0.08);
+  const double rho = 1.0 / 4.0;
+  // the measurement the truth predicts, moved by a few pixels so the residual is not zero
+  const Vec3 p = predictInCamera(xy_a, rho, T_a, T_j, T_I_C);
+  ASSERT_GT(p.z(), 0.0);
+  const Vec2 xy_j = p.head<2>() / p.z() + Vec2(0.004, -0.003);
+  std::unique_ptr<ceres::CostFunction> f(makeReprojectionFactor(xy_a, xy_j, T_I_C, 450.0, 1.5));
+  std::vector<double> qa = quaternionBlock(T_a.linear()), qj = quaternionBlock(T_j.linear());
+  std::vector<double> pa(T_a.translation().data(), T_a.translation().data() + 3);
+  std::vector<double> pj(T_j.translation().data(), T_j.translation().data() + 3);
+  std::vector<double> r0 = {rho};
+  std::vector<std::vector<double>*> blocks = {&qa, &pa, &qj, &pj, &r0};
+  auto evaluate = [&](double* r, double** J) {
+    const double* params[5] = {qa.data(), pa.data(), qj.data(), pj.data(), r0.data()};
+    return f->Evaluate(params, r, J);
+  };
+  double r[2];
+  std::vector<std::vector<double>> J(5);
+  double* Jp[5];
+  for (int b = 0; b < 5; ++b) {
+    J[b].resize(2 * blocks[b]->size());
+    Jp[b] = J[b].data();
+  }
+  ASSERT_TRUE(evaluate(r, Jp));
+  // the residual is the pixel offset over sigma
+  EXPECT_NEAR(r[0], -0.004 * 450.0 / 1.5, 1e-9);
+  EXPECT_NEAR(r[1], 0.003 * 450.0 / 1.5, 1e-9);
+  const double h = 1e-6;
+  for (int b = 0; b < 5; ++b) {
+    for (size_t k = 0; k < blocks[b]->size(); ++k) {
+      double rp[2], rm[2];
+      const double x = (*blocks[b])[k];
+      (*blocks[b])[k] = x + h;
+      ASSERT_TRUE(evaluate(rp, nullptr));
+      (*blocks[b])[k] = x - h;
+      ASSERT_TRUE(evaluate(rm, nullptr));
+      (*blocks[b])[k] = x;
+      for (int i = 0; i < 2; ++i) {
+        const double numeric = (rp[i] - rm[i]) / (2.0 * h);
+        EXPECT_NEAR(J[b][i * blocks[b]->size() + k], numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
+            << "block " << b << " parameter " << k << " residual " << i;
+      }
+    }
+  }
+}
+
+TEST(ReprojectionFactor, RefusesAPointBehindTheCamera) {
+  const Pose3 T_I_C = forwardCamera();
+  const Pose3 T_a = Pose3::Identity();
+  // frame j 10 m ahead of a point 4 m in front of the anchor: the point is behind j's camera
+  const Pose3 T_j = se3::fromRotationTranslation(Mat3::Identity(), Vec3(10.0, 0.0, 0.0));
+  std::unique_ptr<ceres::CostFunction> f(makeReprojectionFactor(Vec2::Zero(), Vec2::Zero(), T_I_C, 450.0, 1.5));
+  std::vector<double> q = quaternionBlock(Mat3::Identity());
+  const double pa[3] = {0, 0, 0}, pj[3] = {10, 0, 0}, rho[1] = {0.25};
+  const double* params[5] = {q.data(), pa, q.data(), pj, rho};
+  double r[2];
+  (void)T_a;
+  (void)T_j;
+  EXPECT_FALSE(f->Evaluate(params, r, nullptr));
+}
+
+TEST(InverseDepthPrior, WeighsTheDepthsSigmaCarriedToItsInverse) {
+  std::unique_ptr<ceres::CostFunction> f(makeInverseDepthPrior(5.0, 0.1));
+  const double rho[1] = {1.0 / 5.1};
+  const double* params[1] = {rho};
+  double r[1];
+  ASSERT_TRUE(f->Evaluate(params, r, nullptr));
+  // 0.1 m off at 5 m is about one sigma
+  EXPECT_NEAR(r[0], -1.0, 0.03);
+}
+
+namespace {
+
+/// Feature tracks of the room walk: landmarks scattered through the room, seen by the forward
+/// camera (640 x 480, f = 450) with pixel noise; a track lives while its landmark stays in view,
+/// new ones fill up to `max_tracks`, as a KLT front end's would. Keyframes by parallax.
+class SyntheticTracks {
+ public:
+  SyntheticTracks(const synth::Trajectory& traj, const Pose3& T_I_C, double pixel_noise, double depth_fraction,
+                  double depth_noise_rel, unsigned seed)
+      : traj_(traj), T_I_C_(T_I_C), pixel_noise_(pixel_noise), depth_fraction_(depth_fraction),
+        depth_noise_rel_(depth_noise_rel), rng_(seed) {
+    std::uniform_real_distribution<double> x(-14.0, 14.0), y(-7.0, 7.0), z(0.0, 4.0);
+    for (int i = 0; i < 4000; ++i) landmarks_.push_back(Vec3(x(rng_), y(rng_), z(rng_)));
+  }
+
+  FrameFeatures frame(double t, int64_t utime) {
+    const Pose3 T_C_W = (traj_.pose(t) * T_I_C_).inverse();
+    std::normal_distribution<double> n01(0.0, 1.0);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    auto pixelOf = [&](size_t i, Vec2* px, double* z) {
+      const Vec3 p = T_C_W * landmarks_[i];
+      if (p.z() < 0.5 || p.z() > 15.0) return false;
+      *px = Vec2(kF * p.x() / p.z() + 320.0, kF * p.y() / p.z() + 240.0);
+      *z = p.z();
+      return px->x() >= 10 && px->x() < 630 && px->y() >= 10 && px->y() < 470;
+    };
+    FrameFeatures out;
+    out.utime = utime;
+    std::set<size_t> alive;
+    std::map<size_t, Vec2> pixels;
+    for (size_t i : tracks_) {
+      Vec2 px;
+      double z = 0.0;
+      if (pixelOf(i, &px, &z)) alive.insert(i), pixels[i] = px;
+    }
+    // new tracks: visible landmarks in a shuffled order until max_tracks
+    std::vector<size_t> order(landmarks_.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), rng_);
+    for (size_t i : order) {
+      if (alive.size() >= kMaxTracks) break;
+      Vec2 px;
+      double z = 0.0;
+      if (!alive.count(i) && pixelOf(i, &px, &z)) alive.insert(i), pixels[i] = px;
+    }
+    tracks_ = alive;
+    double parallax = 0.0;
+    int common = 0;
+    for (size_t i : alive) {
+      Vec2 px;
+      double z = 0.0;
+      pixelOf(i, &px, &z);
+      FeatureMeasurement m;
+      m.id = i;
+      const Vec2 noisy = px + pixel_noise_ * Vec2(n01(rng_), n01(rng_));
+      m.xy = Vec2((noisy.x() - 320.0) / kF, (noisy.y() - 240.0) / kF);
+      if (u01(rng_) < depth_fraction_) m.depth = z * (1.0 + depth_noise_rel_ * n01(rng_));
+      out.features.push_back(m);
+      auto it = last_key_.find(i);
+      if (it != last_key_.end()) parallax += (px - it->second).norm(), ++common;
+    }
+    out.keyframe = last_key_.empty() || common < 0.5 * static_cast<double>(alive.size()) ||
+                   parallax / std::max(common, 1) > 10.0;
+    if (out.keyframe) last_key_ = pixels;
+    return out;
+  }
+
+ private:
+  static constexpr double kF = 450.0;
+  static constexpr size_t kMaxTracks = 150;
+  synth::Trajectory traj_;
+  Pose3 T_I_C_;
+  double pixel_noise_, depth_fraction_, depth_noise_rel_;
+  std::mt19937 rng_;
+  std::vector<Vec3> landmarks_;
+  std::set<size_t> tracks_;
+  std::map<size_t, Vec2> last_key_;
+};
+
+SlidingWindowOptions optionsFor(const synth::SequenceSpec& spec) {
+  SlidingWindowOptions o;
+  o.T_I_C = forwardCamera();
+  o.focal = 450.0;
+  o.pixel_sigma = 1.0;
+  o.gravity = -spec.traj.gravity.z();
+  o.imu_noise.gyro_noise_density = spec.imu_error.noise.gyro_noise_density;
+  o.imu_noise.accel_noise_density = spec.imu_error.noise.accel_noise_density;
+  o.imu_noise.gyro_random_walk = spec.imu_error.noise.gyro_random_walk;
+  o.imu_noise.accel_random_walk = spec.imu_error.noise.accel_random_walk;
+  return o;
+}
+
+struct RunResult {
+  double ate = 0.0;
+  double distance = 0.0;
+  FrameResult first;
+  VisualState last;
+  std::vector<FrameResult> results;
+};
+
+/// Runs the room walk from trajectory time t_start for `duration` s at 20 Hz.
+RunResult run(const synth::SequenceSpec& spec, SlidingWindowOptions o, double t_start, double duration,
+              double depth_fraction, bool wheels) {
+  const synth::SyntheticSequence seq(spec);
+  SyntheticTracks tracks(spec.traj, o.T_I_C, 1.0, depth_fraction, 0.01, spec.seed);
+  if (wheels) {
+    o.use_wheel = true;
+    o.wheel_rig.rate_hz = 50.0;
+    o.wheel_rig.track_width = 0.5;
+    o.wheel_rig.speed_noise_std = 0.01;
+    o.wheel_noise = WheelPreintegrationNoise::fromRig(o.wheel_rig);
+    // the walk slides sideways and bobs, which a car does not: the wheels speak for the forward
+    // speed and the yaw rate only
+    o.wheel_noise.lateral_speed_std = 2.0;
+    o.wheel_noise.vertical_speed_std = 2.0;
+    o.wheel_noise.roll_pitch_rate_std = 2.0;
+  }
+  SlidingWindowEstimator est(o);
+  std::mt19937 rng(spec.seed + 100);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  size_t next_imu = 0;
+  double t_wheel = t_start - 1.0;
+  RunResult out;
+  std::vector<Vec3> e, g;
+  bool first = true;
+  for (double t = t_start; t < t_start + duration; t += 0.05) {
+    const int64_t utime = spec.base_utime + static_cast<int64_t>(std::llround(t * 1e6));
+    while (next_imu < seq.imu().size() && seq.imu()[next_imu].utime <= utime + 10000) {
+      if (seq.imu()[next_imu].utime >= utime - 1'000'000) est.addImu(seq.imu()[next_imu]);
+      ++next_imu;
+    }
+    for (; wheels && spec.base_utime + static_cast<int64_t>(std::llround(t_wheel * 1e6)) <= utime + 20000; t_wheel += 0.02) {
+      const Pose3 T = spec.traj.pose(t_wheel);
+      const double v = (T.linear().transpose() * spec.traj.velocity(t_wheel)).x();
+      const double w = spec.traj.omegaBody(t_wheel).z();
+      const double half = 0.5 * o.wheel_rig.track_width * w;
+      est.addWheel(WheelSample{spec.base_utime + static_cast<int64_t>(std::llround(t_wheel * 1e6)),
+                               v - half + noise(rng), v + half + noise(rng)});
+    }
+    const FrameResult r = est.addFrame(tracks.frame(t, utime));
+    out.results.push_back(r);
+    if (r.status != FrameResult::Status::kTracked && r.status != FrameResult::Status::kInitialized) continue;
+    if (first) out.first = r, first = false;
+    out.last = r.state;
+    if (!g.empty()) out.distance += (seq.truth(r.state.utime).translation() - g.back()).norm();
+    e.push_back(r.state.pose.translation());
+    g.push_back(seq.truth(r.state.utime).translation());
+  }
+  out.ate = e.size() > 2 ? synth::alignedRmse(e, g) : 1e9;
+  return out;
+}
+
+}  // namespace
+
+TEST(SlidingWindowEstimator, FollowsTheRoomWalkStartedAtRest) {
+  synth::SequenceSpec spec;
+  spec.traj = synth::roomTrajectory(1.5);
+  spec.duration = 22.0;
+  spec.imu_error = synth::realisticImu();
+  const RunResult r = run(spec, optionsFor(spec), 0.6, 20.0, 0.0, false);
+  ASSERT_EQ(r.first.status, FrameResult::Status::kInitialized);
+  EXPECT_TRUE(r.first.static_start);
+  const double drift = r.ate / r.distance;
+  std::cout << "room walk, monocular + IMU: ATE " << r.ate << " m over " << r.distance << " m (" << 100.0 * drift
+            << " %), accel bias " << r.last.accel_bias.transpose() << " (truth " << spec.imu_error.accel_bias.transpose()
+            << "), gyro bias " << r.last.gyro_bias.transpose() << " (truth " << spec.imu_error.gyro_bias.transpose()
+            << ")\n";
+  EXPECT_LT(drift, 0.01);
+  EXPECT_LT((r.last.gyro_bias - spec.imu_error.gyro_bias).norm(), 2e-3);
+  EXPECT_LT((r.last.accel_bias - spec.imu_error.accel_bias).norm(), 0.05);
+}
+
+TEST(SlidingWindowEstimator, MeasuredDepthsAnchorTheScale) {
+  // Half the features with a measured depth (1 % noise, as an RGB-D camera's or the LiDAR's):
+  // the scale no longer rests on the accelerometer alone.
+  synth::SequenceSpec spec;
+  spec.traj = synth::roomTrajectory(1.5);
+  spec.duration = 22.0;
+  spec.imu_error = synth::realisticImu();
+  spec.seed = 2;
+  const RunResult mono = run(spec, optionsFor(spec), 0.6, 20.0, 0.0, false);
+  const RunResult depth = run(spec, optionsFor(spec), 0.6, 20.0, 0.5, false);
+  int with_depth = 0;
+  for (const FrameResult& f : depth.results) with_depth = std::max(with_depth, f.features_with_depth);
+  std::cout << "room walk seed 2: ATE " << mono.ate << " m without depth, " << depth.ate << " m with depth ("
+            << with_depth << " features with depth at most)\n";
+  EXPECT_GT(with_depth, 30);
+  EXPECT_LT(depth.ate / depth.distance, 0.01);
+  EXPECT_LT(depth.ate, mono.ate * 1.05);
+}
+
+TEST(SlidingWindowEstimator, IsDeterministic) {
+  synth::SequenceSpec spec;
+  spec.traj = synth::roomTrajectory(1.5);
+  spec.duration = 8.0;
+  spec.imu_error = synth::realisticImu();
+  const RunResult a = run(spec, optionsFor(spec), 0.6, 6.0, 0.3, false);
+  const RunResult b = run(spec, optionsFor(spec), 0.6, 6.0, 0.3, false);
+  ASSERT_EQ(a.results.size(), b.results.size());
+  for (size_t i = 0; i < a.results.size(); ++i)
+    EXPECT_TRUE(a.results[i].state.pose.matrix() == b.results[i].state.pose.matrix()) << i;
+}
