@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -119,16 +120,18 @@ namespace {
 /// new ones fill up to `max_tracks`, as a KLT front end's would. Keyframes by parallax.
 class SyntheticTracks {
  public:
-  SyntheticTracks(const synth::Trajectory& traj, const Pose3& T_I_C, double pixel_noise, double depth_fraction,
-                  double depth_noise_rel, unsigned seed)
-      : traj_(traj), T_I_C_(T_I_C), pixel_noise_(pixel_noise), depth_fraction_(depth_fraction),
+  /// Landmarks uniform in the box [lo, hi], `count` of them; the body's pose W_T_I(t) from `pose`.
+  SyntheticTracks(std::function<Pose3(double)> pose, const Pose3& T_I_C, double pixel_noise, double depth_fraction,
+                  double depth_noise_rel, unsigned seed, const Vec3& lo = Vec3(-14.0, -7.0, 0.0),
+                  const Vec3& hi = Vec3(14.0, 7.0, 4.0), int count = 4000)
+      : pose_(std::move(pose)), T_I_C_(T_I_C), pixel_noise_(pixel_noise), depth_fraction_(depth_fraction),
         depth_noise_rel_(depth_noise_rel), rng_(seed) {
-    std::uniform_real_distribution<double> x(-14.0, 14.0), y(-7.0, 7.0), z(0.0, 4.0);
-    for (int i = 0; i < 4000; ++i) landmarks_.push_back(Vec3(x(rng_), y(rng_), z(rng_)));
+    std::uniform_real_distribution<double> x(lo.x(), hi.x()), y(lo.y(), hi.y()), z(lo.z(), hi.z());
+    for (int i = 0; i < count; ++i) landmarks_.push_back(Vec3(x(rng_), y(rng_), z(rng_)));
   }
 
   FrameFeatures frame(double t, int64_t utime) {
-    const Pose3 T_C_W = (traj_.pose(t) * T_I_C_).inverse();
+    const Pose3 T_C_W = (pose_(t) * T_I_C_).inverse();
     std::normal_distribution<double> n01(0.0, 1.0);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     auto pixelOf = [&](size_t i, Vec2* px, double* z) {
@@ -182,7 +185,7 @@ class SyntheticTracks {
  private:
   static constexpr double kF = 450.0;
   static constexpr size_t kMaxTracks = 150;
-  synth::Trajectory traj_;
+  std::function<Pose3(double)> pose_;
   Pose3 T_I_C_;
   double pixel_noise_, depth_fraction_, depth_noise_rel_;
   std::mt19937 rng_;
@@ -213,27 +216,12 @@ struct RunResult {
 };
 
 /// Runs the room walk from trajectory time t_start for `duration` s at 20 Hz.
-RunResult run(const synth::SequenceSpec& spec, SlidingWindowOptions o, double t_start, double duration,
-              double depth_fraction, bool wheels) {
+RunResult run(const synth::SequenceSpec& spec, const SlidingWindowOptions& o, double t_start, double duration,
+              double depth_fraction) {
   const synth::SyntheticSequence seq(spec);
-  SyntheticTracks tracks(spec.traj, o.T_I_C, 1.0, depth_fraction, 0.01, spec.seed);
-  if (wheels) {
-    o.use_wheel = true;
-    o.wheel_rig.rate_hz = 50.0;
-    o.wheel_rig.track_width = 0.5;
-    o.wheel_rig.speed_noise_std = 0.01;
-    o.wheel_noise = WheelPreintegrationNoise::fromRig(o.wheel_rig);
-    // the walk slides sideways and bobs, which a car does not: the wheels speak for the forward
-    // speed and the yaw rate only
-    o.wheel_noise.lateral_speed_std = 2.0;
-    o.wheel_noise.vertical_speed_std = 2.0;
-    o.wheel_noise.roll_pitch_rate_std = 2.0;
-  }
+  SyntheticTracks tracks([&](double t) { return spec.traj.pose(t); }, o.T_I_C, 1.0, depth_fraction, 0.01, spec.seed);
   SlidingWindowEstimator est(o);
-  std::mt19937 rng(spec.seed + 100);
-  std::normal_distribution<double> noise(0.0, 0.01);
   size_t next_imu = 0;
-  double t_wheel = t_start - 1.0;
   RunResult out;
   std::vector<Vec3> e, g;
   bool first = true;
@@ -242,14 +230,6 @@ RunResult run(const synth::SequenceSpec& spec, SlidingWindowOptions o, double t_
     while (next_imu < seq.imu().size() && seq.imu()[next_imu].utime <= utime + 10000) {
       if (seq.imu()[next_imu].utime >= utime - 1'000'000) est.addImu(seq.imu()[next_imu]);
       ++next_imu;
-    }
-    for (; wheels && spec.base_utime + static_cast<int64_t>(std::llround(t_wheel * 1e6)) <= utime + 20000; t_wheel += 0.02) {
-      const Pose3 T = spec.traj.pose(t_wheel);
-      const double v = (T.linear().transpose() * spec.traj.velocity(t_wheel)).x();
-      const double w = spec.traj.omegaBody(t_wheel).z();
-      const double half = 0.5 * o.wheel_rig.track_width * w;
-      est.addWheel(WheelSample{spec.base_utime + static_cast<int64_t>(std::llround(t_wheel * 1e6)),
-                               v - half + noise(rng), v + half + noise(rng)});
     }
     const FrameResult r = est.addFrame(tracks.frame(t, utime));
     out.results.push_back(r);
@@ -271,7 +251,7 @@ TEST(SlidingWindowEstimator, FollowsTheRoomWalkStartedAtRest) {
   spec.traj = synth::roomTrajectory(1.5);
   spec.duration = 22.0;
   spec.imu_error = synth::realisticImu();
-  const RunResult r = run(spec, optionsFor(spec), 0.6, 20.0, 0.0, false);
+  const RunResult r = run(spec, optionsFor(spec), 0.6, 20.0, 0.0);
   ASSERT_EQ(r.first.status, FrameResult::Status::kInitialized);
   EXPECT_TRUE(r.first.static_start);
   const double drift = r.ate / r.distance;
@@ -284,6 +264,110 @@ TEST(SlidingWindowEstimator, FollowsTheRoomWalkStartedAtRest) {
   EXPECT_LT((r.last.accel_bias - spec.imu_error.accel_bias).norm(), 0.05);
 }
 
+namespace {
+
+/// A car on flat ground: speed v(t) = 1.5 + 0.5 sin(0.4 t) m/s along its heading, yaw rate
+/// 0.05 + 0.25 sin(0.3 t) rad/s, never at rest. Exact IMU (white noise and the realistic biases
+/// added), wheel speeds of a 0.5 m track (1 cm/s noise); poses integrated at 10 kHz.
+class CarMotion {
+ public:
+  explicit CarMotion(double duration) {
+    double x = 0, y = 0, yaw = 0;
+    for (int k = 0; k <= static_cast<int>(duration / kStep) + 1; ++k) {
+      table_.push_back(Vec3(x, y, yaw));
+      const double t = k * kStep, tm = t + 0.5 * kStep;
+      const double yaw_m = yaw + 0.5 * kStep * yawRate(t);
+      x += kStep * speed(tm) * std::cos(yaw_m);
+      y += kStep * speed(tm) * std::sin(yaw_m);
+      yaw += kStep * yawRate(tm);
+    }
+  }
+  static double speed(double t) { return 1.5 + 0.5 * std::sin(0.4 * t); }
+  static double acceleration(double t) { return 0.2 * std::cos(0.4 * t); }
+  static double yawRate(double t) { return 0.05 + 0.25 * std::sin(0.3 * t); }
+  Pose3 pose(double t) const {
+    const double u = t / kStep;
+    const size_t i = std::min(static_cast<size_t>(std::max(u, 0.0)), table_.size() - 2);
+    const double s = u - static_cast<double>(i);
+    const Vec3 c = (1.0 - s) * table_[i] + s * table_[i + 1];
+    return se3::fromRotationTranslation(so3::Exp(Vec3(0, 0, c.z())), Vec3(c.x(), c.y(), 0.0));
+  }
+  Vec3 velocity(double t) const { return pose(t).linear() * Vec3(speed(t), 0.0, 0.0); }
+  ImuSample imu(double t, int64_t utime, const synth::ImuErrorModel& err, double dt, std::mt19937* rng) const {
+    std::normal_distribution<double> n01(0.0, 1.0);
+    const Mat3 R = pose(t).linear();
+    const Vec3 a_W = R * Vec3(acceleration(t), speed(t) * yawRate(t), 0.0);
+    const Vec3 f = R.transpose() * (a_W - Vec3(0.0, 0.0, -9.81));
+    const double sg = err.noise.gyro_noise_density / std::sqrt(dt), sa = err.noise.accel_noise_density / std::sqrt(dt);
+    return ImuSample{utime, Vec3(0.0, 0.0, yawRate(t)) + err.gyro_bias + sg * Vec3(n01(*rng), n01(*rng), n01(*rng)),
+                     f + err.accel_bias + sa * Vec3(n01(*rng), n01(*rng), n01(*rng))};
+  }
+
+ private:
+  static constexpr double kStep = 1e-4;
+  std::vector<Vec3> table_;  // x, y, yaw
+};
+
+}  // namespace
+
+TEST(SlidingWindowEstimator, StartsInMotionFromTheWheels) {
+  // A car already driving at 1.5 m/s when the estimator first hears it: no rest to initialise
+  // from, so the wheels give the velocity and, with the gyro, the gravity direction.
+  const CarMotion car(26.0);
+  const synth::ImuErrorModel err = synth::realisticImu();
+  SlidingWindowOptions o;
+  o.T_I_C = forwardCamera();
+  o.focal = 450.0;
+  o.pixel_sigma = 1.0;
+  o.use_wheel = true;
+  o.wheel_rig.rate_hz = 50.0;
+  o.wheel_rig.track_width = 0.5;
+  o.wheel_rig.speed_noise_std = 0.01;
+  o.wheel_noise = WheelPreintegrationNoise::fromRig(o.wheel_rig);
+  SlidingWindowEstimator est(o);
+  SyntheticTracks tracks([&](double t) { return car.pose(t); }, o.T_I_C, 1.0, 0.0, 0.0, 3, Vec3(-30.0, -30.0, -1.0),
+                         Vec3(50.0, 50.0, 4.0), 25000);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const int64_t base = 1'000'000'000;
+  auto utimeOf = [&](double t) { return base + static_cast<int64_t>(std::llround(t * 1e6)); };
+  double t_imu = 0.0, t_wheel = 0.0;
+  std::vector<Vec3> e, g;
+  double distance = 0.0;
+  FrameResult first;
+  for (double t = 0.6; t < 24.0; t += 0.05) {
+    for (; t_imu <= t + 0.01; t_imu += 0.005) est.addImu(car.imu(t_imu, utimeOf(t_imu), err, 0.005, &rng));
+    for (; t_wheel <= t + 0.02; t_wheel += 0.02) {
+      const double half = 0.5 * o.wheel_rig.track_width * CarMotion::yawRate(t_wheel);
+      est.addWheel(WheelSample{utimeOf(t_wheel), CarMotion::speed(t_wheel) - half + 0.01 * n01(rng),
+                               CarMotion::speed(t_wheel) + half + 0.01 * n01(rng)});
+    }
+    const FrameResult r = est.addFrame(tracks.frame(t, utimeOf(t)));
+    if (r.status != FrameResult::Status::kTracked && r.status != FrameResult::Status::kInitialized) continue;
+    if (e.empty()) first = r;
+    const Vec3 truth = car.pose(static_cast<double>(r.state.utime - base) * 1e-6).translation();
+    if (!g.empty()) distance += (truth - g.back()).norm();
+    e.push_back(r.state.pose.translation());
+    g.push_back(truth);
+  }
+  ASSERT_EQ(first.status, FrameResult::Status::kInitialized) << first.note;
+  EXPECT_FALSE(first.static_start);
+  const double t0 = static_cast<double>(first.state.utime - base) * 1e-6;
+  const Pose3 truth = car.pose(t0);
+  const Vec3 up_est = first.state.pose.linear().transpose() * Vec3::UnitZ();
+  const Vec3 up_true = truth.linear().transpose() * Vec3::UnitZ();
+  const double tilt_deg = std::acos(std::min(1.0, up_est.dot(up_true))) * 180.0 / M_PI;
+  const Vec3 v_body_est = first.state.pose.linear().transpose() * first.state.velocity;
+  const Vec3 v_body_true = truth.linear().transpose() * car.velocity(t0);
+  const double ate = synth::alignedRmse(e, g);
+  std::cout << "moving start at " << v_body_true.norm() << " m/s: gravity off by " << tilt_deg
+            << " deg, body velocity off by " << (v_body_est - v_body_true).norm() << " m/s; ATE " << ate
+            << " m over " << distance << " m (" << 100.0 * ate / distance << " %)\n";
+  EXPECT_LT(tilt_deg, 0.5);
+  EXPECT_LT((v_body_est - v_body_true).norm(), 0.05);
+  EXPECT_LT(ate / distance, 0.01);
+}
+
 TEST(SlidingWindowEstimator, MeasuredDepthsAnchorTheScale) {
   // Half the features with a measured depth (1 % noise, as an RGB-D camera's or the LiDAR's):
   // the scale no longer rests on the accelerometer alone.
@@ -292,8 +376,8 @@ TEST(SlidingWindowEstimator, MeasuredDepthsAnchorTheScale) {
   spec.duration = 22.0;
   spec.imu_error = synth::realisticImu();
   spec.seed = 2;
-  const RunResult mono = run(spec, optionsFor(spec), 0.6, 20.0, 0.0, false);
-  const RunResult depth = run(spec, optionsFor(spec), 0.6, 20.0, 0.5, false);
+  const RunResult mono = run(spec, optionsFor(spec), 0.6, 20.0, 0.0);
+  const RunResult depth = run(spec, optionsFor(spec), 0.6, 20.0, 0.5);
   int with_depth = 0;
   for (const FrameResult& f : depth.results) with_depth = std::max(with_depth, f.features_with_depth);
   std::cout << "room walk seed 2: ATE " << mono.ate << " m without depth, " << depth.ate << " m with depth ("
@@ -308,8 +392,8 @@ TEST(SlidingWindowEstimator, IsDeterministic) {
   spec.traj = synth::roomTrajectory(1.5);
   spec.duration = 8.0;
   spec.imu_error = synth::realisticImu();
-  const RunResult a = run(spec, optionsFor(spec), 0.6, 6.0, 0.3, false);
-  const RunResult b = run(spec, optionsFor(spec), 0.6, 6.0, 0.3, false);
+  const RunResult a = run(spec, optionsFor(spec), 0.6, 6.0, 0.3);
+  const RunResult b = run(spec, optionsFor(spec), 0.6, 6.0, 0.3);
   ASSERT_EQ(a.results.size(), b.results.size());
   for (size_t i = 0; i < a.results.size(); ++i)
     EXPECT_TRUE(a.results[i].state.pose.matrix() == b.results[i].state.pose.matrix()) << i;

@@ -69,6 +69,8 @@ struct SlidingWindowEstimator::Feature {
 
 namespace {
 
+constexpr double kStillWheelSpeed = 0.02;  // m/s: a wheel turning slower than this is at rest
+
 double depthSigma(const SlidingWindowOptions& o, double d) { return o.depth_sigma_base + o.depth_sigma_relative * d; }
 
 bool validDepth(const SlidingWindowOptions& o, double d) { return std::isfinite(d) && d >= o.min_depth && d <= o.max_depth; }
@@ -180,6 +182,13 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
 
 bool SlidingWindowEstimator::initialize(int64_t t, FrameResult* res) {
   res->status = FrameResult::Status::kInitializing;
+  // A car cruising on a smooth road can look still to the IMU: where the wheels turn, it is not.
+  bool wheels_turn = false;
+  if (opts_.use_wheel)
+    for (const WheelSample& w : wheel_)
+      if (w.utime <= t && w.utime >= t - toUtime(opts_.init.window_s))
+        wheels_turn |= std::abs(w.left_speed) + std::abs(w.right_speed) > 2.0 * kStillWheelSpeed;
+  if (wheels_turn) return initializeMoving(t, res);
   if (initializeAtRest(t, res)) return true;
   if (opts_.use_wheel && initializeMoving(t, res)) return true;
   if (res->note.empty()) res->note = opts_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
