@@ -22,6 +22,8 @@ Eigen::Matrix<double, 4, 3> plusJacobianOf(const double* x) {
 
 }  // namespace
 
+Eigen::Matrix<double, 3, 4> tangentToAmbient(const double* q) { return 4.0 * plusJacobianOf(q).transpose(); }
+
 bool RightQuaternionManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   const Eigen::Map<const Quatd> q(x);
   Eigen::Map<Quatd> out(x_plus_delta);
@@ -45,7 +47,7 @@ bool RightQuaternionManifold::Minus(const double* y, const double* x, double* y_
 bool RightQuaternionManifold::MinusJacobian(const double* x, double* jacobian) const {
   // at y = x: the pseudo-inverse of PlusJacobian (its columns are orthogonal with norm 1/2)
   Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> out_map(jacobian);
-  out_map = 4.0 * plusJacobianOf(x).transpose();
+  out_map = tangentToAmbient(x);
   return true;
 }
 

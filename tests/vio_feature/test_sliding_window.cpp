@@ -13,6 +13,7 @@
 #include <set>
 #include <vector>
 
+#include "livo/quaternion_manifold.hpp"
 #include "livo/so3.hpp"
 #include "livo/vio_feature/reprojection_factor.hpp"
 #include "livo/vio_feature/sliding_window_estimator.hpp"
@@ -69,20 +70,39 @@ TEST(ReprojectionFactor, JacobiansMatchCentralDifferences) {
   // the residual is the pixel offset over sigma
   EXPECT_NEAR(r[0], -0.004 * 450.0 / 1.5, 1e-9);
   EXPECT_NEAR(r[1], 0.003 * 450.0 / 1.5, 1e-9);
+  // Tangent Jacobians (ambient times PlusJacobian, as Ceres uses them) against central differences
+  // along the manifold: q Exp(+-h e_k) for the orientations, plain steps for the rest.
+  const RightQuaternionManifold manifold;
   const double h = 1e-6;
   for (int b = 0; b < 5; ++b) {
-    for (size_t k = 0; k < blocks[b]->size(); ++k) {
+    const bool quaternion = blocks[b]->size() == 4;
+    const int tangent = quaternion ? 3 : static_cast<int>(blocks[b]->size());
+    Eigen::MatrixXd J_tangent = Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor>>(
+        J[b].data(), 2, static_cast<int>(blocks[b]->size()));
+    if (quaternion) {
+      Eigen::Matrix<double, 4, 3, Eigen::RowMajor> P;
+      manifold.PlusJacobian(blocks[b]->data(), P.data());
+      J_tangent = J_tangent * P;
+    }
+    const std::vector<double> x0 = *blocks[b];
+    for (int k = 0; k < tangent; ++k) {
       double rp[2], rm[2];
-      const double x = (*blocks[b])[k];
-      (*blocks[b])[k] = x + h;
-      ASSERT_TRUE(evaluate(rp, nullptr));
-      (*blocks[b])[k] = x - h;
-      ASSERT_TRUE(evaluate(rm, nullptr));
-      (*blocks[b])[k] = x;
+      for (double sign : {1.0, -1.0}) {
+        double delta[3] = {0, 0, 0};
+        delta[k] = sign * h;
+        if (quaternion) {
+          manifold.Plus(x0.data(), delta, blocks[b]->data());
+        } else {
+          *blocks[b] = x0;
+          (*blocks[b])[k] += sign * h;
+        }
+        ASSERT_TRUE(evaluate(sign > 0 ? rp : rm, nullptr));
+      }
+      *blocks[b] = x0;
       for (int i = 0; i < 2; ++i) {
         const double numeric = (rp[i] - rm[i]) / (2.0 * h);
-        EXPECT_NEAR(J[b][i * blocks[b]->size() + k], numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
-            << "block " << b << " parameter " << k << " residual " << i;
+        EXPECT_NEAR(J_tangent(i, k), numeric, 1e-5 * std::max(1.0, std::abs(numeric)))
+            << "block " << b << " direction " << k << " residual " << i;
       }
     }
   }

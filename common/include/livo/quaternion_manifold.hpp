@@ -18,6 +18,11 @@ class RightQuaternionManifold : public ceres::Manifold {
   bool MinusJacobian(const double* x, double* jacobian) const override;  // 3x4 row-major
 };
 
+/// The left inverse of PlusJacobian(q) (3x4): an analytic Jacobian J with respect to the right
+/// perturbation (rows x 3) times this is an ambient Jacobian that Ceres, multiplying it by
+/// PlusJacobian, turns back into J. For cost functions with hand-written Jacobians.
+Eigen::Matrix<double, 3, 4> tangentToAmbient(const double* q);
+
 /// d Log(x0^-1 q) / dq (3x4, row-major ambient Jacobian) such that, times PlusJacobian(q), it gives
 /// Jr^-1 of the difference: what a linear prior in the tangent space needs.
 void minusAmbientJacobian(const double* q0, const double* q, double* jacobian);
