@@ -1,0 +1,99 @@
+// Rendered test data for the feature front end from the simulator library (livo_sim): a scene, a
+// trajectory and a camera rig (a sim config's, or built by a test), grey images rendered at
+// trajectory times with the simulator's noise and exposure drift, and the truth to check tracks
+// against: the scene point a pixel's ray hits, and where a world point lands in a later image.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include <opencv2/core.hpp>
+
+#include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/simulation_setup.hpp"
+
+namespace livo_test {
+
+class RenderedSequence {
+ public:
+  /// A sim config's scene, trajectory, camera and camera effects (`config` relative to the source tree).
+  explicit RenderedSequence(const std::string& config = "config/sim/room.yaml") {
+    livo::sim::SimOverrides ov;
+    ov.duration_s = 30.0;
+    livo::sim::SimulationSetup setup = livo::sim::loadSimulation(std::string(LIVO_SOURCE_DIR) + "/" + config, ov);
+    camera_ = *setup.rig.camera;
+    seed_ = setup.options.seed;
+    start_utime_ = setup.start_utime;
+    effects_ = setup.options.camera;
+    scene_ = std::move(setup.scene);
+    trajectory_ = std::move(setup.trajectory);
+    renderer_ = std::make_unique<livo::sim::CameraRenderer>(camera_, effects_);
+  }
+  /// A scene and trajectory of a test's own.
+  RenderedSequence(std::unique_ptr<livo::sim::Scene> scene, std::unique_ptr<livo::sim::BodyTrajectory> trajectory,
+                   const livo::CameraRig& camera, const livo::sim::CameraEffects& effects)
+      : camera_(camera), effects_(effects), scene_(std::move(scene)), trajectory_(std::move(trajectory)),
+        renderer_(std::make_unique<livo::sim::CameraRenderer>(camera, effects)) {}
+
+  /// From now on renders (and answers for) another camera in the same mount: its size,
+  /// intrinsics and distortion; T_I_C stays.
+  void setLens(livo::CameraRig lens) {
+    lens.T_I_C = camera_.T_I_C;
+    camera_ = lens;
+    renderer_ = std::make_unique<livo::sim::CameraRenderer>(camera_, effects_);
+  }
+
+  const livo::CameraRig& camera() const { return camera_; }
+  const livo::sim::Scene& scene() const { return *scene_; }
+  int64_t utime(double t) const { return start_utime_ + static_cast<int64_t>(std::llround(t * 1e6)); }
+
+  /// The grey image at trajectory time t (noise stream k).
+  cv::Mat image(double t, uint64_t k = 0) const {
+    const livo::sim::CameraImage c = renderer_->render(*scene_, *trajectory_, t, utime(t), livo::sim::Random(seed_, 7, k));
+    const cv::Mat view(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data()));
+    return view.clone();
+  }
+
+  livo::Pose3 cameraPose(double t) const { return trajectory_->at(t).T_W_I * camera_.T_I_C; }
+  /// Rotation from the camera frame at t_prev to the one at t (what a gyro integrates).
+  livo::Mat3 rotationCurPrev(double t, double t_prev) const {
+    return cameraPose(t).linear().transpose() * cameraPose(t_prev).linear();
+  }
+
+  /// The world point the ray through `pixel` hits at time t, and the object it is on; false for sky.
+  bool pointAt(const Eigen::Vector2d& pixel, double t, livo::Vec3* p_W, int* object = nullptr) const {
+    const livo::Pose3 T_W_C = cameraPose(t);
+    livo::sim::Ray ray;
+    ray.origin = T_W_C.translation();
+    ray.direction = T_W_C.linear() * renderer_->camera().pixelRay(pixel);
+    const livo::sim::RayHit hit = scene_->cast(ray, livo::sim::CastContext::camera(t, 0));
+    if (!hit.valid()) return false;
+    *p_W = ray.origin + hit.t * ray.direction;
+    if (object) *object = hit.object;
+    return true;
+  }
+  /// The pixel of world point p_W at time t; false if behind the camera or hidden by a nearer surface.
+  bool visiblePixel(const livo::Vec3& p_W, double t, Eigen::Vector2d* pixel) const {
+    const livo::Pose3 T_W_C = cameraPose(t);
+    if (!renderer_->camera().project(T_W_C.inverse() * p_W, pixel)) return false;
+    livo::sim::Ray ray;
+    ray.origin = T_W_C.translation();
+    const livo::Vec3 d = p_W - ray.origin;
+    ray.direction = d.normalized();
+    const livo::sim::RayHit hit = scene_->cast(ray, livo::sim::CastContext::camera(t, 0));
+    return !hit.valid() || hit.t > d.norm() - 0.01;
+  }
+
+ private:
+  livo::CameraRig camera_;
+  livo::sim::CameraEffects effects_;
+  uint64_t seed_ = 1;
+  int64_t start_utime_ = 1'700'000'000'000'000;
+  std::unique_ptr<livo::sim::Scene> scene_;
+  std::unique_ptr<livo::sim::BodyTrajectory> trajectory_;
+  std::unique_ptr<livo::sim::CameraRenderer> renderer_;
+};
+
+}  // namespace livo_test
