@@ -87,6 +87,12 @@ AslSensorYaml readAslSensorYaml(const std::string& path) {
     if (y["rate_hz"]) s.rate_hz = y["rate_hz"].as<double>();
     if (y["intrinsics"]) s.intrinsics = y["intrinsics"].as<std::vector<double>>();
     if (y["distortion_coefficients"]) s.distortion = y["distortion_coefficients"].as<std::vector<double>>();
+    if (y["distortion_model"]) {
+      const std::string model = y["distortion_model"].as<std::string>();
+      if (model == "radial-tangential" || model == "radtan") s.distortion_model = DistortionModel::kRadtan;
+      else if (model == "equidistant") s.distortion_model = DistortionModel::kEquidistant;
+      else throw TrajectoryError(path + ": distortion_model '" + model + "' is neither radial-tangential nor equidistant");
+    }
     if (y["resolution"]) {
       const auto r = y["resolution"].as<std::vector<int>>();
       if (r.size() == 2) s.width = r[0], s.height = r[1];
@@ -99,6 +105,24 @@ AslSensorYaml readAslSensorYaml(const std::string& path) {
     throw TrajectoryError(path + ": " + e.msg);
   }
   return s;
+}
+
+CameraRig aslCameraRig(const AslSensorYaml& s, const std::string& path) {
+  if (s.intrinsics.size() != 4 || s.width <= 0 || s.height <= 0 || s.distortion.size() != 4)
+    throw TrajectoryError(path + ": not a pinhole camera's sensor.yaml (needs intrinsics [fu, fv, cu, cv], resolution "
+                          "and four distortion_coefficients)");
+  CameraRig c;
+  c.width = s.width;
+  c.height = s.height;
+  c.fx = s.intrinsics[0];
+  c.fy = s.intrinsics[1];
+  c.cx = s.intrinsics[2];
+  c.cy = s.intrinsics[3];
+  c.distortion_model = s.distortion_model;
+  std::copy(s.distortion.begin(), s.distortion.end(), c.distortion.begin());
+  if (s.rate_hz > 0.0) c.rate_hz = s.rate_hz;
+  c.T_I_C = s.T_body_sensor;
+  return c;
 }
 
 }  // namespace livo

@@ -63,8 +63,28 @@ std::string containerProblem(const RawImage& raw) {
   return "";
 }
 
-bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat format, cv::Mat* out,
-                      std::string* why) {
+const char* encodingName(int encoding) {
+  switch (static_cast<ImageEncoding>(encoding)) {
+    case ImageEncoding::kGray8: return "GRAY8";
+    case ImageEncoding::kRgb8: return "RGB8";
+    case ImageEncoding::kBgr8: return "BGR8";
+    case ImageEncoding::kJpeg: return "JPEG";
+    case ImageEncoding::kPng: return "PNG";
+    case ImageEncoding::kDepth16: return "DEPTH16";
+    case ImageEncoding::kDepth32f: return "DEPTH32F";
+  }
+  return nullptr;
+}
+
+/// "encoding NAME (N)", or "unknown image encoding N".
+std::string encodingText(int encoding) {
+  const char* name = encodingName(encoding);
+  return name ? std::string("encoding ") + name + " (" + std::to_string(encoding) + ")"
+              : "unknown image encoding " + std::to_string(encoding);
+}
+
+/// The JPEG or PNG in `raw` decoded with imdecode `flags` (not yet checked for depth or size).
+bool imdecodeChecked(const RawImage& raw, int flags, cv::Mat* img, std::string* why) {
   const char* name = raw.encoding == static_cast<int>(ImageEncoding::kJpeg) ? "JPEG" : "PNG";
   if (raw.data == nullptr || raw.size == 0) {
     *why = std::string("empty ") + name + " image";
@@ -79,22 +99,30 @@ bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat fo
     return false;
   }
   const cv::Mat buf(1, static_cast<int>(raw.size), CV_8UC1, const_cast<uint8_t*>(raw.data));
-  // a JPEG wanted in grey is decoded to its luma directly (no chroma work); the rest as stored
-  const bool jpeg_luma = format == PixelFormat::kGrey && raw.encoding == static_cast<int>(ImageEncoding::kJpeg);
-  cv::Mat img;
   try {
-    img = cv::imdecode(buf, jpeg_luma ? cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION : cv::IMREAD_UNCHANGED);
+    *img = cv::imdecode(buf, flags);
   } catch (const std::exception& e) {
     *why = std::string(name) + " image does not decode: " + e.what();
     return false;
   }
-  if (img.empty()) {
+  if (img->empty()) {
     *why = std::string(name) + " image does not decode";
     return false;
   }
+  return true;
+}
+
+bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat format, cv::Mat* out,
+                      std::string* why) {
+  // a JPEG wanted in grey is decoded to its luma directly (no chroma work); the rest as stored
+  const bool jpeg_luma = format == PixelFormat::kGrey && raw.encoding == static_cast<int>(ImageEncoding::kJpeg);
+  cv::Mat img;
+  if (!imdecodeChecked(raw, jpeg_luma ? cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION : cv::IMREAD_UNCHANGED,
+                       &img, why))
+    return false;
   if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257.0);
   else if (img.depth() != CV_8U) {
-    *why = std::string(name) + " image has pixels of neither 8 nor 16 bits";
+    *why = std::string(encodingName(raw.encoding)) + " image has pixels of neither 8 nor 16 bits";
     return false;
   }
   if (img.cols != width || img.rows != height) {
@@ -102,6 +130,36 @@ bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat fo
     return false;
   }
   return toFormat(img, true, true, format, out, why);  // imdecode gives B, G, R[, A]
+}
+
+/// A view (no copy) of raw pixels of `type` laid out `width` x `height`, rows `row_stride` bytes
+/// apart (0: packed); false with `why` if the layout is not the camera's or the data is short.
+bool rawView(const RawImage& raw, int width, int height, int type, cv::Mat* view, std::string* why) {
+  if (raw.width != width || raw.height != height) {
+    *why = wrongSize(raw.width, raw.height, width, height);
+    return false;
+  }
+  const size_t row = static_cast<size_t>(width) * CV_ELEM_SIZE(type);
+  if (raw.row_stride != 0 && (raw.row_stride < 0 || static_cast<size_t>(raw.row_stride) < row)) {
+    *why = "image row_stride " + std::to_string(raw.row_stride) + " is shorter than a row of " +
+           std::to_string(width) + " pixels (" + std::to_string(row) + " bytes)";
+    return false;
+  }
+  const size_t stride = raw.row_stride > 0 ? static_cast<size_t>(raw.row_stride) : row;
+  const size_t needed = stride * static_cast<size_t>(height - 1) + row;
+  if (raw.data == nullptr || raw.size < needed) {
+    *why = "image data shorter than its width x height (" + std::to_string(raw.data ? raw.size : 0) + " of " +
+           std::to_string(needed) + " bytes)";
+    return false;
+  }
+  *view = cv::Mat(height, width, type, const_cast<uint8_t*>(raw.data), stride);
+  return true;
+}
+
+bool checkCameraSize(int width, int height, std::string* why) {
+  if (width > 0 && height > 0) return true;
+  *why = "no camera size to check the image against (" + sizeText(width, height) + ")";
+  return false;
 }
 
 }  // namespace
@@ -124,39 +182,59 @@ float exposureTime(const RawImage& raw) {
 }
 
 bool decodeImage(const RawImage& raw, int width, int height, PixelFormat format, cv::Mat* out, std::string* why) {
-  if (width <= 0 || height <= 0) {
-    *why = "no camera size to check the image against (" + sizeText(width, height) + ")";
-    return false;
-  }
+  if (!checkCameraSize(width, height, why)) return false;
   const auto enc = static_cast<ImageEncoding>(raw.encoding);
   if (enc == ImageEncoding::kJpeg || enc == ImageEncoding::kPng)
     return decodeCompressed(raw, width, height, format, out, why);
   int channels = 0;
   if (enc == ImageEncoding::kGray8) channels = 1;
   else if (enc == ImageEncoding::kRgb8 || enc == ImageEncoding::kBgr8) channels = 3;
-  else {
-    *why = "unknown image encoding " + std::to_string(raw.encoding);
+  else if (enc == ImageEncoding::kDepth16 || enc == ImageEncoding::kDepth32f) {
+    *why = "image " + encodingText(raw.encoding) + " is a depth image, not a picture";
+    return false;
+  } else {
+    *why = encodingText(raw.encoding);
     return false;
   }
-  if (raw.width != width || raw.height != height) {
-    *why = wrongSize(raw.width, raw.height, width, height);
-    return false;
-  }
-  const size_t row = static_cast<size_t>(width) * channels;
-  if (raw.row_stride != 0 && (raw.row_stride < 0 || static_cast<size_t>(raw.row_stride) < row)) {
-    *why = "image row_stride " + std::to_string(raw.row_stride) + " is shorter than a row of " +
-           std::to_string(width) + " pixels (" + std::to_string(row) + " bytes)";
-    return false;
-  }
-  const size_t stride = raw.row_stride > 0 ? static_cast<size_t>(raw.row_stride) : row;
-  const size_t needed = stride * static_cast<size_t>(height - 1) + row;
-  if (raw.data == nullptr || raw.size < needed) {
-    *why = "image data shorter than its width x height (" + std::to_string(raw.data ? raw.size : 0) + " of " +
-           std::to_string(needed) + " bytes)";
-    return false;
-  }
-  const cv::Mat view(height, width, CV_8UC(channels), const_cast<uint8_t*>(raw.data), stride);
+  cv::Mat view;
+  if (!rawView(raw, width, height, CV_8UC(channels), &view, why)) return false;
   return toFormat(view, enc == ImageEncoding::kBgr8, false, format, out, why);
+}
+
+bool decodeDepth(const RawImage& raw, int width, int height, cv::Mat* out, std::string* why) {
+  if (!checkCameraSize(width, height, why)) return false;
+  const auto enc = static_cast<ImageEncoding>(raw.encoding);
+  cv::Mat metres;
+  if (enc == ImageEncoding::kDepth16 || enc == ImageEncoding::kDepth32f) {
+    // the bytes are little-endian, as is every machine this runs on
+    cv::Mat view;
+    if (!rawView(raw, width, height, enc == ImageEncoding::kDepth16 ? CV_16UC1 : CV_32FC1, &view, why)) return false;
+    view.convertTo(metres, CV_32F, enc == ImageEncoding::kDepth16 ? 1e-3 : 1.0);  // a copy in both cases
+  } else if (enc == ImageEncoding::kPng) {
+    cv::Mat img;
+    if (!imdecodeChecked(raw, cv::IMREAD_UNCHANGED, &img, why)) return false;
+    if (img.depth() != CV_16U || img.channels() != 1) {
+      *why = "PNG depth image must be 16-bit grey (millimetres), not " + std::to_string(8 * img.elemSize1()) +
+             "-bit with " + std::to_string(img.channels()) + " channels";
+      return false;
+    }
+    if (img.cols != width || img.rows != height) {
+      *why = wrongSize(img.cols, img.rows, width, height);
+      return false;
+    }
+    img.convertTo(metres, CV_32F, 1e-3);
+  } else {
+    *why = "image " + encodingText(raw.encoding) + " is not depth (DEPTH16, DEPTH32F or 16-bit PNG)";
+    return false;
+  }
+  // no depth: 0 (NaN, infinities and negatives included)
+  for (int y = 0; y < metres.rows; ++y) {
+    float* row = metres.ptr<float>(y);
+    for (int x = 0; x < metres.cols; ++x)
+      if (!(std::isfinite(row[x]) && row[x] > 0.0f)) row[x] = 0.0f;
+  }
+  *out = metres;
+  return true;
 }
 
 }  // namespace livo

@@ -9,6 +9,10 @@ namespace livo {
 
 const std::vector<std::string> kLidarModels = {"VLP-16", "OS1-16", "OS1-64", "HDL-64E", "livox-avia"};
 
+const char* distortionModelName(DistortionModel m) {
+  return m == DistortionModel::kEquidistant ? "equidistant" : "radtan";
+}
+
 namespace {
 
 void requirePositive(const Config& c, const std::string& key, double v) {
@@ -70,13 +74,22 @@ CameraRig readCamera(const Config& c) {
   c.read("fy", cam.fy);
   c.read("cx", cam.cx);
   c.read("cy", cam.cy);
+  std::string model = distortionModelName(cam.distortion_model);
+  c.readOptional("distortion_model", model);
+  if (model == distortionModelName(DistortionModel::kRadtan)) cam.distortion_model = DistortionModel::kRadtan;
+  else if (model == distortionModelName(DistortionModel::kEquidistant)) cam.distortion_model = DistortionModel::kEquidistant;
+  else throw ConfigError(c.where("distortion_model") + ": '" + model + "' is not radtan or equidistant");
   std::vector<double> d;
   if (c.readOptional("distortion", d)) {
-    if (d.size() != 4) throw ConfigError(c.where("distortion") + ": expected [k1, k2, p1, p2]");
+    if (d.size() != 4)
+      throw ConfigError(c.where("distortion") + (cam.distortion_model == DistortionModel::kRadtan
+                                                     ? ": expected [k1, k2, p1, p2] (radtan)"
+                                                     : ": expected [k1, k2, k3, k4] (equidistant)"));
     std::copy(d.begin(), d.end(), cam.distortion.begin());
   }
   c.read("rate_hz", cam.rate_hz);
   c.readOptional("color", cam.color);
+  c.readOptional("depth", cam.depth);
   c.read("T_I_C", cam.T_I_C);
   c.readOptional("time_offset_s", cam.time_offset_s);
   if (!(std::abs(cam.time_offset_s) < 1.0)) throw ConfigError(c.where("time_offset_s") + ": must be within (-1, 1) s");
@@ -122,6 +135,7 @@ SensorRig readSensorRig(const Config& rig) {
   ch.readOptional("imu", r.channels.imu);
   ch.readOptional("lidar", r.channels.lidar);
   ch.readOptional("camera", r.channels.camera);
+  ch.readOptional("depth", r.channels.depth);
   ch.readOptional("wheel", r.channels.wheel);
   ch.readOptional("ground_truth", r.channels.ground_truth);
   r.imu = readImu(rig.section("imu"));
@@ -129,6 +143,9 @@ SensorRig readSensorRig(const Config& rig) {
   if (rig.has("camera")) r.camera = readCamera(rig.section("camera"));
   if (rig.has("wheel")) r.wheel = readWheel(rig.section("wheel"));
   rig.checkAllUsed();
+  if (r.camera && r.camera->depth && r.channels.depth == r.channels.camera)
+    throw ConfigError(ch.where("depth") + ": the depth images need a channel of their own, not the camera's (" +
+                      r.channels.camera + ")");
   return r;
 }
 
@@ -149,8 +166,10 @@ void printSensorRig(const SensorRig& r, std::ostream& os) {
     const auto& c = *r.camera;
     os << "  camera: " << c.width << "x" << c.height << (c.color ? " RGB8" : " GRAY8") << " at " << c.rate_hz
        << " Hz on " << r.channels.camera << ", f " << c.fx << "/" << c.fy << ", c " << c.cx << "/" << c.cy
-       << ", distortion [" << c.distortion[0] << ", " << c.distortion[1] << ", " << c.distortion[2] << ", "
-       << c.distortion[3] << "]\n          T_I_C ";
+       << ", " << distortionModelName(c.distortion_model) << " distortion [" << c.distortion[0] << ", "
+       << c.distortion[1] << ", " << c.distortion[2] << ", " << c.distortion[3] << "]";
+    if (c.depth) os << "\n          depth images registered to it on " << r.channels.depth;
+    os << "\n          T_I_C ";
     printPose(os, c.T_I_C);
     os << "\n";
   }

@@ -26,7 +26,7 @@ livo::import::KittiPointFields pointFields(const std::string& s) {
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-import",
                         "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
-                        "GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
+                        "DEPTH, GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
   cli.positional("FORMAT", "rosbag (ROS 1 bag), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
                            "ouster (pcap + metadata JSON)");
   cli.positional("INPUT", "the bag, folder or pcap file");
@@ -36,16 +36,18 @@ int main(int argc, char** argv) {
       .option("--lidar", "TOPIC", "rosbag: LiDAR topic (sensor_msgs/PointCloud2)")
       .option("--camera", "TOPIC", "rosbag: camera topic (sensor_msgs/Image or CompressedImage)")
       .option("--camera-right", "TOPIC", "rosbag: second camera topic")
+      .option("--depth", "TOPIC", "rosbag: depth image topic registered to the camera (sensor_msgs/Image 16UC1 mm or 32FC1 m)")
       .option("--ground-truth", "TOPIC|FILE",
               "rosbag: ground-truth topic (Odometry, PoseStamped, PoseWithCovarianceStamped, TransformStamped, "
               "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
-      .flag("--no-auto-topics", "rosbag: do not pick the only IMU / PointCloud2 / image topic when none is given")
+      .flag("--no-auto-topics", "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
       .flag("--list-topics", "rosbag: print the bag's topics, types and counts, then exit")
       .flag("--list-presets", "print the presets, then exit")
       .option("--imu-channel", "NAME", "IMU channel", "IMU")
       .option("--lidar-channel", "NAME", "LiDAR channel", "LIDAR")
       .option("--camera-channel", "NAME", "camera channel", "CAMERA")
       .option("--camera-right-channel", "NAME", "second camera channel", "CAMERA_RIGHT")
+      .option("--depth-channel", "NAME", "depth image channel", "DEPTH")
       .option("--ground-truth-channel", "NAME", "ground-truth channel", "GROUND_TRUTH")
       .option("--lidar-stamp", "start|end", "rosbag: what a cloud's header stamp marks (preset or start)")
       .option("--sweep-duration", "S", "sweep length in seconds (rosbag, kitti; default 0.1)")
@@ -88,6 +90,7 @@ int main(int argc, char** argv) {
     job.channels.lidar = cli.get("--lidar-channel");
     job.channels.camera = cli.get("--camera-channel");
     job.channels.camera_right = cli.get("--camera-right-channel");
+    job.channels.depth = cli.get("--depth-channel");
     job.channels.ground_truth = cli.get("--ground-truth-channel");
     job.max_buffer_mb = cli.getInt("--max-buffer-mb");
     job.quiet = cli.has("--quiet");
@@ -97,6 +100,7 @@ int main(int argc, char** argv) {
     r.lidar_topic = cli.get("--lidar");
     r.camera_topic = cli.get("--camera");
     r.camera_right_topic = cli.get("--camera-right");
+    r.depth_topic = cli.get("--depth");
     if (cli.has("--ground-truth")) {
       const std::string gt = cli.get("--ground-truth");
       if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::import::isFile(gt))

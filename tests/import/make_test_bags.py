@@ -252,6 +252,48 @@ def write_bad_bag(path):
             bag.write('/imu', m, m.header.stamp)
 
 
+def depth_images(k, ns):
+    """An RGB-D camera's frame k: rgb8 colour, aligned depth as 16UC1 (mm, little-endian) and the
+    same as 32FC1 (m, big-endian, one NaN), 3 x 2 pixels, with padded rows."""
+    colour = Image()
+    colour.header.stamp = stamp(ns)
+    colour.height, colour.width, colour.encoding, colour.step = 2, 3, 'rgb8', 9
+    colour.data = bytes(range(k, k + 18))
+    mm = [0, 500 + k, 1000, 2500, 65535, 7]
+    d16 = Image()
+    d16.header.stamp = stamp(ns)
+    d16.height, d16.width, d16.encoding, d16.is_bigendian, d16.step = 2, 3, '16UC1', 0, 8
+    d16.data = b''.join(struct.pack('<3H', *mm[3 * j:3 * j + 3]) + b'\x00\x00' for j in range(2))
+    metres = [0.0, 0.5 + k * 1e-3, 1.0, float('nan'), 65.535, 0.007]
+    d32 = Image()
+    d32.header.stamp = stamp(ns)
+    d32.height, d32.width, d32.encoding, d32.is_bigendian, d32.step = 2, 3, '32FC1', 1, 12
+    d32.data = struct.pack('>6f', *metres)
+    return colour, d16, d32, dict(utime=ns // 1000, millimetres=mm, metres=[None if math.isnan(v) else v for v in metres])
+
+
+def write_rgbd_bags(one_path, two_path):
+    """A RealSense-like RGB-D camera: colour and aligned depth (16UC1) in one bag; colour and depth
+    as 16UC1 and as 32FC1 in the other (two depth topics: none is chosen unless named)."""
+    expected = dict(depth=[])
+    with rosbag.Bag(one_path, 'w', compression='none') as one, rosbag.Bag(two_path, 'w', compression='lz4') as two:
+        for i in range(10):
+            m, _ = imu_msg(i)
+            one.write('/imu', m, m.header.stamp)
+            two.write('/imu', m, m.header.stamp)
+        for k in range(3):
+            ns = BASE_NS + k * 50000000 + 3000
+            colour, d16, d32, e = depth_images(k, ns)
+            for bag in (one, two):
+                bag.write('/camera/color/image_raw', colour, colour.header.stamp)
+                bag.write('/camera/aligned_depth_to_color/image_raw', d16, d16.header.stamp)
+            two.write('/camera/depth/image_float', d32, d32.header.stamp)
+            expected['depth'].append(e)
+    for path in (one_path, two_path):
+        with open(path + '.expected.json', 'w') as f:
+            json.dump(expected, f)
+
+
 def main():
     out, jpeg_path, png_path = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(out, exist_ok=True)
@@ -261,6 +303,7 @@ def main():
         write_layout_bag(os.path.join(out, 'layouts_%s.bag' % compression), compression, jpeg, png)
     write_ntu_viral_bag(os.path.join(out, 'ntu_viral.bag'))
     write_bad_bag(os.path.join(out, 'bad.bag'))
+    write_rgbd_bags(os.path.join(out, 'rgbd.bag'), os.path.join(out, 'rgbd_two_depths.bag'))
     print('wrote test bags to', out)
 
 

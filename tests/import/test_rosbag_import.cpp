@@ -1,6 +1,8 @@
 // ROS 1 bags written by the real ROS library (make_test_bags.py, a ctest fixture), one per chunk
 // compression, imported and compared value by value with what was written.
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -153,6 +155,87 @@ TEST(RosbagImport, AutoMapsTheOnlyTopicOfAType) {
   const ImportOutcome r = runImport(job, nullptr);
   EXPECT_EQ(r.channel_counts.at("IMU"), 40) << "the bag's only sensor_msgs/Imu topic";
   EXPECT_EQ(r.channel_counts.count("LIDAR"), 0u) << "five PointCloud2 topics: none chosen";
+}
+
+// An RGB-D camera's bag: the colour camera and its aligned depth (16UC1, mm) side by side.
+bool anyNoteHas(const ImportReport& report, const std::string& text) {
+  for (const std::string& n : report.notes())
+    if (n.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(RosbagImport, DepthImagesGoToTheDepthChannelNotTheCamera) {
+  const std::string bag = kBags + "/rgbd.bag";
+  const json exp = expectedFor(bag);
+  const std::string dir = test::freshTempDir("rosbag_rgbd");
+  const ImportOutcome r = runImport(bagJob(bag, dir + "/out.lcmlog"), nullptr);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.channel_counts.at("CAMERA"), 3) << "the only colour Image topic; the depth topic is no camera";
+  EXPECT_EQ(r.report.metadataValue("topic_camera"), "\"/camera/color/image_raw\"");
+  EXPECT_EQ(r.report.metadataValue("topic_depth"), "\"/camera/aligned_depth_to_color/image_raw\"");
+  EXPECT_TRUE(anyNoteHas(r.report, "--depth not given: using the bag's only fitting topic"));
+  const auto depth = test::messagesOn<image_t>(test::readLog(dir + "/out.lcmlog"), "DEPTH");
+  ASSERT_EQ(depth.size(), 3u);
+  for (size_t k = 0; k < depth.size(); ++k) {
+    const image_t& d = depth[k];
+    const json& e = exp["depth"][k];
+    EXPECT_EQ(d.utime, e["utime"].get<int64_t>());
+    EXPECT_EQ(d.encoding, int8_t{image_t::ENCODING_DEPTH16});
+    EXPECT_EQ(d.frame, "C");
+    EXPECT_EQ(d.width, 3);
+    EXPECT_EQ(d.height, 2);
+    ASSERT_EQ(d.row_stride, 8) << "the padded rows are kept";
+    ASSERT_EQ(d.size, 16);
+    for (int i = 0; i < 6; ++i) {
+      const uint8_t* p = &d.data[(i / 3) * 8 + (i % 3) * 2];
+      EXPECT_EQ(p[0] | (p[1] << 8), e["millimetres"][i].get<int>()) << "frame " << k << " pixel " << i;
+    }
+  }
+}
+
+TEST(RosbagImport, SeveralDepthTopicsAreNotGuessedAndEachCanBeNamed) {
+  const std::string bag = kBags + "/rgbd_two_depths.bag";
+  const json exp = expectedFor(bag);
+  {
+    const std::string dir = test::freshTempDir("rosbag_two_depths_auto");
+    const ImportOutcome r = runImport(bagJob(bag, dir + "/out.lcmlog"), nullptr);
+    EXPECT_EQ(r.channel_counts.at("CAMERA"), 3);
+    EXPECT_EQ(r.channel_counts.count("DEPTH"), 0u);
+    EXPECT_TRUE(anyNoteHas(r.report, "--depth not given and several topics fit"));
+  }
+  {
+    // 32FC1, big-endian in the bag: little-endian floats in the log, NaN as sent
+    const std::string dir = test::freshTempDir("rosbag_two_depths_float");
+    ImportJob job = bagJob(bag, dir + "/out.lcmlog");
+    job.rosbag.depth_topic = "/camera/depth/image_float";
+    const ImportOutcome r = runImport(job, nullptr);
+    ASSERT_TRUE(r.ok());
+    const auto depth = test::messagesOn<image_t>(test::readLog(dir + "/out.lcmlog"), "DEPTH");
+    ASSERT_EQ(depth.size(), 3u);
+    for (size_t k = 0; k < depth.size(); ++k) {
+      EXPECT_EQ(depth[k].encoding, int8_t{image_t::ENCODING_DEPTH32F});
+      ASSERT_EQ(depth[k].size, 24);
+      for (int i = 0; i < 6; ++i) {
+        float v;
+        std::memcpy(&v, &depth[k].data[4 * i], 4);
+        const json& e = exp["depth"][k]["metres"][i];
+        if (e.is_null()) EXPECT_TRUE(std::isnan(v)) << "pixel " << i;
+        else EXPECT_FLOAT_EQ(v, e.get<float>()) << "frame " << k << " pixel " << i;
+      }
+    }
+  }
+  {
+    // a depth topic named as the camera is refused with the reason
+    const std::string dir = test::freshTempDir("rosbag_depth_as_camera");
+    ImportJob job = bagJob(bag, dir + "/out.lcmlog");
+    job.rosbag.camera_topic = "/camera/aligned_depth_to_color/image_raw";
+    const ImportOutcome r = runImport(job, nullptr);
+    EXPECT_EQ(r.channel_counts.count("CAMERA"), 0u);
+    bool refused = false;
+    for (const auto& [reason, s] : r.report.skipped())
+      refused |= reason.find("'16UC1' is depth, not a camera image") != std::string::npos && s.count == 3;
+    EXPECT_TRUE(refused);
+  }
 }
 
 TEST(RosbagImport, NtuViralPresetConvertsEndOfSweepStampsAndKeepsThePrismOffset) {

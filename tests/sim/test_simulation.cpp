@@ -64,7 +64,7 @@ struct ChannelCount {
 /// Reads a log, checks order, tie order and that each event's stamp is its message's utime.
 std::map<std::string, ChannelCount> checkLog(const std::string& path, const RigChannels& ch) {
   const std::map<std::string, int> rank = {
-      {ch.imu, 0}, {ch.wheel, 1}, {ch.ground_truth, 2}, {ch.lidar, 3}, {ch.camera, 4}};
+      {ch.imu, 0}, {ch.wheel, 1}, {ch.ground_truth, 2}, {ch.lidar, 3}, {ch.camera, 4}, {ch.depth, 5}};
   lcm::LogFile log(path, "r");
   EXPECT_TRUE(log.good());
   std::map<std::string, ChannelCount> out;
@@ -76,7 +76,7 @@ std::map<std::string, ChannelCount> checkLog(const std::string& path, const RigC
     else if (ev->channel == ch.ground_truth) u = utimeOf<pose_t>(ev);
     else if (ev->channel == ch.wheel) u = utimeOf<wheel_odometry_t>(ev);
     else if (ev->channel == ch.lidar) u = utimeOf<point_cloud_t>(ev);
-    else if (ev->channel == ch.camera) u = utimeOf<image_t>(ev);
+    else if (ev->channel == ch.camera || ev->channel == ch.depth) u = utimeOf<image_t>(ev);
     else ADD_FAILURE() << "unexpected channel " << ev->channel;
     EXPECT_EQ(u, ev->timestamp) << ev->channel;
     EXPECT_GE(ev->timestamp, prev_t);
@@ -299,6 +299,11 @@ TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
     expectRate(counts, ch.ground_truth, setup.options.ground_truth_rate_hz, duration);
     if (setup.rig.wheel) expectRate(counts, ch.wheel, setup.rig.wheel->rate_hz, duration);
     if (setup.rig.camera) expectRate(counts, ch.camera, setup.rig.camera->rate_hz, duration, 0.5);
+    if (setup.rig.camera && setup.rig.camera->depth) {
+      expectRate(counts, ch.depth, setup.rig.camera->rate_hz, duration, 0.5);
+    } else {
+      EXPECT_EQ(counts.count(ch.depth), 0u);
+    }
     if (setup.rig.lidar) {
       ASSERT_TRUE(counts.count(ch.lidar));
       EXPECT_EQ(counts.at(ch.lidar).count, static_cast<int64_t>(std::floor(duration * setup.rig.lidar->rate_hz)));

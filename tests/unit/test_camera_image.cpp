@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -339,4 +340,65 @@ TEST(CameraImage, RawImageViewsTheMessage) {
   EXPECT_EQ(static_cast<int>(ImageEncoding::kBgr8), static_cast<int>(image_t::ENCODING_BGR8));
   EXPECT_EQ(static_cast<int>(ImageEncoding::kJpeg), static_cast<int>(image_t::ENCODING_JPEG));
   EXPECT_EQ(static_cast<int>(ImageEncoding::kPng), static_cast<int>(image_t::ENCODING_PNG));
+}
+
+// Depth images: DEPTH16 (mm) and DEPTH32F (m) with row padding, 16-bit PNG (mm), to metres with 0
+// where there is no depth; everything that is not depth refused, and depth refused as a picture.
+TEST(CameraImage, DepthEncodingsDecodeToMetresWithZeroForNoDepth) {
+  const int w = 3, h = 2;
+  // DEPTH16, rows padded to 8 bytes (little-endian)
+  const uint16_t mm[6] = {0, 500, 1000, 2500, 65535, 7};
+  std::vector<uint8_t> d16(8 * h, 0xEE);
+  for (int i = 0; i < 6; ++i) {
+    d16[(i / 3) * 8 + (i % 3) * 2] = static_cast<uint8_t>(mm[i] & 0xff);
+    d16[(i / 3) * 8 + (i % 3) * 2 + 1] = static_cast<uint8_t>(mm[i] >> 8);
+  }
+  cv::Mat out;
+  std::string why;
+  ASSERT_TRUE(decodeDepth(raw(d16, w, h, 8, ImageEncoding::kDepth16), w, h, &out, &why)) << why;
+  ASSERT_EQ(out.type(), CV_32FC1);
+  for (int i = 0; i < 6; ++i) EXPECT_FLOAT_EQ(out.at<float>(i / 3, i % 3), static_cast<float>(mm[i] * 1e-3));
+  // DEPTH32F: NaN, infinities and negatives are no depth
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const float metres[6] = {1.25f, nan, inf, -2.0f, 0.0f, 7.5f};
+  std::vector<uint8_t> d32(sizeof(metres));
+  std::memcpy(d32.data(), metres, sizeof(metres));
+  ASSERT_TRUE(decodeDepth(raw(d32, w, h, 0, ImageEncoding::kDepth32f), w, h, &out, &why)) << why;
+  const float want[6] = {1.25f, 0.0f, 0.0f, 0.0f, 0.0f, 7.5f};
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(out.at<float>(i / 3, i % 3), want[i]) << "pixel " << i;
+  // a 16-bit grey PNG, as ROS and the RGB-D datasets store depth: millimetres
+  cv::Mat png16(h, w, CV_16UC1);
+  for (int i = 0; i < 6; ++i) png16.at<uint16_t>(i / 3, i % 3) = mm[i];
+  const std::vector<uint8_t> png = encode(".png", png16);
+  ASSERT_TRUE(decodeDepth(raw(png, 0, 0, 0, ImageEncoding::kPng), w, h, &out, &why)) << why;
+  for (int i = 0; i < 6; ++i) EXPECT_FLOAT_EQ(out.at<float>(i / 3, i % 3), static_cast<float>(mm[i] * 1e-3));
+}
+
+TEST(CameraImage, DepthRefusesWhatIsNotDepthAndPicturesRefuseDepth) {
+  const int w = 3, h = 2;
+  const std::vector<uint8_t> d16(w * h * 2, 1);
+  cv::Mat out;
+  std::string why;
+  // short data, another size, a bad stride
+  const std::vector<uint8_t> short_data(w * h * 2 - 1, 1);
+  EXPECT_FALSE(decodeDepth(raw(short_data, w, h, 0, ImageEncoding::kDepth16), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "shorter")) << why;
+  EXPECT_FALSE(decodeDepth(raw(d16, w, h, 0, ImageEncoding::kDepth16), 4, 2, &out, &why));
+  EXPECT_TRUE(has(why, "3x2") && has(why, "4x2")) << why;
+  EXPECT_FALSE(decodeDepth(raw(d16, w, h, 4, ImageEncoding::kDepth16), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "row_stride")) << why;
+  // a picture is not depth
+  const std::vector<uint8_t> grey(w * h, 100);
+  EXPECT_FALSE(decodeDepth(raw(grey, w, h, 0, ImageEncoding::kGray8), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "GRAY8") && has(why, "not depth")) << why;
+  const std::vector<uint8_t> png8 = encode(".png", cv::Mat(h, w, CV_8UC1, cv::Scalar(9)));
+  EXPECT_FALSE(decodeDepth(raw(png8, 0, 0, 0, ImageEncoding::kPng), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "16-bit grey")) << why;
+  EXPECT_TRUE(out.empty());
+  // depth is not a picture
+  EXPECT_FALSE(decodeGrey(raw(d16, w, h, 0, ImageEncoding::kDepth16), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "DEPTH16") && has(why, "depth image, not a picture")) << why;
+  EXPECT_FALSE(decodeRgb(raw(d16, w, h, 0, ImageEncoding::kDepth32f), w, h, &out, &why));
+  EXPECT_TRUE(has(why, "DEPTH32F")) << why;
+  EXPECT_TRUE(out.empty());
 }

@@ -108,6 +108,13 @@ TEST(LcmTypes, Image) {
   EXPECT_EQ(d.encoding, int8_t{image_t::ENCODING_GRAY8});
 }
 
+// The depth encodings (constants) left the fingerprint as it was: logs recorded before them decode.
+TEST(LcmTypes, ImageFingerprintUnchangedByTheDepthEncodings) {
+  EXPECT_EQ(static_cast<uint64_t>(image_t::getHash()), 0x804e5142b3028bd3ULL);
+  EXPECT_EQ(int{image_t::ENCODING_DEPTH16}, 20);
+  EXPECT_EQ(int{image_t::ENCODING_DEPTH32F}, 21);
+}
+
 TEST(LcmTypes, WheelPoseOdometry) {
   wheel_odometry_t w;
   w.utime = 5;

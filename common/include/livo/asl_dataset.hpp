@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "livo/sensor_rig.hpp"
 #include "livo/so3.hpp"
 
 namespace livo {
@@ -31,13 +32,22 @@ struct AslSensorYaml {
   double rate_hz = 0.0;
   // cameras
   std::vector<double> intrinsics;            // fu fv cu cv
-  std::vector<double> distortion;            // radtan k1 k2 p1 p2
+  DistortionModel distortion_model = DistortionModel::kRadtan;  // distortion_model: radial-tangential
+                                                                // (EuRoC) or equidistant (TUM-VI)
+  std::vector<double> distortion;            // radtan: k1 k2 p1 p2; equidistant: k1 k2 k3 k4
   int width = 0, height = 0;
   // IMUs
   double gyro_noise_density = 0.0, gyro_random_walk = 0.0;
   double accel_noise_density = 0.0, accel_random_walk = 0.0;
 };
-/// Reads an ASL sensor.yaml (the %YAML:1.0 header is accepted).
+/// Reads an ASL sensor.yaml (the %YAML:1.0 header is accepted). A distortion_model other than
+/// radial-tangential (radtan) or equidistant is an error naming the file.
 AslSensorYaml readAslSensorYaml(const std::string& path);
+
+/// The camera part of a rig from a camera's sensor.yaml: size, intrinsics, distortion model and
+/// coefficients, rate and T_I_C = T_BS (the body being the IMU, as in EuRoC and TUM-VI). Throws
+/// TrajectoryError naming `path` if the yaml is not a pinhole camera's (no intrinsics, resolution
+/// or four distortion coefficients).
+CameraRig aslCameraRig(const AslSensorYaml& s, const std::string& path);
 
 }  // namespace livo

@@ -1,5 +1,7 @@
-// Pinhole projection with radial-tangential (k1 k2 p1 p2) distortion, OpenCV convention (pixel
-// (i, j) has its centre at (i, j)); camera frame z forward, x right, y down.
+// Pinhole projection with radial-tangential (k1 k2 p1 p2, cv::projectPoints) or equidistant
+// (Kannala-Brandt k1..k4, cv::fisheye) distortion, as CameraRig::distortion_model says; OpenCV
+// convention (pixel (i, j) has its centre at (i, j)); camera frame z forward, x right, y down.
+// The one camera model of the project: estimators and the simulator's renderer use it alike.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,7 +23,8 @@ class CameraProjection {
   Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
   /// d distort(xy) / d xy.
   Eigen::Matrix2d distortJacobian(const Eigen::Vector2d& xy) const;
-  /// The normalised image point xy whose distortion is `distorted` (Newton on distort(xy)).
+  /// The normalised image point xy whose distortion is `distorted` (radtan: Newton on distort(xy);
+  /// equidistant: Newton on theta_d(theta), theta kept below 90 degrees).
   Eigen::Vector2d undistort(const Eigen::Vector2d& distorted) const;
   /// The unit ray of a pixel, camera frame (the inverse of project() up to scale).
   Eigen::Vector3d pixelRay(const Eigen::Vector2d& pixel) const;

@@ -19,6 +19,7 @@ struct RigChannels {
   std::string imu = "IMU";
   std::string lidar = "LIDAR";
   std::string camera = "CAMERA";
+  std::string depth = "DEPTH";          // depth images registered to the camera (CameraRig::depth)
   std::string wheel = "WHEEL";
   std::string ground_truth = "GROUND_TRUTH";
 };
@@ -45,14 +46,25 @@ struct LidarRig {
   Pose3 T_I_L = Pose3::Identity();    // p_I = T_I_L * p_L
 };
 
-/// Pinhole camera with radial-tangential distortion, z forward, x right, y down.
+/// The lens distortion of a CameraRig, as OpenCV and Kalibr name them.
+enum class DistortionModel {
+  kRadtan,       // radial-tangential (cv::projectPoints): k1 k2 p1 p2
+  kEquidistant,  // Kannala-Brandt (cv::fisheye): theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8)
+};
+/// "radtan" or "equidistant" (the names of the yaml key camera.distortion_model).
+const char* distortionModelName(DistortionModel m);
+
+/// Pinhole camera with radial-tangential or equidistant distortion, z forward, x right, y down.
 struct CameraRig {
   int width = 640;
   int height = 480;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
-  std::array<double, 4> distortion{{0.0, 0.0, 0.0, 0.0}};  // k1 k2 p1 p2
+  DistortionModel distortion_model = DistortionModel::kRadtan;
+  std::array<double, 4> distortion{{0.0, 0.0, 0.0, 0.0}};  // radtan: k1 k2 p1 p2; equidistant: k1 k2 k3 k4
   double rate_hz = 20.0;
   bool color = false;                 // RGB8 if true, else GRAY8
+  bool depth = false;                 // also a depth image registered to it (same intrinsics, size and
+                                      // stamp, as an RGB-D camera's aligned depth), on RigChannels::depth
   Pose3 T_I_C = Pose3::Identity();    // p_I = T_I_C * p_C
   double time_offset_s = 0.0;         // image utime + time_offset_s = the same instant on the IMU clock
   double rolling_shutter_s = 0.0;     // readout time, first to last row (0: global shutter); the

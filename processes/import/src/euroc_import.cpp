@@ -23,7 +23,8 @@ void sensorMetadata(const std::string& yaml, const std::string& prefix, ImportRe
     const std::vector<double> t(Tr.data(), Tr.data() + 16);
     report.metadata(prefix + "_T_body_sensor", yamlList(t));
     if (!s.intrinsics.empty()) report.metadata(prefix + "_intrinsics_fu_fv_cu_cv", yamlList(s.intrinsics));
-    if (!s.distortion.empty()) report.metadata(prefix + "_distortion_radtan", yamlList(s.distortion));
+    if (!s.distortion.empty())
+      report.metadata(prefix + "_distortion_" + distortionModelName(s.distortion_model), yamlList(s.distortion));
     if (s.width > 0) report.metadata(prefix + "_resolution", yamlList({double(s.width), double(s.height)}));
     if (s.gyro_noise_density > 0)
       report.metadata(prefix + "_noise_gyro_accel_density_walk",

@@ -1,5 +1,6 @@
 #include "livo/import/image_encoding.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "livo/import/stamp_conversion.hpp"
@@ -59,6 +60,8 @@ image_t convertRosImage(const RosImage& m, const std::string& frame, const std::
     img.encoding = image_t::ENCODING_RGB8, channels = 3;
   } else if (m.encoding == "bgr8" || m.encoding == "8UC3") {
     img.encoding = image_t::ENCODING_BGR8, channels = 3;
+  } else if (isRosDepthEncoding(m.encoding)) {
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is depth, not a camera image (map the topic with --depth)");
   } else {
     throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
   }
@@ -70,6 +73,40 @@ image_t convertRosImage(const RosImage& m, const std::string& frame, const std::
   const size_t size = static_cast<size_t>(m.step) * m.height;
   img.size = static_cast<int32_t>(size);
   img.data.assign(m.data, m.data + size);
+  return img;
+}
+
+bool isRosDepthEncoding(const std::string& encoding) {
+  return encoding == "16UC1" || encoding == "mono16" || encoding == "32FC1";
+}
+
+image_t convertRosDepthImage(const RosImage& m, const std::string& frame, const std::string& where) {
+  if (!isRosDepthEncoding(m.encoding))
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is not depth (16UC1 in mm, 32FC1 in m)");
+  const bool metres = m.encoding == "32FC1";
+  const uint64_t bytes = metres ? 4 : 2;
+  if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * bytes)
+    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " + std::to_string(bytes));
+  const uint64_t size = static_cast<uint64_t>(m.step) * m.height;
+  if (size > m.data_size)
+    throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
+                      std::to_string(size));
+  image_t img;
+  img.utime = nsToUtime(m.header.stampNs());
+  img.frame = frame;
+  img.width = static_cast<int32_t>(m.width);
+  img.height = static_cast<int32_t>(m.height);
+  img.row_stride = static_cast<int32_t>(m.step);
+  img.encoding = metres ? image_t::ENCODING_DEPTH32F : image_t::ENCODING_DEPTH16;
+  img.exposure_time = 0.0f;
+  img.size = static_cast<int32_t>(size);
+  img.data.assign(m.data, m.data + size);
+  if (m.is_bigendian) {
+    for (uint32_t y = 0; y < m.height; ++y) {
+      uint8_t* row = img.data.data() + static_cast<size_t>(y) * m.step;
+      for (uint64_t x = 0; x < m.width; ++x) std::reverse(row + x * bytes, row + (x + 1) * bytes);
+    }
+  }
   return img;
 }
 

@@ -25,6 +25,7 @@ void applyPreset(ImportJob& job) {
   fill(r.lidar_topic, p->lidar_topic);
   fill(r.camera_topic, p->camera_topic);
   fill(r.camera_right_topic, p->camera_right_topic);
+  fill(r.depth_topic, p->depth_topic);
   if (r.ground_truth_file.empty()) fill(r.ground_truth_topic, p->ground_truth_topic);
   r.ground_truth_child_frame = p->ground_truth_child_frame;
   r.lidar.stamp = p->lidar_stamp;
@@ -41,6 +42,7 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
                        {ch.lidar, "livo.point_cloud_t"},
                        {ch.camera, "livo.image_t"},
                        {ch.camera_right, "livo.image_t"},
+                       {ch.depth, "livo.image_t"},
                        {ch.ground_truth, "livo.pose_t"}};
   SortedLogWriterOptions wo;
   wo.max_buffer_bytes = job.max_buffer_mb << 20;

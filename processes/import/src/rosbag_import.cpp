@@ -18,7 +18,7 @@ namespace livo::import {
 
 namespace {
 
-enum class Role { kIgnored, kImu, kLidar, kCamera, kCameraRight, kGroundTruth };
+enum class Role { kIgnored, kImu, kLidar, kCamera, kCameraRight, kDepth, kGroundTruth };
 
 const char* roleName(Role r) {
   switch (r) {
@@ -26,6 +26,7 @@ const char* roleName(Role r) {
     case Role::kLidar: return "lidar";
     case Role::kCamera: return "camera";
     case Role::kCameraRight: return "camera-right";
+    case Role::kDepth: return "depth";
     case Role::kGroundTruth: return "ground-truth";
     default: return "ignored";
   }
@@ -38,9 +39,41 @@ bool fits(Role role, RosMessageKind kind) {
     case Role::kLidar: return kind == RosMessageKind::kPointCloud2;
     case Role::kCamera:
     case Role::kCameraRight: return kind == RosMessageKind::kImage || kind == RosMessageKind::kCompressedImage;
+    case Role::kDepth: return kind == RosMessageKind::kImage;
     case Role::kGroundTruth: return kind == RosMessageKind::kPose;
     default: return false;
   }
+}
+
+/// The encoding of each sensor_msgs/Image topic's first message (the bag is read until every
+/// Image topic has shown one): whether a topic is depth is in its messages, not its type.
+std::map<std::string, std::string> firstImageEncodings(const std::string& bag,
+                                                       const std::map<uint32_t, BagConnection>& connections) {
+  std::set<std::string> image_topics;
+  for (const auto& kv : connections)
+    if (rosTypeInfo(kv.second.type).kind == RosMessageKind::kImage) image_topics.insert(kv.second.topic);
+  std::map<std::string, std::string> encodings;
+  if (image_topics.empty()) return encodings;
+  struct AllSeen {};
+  try {
+    BagReader reader(bag);
+    reader.readAll([&](const BagMessage& m) {
+      const std::string& topic = m.connection->topic;
+      if (!image_topics.count(topic) || encodings.count(topic)) return;
+      if (rosTypeInfo(m.connection->type).kind != RosMessageKind::kImage) return;
+      try {
+        ByteReader r(m.data, m.size, bag);
+        encodings[topic] = decodeRosImage(r).encoding;
+      } catch (const DecodeError&) {
+        return;  // the import reports it
+      }
+      if (encodings.size() == image_topics.size()) throw AllSeen{};
+    });
+  } catch (const AllSeen&) {
+  } catch (const std::exception&) {
+    // a damaged bag: what was seen is used; the import reports the damage
+  }
+  return encodings;
 }
 
 class BagConverter {
@@ -50,17 +83,29 @@ class BagConverter {
     topics_[Role::kLidar] = o.lidar_topic;
     topics_[Role::kCamera] = o.camera_topic;
     topics_[Role::kCameraRight] = o.camera_right_topic;
+    topics_[Role::kDepth] = o.depth_topic;
     topics_[Role::kGroundTruth] = o.ground_truth_file.empty() ? o.ground_truth_topic : "";
   }
 
-  /// Fills empty roles from the bag's connections when exactly one topic fits.
-  void autoMap(const std::map<uint32_t, BagConnection>& connections) {
+  /// Fills empty roles from the bag's connections when exactly one topic fits. `image_encodings`
+  /// (firstImageEncodings) tells depth Image topics, which fit only the depth role, from cameras.
+  void autoMap(const std::map<uint32_t, BagConnection>& connections,
+               const std::map<std::string, std::string>& image_encodings) {
     if (!o_.auto_map) return;
-    for (Role role : {Role::kImu, Role::kLidar, Role::kCamera}) {
+    auto isDepth = [&](const std::string& topic) {
+      const auto it = image_encodings.find(topic);
+      return it != image_encodings.end() && isRosDepthEncoding(it->second);
+    };
+    for (Role role : {Role::kImu, Role::kLidar, Role::kCamera, Role::kDepth}) {
       if (!topics_[role].empty()) continue;
       std::set<std::string> candidates;
-      for (const auto& kv : connections)
-        if (fits(role, rosTypeInfo(kv.second.type).kind)) candidates.insert(kv.second.topic);
+      for (const auto& kv : connections) {
+        const std::string& topic = kv.second.topic;
+        if (!fits(role, rosTypeInfo(kv.second.type).kind)) continue;
+        if (role == Role::kCamera && isDepth(topic)) continue;
+        if (role == Role::kDepth && !isDepth(topic)) continue;
+        candidates.insert(topic);
+      }
       for (const auto& kv : topics_) candidates.erase(kv.second);
       if (candidates.size() == 1) {
         topics_[role] = *candidates.begin();
@@ -103,7 +148,11 @@ class BagConverter {
       switch (info.kind) {
         case RosMessageKind::kImu: return imu(decodeRosImu(r), m, where);
         case RosMessageKind::kPointCloud2: return cloud(decodeRosPointCloud2(r), m, where);
-        case RosMessageKind::kImage: return image(role, convertRosImage(decodeRosImage(r), frameOf(role), where), m);
+        case RosMessageKind::kImage: {
+          const RosImage msg = decodeRosImage(r);
+          return image(role, role == Role::kDepth ? convertRosDepthImage(msg, frameOf(role), where)
+                                                  : convertRosImage(msg, frameOf(role), where), m);
+        }
         case RosMessageKind::kCompressedImage:
           return image(role, convertRosCompressedImage(decodeRosCompressedImage(r), frameOf(role), where), m);
         case RosMessageKind::kPose: return pose(info.decode_pose(r), m, where);
@@ -179,7 +228,10 @@ class BagConverter {
 
   void image(Role role, image_t img, const BagMessage& m) {
     if (o_.use_bag_time) img.utime = nsToUtime(m.record_time_ns);
-    writer_.add(role == Role::kCameraRight ? o_.channels.camera_right : o_.channels.camera, img);
+    writer_.add(role == Role::kCameraRight ? o_.channels.camera_right
+                : role == Role::kDepth        ? o_.channels.depth
+                                              : o_.channels.camera,
+                img);
   }
 
   void pose(const RosStampedPose& p, const BagMessage& m, const std::string& where) {
@@ -224,10 +276,14 @@ std::map<uint32_t, BagConnection> bagConnections(const std::string& bag) {
 void importRosbag(const std::vector<std::string>& bags, const RosbagImportOptions& o, SortedLogWriter& writer,
                   ImportReport& report) {
   BagConverter conv(o, writer, report);
-  const bool need_auto = o.auto_map && (o.imu_topic.empty() || o.lidar_topic.empty() || o.camera_topic.empty());
+  const bool need_auto = o.auto_map && (o.imu_topic.empty() || o.lidar_topic.empty() || o.camera_topic.empty() ||
+                                        o.depth_topic.empty());
   if (need_auto && !bags.empty()) {
     try {
-      conv.autoMap(bagConnections(bags.front()));
+      const std::map<uint32_t, BagConnection> connections = bagConnections(bags.front());
+      const bool images_to_map = o.camera_topic.empty() || o.depth_topic.empty();
+      conv.autoMap(connections, images_to_map ? firstImageEncodings(bags.front(), connections)
+                                              : std::map<std::string, std::string>{});
     } catch (const std::exception& e) {
       report.error(e.what());
       return;

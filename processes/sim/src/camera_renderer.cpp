@@ -109,7 +109,7 @@ Eigen::Vector3f CameraRenderer::shadeThroughGlass(const Scene& scene, const Ray&
 }
 
 void CameraRenderer::accumulate(const Scene& scene, const PoseAt& T_W_C_at, double t, uint64_t key, float weight,
-                                std::vector<float>* rgb) const {
+                                std::vector<float>* rgb, std::vector<float>* z_depth) const {
   Mat3 R = Mat3::Identity();
   Ray ray;
   double pose_time = std::numeric_limits<double>::quiet_NaN();
@@ -135,6 +135,12 @@ void CameraRenderer::accumulate(const Scene& scene, const PoseAt& T_W_C_at, doub
         context.key = mix64(key ^ (k * 0x9e3779b97f4a7c15ULL));
         const RayHit hit = tile.culled ? scene.castAmong(ray, candidates, hint, context) : scene.cast(ray, context);
         hint = hit.object;
+        if (z_depth) {
+          // a depth camera's stereo matching fails on glass: no depth there
+          const bool depth = hit.valid() && scene.material(hit.object).kind != MaterialKind::kGlass;
+          (*z_depth)[k] = depth ? static_cast<float>(hit.t) * rays_[k].z() : 0.0f;
+        }
+        if (!rgb) continue;
         const Eigen::Vector3f c = shadeThroughGlass(scene, ray, hit, context);
         float* px = &(*rgb)[3 * k];
         px[0] += weight * c[0];
@@ -151,16 +157,22 @@ CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& tra
 }
 
 CameraImage CameraRenderer::render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime,
-                                   Random rng, const ExposureSetting& setting) const {
+                                   Random rng, const ExposureSetting& setting, std::vector<float>* z_depth) const {
   const double exposure = setting.exposure;
   const int samples = std::max(1, effects_.motion_blur_samples);
   const uint64_t key = rng.key();  // seeds the per-pixel interactions (vegetation depth)
   auto T_W_C_at = [&](double t) { return Pose3(trajectory.at(t).T_W_I * rig_.T_I_C); };
   std::vector<float> rgb(rays_.size() * 3, 0.0f);
+  if (z_depth) z_depth->assign(rays_.size(), 0.0f);
+  // an odd number of sub-frames has one at t_mid, whose rays give the depth; else a pass of its own
+  const int depth_sample = z_depth && samples % 2 == 1 ? samples / 2 : -1;
   for (int s = 0; s < samples; ++s) {
     const double t = samples == 1 ? t_mid : t_mid + exposure * ((s + 0.5) / samples - 0.5);
-    accumulate(scene, T_W_C_at, t, mix64(key + static_cast<uint64_t>(s)), 1.0f / samples, &rgb);
+    accumulate(scene, T_W_C_at, t, mix64(key + static_cast<uint64_t>(s)), 1.0f / samples, &rgb,
+               s == depth_sample ? z_depth : nullptr);
   }
+  if (z_depth && depth_sample < 0)
+    accumulate(scene, T_W_C_at, t_mid, mix64(key + static_cast<uint64_t>(samples)), 0.0f, nullptr, z_depth);
   CameraImage img;
   img.utime = utime;
   img.log_utime = utime;

@@ -1,5 +1,6 @@
 #include "livo/sim/log_writer.hpp"
 
+#include <cstring>
 #include <stdexcept>
 
 #include <lcm/lcm-cpp.hpp>
@@ -89,6 +90,21 @@ void LogWriter::write(const CameraImage& m) {
   msg.size = static_cast<int32_t>(m.data.size());
   msg.data = m.data;
   writeEvent(channels_.camera, m.log_utime, msg);
+}
+
+void LogWriter::write(const DepthImage& m) {
+  image_t msg;
+  msg.utime = m.utime;
+  msg.frame = "C";
+  msg.width = m.width;
+  msg.height = m.height;
+  msg.row_stride = m.width * 2;
+  msg.encoding = image_t::ENCODING_DEPTH16;
+  msg.exposure_time = 0.0f;
+  msg.size = static_cast<int32_t>(m.millimetres.size() * 2);
+  msg.data.resize(m.millimetres.size() * 2);
+  std::memcpy(msg.data.data(), m.millimetres.data(), msg.data.size());  // little-endian, as image_t says
+  writeEvent(channels_.depth, m.log_utime, msg);
 }
 
 }  // namespace livo::sim

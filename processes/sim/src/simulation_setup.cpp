@@ -189,6 +189,32 @@ void readWheelSlip(const Config& slip, WheelSlipOptions* w) {
   slip.checkAllUsed();
 }
 
+/// sim.depth: the depth sensor's effects (rig.camera.depth).
+void readDepthEffects(const Config& sim, const SensorRig& rig, DepthEffects* d) {
+  const Config depth = sim.optionalSection("depth");
+  if (!depth.isNull() && !(rig.camera && rig.camera->depth))
+    throw ConfigError(sim.where("depth") + ": the rig's camera has no depth (rig.camera.depth)");
+  depth.readOptional("noise_floor", d->noise_floor);
+  depth.readOptional("noise_per_m2", d->noise_per_m2);
+  depth.readOptional("min_range", d->min_range);
+  depth.readOptional("max_range", d->max_range);
+  depth.readOptional("edge_jump", d->edge_jump);
+  depth.readOptional("edge_hole_px", d->edge_hole_px);
+  depth.readOptional("hole_fraction", d->hole_fraction);
+  depth.readOptional("hole_radius_px", d->hole_radius_px);
+  if (!(d->noise_floor >= 0.0)) throw ConfigError(depth.where("noise_floor") + ": must be >= 0");
+  if (!(d->noise_per_m2 >= 0.0)) throw ConfigError(depth.where("noise_per_m2") + ": must be >= 0");
+  if (!(d->min_range >= 0.0)) throw ConfigError(depth.where("min_range") + ": must be >= 0");
+  if (!(d->max_range > d->min_range && d->max_range <= 65.0))
+    throw ConfigError(depth.where("max_range") + ": must be greater than min_range and at most 65 m (DEPTH16 in mm)");
+  if (!(d->edge_jump > 0.0)) throw ConfigError(depth.where("edge_jump") + ": must be > 0");
+  if (d->edge_hole_px < 0 || d->edge_hole_px > 50) throw ConfigError(depth.where("edge_hole_px") + ": must be in 0..50");
+  if (!(d->hole_fraction >= 0.0 && d->hole_fraction < 0.9)) throw ConfigError(depth.where("hole_fraction") + ": must be in [0, 0.9)");
+  if (!(d->hole_radius_px >= 0.5 && d->hole_radius_px <= 200.0))
+    throw ConfigError(depth.where("hole_radius_px") + ": must be in [0.5, 200]");
+  depth.checkAllUsed();
+}
+
 void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   sim.readOptional("start_time_s", o->start_time_s);
   sim.readOptional("duration_s", o->duration_s);
@@ -257,6 +283,7 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!(e.rolling_shutter_s >= 0.0) || (rig.camera && !(e.rolling_shutter_s <= 1.0 / rig.camera->rate_hz)))
     throw ConfigError(cam.where("rolling_shutter_s") + ": must be in [0, 1 / rate_hz] (the readout fits in a frame)");
   cam.checkAllUsed();
+  readDepthEffects(sim, rig, &o->depth);
 
   const Config wheel = sim.optionalSection("wheel");
   if (!wheel.isNull() && !rig.wheel) throw ConfigError(sim.where("wheel") + ": the rig has no wheel encoder");
@@ -266,6 +293,13 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!(o->wheel_right_scale > 0.0)) throw ConfigError(wheel.where("right_scale") + ": must be > 0");
   readWheelSlip(wheel.optionalSection("slip"), &o->wheel_slip);
   wheel.checkAllUsed();
+}
+
+void printDepthEffects(const DepthEffects& d, std::ostream& os) {
+  os << "  depth: noise " << d.noise_floor * 1e3 << " mm + " << d.noise_per_m2 * 1e3 << " mm/m^2 z^2 (" << d.sigmaAt(1.0) * 1e3
+     << " mm at 1 m, " << d.sigmaAt(3.0) * 1e3 << " mm at 3 m), range " << d.min_range << ".." << d.max_range
+     << " m, holes: " << d.edge_hole_px << " px at jumps over " << d.edge_jump * 100 << " %, blobs of " << d.hole_radius_px
+     << " px over " << d.hole_fraction * 100 << " % of the image\n";
 }
 
 void printLidarEffects(const LidarEffects& e, std::ostream& os) {
@@ -433,6 +467,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
        << a.max_exposure * 1e3 << " ms, gain " << a.min_gain << ".." << a.max_gain << ", rate " << a.rate
        << " per frame (exposure_variation drifts the scene light)\n";
   }
+  if (s.rig.camera && s.rig.camera->depth) printDepthEffects(o.depth, os);
   if (s.rig.wheel)
     os << "  wheel: scale errors left " << o.wheel_left_scale << ", right " << o.wheel_right_scale << "\n";
   if (s.rig.wheel && o.wheel_slip.enabled()) {

@@ -10,6 +10,7 @@
 
 #include "livo/sim/calibration_errors.hpp"
 #include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/depth_effects.hpp"
 #include "livo/sim/imu_model.hpp"
 #include "livo/sim/lidar_scanner.hpp"
 #include "livo/sim/random.hpp"
@@ -20,9 +21,16 @@ namespace livo::sim {
 namespace {
 
 // Random stream ids, one per sensor.
-enum Stream : uint64_t { kImuStream = 1, kWheelStream = 2, kLidarStream = 3, kCameraStream = 4, kWheelSlipStream = 5 };
+enum Stream : uint64_t {
+  kImuStream = 1,
+  kWheelStream = 2,
+  kLidarStream = 3,
+  kCameraStream = 4,
+  kWheelSlipStream = 5,
+  kDepthStream = 6,
+};
 // Order of messages that share a stamp.
-enum Rank : int { kImuRank = 0, kWheelRank = 1, kGroundTruthRank = 2, kLidarRank = 3, kCameraRank = 4 };
+enum Rank : int { kImuRank = 0, kWheelRank = 1, kGroundTruthRank = 2, kLidarRank = 3, kCameraRank = 4, kDepthRank = 5 };
 
 constexpr int64_t kChunkUs = 1000000;
 
@@ -63,6 +71,7 @@ struct Chunk {
   std::vector<WheelReading> wheels;
   std::vector<LidarSweep> sweeps;
   std::vector<CameraImage> images;
+  std::vector<DepthImage> depths;  // with rig.camera.depth: one per image, in the same slot
   std::vector<Pending> pending;
   std::vector<std::function<void()>> jobs;  // fill the reserved sweep and image slots
 };
@@ -94,6 +103,7 @@ class SimulationRun {
     }
     if (rig_.camera) {
       stats_.messages[rig_.channels.camera] = 0;
+      if (rig_.camera->depth) stats_.messages[rig_.channels.depth] = 0;
       renderer_ = std::make_unique<CameraRenderer>(*mounted_.camera, o_.camera);
       camera_offset_us_ = static_cast<int64_t>(std::llround(rig_.camera->time_offset_s * 1e6));
       if (o_.camera.auto_exposure.enabled) auto_exposure_.emplace(o_.camera.auto_exposure, o_.camera.exposure_time);
@@ -180,6 +190,10 @@ class SimulationRun {
       c->pending.push_back({u, kCameraRank, c->images.size()});
       c->images.emplace_back();
       const size_t slot = c->images.size() - 1;
+      if (rig_.camera->depth) {
+        c->depths.emplace_back();
+        c->pending.push_back({u, kDepthRank, slot});
+      }
       const int64_t k = frame_k_;
       frames.push_back([this, c, slot, k, u] {
         // stamped on the camera's clock as the rig believes it (rig camera time_offset_s) and logged at
@@ -187,13 +201,23 @@ class SimulationRun {
         const double t = s_.trajectoryTime(u) + errors_.camera_time_offset_s;
         const Random rng(o_.seed, kCameraStream, static_cast<uint64_t>(k));
         CameraImage& image = c->images[slot];
-        if (auto_exposure_) {
-          image = renderer_->render(*s_.scene, *s_.trajectory, t, u - camera_offset_us_, rng, auto_exposure_->setting());
-          auto_exposure_->update(AutoExposure::meanLevel(image.data));
-        } else {
-          image = renderer_->render(*s_.scene, *s_.trajectory, t, u - camera_offset_us_, rng);
-        }
+        const ExposureSetting setting =
+            auto_exposure_ ? auto_exposure_->setting() : ExposureSetting{renderer_->exposureAt(t), 1.0};
+        std::vector<float> z_depth;
+        image = renderer_->render(*s_.scene, *s_.trajectory, t, u - camera_offset_us_, rng, setting,
+                                  rig_.camera->depth ? &z_depth : nullptr);
+        if (auto_exposure_) auto_exposure_->update(AutoExposure::meanLevel(image.data));
         image.log_utime = u;
+        if (rig_.camera->depth) {
+          // its noise from a stream of its own: every other channel is as it is without depth
+          DepthImage& depth = c->depths[slot];
+          depth.utime = image.utime;
+          depth.log_utime = u;
+          depth.width = image.width;
+          depth.height = image.height;
+          depth.millimetres = measureDepth(z_depth, image.width, image.height, o_.depth,
+                                           Random(o_.seed, kDepthStream, static_cast<uint64_t>(k)));
+        }
       });
     }
     if (auto_exposure_) c->jobs.push_back([frames] { for (const auto& f : frames) f(); });
@@ -216,6 +240,7 @@ class SimulationRun {
           stats_.lidar_points += static_cast<int64_t>(c->sweeps[p.index].size());
           break;
         case kCameraRank: sink.write(c->images[p.index]); ++stats_.messages[rig_.channels.camera]; break;
+        case kDepthRank: sink.write(c->depths[p.index]); ++stats_.messages[rig_.channels.depth]; break;
       }
     }
   }

@@ -173,8 +173,8 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
   os << "[" << n.name << "] inputs " << n.camera_channel << ", " << n.state_prior_channel << ", "
      << n.registered_scan_channel << ", " << n.loop_correction_channel << "; output " << n.state_posterior_channel << "\n"
      << "  camera " << c.width << "x" << c.height << " f " << c.fx << "/" << c.fy << " c " << c.cx << "/" << c.cy
-     << ", distortion [" << c.distortion[0] << ", " << c.distortion[1] << ", " << c.distortion[2] << ", "
-     << c.distortion[3] << "], time offset " << n.camera_time_offset_s << " s (match within " << n.time_tolerance_s
+     << ", " << distortionModelName(c.distortion_model) << " distortion [" << c.distortion[0] << ", " << c.distortion[1]
+     << ", " << c.distortion[2] << ", " << c.distortion[3] << "], time offset " << n.camera_time_offset_s << " s (match within " << n.time_tolerance_s
      << " s)\n"
      << "  map: voxel " << o.map.voxel_size << " m, radius " << o.map.radius << " m, max " << o.map.max_points
      << " points x " << o.map.max_observations << " patches, " << o.map.recent_scans << " recent scans, plane snap "

@@ -20,6 +20,13 @@ CompressedImageInfo sniffCompressedImage(const uint8_t* data, size_t size);
 /// sensor_msgs/Image -> image_t. mono8/8UC1 -> GRAY8, rgb8 -> RGB8, bgr8/8UC3 -> BGR8; the
 /// row stride (step) is kept. Throws DecodeError naming `where` for other encodings or short data.
 image_t convertRosImage(const RosImage& m, const std::string& frame, const std::string& where);
+/// Depth encodings of sensor_msgs/Image: 16UC1 (and mono16, as some drivers label it), millimetres;
+/// 32FC1, metres (REP 118).
+bool isRosDepthEncoding(const std::string& encoding);
+/// A depth sensor_msgs/Image -> image_t: 16UC1 / mono16 -> DEPTH16, 32FC1 -> DEPTH32F, the row
+/// stride kept and big-endian data swapped to little-endian. Throws DecodeError naming `where`
+/// for other encodings or short data.
+image_t convertRosDepthImage(const RosImage& m, const std::string& frame, const std::string& where);
 /// sensor_msgs/CompressedImage -> image_t kept compressed. Throws DecodeError if the data is
 /// neither JPEG nor PNG.
 image_t convertRosCompressedImage(const RosCompressedImage& m, const std::string& frame, const std::string& where);

@@ -1,5 +1,6 @@
 // ROS 1 bag -> LCM log: each mapped topic's messages converted to the project's types
 // (sensor_msgs/Imu -> imu_t, PointCloud2 -> point_cloud_t, Image / CompressedImage -> image_t,
+// depth Image (16UC1 mm, 32FC1 m) -> image_t DEPTH16 / DEPTH32F,
 // Odometry / PoseStamped / PoseWithCovarianceStamped / TransformStamped / PointStamped -> pose_t),
 // stamped by their header stamps. Other topics are counted, never decoded.
 #pragma once
@@ -17,8 +18,9 @@ namespace livo::import {
 
 struct RosbagImportOptions {
   // Topics; empty ones are chosen automatically when the bag has exactly one topic of the type
-  // (IMU, PointCloud2, image) and `auto_map` is set.
-  std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, ground_truth_topic;
+  // (IMU, PointCloud2, image, depth image) and `auto_map` is set. An Image topic whose first
+  // message is 16UC1 or 32FC1 is depth, never a camera.
+  std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, depth_topic, ground_truth_topic;
   bool auto_map = true;
   std::string ground_truth_file;              // TUM / EuRoC csv instead of a topic
   std::string ground_truth_child_frame = "I";

@@ -12,7 +12,7 @@ namespace livo::import {
 struct RosbagPreset {
   std::string name;
   std::string description;
-  std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, ground_truth_topic;
+  std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, depth_topic, ground_truth_topic;
   std::string ground_truth_child_frame = "I";
   LidarStampConvention lidar_stamp = LidarStampConvention::kStart;
   double sweep_duration = 0.1;

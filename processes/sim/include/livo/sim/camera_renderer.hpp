@@ -3,6 +3,8 @@
 // time, optional motion blur (averaged sub-frames over the exposure), optional rolling shutter
 // (each row from the pose and scene at its own time), gain and exposure set by an auto-exposure
 // controller (auto_exposure.hpp, run by the simulator frame after frame), vignetting and noise.
+// The same rays give the exact z-depth of each pixel for an RGB-D camera (depth_effects.hpp adds
+// what the depth sensor does to it).
 #pragma once
 
 #include <functional>
@@ -10,8 +12,8 @@
 
 #include "livo/sim/auto_exposure.hpp"
 
+#include "livo/camera_projection.hpp"
 #include "livo/sensor_rig.hpp"
-#include "livo/sim/pinhole_camera.hpp"
 #include "livo/sim/random.hpp"
 #include "livo/sim/scene.hpp"
 #include "livo/sim/sensor_data.hpp"
@@ -37,9 +39,12 @@ class CameraRenderer {
 
   /// The image whose exposure is centred on trajectory time `t_mid` (stamped `utime`).
   CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime, Random rng) const;
-  /// The same with the exposure and gain an auto-exposure controller chose.
+  /// The same with the exposure and gain an auto-exposure controller chose; with `z_depth`, also
+  /// the exact depth along the optical axis per pixel (m, row-major; 0 where the ray meets nothing
+  /// or glass first), from the rays of the sub-frame at t_mid (rows at their own times under a
+  /// rolling shutter), so it is registered to the image. It leaves the image unchanged.
   CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime, Random rng,
-                     const ExposureSetting& setting) const;
+                     const ExposureSetting& setting, std::vector<float>* z_depth = nullptr) const;
 
   /// Exposure time at trajectory time t (the drift without auto exposure).
   double exposureAt(double t) const;
@@ -47,13 +52,14 @@ class CameraRenderer {
   double illuminationAt(double t) const;
   /// Time of row y's mid-exposure relative to the image stamp (the centre row's mid-exposure).
   double rowTimeOffset(int y) const;
-  const PinholeCamera& camera() const { return camera_; }
+  const CameraProjection& camera() const { return camera_; }
 
  private:
   using PoseAt = std::function<Pose3(double)>;
-  /// Adds weight x the image seen at time t (each row at t + rowTimeOffset) to rgb.
+  /// Adds weight x the image seen at time t (each row at t + rowTimeOffset) to rgb, and, if
+  /// `z_depth` is given, sets each pixel's z-depth; either may be null.
   void accumulate(const Scene& scene, const PoseAt& T_W_C_at, double t, uint64_t key, float weight,
-                  std::vector<float>* rgb) const;
+                  std::vector<float>* rgb, std::vector<float>* z_depth) const;
   Eigen::Vector3f shade(const Scene& scene, const Ray& ray, const RayHit& hit) const;
   /// shade() behind glass surfaces: each mixes its own shade in by (1 - transmission).
   Eigen::Vector3f shadeThroughGlass(const Scene& scene, const Ray& ray, RayHit hit, const CastContext& context) const;
@@ -69,7 +75,7 @@ class CameraRenderer {
 
   CameraRig rig_;
   CameraEffects effects_;
-  PinholeCamera camera_;
+  CameraProjection camera_;
   std::vector<Eigen::Vector3f> rays_;  // unit ray per pixel, camera frame
   std::vector<float> vignette_;        // gain per pixel
   std::vector<Tile> tiles_;

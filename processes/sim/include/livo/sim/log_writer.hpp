@@ -25,6 +25,7 @@ class LogWriter : public SensorDataSink {
   void write(const WheelReading& m) override;
   void write(const LidarSweep& m) override;
   void write(const CameraImage& m) override;
+  void write(const DepthImage& m) override;
 
   int64_t bytesWritten() const { return bytes_; }
 

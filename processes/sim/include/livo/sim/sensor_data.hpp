@@ -45,6 +45,14 @@ struct CameraImage {
   std::vector<uint8_t> data;
 };
 
+/// The depth image registered to a CameraImage (rig.camera.depth): the same size and stamps.
+struct DepthImage {
+  int64_t utime = 0;             // the colour image's
+  int64_t log_utime = 0;
+  int width = 0, height = 0;
+  std::vector<uint16_t> millimetres;  // z along the optical axis per pixel, row-major; 0: no depth
+};
+
 class SensorDataSink {
  public:
   virtual ~SensorDataSink() = default;
@@ -53,6 +61,8 @@ class SensorDataSink {
   virtual void write(const WheelReading& m) = 0;
   virtual void write(const LidarSweep& m) = 0;
   virtual void write(const CameraImage& m) = 0;
+  /// Only with rig.camera.depth; a sink that has no use for depth need not take it.
+  virtual void write(const DepthImage&) {}
 };
 
 }  // namespace livo::sim

@@ -10,6 +10,7 @@
 
 #include "livo/sim/calibration_errors.hpp"
 #include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/depth_effects.hpp"
 #include "livo/sim/imu_model.hpp"
 #include "livo/sim/lidar_effects.hpp"
 #include "livo/sim/lidar_pattern.hpp"
@@ -39,6 +40,7 @@ struct SimOptions {
   LidarEffects lidar_effects;         // sim.lidar receiver effects, all off by default
   CameraEffects camera;
   CameraTrigger camera_trigger = CameraTrigger::kFree;
+  DepthEffects depth;                 // sim.depth, for a camera with rig.camera.depth
   double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;
   WheelSlipOptions wheel_slip;        // sim.wheel.slip, off by default

@@ -1,0 +1,120 @@
+// The rig's camera keys: depth (an RGB-D camera's registered depth, its channel) and the
+// distortion model, read, printed and validated; the model read from an ASL sensor.yaml.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "livo/asl_dataset.hpp"
+#include "livo/sensor_rig.hpp"
+#include "livo/trajectory_io.hpp"
+
+using namespace livo;
+
+namespace {
+
+std::string rigYaml(const std::string& camera_extra, const std::string& channels = "") {
+  return "rig:\n" + channels +
+         "  imu: {rate_hz: 200, gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
+         "accel_random_walk: 0}\n"
+         "  camera:\n"
+         "    width: 640\n    height: 480\n    fx: 400\n    fy: 400\n    cx: 319.5\n    cy: 239.5\n"
+         "    rate_hz: 30\n    T_I_C: {translation: [0, 0, 0], rpy_deg: [0, 0, 0]}\n" +
+         camera_extra;
+}
+
+SensorRig readRig(const std::string& yaml) { return readSensorRig(Config::fromString(yaml, "rig.yaml").section("rig")); }
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    readRig(yaml);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(SensorRig, CameraDefaultsToNoDepthAndRadtan) {
+  const SensorRig r = readRig(rigYaml(""));
+  ASSERT_TRUE(r.camera);
+  EXPECT_FALSE(r.camera->depth);
+  EXPECT_EQ(r.camera->distortion_model, DistortionModel::kRadtan);
+  EXPECT_EQ(r.channels.depth, "DEPTH");
+  std::ostringstream os;
+  printSensorRig(r, os);
+  EXPECT_EQ(os.str().find("depth"), std::string::npos) << os.str();
+  EXPECT_NE(os.str().find("radtan distortion"), std::string::npos) << os.str();
+}
+
+TEST(SensorRig, DepthCameraOnItsChannel) {
+  const SensorRig r = readRig(rigYaml("    depth: true\n", "  channels: {depth: ALIGNED_DEPTH}\n"));
+  ASSERT_TRUE(r.camera);
+  EXPECT_TRUE(r.camera->depth);
+  EXPECT_EQ(r.channels.depth, "ALIGNED_DEPTH");
+  std::ostringstream os;
+  printSensorRig(r, os);
+  EXPECT_NE(os.str().find("depth images registered to it on ALIGNED_DEPTH"), std::string::npos) << os.str();
+  const std::string e = errorOf(rigYaml("    depth: true\n", "  channels: {depth: CAMERA}\n"));
+  EXPECT_NE(e.find("channels.depth"), std::string::npos) << e;
+  EXPECT_NE(e.find("a channel of their own"), std::string::npos) << e;
+  EXPECT_NE(errorOf(rigYaml("    depth: maybe\n")), "");
+}
+
+TEST(SensorRig, DistortionModelIsReadAndChecked) {
+  const SensorRig r = readRig(rigYaml("    distortion_model: equidistant\n    distortion: [0.01, -0.002, 0.0005, -0.0001]\n"));
+  EXPECT_EQ(r.camera->distortion_model, DistortionModel::kEquidistant);
+  EXPECT_DOUBLE_EQ(r.camera->distortion[2], 0.0005);
+  std::ostringstream os;
+  printSensorRig(r, os);
+  EXPECT_NE(os.str().find("equidistant distortion [0.01, -0.002, 0.0005, -0.0001]"), std::string::npos) << os.str();
+  EXPECT_EQ(readRig(rigYaml("    distortion_model: radtan\n")).camera->distortion_model, DistortionModel::kRadtan);
+  const std::string e = errorOf(rigYaml("    distortion_model: fisheye\n"));
+  EXPECT_NE(e.find("camera.distortion_model"), std::string::npos) << e;
+  EXPECT_NE(e.find("not radtan or equidistant"), std::string::npos) << e;
+  const std::string n = errorOf(rigYaml("    distortion_model: equidistant\n    distortion: [0.1, 0.2]\n"));
+  EXPECT_NE(n.find("[k1, k2, k3, k4]"), std::string::npos) << n;
+}
+
+// ASL sensor.yaml: EuRoC's cam0 says radial-tangential, TUM-VI's say equidistant; the camera rig
+// made from one carries the model.
+TEST(SensorRig, AslSensorYamlCarriesTheDistortionModelIntoTheRig) {
+  const std::string euroc = std::string(LIVO_SHARED_DATA) + "/euroc_v1_01/mav0/cam0/sensor.yaml";
+  const CameraRig e = aslCameraRig(readAslSensorYaml(euroc), euroc);
+  EXPECT_EQ(e.distortion_model, DistortionModel::kRadtan);
+  EXPECT_EQ(e.width, 752);
+  EXPECT_DOUBLE_EQ(e.fx, 458.654);
+  EXPECT_DOUBLE_EQ(e.distortion[3], 1.76187114e-05);
+  EXPECT_DOUBLE_EQ(e.rate_hz, 20.0);
+
+  const std::string tumvi = ::testing::TempDir() + "livo_tumvi_cam0_sensor.yaml";
+  {
+    std::ofstream out(tumvi);
+    out << "%YAML:1.0\nsensor_type: camera\n"
+           "T_BS:\n  cols: 4\n  rows: 4\n  data: [1, 0, 0, 0.1, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+           "rate_hz: 20\nresolution: [512, 512]\ncamera_model: pinhole\n"
+           "intrinsics: [190.97847715128717, 190.9733070521226, 254.93170605935475, 256.8974428996504]\n"
+           "distortion_model: equidistant\n"
+           "distortion_coefficients: [0.0034823894022493434, 0.0007150348452162257, -0.0020532361418706202, "
+           "0.00020293673591811182]\n";
+  }
+  const CameraRig t = aslCameraRig(readAslSensorYaml(tumvi), tumvi);
+  EXPECT_EQ(t.distortion_model, DistortionModel::kEquidistant);
+  EXPECT_DOUBLE_EQ(t.distortion[2], -0.0020532361418706202);
+  EXPECT_DOUBLE_EQ(t.T_I_C.translation().x(), 0.1);
+  {
+    std::ofstream out(tumvi);
+    out << "resolution: [512, 512]\nintrinsics: [190, 190, 255, 256]\ndistortion_model: fov\n"
+           "distortion_coefficients: [0.9]\n";
+  }
+  try {
+    readAslSensorYaml(tumvi);
+    ADD_FAILURE() << "an unknown distortion model is refused";
+  } catch (const TrajectoryError& err) {
+    EXPECT_NE(std::string(err.what()).find("'fov'"), std::string::npos) << err.what();
+  }
+  std::remove(tumvi.c_str());
+}
