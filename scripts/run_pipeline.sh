@@ -14,7 +14,7 @@
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
 #                           [--stop-grace S] [--overlay FILE,...] [--calibrate-camera]
-# Processes default to those of lio, vio, loop, colour, octomap that have a section in FILE.
+# Processes default to those of lio, vio, vio_feature, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
 # every restart. Without it a process that dies stops the run. --kill P:SIG:AT_S sends SIG to
@@ -32,13 +32,13 @@ set -euo pipefail
 {
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
-all_processes=(lio vio loop colour octomap)
+all_processes=(lio vio vio_feature loop colour octomap)
 
 usage() { sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0
-record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,HEALTH,GROUND_TRUTH'
+record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -118,7 +118,7 @@ for p in "${wanted[@]}"; do
   selected+=("$p")
 done
 [ ${#selected[@]} -gt 0 ] || die "no process to run (none of ${all_processes[*]} has a section in $config, or all are --without)"
-exe_of() { echo "${swap[$1]:-$bin/livo-$1}"; }
+exe_of() { echo "${swap[$1]:-$bin/livo-${1//_/-}}"; }  # process vio_feature: build/bin/livo-vio-feature
 for p in "${selected[@]}"; do
   [ -x "$(exe_of "$p")" ] || die "no executable for process '$p': $(exe_of "$p") (not built yet? use --without $p)"
 done

@@ -602,6 +602,45 @@ Mat6 SlidingWindowEstimator::newestPoseCovariance(const std::vector<Feature*>& f
   return Mat6(es.eigenvectors() * ev.cwiseInverse().asDiagonal() * es.eigenvectors().transpose());
 }
 
+bool SlidingWindowEstimator::poseAt(int64_t t, Pose3* pose) const {
+  if (window_.empty() || t < window_.front()->utime) return false;
+  const Frame& last = *window_.back();
+  if (t <= last.utime) {
+    size_t k = 1;
+    while (window_[k]->utime < t) ++k;
+    const Frame& a = *window_[k - 1];
+    const Frame& b = *window_[k];
+    const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
+    const Pose3 Ta = a.pose(), Tb = b.pose();
+    const Mat3 R = Ta.linear() * so3::Exp(s * so3::Log(Mat3(Ta.linear().transpose() * Tb.linear())));
+    *pose = se3::fromRotationTranslation(R, (1.0 - s) * Ta.translation() + s * Tb.translation());
+    return true;
+  }
+  std::vector<ImuSample> samples;
+  if (!samplesOver(imu_, last.utime, t, &samples)) return false;
+  ImuPreintegration pre(last.gyroBias(), last.accelBias(), opts_.imu_noise);
+  for (size_t k = 0; k + 1 < samples.size(); ++k)
+    pre.integrate(0.5 * (samples[k].gyro + samples[k + 1].gyro), 0.5 * (samples[k].accel + samples[k + 1].accel),
+                  toSeconds(samples[k + 1].utime - samples[k].utime));
+  Mat3 R;
+  Vec3 p, v;
+  pre.predict(last.pose().linear(), last.pose().translation(), last.velocity(), last.gyroBias(), last.accelBias(),
+              gravity_W_, &R, &p, &v);
+  *pose = se3::fromRotationTranslation(R, p);
+  return true;
+}
+
+bool SlidingWindowEstimator::gyroRotation(int64_t t0, int64_t t1, Mat3* R) const {
+  std::vector<ImuSample> samples;
+  if (imu_.empty() || imu_.front().utime > t0 || !samplesOver(imu_, t0, t1, &samples)) return false;
+  const Vec3 bg = window_.empty() ? Vec3::Zero() : window_.back()->gyroBias();
+  *R = Mat3::Identity();
+  for (size_t k = 0; k + 1 < samples.size(); ++k)
+    *R = *R * so3::Exp((0.5 * (samples[k].gyro + samples[k + 1].gyro) - bg) *
+                       toSeconds(samples[k + 1].utime - samples[k].utime));
+  return true;
+}
+
 VisualState SlidingWindowEstimator::stateOf(const Frame& f) const {
   VisualState s;
   s.utime = f.utime;

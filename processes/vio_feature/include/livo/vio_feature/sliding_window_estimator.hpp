@@ -87,6 +87,13 @@ class SlidingWindowEstimator {
   FrameResult addFrame(const FrameFeatures& frame);
 
   bool initialized() const { return !window_.empty(); }
+  /// W_T_I at time t (IMU clock): between two window states (interpolated), or after the newest
+  /// (the IMU's prediction from it). False before initialisation, before the oldest state or past
+  /// the buffered IMU.
+  bool poseAt(int64_t t, Pose3* pose) const;
+  /// The body's rotation from t0 to t1 (R_I0_I1) integrated from the gyro, less the newest state's
+  /// bias (none before initialisation); false where the IMU does not cover [t0, t1].
+  bool gyroRotation(int64_t t0, int64_t t1, Mat3* R) const;
   /// Drops the window, the features and the prior (the buffers stay): the next frames initialise.
   void reset();
   /// The newest IMU sample's time (0 before any).

@@ -1,0 +1,91 @@
+// The livo-vio-feature node: IMU, CAMERA (and DEPTH, WHEEL, REGISTERED_SCAN) in; VISUAL_STATE
+// (visual_state_t, the coupling with livo-lio-graph) and VISUAL_ODOMETRY (the same as odometry_t,
+// for the evaluation and the tools) out, around a FeatureTracker and a SlidingWindowEstimator.
+//
+// Determinism: images wait in a queue and are processed once the IMU has passed their time and,
+// for what the rig has, a wheel reading has, their depth image has arrived and a REGISTERED_SCAN
+// ending after them has (each of the last three at most *_max_wait_s of IMU beyond the image), so
+// the output depends only on the messages' contents and stamps, not on how the channels interleave.
+// An estimator restart (an IMU gap) starts a new epoch of the frame V.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/core.hpp>
+
+#include "livo/image_t.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/node.hpp"
+#include "livo/registered_scan_t.hpp"
+#include "livo/vio_feature/feature_depth.hpp"
+#include "livo/vio_feature/feature_tracker.hpp"
+#include "livo/vio_feature/sliding_window_estimator.hpp"
+#include "livo/vio_feature/vio_feature_config.hpp"
+#include "livo/wheel_odometry_t.hpp"
+
+namespace livo::vio_feature {
+
+class VioFeatureNode {
+ public:
+  VioFeatureNode(lcm::LCM& lcm, NodeOptions node_options, VioFeatureNodeOptions options);
+  Node& node() { return node_; }
+  const SlidingWindowEstimator& estimator() const { return estimator_; }
+  /// Restarts so far (= the current epoch).
+  int32_t epoch() const { return epoch_; }
+
+  struct Counts {
+    int64_t images = 0;        // processed
+    int64_t tracked = 0;       // ... giving a state
+    int64_t bad_images = 0;    // refused (size, decoding)
+    int64_t dropped = 0;       // dropped from a full queue (no IMU)
+    int64_t with_depth_image = 0;  // processed with their depth image
+    int64_t with_lidar = 0;    // processed with LiDAR points
+  };
+  const Counts& counts() const { return counts_; }
+  std::string summary() const;
+
+ private:
+  struct PendingImage {
+    int64_t utime = 0;  // camera clock (the message's)
+    int64_t t = 0;      // IMU clock
+    cv::Mat grey;
+  };
+  struct StoredScan {
+    int64_t t = 0;               // end of sweep (IMU clock)
+    std::vector<Vec3> points_I;  // body frame at t, in front of the camera
+  };
+  void onImu(const imu_t& m);
+  void onWheel(const wheel_odometry_t& m);
+  void onImage(const image_t& m);
+  void onDepth(const image_t& m);
+  void onScan(const registered_scan_t& m);
+  bool ready(const PendingImage& p) const;
+  void processReady();
+  void process(const PendingImage& p);
+  /// Depth from the stored scans moved into the camera at t (the window's poses); how many features got one.
+  int lidarDepth(int64_t t, std::vector<FeatureObservation>* features);
+  void publish(const FrameResult& r);
+
+  Node node_;
+  VioFeatureNodeOptions opts_;
+  SlidingWindowEstimator estimator_;
+  FeatureTracker tracker_;
+  LidarDepthMap lidar_map_;
+  int64_t offset_us_ = 0;
+  std::deque<PendingImage> pending_;
+  std::map<int64_t, cv::Mat> depth_images_;  // by camera utime
+  std::deque<StoredScan> scans_;
+  int64_t imu_watermark_ = INT64_MIN;
+  int64_t wheel_watermark_ = INT64_MIN;
+  int64_t scan_watermark_ = INT64_MIN;
+  int64_t last_image_t_ = INT64_MIN;
+  int32_t epoch_ = 0;
+  Counts counts_;
+};
+
+}  // namespace livo::vio_feature
