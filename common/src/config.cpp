@@ -10,7 +10,7 @@
 namespace livo {
 
 const std::vector<std::string> kConfigSections = {
-    "rig", "sim", "bus", "playback", "lio", "lio_graph", "vio", "loop", "colour", "octomap", "pipeline", "evaluate"};
+    "rig", "sim", "bus", "playback", "lio", "lio_graph", "vio", "vio_feature", "loop", "colour", "octomap", "pipeline", "evaluate"};
 
 namespace {
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <ceres/ceres.h>
@@ -119,6 +120,7 @@ bool SlidingWindowEstimator::addWheel(const WheelSample& s, std::string* why) {
 void SlidingWindowEstimator::reset() {
   features_.clear();
   rejected_.clear();
+  recent_.clear();
   prior_factor_.reset();
   prior_.reset();
   window_.clear();
@@ -136,7 +138,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
     return res;
   }
   if (window_.empty()) {
-    if (!initialize(t, &res)) return res;
+    if (!initialize(t, in, &res)) return res;
     window_.back()->keyframe = true;
     addObservations(*window_.back(), in);
     res.status = FrameResult::Status::kInitialized;
@@ -180,8 +182,27 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   return res;
 }
 
-bool SlidingWindowEstimator::initialize(int64_t t, FrameResult* res) {
+bool SlidingWindowEstimator::cameraStill(int64_t t, const FrameFeatures& frame) {
+  std::map<uint64_t, Vec2> now;
+  for (const FeatureMeasurement& m : frame.features) now[m.id] = m.xy;
+  recent_.emplace_back(t, std::move(now));
+  const int64_t span = toUtime(opts_.init.window_s);
+  while (recent_.size() > 2 && recent_[1].first <= t - span) recent_.pop_front();
+  if (recent_.size() < 2 || recent_.front().first > t - span) return false;
+  std::vector<double> moved;
+  const auto& then = recent_.front().second;
+  for (const auto& [id, xy] : recent_.back().second) {
+    const auto it = then.find(id);
+    if (it != then.end()) moved.push_back((xy - it->second).norm() * opts_.focal);
+  }
+  if (moved.size() < 10) return false;
+  std::nth_element(moved.begin(), moved.begin() + static_cast<long>(moved.size() / 2), moved.end());
+  return moved[moved.size() / 2] < opts_.still_parallax_px;
+}
+
+bool SlidingWindowEstimator::initialize(int64_t t, const FrameFeatures& frame, FrameResult* res) {
   res->status = FrameResult::Status::kInitializing;
+  const bool camera_still = cameraStill(t, frame);
   // A car cruising on a smooth road can look still to the IMU: where the wheels turn, it is not.
   bool wheels_turn = false;
   if (opts_.use_wheel)
@@ -189,13 +210,13 @@ bool SlidingWindowEstimator::initialize(int64_t t, FrameResult* res) {
       if (w.utime <= t && w.utime >= t - toUtime(opts_.init.window_s))
         wheels_turn |= std::abs(w.left_speed) + std::abs(w.right_speed) > 2.0 * kStillWheelSpeed;
   if (wheels_turn) return initializeMoving(t, res);
-  if (initializeAtRest(t, res)) return true;
+  if (initializeAtRest(t, camera_still, res)) return true;
   if (opts_.use_wheel && initializeMoving(t, res)) return true;
   if (res->note.empty()) res->note = opts_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
   return false;
 }
 
-bool SlidingWindowEstimator::initializeAtRest(int64_t t, FrameResult* res) {
+bool SlidingWindowEstimator::initializeAtRest(int64_t t, bool camera_still, FrameResult* res) {
   std::vector<ImuSample> window;
   for (const ImuSample& s : imu_)
     if (s.utime <= t && s.utime >= t - toUtime(opts_.init.window_s)) window.push_back(s);
@@ -206,12 +227,20 @@ bool SlidingWindowEstimator::initializeAtRest(int64_t t, FrameResult* res) {
   ImuInitOptions init = opts_.init;
   init.gravity = opts_.gravity;
   init.mode = ImuInitOptions::Mode::kStatic;
+  if (camera_still) init.max_gyro_std = init.max_accel_std = std::numeric_limits<double>::infinity();
   const ImuInitResult r = initializeImu(window, init);
   if (!r.ok) return false;
+  // the mean's own uncertainty where the IMU shakes: the samples' spread over their number
+  Vec3 mean = Vec3::Zero(), var = Vec3::Zero();
+  for (const ImuSample& s : window) mean += s.gyro;
+  mean /= static_cast<double>(window.size());
+  for (const ImuSample& s : window) var += (s.gyro - mean).cwiseAbs2();
+  const double gyro_mean_std = std::sqrt(var.maxCoeff() / static_cast<double>(window.size() * window.size()));
   startWindow(t, r.state.rot, Vec3::Zero(), r.state.gyro_bias, r.state.accel_bias, init.static_rot_std,
-              init.static_vel_std, 0.002);
+              init.static_vel_std, 0.002 + gyro_mean_std);
   res->static_start = true;
   res->note = "initialised at rest";
+  if (camera_still && !isStill(window, opts_.init)) res->note = "initialised at rest (the images still, the IMU shaking)";
   return true;
 }
 
@@ -285,6 +314,7 @@ void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v
   f->priors.emplace_back(makeVectorPriorFactor(ba, Vec3::Constant(opts_.init.accel_bias_std)));
   f->prior_blocks.push_back({f->ba});
   window_.push_back(std::move(f));
+  recent_.clear();
 }
 
 bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::string* why) {

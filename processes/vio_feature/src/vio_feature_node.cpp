@@ -191,7 +191,12 @@ void VioFeatureNode::process(const PendingImage& p) {
     node_.reject(opts_.camera_channel, r.note);
     return;
   }
-  if (r.status == FrameResult::Status::kInitializing) return;
+  if (r.status == FrameResult::Status::kInitializing) {
+    if (r.note != init_note_) node_.info(r.note);  // what it waits for, once
+    init_note_ = r.note;
+    return;
+  }
+  init_note_.clear();
   if (r.status == FrameResult::Status::kInitialized) node_.info(r.note);
   ++counts_.tracked;
   publish(r);

@@ -105,8 +105,13 @@ class SlidingWindowEstimator {
   struct Frame;
   struct Feature;
 
-  bool initialize(int64_t t, FrameResult* res);
-  bool initializeAtRest(int64_t t, FrameResult* res);
+  bool initialize(int64_t t, const FrameFeatures& frame, FrameResult* res);
+  /// `camera_still`: the image says the body is at rest, so the IMU's own stillness test (which a
+  /// vibrating platform, a drone on its rotors, fails) is waived.
+  bool initializeAtRest(int64_t t, bool camera_still, FrameResult* res);
+  /// True if the features have not moved (median under still_parallax_px) since an image at least
+  /// init.window_s older; keeps the images of that span.
+  bool cameraStill(int64_t t, const FrameFeatures& frame);
   bool initializeMoving(int64_t t, FrameResult* res);
   void startWindow(int64_t t, const Mat3& R, const Vec3& v, const Vec3& bg, const Vec3& ba, double rot_std,
                    double vel_std, double bg_std);
@@ -133,7 +138,8 @@ class SlidingWindowEstimator {
   std::deque<WheelSample> wheel_;
   std::deque<std::unique_ptr<Frame>> window_;
   std::map<uint64_t, std::unique_ptr<Feature>> features_;
-  std::set<uint64_t> rejected_;  // outlier tracks: their later observations are ignored
+  std::set<uint64_t> rejected_;
+  std::deque<std::pair<int64_t, std::map<uint64_t, Vec2>>> recent_;  // before initialisation: t, features  // outlier tracks: their later observations are ignored
   std::shared_ptr<MarginalPrior> prior_;
   std::unique_ptr<ceres::CostFunction> prior_factor_;
   std::unique_ptr<ceres::LossFunction> reprojection_loss_;

@@ -85,6 +85,7 @@ class VioFeatureNode {
   int64_t scan_watermark_ = INT64_MIN;
   int64_t last_image_t_ = INT64_MIN;
   int32_t epoch_ = 0;
+  std::string init_note_;  // the last reason the estimator gave for not initialising yet
   Counts counts_;
 };
 

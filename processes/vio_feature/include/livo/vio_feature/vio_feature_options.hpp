@@ -15,6 +15,9 @@ struct SlidingWindowOptions {
   ImuPreintegrationNoise imu_noise;     // rig.imu
   double gravity = 9.81;                // m/s^2 (rig.imu.gravity)
   ImuInitOptions init;                  // the static start (IMU at rest)
+  // The images may say the body is at rest where the IMU cannot (rotor vibration): features
+  // moving less than this (median, px) over init.window_s.
+  double still_parallax_px = 0.5;
 
   bool use_wheel = false;               // rig.wheel present and vio_feature.wheel not false
   WheelRig wheel_rig;
