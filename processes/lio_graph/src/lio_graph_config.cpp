@@ -33,6 +33,9 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     ch.readOptional("registered_scan", n.registered_scan_channel);
     ch.readOptional("keyframe", n.keyframe_channel);
     ch.readOptional("loop_correction", n.loop_correction_channel);
+    ch.readOptional("visual_state", n.visual_state_channel);
+    c.readOptional("visual_state", o.use_visual_motion);
+    c.readOptional("visual_max_wait_s", n.visual_max_wait_s);
     bool wheel = o.use_wheel;
     if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
     c.readOptional("wheel_cauchy", o.wheel_cauchy);
@@ -83,19 +86,22 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     fail("plane_threshold_base", "plane_threshold_base must be > 0 and plane_threshold_per_metre >= 0");
   if (!(o.planes.max_quality_ratio > 0.0)) fail("plane_max_quality_ratio", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0)) fail("wheel_max_wait_s", "must be >= 0");
+  if (!(n.visual_max_wait_s >= 0.0)) fail("visual_max_wait_s", "must be >= 0");
   return n;
 }
 
 void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
   const LioGraphOptions& o = n.core;
   os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.lidar_channel
-     << (o.use_wheel ? ", " + n.wheel_channel : std::string()) << ", " << n.loop_correction_channel << "; outputs " << n.odometry_channel << ", "
+     << (o.use_wheel ? ", " + n.wheel_channel : std::string())
+     << (o.use_visual_motion ? ", " + n.visual_state_channel : std::string()) << ", " << n.loop_correction_channel << "; outputs " << n.odometry_channel << ", "
      << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
      << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
      << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
-     << (o.planar_factors ? ", adaptive planar factors" : "") << "\n"
+     << (o.planar_factors ? ", adaptive planar factors" : "")
+     << (o.use_visual_motion ? "; deskew and guess from the visual subsystem's motion" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
      << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";
 }

@@ -185,6 +185,8 @@ int64_t LioGraphEstimator::scanEndUtime(const LidarScan& scan) const {
   return scan.utime + toUtime(opts_.extrinsics.time_offset_s) + toUtime(end);
 }
 
+bool LioGraphEstimator::addVisualState(const VisualSample& s, std::string* why) { return visual_.add(s, why); }
+
 bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
   std::vector<ImuSample> window;
   for (const ImuSample& s : imu_)
@@ -356,6 +358,23 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     return res;
   }
 
+  // The visual subsystem's motion over the sweep, where it covers it, replaces the IMU's
+  // translation (which rests on the graph's velocity); the rotation stays the gyro's.
+  if (!seeding && opts_.use_visual_motion) {
+    const Pose3 T_prev = window_.back()->pose();
+    std::vector<Vec3> p_visual(steps.size());
+    bool covered = true;
+    for (size_t k = 0; k < steps.size() && covered; ++k) {
+      Pose3 rel;
+      covered = visual_.relative(window_.back()->utime, steps[k].utime, &rel);
+      p_visual[k] = T_prev * rel.translation();
+    }
+    if (covered) {
+      for (size_t k = 0; k < steps.size(); ++k) steps[k].pose.translation() = p_visual[k];
+      res.visual_motion = true;
+    }
+  }
+
   // 2. deskewed points and their features
   std::vector<Vec3> body;
   RingCloud cloud;
@@ -382,7 +401,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     Vec3 p, v;
     pre.predict(prev.pose().linear(), Vec3(prev.p[0], prev.p[1], prev.p[2]), Vec3(prev.v[0], prev.v[1], prev.v[2]),
                 pre.gyroBias(), pre.accelBias(), gravity_W_, &R, &p, &v);
-    n->setPose(se3::fromRotationTranslation(R, p));
+    n->setPose(res.visual_motion ? steps.back().pose : se3::fromRotationTranslation(R, p));
     Eigen::Map<Vec3>(n->v) = v;
     std::copy(prev.bg, prev.bg + 3, n->bg);
     std::copy(prev.ba, prev.ba + 3, n->ba);

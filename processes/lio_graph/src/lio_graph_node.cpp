@@ -47,6 +47,21 @@ LioGraphNode::LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNode
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
+  if (opts_.core.use_visual_motion)
+    node_.subscribe<visual_state_t>(opts_.visual_state_channel, [this](const visual_state_t& m) { onVisualState(m); });
+}
+
+void LioGraphNode::onVisualState(const visual_state_t& m) {
+  VisualSample s;
+  s.utime = m.utime;
+  s.pose = poseFrom(m.position, m.orientation);
+  s.epoch = m.epoch;
+  std::string why;
+  if (!estimator_.addVisualState(s, &why)) {
+    node_.reject(opts_.visual_state_channel, why);
+    return;
+  }
+  processReady();
 }
 
 void LioGraphNode::announceReset(const std::string& why) {
@@ -123,6 +138,9 @@ void LioGraphNode::processReady() {
     if (opts_.core.use_wheel && wheel_watermark_ < p.end_utime &&
         imu_watermark_ < p.end_utime + toUtime(opts_.wheel_max_wait_s))
       return;
+    if (opts_.core.use_visual_motion && estimator_.visualWatermark() < p.end_utime &&
+        imu_watermark_ < p.end_utime + toUtime(opts_.visual_max_wait_s))
+      return;
     process(p);
     pending_.pop_front();
   }
@@ -140,6 +158,7 @@ void LioGraphNode::process(const PendingSweep& p) {
   tracked_ += r.status == GraphScanResult::Status::kTracked;
   predicted_ += r.status == GraphScanResult::Status::kPredicted;
   degenerate_ += r.degenerate;
+  visual_ += r.visual_motion;
   if (!r.message.empty()) node_.info(r.message);
   const OutputFrame frame{estimator_.frame().epoch, estimator_.frame().correction_id};
   node_.publish(opts_.odometry_channel, toOdometry(r, estimator_.frame()));
@@ -155,6 +174,7 @@ std::string LioGraphNode::summary() const {
   std::ostringstream s;
   s << processed_ << " sweeps: " << tracked_ << " tracked, " << predicted_ << " predicted only, " << degenerate_
     << " degenerate";
+  if (opts_.core.use_visual_motion) s << "; " << visual_ << " deskewed with the visual subsystem's motion";
   if (opts_.core.use_wheel && opts_.core.wheel_scale_std > 0.0)
     s << "; tyre scales " << estimator_.wheelScale().x() << " (left), " << estimator_.wheelScale().y() << " (right)";
   return s.str();

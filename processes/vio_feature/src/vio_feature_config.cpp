@@ -42,6 +42,7 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
     c.readOptional("depth_max_wait_s", n.depth_max_wait_s);
     c.readOptional("lidar_max_wait_s", n.lidar_max_wait_s);
     c.readOptional("lidar_depth_window_s", n.lidar_depth_window_s);
+    c.readOptional("lidar_lag_s", n.lidar_lag_s);
     c.readOptional("tracked_features", n.tracker.max_features);
     c.readOptional("min_distance_px", n.tracker.min_distance_px);
     c.readOptional("ransac_threshold_px", n.tracker.ransac_threshold_px);
@@ -73,6 +74,7 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   if (!(n.wheel_max_wait_s >= 0.0 && n.depth_max_wait_s >= 0.0 && n.lidar_max_wait_s >= 0.0))
     fail("lidar_max_wait_s", "the waits must be >= 0");
   if (!(n.lidar_depth_window_s >= 0.0)) fail("lidar_depth_window_s", "must be >= 0");
+  if (!(n.lidar_lag_s >= 0.0)) fail("lidar_lag_s", "must be >= 0");
   if (!(w.focal > 0.0)) throw ConfigError(root.where("rig") + ": the camera's fx and fy must be > 0");
   return n;
 }

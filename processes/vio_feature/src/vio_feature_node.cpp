@@ -125,7 +125,8 @@ bool VioFeatureNode::ready(const PendingImage& p) const {
   auto waited = [&](double max_wait_s) { return imu_watermark_ >= p.t + toUtime(max_wait_s); };
   if (opts_.window.use_wheel && wheel_watermark_ < p.t && !waited(opts_.wheel_max_wait_s)) return false;
   if (opts_.use_depth_image && !depth_images_.count(p.utime) && !waited(opts_.depth_max_wait_s)) return false;
-  if (opts_.use_lidar_depth && scan_watermark_ < p.t && !waited(opts_.lidar_max_wait_s)) return false;
+  if (opts_.use_lidar_depth && scan_watermark_ < p.t - toUtime(opts_.lidar_lag_s) && !waited(opts_.lidar_max_wait_s))
+    return false;
   return true;
 }
 
@@ -142,7 +143,9 @@ int VioFeatureNode::lidarDepth(int64_t t, std::vector<FeatureObservation>* featu
   const Pose3 T_C_W = (T_W_It * opts_.window.T_I_C).inverse();
   std::vector<Vec3> points_C;
   for (const StoredScan& s : scans_) {
-    if (s.t < t - toUtime(opts_.lidar_depth_window_s)) continue;
+    // the scans that ended lidar_lag_s before the image at the latest: the same set however the
+    // channels interleave (a later one may or may not have arrived)
+    if (s.t < t - toUtime(opts_.lidar_depth_window_s) || s.t > t - toUtime(opts_.lidar_lag_s)) continue;
     Pose3 T_W_Is;
     if (!estimator_.poseAt(s.t, &T_W_Is)) continue;  // older than the window, or past the IMU
     const Pose3 T_C_Is = T_C_W * T_W_Is;

@@ -22,9 +22,12 @@ struct LioGraphNodeOptions {
   std::string registered_scan_channel = "REGISTERED_SCAN";
   std::string keyframe_channel = "KEYFRAME";
   std::string loop_correction_channel = "LOOP_CORRECTION";  // in: adopted as livo-lio adopts it
+  std::string visual_state_channel = "VISUAL_STATE";        // in (lio_graph.visual_state: true): livo-vio-feature's
   /// A sweep waits for a wheel reading past its end, or for this much IMU beyond it (a dead
   /// encoder must not stall the odometry).
   double wheel_max_wait_s = 0.1;
+  /// With the visual subsystem, a sweep waits for a visual state past its end, or for this much IMU.
+  double visual_max_wait_s = 0.2;
   LioGraphOptions core;
 };
 

@@ -23,6 +23,7 @@
 
 #include "livo/keyframe_selector.hpp"
 #include "livo/lio_graph/lio_graph_options.hpp"
+#include "livo/lio_graph/visual_motion.hpp"
 #include "livo/marginalization.hpp"
 #include "livo/odometry_frame.hpp"
 
@@ -50,6 +51,7 @@ struct GraphScanResult {
   Vec2 wheel_scale = Vec2::Ones();          // [left, right] tyre radius over the nominal
   Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
   bool degenerate = false;
+  bool visual_motion = false;   // the deskew and the guess took the visual subsystem's motion
   Vec6 weakest_direction = Vec6::Zero();    // of the scan matching, [rotation, translation]
   int edge_residuals = 0, surface_residuals = 0;
   int planes = 0;                 // planes observed in the sweep (planar factors)
@@ -77,6 +79,10 @@ class LioGraphEstimator {
   /// False (with the reason) for non-finite values or a sample not later than the previous one.
   bool addImu(const ImuSample& s, std::string* why = nullptr);
   bool addWheel(const WheelSample& s, std::string* why = nullptr);
+  /// The visual subsystem's estimate (used when options().use_visual_motion); the same checks.
+  bool addVisualState(const VisualSample& s, std::string* why = nullptr);
+  /// The newest visual state's time (INT64_MIN before any).
+  int64_t visualWatermark() const { return visual_.newest(); }
   /// End of the sweep in the IMU clock: the IMU must have passed it before addScan.
   int64_t scanEndUtime(const LidarScan& scan) const;
   GraphScanResult addScan(const LidarScan& scan);
@@ -138,6 +144,7 @@ class LioGraphEstimator {
   std::vector<double*> wheelBlocks(Node& a, Node& b);
 
   LioGraphOptions opts_;
+  VisualMotion visual_;
   std::deque<ImuSample> imu_;
   std::deque<WheelSample> wheel_;
   std::deque<std::unique_ptr<Node>> window_;

@@ -6,7 +6,8 @@
 // (epoch, correction_id). An estimator reset (an IMU gap) starts a new epoch.
 //
 // Determinism: sweeps wait in a queue and are processed once the IMU has passed their end (and,
-// with wheels, a wheel reading has, or wheel_max_wait_s of IMU beyond it), so the output depends
+// with wheels, a wheel reading has, or wheel_max_wait_s of IMU beyond it; with the visual subsystem,
+// a VISUAL_STATE has, or visual_max_wait_s of IMU beyond it), so the output depends
 // only on the messages' contents and stamps, not on how the channels interleave.
 #pragma once
 
@@ -20,6 +21,7 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "livo/visual_state_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
 namespace livo::lio_graph {
@@ -45,6 +47,7 @@ class LioGraphNode {
   void onWheel(const wheel_odometry_t& m);
   void onLidar(const point_cloud_t& m);
   void onLoopCorrection(const loop_correction_t& m);
+  void onVisualState(const visual_state_t& m);
   /// Warns (HEALTH, stderr) "odometry reset to epoch N: why: re-initialising" after the estimator
   /// was reset.
   void announceReset(const std::string& why);
@@ -57,7 +60,7 @@ class LioGraphNode {
   std::deque<PendingSweep> pending_;
   int64_t imu_watermark_ = INT64_MIN;
   int64_t wheel_watermark_ = INT64_MIN;
-  int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0;
+  int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0, visual_ = 0;
   int64_t resets_ = 0;
 };
 

@@ -44,6 +44,10 @@ struct LioGraphOptions {
   double plane_match_angle_deg = 10.0;  // an observation joins a landmark this close in normal ...
   double plane_match_distance = 0.2;    // ... whose plane passes this close to its centroid (m)
 
+  // The visual subsystem's motion (VISUAL_STATE from livo-vio-feature) for the deskew's translation
+  // and the scan-matching guess where it covers the sweep (rotation stays the gyro's).
+  bool use_visual_motion = false;
+
   int window_states = 10;               // sweeps in the fixed-lag smoother
   int solver_iterations = 10;
   KeyframeOptions keyframe;             // a new keyframe (local map, KEYFRAME) after 1 m or 10 deg
