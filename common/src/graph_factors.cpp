@@ -79,6 +79,24 @@ struct WheelCost {
 
 }  // namespace
 
+ceres::Problem::Options nonOwningProblemOptions() {
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return po;
+}
+
+void solveWindow(ceres::Problem* problem, int iterations) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.max_num_iterations = iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, problem, &summary);
+}
+
 ceres::CostFunction* makeImuFactor(const ImuPreintegration& preintegration, const Vec3& gravity_W) {
   return new ceres::AutoDiffCostFunction<ImuCost, 9, 4, 3, 3, 3, 3, 4, 3, 3>(
       new ImuCost{preintegration, gravity_W, preintegration.sqrtInformation()});

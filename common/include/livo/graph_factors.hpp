@@ -14,6 +14,13 @@
 
 namespace livo {
 
+/// A problem that owns none of its cost functions, losses or manifolds: the windows keep their
+/// factors across optimisations and rebuild the problem each time.
+ceres::Problem::Options nonOwningProblemOptions();
+
+/// Solves a window's problem: dense Schur, one thread, silent, at most `iterations` iterations.
+void solveWindow(ceres::Problem* problem, int iterations);
+
 /// The pose W_T_I of a state's orientation block q (x y z w, normalised here) and position block p.
 inline Pose3 poseFromBlocks(const double* q, const double* p) {
   return se3::fromRotationTranslation(Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix(),

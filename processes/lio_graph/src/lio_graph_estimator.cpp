@@ -526,11 +526,7 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
 }
 
 void LioGraphEstimator::optimize() {
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
+  ceres::Problem problem(nonOwningProblemOptions());
   static RightQuaternionManifold manifold;
   for (auto& n : window_) {
     problem.AddParameterBlock(n->q, 4, &manifold);
@@ -549,13 +545,7 @@ void LioGraphEstimator::optimize() {
     if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, m.bg, m.ba, n.bg, n.ba);
     if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), wheelBlocks(m, n));
   }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_SCHUR;
-  so.max_num_iterations = opts_.solver_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  solveWindow(&problem, opts_.solver_iterations);
 }
 
 void LioGraphEstimator::marginalizeOldest() {

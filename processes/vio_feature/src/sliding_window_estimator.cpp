@@ -442,44 +442,42 @@ std::vector<SlidingWindowEstimator::Feature*> SlidingWindowEstimator::graphFeatu
   return out;
 }
 
+template <class Add>
+void SlidingWindowEstimator::forEachFactor(const std::vector<Feature*>& features, Add&& add) const {
+  if (prior_factor_) add(prior_factor_.get(), nullptr, prior_->blocks);
+  for (size_t k = 0; k < window_.size(); ++k) {
+    Frame& f = *window_[k];
+    for (size_t i = 0; i < f.priors.size(); ++i) add(f.priors[i].get(), nullptr, f.prior_blocks[i]);
+    if (k == 0) continue;
+    Frame& e = *window_[k - 1];
+    if (f.imu) add(f.imu.get(), nullptr, {e.q, e.p, e.v, e.bg, e.ba, f.q, f.p, f.v});
+    if (f.bias_walk) add(f.bias_walk.get(), nullptr, {e.bg, e.ba, f.bg, f.ba});
+    if (f.wheel) add(f.wheel.get(), f.wheel_loss.get(), {e.q, e.p, f.q, f.p});
+  }
+  for (Feature* ft : features) {
+    Frame& a = *ft->anchor();
+    for (size_t k = 1; k < ft->obs.size(); ++k)
+      add(ft->obs[k].cost.get(), reprojection_loss_.get(),
+          {a.q, a.p, ft->obs[k].frame->q, ft->obs[k].frame->p, ft->rho});
+    if (ft->depth_prior) add(ft->depth_prior.get(), nullptr, {ft->rho});
+  }
+}
+
 void SlidingWindowEstimator::optimize(const std::vector<Feature*>& features) {
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
+  ceres::Problem problem(nonOwningProblemOptions());
   static RightQuaternionManifold manifold;
   for (auto& f : window_) {
     problem.AddParameterBlock(f->q, 4, &manifold);
     for (double* b : {f->p, f->v, f->bg, f->ba}) problem.AddParameterBlock(b, 3);
   }
-  if (prior_factor_) problem.AddResidualBlock(prior_factor_.get(), nullptr, prior_->blocks);
-  for (size_t k = 0; k < window_.size(); ++k) {
-    Frame& f = *window_[k];
-    for (size_t i = 0; i < f.priors.size(); ++i) problem.AddResidualBlock(f.priors[i].get(), nullptr, f.prior_blocks[i]);
-    if (k == 0) continue;
-    Frame& e = *window_[k - 1];
-    if (f.imu) problem.AddResidualBlock(f.imu.get(), nullptr, {e.q, e.p, e.v, e.bg, e.ba, f.q, f.p, f.v});
-    if (f.bias_walk) problem.AddResidualBlock(f.bias_walk.get(), nullptr, e.bg, e.ba, f.bg, f.ba);
-    if (f.wheel) problem.AddResidualBlock(f.wheel.get(), f.wheel_loss.get(), e.q, e.p, f.q, f.p);
-  }
+  forEachFactor(features, [&](ceres::CostFunction* cost, ceres::LossFunction* loss, std::vector<double*> blocks) {
+    problem.AddResidualBlock(cost, loss, blocks);
+  });
   for (Feature* ft : features) {
-    Frame& a = *ft->anchor();
-    for (size_t k = 1; k < ft->obs.size(); ++k) {
-      Frame& j = *ft->obs[k].frame;
-      problem.AddResidualBlock(ft->obs[k].cost.get(), reprojection_loss_.get(), a.q, a.p, j.q, j.p, ft->rho);
-    }
-    if (ft->depth_prior) problem.AddResidualBlock(ft->depth_prior.get(), nullptr, ft->rho);
     problem.SetParameterLowerBound(ft->rho, 0, 1.0 / opts_.max_depth);
     problem.SetParameterUpperBound(ft->rho, 0, 1.0 / opts_.min_depth);
   }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_SCHUR;
-  so.max_num_iterations = opts_.solver_iterations;
-  so.num_threads = 1;
-  so.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(so, &problem, &summary);
+  solveWindow(&problem, opts_.solver_iterations);
 }
 
 int SlidingWindowEstimator::rejectOutliers() {
@@ -607,23 +605,9 @@ void SlidingWindowEstimator::dropSecondNewest() {
 Mat6 SlidingWindowEstimator::newestPoseCovariance(const std::vector<Feature*>& features) const {
   Marginalizer m;
   for (auto& f : window_) m.setQuaternion(f->q);
-  if (prior_factor_) m.addFactor(prior_factor_.get(), prior_->blocks);
-  for (size_t k = 0; k < window_.size(); ++k) {
-    Frame& f = *window_[k];
-    for (size_t i = 0; i < f.priors.size(); ++i) m.addFactor(f.priors[i].get(), f.prior_blocks[i]);
-    if (k == 0) continue;
-    Frame& e = *window_[k - 1];
-    if (f.imu) m.addFactor(f.imu.get(), {e.q, e.p, e.v, e.bg, e.ba, f.q, f.p, f.v});
-    if (f.bias_walk) m.addFactor(f.bias_walk.get(), {e.bg, e.ba, f.bg, f.ba});
-    if (f.wheel) m.addFactor(f.wheel.get(), {e.q, e.p, f.q, f.p}, f.wheel_loss.get());
-  }
-  for (Feature* ft : features) {
-    Frame& a = *ft->anchor();
-    for (size_t k = 1; k < ft->obs.size(); ++k)
-      m.addFactor(ft->obs[k].cost.get(), {a.q, a.p, ft->obs[k].frame->q, ft->obs[k].frame->p, ft->rho},
-                  reprojection_loss_.get());
-    if (ft->depth_prior) m.addFactor(ft->depth_prior.get(), {ft->rho});
-  }
+  forEachFactor(features, [&](ceres::CostFunction* cost, ceres::LossFunction* loss, std::vector<double*> blocks) {
+    m.addFactor(cost, std::move(blocks), loss);
+  });
   const Frame& c = *window_.back();
   Eigen::MatrixXd info;
   if (!m.marginalInformation({c.q, c.p}, &info)) return Mat6::Identity();

@@ -123,6 +123,10 @@ class SlidingWindowEstimator {
   void triangulate();
   /// The features that enter the optimisation (inverse depth known, two frames or more).
   std::vector<Feature*> graphFeatures();
+  /// Every factor of the window: the marginal prior, the first state's priors, the IMU, bias-walk
+  /// and wheel factors, the features' reprojections and depth priors, as add(cost, loss, blocks).
+  template <class Add>
+  void forEachFactor(const std::vector<Feature*>& features, Add&& add) const;
   void optimize(const std::vector<Feature*>& features);
   /// Drops the features of the last optimisation that are off by more than outlier_px anywhere.
   int rejectOutliers();
