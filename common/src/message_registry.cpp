@@ -17,6 +17,7 @@
 #include "livo/pose_t.hpp"
 #include "livo/progress_t.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "livo/visual_state_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
 namespace livo {
@@ -63,7 +64,7 @@ const std::vector<MessageType>& messageTypes() {
   static const std::vector<MessageType> types =
       listTypes<imu_t, point_cloud_t, image_t, wheel_odometry_t, pose_t, odometry_t, filter_state_t,
                 registered_scan_t, keyframe_t, loop_correction_t, colored_cloud_t, octomap_t, progress_t,
-                channel_stats_t, health_t>();
+                channel_stats_t, health_t, visual_state_t>();
   return types;
 }
 
@@ -143,6 +144,10 @@ int64_t nonFiniteIn(const loop_correction_t& m) {
   for (const auto& q : m.orientation) n += nonFinite(q);
   return n;
 }
+int64_t nonFiniteIn(const visual_state_t& m) {
+  return nonFinite(m.position) + nonFinite(m.orientation) + nonFinite(m.velocity) + nonFinite(m.gyro_bias) +
+         nonFinite(m.accel_bias) + nonFinite(m.pose_covariance);
+}
 int64_t nonFiniteIn(const colored_cloud_t& m) { return nonFinite(m.x) + nonFinite(m.y) + nonFinite(m.z); }
 int64_t nonFiniteIn(const octomap_t& m) { return nonFinite(m.resolution); }
 int64_t nonFiniteIn(const channel_stats_t& m) {
@@ -175,7 +180,7 @@ int64_t countNonFinite(const void* data, int size) {
   if (size < 8) return -1;
   return countFor<imu_t, point_cloud_t, image_t, wheel_odometry_t, pose_t, odometry_t, filter_state_t,
                   registered_scan_t, keyframe_t, loop_correction_t, colored_cloud_t, octomap_t, progress_t,
-                  channel_stats_t, health_t>(data, size);
+                  channel_stats_t, health_t, visual_state_t>(data, size);
 }
 
 }  // namespace livo

@@ -20,6 +20,7 @@
 #include "livo/pose_t.hpp"
 #include "livo/progress_t.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "livo/visual_state_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
 using namespace livo;
@@ -255,7 +256,7 @@ TEST(LcmTypes, ProgressHealth) {
 
 TEST(LcmTypes, RegistryHasEveryTypeOnce) {
   const auto& types = messageTypes();
-  EXPECT_EQ(types.size(), 15u);
+  EXPECT_EQ(types.size(), 16u);
   for (size_t i = 0; i < types.size(); ++i)
     for (size_t j = i + 1; j < types.size(); ++j) EXPECT_NE(types[i].fingerprint, types[j].fingerprint);
   const uint8_t junk[8] = {1, 2, 3, 4, 5, 6, 7, 8};
@@ -281,7 +282,7 @@ TEST(LcmTypes, LeadingUtimeReadAndWrittenInPlace) {
   EXPECT_FALSE(messageUtime(kb.data(), static_cast<int>(kb.size()), &t));
   int with_utime = 0;
   for (const auto& type : messageTypes()) with_utime += type.leading_utime;
-  EXPECT_EQ(with_utime, 13);  // all but keyframe_t and channel_stats_t
+  EXPECT_EQ(with_utime, 14);  // all but keyframe_t and channel_stats_t
 }
 
 // countNonFinite sees a NaN or an infinity in any floating-point field, nested ones included.
@@ -321,6 +322,13 @@ TEST(LcmTypes, CountNonFiniteFindsEveryBadValue) {
   h.channels.resize(1);
   h.channels[0].median_ms = NAN;
   EXPECT_EQ(count(h), 1);
+
+  visual_state_t v{};
+  v.orientation[0] = 1.0;
+  EXPECT_EQ(count(v), 0);
+  v.velocity[2] = NAN;
+  v.pose_covariance[7] = -INFINITY;
+  EXPECT_EQ(count(v), 2);
 
   const uint8_t junk[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
   EXPECT_EQ(countNonFinite(junk, 12), -1);  // not a project message

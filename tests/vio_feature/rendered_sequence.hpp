@@ -2,16 +2,20 @@
 // trajectory and a camera rig (a sim config's, or built by a test), grey images rendered at
 // trajectory times with the simulator's noise and exposure drift, and the truth to check tracks
 // against: the scene point a pixel's ray hits, and where a world point lands in a later image.
+// For an RGB-D rig (rig.camera.depth), the depth image registered to each grey image, with the
+// simulator's depth-sensor effects (sim.depth), as livo-sim logs it on DEPTH.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "livo/sim/camera_renderer.hpp"
+#include "livo/sim/depth_effects.hpp"
 #include "livo/sim/simulation_setup.hpp"
 
 namespace livo_test {
@@ -27,6 +31,7 @@ class RenderedSequence {
     seed_ = setup.options.seed;
     start_utime_ = setup.start_utime;
     effects_ = setup.options.camera;
+    depth_effects_ = setup.options.depth;
     scene_ = std::move(setup.scene);
     trajectory_ = std::move(setup.trajectory);
     renderer_ = std::make_unique<livo::sim::CameraRenderer>(camera_, effects_);
@@ -56,6 +61,19 @@ class RenderedSequence {
     return view.clone();
   }
 
+  /// The grey image at trajectory time t (noise stream k) and its depth image: CV_32F metres along
+  /// z, 0 where the sensor gives none (the simulator's millimetres, as livo-vio-feature decodes them).
+  void imageAndDepth(double t, uint64_t k, cv::Mat* grey, cv::Mat* depth) const {
+    std::vector<float> z;
+    const livo::sim::ExposureSetting setting{renderer_->exposureAt(t), 1.0};
+    const livo::sim::CameraImage c =
+        renderer_->render(*scene_, *trajectory_, t, utime(t), livo::sim::Random(seed_, 7, k), setting, &z);
+    *grey = cv::Mat(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data())).clone();
+    std::vector<uint16_t> mm = livo::sim::measureDepth(z, c.width, c.height, depth_effects_, livo::sim::Random(seed_, 8, k));
+    cv::Mat(c.height, c.width, CV_16UC1, mm.data()).convertTo(*depth, CV_32F, 1e-3);
+  }
+
+  const livo::sim::BodyTrajectory& trajectory() const { return *trajectory_; }
   livo::Pose3 cameraPose(double t) const { return trajectory_->at(t).T_W_I * camera_.T_I_C; }
   /// Rotation from the camera frame at t_prev to the one at t (what a gyro integrates).
   livo::Mat3 rotationCurPrev(double t, double t_prev) const {
@@ -89,6 +107,7 @@ class RenderedSequence {
  private:
   livo::CameraRig camera_;
   livo::sim::CameraEffects effects_;
+  livo::sim::DepthEffects depth_effects_;
   uint64_t seed_ = 1;
   int64_t start_utime_ = 1'700'000'000'000'000;
   std::unique_ptr<livo::sim::Scene> scene_;
