@@ -284,6 +284,34 @@ TEST(SlidingWindowEstimator, FollowsTheRoomWalkStartedAtRest) {
   EXPECT_LT((r.last.accel_bias - spec.imu_error.accel_bias).norm(), 0.05);
 }
 
+TEST(SlidingWindowEstimator, PoseAtWithTheFirstFrameAlone) {
+  // Right after the initialisation the window holds one frame: the pose at its time is its own
+  // (livo-vio-feature asks for it when a LiDAR scan ends exactly there), and earlier is unknown.
+  synth::SequenceSpec spec;
+  spec.traj = synth::roomTrajectory(1.5);
+  spec.duration = 4.0;
+  spec.imu_error = synth::realisticImu();
+  const SlidingWindowOptions o = optionsFor(spec);
+  const synth::SyntheticSequence seq(spec);
+  SyntheticTracks tracks([&](double t) { return spec.traj.pose(t); }, o.T_I_C, 1.0, 0.0, 0.01, spec.seed);
+  SlidingWindowEstimator est(o);
+  size_t next_imu = 0;
+  for (double t = 0.6; t < 3.0; t += 0.05) {
+    const int64_t utime = spec.base_utime + static_cast<int64_t>(std::llround(t * 1e6));
+    while (next_imu < seq.imu().size() && seq.imu()[next_imu].utime <= utime + 10000) est.addImu(seq.imu()[next_imu++]);
+    const FrameResult r = est.addFrame(tracks.frame(t, utime));
+    if (r.status != FrameResult::Status::kInitialized) continue;
+    Pose3 at;
+    ASSERT_TRUE(est.poseAt(utime, &at));
+    EXPECT_LT((at.matrix() - r.state.pose.matrix()).norm(), 1e-12);
+    EXPECT_FALSE(est.poseAt(utime - 1, &at));
+    ASSERT_TRUE(est.poseAt(utime + 5000, &at));  // predicted with the IMU beyond it
+    EXPECT_LT((at.translation() - r.state.pose.translation()).norm(), 0.05);
+    return;
+  }
+  FAIL() << "never initialised";
+}
+
 namespace {
 
 /// A car on flat ground: speed v(t) = 1.5 + 0.5 sin(0.4 t) m/s along its heading, yaw rate

@@ -620,8 +620,12 @@ bool SlidingWindowEstimator::poseAt(int64_t t, Pose3* pose) const {
   if (window_.empty() || t < window_.front()->utime) return false;
   const Frame& last = *window_.back();
   if (t <= last.utime) {
-    size_t k = 1;
+    size_t k = 0;  // the first frame not before t: one exists, and k > 0 unless it is at t
     while (window_[k]->utime < t) ++k;
+    if (window_[k]->utime == t) {
+      *pose = window_[k]->pose();
+      return true;
+    }
     const Frame& a = *window_[k - 1];
     const Frame& b = *window_[k];
     const double s = static_cast<double>(t - a.utime) / static_cast<double>(b.utime - a.utime);
