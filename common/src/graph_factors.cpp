@@ -49,6 +49,29 @@ struct PoseCost {
   }
 };
 
+struct RelativePoseCost {
+  Quatd q_measured_inverse;
+  Vec3 p_measured;
+  Mat6 sqrt_info;
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, T* r) const {
+    const T unit(1.0);
+    return (*this)(q_i, p_i, q_j, p_j, &unit, r);
+  }
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qi(q_i), qj(q_j);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pi(p_i), pj(p_j);
+    const Eigen::Quaternion<T> qi_inv = qi.conjugate();
+    Eigen::Matrix<T, 6, 1> e;
+    e.template head<3>() = quaternionLog(Eigen::Quaternion<T>(q_measured_inverse.cast<T>() * qi_inv * qj));
+    e.template tail<3>() = qi_inv * (pj - pi) - *scale * p_measured.cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> out_map(r);
+    out_map = sqrt_info.cast<T>() * e;
+    return true;
+  }
+};
+
 template <int N>
 struct VectorPriorCost {
   Eigen::Matrix<double, N, 1> mean, inv_sigma;
@@ -113,6 +136,21 @@ ceres::CostFunction* makeBiasWalkFactor(double gyro_random_walk, double accel_ra
 ceres::CostFunction* makePoseFactor(const Pose3& measured, const Mat6& information) {
   return new ceres::AutoDiffCostFunction<PoseCost, 6, 4, 3>(new PoseCost{
       Quatd(measured.linear()).normalized().inverse(), measured.translation(), Mat6(sqrtInformation(information))});
+}
+
+ceres::CostFunction* makeRelativePoseFactor(const Pose3& T_i_j, const Mat6& information) {
+  return new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 4, 3, 4, 3>(new RelativePoseCost{
+      Quatd(T_i_j.linear()).normalized().inverse(), T_i_j.translation(), Mat6(sqrtInformation(information))});
+}
+
+ceres::CostFunction* makeScaledRelativePoseFactor(const Pose3& T_i_j, const Mat6& information) {
+  return new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 4, 3, 4, 3, 1>(new RelativePoseCost{
+      Quatd(T_i_j.linear()).normalized().inverse(), T_i_j.translation(), Mat6(sqrtInformation(information))});
+}
+
+ceres::CostFunction* makeScalarPriorFactor(double mean, double sigma) {
+  return new ceres::AutoDiffCostFunction<VectorPriorCost<1>, 1, 1>(
+      new VectorPriorCost<1>{Eigen::Matrix<double, 1, 1>(mean), Eigen::Matrix<double, 1, 1>(1.0 / sigma)});
 }
 
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma) {

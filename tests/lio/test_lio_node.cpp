@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 
+#include "bus_messages.hpp"
 #include "livo/filter_state_message.hpp"
 #include "livo/image_t.hpp"
 #include "livo/loop_correction_t.hpp"
@@ -39,23 +40,8 @@ struct Outputs {
   std::vector<keyframe_t> keyframes;
 };
 
-struct Message {
-  int64_t order_key;
-  std::string channel;
-  std::vector<uint8_t> bytes;
-};
-
-template <class M>
-Message encode(int64_t key, const std::string& channel, const M& m) {
-  Message out{key, channel, std::vector<uint8_t>(static_cast<size_t>(m.getEncodedSize()))};
-  m.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
-  return out;
-}
-
-void drain(lcm::LCM& lcm) {
-  while (lcm.handleTimeout(0) > 0) {
-  }
-}
+using livo_test::Message;
+using livo_test::encode;
 
 struct RunSetup {
   std::string config = kConfig;
@@ -86,10 +72,7 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
   });
   observer.subscribe<registered_scan_t>("REGISTERED_SCAN", [&](const registered_scan_t& m) { out.scans.push_back(m); });
   observer.subscribe<keyframe_t>("KEYFRAME", [&](const keyframe_t& m) { out.keyframes.push_back(m); });
-  for (const auto& m : messages) {
-    lcm.publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
-    drain(lcm);
-  }
+  livo_test::publishAll(lcm, messages);
   if (rejected) {
     *rejected = 0;
     for (const auto& c : node.node().channelStats()) *rejected += c.rejected + c.decode_failures;
@@ -119,7 +102,7 @@ std::vector<Message> syntheticRun() {
   std::vector<Message> msgs;
   for (const auto& s : seq.imu()) msgs.push_back(encode(s.utime, "IMU", synth::imuMessage(s)));
   for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
-  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&msgs);
   return msgs;
 }
 }  // namespace
@@ -215,9 +198,8 @@ TEST(LioNode, OutputDoesNotDependOnChannelInterleaving) {
     if (m.channel == "LIDAR") m.order_key -= 350'000;
   for (auto& m : imu_early)
     if (m.channel == "IMU") m.order_key = (m.order_key / 1'000'000) * 1'000'000;
-  auto by_key = [](const Message& a, const Message& b) { return a.order_key < b.order_key; };
-  std::stable_sort(lidar_early.begin(), lidar_early.end(), by_key);
-  std::stable_sort(imu_early.begin(), imu_early.end(), by_key);
+  livo_test::sortByArrival(&lidar_early);
+  livo_test::sortByArrival(&imu_early);
   const Outputs a = runNode(in_order), b = runNode(lidar_early), c = runNode(imu_early);
   ASSERT_GE(a.odometry_bytes.size(), 24u);
   EXPECT_EQ(a.odometry_bytes, b.odometry_bytes);
@@ -241,7 +223,7 @@ TEST(LioNode, RefusesBadInputAndKeepsGoing) {
   Message junk{1'000'000'000 + 2'200'000, "LIDAR", {1, 2, 3, 4, 5}};
   bad.push_back(junk);
   msgs.insert(msgs.end(), bad.begin(), bad.end());
-  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&msgs);
   int64_t rejected = 0;
   const Outputs out = runNode(msgs, &rejected);
   EXPECT_EQ(rejected, 3);
@@ -274,7 +256,7 @@ TEST(LioNode, CorruptedImuSamplesChangeNothing) {
   msgs.push_back(encode(kBaseTime + 1'200'001, "IMU", ahead));
   msgs.push_back(encode(kBaseTime + 1'700'001, "IMU", behind));
   msgs.push_back(encode(kBaseTime + 2'100'001, "IMU", wild));
-  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&msgs);
   int64_t rejected = 0;
   const Outputs out = runNode(msgs, &rejected);
   const Outputs ref = runNode(clean);
@@ -304,7 +286,7 @@ std::vector<Message> withImages(std::vector<Message> msgs, int64_t* first_image,
     msgs.push_back(tinyImage(t));
     *last_image = t;
   }
-  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&msgs);
   return msgs;
 }
 
@@ -539,7 +521,7 @@ TEST(LioNode, ImagesAtTheSweepEndsCostNoSweep) {
     in.push_back(tinyImage(seq.scanEndUtime(k)));  // before the sweep on equal keys (stable sort)
   const std::vector<Message> run = syntheticRun();
   in.insert(in.end(), run.begin(), run.end());
-  std::stable_sort(in.begin(), in.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&in);
 
   std::vector<int64_t> prior_times;
   RunSetup setup;
@@ -596,7 +578,7 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
   filter_state_t posterior = toFilterState(kBase + 1'400'000, FilterState(), Mat18::Identity(), 1, "vio");
   posterior.epoch = 0;
   msgs.push_back(encode(kBase + 1'500'003, "STATE_POSTERIOR", posterior));
-  std::stable_sort(msgs.begin(), msgs.end(), [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&msgs);
   int64_t rejected = 0, rejected_posteriors = 0;
   RunSetup setup;
   setup.rejected_posteriors = &rejected_posteriors;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "bus_messages.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/lio_graph/lio_graph_node.hpp"
 #include "livo/loop_correction_message.hpp"
@@ -32,18 +33,8 @@ rig:
 
 constexpr int64_t kBase = 1'000'000'000;  // the synthetic sequence's first stamp
 
-struct Message {
-  int64_t order_key;
-  std::string channel;
-  std::vector<uint8_t> bytes;
-};
-
-template <class M>
-Message encode(int64_t key, const std::string& channel, const M& m) {
-  Message out{key, channel, std::vector<uint8_t>(static_cast<size_t>(m.getEncodedSize()))};
-  m.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
-  return out;
-}
+using livo_test::Message;
+using livo_test::encode;
 
 struct Outputs {
   std::vector<odometry_t> odometry;
@@ -55,8 +46,7 @@ struct Outputs {
 };
 
 Outputs runNode(std::vector<Message> messages) {
-  std::stable_sort(messages.begin(), messages.end(),
-                   [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&messages);
   lcm::LCM lcm("memq://");
   EXPECT_TRUE(lcm.good());
   NodeOptions node_options;
@@ -69,11 +59,7 @@ Outputs runNode(std::vector<Message> messages) {
   observer.subscribe<odometry_t>("ODOMETRY", [&](const odometry_t& m) { out.odometry.push_back(m); });
   observer.subscribe<registered_scan_t>("REGISTERED_SCAN", [&](const registered_scan_t& m) { out.scans.push_back(m); });
   observer.subscribe<keyframe_t>("KEYFRAME", [&](const keyframe_t& m) { out.keyframes.push_back(m); });
-  for (const auto& m : messages) {
-    lcm.publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
-    while (lcm.handleTimeout(0) > 0) {
-    }
-  }
+  livo_test::publishAll(lcm, messages);
   for (const auto& c : node.node().channelStats())
     if (c.channel == "LOOP_CORRECTION") out.rejected_corrections = c.rejected + c.decode_failures;
   out.resets = node.resets();

@@ -70,7 +70,7 @@ rc=$?
 import re, sys
 rows = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | 1 |')]
 assert len(rows) == 1, rows
-cells = [c.strip().strip('*') for c in rows[0].strip().strip('|').split('|')][3:]
+cells = [c.strip().strip("*") for c in rows[0].strip().strip("|").split("|")][4:]
 assert len(cells) == 3 and all(re.fullmatch(r'\d+\.\d{4} / \d+\.\d{3}', c) for c in cells), cells
 print('ablation table row:', rows[0].strip())
 PY

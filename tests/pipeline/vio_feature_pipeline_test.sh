@@ -118,3 +118,17 @@ assert after and after[0] < 8.5, 'no state in the 0.5 s after the camera came ba
 restarts = re.findall(r'; (\d+) restarts', open(d + '/logs/vio_feature.log').read())
 print('dead camera 6-8 s: first state again at %.2f s, %s restarts' % (after[0], restarts[-1] if restarts else 0))
 PY
+
+# (f) the coupling table end to end on 4 s (too short for its bars: only the table is checked)
+/usr/bin/python3 "$root/scripts/visual_coupling_table.py" --out "$dir/coupling" --configs bridge_deck --seeds 1 \
+  --duration 4 >"$dir/coupling.txt" 2>&1
+rc=$?
+[ $rc -le 1 ] || { cat "$dir/coupling.txt"; fail "visual_coupling_table.py failed ($rc)"; }
+/usr/bin/python3 - "$dir/coupling/table.md" <<'PY' || { cat "$dir/coupling.txt"; exit 1; }
+import re, sys
+rows = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | 1 |')]
+assert len(rows) == 1, rows
+cells = [c.strip().strip('*') for c in rows[0].strip().strip('|').split('|')][4:]
+assert len(cells) == 3 and all(re.fullmatch(r'\d+\.\d{4} / \d+\.\d{3}', c) for c in cells), cells
+print('coupling table row:', rows[0].strip())
+PY

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "bus_messages.hpp"
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
@@ -19,18 +20,8 @@ using namespace livo::vio_feature;
 
 namespace {
 
-struct Message {
-  int64_t order_key;
-  std::string channel;
-  std::vector<uint8_t> bytes;
-};
-
-template <class M>
-Message encode(int64_t key, const std::string& channel, const M& m) {
-  Message out{key, channel, std::vector<uint8_t>(static_cast<size_t>(m.getEncodedSize()))};
-  m.encode(out.bytes.data(), 0, static_cast<int>(out.bytes.size()));
-  return out;
-}
+using livo_test::Message;
+using livo_test::encode;
 
 /// The room's first `duration` s (2 s at rest, then walking): IMU at 200 Hz from the trajectory's
 /// exact motion, grey images at 20 Hz; `image_lag_us` delays the images' place in the stream.
@@ -70,8 +61,7 @@ struct Outputs {
 };
 
 Outputs runNode(std::vector<Message> messages, const VioFeatureNodeOptions& options) {
-  std::stable_sort(messages.begin(), messages.end(),
-                   [](const Message& a, const Message& b) { return a.order_key < b.order_key; });
+  livo_test::sortByArrival(&messages);
   lcm::LCM lcm("memq://");
   EXPECT_TRUE(lcm.good());
   NodeOptions node_options;
@@ -83,11 +73,7 @@ Outputs runNode(std::vector<Message> messages, const VioFeatureNodeOptions& opti
   Outputs out;
   observer.subscribe<visual_state_t>("VISUAL_STATE", [&](const visual_state_t& m) { out.states.push_back(m); });
   observer.subscribe<odometry_t>("VISUAL_ODOMETRY", [&](const odometry_t& m) { out.odometry.push_back(m); });
-  for (const auto& m : messages) {
-    lcm.publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
-    while (lcm.handleTimeout(0) > 0) {
-    }
-  }
+  livo_test::publishAll(lcm, messages);
   for (const auto& c : node.node().channelStats())
     if (c.channel == "CAMERA") out.camera_rejected = c.rejected + c.decode_failures;
   out.counts = node.counts();

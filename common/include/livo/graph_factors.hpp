@@ -36,10 +36,21 @@ ceres::CostFunction* makeBiasWalkFactor(double gyro_random_walk, double accel_ra
 /// A measured pose with its information in [dtheta (right), dp] (6 residuals; blocks q p).
 ceres::CostFunction* makePoseFactor(const Pose3& measured, const Mat6& information);
 
+/// A measured relative pose T_i_j (state j in the body frame of state i) with its information in
+/// [dtheta (right, of R_i^T R_j), dp (frame i)] (6 residuals; blocks q_i p_i q_j p_j). The
+/// residual is [Log(R_m^T R_i^T R_j), R_i^T (p_j - p_i) - p_m]; a rigid motion of the world
+/// leaves it unchanged.
+ceres::CostFunction* makeRelativePoseFactor(const Pose3& T_i_j, const Mat6& information);
+/// The same with the measurement's scale s as a block (blocks q_i p_i q_j p_j s; the translation
+/// residual R_i^T (p_j - p_i) - s p_m): a relative motion whose metric scale is not trusted.
+ceres::CostFunction* makeScaledRelativePoseFactor(const Pose3& T_i_j, const Mat6& information);
+
 /// A Gaussian prior on a 3-vector block (velocity, a bias): per-axis sigmas.
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma);
 /// The wheel scales' prior (2 residuals; block s).
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma);
+/// A Gaussian prior on a scalar block (1 residual).
+ceres::CostFunction* makeScalarPriorFactor(double mean, double sigma);
 
 /// The wheel preintegration between i and j (6 residuals; blocks q_i p_i q_j p_j).
 ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration);

@@ -36,6 +36,12 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     ch.readOptional("visual_state", n.visual_state_channel);
     c.readOptional("visual_state", o.use_visual_motion);
     c.readOptional("visual_max_wait_s", n.visual_max_wait_s);
+    c.readOptional("visual_factor", o.visual_factor);
+    c.readOptional("visual_sigma_rotation_deg", o.visual_sigma_rotation_deg);
+    c.readOptional("visual_sigma_translation", o.visual_sigma_translation);
+    c.readOptional("visual_sigma_translation_ratio", o.visual_sigma_translation_ratio);
+    c.readOptional("visual_cauchy", o.visual_cauchy);
+    c.readOptional("visual_scale_std", o.visual_scale_std);
     bool wheel = o.use_wheel;
     if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
     c.readOptional("wheel_cauchy", o.wheel_cauchy);
@@ -87,6 +93,11 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.planes.max_quality_ratio > 0.0)) fail("plane_max_quality_ratio", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0)) fail("wheel_max_wait_s", "must be >= 0");
   if (!(n.visual_max_wait_s >= 0.0)) fail("visual_max_wait_s", "must be >= 0");
+  if (!(o.visual_sigma_rotation_deg > 0.0 && o.visual_sigma_translation > 0.0 && o.visual_sigma_translation_ratio >= 0.0))
+    fail("visual_sigma_translation",
+         "visual_sigma_rotation_deg and visual_sigma_translation must be > 0, visual_sigma_translation_ratio >= 0");
+  if (!(o.visual_cauchy > 0.0)) fail("visual_cauchy", "must be > 0");
+  if (!(o.visual_scale_std >= 0.0 && o.visual_scale_std <= 0.2)) fail("visual_scale_std", "must be in [0, 0.2]");
   return n;
 }
 
@@ -101,7 +112,8 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
      << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
      << (o.planar_factors ? ", adaptive planar factors" : "")
-     << (o.use_visual_motion ? "; deskew and guess from the visual subsystem's motion" : "") << "\n"
+     << (o.use_visual_motion ? "; deskew and guess from the visual subsystem's motion" : "")
+     << (o.use_visual_motion && o.visual_factor ? ", and its motion as a relative-pose factor" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
      << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";
 }

@@ -74,25 +74,26 @@ struct LioGraphEstimator::Node {
   double bg[3] = {0, 0, 0};
   double ba[3] = {0, 0, 0};
   Vec3 last_gyro = Vec3::Zero();
-  std::unique_ptr<ceres::CostFunction> imu, bias_walk, wheel, lidar;
-  std::unique_ptr<ceres::LossFunction> wheel_loss;
+  std::unique_ptr<ceres::CostFunction> imu, bias_walk, wheel, lidar, visual;
+  std::unique_ptr<ceres::LossFunction> wheel_loss, visual_loss;
   // What the factors holding world-frame quantities were made from, to remake them when a loop
-  // correction moves the world (the wheel and bias factors are relative: they never move).
+  // correction moves the world (the wheel, visual and bias factors are relative: they never move).
   std::optional<ImuPreintegration> imu_preintegration;  // its factor holds the world gravity
   Pose3 lidar_pose = Pose3::Identity();   // the matched W_T_I ...
   Mat6 lidar_information = Mat6::Zero();  // ... and its information [dtheta (right), dp]
   /// A prior of the first state (the initialisation).
   struct Unary {
-    enum class Kind { kPose, kVelocity, kBias, kWheelScale } kind;
+    enum class Kind { kPose, kVelocity, kBias, kWheelScale, kVisualScale } kind;
     std::vector<double*> blocks;
     Pose3 pose = Pose3::Identity();   // kPose: W_T_I and its information
     Mat6 information = Mat6::Zero();
-    Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();  // kVelocity (world frame), kBias; kWheelScale: head<2>, sigma(0)
+    Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();  // kVelocity (world frame), kBias; kWheelScale: head<2>, sigma(0); kVisualScale: (0)
     std::unique_ptr<ceres::CostFunction> cost;
     void remake() {
       switch (kind) {
         case Kind::kPose: cost.reset(makePoseFactor(pose, information)); break;
         case Kind::kWheelScale: cost.reset(makeWheelScalePrior(mean.head<2>(), sigma(0))); break;
+        case Kind::kVisualScale: cost.reset(makeScalarPriorFactor(mean(0), sigma(0))); break;
         default: cost.reset(makeVectorPriorFactor(mean, sigma));
       }
     }
@@ -244,6 +245,15 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.blocks = {wheel_scale_};
     u.mean.head<2>() = wheelScale();
     u.sigma.setConstant(opts_.wheel_scale_std);
+  }
+  // the visual motion's scale likewise
+  if (estimatesVisualScale()) {
+    n->priors.emplace_back();
+    Unary& u = n->priors.back();
+    u.kind = Unary::Kind::kVisualScale;
+    u.blocks = {visual_scale_};
+    u.mean(0) = visual_scale_[0];
+    u.sigma.setConstant(opts_.visual_scale_std);
   }
   for (Unary& u : n->priors) u.remake();
   window_.push_back(std::move(n));
@@ -437,6 +447,15 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
         appendNote(note, "no wheel readings over the sweep");
       }
     }
+    if (res.visual_motion && opts_.visual_factor) {
+      // the visual subsystem's motion from the previous state to this one (the deskew's last step)
+      Pose3 rel;
+      visual_.relative(prev.utime, t_end, &rel);
+      n->visual.reset(estimatesVisualScale() ? makeScaledRelativePoseFactor(rel, visualInformation(rel))
+                                             : makeRelativePoseFactor(rel, visualInformation(rel)));
+      n->visual_loss = std::make_unique<ceres::CauchyLoss>(opts_.visual_cauchy);
+      res.visual_factor = true;
+    }
     observePlanes(body, n.get(), &res);
     window_.push_back(std::move(n));
     newest = window_.back().get();
@@ -544,6 +563,7 @@ void LioGraphEstimator::optimize() {
     if (n.imu) problem.AddResidualBlock(n.imu.get(), nullptr, {m.q, m.p, m.v, m.bg, m.ba, n.q, n.p, n.v});
     if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, m.bg, m.ba, n.bg, n.ba);
     if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), wheelBlocks(m, n));
+    if (n.visual) problem.AddResidualBlock(n.visual.get(), n.visual_loss.get(), visualBlocks(m, n));
   }
   solveWindow(&problem, opts_.solver_iterations);
 }
@@ -559,6 +579,7 @@ void LioGraphEstimator::marginalizeOldest() {
   if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
   if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
   if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
+  if (b.visual) m.addFactor(b.visual.get(), visualBlocks(a, b), b.visual_loss.get());
   std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   for (auto& o : a.planes) {
     m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
@@ -571,12 +592,27 @@ void LioGraphEstimator::marginalizeOldest() {
   b.bias_walk.reset();
   b.wheel.reset();
   b.wheel_loss.reset();
+  b.visual.reset();
+  b.visual_loss.reset();
   for (StoredKeyframe& k : keyframes_)
     if (k.node == &a) k.node = nullptr;
   window_.pop_front();
   landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
                                   [](const std::unique_ptr<PlaneLandmark>& l) { return l->observers == 0; }),
                    landmarks_.end());
+}
+
+Mat6 LioGraphEstimator::visualInformation(const Pose3& T_i_j) const {
+  const double sr = opts_.visual_sigma_rotation_deg * M_PI / 180.0;
+  const double st = opts_.visual_sigma_translation + opts_.visual_sigma_translation_ratio * T_i_j.translation().norm();
+  Vec6 d;
+  d << Vec3::Constant(1.0 / (sr * sr)), Vec3::Constant(1.0 / (st * st));
+  return d.asDiagonal();
+}
+
+std::vector<double*> LioGraphEstimator::visualBlocks(Node& a, Node& b) {
+  if (estimatesVisualScale()) return {a.q, a.p, b.q, b.p, visual_scale_};
+  return {a.q, a.p, b.q, b.p};
 }
 
 std::vector<double*> LioGraphEstimator::wheelBlocks(Node& a, Node& b) {
@@ -615,7 +651,7 @@ WorldMotion LioGraphEstimator::motionOf(const double* block) const {
     if (block == n->v) return WorldMotion::kDirection;
     if (block == n->bg || block == n->ba) return WorldMotion::kNone;
   }
-  if (block == wheel_scale_) return WorldMotion::kNone;
+  if (block == wheel_scale_ || block == visual_scale_) return WorldMotion::kNone;
   for (const auto& l : landmarks_)
     if (block == l->c) return WorldMotion::kDirection;
   throw std::logic_error("the marginal prior holds a block that is neither a window state's nor a landmark's");
@@ -699,6 +735,7 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
     if (a.imu) m.addFactor(a.imu.get(), {b.q, b.p, b.v, b.bg, b.ba, a.q, a.p, a.v});
     if (a.bias_walk) m.addFactor(a.bias_walk.get(), {b.bg, b.ba, a.bg, a.ba});
     if (a.wheel) m.addFactor(a.wheel.get(), wheelBlocks(b, a), a.wheel_loss.get());
+    if (a.visual) m.addFactor(a.visual.get(), visualBlocks(b, a), a.visual_loss.get());
   }
   // by a Cholesky factorisation of the rest; the eigen-decomposition (which also copes with a rank
   // deficient rest) only where that fails
@@ -719,6 +756,7 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
         if (b != n.q && b != n.p) drop.insert(b);
     for (auto& l : landmarks_) drop.insert(l->c);
     drop.insert(wheel_scale_);
+    drop.insert(visual_scale_);
     const auto marginal = m.marginalize(drop, 1e-12);
     if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();
     // blocks in first-seen order: make it [q, p]

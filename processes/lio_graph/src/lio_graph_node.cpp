@@ -159,6 +159,7 @@ void LioGraphNode::process(const PendingSweep& p) {
   predicted_ += r.status == GraphScanResult::Status::kPredicted;
   degenerate_ += r.degenerate;
   visual_ += r.visual_motion;
+  visual_factors_ += r.visual_factor;
   if (!r.message.empty()) node_.info(r.message);
   const OutputFrame frame{estimator_.frame().epoch, estimator_.frame().correction_id};
   node_.publish(opts_.odometry_channel, toOdometry(r, estimator_.frame()));
@@ -175,6 +176,8 @@ std::string LioGraphNode::summary() const {
   s << processed_ << " sweeps: " << tracked_ << " tracked, " << predicted_ << " predicted only, " << degenerate_
     << " degenerate";
   if (opts_.core.use_visual_motion) s << "; " << visual_ << " deskewed with the visual subsystem's motion";
+  if (opts_.core.use_visual_motion && opts_.core.visual_factor)
+    s << ", " << visual_factors_ << " with its relative-pose factor (visual scale " << estimator_.visualScale() << ")";
   if (opts_.core.use_wheel && opts_.core.wheel_scale_std > 0.0)
     s << "; tyre scales " << estimator_.wheelScale().x() << " (left), " << estimator_.wheelScale().y() << " (right)";
   return s.str();

@@ -6,9 +6,10 @@
 //   3. scan-to-local-map matching from the predicted pose (the LiDAR odometry measurement);
 //   4. a new state (pose, velocity, biases) joins a fixed-lag window with an IMU preintegration
 //      factor, a bias random walk, the LiDAR pose factor (its information from the matching, so a
-//      degenerate direction is left to the other sensors) and, with wheels, a wheel
-//      preintegration factor; the window is optimised and its oldest state marginalised into a
-//      linear prior, so the cost per sweep does not grow with the run;
+//      degenerate direction is left to the other sensors), with wheels a wheel preintegration
+//      factor and, with the visual subsystem, its motion since the previous state as a relative
+//      pose factor; the window is optimised and its oldest state marginalised into a linear prior,
+//      so the cost per sweep does not grow with the run;
 //   5. every keyframe_distance / keyframe_angle a keyframe: its features enter the local map.
 // A LOOP_CORRECTION is adopted as livo-lio adopts it (applyLoopCorrection): the poses are then in
 // the corrected frame C_k that frame() names.
@@ -52,6 +53,7 @@ struct GraphScanResult {
   Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
   bool degenerate = false;
   bool visual_motion = false;   // the deskew and the guess took the visual subsystem's motion
+  bool visual_factor = false;   // and its motion since the previous state joined the graph
   Vec6 weakest_direction = Vec6::Zero();    // of the scan matching, [rotation, translation]
   int edge_residuals = 0, surface_residuals = 0;
   int planes = 0;                 // planes observed in the sweep (planar factors)
@@ -92,6 +94,8 @@ class LioGraphEstimator {
   size_t planeLandmarks() const { return landmarks_.size(); }
   size_t storedKeyframes() const { return keyframes_.size(); }
   Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
+  /// What the visual subsystem's translations are multiplied by to be true (estimated).
+  double visualScale() const { return visual_scale_[0]; }
   /// Stored keyframe i, oldest first (i < storedKeyframes()).
   const GraphKeyframe& storedKeyframe(size_t i) const { return keyframes_.at(i).kf; }
   const LioGraphOptions& options() const { return opts_; }
@@ -140,6 +144,13 @@ class LioGraphEstimator {
   Mat6 newestPoseCovariance();
   void dropImuBefore(int64_t utime);
   bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
+  /// The visual relative-pose factor's information for a measured motion T_i_j.
+  Mat6 visualInformation(const Pose3& T_i_j) const;
+  bool estimatesVisualScale() const {
+    return opts_.use_visual_motion && opts_.visual_factor && opts_.visual_scale_std > 0.0;
+  }
+  /// The parameter blocks of the visual factor that ends at state b.
+  std::vector<double*> visualBlocks(Node& a, Node& b);
   /// The parameter blocks of the wheel factor that ends at state b.
   std::vector<double*> wheelBlocks(Node& a, Node& b);
 
@@ -162,6 +173,7 @@ class LioGraphEstimator {
   int64_t next_keyframe_id_ = 0;
   int64_t last_sweep_end_ = -1;
   double wheel_scale_[2] = {1.0, 1.0};  // a block of the graph for as long as it runs (never marginalised)
+  double visual_scale_[1] = {1.0};      // the truth over the visual motion's scale, likewise
   OdometryFrame frame_;
   Vec3 gravity_W_;  // what the IMU factors, the prediction and the plane extraction's "up" use
 };

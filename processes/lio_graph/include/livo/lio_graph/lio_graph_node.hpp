@@ -60,7 +60,7 @@ class LioGraphNode {
   std::deque<PendingSweep> pending_;
   int64_t imu_watermark_ = INT64_MIN;
   int64_t wheel_watermark_ = INT64_MIN;
-  int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0, visual_ = 0;
+  int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0, visual_ = 0, visual_factors_ = 0;
   int64_t resets_ = 0;
 };
 
