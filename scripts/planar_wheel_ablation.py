@@ -2,7 +2,7 @@
 """The second paper's Table 4 on simulated ground-vehicle scenes, one command.
 
     scripts/planar_wheel_ablation.py --out DIR [--configs bridge_deck,tree_campus] [--seeds 2,3]
-                                     [--duration 60] [--keep-logs] [--logs DIR]
+                                     [--duration 60] [--keep-logs] [--logs DIR] [--resume]
 
 For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log, then scripts/run_pipeline.sh
 runs the LiDAR subsystem alone on it in six variants (sim_variants.py; --logs DIR keeps the logs
@@ -57,6 +57,7 @@ def main():
     ap.add_argument('--seeds', default='2,3', help='seeds not used for tuning (seed 1 was)')
     ap.add_argument('--duration', type=float, default=60.0)
     ap.add_argument('--keep-logs', action='store_true')
+    ap.add_argument('--resume', action='store_true', help='reuse the runs already evaluated in --out')
     ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs.lcmlog): reused when there, kept')
     ap.add_argument('--variants', default=','.join(v.name for v in VARIANTS))
     a = ap.parse_args()
@@ -69,7 +70,7 @@ def main():
         sv.config_path('planar_wheel_ablation.py', name)
     variants = [v for v in VARIANTS if v.name in chosen]
     rows, failures = sv.sweep(a.configs.split(','), a.seeds.split(','), a.duration, variants, a.out, a.logs,
-                              a.keep_logs, check_row)
+                              a.keep_logs, check_row, resume=a.resume)
 
     def best(row, v):
         return v in GRAPH and all(row[v][0] <= row[w][0] for w in GRAPH if w in row)

@@ -49,12 +49,34 @@ def config_path(script, name):
     return config
 
 
-def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, check_row=None, durations=None):
+def run_variant(v, log, config, run_dir, base, bin_dir, env):
+    """One variant on one log; its evaluation, or None if the run failed."""
+    # only what the evaluation reads: dozens of runs of every output would fill a disk
+    cmd = [os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
+           '--out', run_dir, '--processes', v.processes,
+           '--record', ','.join(('ODOMETRY', 'GROUND_TRUTH', 'HEALTH') + tuple(v.record))]
+    for process, exe in sorted(v.swaps.items()):
+        cmd += ['--swap', '%s=%s' % (process, os.path.join(bin_dir, exe))]
+    if v.overlay:
+        path = os.path.join(base, v.name + '.overlay.yaml')
+        open(path, 'w').write(v.overlay)
+        cmd += ['--overlay', path]
+    ok = run(cmd, os.path.join(base, v.name + '.txt'), env)
+    # the recording is the bulk of a run's directory and nothing reads it again
+    rec = os.path.join(run_dir, 'outputs.lcmlog')
+    if os.path.exists(rec):
+        os.remove(rec)
+    return evaluation(run_dir) if ok else None
+
+
+def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, check_row=None, durations=None,
+          resume=False):
     """Runs every variant on every config x seed. Returns (rows, failures): a row is
     {'config', 'seed', 'length', variant name: (ATE m, end-point drift m, coverage)}; check_row(row,
     failures) adds the failures of a finished row. durations maps a config to its own duration.
     Logs go to logs/NAME_sSEED_DURs.lcmlog when `logs` is given (reused when there, kept), else
-    beside the runs (removed unless keep_logs)."""
+    beside the runs (removed unless keep_logs). resume: a run whose directory already holds its
+    evaluation is not run again (the log is then not needed)."""
     build = build_dir()
     bin_dir = os.path.join(build, 'bin')
     env = dict(os.environ, LIVO_BUILD_DIR=build)
@@ -71,7 +93,8 @@ def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, c
                 os.makedirs(logs, exist_ok=True)
             log = os.path.join(logs, '%s_%gs.lcmlog' % (tag, dur)) if logs else base + '.lcmlog'
             made_log = False
-            if not os.path.exists(log):
+            done = resume and all(evaluation(os.path.join(base, v.name)) for v in variants)
+            if not done and not os.path.exists(log):
                 print('%s: simulating %g s' % (tag, dur), file=sys.stderr, flush=True)
                 if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', log + '.part', '--seed', seed,
                             '--duration', str(dur), '--quiet'], base + '.sim.txt'):
@@ -81,20 +104,11 @@ def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, c
                 made_log = True
             row = {'config': name, 'seed': seed, 'duration': dur}
             for v in variants:
-                print('%s: %s' % (tag, v.name), file=sys.stderr, flush=True)
                 run_dir = os.path.join(base, v.name)
-                # only what the evaluation reads: dozens of runs of every output would fill a disk
-                cmd = [os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
-                       '--out', run_dir, '--processes', v.processes,
-                       '--record', ','.join(('ODOMETRY', 'GROUND_TRUTH', 'HEALTH') + tuple(v.record))]
-                for process, exe in sorted(v.swaps.items()):
-                    cmd += ['--swap', '%s=%s' % (process, os.path.join(bin_dir, exe))]
-                if v.overlay:
-                    path = os.path.join(base, v.name + '.overlay.yaml')
-                    open(path, 'w').write(v.overlay)
-                    cmd += ['--overlay', path]
-                ok = run(cmd, os.path.join(base, v.name + '.txt'), env)
-                e = evaluation(run_dir) if ok else None
+                e = evaluation(run_dir) if resume else None
+                if e is None:
+                    print('%s: %s' % (tag, v.name), file=sys.stderr, flush=True)
+                    e = run_variant(v, log, config, run_dir, base, bin_dir, env)
                 if e is None:
                     failures.append('%s: the %s run failed (%s/%s.txt)' % (tag, v.name, base, v.name))
                     continue
@@ -102,10 +116,6 @@ def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, c
                 row['length'] = e['end_point']['path_length_m']
                 if e['ate']['coverage'] < 0.9:
                     failures.append('%s: %s has odometry over only %.0f %% of the run' % (tag, v.name, 100 * e['ate']['coverage']))
-                # the recording is the bulk of a run's directory and nothing reads it again
-                rec = os.path.join(run_dir, 'outputs.lcmlog')
-                if os.path.exists(rec):
-                    os.remove(rec)
             rows.append(row)
             if check_row:
                 check_row(row, failures)

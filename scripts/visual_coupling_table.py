@@ -3,7 +3,7 @@
 
     scripts/visual_coupling_table.py --out DIR [--configs NAME,...] [--seeds 2,3,4] [--duration 60]
                                      [--duration-of NAME=S,...] [--logs DIR] [--keep-logs]
-                                     [--variants graph,vio,coupled,coupled-factor]
+                                     [--variants graph,vio,coupled,coupled-factor] [--resume]
 
 For every config (config/sim/NAME.yaml; by default every one except the long soak scenes) and
 seed, livo-sim writes the log, then scripts/run_pipeline.sh runs (sim_variants.py):
@@ -66,6 +66,7 @@ def main():
     ap.add_argument('--duration', type=float, default=60.0)
     ap.add_argument('--duration-of', default='', help='NAME=S,...: a duration of its own for a config')
     ap.add_argument('--keep-logs', action='store_true')
+    ap.add_argument('--resume', action='store_true', help='reuse the runs already evaluated in --out')
     ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs.lcmlog): reused when there, kept')
     ap.add_argument('--variants', default=DEFAULT_VARIANTS)
     a = ap.parse_args()
@@ -86,7 +87,7 @@ def main():
     sv.require_tools('visual_coupling_table.py', ('livo-sim', 'livo-lio-graph', 'livo-vio-feature', 'livo-evaluate'))
     variants = [v for v in VARIANTS if v.name in chosen]
     rows, failures = sv.sweep(configs, a.seeds.split(','), a.duration, variants, a.out, a.logs, a.keep_logs,
-                              check_row, durations)
+                              check_row, durations, a.resume)
 
     def lowest(row, v):
         return all(row[v][0] <= row[w.name][0] for w in variants if w.name in row)
