@@ -28,6 +28,8 @@ Exit status 1 if any bar is missed. Runs one after the other (each run uses both
 """
 import argparse, json, os, struct, subprocess, sys
 
+import sim_variants as sv
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'loop'))
 import check_loops as cl  # noqa: E402  (LCM log reading, ground truth, interpolation; pure Python)
@@ -70,17 +72,6 @@ def diverged(ate):
     return ate['coverage'] < 0.9 or ate['max'] > 1.0
 
 
-def run(cmd, log, env=None):
-    with open(log, 'w') as f:
-        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, env=env)
-    return r.returncode == 0
-
-
-def evaluation(run_dir, name='odometry'):
-    path = os.path.join(run_dir, 'evaluation_%s.json' % name)
-    return json.load(open(path)) if os.path.exists(path) else None
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--out', required=True)
@@ -114,7 +105,7 @@ def main():
             os.makedirs(base, exist_ok=True)
             log = base + '.lcmlog'
             print('%s: simulating %.0f s' % (tag, duration), file=sys.stderr, flush=True)
-            if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', log, '--seed', seed,
+            if not sv.run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', log, '--seed', seed,
                         '--duration', str(duration), '--quiet'], base + '.sim.txt'):
                 failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                 continue
@@ -127,11 +118,11 @@ def main():
             for variant, processes in variants:
                 print('%s: %s' % (tag, variant), file=sys.stderr, flush=True)
                 extra = ['--calibrate-camera'] if variant == 'livo' and a.calibrate_camera else []
-                ok[variant] = run([os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
+                ok[variant] = sv.run([os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
                                    '--out', os.path.join(base, variant), '--processes', processes] + extra,
                                   os.path.join(base, variant + '.txt'), env)
             row = {'config': name, 'seed': seed}
-            lio = evaluation(os.path.join(base, 'lio'))
+            lio = sv.evaluation(os.path.join(base, 'lio'))
             if not ok['lio'] or lio is None:
                 failures.append('%s: the LIO run failed (%s/lio.txt)' % (tag, base))
                 rows.append(row)
@@ -141,7 +132,7 @@ def main():
             degenerate, sweeps = degenerate_sweeps(os.path.join(base, 'lio', 'outputs.lcmlog'))
             row.update(lio_ate=ate['rmse'], length=length, percent=100.0 * ate['rmse'] / max(length, 1e-9),
                        diverged=diverged(ate), degenerate=degenerate)
-            livo = evaluation(os.path.join(base, 'livo')) if ok.get('livo') else None
+            livo = sv.evaluation(os.path.join(base, 'livo')) if ok.get('livo') else None
             if 'livo' in ok:
                 row['livo_ate'] = livo['ate']['rmse'] if livo else float('nan')
             # A scene the LiDAR cannot observe in some direction (flagged on most sweeps: the corridor's
@@ -208,11 +199,7 @@ def main():
             ('yes' if r['diverged'] else 'no') if 'diverged' in r else '-', f(r, 'degenerate', '%d'),
             f(r, 'livo_ate', '%.4f') + (' (judged: LIO degenerate)' if r.get('judged') == 'LIVO' else ''), loops, drift))
     lines.append('')
-    lines += ['bars missed:'] + ['- ' + x for x in failures] if failures else ['every bar met']
-    text = '\n'.join(lines) + '\n'
-    open(os.path.join(a.out, 'table.md'), 'w').write(text)
-    print(text)
-    return 1 if failures else 0
+    return sv.finish(a.out, lines, failures)
 
 
 if __name__ == '__main__':

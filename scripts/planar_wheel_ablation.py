@@ -80,11 +80,7 @@ def main():
     lines += ['', 'graph: planar factors + wheels; graph-wheel: no planar factors; graph-planar: no wheels; '
               'graph-bare: neither (livo-lio-graph). lio / lio-nowheel: livo-lio with / without its wheel update. '
               'Bold: the lowest ATE of the four graph variants.', '']
-    lines += ['bars missed:'] + ['- ' + x for x in failures] if failures else ['every bar met']
-    text = '\n'.join(lines) + '\n'
-    open(a.out + '/table.md', 'w').write(text)
-    print(text)
-    return 1 if failures else 0
+    return sv.finish(a.out, lines, failures)
 
 
 if __name__ == '__main__':

@@ -26,8 +26,9 @@ def run(cmd, log, env=None):
         return subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, env=env).returncode == 0
 
 
-def evaluation(run_dir):
-    path = os.path.join(run_dir, 'evaluation_odometry.json')
+def evaluation(run_dir, name='odometry'):
+    """livo-evaluate's JSON of a run (evaluation_NAME.json), None if there is none."""
+    path = os.path.join(run_dir, 'evaluation_%s.json' % name)
     return json.load(open(path)) if os.path.exists(path) else None
 
 
@@ -139,3 +140,12 @@ def markdown(rows, shown, bold=lambda row, variant: False):
         lines.append('| %s | %s | %g | %s | %s |' % (r['config'], r['seed'], r['duration'],
                                                      '%.0f' % r['length'] if 'length' in r else '-', ' | '.join(cells)))
     return lines
+
+
+def finish(out, lines, failures):
+    """Appends the bars' verdict to the table's lines, writes out/table.md, prints it; the exit status."""
+    lines = lines + (['bars missed:'] + ['- ' + x for x in failures] if failures else ['every bar met'])
+    text = '\n'.join(lines) + '\n'
+    open(os.path.join(out, 'table.md'), 'w').write(text)
+    print(text)
+    return 1 if failures else 0

@@ -97,11 +97,7 @@ def main():
     lines += ['', 'graph: livo-lio-graph alone; vio: livo-vio-feature alone; coupled: both (the visual motion '
               'deskews the sweeps and guesses the match, the LiDAR gives the features depth); coupled-factor: '
               'coupled, and the visual motion a relative-pose factor of the LiDAR graph. Bold: the lowest ATE.', '']
-    lines += ['bars missed:'] + ['- ' + x for x in failures] if failures else ['every bar met']
-    text = '\n'.join(lines) + '\n'
-    open(os.path.join(a.out, 'table.md'), 'w').write(text)
-    print(text)
-    return 1 if failures else 0
+    return sv.finish(a.out, lines, failures)
 
 
 if __name__ == '__main__':
