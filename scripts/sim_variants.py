@@ -97,11 +97,12 @@ def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, c
             done = resume and all(evaluation(os.path.join(base, v.name)) for v in variants)
             if not done and not os.path.exists(log):
                 print('%s: simulating %g s' % (tag, dur), file=sys.stderr, flush=True)
-                if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', log + '.part', '--seed', seed,
+                part = '%s.%d.part' % (log, os.getpid())  # a concurrent run simulating the same log keeps its own
+                if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', part, '--seed', seed,
                             '--duration', str(dur), '--quiet'], base + '.sim.txt'):
                     failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                     continue
-                os.replace(log + '.part', log)
+                os.replace(part, log)
                 made_log = True
             row = {'config': name, 'seed': seed, 'duration': dur}
             for v in variants:
