@@ -7,7 +7,9 @@
 
 namespace livo {
 
-const std::vector<std::string> kLidarModels = {"VLP-16", "OS1-16", "OS1-64", "HDL-64E", "livox-avia"};
+const std::vector<std::string> kLidarModels = {"VLP-16",  "OS1-16",  "OS1-64",  "HDL-64E",      "livox-avia",
+                                                "VLP-32C", "OS0-128", "OS1-128", "OS2-128", "livox-mid360",
+                                                "hesai-xt32"};
 
 const char* distortionModelName(DistortionModel m) {
   return m == DistortionModel::kEquidistant ? "equidistant" : "radtan";

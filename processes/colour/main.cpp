@@ -3,6 +3,7 @@
 
 #include "livo/colour/colour_node.hpp"
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-colour",
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
       .option("--output-dir", "DIR", "where the map files go", ".")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
       .flag("--quiet", "no option summary at start");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-colour: --config is required\n" << cli.usage();
@@ -19,9 +21,10 @@ int main(int argc, char** argv) {
   }
   try {
     const livo::Config cfg = livo::Config::load(cli.get("--config"));
-    const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
+    const livo::SensorRig rig = livo::colour::readColourRig(cfg);
     const livo::colour::ColourNodeOptions options = livo::colour::readColourNodeOptions(cfg);
     if (!cli.has("--quiet")) livo::colour::printOptions(options, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;

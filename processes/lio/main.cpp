@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 #include "livo/lio/lio_node.hpp"
 
 int main(int argc, char** argv) {
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
       .option("--name", "NAME", "node name on the bus (overrides lio.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
       .flag("--quiet", "no start-up options and no summary at shutdown");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-lio: --config FILE is required\n" << cli.usage();
@@ -29,6 +31,7 @@ int main(int argc, char** argv) {
     }
     const bool quiet = cli.has("--quiet");
     if (!quiet) livo::lio::printOptions(opts, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::lio::LioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();

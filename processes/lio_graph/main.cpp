@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 #include "livo/lio_graph/lio_graph_node.hpp"
 
 int main(int argc, char** argv) {
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
       .option("--name", "NAME", "node name on the bus (overrides lio_graph.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
       .flag("--quiet", "no start-up options and no summary at shutdown");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-lio-graph: --config FILE is required\n" << cli.usage();
@@ -23,6 +25,7 @@ int main(int argc, char** argv) {
     if (cli.has("--name")) opts.name = cli.get("--name");
     const bool quiet = cli.has("--quiet");
     if (!quiet) livo::lio_graph::printOptions(opts, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;
     node_options.name = opts.name;

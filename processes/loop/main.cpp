@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 #include "livo/config.hpp"
 #include "livo/node.hpp"
 #include "livo/loop/loop_node.hpp"
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
       .option("--output-dir", "DIR", "write keyframes.tum, loops.json and global_map.ply here (overrides loop.output_dir)")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
       .flag("--quiet", "no option summary at start, no summary at shutdown");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-loop: --config FILE is required\n" << cli.usage();
@@ -24,6 +26,7 @@ int main(int argc, char** argv) {
     livo::loop::LoopNodeOptions options = livo::loop::readLoopNodeOptions(config);
     if (cli.has("--output-dir")) options.output_dir = cli.get("--output-dir");
     if (!cli.has("--quiet")) livo::loop::printOptions(options, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     livo::NodeOptions node_options;
     node_options.name = cli.get("--name");
     node_options.quiet = cli.has("--quiet");

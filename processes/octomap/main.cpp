@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 #include "livo/octomap/octomap_node.hpp"
 
 int main(int argc, char** argv) {
@@ -12,6 +13,7 @@ int main(int argc, char** argv) {
       .option("--output-dir", "DIR", "where the .bt/.ot files go", ".")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
       .flag("--quiet", "no option summary at start");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-octomap: --config is required\n" << cli.usage();
@@ -22,6 +24,7 @@ int main(int argc, char** argv) {
     const livo::SensorRig rig = livo::readSensorRig(cfg.section("rig"));
     const auto options = livo::octomap::readOctomapNodeOptions(cfg);
     if (!cli.has("--quiet")) livo::octomap::printOptions(options, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;

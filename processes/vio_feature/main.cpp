@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 #include "livo/vio_feature/vio_feature_node.hpp"
 
 int main(int argc, char** argv) {
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
       .option("--name", "NAME", "node name on the bus (overrides vio_feature.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
       .flag("--quiet", "no start-up options and no summary at shutdown");
+  livo::declareConfigCheck(cli);
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config")) {
     std::cerr << "livo-vio-feature: --config FILE is required\n" << cli.usage();
@@ -24,6 +26,7 @@ int main(int argc, char** argv) {
     if (cli.has("--name")) opts.name = cli.get("--name");
     const bool quiet = cli.has("--quiet");
     if (!quiet) livo::vio_feature::printOptions(opts, std::cerr);
+    if (livo::configCheckDone(cli, std::cout)) return 0;
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::NodeOptions node_options;
     node_options.name = opts.name;

@@ -418,6 +418,21 @@ TEST(ColourNode, RefusesARigWithoutCamera) {
   EXPECT_THROW(colour::ColourNode(lcm, node_options, colour::ColourNodeOptions{}, rig, "."), ConfigError);
 }
 
+// livo-colour reads the rig before it opens LCM (so --check-config refuses a rig without camera too).
+TEST(ColourConfig, RigMustHaveACamera) {
+  const std::string imu = "rig:\n  imu: {rate_hz: 200, gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
+                          "accel_random_walk: 0}\n";
+  try {
+    colour::readColourRig(Config::fromString(imu, "nocam.yaml"));
+    ADD_FAILURE() << "a rig without camera is refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("nocam.yaml: rig.camera: livo-colour needs a camera"), std::string::npos) << e.what();
+  }
+  const std::string camera = "  camera: {width: 640, height: 480, fx: 400, fy: 400, cx: 319.5, cy: 239.5, rate_hz: 20, "
+                             "T_I_C: {translation: [0, 0, 0], rpy_deg: [-90, 0, -90]}}\n";
+  EXPECT_EQ(colour::readColourRig(Config::fromString(imu + camera)).camera->width, 640);
+}
+
 TEST(ColourConfig, ReadsKeysStrictly) {
   const Config ok = Config::fromString("colour: {voxel_size: 0.1, vignetting: 0.25, map_name: room}");
   const colour::ColourNodeOptions o = colour::readColourNodeOptions(ok);

@@ -357,6 +357,12 @@ TEST(SimulationConfig, ErrorsNameTheFileAndKey) {
                         test::boxRoomScene() + good_traj)
                 .find("rig.lidar.model: unknown LiDAR model 'VLP-32'"),
             std::string::npos);
+  // a real LiDAR the rig may name (config/rigs/) but that has no beam table in the simulator
+  EXPECT_NE(configError(rig + "  lidar: {model: VLP-32C, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
+                              "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
+                        test::boxRoomScene() + good_traj)
+                .find("rig.lidar.model: livo-sim cannot simulate a 'VLP-32C'"),
+            std::string::npos);
   std::string bad_texture = test::boxRoomScene();
   bad_texture.replace(bad_texture.find("texture: grey"), 13, "texture: gray");
   EXPECT_NE(configError(rig + "sim:\n" + bad_texture + good_traj).find("sim.scene.objects.room.texture: unknown texture 'gray'"),

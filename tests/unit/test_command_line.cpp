@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "livo/command_line.hpp"
+#include "livo/config_check.hpp"
 
 namespace {
 struct Argv {
@@ -60,5 +63,33 @@ TEST(CommandLine, DefaultsAndErrors) {
     Argv a({"prog", "x", "--speed", "fast"});
     ASSERT_TRUE(c.parse(a.argc(), a.argv()));
     EXPECT_THROW(c.getDouble("--speed"), std::invalid_argument);
+  }
+}
+
+// --check-config (every process that reads a config): declared once, answered once the options
+// are read; without it the process goes on to start.
+TEST(CommandLine, ConfigCheckFlag) {
+  auto command = [] {
+    livo::CommandLine c("livo-x", "test");
+    c.option("--config", "FILE", "config");
+    livo::declareConfigCheck(c);
+    return c;
+  };
+  {
+    auto c = command();
+    Argv a({"livo-x", "--config", "rig.yaml", "--check-config"});
+    ASSERT_TRUE(c.parse(a.argc(), a.argv()));
+    std::ostringstream out;
+    EXPECT_TRUE(livo::configCheckDone(c, out));
+    EXPECT_EQ(out.str(), "livo-x: rig.yaml: valid (--check-config: not started)\n");
+    EXPECT_NE(c.usage().find("--check-config"), std::string::npos);
+  }
+  {
+    auto c = command();
+    Argv a({"livo-x", "--config", "rig.yaml"});
+    ASSERT_TRUE(c.parse(a.argc(), a.argv()));
+    std::ostringstream out;
+    EXPECT_FALSE(livo::configCheckDone(c, out));
+    EXPECT_EQ(out.str(), "");
   }
 }

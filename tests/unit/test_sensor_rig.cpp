@@ -118,3 +118,16 @@ TEST(SensorRig, AslSensorYamlCarriesTheDistortionModelIntoTheRig) {
   }
   std::remove(tumvi.c_str());
 }
+
+// The LiDAR model is one of kLidarModels: the simulator's and the real sensors of config/rigs/.
+TEST(SensorRig, LidarModelIsOneOfTheKnown) {
+  auto withLidar = [](const std::string& model) {
+    return rigYaml("") + "  lidar: {model: " + model +
+           ", rate_hz: 10, min_range: 1, max_range: 200, range_noise_std: 0.03, "
+           "T_I_L: {translation: [0, 0, 0], rpy_deg: [0, 0, 0]}}\n";
+  };
+  for (const std::string& model : kLidarModels) EXPECT_EQ(errorOf(withLidar(model)), "") << model;
+  EXPECT_EQ(readRig(withLidar("VLP-32C")).lidar->model, "VLP-32C");
+  const std::string e = errorOf(withLidar("VLP-32"));
+  EXPECT_NE(e.find("rig.lidar.model: unknown LiDAR model 'VLP-32'"), std::string::npos) << e;
+}

@@ -23,7 +23,7 @@ class SimScene {
  public:
   /// `config` relative to the source tree; `height` > 0 overrides the camera's image height
   /// (keeping the principal point centred), e.g. 512 for the 640x512 benchmark image;
-  /// `lidar_model` (one of livo::kLidarModels) replaces the rig's LiDAR.
+  /// `lidar_model` (one of livo::sim::LidarPattern::models()) replaces the rig's LiDAR.
   explicit SimScene(const std::string& config = "config/sim/room.yaml", int height = 0,
                     const std::string& lidar_model = "") {
     livo::sim::SimOverrides ov;

@@ -35,6 +35,7 @@ class CommandLine {
   void allowRest(const std::string& name, const std::string& help);
 
   std::string usage() const;
+  const std::string& program() const { return program_; }
 
  private:
   struct Opt {

@@ -87,7 +87,10 @@ struct SensorRig {
   std::optional<WheelRig> wheel;      // absent: no wheel encoder
 };
 
-/// LiDAR models the rig may name.
+/// LiDAR models the rig may name: the five livo-sim has a beam table for (VLP-16, OS1-16, OS1-64,
+/// HDL-64E, livox-avia; livo::sim::LidarPattern) and the real sensors of config/rigs/. The
+/// estimators read the model only as a label (they use the rate, ranges, noise and T_I_L), so a
+/// model here needs no code; the simulator refuses one it cannot simulate.
 extern const std::vector<std::string> kLidarModels;
 
 /// Reads and validates a `rig:` section (every key under it must be known); throws ConfigError

@@ -68,6 +68,13 @@ ColourNodeOptions readColourNodeOptions(const Config& root) {
   return n;
 }
 
+SensorRig readColourRig(const Config& root) {
+  const Config rig = root.section("rig");
+  SensorRig r = readSensorRig(rig);
+  if (!r.camera) throw ConfigError(rig.where("camera") + ": livo-colour needs a camera in the rig");
+  return r;
+}
+
 void printOptions(const ColourNodeOptions& o, std::ostream& os) {
   os << "colour: inputs " << o.registered_scan_channel << ", " << o.odometry_channel << ", "
      << (o.camera_channel.empty() ? std::string("the rig's camera channel") : o.camera_channel) << ", "

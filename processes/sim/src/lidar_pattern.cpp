@@ -24,6 +24,11 @@ void assignRingsByElevation(std::vector<double> elevations, std::vector<int>* ri
 }
 }  // namespace
 
+const std::vector<std::string>& LidarPattern::models() {
+  static const std::vector<std::string> kModels = {"VLP-16", "HDL-64E", "OS1-16", "OS1-64", "livox-avia"};
+  return kModels;
+}
+
 LidarPattern::LidarPattern(const std::string& model, double rate_hz, const LidarPatternOptions& options) {
   if (!(rate_hz > 0.0)) throw std::invalid_argument("LiDAR rate must be > 0");
   sweep_duration_ = 1.0 / rate_hz;

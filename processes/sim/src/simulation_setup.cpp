@@ -1,10 +1,12 @@
 #include "livo/sim/simulation_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <ostream>
 #include <sstream>
 
+#include "livo/sim/lidar_pattern.hpp"
 #include "livo/sim/scene_config.hpp"
 #include "livo/sim/trajectory_config.hpp"
 
@@ -20,6 +22,15 @@ std::string dirOf(const std::string& file) {
 std::string resolve(const std::string& base_dir, const std::string& path) {
   if (path.empty() || path[0] == '/' || base_dir.empty()) return path;
   return base_dir + "/" + path;
+}
+
+/// The rig may name real LiDARs (config/rigs/) that have no beam table here.
+void requireSimulatedLidar(const Config& lidar, const std::string& model) {
+  const std::vector<std::string>& simulated = LidarPattern::models();
+  if (std::find(simulated.begin(), simulated.end(), model) != simulated.end()) return;
+  std::string list;
+  for (const std::string& m : simulated) list += (list.empty() ? "" : ", ") + m;
+  throw ConfigError(lidar.where("model") + ": livo-sim cannot simulate a '" + model + "' (it simulates " + list + ")");
 }
 
 std::string number(double x) {
@@ -329,6 +340,7 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   SimulationSetup s;
   s.config_file = root.file();
   s.rig = readSensorRig(root.section("rig"));
+  if (s.rig.lidar) requireSimulatedLidar(root.section("rig").section("lidar"), s.rig.lidar->model);
   const Config sim = root.section("sim");
   readSimOptions(sim, s.rig, &s.options);
 

@@ -7,6 +7,7 @@
 
 #include "livo/colour/colour_options.hpp"
 #include "livo/config.hpp"
+#include "livo/sensor_rig.hpp"
 
 namespace livo::colour {
 
@@ -27,6 +28,10 @@ struct ColourNodeOptions {
 };
 
 ColourNodeOptions readColourNodeOptions(const Config& root);
+
+/// The rig (`rig:`, livo::readSensorRig), which must have a camera: colouring needs its
+/// intrinsics and T_I_C. Throws ConfigError naming rig.camera otherwise.
+SensorRig readColourRig(const Config& root);
 
 /// The channels and options, for the log at start-up.
 void printOptions(const ColourNodeOptions& o, std::ostream& os);

@@ -19,7 +19,11 @@ struct LidarPatternOptions {
 
 class LidarPattern {
  public:
-  /// One of livo::kLidarModels at `rate_hz`; throws std::invalid_argument for unknown models.
+  /// The models with a firing schedule here (a subset of livo::kLidarModels, which also names
+  /// real sensors the simulator cannot simulate).
+  static const std::vector<std::string>& models();
+
+  /// One of models() at `rate_hz`; throws std::invalid_argument for any other model.
   LidarPattern(const std::string& model, double rate_hz, const LidarPatternOptions& options = {});
 
   bool solidState() const { return solid_state_; }
