@@ -56,18 +56,6 @@ def section_names(config):
     return {line.split(':')[0] for line in open(config) if line[:1].isalpha() and ':' in line}
 
 
-def has_camera(config):
-    in_rig = False
-    for line in open(config):
-        if line.startswith('rig:'):
-            in_rig = True
-        elif line[:1].isalpha():
-            in_rig = False
-        elif in_rig and line.startswith('  camera:'):
-            return True
-    return False
-
-
 def diverged(ate):
     return ate['coverage'] < 0.9 or ate['max'] > 1.0
 
@@ -110,7 +98,7 @@ def main():
                 failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                 continue
             variants = [('lio', 'lio')]
-            if 'vio' in sections and has_camera(config):
+            if 'vio' in sections and sv.has_camera(config):
                 variants.append(('livo', 'lio,vio'))
             if 'loop' in sections and not a.without_loop:
                 variants.append(('loop', 'lio,loop'))

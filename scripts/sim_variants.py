@@ -32,6 +32,19 @@ def evaluation(run_dir, name='odometry'):
     return json.load(open(path)) if os.path.exists(path) else None
 
 
+def has_camera(config):
+    """Whether a config file's rig: section has a camera: block."""
+    in_rig = False
+    for line in open(config):
+        if line.startswith('rig:'):
+            in_rig = True
+        elif line[:1].isalpha():
+            in_rig = False
+        elif in_rig and line.startswith('  camera:'):
+            return True
+    return False
+
+
 def build_dir():
     return os.environ.get('LIVO_BUILD_DIR', os.path.join(ROOT, 'build'))
 

@@ -5,7 +5,7 @@
                                      [--duration-of NAME=S,...] [--logs DIR] [--keep-logs]
                                      [--variants graph,vio,coupled,coupled-factor] [--resume]
 
-For every config (config/sim/NAME.yaml; by default every one except the long soak scenes) and
+For every config (config/sim/NAME.yaml; by default every one with a camera but the long soak scenes) and
 seed, livo-sim writes the log, then scripts/run_pipeline.sh runs (sim_variants.py):
   graph           livo-lio-graph alone (the LiDAR subsystem: IMU, LiDAR, wheels where the rig has them)
   vio             livo-vio-feature alone, its VISUAL_ODOMETRY evaluated (camera, depth image where the
@@ -37,8 +37,9 @@ GROUND_VEHICLES = ('bridge_deck', 'tree_campus')  # where the coupled pair must 
 
 
 def default_configs():
-    names = sorted(os.path.basename(p)[:-5] for p in glob.glob(os.path.join(sv.ROOT, 'config', 'sim', '*.yaml')))
-    return [n for n in names if 'long' not in n]
+    """Every sim config with a camera, but the long soak scenes."""
+    paths = sorted(glob.glob(os.path.join(sv.ROOT, 'config', 'sim', '*.yaml')))
+    return [os.path.basename(p)[:-5] for p in paths if 'long' not in os.path.basename(p) and sv.has_camera(p)]
 
 
 def check_row(row, failures):
