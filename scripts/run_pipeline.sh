@@ -5,7 +5,9 @@
 #   odometry.tum     the online estimate (body pose at every scan)
 #   trajectory.tum   the final estimate (loop-corrected when loop closure ran)
 #   timing.json      per process: messages, median/p90/max ms, peak RSS
-#   evaluation_*.json, *.svg   accuracy against GROUND_TRUTH, if the log has it
+#   weak_spots.json  degenerate and predicted sweeps, images the VIO did not use, loop closures
+#   evaluation_*.json, *.svg   accuracy against GROUND_TRUTH, if the log has it (the figures mark
+#                    the weak spots)
 #   report.md        all of it for a person; logs/<process>.log: what each process printed
 #   maps and other files the processes write (they run in DIR)
 #
@@ -34,7 +36,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0
@@ -154,8 +156,10 @@ if [ "$inside" = 0 ]; then
     # that shift time (jump) it carries the same stamps the estimators saw
     gt="$log:GROUND_TRUTH"
     "$bin/livo-loginfo" "$out/outputs.lcmlog" 2>/dev/null | grep -q '^GROUND_TRUTH ' && gt="$out/outputs.lcmlog:GROUND_TRUTH"
+    marks=()
+    [ -s "$out/weak_spots.json" ] && marks=(--marks "$out/weak_spots.json")
     for kind in odometry trajectory; do
-      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$gt" --align se3 \
+      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$gt" --align se3 ${marks[@]+"${marks[@]}"} \
           --json "$out/evaluation_$kind.json" --plot "$out/$kind.svg" >"$out/logs/evaluate_$kind.txt" 2>&1; then
         evaluations+="${evaluations:+;}$kind=$out/evaluation_$kind.json"
         figures+="${figures:+;}$kind against ground truth=$kind.svg"

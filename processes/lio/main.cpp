@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
     livo::lio::LioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
     const int rc = livo::spin(*lcm, node.node());
+    if (!quiet) std::cerr << "[" << opts.name << "] " << node.sweepSummary() << "\n";
     if (!quiet && opts.lio.wheel.enabled) std::cerr << "[" << opts.name << "] " << node.wheelSummary() << "\n";
     if (!quiet && opts.camera_handoff) {
       const auto& h = node.handoffCounts();

@@ -1,5 +1,6 @@
 // livo-report: turns a pipeline run's recorded outputs into the files the user gets back.
-//   livo-report extract OUTPUTS.lcmlog --dir DIR     odometry.tum, trajectory.tum, timing.json
+//   livo-report extract OUTPUTS.lcmlog --dir DIR     odometry.tum, trajectory.tum, timing.json,
+//                                                    resets.json, weak_spots.json
 //   livo-report markdown --dir DIR [...]             report.md from those and livo-evaluate's JSON
 //   livo-report memory OUTPUTS.lcmlog [--at S,S,...]  peak RSS per process at sensor times (HEALTH)
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "livo/report/memory_profile.hpp"
 #include "livo/report/pipeline_outputs.hpp"
 #include "livo/report/run_report.hpp"
+#include "livo/report/weak_spots.hpp"
 
 namespace {
 
@@ -29,27 +31,37 @@ void writeText(const std::string& path, const std::string& text) {
 }
 
 int extract(int argc, char** argv) {
-  livo::CommandLine cli("livo-report extract", "Writes odometry.tum, trajectory.tum and timing.json from a run's outputs log.");
+  livo::CommandLine cli("livo-report extract", "Writes odometry.tum, trajectory.tum, timing.json, resets.json and "
+                                               "weak_spots.json from a run's outputs log.");
   cli.positional("OUTPUTS", "LCM log recorded during the run (lcm-logger)")
       .option("--dir", "DIR", "where to write the files", ".")
       .option("--odometry-channel", "CH", "online estimate", "ODOMETRY")
       .option("--keyframe-channel", "CH", "keyframes", "KEYFRAME")
       .option("--loop-channel", "CH", "loop corrections", "LOOP_CORRECTION")
-      .option("--health-channel", "CH", "node health", "HEALTH");
+      .option("--health-channel", "CH", "node health", "HEALTH")
+      .option("--prior-channel", "CH", "images handed to the VIO (STATE_PRIOR)", "STATE_PRIOR")
+      .option("--posterior-channel", "CH", "the VIO's answers (STATE_POSTERIOR)", "STATE_POSTERIOR")
+      .option("--camera-channel", "CH", "images (named in the VIOs' HEALTH)", "CAMERA");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   livo::report::PipelineChannels ch;
   ch.odometry = cli.get("--odometry-channel");
   ch.keyframe = cli.get("--keyframe-channel");
   ch.loop_correction = cli.get("--loop-channel");
   ch.health = cli.get("--health-channel");
+  ch.state_prior = cli.get("--prior-channel");
+  ch.state_posterior = cli.get("--posterior-channel");
+  ch.camera = cli.get("--camera-channel");
   const livo::report::PipelineOutputs out = livo::report::readPipelineOutputs(cli.get("OUTPUTS"), ch);
   const std::string dir = cli.get("--dir");
   livo::writeTum(dir + "/odometry.tum", out.odometry);
   livo::writeTum(dir + "/trajectory.tum", livo::report::loopCorrectedTrajectory(out));
   writeText(dir + "/timing.json", livo::report::timingJson(out.final_health).dump(2) + "\n");
   writeText(dir + "/resets.json", livo::report::resetsJson(out.resets));
+  const livo::report::WeakSpots weak = livo::report::findWeakSpots(out, ch.camera);
+  writeText(dir + "/weak_spots.json", livo::report::weakSpotsJson(weak).dump(2) + "\n");
   std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
-            << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes\n";
+            << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes; "
+            << weak.degenerate << " degenerate and " << weak.predicted << " predicted sweeps\n";
   if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
   if (out.non_finite) std::cerr << "livo-report: warning: " << out.non_finite << " odometry poses were not finite\n";
   if (out.odometry.empty()) {
@@ -111,6 +123,10 @@ int markdown(int argc, char** argv) {
     in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
+  if (std::ifstream w(dir + "/weak_spots.json"); w)
+    in.weak_spots = livo::report::weakSpotsFromJson(nlohmann::json::parse(w));
+  else
+    in.warnings.push_back("weak_spots.json is missing (livo-report extract writes it): no \"Where the estimate was weak\"");
   for (const auto& [node, p] : in.timing.items()) {
     for (const auto& [channel, c] : p["channels"].items()) {
       if (c.value("decode_failures", 0) > 0)

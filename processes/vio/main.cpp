@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
     livo::vio::VioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
-    const int status = livo::spin(*lcm, node.node());
+    const int status = livo::spin(*lcm, node.node(), [&] { node.reportKeptReasons(); });
     writeRotationOverlay(opts, node.estimator(), quiet);
     if (!quiet && opts.vio.calibration.any()) {
       // what the online calibration learnt: the extrinsic against the rig's, and the time offset

@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
     node_options.quiet = quiet;
     livo::vio_feature::VioFeatureNode node(*lcm, node_options, opts);
     livo::installSignalHandlers();
-    const int rc = livo::spin(*lcm, node.node());
+    const int rc = livo::spin(*lcm, node.node(), [&] { node.reportRefusals(); });
     if (!quiet) std::cerr << "[" << opts.name << "] " << node.summary() << "\n";
     return rc;
   } catch (const std::exception& e) {

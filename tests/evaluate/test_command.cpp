@@ -191,3 +191,46 @@ TEST(EvaluateCommand, FailsClearlyOnBadInput) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("--est and --gt are both required"), std::string::npos) << r.err;
 }
+
+// --marks (a pipeline run's weak_spots.json): degenerate and predicted stretches overlaid on the
+// path and shaded on the time axes, loop closures joining their keyframes, each in the legend;
+// without marks none of it.
+TEST(EvaluateCommand, PlotMarksWeakStretchesAndLoops) {
+  const std::string dir = livo_test::tempDir();
+  const Trajectory gt = fixtures::wigglyTrajectory(300);  // 30 s from t = 1000 s
+  writeTum(dir + "/gt.tum", gt);
+  writeTum(dir + "/est.tum", gt);
+  {
+    std::ofstream marks(dir + "/weak_spots.json");
+    marks << R"({"degenerate": {"spans": [{"from": 1005.0, "to": 1009.0}, {"from": 1020.0, "to": 1020.0}]},
+                 "predicted": {"spans": [{"from": 1012.0, "to": 1012.5}]},
+                 "loops": [{"time": 1025.0, "from_time": 1025.0, "to_time": 1001.0},
+                           {"time": 1026.0, "from_time": 1026.0, "to_time": null}]})";
+  }
+  const CommandResult plain = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/plain.svg", "--quiet"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  const CommandResult marked = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/marked.svg",
+                                    "--marks", dir + "/weak_spots.json", "--quiet"});
+  ASSERT_EQ(marked.code, 0) << marked.err;
+  const std::string a = readFile(dir + "/plain.svg"), b = readFile(dir + "/marked.svg");
+  for (const char* mark : {"degenerate sweeps", "predicted, no LiDAR update", "loop closure", "#ff8c00", "#c51b7d"}) {
+    EXPECT_EQ(count(a, mark), 0u) << mark;
+    EXPECT_GT(count(b, mark), 0u) << mark;
+  }
+  // two overlay runs, the legend's sample, two shaded stretches on each of the three panels
+  EXPECT_EQ(count(b, "stroke=\"#ff8c00\""), 3u);
+  EXPECT_EQ(count(b, "fill=\"#ff8c00\""), 6u);
+  // the loop with both keyframes: a line, two dots, a line on each panel; the one without: only its time
+  EXPECT_EQ(count(b, "r=\"3.5\" fill=\"#c51b7d\""), 4u);  // two on the path, two in the legend
+  EXPECT_EQ(count(b, "stroke=\"#c51b7d\""), 1u + 1u + 3u * 2u);
+  EXPECT_EQ(count(b, "nan"), 0u);
+
+  const CommandResult no_plot = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--marks", dir + "/weak_spots.json"});
+  EXPECT_EQ(no_plot.code, 1);
+  EXPECT_NE(no_plot.err.find("--marks draws on the figure"), std::string::npos) << no_plot.err;
+  { std::ofstream(dir + "/bad.json") << R"({"degenerate": {}})"; }
+  const CommandResult bad = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/bad.svg",
+                                 "--marks", dir + "/bad.json", "--quiet"});
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find(dir + "/bad.json: not a weak_spots.json"), std::string::npos) << bad.err;
+}

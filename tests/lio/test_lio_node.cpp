@@ -49,6 +49,7 @@ struct RunSetup {
   std::function<void(Node& observer)> attach;
   LioNode::HandoffCounts* handoff = nullptr;  // filled after the run
   int64_t* rejected_posteriors = nullptr;     // filled after the run
+  LioNode::SweepCounts* sweeps = nullptr;     // filled after the run
 };
 
 constexpr int64_t kBaseTime = 1'000'000'000;  // the synthetic sequence's first stamp
@@ -78,6 +79,7 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
     for (const auto& c : node.node().channelStats()) *rejected += c.rejected + c.decode_failures;
   }
   if (setup.handoff) *setup.handoff = node.handoffCounts();
+  if (setup.sweeps) *setup.sweeps = node.sweepCounts();
   if (setup.rejected_posteriors) {
     *setup.rejected_posteriors = 0;
     for (const auto& c : node.node().channelStats())
@@ -127,7 +129,10 @@ TEST(LioNode, ReadsTheRigSchemaAndStrictLioSection) {
 }
 
 TEST(LioNode, PublishesOdometryScansAndKeyframes) {
-  const Outputs out = runNode(syntheticRun());
+  LioNode::SweepCounts sweeps;
+  RunSetup setup;
+  setup.sweeps = &sweeps;
+  const Outputs out = runNode(syntheticRun(), nullptr, setup);
   // 30 sweeps, the first ~5 during the IMU initialisation
   EXPECT_GE(out.odometry.size(), 24u);
   EXPECT_EQ(out.scans.size(), out.odometry.size());
@@ -138,11 +143,32 @@ TEST(LioNode, PublishesOdometryScansAndKeyframes) {
     EXPECT_EQ(o.degenerate, 0);
   }
   for (size_t i = 1; i < out.odometry.size(); ++i) EXPECT_GT(out.odometry[i].utime, out.odometry[i - 1].utime);
+  // the first sweep seeds the map (no residual), every later one is a LiDAR update
+  EXPECT_EQ(out.odometry.front().num_residuals, 0);
+  for (size_t i = 1; i < out.odometry.size(); ++i) EXPECT_GT(out.odometry[i].num_residuals, 0);
+  EXPECT_EQ(sweeps.published, static_cast<int64_t>(out.odometry.size()));
+  EXPECT_EQ(sweeps.tracked, sweeps.published - 1);
+  EXPECT_EQ(sweeps.predicted, 0);
+  EXPECT_EQ(sweeps.degenerate, 0);
   EXPECT_EQ(out.scans.back().cloud.frame, "W");
   EXPECT_GT(out.scans.back().cloud.num_points, 20000);
   EXPECT_EQ(out.scans.back().utime, out.odometry.back().utime);
   EXPECT_EQ(out.keyframes.front().cloud.frame, "I");
   EXPECT_EQ(out.keyframes.front().id, 0);
+}
+
+// ODOMETRY.num_residuals counts the measurements the published pose used: none on a sweep kept at
+// the IMU prediction (report.md counts those), whatever its rejected registration had matched.
+TEST(LioNode, PredictedSweepsPublishNoResiduals) {
+  ScanResult r;
+  r.status = ScanResult::Status::kPredicted;
+  r.num_residuals = 57;  // too few to be taken
+  r.degeneracy.degenerate = true;
+  const odometry_t predicted = toOdometry(r, OdometryFrame{});
+  EXPECT_EQ(predicted.num_residuals, 0);
+  EXPECT_EQ(predicted.degenerate, 1);
+  r.status = ScanResult::Status::kTracked;
+  EXPECT_EQ(toOdometry(r, OdometryFrame{}).num_residuals, 57);
 }
 
 // REGISTERED_SCAN keeps each point's capture time (cloud.utime = sweep start, the input offsets)

@@ -116,6 +116,13 @@ TEST(LcmTypes, ImageFingerprintUnchangedByTheDepthEncodings) {
   EXPECT_EQ(int{image_t::ENCODING_DEPTH32F}, 21);
 }
 
+// odometry_t is recorded in every run's outputs.lcmlog: its fields (hence its fingerprint) stay as
+// they are, so that livo-report and livo-evaluate read the runs recorded before. The weak
+// direction the report names comes from the pose covariance, not from a new field.
+TEST(LcmTypes, OdometryFingerprintUnchanged) {
+  EXPECT_EQ(static_cast<uint64_t>(odometry_t::getHash()), 0x416e341392b517b3ULL);
+}
+
 TEST(LcmTypes, WheelPoseOdometry) {
   wheel_odometry_t w;
   w.utime = 5;

@@ -14,4 +14,13 @@ inline std::string formatSignificant(double v, int digits = 3) {
   return os.str();
 }
 
+/// `v` with `digits` digits after the point (1.50, 0.0), as std::fixed prints it.
+inline std::string formatFixed(double v, int digits) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(digits);
+  os << v;
+  return os.str();
+}
+
 }  // namespace livo

@@ -54,6 +54,8 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
       .option("--coverage-gap", "S", "longest interval between pairs that counts as covered, s (default: 3x median)")
       .option("--json", "F", "write the figures as JSON")
       .option("--plot", "F", "write a figure (SVG): top view coloured by error, errors over time")
+      .option("--marks", "F", "mark on the figure the degenerate and predicted stretches and the loop closures of a "
+                              "pipeline run (its weak_spots.json, from livo-report extract)")
       .option("--report", "F", "write a Markdown report with the tables, embedding the --plot figure")
       .option("--title", "T", "title of the figure and report (default: estimate vs ground truth)")
       .flag("--quiet", "print nothing on success");
@@ -61,6 +63,7 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
 
   try {
     if (!cli.has("--est") || !cli.has("--gt")) throw std::invalid_argument("--est and --gt are both required");
+    if (cli.has("--marks") && !cli.has("--plot")) throw std::invalid_argument("--marks draws on the figure: give --plot F too");
     EvaluationOptions options;
     options.alignment = parseAlignment(cli.get("--align"));
     options.max_dt = cli.getDouble("--max-dt");
@@ -83,7 +86,12 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
     const std::string title =
         cli.has("--title") ? cli.get("--title") : baseName(est.spec) + " vs " + baseName(gt.spec) + " (" + alignmentName(options.alignment) + " aligned)";
     if (cli.has("--json")) writeEvaluationJson(cli.get("--json"), ev, est, gt, options);
-    if (cli.has("--plot")) writeEvaluationSvg(cli.get("--plot"), ev, PlotOptions{title});
+    if (cli.has("--plot")) {
+      PlotOptions plot;
+      plot.title = title;
+      if (cli.has("--marks")) plot.marks = readPlotMarks(cli.get("--marks"));
+      writeEvaluationSvg(cli.get("--plot"), ev, plot);
+    }
     if (cli.has("--report"))
       writeMarkdownReport(cli.get("--report"), ev, est, gt, options, cli.has("--plot") ? cli.get("--plot") : "");
   } catch (const std::exception& e) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -58,6 +60,9 @@ class Svg {
     os << "<line x1=\"" << f1(x0) << "\" y1=\"" << f1(y0) << "\" x2=\"" << f1(x1) << "\" y2=\"" << f1(y1)
        << "\" stroke=\"" << stroke << "\" stroke-width=\"" << width << "\" " << extra << "/>\n";
   }
+  void dot(double x, double y, double r, const std::string& fill) {
+    os << "<circle cx=\"" << f1(x) << "\" cy=\"" << f1(y) << "\" r=\"" << r << "\" fill=\"" << fill << "\"/>\n";
+  }
   void polyline(const std::vector<std::pair<double, double>>& pts, const std::string& stroke, double width,
                 const char* extra = "") {
     if (pts.size() < 2) return;
@@ -77,6 +82,87 @@ std::vector<std::pair<double, double>> thin(const std::vector<std::pair<double, 
     out.push_back(pts[i]);
   }
   return out;
+}
+
+// The marks (PlotMarks): a degenerate stretch, a predicted one, a loop closure.
+const char* const kDegenerateColour = "#ff8c00";
+const char* const kPredictedColour = "#5e5e5e";
+const char* const kLoopColour = "#c51b7d";
+constexpr double kMarkSlack_s = 1e-3;  // a pose within this of a span's end is in it (TUM rounding)
+constexpr double kLoopSlack_s = 0.25;  // a loop's keyframe is drawn at the pose this near in time
+
+/// The marks on the time axes of the panels, in seconds since the first pair.
+struct TimeMarks {
+  std::vector<std::pair<double, double>> degenerate, predicted;
+  std::vector<double> loops;
+};
+
+TimeMarks marksSinceStart(const PlotMarks& m, double t0) {
+  TimeMarks out;
+  for (const auto& [a, b] : m.degenerate) out.degenerate.emplace_back(a - t0, b - t0);
+  for (const auto& [a, b] : m.predicted) out.predicted.emplace_back(a - t0, b - t0);
+  for (const auto& l : m.loops) out.loops.push_back(l.time - t0);
+  return out;
+}
+
+/// Per stamp (in time order), whether it lies in one of the [from, to] spans (which do not overlap).
+std::vector<bool> inSpans(const std::vector<double>& stamps, std::vector<std::pair<double, double>> spans) {
+  std::sort(spans.begin(), spans.end());
+  std::vector<bool> in(stamps.size(), false);
+  for (size_t k = 0; k < stamps.size(); ++k) {
+    // the last span starting at or before the stamp
+    const auto after = std::upper_bound(spans.begin(), spans.end(), stamps[k] + kMarkSlack_s,
+                                        [](double t, const std::pair<double, double>& s) { return t < s.first; });
+    in[k] = after != spans.begin() && stamps[k] <= std::prev(after)->second + kMarkSlack_s;
+  }
+  return in;
+}
+
+/// The pose whose stamp (in time order) is nearest `t`, or npos when none is within kLoopSlack_s.
+size_t nearestPose(const std::vector<double>& stamps, double t) {
+  if (!std::isfinite(t) || stamps.empty()) return std::string::npos;
+  const size_t hi = static_cast<size_t>(std::lower_bound(stamps.begin(), stamps.end(), t) - stamps.begin());
+  size_t best = std::min(hi, stamps.size() - 1);
+  if (hi > 0 && std::abs(stamps[hi - 1] - t) <= std::abs(stamps[best] - t)) best = hi - 1;
+  return std::abs(stamps[best] - t) <= kLoopSlack_s ? best : std::string::npos;
+}
+
+/// A wide translucent stroke along the path where `flagged`, from halfway to the pose before to
+/// halfway to the pose after (never across a gap longer than max_step). False if nothing was drawn.
+bool overlayRuns(Svg& svg, const std::vector<std::pair<double, double>>& px, const std::vector<double>& stamps,
+                 const std::vector<bool>& flagged, double max_step, const char* colour) {
+  auto mid = [&](size_t a, size_t b) {
+    return std::make_pair(0.5 * (px[a].first + px[b].first), 0.5 * (px[a].second + px[b].second));
+  };
+  auto joined = [&](size_t a, size_t b) { return std::abs(stamps[b] - stamps[a]) <= max_step; };
+  bool drawn = false;
+  for (size_t i = 0; i < px.size(); ++i) {
+    if (!flagged[i]) continue;
+    std::vector<std::pair<double, double>> run;
+    if (i > 0 && joined(i - 1, i)) run.push_back(mid(i - 1, i));
+    run.push_back(px[i]);
+    while (i + 1 < px.size() && flagged[i + 1] && joined(i, i + 1)) run.push_back(px[++i]);
+    if (i + 1 < px.size() && joined(i, i + 1)) run.push_back(mid(i, i + 1));
+    if (run.size() == 1) run.push_back(run.front());  // a lone pose: a dot (round caps)
+    svg.polyline(thin(run, 0.7), colour, 9, "stroke-opacity=\"0.45\"");
+    drawn = true;
+  }
+  return drawn;
+}
+
+/// Each loop closure as a dashed line between the poses at its two keyframes' stamps, with a dot at
+/// each end. False if none could be placed.
+bool loopLines(Svg& svg, const std::vector<std::pair<double, double>>& px, const std::vector<double>& stamps,
+               const std::vector<PlotMarks::Loop>& loops) {
+  bool drawn = false;
+  for (const PlotMarks::Loop& l : loops) {
+    const size_t a = nearestPose(stamps, l.from_stamp), b = nearestPose(stamps, l.to_stamp);
+    if (a == std::string::npos || b == std::string::npos) continue;
+    svg.line(px[a].first, px[a].second, px[b].first, px[b].second, kLoopColour, 1.8, "stroke-dasharray=\"6,3\"");
+    for (size_t k : {a, b}) svg.dot(px[k].first, px[k].second, 3.5, kLoopColour);
+    drawn = true;
+  }
+  return drawn;
 }
 
 /// Frame, grid, ticks and axis titles of a panel; returns the scales.
@@ -106,7 +192,8 @@ std::pair<LinearScale, LinearScale> axes(Svg& svg, const Rect& r, double xlo, do
   return {sx, sy};
 }
 
-void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, double err_hi, double max_step) {
+void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, double err_hi, double max_step,
+             const PlotMarks& marks) {
   // The two axes along which the ground truth spreads most.
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (const auto& p : ev.gt_path) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -131,6 +218,14 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
   std::vector<std::pair<double, double>> gt_px;
   for (const auto& p : ev.gt_path) gt_px.emplace_back(sx(p[a]), sy(p[b]));
   svg.polyline(thin(gt_px, 0.7), "#555555", 1.6, "stroke-dasharray=\"5,3\"");
+
+  // Under the estimate, where the estimator was weak.
+  std::vector<std::pair<double, double>> est_px;
+  for (const auto& T : ev.est) est_px.emplace_back(sx(T.translation()[a]), sy(T.translation()[b]));
+  const bool degenerate_drawn =
+      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.degenerate), max_step, kDegenerateColour);
+  const bool predicted_drawn =
+      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.predicted), max_step, kPredictedColour);
 
   // Estimate: runs of segments in one colour level become one polyline.
   const double span = err_hi > err_lo ? err_hi - err_lo : 1.0;
@@ -157,6 +252,7 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
     run.push_back(p1);
   }
   svg.polyline(thin(run, 0.7), errorColour((run_level + 0.5) / kColourLevels), 2.6);
+  const bool loops_drawn = loopLines(svg, est_px, ev.est_stamps, marks.loops);
   if (!ev.est.empty()) {
     const auto& s = ev.est.front().translation();
     const auto& e = ev.est.back().translation();
@@ -165,19 +261,41 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
     svg.os << "<rect x=\"" << f1(sx(e[a]) - 5) << "\" y=\"" << f1(sy(e[b]) - 5)
            << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
   }
-  // Legend.
-  const double lx = area.x + 12, ly = area.y + 14;
-  svg.os << "<rect x=\"" << f1(lx - 6) << "\" y=\"" << f1(ly - 8) << "\" width=\"250\" height=\"64\" fill=\"#ffffff\" "
+  // Legend: a row per thing drawn.
+  std::vector<std::pair<std::function<void(double, double)>, std::string>> rows;
+  rows.push_back({[&](double x, double y) { svg.line(x, y, x + 30, y, "#555555", 1.6, "stroke-dasharray=\"5,3\""); },
+                  "ground truth"});
+  rows.push_back({[&](double x, double y) {
+                    svg.line(x, y, x + 15, y, errorColour(0.1), 2.6);
+                    svg.line(x + 15, y, x + 30, y, errorColour(0.9), 2.6);
+                  },
+                  "estimate, coloured by ATE"});
+  auto overlay = [&](const char* colour) {
+    return [&svg, colour](double x, double y) { svg.line(x, y, x + 30, y, colour, 9, "stroke-opacity=\"0.45\""); };
+  };
+  if (degenerate_drawn) rows.push_back({overlay(kDegenerateColour), "degenerate sweeps"});
+  if (predicted_drawn) rows.push_back({overlay(kPredictedColour), "predicted, no LiDAR update"});
+  if (loops_drawn)
+    rows.push_back({[&](double x, double y) {
+                      svg.line(x, y, x + 30, y, kLoopColour, 1.8, "stroke-dasharray=\"6,3\"");
+                      svg.dot(x, y, 3.5, kLoopColour);
+                      svg.dot(x + 30, y, 3.5, kLoopColour);
+                    },
+                    "loop closure (its keyframes)"});
+  const double lx = area.x + 12, ly = area.y + 14, row_h = 20;
+  svg.os << "<rect x=\"" << f1(lx - 6) << "\" y=\"" << f1(ly - 8) << "\" width=\"250\" height=\""
+         << f1(row_h * static_cast<double>(rows.size() + 1) + 4) << "\" fill=\"#ffffff\" "
          << "fill-opacity=\"0.85\" stroke=\"#bbbbbb\"/>\n";
-  svg.line(lx, ly + 4, lx + 30, ly + 4, "#555555", 1.6, "stroke-dasharray=\"5,3\"");
-  svg.text(lx + 38, ly + 9, "ground truth", 13);
-  svg.line(lx, ly + 24, lx + 15, ly + 24, errorColour(0.1), 2.6);
-  svg.line(lx + 15, ly + 24, lx + 30, ly + 24, errorColour(0.9), 2.6);
-  svg.text(lx + 38, ly + 29, "estimate, coloured by ATE", 13);
-  svg.os << "<circle cx=\"" << f1(lx + 8) << "\" cy=\"" << f1(ly + 44) << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
-  svg.text(lx + 18, ly + 49, "start", 13);
-  svg.os << "<rect x=\"" << f1(lx + 64) << "\" y=\"" << f1(ly + 39) << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
-  svg.text(lx + 80, ly + 49, "end", 13);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double y = ly + 4 + row_h * static_cast<double>(i);
+    rows[i].first(lx, y);
+    svg.text(lx + 38, y + 5, rows[i].second, 13);
+  }
+  const double ey = ly + 4 + row_h * static_cast<double>(rows.size());
+  svg.os << "<circle cx=\"" << f1(lx + 8) << "\" cy=\"" << f1(ey) << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.text(lx + 18, ey + 5, "start", 13);
+  svg.os << "<rect x=\"" << f1(lx + 64) << "\" y=\"" << f1(ey - 5) << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.text(lx + 80, ey + 5, "end", 13);
 }
 
 void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
@@ -199,13 +317,31 @@ void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
   svg.text(r.x + r.w + 62, r.y + r.h / 2, "ATE (m)", 15, "middle", rot.str().c_str());
 }
 
-/// One error series over time, with dashed RMSE and dotted median lines; the line breaks where
-/// consecutive samples are more than `max_step` apart. When a few spikes
+/// The marks on a panel's time axis: shaded degenerate and predicted stretches, a dashed line at
+/// each loop closure.
+void shadeTimeMarks(Svg& svg, const Rect& r, const LinearScale& sx, const TimeMarks& marks) {
+  auto shade = [&](const std::vector<std::pair<double, double>>& spans, const char* colour) {
+    for (const auto& [from, to] : spans) {
+      if (to < sx.lo || from > sx.hi) continue;
+      const double x0 = sx(std::max(from, sx.lo)), x1 = sx(std::min(to, sx.hi));
+      svg.os << "<rect x=\"" << f1(x0) << "\" y=\"" << f1(r.y) << "\" width=\"" << f1(std::max(1.5, x1 - x0))
+             << "\" height=\"" << f1(r.h) << "\" fill=\"" << colour << "\" fill-opacity=\"0.2\"/>\n";
+    }
+  };
+  shade(marks.degenerate, kDegenerateColour);
+  shade(marks.predicted, kPredictedColour);
+  for (double t : marks.loops)
+    if (t >= sx.lo && t <= sx.hi)
+      svg.line(sx(t), r.y, sx(t), r.y + r.h, kLoopColour, 1.0, "stroke-dasharray=\"4,3\" stroke-opacity=\"0.7\"");
+}
+
+/// One error series over time, with dashed RMSE and dotted median lines, over the marks; the line
+/// breaks where consecutive samples are more than `max_step` apart. When a few spikes
 /// dwarf the rest, the axis stops above the 99th percentile and the clipped values sit on the
 /// top edge (the panel says how many).
 void seriesPanel(Svg& svg, const Rect& r, const std::vector<double>& t, const std::vector<double>& e, double t0,
                  double t1, double max_step, const std::string& xtitle, const std::string& ytitle,
-                 const std::string& colour, const ErrorStatistics& stats) {
+                 const std::string& colour, const ErrorStatistics& stats, const TimeMarks& marks) {
   double ylo = 0.0, yhi = e.empty() ? 1.0 : *std::max_element(e.begin(), e.end());
   if (e.size() >= 100) {
     std::vector<double> sorted = e;
@@ -218,6 +354,7 @@ void seriesPanel(Svg& svg, const Rect& r, const std::vector<double>& t, const st
   niceRange(ylo, yhi, 5);
   ylo = 0.0;
   const auto [sx, sy] = axes(svg, r, t0, t1, ylo, yhi, xtitle, ytitle, 8, 5);
+  shadeTimeMarks(svg, r, sx, marks);
   // Per pixel column keep the first, highest and lowest value, so spikes survive thinning.
   std::vector<std::pair<double, double>> pts;
   size_t clipped = 0;
@@ -303,7 +440,9 @@ std::string evaluationSvg(const Evaluation& ev, const PlotOptions& options) {
   const Rect view{84, top, view_size, view_size};
   // Lines break where the estimate has a gap longer than the coverage threshold.
   const double max_step = ev.coverage.gap > 0.0 ? ev.coverage.gap : INFINITY;
-  topView(svg, view, ev, err_lo, err_hi, max_step);
+  // Marks need stamps: none on poses paired by index.
+  const PlotMarks marks = ev.pairs.by_index ? PlotMarks{} : options.marks;
+  topView(svg, view, ev, err_lo, err_hi, max_step, marks);
   colourBar(svg, Rect{view.x + view.w + 16, view.y, 20, view.h}, err_lo, err_hi);
 
   // Right column: ATE, RPE translation and RPE rotation over time.
@@ -324,11 +463,13 @@ std::string evaluationSvg(const Evaluation& ev, const PlotOptions& options) {
   const double gap = 62, ph = (view.h - 2 * gap) / 3.0;
   // RPE samples are one pair stride apart.
   const double rpe_step = ev.rpe.from.size() > 1 ? max_step * static_cast<double>(ev.rpe.from[1] - ev.rpe.from[0]) : max_step;
-  seriesPanel(svg, Rect{rx, top, rw, ph}, t_ate, ev.ate_m, tmin, tmax, max_step, xtitle, "ATE (m)", "#d7191c", ev.ate);
+  const TimeMarks time_marks = marksSinceStart(marks, t0);
+  seriesPanel(svg, Rect{rx, top, rw, ph}, t_ate, ev.ate_m, tmin, tmax, max_step, xtitle, "ATE (m)", "#d7191c", ev.ate,
+              time_marks);
   seriesPanel(svg, Rect{rx, top + ph + gap, rw, ph}, t_rpe, ev.rpe.translation_m, tmin, tmax, rpe_step, xtitle,
-              "RPE (m)", "#2c7bb6", ev.rpe_translation_m);
+              "RPE (m)", "#2c7bb6", ev.rpe_translation_m, time_marks);
   seriesPanel(svg, Rect{rx, top + 2 * (ph + gap), rw, ph}, t_rpe, ev.rpe.rotation_deg, tmin, tmax, rpe_step, xtitle,
-              "RPE (deg)", "#7b3294", ev.rpe_rotation_deg);
+              "RPE (deg)", "#7b3294", ev.rpe_rotation_deg, time_marks);
   svg.os << "</svg>\n";
   return svg.os.str();
 }

@@ -18,7 +18,8 @@ odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame) {
   vec3To(r.angular_velocity, o.angular_velocity);
   matrixTo<6>(Mat6(r.covariance.topLeftCorner<6, 6>()), o.pose_covariance);
   matrixTo<3>(Mat3(r.covariance.block<3, 3>(FilterState::kVel, FilterState::kVel)), o.velocity_covariance);
-  o.num_residuals = r.num_residuals;
+  // a predicted sweep used none: its registration, if any, was not taken
+  o.num_residuals = r.status == ScanResult::Status::kPredicted ? 0 : r.num_residuals;
   o.degenerate = r.degeneracy.degenerate ? 1 : 0;
   o.min_information_eigenvalue = r.min_information_eigenvalue;
   o.epoch = frame.epoch;

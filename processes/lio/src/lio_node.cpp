@@ -308,12 +308,23 @@ void LioNode::process(const PendingScan& p) {
     return;
   }
   node_.publish(opts_.odometry_channel, odo);
+  ++sweep_counts_.published;
+  sweep_counts_.tracked += r.status == ScanResult::Status::kTracked;
+  sweep_counts_.predicted += r.status == ScanResult::Status::kPredicted;
+  sweep_counts_.degenerate += odo.degenerate != 0;
   if (opts_.publish_registered_scan)
     node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, lio_.frame()));
   if (r.is_keyframe) {
     node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
     saveNumbering();
   }
+}
+
+std::string LioNode::sweepSummary() const {
+  const SweepCounts& c = sweep_counts_;
+  return "odometry of " + std::to_string(c.published) + " sweeps: " + std::to_string(c.tracked) + " tracked, " +
+         std::to_string(c.predicted) + " predicted without a LiDAR update, " + std::to_string(c.degenerate) +
+         " degenerate (report.md: \"Where the estimate was weak\")";
 }
 
 std::string LioNode::wheelSummary() const {

@@ -26,7 +26,8 @@ odometry_t toOdometry(const GraphScanResult& r, const OdometryFrame& frame) {
   vec3To(r.angular_velocity, o.angular_velocity);
   matrixTo<6>(r.pose_covariance, o.pose_covariance);
   matrixTo<3>(Mat3(Mat3::Identity() * 1e-2), o.velocity_covariance);
-  o.num_residuals = r.edge_residuals + r.surface_residuals;
+  // a predicted sweep used none: its matching, if any, was not taken
+  o.num_residuals = r.status == GraphScanResult::Status::kPredicted ? 0 : r.edge_residuals + r.surface_residuals;
   o.degenerate = r.degenerate ? 1 : 0;
   o.min_information_eigenvalue = 0.0;
   o.epoch = frame.epoch;

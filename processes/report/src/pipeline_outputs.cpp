@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "livo/correction_frames.hpp"
+#include "livo/filter_state_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/map_inputs.hpp"
 #include "livo/messages.hpp"
@@ -21,6 +22,45 @@ namespace {
 template <class T>
 bool decodeInto(const lcm::LogEvent* ev, T& msg) {
   return msg.decode(ev->data, 0, ev->datalen) == ev->datalen;
+}
+
+OdometryQuality qualityOf(const odometry_t& m) {
+  OdometryQuality q;
+  q.degenerate = m.degenerate != 0;
+  q.num_residuals = m.num_residuals;
+  if (allFinite(m.velocity, 3)) q.velocity = vec3From(m.velocity);
+  const Mat6 P = matrixFrom<6>(m.pose_covariance);
+  if (P.allFinite()) q.position_covariance = P.bottomRightCorner<3, 3>();
+  return q;
+}
+
+LoopEvent loopEventOf(const loop_correction_t& m) {
+  LoopEvent e;
+  e.correction_id = m.correction_id;
+  e.epoch = m.epoch;
+  e.stamp = toSeconds(m.utime);
+  e.from_id = m.loop_from_id;
+  e.to_id = m.loop_to_id;
+  e.fitness = m.loop_fitness;
+  // T_Ck_Cj moved the newest keyframe (the largest id) from where it was onto its corrected pose
+  const Pose3 step = poseFrom(m.correction_position, m.correction_orientation);
+  size_t newest = 0;
+  for (size_t i = 1; i < m.keyframe_id.size(); ++i)
+    if (m.keyframe_id[i] > m.keyframe_id[newest]) newest = i;
+  if (!m.position.empty()) {
+    const Vec3 corrected(m.position[newest][0], m.position[newest][1], m.position[newest][2]);
+    e.shift_m = (corrected - step.inverse() * corrected).norm();
+  }
+  e.turn_deg = Eigen::AngleAxisd(step.linear()).angle() * 180.0 / M_PI;
+  return e;
+}
+
+template <class T>
+std::vector<T> permuted(const std::vector<T>& v, const std::vector<size_t>& order) {
+  std::vector<T> out;
+  out.reserve(order.size());
+  for (size_t i : order) out.push_back(v[i]);
+  return out;
 }
 }  // namespace
 
@@ -42,6 +82,7 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
       }
       out.odometry.push_back({toSeconds(m.utime), poseFrom(m.position, m.orientation)});
       out.odometry_frames.push_back({m.epoch, m.correction_id});
+      out.odometry_quality.push_back(qualityOf(m));
     } else if (ev->channel == ch.keyframe) {
       keyframe_t m;
       if (!decodeInto(ev, m)) {
@@ -64,6 +105,16 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
       auto last = out.last_loop.find(m.epoch);
       if (last == out.last_loop.end() || last->second.correction_id < m.correction_id) out.last_loop[m.epoch] = m;
       ++out.loop_corrections;
+      out.loops.push_back(loopEventOf(m));
+    } else if (ev->channel == ch.state_prior) {
+      ++out.state_priors;
+    } else if (ev->channel == ch.state_posterior) {
+      filter_state_t m;
+      if (!decodeInto(ev, m)) {
+        ++out.undecodable;
+        continue;
+      }
+      out.visual_answers.push_back({toSeconds(m.utime), m.source, m.valid != 0});
     } else if (ev->channel == ch.health) {
       health_t m;
       if (!decodeInto(ev, m)) {
@@ -79,19 +130,16 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
       }
     }
   }
-  // odometry in stamp order with its frames
+  // odometry in stamp order with its frames and qualities
   std::vector<size_t> order(out.odometry.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return out.odometry[a].stamp < out.odometry[b].stamp; });
-  Trajectory odometry;
-  std::vector<PublishedFrame> frames;
-  for (size_t i : order) {
-    odometry.push_back(out.odometry[i]);
-    frames.push_back(out.odometry_frames[i]);
-  }
-  out.odometry = std::move(odometry);
-  out.odometry_frames = std::move(frames);
+  out.odometry = permuted(out.odometry, order);
+  out.odometry_frames = permuted(out.odometry_frames, order);
+  out.odometry_quality = permuted(out.odometry_quality, order);
+  std::stable_sort(out.visual_answers.begin(), out.visual_answers.end(),
+                   [](const VisualAnswer& a, const VisualAnswer& b) { return a.stamp < b.stamp; });
   // the stamp order of a reset's first odometry (in log order, a new epoch's stamps may be earlier)
   int32_t epoch = 0;
   for (size_t i = 0; i < out.odometry.size(); ++i) {

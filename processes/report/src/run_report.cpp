@@ -3,9 +3,10 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
+
+#include "livo/text_format.hpp"
 
 namespace livo::report {
 
@@ -36,12 +37,7 @@ nlohmann::json timingJson(const std::map<std::string, health_t>& final_health) {
 }
 
 namespace {
-std::string fixed(double v, int digits) {
-  if (!std::isfinite(v)) return "n/a";
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(digits) << v;
-  return os.str();
-}
+std::string fixed(double v, int digits) { return std::isfinite(v) ? formatFixed(v, digits) : "n/a"; }
 // j[a][b][c...] as a number, NaN when absent or null (a metric with no data).
 double num(const nlohmann::json& j, std::initializer_list<const char*> path) {
   const nlohmann::json* node = &j;
@@ -131,6 +127,8 @@ std::string reportMarkdown(const ReportInputs& in) {
   }
 
   for (const auto& [caption, path] : in.figures) md << "![" << caption << "](" << path << ")\n\n";
+
+  if (in.weak_spots) md << weakSpotsMarkdown(*in.weak_spots);
 
   md << "## Processing time\n\n";
   md << "Per process, its busiest input (median x messages); `timing.json` lists every channel.\n\n";

@@ -218,15 +218,18 @@ void VioNode::keep(const filter_state_t& prior, const std::string& why) {
   if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
   ++counts_.priors;
   ++counts_.kept;
-  // reasons with numbers in them are grouped by their text up to the first '('
-  const std::string key = why.substr(0, why.find(" ("));
-  ++kept_reasons_[key];
+  kept_reasons_.add(why);
+  const std::string key = ReasonCounts::key(why);  // reasons with numbers grouped by their text
   auto it = last_warned_.find(key);
   if (it == last_warned_.end() || prior.utime - it->second >= 1000000 || prior.utime < it->second) {
     last_warned_[key] = prior.utime;
     node_.warn("prior " + std::to_string(prior.request_id) + " at " + std::to_string(prior.utime) +
                " kept (valid = 0): " + why);
   }
+}
+
+void VioNode::reportKeptReasons() {
+  if (!kept_reasons_.empty()) node_.warn(kept_reasons_.summary("priors kept"));
 }
 
 void VioNode::onScan(const registered_scan_t& m) {

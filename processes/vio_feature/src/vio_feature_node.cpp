@@ -65,15 +65,18 @@ void VioFeatureNode::onImage(const image_t& m) {
   std::string why;
   if (!decodeGrey(rawImage(m), opts_.camera.width, opts_.camera.height, &p.grey, &why)) {
     node_.reject(opts_.camera_channel, why);
+    refused_.add(why);
     ++counts_.bad_images;
     return;
   }
   if ((!pending_.empty() && p.t <= pending_.back().t) || p.t <= last_image_t_) {
     node_.reject(opts_.camera_channel, "image not later than the previous one");
+    refused_.add("image not later than the previous one");
     return;
   }
   if (pending_.size() >= kMaxPendingImages) {
     node_.warn("no IMU up to " + std::to_string(pending_.front().t) + ": image dropped");
+    refused_.add("dropped waiting for the IMU");
     pending_.pop_front();
     ++counts_.dropped;
   }
@@ -188,13 +191,16 @@ void VioFeatureNode::process(const PendingImage& p) {
     tracker_.reset();
     node_.warn("visual state reset to epoch " + std::to_string(epoch_) + ": " + r.note);
     node_.publishHealthNow();
+    refused_.add("the visual state restarted (" + r.note + ")");
     return;
   }
   if (r.status == FrameResult::Status::kRejected) {
     node_.reject(opts_.camera_channel, r.note);
+    refused_.add(r.note);
     return;
   }
   if (r.status == FrameResult::Status::kInitializing) {
+    refused_.add("before the visual state was initialised (" + r.note + ")");
     if (r.note != init_note_) node_.info(r.note);  // what it waits for, once
     init_note_ = r.note;
     return;
@@ -236,6 +242,10 @@ void VioFeatureNode::publish(const FrameResult& r) {
   o.epoch = epoch_;
   o.correction_id = 0;
   node_.publish(opts_.odometry_channel, o);
+}
+
+void VioFeatureNode::reportRefusals() {
+  if (!refused_.empty()) node_.warn(refused_.summary("images refused"));
 }
 
 std::string VioFeatureNode::summary() const {

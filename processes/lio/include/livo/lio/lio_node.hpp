@@ -51,6 +51,16 @@ class LioNode {
     int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
+  /// What became of the sweeps whose odometry was published.
+  struct SweepCounts {
+    int64_t published = 0;
+    int64_t tracked = 0;     // registered against the map (a LiDAR update)
+    int64_t predicted = 0;   // the IMU prediction only
+    int64_t degenerate = 0;  // ODOMETRY.degenerate: some direction left to the prediction
+  };
+  const SweepCounts& sweepCounts() const { return sweep_counts_; }
+  /// "odometry of N sweeps: T tracked, P predicted without a LiDAR update, D degenerate", printed at exit.
+  std::string sweepSummary() const;
   /// "wheel updates: A accepted, R rejected (chi2 gate), N without a reading; scales left
   /// l +/- sl, right r +/- sr (L intervals learnt from, O gated as slip, U unobservable)", or the
   /// calibration being off. Printed every wheel_log_period_s of sensor time and at exit.
@@ -98,6 +108,7 @@ class LioNode {
   int64_t fed_wheel_ = 0;
   bool fed_any_wheel_ = false;
   int64_t sweeps_ = 0;
+  SweepCounts sweep_counts_;
   int64_t last_wheel_log_ = 0;  // IMU time of the last periodic wheel summary
 
   struct PendingPrior {

@@ -1,5 +1,6 @@
-// What a pipeline run left in its recorded outputs log: the online odometry, the keyframes, the
-// last loop correction, and every node's final HEALTH.
+// What a pipeline run left in its recorded outputs log: the online odometry with what each pose
+// says of its own quality, the keyframes, the loop corrections, the VIO's answers, and every
+// node's final HEALTH.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +20,9 @@ struct PipelineChannels {
   std::string keyframe = "KEYFRAME";
   std::string loop_correction = "LOOP_CORRECTION";
   std::string health = "HEALTH";
+  std::string state_prior = "STATE_PRIOR";
+  std::string state_posterior = "STATE_POSTERIOR";
+  std::string camera = "CAMERA";  // only its name: the VIOs' HEALTH counts the images on it
 };
 
 /// The frame a published pose is in (odometry_t / keyframe_t epoch and correction_id).
@@ -34,6 +38,32 @@ struct KeyframePose {
   PublishedFrame frame;
 };
 
+/// What an odometry message says of its own quality (odometry_t).
+struct OdometryQuality {
+  bool degenerate = false;                  // some direction was left to the prediction
+  int32_t num_residuals = 0;                // 0: no LiDAR update (predicted, or seeding the map)
+  Vec3 velocity = Vec3::Zero();             // W_v_I
+  Mat3 position_covariance = Mat3::Zero();  // of W_p_I
+};
+
+/// A LOOP_CORRECTION: the loop that triggered it and how far it moved the newest keyframe.
+struct LoopEvent {
+  int64_t correction_id = 0;
+  int32_t epoch = 0;
+  double stamp = 0.0;  // the newest keyframe in the graph
+  int64_t from_id = 0, to_id = 0;  // the loop edge's keyframes
+  double fitness = 0.0;            // m^2
+  double shift_m = 0.0;            // the newest corrected keyframe moved by it (T_Ck_Cj)
+  double turn_deg = 0.0;           // its rotation
+};
+
+/// A STATE_POSTERIOR: a VIO's answer to the prior of the image at `stamp`.
+struct VisualAnswer {
+  double stamp = 0.0;
+  std::string source;  // the answering node
+  bool valid = false;  // false: the prior was kept (the image was not used)
+};
+
 /// An LIO reset seen in the outputs: the first odometry of a new epoch.
 struct OdometryReset {
   double stamp = 0.0;   // first odometry of the new epoch
@@ -44,10 +74,14 @@ struct OdometryReset {
 struct PipelineOutputs {
   Trajectory odometry;                          // body pose at every scan, in stamp order
   std::vector<PublishedFrame> odometry_frames;  // the frame of each odometry pose (same order)
+  std::vector<OdometryQuality> odometry_quality;  // and what it says of itself (same order)
   std::vector<KeyframePose> keyframes;          // in id order
   std::map<int32_t, loop_correction_t> last_loop;  // the newest LOOP_CORRECTION of each epoch
   std::map<int64_t, std::pair<int32_t, Pose3>> corrections;  // every correction: id -> (epoch, T_Ck_O)
   int64_t loop_corrections = 0;
+  std::vector<LoopEvent> loops;                 // every LOOP_CORRECTION, in log order
+  int64_t state_priors = 0;                     // STATE_PRIOR: images handed to a VIO
+  std::vector<VisualAnswer> visual_answers;     // STATE_POSTERIOR, in stamp order
   std::vector<OdometryReset> resets;            // in stamp order
   std::map<std::string, health_t> final_health; // newest HEALTH per node
   int64_t undecodable = 0;                      // messages on these channels that did not decode

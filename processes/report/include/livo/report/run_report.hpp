@@ -1,14 +1,16 @@
 // The files a pipeline run hands back: timing.json (per process: messages, median/p90/max ms,
-// peak RSS) and report.md (timing, accuracy, figures, warnings).
+// peak RSS) and report.md (accuracy, figures, where the estimate was weak, timing, warnings).
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "livo/report/pipeline_outputs.hpp"
+#include "livo/report/weak_spots.hpp"
 
 namespace livo::report {
 
@@ -53,6 +55,7 @@ struct ReportInputs {
   std::vector<ProcessRestart> restarts;
   bool supervised = false;  // the run restarted processes that exited (the Restarts section)
   nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
+  std::optional<WeakSpots> weak_spots;       // weak_spots.json: the "Where the estimate was weak" section
   const PipelineOutputs* outputs = nullptr;
 };
 

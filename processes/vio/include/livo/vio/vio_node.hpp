@@ -24,6 +24,7 @@
 #include "livo/imu_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
+#include "livo/reason_counts.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "livo/vio/vio_config.hpp"
 #include "livo/vio/vio_estimator.hpp"
@@ -49,7 +50,10 @@ class VioNode {
   };
   const Counts& counts() const { return counts_; }
   /// Why priors were answered valid = 0, and how often.
-  const std::map<std::string, int64_t>& keptReasons() const { return kept_reasons_; }
+  const std::map<std::string, int64_t>& keptReasons() const { return kept_reasons_.counts(); }
+  /// At shutdown: "priors kept by reason: N x why; ..." as a warning, so the final HEALTH carries
+  /// it (livo-report lists it under "Where the estimate was weak"); nothing when none was kept.
+  void reportKeptReasons();
 
  private:
   struct BufferedImage {
@@ -82,7 +86,7 @@ class VioNode {
   std::deque<int64_t> answered_ids_;   // recent request ids, to answer each only once
   Counts counts_;
   MapFrame frame_;  // the map's odometry epoch and loop correction
-  std::map<std::string, int64_t> kept_reasons_;
+  ReasonCounts kept_reasons_;
   std::map<std::string, int64_t> last_warned_;  // reason -> sensor time of its last warning
   std::deque<filter_state_t> camera_free_;  // lio's camera-free states, newest last (by request id)
   bool warned_no_camera_free_ = false;

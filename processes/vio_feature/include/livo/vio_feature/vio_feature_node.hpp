@@ -21,6 +21,7 @@
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/node.hpp"
+#include "livo/reason_counts.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "livo/vio_feature/feature_depth.hpp"
 #include "livo/vio_feature/feature_tracker.hpp"
@@ -48,6 +49,12 @@ class VioFeatureNode {
   };
   const Counts& counts() const { return counts_; }
   std::string summary() const;
+  /// Why images gave no state, and how often (bad, out of order, dropped, before initialisation,
+  /// rejected by the window).
+  const ReasonCounts& refusals() const { return refused_; }
+  /// At shutdown: "images refused by reason: N x why; ..." as a warning, so the final HEALTH
+  /// carries it (livo-report lists it); nothing when every image gave a state.
+  void reportRefusals();
 
  private:
   struct PendingImage {
@@ -87,6 +94,7 @@ class VioFeatureNode {
   int32_t epoch_ = 0;
   std::string init_note_;  // the last reason the estimator gave for not initialising yet
   Counts counts_;
+  ReasonCounts refused_;  // why images gave no state
 };
 
 }  // namespace livo::vio_feature
