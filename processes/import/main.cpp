@@ -1,10 +1,12 @@
-// livo-import FORMAT INPUT --out LOG [--preset NAME]: dataset formats -> the project's LCM log.
+// livo-import FORMAT INPUT --out LOG [--preset NAME] [--rig-out FILE] [--rig FILE]: dataset formats -> the
+// project's LCM log (exit 0; 1 an input not read to its end; 2 usage or a bad --rig; 3 the log does not fit --rig).
 #include <iostream>
 
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
 #include "livo/command_line.hpp"
 #include "livo/import/rosbag_presets.hpp"
+#include "livo/config.hpp"
 
 namespace {
 
@@ -37,18 +39,28 @@ int main(int argc, char** argv) {
       .option("--camera", "TOPIC", "rosbag: camera topic (sensor_msgs/Image or CompressedImage)")
       .option("--camera-right", "TOPIC", "rosbag: second camera topic")
       .option("--depth", "TOPIC", "rosbag: depth image topic registered to the camera (sensor_msgs/Image 16UC1 mm or 32FC1 m)")
+      .option("--camera-info", "TOPIC",
+              "rosbag: the camera's sensor_msgs/CameraInfo (default: the only one, or the one in the camera's namespace); "
+              "read for --rig-out, --rig and the sidecar")
       .option("--ground-truth", "TOPIC|FILE",
               "rosbag: ground-truth topic (Odometry, PoseStamped, PoseWithCovarianceStamped, TransformStamped, "
               "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
       .flag("--no-auto-topics", "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
       .flag("--list-topics", "rosbag: print the bag's topics, types and counts, then exit")
       .flag("--list-presets", "print the presets, then exit")
-      .option("--imu-channel", "NAME", "IMU channel", "IMU")
-      .option("--lidar-channel", "NAME", "LiDAR channel", "LIDAR")
-      .option("--camera-channel", "NAME", "camera channel", "CAMERA")
+      .option("--rig-out", "FILE",
+              "also write a starter rig config (YAML) from what the input told: channels, measured rates, LiDAR "
+              "rings and model, camera size, colour and calibration; REPLACE: marks what it could not tell")
+      .option("--rig", "FILE",
+              "the rig config the log is for: its channel names are written (unless a --*-channel flag says "
+              "otherwise) and the log is checked against it (camera size, sensors, channels: errors, exit 3; "
+              "intrinsics, rates, rings: warnings)")
+      .option("--imu-channel", "NAME", "IMU channel (default IMU, or the --rig's)")
+      .option("--lidar-channel", "NAME", "LiDAR channel (default LIDAR, or the --rig's)")
+      .option("--camera-channel", "NAME", "camera channel (default CAMERA, or the --rig's)")
       .option("--camera-right-channel", "NAME", "second camera channel", "CAMERA_RIGHT")
-      .option("--depth-channel", "NAME", "depth image channel", "DEPTH")
-      .option("--ground-truth-channel", "NAME", "ground-truth channel", "GROUND_TRUTH")
+      .option("--depth-channel", "NAME", "depth image channel (default DEPTH, or the --rig's)")
+      .option("--ground-truth-channel", "NAME", "ground-truth channel (default GROUND_TRUTH, or the --rig's)")
       .option("--lidar-stamp", "start|end", "rosbag: what a cloud's header stamp marks (preset or start)")
       .option("--sweep-duration", "S", "sweep length in seconds (rosbag, kitti; default 0.1)")
       .option("--lidar-rings", "N", "rosbag: beams of the LiDAR (default: from the cloud)")
@@ -86,12 +98,21 @@ int main(int argc, char** argv) {
     if (!cli.has("--out")) throw std::invalid_argument("--out LOG is required");
     job.out = cli.get("--out");
     job.preset = cli.get("--preset");
-    job.channels.imu = cli.get("--imu-channel");
-    job.channels.lidar = cli.get("--lidar-channel");
-    job.channels.camera = cli.get("--camera-channel");
-    job.channels.camera_right = cli.get("--camera-right-channel");
-    job.channels.depth = cli.get("--depth-channel");
-    job.channels.ground_truth = cli.get("--ground-truth-channel");
+    if (cli.has("--rig")) {
+      job.rig_file = cli.get("--rig");
+      job.rig = livo::readSensorRig(livo::Config::load(job.rig_file).section("rig"));
+      job.channels = livo::import::channelNamesOf(*job.rig, job.channels);
+    }
+    job.rig_out = cli.get("--rig-out");
+    auto channel = [&](const char* flag, std::string& name) {
+      if (cli.has(flag)) name = cli.get(flag);
+    };
+    channel("--imu-channel", job.channels.imu);
+    channel("--lidar-channel", job.channels.lidar);
+    channel("--camera-channel", job.channels.camera);
+    channel("--camera-right-channel", job.channels.camera_right);
+    channel("--depth-channel", job.channels.depth);
+    channel("--ground-truth-channel", job.channels.ground_truth);
     job.max_buffer_mb = cli.getInt("--max-buffer-mb");
     job.quiet = cli.has("--quiet");
 
@@ -101,6 +122,7 @@ int main(int argc, char** argv) {
     r.camera_topic = cli.get("--camera");
     r.camera_right_topic = cli.get("--camera-right");
     r.depth_topic = cli.get("--depth");
+    r.camera_info_topic = cli.get("--camera-info");
     if (cli.has("--ground-truth")) {
       const std::string gt = cli.get("--ground-truth");
       if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::import::isFile(gt))
@@ -136,5 +158,6 @@ int main(int argc, char** argv) {
     return 2;
   }
   const livo::import::ImportOutcome outcome = livo::import::runImport(job, &std::cout);
-  return outcome.ok() ? 0 : 1;
+  if (!outcome.ok()) return 1;
+  return outcome.rigFits() ? 0 : 3;
 }

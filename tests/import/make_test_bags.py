@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Writes ROS 1 bags with the real ROS library (Debian's python3-rosbag) for the livo-import tests,
 one per chunk compression, holding every message type and PointCloud2 layout the importer reads,
-plus a bag of malformed messages. Beside each bag, <bag>.expected.json lists what the import must
+plus a bag of malformed messages and a small VLP-16 + IMU + camera bag with CameraInfo topics (the
+starter rig of --rig-out). Beside each bag, <bag>.expected.json lists what the import must
 produce, computed here from the values written (float32 rounding done with numpy).
 
 usage: make_test_bags.py OUTDIR JPEG_FILE PNG_FILE
@@ -17,7 +18,7 @@ import rosbag
 import rospy
 from geometry_msgs.msg import PointStamped, PoseStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import CompressedImage, Image, Imu, PointCloud2, PointField
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu, PointCloud2, PointField
 from std_msgs.msg import String
 
 F32, F64, U8, U16, U32 = PointField.FLOAT32, PointField.FLOAT64, PointField.UINT8, PointField.UINT16, PointField.UINT32
@@ -294,6 +295,55 @@ def write_rgbd_bags(one_path, two_path):
             json.dump(expected, f)
 
 
+def write_camera_info_bag(path):
+    """1.5 s of a VLP-16 (16 rings, Velodyne time field) at 10 Hz, an IMU at 200 Hz at rest (|a| =
+    9.8), rgb8 images of 8 x 6 at 20 Hz with a calibrated plumb_bob CameraInfo in the camera's
+    namespace, and a second CameraInfo elsewhere (not the camera's: must not be chosen)."""
+    expected = dict(camera_info=dict(width=8, height=6, fx=5.5, fy=5.25, cx=3.5, cy=2.5,
+                                     D=[-0.1, 0.01, 0.001, -0.002, 0.0005]),
+                    imu_hz=200, lidar_hz=10, camera_hz=20, rings=16)
+    fields = [('x', 0, F32), ('y', 4, F32), ('z', 8, F32), ('intensity', 12, F32), ('ring', 16, U16), ('time', 18, F32)]
+    with rosbag.Bag(path, 'w', compression='none') as bag:
+        for i in range(300):
+            m = Imu()
+            ns = BASE_NS + i * 5000000
+            m.header.stamp = stamp(ns)
+            m.linear_acceleration.z = 9.8
+            bag.write('/imu/data', m, m.header.stamp)
+        for k in range(15):
+            ns = BASE_NS + k * 100000000
+            pts = [dict(x=f32(2.0 + 0.1 * j), y=f32(0.5 * math.sin(j)), z=f32(-0.2 + 0.02 * j), intensity=1.0,
+                        ring=j % 16, time=f32(j * 0.003)) for j in range(32)]
+            msg = cloud_msg(ns, fields, pts, 22, frame='velodyne')
+            bag.write('/velodyne_points', msg, msg.header.stamp)
+        for k in range(30):
+            ns = BASE_NS + k * 50000000 + 7000
+            img = Image()
+            img.header.stamp = stamp(ns)
+            img.height, img.width, img.encoding, img.step = 6, 8, 'rgb8', 24
+            img.data = bytes((k + b) % 256 for b in range(144))
+            bag.write('/camera/image_raw', img, img.header.stamp)
+            ci = expected['camera_info']
+            info = CameraInfo()
+            info.header.stamp = img.header.stamp
+            info.width, info.height = ci['width'], ci['height']
+            info.distortion_model = 'plumb_bob'
+            info.D = ci['D']
+            info.K = [ci['fx'], 0.0, ci['cx'], 0.0, ci['fy'], ci['cy'], 0.0, 0.0, 1.0]
+            info.R = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+            info.P = [ci['fx'], 0.0, ci['cx'], 0.0, 0.0, ci['fy'], ci['cy'], 0.0, 0.0, 0.0, 1.0, 0.0]
+            bag.write('/camera/camera_info', info, info.header.stamp)
+            other = CameraInfo()
+            other.header.stamp = img.header.stamp
+            other.width, other.height = 100, 50
+            other.distortion_model = 'equidistant'
+            other.D = [0.1, 0.2, 0.3, 0.4]
+            other.K = [40.0, 0.0, 50.0, 0.0, 40.0, 25.0, 0.0, 0.0, 1.0]
+            bag.write('/thermal/camera_info', other, other.header.stamp)
+    with open(path + '.expected.json', 'w') as f:
+        json.dump(expected, f)
+
+
 def main():
     out, jpeg_path, png_path = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(out, exist_ok=True)
@@ -304,6 +354,7 @@ def main():
     write_ntu_viral_bag(os.path.join(out, 'ntu_viral.bag'))
     write_bad_bag(os.path.join(out, 'bad.bag'))
     write_rgbd_bags(os.path.join(out, 'rgbd.bag'), os.path.join(out, 'rgbd_two_depths.bag'))
+    write_camera_info_bag(os.path.join(out, 'camera_info.bag'))
     print('wrote test bags to', out)
 
 

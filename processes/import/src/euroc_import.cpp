@@ -29,6 +29,26 @@ void sensorMetadata(const std::string& yaml, const std::string& prefix, ImportRe
     if (s.gyro_noise_density > 0)
       report.metadata(prefix + "_noise_gyro_accel_density_walk",
                       yamlList({s.gyro_noise_density, s.accel_noise_density, s.gyro_random_walk, s.accel_random_walk}));
+    // The starter rig's calibration (--rig-out): cam0 is the camera, the body is imu0.
+    InputCalibration& cal = report.calibration();
+    const std::string source = prefix + "/sensor.yaml";
+    if (prefix == "imu0" && s.gyro_noise_density > 0)
+      cal.imu_noise = ImuNoise{s.gyro_noise_density, s.gyro_random_walk, s.accel_noise_density, s.accel_random_walk, source};
+    if (prefix == "cam0" && s.intrinsics.size() == 4 && s.width > 0) {
+      CameraIntrinsics k;
+      k.width = s.width;
+      k.height = s.height;
+      k.fx = s.intrinsics[0];
+      k.fy = s.intrinsics[1];
+      k.cx = s.intrinsics[2];
+      k.cy = s.intrinsics[3];
+      k.distortion_model = s.distortion_model;
+      for (size_t i = 0; i < 4 && i < s.distortion.size(); ++i) k.distortion[i] = s.distortion[i];
+      k.source = source;
+      if (s.distortion.size() > 4) k.note = "the rig holds four distortion coefficients; the rest are dropped";
+      cal.camera = k;
+      cal.T_I_C = KnownExtrinsic{s.T_body_sensor, "", source + " T_BS"};
+    }
   } catch (const std::exception& e) {
     report.skip("unreadable sensor.yaml (metadata not recorded)", e.what());
   }

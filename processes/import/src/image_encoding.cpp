@@ -20,6 +20,10 @@ CompressedImageInfo sniffCompressedImage(const uint8_t* d, size_t n) {
     if (n >= 24 && std::memcmp(d + 12, "IHDR", 4) == 0) {
       info.width = static_cast<int>(be32(d + 16));
       info.height = static_cast<int>(be32(d + 20));
+      if (n >= 26) {
+        static const int kChannels[7] = {1, 0, 3, 3, 2, 0, 4};  // by PNG colour type (3: palette, colour)
+        info.channels = d[25] <= 6 ? kChannels[d[25]] : 0;
+      }
     }
     return info;
   }
@@ -36,6 +40,7 @@ CompressedImageInfo sniffCompressedImage(const uint8_t* d, size_t n) {
       if (sof && i + 9 <= n) {
         info.height = be16(d + i + 5);
         info.width = be16(d + i + 7);
+        if (i + 10 <= n) info.channels = d[i + 9];  // Nf: 1 grey, 3 YCbCr, 4 CMYK
         break;
       }
       if (marker == 0xda || len < 2) break;  // start of scan: no frame header before it

@@ -1,10 +1,14 @@
 #include "livo/import/import_job.hpp"
 
+#include <iostream>
 #include <ostream>
 #include <stdexcept>
 
+#include "livo/config.hpp"
+#include "livo/import/rig_survey.hpp"
 #include "livo/import/rosbag_presets.hpp"
 #include "livo/import/sorted_log_writer.hpp"
+#include "livo/import/starter_rig_config.hpp"
 
 namespace livo::import {
 
@@ -33,6 +37,42 @@ void applyPreset(ImportJob& job) {
   if (r.lidar.num_rings == 0) r.lidar.num_rings = p->num_rings;
 }
 
+ChannelNames channelNamesOf(const SensorRig& rig, ChannelNames names) {
+  names.imu = rig.channels.imu;
+  names.lidar = rig.channels.lidar;
+  names.camera = rig.channels.camera;
+  names.depth = rig.channels.depth;
+  names.ground_truth = rig.channels.ground_truth;
+  return names;
+}
+
+namespace {
+
+/// A preset's extrinsics, for the LiDAR and camera topics the preset names (another topic of the
+/// dataset, e.g. NTU VIRAL's vertical LiDAR, has another extrinsic).
+void presetCalibration(const RosbagPreset& p, const RosbagImportOptions& r, ImportReport& report) {
+  InputCalibration& cal = report.calibration();
+  cal.calibrated_rig = p.calibrated_rig;
+  auto extrinsic = [&](const std::string& yaml) {
+    const Pose3 T = Config::fromString("T: " + yaml, "preset " + p.name).get<Pose3>("T");
+    return KnownExtrinsic{T, yaml, "preset " + p.name + ": " + p.extrinsics_source};
+  };
+  if (!p.T_I_L.empty() && r.lidar_topic == p.lidar_topic) cal.T_I_L = extrinsic(p.T_I_L);
+  if (!p.T_I_C.empty() && r.camera_topic == p.camera_topic) cal.T_I_C = extrinsic(p.T_I_C);
+}
+
+void printRigFindings(const std::vector<RigFinding>& findings, const std::string& rig_file, std::ostream* summary,
+                      bool quiet) {
+  if (summary) *summary << "rig check against " << rig_file << ": " << (findings.empty() ? "the log fits it" : "") << "\n";
+  for (const RigFinding& f : findings) {
+    const std::string line = std::string(f.error ? "error: " : "warning: ") + f.message;
+    if (summary) *summary << "  " << line << "\n";
+    if (!quiet || f.error) std::cerr << "livo-import: rig check: " << line << "\n";
+  }
+}
+
+}  // namespace
+
 ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
   ImportOutcome out;
   ImportReport& report = out.report;
@@ -47,10 +87,14 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
   SortedLogWriterOptions wo;
   wo.max_buffer_bytes = job.max_buffer_mb << 20;
   SortedLogWriter writer(job.out, wo);
+  RigSurvey survey(ch);
+  writer.setObserver(&survey);
   if (!job.preset.empty()) {
     report.metadataString("preset", job.preset);
-    if (const RosbagPreset* p = findRosbagPreset(job.preset))
+    if (const RosbagPreset* p = findRosbagPreset(job.preset)) {
       for (const auto& [k, v] : p->metadata) report.metadata(k, v);
+      presetCalibration(*p, job.rosbag, report);
+    }
   }
   try {
     if (job.format == "rosbag") {
@@ -83,6 +127,8 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
     writer.finish();
     out.wrote_log = true;
     out.channel_counts = writer.counts();
+    out.survey = survey.result();
+    addSurveyMetadata(out.survey, ch, report);
     report.writeSidecar(job.out + ".meta.yaml", job.format, job.input, job.out, out.channel_counts);
   } catch (const std::exception& e) {
     report.error(e.what());
@@ -91,6 +137,30 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
     *summary << "livo-import " << job.format << " " << job.input << " -> " << job.out << "\n";
     report.print(*summary, out.channel_counts, out.channel_types);
     if (out.wrote_log) *summary << "sidecar: " << job.out << ".meta.yaml\n";
+  }
+  if (!out.wrote_log) return out;
+  if (!job.rig_out.empty()) {
+    StarterRigInputs in;
+    in.format = job.format;
+    in.input = job.input;
+    in.log = job.out;
+    in.preset = job.preset;
+    in.channels = ch;
+    in.channel_counts = out.channel_counts;
+    in.survey = out.survey;
+    in.calibration = report.calibration();
+    const std::string layout = report.metadataValue("lidar_point_layout");
+    in.lidar_layout = layout.size() >= 2 && layout.front() == '"' ? layout.substr(1, layout.size() - 2) : layout;
+    try {
+      writeStarterRigConfig(job.rig_out, in);
+      if (summary) *summary << "starter rig: " << job.rig_out << "\n";
+    } catch (const std::exception& e) {
+      report.error(e.what());
+    }
+  }
+  if (job.rig) {
+    out.rig_findings = checkRigAgainstLog(*job.rig, job.rig_file, out.survey, report.calibration(), ch);
+    printRigFindings(out.rig_findings, job.rig_file, summary, job.quiet);
   }
   return out;
 }

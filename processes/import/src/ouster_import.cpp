@@ -198,6 +198,16 @@ void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedL
   report.metadata("T_sensor_lidar", matrixYaml(meta.lidar_to_sensor));
   // Points are in the sensor frame, so the body(IMU)-from-LiDAR extrinsic is inv(T_sensor_imu).
   report.metadata("extrinsic_imu_lidar", matrixYaml(Eigen::Matrix4d(meta.imu_to_sensor.inverse())));
+  // The starter rig's (--rig-out): T_I_L in metres, and the model from the product line
+  // ("OS-1-128" -> OS1-128) when it is one the rig knows.
+  Pose3 T_I_L;
+  T_I_L.matrix() = meta.imu_to_sensor.inverse();
+  T_I_L.translation() *= 1e-3;
+  report.calibration().T_I_L = KnownExtrinsic{T_I_L, "", "the metadata's imu_to_sensor_transform, inverted (mm -> m)"};
+  std::string model = meta.prod_line;
+  if (model.rfind("OS-", 0) == 0 && model.size() > 4 && model[4] == '-') model = "OS" + model.substr(3, 1) + model.substr(4);
+  report.calibration().lidar_model = model;
+  report.calibration().lidar_model_source = "Ouster metadata prod_line " + meta.prod_line;
 
   SweepAssembler sweeps(meta, o, writer, report);
   int64_t lidar_packets = 0, imu_packets = 0;

@@ -18,6 +18,7 @@ RosTypeInfo rosTypeInfo(const std::string& type) {
   if (type == "sensor_msgs/Image") t = {RosMessageKind::kImage, "060021388200f6f0f447d0fcd9c64743", nullptr};
   if (type == "sensor_msgs/CompressedImage")
     t = {RosMessageKind::kCompressedImage, "8f7a12909da2c9d3332d540a0977563f", nullptr};
+  if (type == "sensor_msgs/CameraInfo") t = {RosMessageKind::kCameraInfo, "c9a58c1b0b154e0e6da7578cb991d214", nullptr};
   if (type == "nav_msgs/Odometry") t = {RosMessageKind::kPose, "cd5e73d190d741a2f92e81eda573aca7", decodeRosOdometry};
   if (type == "geometry_msgs/PoseStamped")
     t = {RosMessageKind::kPose, "d3812c3cbc69362b77dc0b19b345f8f5", decodeRosPoseStamped};

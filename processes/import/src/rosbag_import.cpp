@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -18,7 +19,7 @@ namespace livo::import {
 
 namespace {
 
-enum class Role { kIgnored, kImu, kLidar, kCamera, kCameraRight, kDepth, kGroundTruth };
+enum class Role { kIgnored, kImu, kLidar, kCamera, kCameraRight, kDepth, kCameraInfo, kGroundTruth };
 
 const char* roleName(Role r) {
   switch (r) {
@@ -27,6 +28,7 @@ const char* roleName(Role r) {
     case Role::kCamera: return "camera";
     case Role::kCameraRight: return "camera-right";
     case Role::kDepth: return "depth";
+    case Role::kCameraInfo: return "camera-info";
     case Role::kGroundTruth: return "ground-truth";
     default: return "ignored";
   }
@@ -40,6 +42,7 @@ bool fits(Role role, RosMessageKind kind) {
     case Role::kCamera:
     case Role::kCameraRight: return kind == RosMessageKind::kImage || kind == RosMessageKind::kCompressedImage;
     case Role::kDepth: return kind == RosMessageKind::kImage;
+    case Role::kCameraInfo: return kind == RosMessageKind::kCameraInfo;
     case Role::kGroundTruth: return kind == RosMessageKind::kPose;
     default: return false;
   }
@@ -84,6 +87,7 @@ class BagConverter {
     topics_[Role::kCamera] = o.camera_topic;
     topics_[Role::kCameraRight] = o.camera_right_topic;
     topics_[Role::kDepth] = o.depth_topic;
+    topics_[Role::kCameraInfo] = o.camera_info_topic;
     topics_[Role::kGroundTruth] = o.ground_truth_file.empty() ? o.ground_truth_topic : "";
   }
 
@@ -118,6 +122,36 @@ class BagConverter {
                      "): none imported; choose one with --" + roleName(role));
       }
     }
+    if (topics_[Role::kCameraInfo].empty()) autoMapCameraInfo(connections);
+  }
+
+  /// The camera's CameraInfo: the only CameraInfo topic, else the one in the camera topic's
+  /// namespace or a parent's (/cam/color/image_raw/compressed -> /cam/color/image_raw/camera_info,
+  /// /cam/color/camera_info, /cam/camera_info).
+  void autoMapCameraInfo(const std::map<uint32_t, BagConnection>& connections) {
+    std::set<std::string> candidates;
+    for (const auto& kv : connections)
+      if (rosTypeInfo(kv.second.type).kind == RosMessageKind::kCameraInfo) candidates.insert(kv.second.topic);
+    if (candidates.empty()) return;
+    std::string chosen;
+    if (candidates.size() == 1) {
+      chosen = *candidates.begin();
+    } else {
+      for (std::string ns = topics_[Role::kCamera]; chosen.empty() && !ns.empty();) {
+        ns = ns.substr(0, ns.rfind('/'));
+        if (candidates.count(ns + "/camera_info")) chosen = ns + "/camera_info";
+      }
+    }
+    if (chosen.empty()) {
+      std::string list;
+      for (const std::string& c : candidates) list += " " + c;
+      report_.note("--camera-info not given and several CameraInfo topics (" + list.substr(1) +
+                   ") with none in the camera's namespace: none read; choose one with --camera-info");
+      return;
+    }
+    topics_[Role::kCameraInfo] = chosen;
+    report_.note("--camera-info not given: using " + chosen + (candidates.size() == 1 ? " (the bag's only CameraInfo topic)"
+                                                                                     : " (in the camera's namespace)"));
   }
 
   void handle(const BagMessage& m, const std::string& bag) {
@@ -155,6 +189,7 @@ class BagConverter {
         }
         case RosMessageKind::kCompressedImage:
           return image(role, convertRosCompressedImage(decodeRosCompressedImage(r), frameOf(role), where), m);
+        case RosMessageKind::kCameraInfo: return cameraInfo(decodeRosCameraInfo(r), m.connection->topic);
         case RosMessageKind::kPose: return pose(info.decode_pose(r), m, where);
         default: return;
       }
@@ -168,6 +203,7 @@ class BagConverter {
 
   void finish() {
     for (auto& kv : imu_units_) kv.second->flush();
+    if (camera_infos_) report_.metadata("camera_info_messages", std::to_string(camera_infos_));
   }
 
  private:
@@ -234,6 +270,29 @@ class BagConverter {
                 img);
   }
 
+  /// The first calibrated CameraInfo becomes the report's camera calibration (and metadata
+  /// camera_info); later ones are only counted, and a change of K or D is noted once.
+  void cameraInfo(const RosCameraInfo& msg, const std::string& topic) {
+    ++camera_infos_;
+    if (camera_infos_ == 1) {
+      report_.metadata("camera_info", "{topic: " + yamlQuote(topic) + ", width: " + std::to_string(msg.width) +
+                                          ", height: " + std::to_string(msg.height) + ", distortion_model: " +
+                                          yamlQuote(msg.distortion_model) + ", D: " + yamlList(msg.D) +
+                                          ", K: " + yamlList(std::vector<double>(msg.K.begin(), msg.K.end())) + "}");
+      first_camera_info_ = msg;
+      const std::optional<CameraIntrinsics> k = intrinsicsFromCameraInfo(msg, topic);
+      if (!k) report_.note("camera_info on " + topic + " is uncalibrated (K[0] = 0): no intrinsics from it");
+      else if (!report_.calibration().camera) report_.calibration().camera = k;
+      return;
+    }
+    if (!camera_info_changed_ && (msg.K != first_camera_info_.K || msg.D != first_camera_info_.D ||
+                                  msg.width != first_camera_info_.width || msg.height != first_camera_info_.height)) {
+      camera_info_changed_ = true;
+      report_.note("camera_info on " + topic + " changes during the bag (message " + std::to_string(camera_infos_) +
+                   "): the first is used");
+    }
+  }
+
   void pose(const RosStampedPose& p, const BagMessage& m, const std::string& where) {
     pose_t out;
     out.utime = stampOf(p.header, m, where);
@@ -254,6 +313,9 @@ class BagConverter {
   ImportReport& report_;
   std::map<Role, std::string> topics_;
   std::map<std::string, std::unique_ptr<ImuUnitNormaliser>> imu_units_;
+  int64_t camera_infos_ = 0;
+  RosCameraInfo first_camera_info_;
+  bool camera_info_changed_ = false;
 
  public:
   const std::map<Role, std::string>& topics() const { return topics_; }
@@ -277,7 +339,7 @@ void importRosbag(const std::vector<std::string>& bags, const RosbagImportOption
                   ImportReport& report) {
   BagConverter conv(o, writer, report);
   const bool need_auto = o.auto_map && (o.imu_topic.empty() || o.lidar_topic.empty() || o.camera_topic.empty() ||
-                                        o.depth_topic.empty());
+                                        o.depth_topic.empty() || o.camera_info_topic.empty());
   if (need_auto && !bags.empty()) {
     try {
       const std::map<uint32_t, BagConnection> connections = bagConnections(bags.front());

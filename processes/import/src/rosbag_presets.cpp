@@ -30,6 +30,11 @@ const std::vector<RosbagPreset>& rosbagPresets() {
         {"extrinsic_body_lidar_horizontal", "{translation: [-0.05, 0.0, 0.055], rotation: [1.0, 0.0, 0.0, 0.0]}"},
         {"frames_note", "\"the IMU and horizontal LiDAR z axes point down (dataset calibration)\""},
     };
+    ntu.calibrated_rig = "config/rigs/ntu_viral.yaml";
+    ntu.T_I_L = "{translation: [-0.05, 0.0, 0.055], rpy_deg: [0, 0, 0]}";
+    ntu.T_I_C = "[0.02183084, -0.01312053, 0.99967558, 0.00552943, 0.99975965, 0.00230088, -0.02180248, -0.12431302, "
+                "-0.00201407, 0.99991127, 0.01316761, 0.01614686, 0.0, 0.0, 0.0, 1.0]";
+    ntu.extrinsics_source = "NTU VIRAL's lidar_horz.yaml / camera_left.yaml T_Body_* (config/rigs/ntu_viral.yaml)";
     v.push_back(ntu);
 
     // M2DGR (SJTU): Velodyne VLP-32C, Handsfree 9-axis IMU, RealSense colour camera (compressed);
@@ -48,6 +53,10 @@ const std::vector<RosbagPreset>& rosbagPresets() {
         {"lidar_model", "\"Velodyne VLP-32C, 10 Hz\""},
         {"ground_truth_note", "\"M2DGR ships ground truth as TUM text files: --ground-truth SEQUENCE.txt\""},
     };
+    m2dgr.calibrated_rig = "config/rigs/m2dgr.yaml";
+    m2dgr.T_I_L = "{translation: [0.27255, -0.00053, 0.17954], rpy_deg: [0, 0, 0]}";
+    m2dgr.T_I_C = "[0.0, 0.0, 1.0, 0.57711, -1.0, 0.0, 0.0, 0.00012, 0.0, -1.0, 0.0, 0.83330, 0.0, 0.0, 0.0, 1.0]";
+    m2dgr.extrinsics_source = "M2DGR's calibration_results.txt (config/rigs/m2dgr.yaml)";
     v.push_back(m2dgr);
     return v;
   }();

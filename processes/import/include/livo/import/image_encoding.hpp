@@ -13,6 +13,7 @@ namespace livo::import {
 struct CompressedImageInfo {
   int8_t encoding = -1;  // image_t::ENCODING_JPEG or ENCODING_PNG, -1 if neither
   int width = 0, height = 0;
+  int channels = 0;  // colour channels: 1 grey, 3 colour (4 with alpha); 0 if the header is cut short
 };
 /// Recognises PNG and JPEG by their signature; width/height 0 if the header is cut short.
 CompressedImageInfo sniffCompressedImage(const uint8_t* data, size_t size);

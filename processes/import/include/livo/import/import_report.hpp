@@ -1,7 +1,8 @@
 // What an import did: messages written per channel, records skipped with their reasons (the
 // first occurrence of each reason is kept as an example naming file, record and field), read
 // errors that stopped an input early, notes, and metadata that has no message type (written to
-// the summary and to the `<log>.meta.yaml` sidecar).
+// the summary and to the `<log>.meta.yaml` sidecar); and the calibration the input's own metadata
+// gives (input_calibration.hpp), for a starter rig.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +11,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "livo/import/input_calibration.hpp"
 
 namespace livo::import {
 
@@ -30,6 +33,10 @@ class ImportReport {
   void metadataString(const std::string& key, const std::string& value);
 
   void setQuiet(bool quiet) { quiet_ = quiet; }
+
+  /// What the input's metadata says of the sensors' calibration (CameraInfo, sensor.yaml, ...).
+  InputCalibration& calibration() { return calibration_; }
+  const InputCalibration& calibration() const { return calibration_; }
 
   struct Skipped {
     int64_t count = 0;
@@ -55,6 +62,7 @@ class ImportReport {
   std::vector<std::string> errors_;
   std::vector<std::string> notes_;
   std::vector<std::pair<std::string, std::string>> metadata_;
+  InputCalibration calibration_;
   bool quiet_ = false;
 };
 

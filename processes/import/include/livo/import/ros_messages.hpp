@@ -74,6 +74,19 @@ struct RosCompressedImage {
 };
 RosCompressedImage decodeRosCompressedImage(ByteReader& r);
 
+/// sensor_msgs/CameraInfo (the calibration; R, P, binning and ROI are read but only binning and
+/// ROI are kept, to tell a calibration that does not describe the images as they are).
+struct RosCameraInfo {
+  RosHeader header;
+  uint32_t height = 0, width = 0;
+  std::string distortion_model;  // plumb_bob, rational_polynomial, equidistant, ...
+  std::vector<double> D;
+  std::array<double, 9> K{};     // row-major [fx 0 cx; 0 fy cy; 0 0 1]
+  uint32_t binning_x = 0, binning_y = 0;
+  uint32_t roi_x_offset = 0, roi_y_offset = 0, roi_height = 0, roi_width = 0;
+};
+RosCameraInfo decodeRosCameraInfo(ByteReader& r);
+
 /// A stamped position with an optional orientation: nav_msgs/Odometry, geometry_msgs/PoseStamped,
 /// PoseWithCovarianceStamped, TransformStamped (orientation) and PointStamped (position only).
 struct RosStampedPose {
@@ -91,7 +104,7 @@ RosStampedPose decodeRosPointStamped(ByteReader& r);
 
 /// The message kinds the importer reads, chosen by type name and checked against the md5sum the
 /// connection record carries (a bag with a different definition under the same name is refused).
-enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kPose };
+enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kCameraInfo, kPose };
 struct RosTypeInfo {
   RosMessageKind kind = RosMessageKind::kUnsupported;
   const char* md5 = "";

@@ -2,7 +2,8 @@
 // (sensor_msgs/Imu -> imu_t, PointCloud2 -> point_cloud_t, Image / CompressedImage -> image_t,
 // depth Image (16UC1 mm, 32FC1 m) -> image_t DEPTH16 / DEPTH32F,
 // Odometry / PoseStamped / PoseWithCovarianceStamped / TransformStamped / PointStamped -> pose_t),
-// stamped by their header stamps. Other topics are counted, never decoded.
+// stamped by their header stamps. The camera's sensor_msgs/CameraInfo is read into the report's
+// calibration (no message type carries it). Other topics are counted, never decoded.
 #pragma once
 
 #include <string>
@@ -21,6 +22,9 @@ struct RosbagImportOptions {
   // (IMU, PointCloud2, image, depth image) and `auto_map` is set. An Image topic whose first
   // message is 16UC1 or 32FC1 is depth, never a camera.
   std::string imu_topic, lidar_topic, camera_topic, camera_right_topic, depth_topic, ground_truth_topic;
+  // The camera's sensor_msgs/CameraInfo; empty: the bag's only CameraInfo topic, or with several
+  // the one in the camera topic's namespace (/a/b/image_raw -> /a/b/camera_info).
+  std::string camera_info_topic;
   bool auto_map = true;
   std::string ground_truth_file;              // TUM / EuRoC csv instead of a topic
   std::string ground_truth_child_frame = "I";

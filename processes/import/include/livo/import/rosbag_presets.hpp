@@ -19,6 +19,10 @@ struct RosbagPreset {
   int num_rings = 0;
   /// Facts with no message type, copied into the summary and the sidecar (YAML values).
   std::vector<std::pair<std::string, std::string>> metadata;
+  /// The dataset's calibration for a starter rig (--rig-out): the project's calibrated rig, and
+  /// the extrinsics of the preset's LiDAR and camera topics (YAML as a rig writes them; "" unknown).
+  std::string calibrated_rig;
+  std::string T_I_L, T_I_C, extrinsics_source;
 };
 
 const std::vector<RosbagPreset>& rosbagPresets();

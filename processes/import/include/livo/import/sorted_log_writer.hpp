@@ -1,7 +1,7 @@
 // Writes an LCM log whose events are in time order (event timestamp = message utime), whatever
 // order the importer produces them in. Ties keep insertion order. Memory is bounded: past
 // `max_buffer_bytes` the buffered events are sorted and spilled to a temporary run file next to
-// the output, and finish() merges the runs.
+// the output, and finish() merges the runs. An observer (optional) sees every message as added.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +9,23 @@
 #include <string>
 #include <vector>
 
+#include "livo/image_t.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/point_cloud_t.hpp"
+#include "livo/pose_t.hpp"
+
 namespace livo::import {
+
+/// Sees each message a SortedLogWriter is given, in the order the importer adds them (not time
+/// order), e.g. RigSurvey measuring rates and sensor facts while the log is written.
+class MessageObserver {
+ public:
+  virtual ~MessageObserver() = default;
+  virtual void observe(const std::string& channel, const imu_t& msg) = 0;
+  virtual void observe(const std::string& channel, const point_cloud_t& msg) = 0;
+  virtual void observe(const std::string& channel, const image_t& msg) = 0;
+  virtual void observe(const std::string& channel, const pose_t& msg) = 0;
+};
 
 struct SortedLogWriterOptions {
   int64_t max_buffer_bytes = 512LL << 20;  // spill to a run file beyond this
@@ -25,11 +41,14 @@ class SortedLogWriter {
   /// Adds an LCM message (any generated type with utime and encode()).
   template <class Msg>
   void add(const std::string& channel, const Msg& msg) {
+    if (observer_) observer_->observe(channel, msg);
     std::vector<uint8_t> bytes(static_cast<size_t>(msg.getEncodedSize()));
     msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     addEncoded(channel, msg.utime, std::move(bytes));
   }
   void addEncoded(const std::string& channel, int64_t utime, std::vector<uint8_t> bytes);
+  /// Shows every message given to add() to `observer` (nullptr: none); not owned.
+  void setObserver(MessageObserver* observer) { observer_ = observer; }
 
   /// Sorts, merges and writes the log. Throws std::runtime_error if it cannot be written.
   void finish();
@@ -54,6 +73,7 @@ class SortedLogWriter {
   std::vector<std::string> runs_;
   std::map<std::string, int64_t> counts_;
   bool finished_ = false;
+  MessageObserver* observer_ = nullptr;
 };
 
 }  // namespace livo::import
