@@ -17,6 +17,8 @@ PACKAGES=(
   # livo-import: Ouster metadata JSON; ROS 1 bags written by the real ROS library in its tests
   nlohmann-json3-dev python3-rosbag python3-roslz4 python3-rospy python3-std-msgs
   python3-sensor-msgs python3-geometry-msgs python3-nav-msgs python3-numpy
+  # report.html: three.js inlined into the page; headless Chromium renders it in the report tests
+  libjs-three chromium fonts-dejavu-core
   # private bus (network namespaces) and process tools
   iproute2 util-linux procps
 )
