@@ -6,10 +6,19 @@
 #   trajectory.tum   the final estimate (loop-corrected when loop closure ran)
 #   timing.json      per process: messages, median/p90/max ms, peak RSS
 #   weak_spots.json  degenerate and predicted sweeps, images the VIO did not use, loop closures
-#   evaluation_*.json, *.svg   accuracy against GROUND_TRUTH, if the log has it (the figures mark
-#                    the weak spots)
-#   report.md        all of it for a person; logs/<process>.log: what each process printed
-#   maps and other files the processes write (they run in DIR)
+#   resets.json      odometry resets (new epochs; [] when there was none)
+#   evaluation_*.json, odometry.svg, trajectory.svg   accuracy against GROUND_TRUTH, if the log has
+#                    it (the figures mark the weak spots)
+#   trajectory_top.svg  the trajectory from above with its weak spots (no ground truth needed)
+#   map_top.png, map_oblique.png   the RGB map (colour_map.ply) from above and from the side
+#   octomap_slice.png   the OctoMap's occupied voxels around the trajectory's height, from above
+#   pictures.json    what livo-report pictures drew, and why it drew no more
+#   report.md        all of it for a person (the pictures in its "Maps" section)
+#   report.html      the same as one self-contained page, with the RGB map and the trajectory in 3D
+#                    (three.js from libjs-three inlined; open it in any browser, no network needed)
+#   logs/<process>.log: what each process printed (logs/report.log: livo-report's notes)
+#   maps and other files the processes write (they run in DIR): colour_map.ply/.pcd, octomap.bt/.ot,
+#                    keyframes.tum, loops.json, global_map.ply, ...
 #
 #   scripts/run_pipeline.sh --log LOG --config FILE --out DIR [--realtime] [--without P,...]
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
@@ -36,7 +45,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,39p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0
@@ -168,6 +177,11 @@ if [ "$inside" = 0 ]; then
       fi
     done
   fi
+  # Pictures of the maps and the trajectory for report.md's "Maps" section: a map the run did not
+  # make is a note there; a failure here only a warning.
+  rm -f "$out/pictures.json"
+  "$bin/livo-report" pictures --dir "$out" >/dev/null 2>>"$out/logs/report.log" \
+    || warnings+=("livo-report pictures failed (no Maps section): $(tail -n 1 "$out/logs/report.log")")
   [ "$rc" = 0 ] || warnings+=("the run failed: $(tail -n 1 "$out/logs/run.txt" 2>/dev/null)")
   # What the replay saw go wrong on the bus (messages lost, consumers away and back).
   while IFS= read -r line; do warnings+=("playback: ${line#*lockstep: }"); done \
@@ -182,6 +196,10 @@ if [ "$inside" = 0 ]; then
     --evaluation "$evaluations" --figure "$figures" --warning "$joined_warnings" --injected "$injected" \
     --sensor-use "$sensor_use" \
     $([ "$respawn" = 1 ] && echo --restarts "$out/logs/restarts.tsv") >/dev/null
+  # The same report as one page with the map in 3D; without it the run still has report.md.
+  rm -f "$out/report.html"
+  "$bin/livo-report" html --dir "$out" >/dev/null 2>>"$out/logs/report.log" \
+    || echo "run_pipeline.sh: warning: report.html: $(grep -E '^livo-report( html)?: ' "$out/logs/report.log" | tail -n 1)" >&2
   if [ "$rc" != 0 ]; then
     echo "run_pipeline.sh: FAILED (outputs so far kept in $out):" >&2
     cat "$out/logs/run.txt" >&2 || true

@@ -1,15 +1,23 @@
 // livo-report: turns a pipeline run's recorded outputs into the files the user gets back.
 //   livo-report extract OUTPUTS.lcmlog --dir DIR     odometry.tum, trajectory.tum, timing.json,
 //                                                    resets.json, weak_spots.json
+//   livo-report pictures --dir DIR [...]             trajectory_top.svg, map_top.png, map_oblique.png,
+//                                                    octomap_slice.png, pictures.json from the run's files
 //   livo-report markdown --dir DIR [...]             report.md from those and livo-evaluate's JSON
+//   livo-report html --dir DIR [...]                 report.html: report.md self-contained, the map in 3D
 //   livo-report memory OUTPUTS.lcmlog [--at S,S,...]  peak RSS per process at sensor times (HEALTH)
+#include <chrono>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "livo/command_line.hpp"
+#include "livo/file_output.hpp"
+#include "livo/text_format.hpp"
+#include "livo/report/html_report.hpp"
 #include "livo/report/memory_profile.hpp"
 #include "livo/report/pipeline_outputs.hpp"
+#include "livo/report/run_pictures.hpp"
 #include "livo/report/run_report.hpp"
 #include "livo/report/weak_spots.hpp"
 
@@ -123,6 +131,7 @@ int markdown(int argc, char** argv) {
     in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
+  if (std::ifstream p(dir + "/pictures.json"); p) in.pictures = livo::report::picturesFromJson(nlohmann::json::parse(p));
   if (std::ifstream w(dir + "/weak_spots.json"); w)
     in.weak_spots = livo::report::weakSpotsFromJson(nlohmann::json::parse(w));
   else
@@ -139,6 +148,94 @@ int markdown(int argc, char** argv) {
   }
   writeText(dir + "/report.md", livo::report::reportMarkdown(in));
   std::cout << dir << "/report.md\n";
+  return 0;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int pictures(int argc, char** argv) {
+  livo::CommandLine cli("livo-report pictures",
+                        "Draws the run's maps and trajectory beside its report: trajectory_top.svg, map_top.png, "
+                        "map_oblique.png, octomap_slice.png and pictures.json (what was drawn; notes on what was not). "
+                        "Run it before `livo-report markdown`, which shows them.");
+  const livo::report::PictureOptions d;
+  cli.option("--dir", "DIR", "the run's output folder", ".")
+      .option("--colour-map", "FILE", "the RGB map (binary PLY), relative to DIR", d.colour_map)
+      .option("--octomap", "FILE", "the OctoMap (.bt), relative to DIR", d.octomap)
+      .option("--cut-above", "M", "RGB map pictures: leave out points higher above the trajectory", livo::formatSignificant(d.cut_above_m))
+      .option("--slice-below", "M", "OctoMap slice: from this far below the trajectory", livo::formatSignificant(d.band.below_m))
+      .option("--slice-above", "M", "OctoMap slice: to this far above it", livo::formatSignificant(d.band.above_m))
+      .option("--point-size", "M", "the RGB map's point spacing", livo::formatSignificant(d.point_size_m))
+      .option("--size", "PX", "the pictures' longer side", std::to_string(d.long_side_px));
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  livo::report::PictureOptions o;
+  o.colour_map = cli.get("--colour-map");
+  o.octomap = cli.get("--octomap");
+  o.cut_above_m = cli.getDouble("--cut-above");
+  o.band.below_m = cli.getDouble("--slice-below");
+  o.band.above_m = cli.getDouble("--slice-above");
+  o.point_size_m = cli.getDouble("--point-size");
+  o.long_side_px = static_cast<int>(cli.getInt("--size"));
+  if (o.long_side_px < 100 || o.long_side_px > 10000) throw std::invalid_argument("--size: between 100 and 10000 pixels");
+  if (!(o.point_size_m > 0) || !(o.band.below_m + o.band.above_m > 0))
+    throw std::invalid_argument("--point-size and the slice's band must be positive");
+  const std::string dir = cli.get("--dir");
+  const auto t0 = std::chrono::steady_clock::now();
+  const livo::report::PictureSet set = livo::report::makePictures(dir, o, &std::cerr);
+  std::string error;
+  if (!livo::writeFileAtomically(dir + "/pictures.json", {livo::report::picturesJson(set).dump(2) + "\n"}, &error))
+    throw std::runtime_error(error);
+  for (const auto& n : set.notes) std::cerr << "livo-report pictures: " << n << "\n";
+  std::cerr << "livo-report pictures: " << set.pictures.size() << (set.pictures.size() == 1 ? " picture" : " pictures")
+            << " in " << livo::formatFixed(secondsSince(t0), 2) << " s\n";
+  for (const auto& p : set.pictures) std::cout << dir << "/" << p.file << "\n";
+  return 0;
+}
+
+int html(int argc, char** argv) {
+  livo::CommandLine cli("livo-report html",
+                        "Writes DIR/report.html: DIR/report.md as one self-contained page (pictures and scripts "
+                        "inlined, nothing from a network) with the RGB map and the trajectory in 3D (three.js from "
+                        "libjs-three). Run it after `livo-report markdown`.");
+  const livo::report::HtmlOptions d;
+  cli.option("--dir", "DIR", "the run's output folder", ".")
+      .option("--out", "FILE", "the page (default DIR/report.html)")
+      .option("--colour-map", "FILE", "the RGB map (binary PLY), relative to DIR", d.colour_map)
+      .option("--max-points", "N", "at most this many map points in the 3D view (thinned on a voxel grid)",
+              std::to_string(d.viewer.max_points))
+      .option("--three-dir", "DIR", "where three.min.js and examples/js/controls/OrbitControls.js are", d.three_dir);
+  if (!cli.parse(argc, argv)) return cli.exitCode();
+  livo::report::HtmlOptions o;
+  o.colour_map = cli.get("--colour-map");
+  o.three_dir = cli.get("--three-dir");
+  if (cli.getInt("--max-points") < 1) throw std::invalid_argument("--max-points: at least 1");
+  o.viewer.max_points = static_cast<size_t>(cli.getInt("--max-points"));
+  const std::string dir = cli.get("--dir");
+  const std::string out = cli.has("--out") ? cli.get("--out") : dir + "/report.html";
+  const auto t0 = std::chrono::steady_clock::now();
+  const livo::report::HtmlReport page = livo::report::reportHtml(dir, o);
+  std::string error;
+  if (!livo::writeFileAtomically(out, {page.html}, &error)) throw std::runtime_error(error);
+  for (const auto& w : page.warnings) std::cerr << "livo-report html: warning: " << w << "\n";
+  std::cerr << "livo-report html: " << livo::formatFixed(page.html.size() / 1048576.0, 1) << " MB, ";
+  if (!page.viewer)
+    std::cerr << "no 3D view" << (page.three_missing ? "" : " (no map, no trajectory)");
+  else if (page.map_points == 0)
+    std::cerr << "the trajectory in 3D (no map)";
+  else
+    std::cerr << page.points_shown << " of " << page.map_points << " map points in 3D";
+  if (page.voxel_m > 0) std::cerr << " (" << livo::formatSignificant(page.voxel_m, 3) << " m voxels)";
+  std::cerr << ", " << livo::formatFixed(secondsSince(t0), 2) << " s\n";
+  std::cout << out << "\n";
+  if (page.three_missing) {
+    std::cerr << "livo-report html: error: no 3D view in " << out << ": three.js is missing (" << o.three_dir
+              << "/three.min.js, " << o.three_dir << "/examples/js/controls/OrbitControls.js); install Debian's "
+              << "libjs-three (sudo apt-get install libjs-three) and run livo-report html again. The rest of the "
+              << "report is written.\n";
+    return 1;
+  }
   return 0;
 }
 
@@ -163,7 +260,8 @@ int memory(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   const std::string usage =
-      "usage: livo-report extract OUTPUTS.lcmlog --dir DIR | livo-report markdown --dir DIR [...] | "
+      "usage: livo-report extract OUTPUTS.lcmlog --dir DIR | livo-report pictures --dir DIR [...] | "
+      "livo-report markdown --dir DIR [...] | livo-report html --dir DIR [...] | "
       "livo-report memory OUTPUTS.lcmlog [--at S,...]\n";
   if (argc < 2) {
     std::cerr << usage;
@@ -173,6 +271,8 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "extract") return extract(argc - 1, argv + 1);
     if (cmd == "markdown") return markdown(argc - 1, argv + 1);
+    if (cmd == "pictures") return pictures(argc - 1, argv + 1);
+    if (cmd == "html") return html(argc - 1, argv + 1);
     if (cmd == "memory") return memory(argc - 1, argv + 1);
     if (cmd == "--help") {
       std::cout << usage;

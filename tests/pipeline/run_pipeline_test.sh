@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The pipeline runner on a 10 s log with a stand-in LIO: every promised output exists and parses,
-# the accuracy is the stand-in's known wobble; a crashing process fails the run with its name and
-# last words, and the outputs so far are kept.
+# the accuracy is the stand-in's known wobble, the report has its Maps section (the trajectory
+# figure; no colour or OctoMap in this run, and it says so) and report.html; a crashing process
+# fails the run with its name and last words, and the outputs so far are kept.
 set -uo pipefail
 root="$1"; bin="$2"
 dir=$(mktemp -d /tmp/livo-runner-test.XXXXXX)
@@ -13,7 +14,8 @@ export LIVO_BUILD_DIR="$(dirname "$bin")"
 report=$("$root/scripts/run_pipeline.sh" --log "$dir/in.lcmlog" --config "$root/tests/pipeline/fake_pipeline.yaml" \
   --out "$dir/run" --swap lio="$bin/test-fake-lio") || fail "run_pipeline.sh failed"
 [ "$report" = "$dir/run/report.md" ] || fail "last line should be the report's path, got: $report"
-for f in outputs.lcmlog odometry.tum trajectory.tum timing.json report.md evaluation_odometry.json odometry.svg logs/lio.log; do
+for f in outputs.lcmlog odometry.tum trajectory.tum timing.json report.md evaluation_odometry.json odometry.svg logs/lio.log \
+         trajectory_top.svg pictures.json report.html; do
   [ -s "$dir/run/$f" ] || fail "missing output $f"
 done
 /usr/bin/python3 - "$dir/run" <<'PY' || exit 1
@@ -36,6 +38,12 @@ assert 0.004 < e['ate']['rmse'] < 0.0085, e['ate']
 assert e['ate']['coverage'] > 0.95, e['ate']
 r = open(d + '/report.md').read()
 assert '## Accuracy' in r and '| lio | LIDAR | 100 |' in r and 'odometry.svg' in r, r
+maps = r.split('## Maps')[1].split('\n## ')[0]
+assert '![Trajectory from above](trajectory_top.svg)' in maps and 'no `colour_map.ply`' in maps, maps
+p = json.load(open(d + '/pictures.json'))
+assert [x['file'] for x in p['pictures']] == ['trajectory_top.svg'], p
+h = open(d + '/report.html').read()
+assert h.startswith('<!DOCTYPE html>') and 'data:image/svg+xml;base64,' in h and 'id="map-in-3d"' in h, h[:2000]
 print('runner outputs ok: ATE rmse %.4f m over %d poses' % (e['ate']['rmse'], len(odo)))
 PY
 
@@ -46,5 +54,5 @@ grep -q "process lio" "$dir/crash.err" || { cat "$dir/crash.err"; fail "the fail
 grep -q "crashing on purpose" "$dir/crash.err" || { cat "$dir/crash.err"; fail "the failure does not show lio's last words"; }
 n=$(grep -vc '^#' "$dir/crash/odometry.tum")
 [ "$n" = 30 ] || fail "outputs so far should be kept: expected 30 odometry poses, got $n"
-[ -s "$dir/crash/report.md" ] || fail "a failed run still writes its report"
+[ -s "$dir/crash/report.md" ] && [ -s "$dir/crash/report.html" ] || fail "a failed run still writes its report"
 echo "crash reported and outputs kept ($n poses)"

@@ -84,10 +84,6 @@ std::vector<std::pair<double, double>> thin(const std::vector<std::pair<double, 
   return out;
 }
 
-// The marks (PlotMarks): a degenerate stretch, a predicted one, a loop closure.
-const char* const kDegenerateColour = "#ff8c00";
-const char* const kPredictedColour = "#5e5e5e";
-const char* const kLoopColour = "#c51b7d";
 constexpr double kMarkSlack_s = 1e-3;  // a pose within this of a span's end is in it (TUM rounding)
 constexpr double kLoopSlack_s = 0.25;  // a loop's keyframe is drawn at the pose this near in time
 

@@ -129,6 +129,7 @@ std::string reportMarkdown(const ReportInputs& in) {
   for (const auto& [caption, path] : in.figures) md << "![" << caption << "](" << path << ")\n\n";
 
   if (in.weak_spots) md << weakSpotsMarkdown(*in.weak_spots);
+  if (in.pictures) md << mapsMarkdown(*in.pictures);
 
   md << "## Processing time\n\n";
   md << "Per process, its busiest input (median x messages); `timing.json` lists every channel.\n\n";

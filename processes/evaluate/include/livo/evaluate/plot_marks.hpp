@@ -24,6 +24,12 @@ struct PlotMarks {
   bool empty() const { return degenerate.empty() && predicted.empty() && loops.empty(); }
 };
 
+/// How every figure draws them (livo-evaluate's, livo-report's trajectory_top.svg): a wide
+/// translucent stroke over the path, a dashed line between a loop's keyframes.
+inline constexpr const char* kDegenerateColour = "#ff8c00";
+inline constexpr const char* kPredictedColour = "#5e5e5e";
+inline constexpr const char* kLoopColour = "#c51b7d";
+
 /// Reads the marks from a weak_spots.json; throws std::runtime_error naming the file when it cannot
 /// be read or lacks a key above.
 PlotMarks readPlotMarks(const std::string& path);

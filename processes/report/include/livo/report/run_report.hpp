@@ -1,5 +1,5 @@
 // The files a pipeline run hands back: timing.json (per process: messages, median/p90/max ms,
-// peak RSS) and report.md (accuracy, figures, where the estimate was weak, timing, warnings).
+// peak RSS) and report.md (accuracy, figures, where the estimate was weak, maps, timing, warnings).
 #pragma once
 
 #include <map>
@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "livo/report/picture_set.hpp"
 #include "livo/report/pipeline_outputs.hpp"
 #include "livo/report/weak_spots.hpp"
 
@@ -56,6 +57,7 @@ struct ReportInputs {
   bool supervised = false;  // the run restarted processes that exited (the Restarts section)
   nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
   std::optional<WeakSpots> weak_spots;       // weak_spots.json: the "Where the estimate was weak" section
+  std::optional<PictureSet> pictures;        // pictures.json (livo-report pictures): the "Maps" section
   const PipelineOutputs* outputs = nullptr;
 };
 
