@@ -27,7 +27,8 @@ rig:
   imu: {rate_hz: 200, gyro_noise_density: 1.7e-4, gyro_random_walk: 1.9e-5, accel_noise_density: 2.0e-3, accel_random_walk: 3.0e-3, gravity: 9.81}
   lidar: {model: VLP-16, rate_hz: 10, min_range: 0.5, max_range: 100.0, range_noise_std: 0.01, dropout_probability: 0.02,
           T_I_L: {translation: [0.05, 0.0, 0.1], rpy_deg: [0.0, 0.0, 90.0]}}
-  camera: {model: pinhole, width: 640}
+  camera: {width: 640, height: 480, fx: 400.0, fy: 400.0, cx: 319.5, cy: 239.5, distortion: [0.0, 0.0, 0.0, 0.0],
+           rate_hz: 20, color: false, T_I_C: {translation: [0.08, 0.0, 0.02], rpy_deg: [-90, 0, -90]}}
 lio:
   init: {window_s: 0.5}
   keyframe: {min_distance: 0.5}

@@ -2,11 +2,16 @@
 
 #include <ostream>
 
+#include "livo/sensor_rig.hpp"
+
 namespace livo::lio {
 
 namespace {
 void readRig(const Config& rig, LioNodeOptions* o) {
   LioOptions& l = o->lio;
+  // The rig is validated as every other process validates it (a model name, ranges and noise the
+  // LIO itself does not read are still errors here); the LIO then reads what it uses.
+  (void)readSensorRig(rig);
   const Config ch = rig.optionalSection("channels");
   ch.readOptional("imu", o->imu_channel);
   ch.readOptional("lidar", o->lidar_channel);
