@@ -183,6 +183,22 @@ PerspectiveView obliqueView(const Box3& box, const Eigen::Vector2d& major_axis, 
   return v;
 }
 
+cv::Mat cropToContent(const cv::Mat& image, const cv::Vec3b& background, int margin_px) {
+  int x0 = image.cols, y0 = image.rows, x1 = -1, y1 = -1;
+  for (int y = 0; y < image.rows; ++y) {
+    const cv::Vec3b* row = image.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      if (row[x] == background) continue;
+      x0 = std::min(x0, x), x1 = std::max(x1, x);
+      y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  if (x1 < 0) return image;
+  x0 = std::max(0, x0 - margin_px), y0 = std::max(0, y0 - margin_px);
+  x1 = std::min(image.cols - 1, x1 + margin_px), y1 = std::min(image.rows - 1, y1 + margin_px);
+  return image(cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)).clone();
+}
+
 colour::ColouredPoints pointsBelowCut(const colour::ColouredPoints& points, const TrajectoryHeight& height,
                                       double cut_above_m) {
   colour::ColouredPoints out;

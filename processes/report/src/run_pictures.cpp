@@ -194,7 +194,7 @@ void colourMapPictures(const std::string& dir, const RunFiles& run, const Trajec
   cv::Mat1f depth;
   cv::Mat oblique = renderPerspective(points, view, style, &depth);
   drawPathPerspective(oblique, depth, run.map_path, view);
-  writePng(inDir(dir, kMapObliqueFile), oblique);
+  writePng(inDir(dir, kMapObliqueFile), cropToContent(oblique, style.background, o.long_side_px / 40));
   set->pictures.push_back({kMapObliqueFile, "RGB map from the side",
                            "the same points seen from above one long side of the map (35 deg down), " +
                                std::string(height.empty() ? "all of them" : "the same cut") +

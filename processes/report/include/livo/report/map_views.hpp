@@ -70,6 +70,11 @@ Eigen::Vector2d majorHorizontalAxis(const std::vector<Vec3>& points);
 PerspectiveView obliqueView(const Box3& box, const Eigen::Vector2d& major_axis, int width = 1600,
                             double elevation_deg = 35.0, double azimuth_deg = 30.0, double distance_factor = 2.0);
 
+/// The image cut to the rectangle holding every pixel that differs from `background`, widened by
+/// `margin_px` on each side (within the image): the oblique view's framing fits the box's corners,
+/// which a map seldom fills. The whole image when every pixel is background.
+cv::Mat cropToContent(const cv::Mat& image, const cv::Vec3b& background, int margin_px);
+
 struct SplatStyle {
   double point_size_m = 0.05;  // the map's point spacing (livo-colour's voxel): a splat's width
   int max_px = 12;             // splats no wider than this
