@@ -98,7 +98,7 @@ TEST(MarkdownHtml, RawHtmlIsEscapedNeverPassedThrough) {
   EXPECT_EQ(markdownToHtml("<script>alert('x')</script> & \"q\"\n"),
             "<p>&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;q&quot;</p>\n");
   EXPECT_EQ(markdownToHtml("> quoted *text*\n> more\n"), "<blockquote>\n<p>quoted <em>text</em>\nmore</p>\n</blockquote>\n");
-  EXPECT_EQ(escapeHtml("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
+  EXPECT_EQ(livo::escapeMarkup("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
 }
 
 TEST(MarkdownHtml, AReportLikePage) {

@@ -1,4 +1,4 @@
-// Numbers in log lines and notes.
+// Numbers in log lines and notes; text inside markup (SVG, HTML).
 #pragma once
 
 #include <sstream>
@@ -21,6 +21,23 @@ inline std::string formatFixed(double v, int digits) {
   os.precision(digits);
   os << v;
   return os.str();
+}
+
+/// `s` safe as XML / HTML text or a quoted attribute value: & < > " ' as entities.
+inline std::string escapeMarkup(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
 }
 
 }  // namespace livo

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "livo/evaluate/plot_scale.hpp"
+#include "livo/text_format.hpp"
 
 namespace livo::evaluate {
 
@@ -18,25 +19,7 @@ namespace {
 constexpr int kColourLevels = 48;
 const char* const kFont = "font-family=\"DejaVu Sans, Arial, sans-serif\"";
 
-std::string f1(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f", v);
-  return buf;
-}
-
-std::string escapeXml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string fixed1(double v) { return formatFixed(v, 1); }
 
 std::string number(double v, int significant = 4) {
   char buf[32];
@@ -53,22 +36,22 @@ class Svg {
   std::ostringstream os;
 
   void text(double x, double y, const std::string& s, int size, const char* anchor = "start", const char* extra = "") {
-    os << "<text x=\"" << f1(x) << "\" y=\"" << f1(y) << "\" font-size=\"" << size << "\" text-anchor=\"" << anchor
-       << "\" " << kFont << " " << extra << ">" << escapeXml(s) << "</text>\n";
+    os << "<text x=\"" << fixed1(x) << "\" y=\"" << fixed1(y) << "\" font-size=\"" << size << "\" text-anchor=\"" << anchor
+       << "\" " << kFont << " " << extra << ">" << escapeMarkup(s) << "</text>\n";
   }
   void line(double x0, double y0, double x1, double y1, const std::string& stroke, double width, const char* extra = "") {
-    os << "<line x1=\"" << f1(x0) << "\" y1=\"" << f1(y0) << "\" x2=\"" << f1(x1) << "\" y2=\"" << f1(y1)
+    os << "<line x1=\"" << fixed1(x0) << "\" y1=\"" << fixed1(y0) << "\" x2=\"" << fixed1(x1) << "\" y2=\"" << fixed1(y1)
        << "\" stroke=\"" << stroke << "\" stroke-width=\"" << width << "\" " << extra << "/>\n";
   }
   void dot(double x, double y, double r, const std::string& fill) {
-    os << "<circle cx=\"" << f1(x) << "\" cy=\"" << f1(y) << "\" r=\"" << r << "\" fill=\"" << fill << "\"/>\n";
+    os << "<circle cx=\"" << fixed1(x) << "\" cy=\"" << fixed1(y) << "\" r=\"" << r << "\" fill=\"" << fill << "\"/>\n";
   }
   void polyline(const std::vector<std::pair<double, double>>& pts, const std::string& stroke, double width,
                 const char* extra = "") {
     if (pts.size() < 2) return;
     os << "<polyline fill=\"none\" stroke=\"" << stroke << "\" stroke-width=\"" << width
        << "\" stroke-linejoin=\"round\" stroke-linecap=\"round\" " << extra << " points=\"";
-    for (const auto& p : pts) os << f1(p.first) << "," << f1(p.second) << " ";
+    for (const auto& p : pts) os << fixed1(p.first) << "," << fixed1(p.second) << " ";
     os << "\"/>\n";
   }
 };
@@ -165,7 +148,7 @@ bool loopLines(Svg& svg, const std::vector<std::pair<double, double>>& px, const
 std::pair<LinearScale, LinearScale> axes(Svg& svg, const Rect& r, double xlo, double xhi, double ylo, double yhi,
                                          const std::string& xtitle, const std::string& ytitle, int xticks, int yticks) {
   LinearScale sx{xlo, xhi, r.x, r.x + r.w}, sy{ylo, yhi, r.y + r.h, r.y};
-  svg.os << "<rect x=\"" << f1(r.x) << "\" y=\"" << f1(r.y) << "\" width=\"" << f1(r.w) << "\" height=\"" << f1(r.h)
+  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\"" << fixed1(r.h)
          << "\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"1\"/>\n";
   const auto xt = niceTicks(xlo, xhi, xticks), yt = niceTicks(ylo, yhi, yticks);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
@@ -183,7 +166,7 @@ std::pair<LinearScale, LinearScale> axes(Svg& svg, const Rect& r, double xlo, do
   }
   svg.text(r.x + r.w / 2, r.y + r.h + 42, xtitle, 15, "middle");
   std::ostringstream rot;
-  rot << "transform=\"rotate(-90 " << f1(r.x - 58) << " " << f1(r.y + r.h / 2) << ")\"";
+  rot << "transform=\"rotate(-90 " << fixed1(r.x - 58) << " " << fixed1(r.y + r.h / 2) << ")\"";
   svg.text(r.x - 58, r.y + r.h / 2, ytitle, 15, "middle", rot.str().c_str());
   return {sx, sy};
 }
@@ -252,9 +235,9 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
   if (!ev.est.empty()) {
     const auto& s = ev.est.front().translation();
     const auto& e = ev.est.back().translation();
-    svg.os << "<circle cx=\"" << f1(sx(s[a])) << "\" cy=\"" << f1(sy(s[b]))
+    svg.os << "<circle cx=\"" << fixed1(sx(s[a])) << "\" cy=\"" << fixed1(sy(s[b]))
            << "\" r=\"6\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
-    svg.os << "<rect x=\"" << f1(sx(e[a]) - 5) << "\" y=\"" << f1(sy(e[b]) - 5)
+    svg.os << "<rect x=\"" << fixed1(sx(e[a]) - 5) << "\" y=\"" << fixed1(sy(e[b]) - 5)
            << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
   }
   // Legend: a row per thing drawn.
@@ -279,8 +262,8 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
                     },
                     "loop closure (its keyframes)"});
   const double lx = area.x + 12, ly = area.y + 14, row_h = 20;
-  svg.os << "<rect x=\"" << f1(lx - 6) << "\" y=\"" << f1(ly - 8) << "\" width=\"250\" height=\""
-         << f1(row_h * static_cast<double>(rows.size() + 1) + 4) << "\" fill=\"#ffffff\" "
+  svg.os << "<rect x=\"" << fixed1(lx - 6) << "\" y=\"" << fixed1(ly - 8) << "\" width=\"250\" height=\""
+         << fixed1(row_h * static_cast<double>(rows.size() + 1) + 4) << "\" fill=\"#ffffff\" "
          << "fill-opacity=\"0.85\" stroke=\"#bbbbbb\"/>\n";
   for (size_t i = 0; i < rows.size(); ++i) {
     const double y = ly + 4 + row_h * static_cast<double>(i);
@@ -288,9 +271,9 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
     svg.text(lx + 38, y + 5, rows[i].second, 13);
   }
   const double ey = ly + 4 + row_h * static_cast<double>(rows.size());
-  svg.os << "<circle cx=\"" << f1(lx + 8) << "\" cy=\"" << f1(ey) << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.os << "<circle cx=\"" << fixed1(lx + 8) << "\" cy=\"" << fixed1(ey) << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
   svg.text(lx + 18, ey + 5, "start", 13);
-  svg.os << "<rect x=\"" << f1(lx + 64) << "\" y=\"" << f1(ey - 5) << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.os << "<rect x=\"" << fixed1(lx + 64) << "\" y=\"" << fixed1(ey - 5) << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
   svg.text(lx + 80, ey + 5, "end", 13);
 }
 
@@ -299,7 +282,7 @@ void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
   for (int i = 0; i <= 8; ++i)
     svg.os << "<stop offset=\"" << i / 8.0 << "\" stop-color=\"" << errorColour(i / 8.0) << "\"/>";
   svg.os << "</linearGradient></defs>\n";
-  svg.os << "<rect x=\"" << f1(r.x) << "\" y=\"" << f1(r.y) << "\" width=\"" << f1(r.w) << "\" height=\"" << f1(r.h)
+  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\"" << fixed1(r.h)
          << "\" fill=\"url(#ate)\" stroke=\"#444444\"/>\n";
   LinearScale s{err_lo, err_hi, r.y + r.h, r.y};
   const auto ticks = niceTicks(err_lo, err_hi, 6);
@@ -309,7 +292,7 @@ void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
     svg.text(r.x + r.w + 8, s(v) + 4.5, tickLabel(v, step), 13);
   }
   std::ostringstream rot;
-  rot << "transform=\"rotate(-90 " << f1(r.x + r.w + 62) << " " << f1(r.y + r.h / 2) << ")\"";
+  rot << "transform=\"rotate(-90 " << fixed1(r.x + r.w + 62) << " " << fixed1(r.y + r.h / 2) << ")\"";
   svg.text(r.x + r.w + 62, r.y + r.h / 2, "ATE (m)", 15, "middle", rot.str().c_str());
 }
 
@@ -320,8 +303,8 @@ void shadeTimeMarks(Svg& svg, const Rect& r, const LinearScale& sx, const TimeMa
     for (const auto& [from, to] : spans) {
       if (to < sx.lo || from > sx.hi) continue;
       const double x0 = sx(std::max(from, sx.lo)), x1 = sx(std::min(to, sx.hi));
-      svg.os << "<rect x=\"" << f1(x0) << "\" y=\"" << f1(r.y) << "\" width=\"" << f1(std::max(1.5, x1 - x0))
-             << "\" height=\"" << f1(r.h) << "\" fill=\"" << colour << "\" fill-opacity=\"0.2\"/>\n";
+      svg.os << "<rect x=\"" << fixed1(x0) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(std::max(1.5, x1 - x0))
+             << "\" height=\"" << fixed1(r.h) << "\" fill=\"" << colour << "\" fill-opacity=\"0.2\"/>\n";
     }
   };
   shade(marks.degenerate, kDegenerateColour);
@@ -398,7 +381,7 @@ void seriesPanel(Svg& svg, const Rect& r, const std::vector<double>& t, const st
   const double kw = pad + sample + 6 + width(rmse_label) + space + sample + 6 + width(median_label) + space +
                     width(max_label) + pad;
   const double kx = r.x + r.w - kw - 6, ky = r.y + 6;
-  svg.os << "<rect x=\"" << f1(kx) << "\" y=\"" << f1(ky) << "\" width=\"" << f1(kw) << "\" height=\"22\" "
+  svg.os << "<rect x=\"" << fixed1(kx) << "\" y=\"" << fixed1(ky) << "\" width=\"" << fixed1(kw) << "\" height=\"22\" "
          << "fill=\"#ffffff\" fill-opacity=\"0.9\" stroke=\"#bbbbbb\"/>\n";
   double x = kx + pad;
   svg.line(x, ky + 11, x + sample, ky + 11, "#222222", 1.4, "stroke-dasharray=\"7,4\"");

@@ -160,11 +160,11 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
     std::string error;
     if (!colour::readPly(map_path, &map, &error)) {
       report->warnings.push_back("the RGB map is not in the 3D view: " + error);
-      map_note = "The RGB map is not shown: " + escapeHtml(error) + ".";
+      map_note = "The RGB map is not shown: " + escapeMarkup(error) + ".";
       map = {};
     }
   } else {
-    map_note = "No RGB map in this run (no <code>" + escapeHtml(map_name) + "</code>): the trajectory alone.";
+    map_note = "No RGB map in this run (no <code>" + escapeMarkup(map_name) + "</code>): the trajectory alone.";
   }
   std::string path_name;
   const Trajectory path = newestEpoch(readTrajectoryIfAny(dir, &path_name), resetStamps(dir));  // the map's epoch
@@ -173,7 +173,7 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
     return "<section id=\"map-3d\">\n<h2 id=\"map-in-3d\">Map in 3D</h2>\n<p class=\"viewer-note\" id=\"viewer-status\" "
            "data-state=\"no-three\">No 3D view: it needs three.js from Debian's <code>libjs-three</code> when the page "
            "is made (<code>sudo apt-get install libjs-three</code>, then <code>livo-report html --dir DIR</code> again): "
-           "<code>" + escapeHtml(o.three_dir) + "/three.min.js</code> or its <code>examples/js/controls/OrbitControls.js"
+           "<code>" + escapeMarkup(o.three_dir) + "/three.min.js</code> or its <code>examples/js/controls/OrbitControls.js"
            "</code> is missing. The rest of this report is complete.</p>\n</section>\n";
   }
   const ViewerScene scene = viewerScene(map, path, {}, o.viewer);
@@ -183,7 +183,7 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
   report->voxel_m = scene.voxel_m;
   std::string description;
   if (scene.size() > 0) {
-    description = thousands(scene.size()) + " points of <code>" + escapeHtml(map_name) + "</code>";
+    description = thousands(scene.size()) + " points of <code>" + escapeMarkup(map_name) + "</code>";
     description += scene.voxel_m > 0 ? " (of " + thousands(scene.map_points) + ": the first of each " +
                                            formatSignificant(scene.voxel_m, 3) + " m voxel)"
                                      : " (all of them)";
@@ -254,7 +254,7 @@ HtmlReport reportHtml(const std::string& dir, const HtmlOptions& options) {
   html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
   html += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
   html += "<meta name=\"generator\" content=\"livo-report html\">\n";
-  html += "<title>" + escapeHtml(title) + "</title>\n<style>" + std::string(kStyle) + "</style>\n";
+  html += "<title>" + escapeMarkup(title) + "</title>\n<style>" + std::string(kStyle) + "</style>\n";
   html += "<script>" + std::string(kErrorCapture) + "</script>\n";
   if (have_three && !section.empty()) {
     html += "<script>/* three.js r111 (Debian libjs-three, MIT licence) */\n" + scriptSafe(three) + "\n</script>\n";

@@ -64,7 +64,7 @@ class InlineRenderer {
     while (i < s.size()) {
       const char c = s[i];
       if (c == '\\' && i + 1 < s.size() && isPunct(s[i + 1])) {
-        out += escapeHtml(std::string(1, s[i + 1]));
+        out += escapeMarkup(std::string(1, s[i + 1]));
         i += 2;
       } else if (c == '`') {
         i = codeSpan(s, i, &out);
@@ -77,7 +77,7 @@ class InlineRenderer {
       } else if (c == '*' || c == '_') {
         i = emphasis(s, i, &out);
       } else {
-        out += escapeHtml(std::string(1, c));
+        out += escapeMarkup(std::string(1, c));
         ++i;
       }
     }
@@ -124,7 +124,7 @@ class InlineRenderer {
     for (char& c : code)
       if (c == '\n') c = ' ';
     if (code.size() >= 2 && code.front() == ' ' && code.back() == ' ' && !blank(code)) code = code.substr(1, code.size() - 2);
-    *out += "<code>" + escapeHtml(code) + "</code>";
+    *out += "<code>" + escapeMarkup(code) + "</code>";
     return end;
   }
 
@@ -179,17 +179,17 @@ class InlineRenderer {
     }
     if (j >= s.size() || s[j] != ')') return fail(image, i, out);
     const std::string text = s.substr(open + 1, close - open - 1);
-    const std::string title_attr = title.empty() ? "" : " title=\"" + escapeHtml(title) + "\"";
+    const std::string title_attr = title.empty() ? "" : " title=\"" + escapeMarkup(title) + "\"";
     if (image) {
       const std::string src = o_.image_source ? o_.image_source(dest) : dest;
       if (src.empty() || !safeUrl(src))
-        *out += "<span class=\"missing-image\">[" + escapeHtml(plain(text)) + ": " + escapeHtml(dest) + "]</span>";
+        *out += "<span class=\"missing-image\">[" + escapeMarkup(plain(text)) + ": " + escapeMarkup(dest) + "]</span>";
       else
-        *out += "<img src=\"" + escapeHtml(src) + "\" alt=\"" + escapeHtml(plain(text)) + "\"" + title_attr + ">";
+        *out += "<img src=\"" + escapeMarkup(src) + "\" alt=\"" + escapeMarkup(plain(text)) + "\"" + title_attr + ">";
     } else if (!safeUrl(dest)) {
       *out += render(text);
     } else {
-      *out += "<a href=\"" + escapeHtml(dest) + "\"" + title_attr + ">" + render(text) + "</a>";
+      *out += "<a href=\"" + escapeMarkup(dest) + "\"" + title_attr + ">" + render(text) + "</a>";
     }
     return j + 1;
   }
@@ -204,7 +204,7 @@ class InlineRenderer {
     std::smatch m;
     const std::string rest = s.substr(i, std::min<size_t>(s.size() - i, 2048));
     if (std::regex_search(rest, m, url)) {
-      *out += "<a href=\"" + escapeHtml(m[1].str()) + "\">" + escapeHtml(m[1].str()) + "</a>";
+      *out += "<a href=\"" + escapeMarkup(m[1].str()) + "\">" + escapeMarkup(m[1].str()) + "</a>";
       return i + static_cast<size_t>(m.length(0));
     }
     *out += "&lt;";
@@ -389,9 +389,9 @@ class BlockRenderer {
     for (; j < lines.size(); ++j) {
       const std::string t = trim(lines[j]);
       if (t.size() >= marker.size() && t.find_first_not_of(marker[0]) == std::string::npos) break;
-      code += escapeHtml(dedent(lines[j], indent)) + "\n";
+      code += escapeMarkup(dedent(lines[j], indent)) + "\n";
     }
-    *out += "<pre><code" + (language.empty() ? std::string() : " class=\"language-" + escapeHtml(language) + "\"") + ">" +
+    *out += "<pre><code" + (language.empty() ? std::string() : " class=\"language-" + escapeMarkup(language) + "\"") + ">" +
             code + "</code></pre>\n";
     return j < lines.size() ? j + 1 : j;
   }
@@ -477,22 +477,6 @@ class BlockRenderer {
 };
 
 }  // namespace
-
-std::string escapeHtml(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string headingId(const std::string& text) {
   std::string id;

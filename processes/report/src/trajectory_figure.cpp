@@ -8,6 +8,7 @@
 
 #include "livo/evaluate/plot_scale.hpp"
 #include "livo/report/map_views.hpp"
+#include "livo/text_format.hpp"
 
 namespace livo::report {
 
@@ -15,26 +16,10 @@ namespace {
 
 constexpr double kSpanSlack_s = 1e-3;  // a pose within this of a span's end is in it (TUM rounding)
 const char* const kFont = "font-family=\"DejaVu Sans, Arial, sans-serif\"";
+
+std::string fixed1(double v) { return formatFixed(v, 1); }
 const char* const kEstimateColour = "#1f77b4";
 const char* const kOdometryColour = "#9e9e9e";
-
-std::string f1(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f", v);
-  return buf;
-}
-
-std::string escapeXml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
-  }
-  return out;
-}
 
 struct Canvas {
   double x0 = 0, y0 = 0, s = 1;       // pixel = (x0 + s (x - xmin), y0 + s (ymax - y))
@@ -48,7 +33,7 @@ void polyline(std::ostringstream& os, const std::vector<std::pair<double, double
   if (pts.size() == 1) {  // one pose: a dot as wide as the stroke
     std::string fill_extra = extra;
     if (const size_t at = fill_extra.find("stroke-opacity"); at != std::string::npos) fill_extra.replace(at, 6, "fill");
-    os << "<circle cx=\"" << f1(pts[0].first) << "\" cy=\"" << f1(pts[0].second) << "\" r=\"" << f1(0.5 * width)
+    os << "<circle cx=\"" << fixed1(pts[0].first) << "\" cy=\"" << fixed1(pts[0].second) << "\" r=\"" << fixed1(0.5 * width)
        << "\" fill=\"" << stroke << "\" " << fill_extra << "/>\n";
     return;
   }
@@ -59,7 +44,7 @@ void polyline(std::ostringstream& os, const std::vector<std::pair<double, double
     // drop points less than 0.5 px from the last one drawn (the last one is kept)
     if (i > 0 && i + 1 < pts.size() && std::hypot(pts[i].first - last.first, pts[i].second - last.second) < 0.5)
       continue;
-    os << f1(pts[i].first) << "," << f1(pts[i].second) << " ";
+    os << fixed1(pts[i].first) << "," << fixed1(pts[i].second) << " ";
     last = pts[i];
   }
   os << "\"/>\n";
@@ -127,35 +112,35 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
   const double height = kTop + plot_h + kBottom;
 
   std::ostringstream os;
-  os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << f1(width) << "\" height=\"" << f1(height)
-     << "\" viewBox=\"0 0 " << f1(width) << " " << f1(height) << "\">\n";
+  os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fixed1(width) << "\" height=\"" << fixed1(height)
+     << "\" viewBox=\"0 0 " << fixed1(width) << " " << fixed1(height) << "\">\n";
   os << "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
-  os << "<text x=\"" << f1(kLeft) << "\" y=\"24\" font-size=\"16\" " << kFont << ">" << escapeXml(in.title) << "</text>\n";
+  os << "<text x=\"" << fixed1(kLeft) << "\" y=\"24\" font-size=\"16\" " << kFont << ">" << escapeMarkup(in.title) << "</text>\n";
 
   // axes: ticks and a light grid, equal scales
   const double x_lo = c.xmin, x_hi = c.xmin + plot_w / s, y_lo = c.ymax - plot_h / s, y_hi = c.ymax;
   const auto xt = evaluate::niceTicks(x_lo, x_hi, 8), yt = evaluate::niceTicks(y_lo, y_hi, 6);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
-  os << "<rect x=\"" << f1(kLeft) << "\" y=\"" << f1(kTop) << "\" width=\"" << f1(plot_w) << "\" height=\"" << f1(plot_h)
+  os << "<rect x=\"" << fixed1(kLeft) << "\" y=\"" << fixed1(kTop) << "\" width=\"" << fixed1(plot_w) << "\" height=\"" << fixed1(plot_h)
      << "\" fill=\"none\" stroke=\"#888888\"/>\n";
   for (double x : xt) {
     const double px = c(Vec3(x, 0, 0)).first;
-    os << "<line x1=\"" << f1(px) << "\" y1=\"" << f1(kTop) << "\" x2=\"" << f1(px) << "\" y2=\"" << f1(kTop + plot_h)
+    os << "<line x1=\"" << fixed1(px) << "\" y1=\"" << fixed1(kTop) << "\" x2=\"" << fixed1(px) << "\" y2=\"" << fixed1(kTop + plot_h)
        << "\" stroke=\"#e6e6e6\"/>\n";
-    os << "<text x=\"" << f1(px) << "\" y=\"" << f1(kTop + plot_h + 18) << "\" font-size=\"12\" text-anchor=\"middle\" "
+    os << "<text x=\"" << fixed1(px) << "\" y=\"" << fixed1(kTop + plot_h + 18) << "\" font-size=\"12\" text-anchor=\"middle\" "
        << kFont << ">" << evaluate::tickLabel(x, xstep) << "</text>\n";
   }
   for (double y : yt) {
     const double py = c(Vec3(0, y, 0)).second;
-    os << "<line x1=\"" << f1(kLeft) << "\" y1=\"" << f1(py) << "\" x2=\"" << f1(kLeft + plot_w) << "\" y2=\"" << f1(py)
+    os << "<line x1=\"" << fixed1(kLeft) << "\" y1=\"" << fixed1(py) << "\" x2=\"" << fixed1(kLeft + plot_w) << "\" y2=\"" << fixed1(py)
        << "\" stroke=\"#e6e6e6\"/>\n";
-    os << "<text x=\"" << f1(kLeft - 8) << "\" y=\"" << f1(py + 4) << "\" font-size=\"12\" text-anchor=\"end\" " << kFont
+    os << "<text x=\"" << fixed1(kLeft - 8) << "\" y=\"" << fixed1(py + 4) << "\" font-size=\"12\" text-anchor=\"end\" " << kFont
        << ">" << evaluate::tickLabel(y, ystep) << "</text>\n";
   }
-  os << "<text x=\"" << f1(kLeft + 0.5 * plot_w) << "\" y=\"" << f1(height - 12) << "\" font-size=\"13\" "
+  os << "<text x=\"" << fixed1(kLeft + 0.5 * plot_w) << "\" y=\"" << fixed1(height - 12) << "\" font-size=\"13\" "
      << "text-anchor=\"middle\" " << kFont << ">x (m)</text>\n";
-  os << "<text x=\"18\" y=\"" << f1(kTop + 0.5 * plot_h) << "\" font-size=\"13\" text-anchor=\"middle\" "
-     << "transform=\"rotate(-90 18 " << f1(kTop + 0.5 * plot_h) << ")\" " << kFont << ">y (m)</text>\n";
+  os << "<text x=\"18\" y=\"" << fixed1(kTop + 0.5 * plot_h) << "\" font-size=\"13\" text-anchor=\"middle\" "
+     << "transform=\"rotate(-90 18 " << fixed1(kTop + 0.5 * plot_h) << ")\" " << kFont << ">y (m)</text>\n";
 
   auto pixels = [&](const Trajectory& t, const std::vector<size_t>& idx) {
     std::vector<std::pair<double, double>> px;
@@ -182,18 +167,18 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
     const long a = nearestPose(est, l.from_stamp, 0.25), b = nearestPose(est, l.to_stamp, 0.25);
     if (a < 0 || b < 0) continue;
     const auto pa = c(est[a].pose.translation()), pb = c(est[b].pose.translation());
-    os << "<line x1=\"" << f1(pa.first) << "\" y1=\"" << f1(pa.second) << "\" x2=\"" << f1(pb.first) << "\" y2=\""
-       << f1(pb.second) << "\" stroke=\"" << evaluate::kLoopColour << "\" stroke-width=\"1.8\" stroke-dasharray=\"6,3\"/>\n";
+    os << "<line x1=\"" << fixed1(pa.first) << "\" y1=\"" << fixed1(pa.second) << "\" x2=\"" << fixed1(pb.first) << "\" y2=\""
+       << fixed1(pb.second) << "\" stroke=\"" << evaluate::kLoopColour << "\" stroke-width=\"1.8\" stroke-dasharray=\"6,3\"/>\n";
     for (const auto& p : {pa, pb})
-      os << "<circle cx=\"" << f1(p.first) << "\" cy=\"" << f1(p.second) << "\" r=\"3.5\" fill=\"" << evaluate::kLoopColour
+      os << "<circle cx=\"" << fixed1(p.first) << "\" cy=\"" << fixed1(p.second) << "\" r=\"3.5\" fill=\"" << evaluate::kLoopColour
          << "\"/>\n";
     ++loops_drawn;
   }
   const auto start = c(est[pieces.front().first].pose.translation());
   const auto end = c(est[pieces.back().second - 1].pose.translation());
-  os << "<circle cx=\"" << f1(start.first) << "\" cy=\"" << f1(start.second) << "\" r=\"5\" fill=\"#3cb43c\" "
+  os << "<circle cx=\"" << fixed1(start.first) << "\" cy=\"" << fixed1(start.second) << "\" r=\"5\" fill=\"#3cb43c\" "
      << "stroke=\"#282828\"/>\n";
-  os << "<rect x=\"" << f1(end.first - 4.5) << "\" y=\"" << f1(end.second - 4.5) << "\" width=\"9\" height=\"9\" "
+  os << "<rect x=\"" << fixed1(end.first - 4.5) << "\" y=\"" << fixed1(end.second - 4.5) << "\" width=\"9\" height=\"9\" "
      << "fill=\"#dc2828\" stroke=\"#282828\"/>\n";
 
   // legend: one row above the plot, only what is drawn
@@ -202,7 +187,7 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
   };
   std::vector<Item> items;
   auto stroke = [](const char* colour, double w, const char* extra) {
-    return std::string("<line x1=\"0\" y1=\"0\" x2=\"26\" y2=\"0\" stroke=\"") + colour + "\" stroke-width=\"" + f1(w) +
+    return std::string("<line x1=\"0\" y1=\"0\" x2=\"26\" y2=\"0\" stroke=\"") + colour + "\" stroke-width=\"" + fixed1(w) +
            "\" " + extra + "/>";
   };
   items.push_back({stroke(kEstimateColour, 1.8, ""), has_final ? "trajectory (trajectory.tum)" : "odometry (odometry.tum)"});
@@ -220,8 +205,8 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
                    "start, end"});
   double x = kLeft;
   for (const Item& item : items) {
-    os << "<g transform=\"translate(" << f1(x) << " 52)\">" << item.swatch << "<text x=\"34\" y=\"4\" font-size=\"12\" "
-       << kFont << ">" << escapeXml(item.label) << "</text></g>\n";
+    os << "<g transform=\"translate(" << fixed1(x) << " 52)\">" << item.swatch << "<text x=\"34\" y=\"4\" font-size=\"12\" "
+       << kFont << ">" << escapeMarkup(item.label) << "</text></g>\n";
     x += 46 + 7.0 * static_cast<double>(item.label.size());
   }
   os << "</svg>\n";

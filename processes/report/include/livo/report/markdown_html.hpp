@@ -10,6 +10,8 @@
 #include <functional>
 #include <string>
 
+#include "livo/text_format.hpp"  // escapeMarkup
+
 namespace livo::report {
 
 struct MarkdownHtmlOptions {
@@ -22,9 +24,6 @@ std::string markdownToHtml(const std::string& markdown, const MarkdownHtmlOption
 
 /// One line or paragraph of inline markdown.
 std::string inlineMarkdownToHtml(const std::string& text, const MarkdownHtmlOptions& options = {});
-
-/// & < > " ' as character references.
-std::string escapeHtml(const std::string& text);
 
 /// A heading's id: its text in lower case, letters, digits, '-' and '_' kept, spaces as '-', the
 /// rest dropped ("Where the estimate was weak" -> "where-the-estimate-was-weak").
