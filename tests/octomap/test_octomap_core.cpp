@@ -17,6 +17,7 @@
 
 #include "livo/octomap/octomap_builder.hpp"
 #include "livo/octomap/octomap_config.hpp"
+#include "livo/octomap/ray_keys.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -420,6 +421,110 @@ TEST(OccupancyMap, SweepSlicesAreOneUpdate) {
   const ::octomap::OcTreeNode* n = tree->search(0.55, 0.05, 0.05);
   ASSERT_NE(n, nullptr);
   EXPECT_NEAR(n->getLogOdds(), one_miss, 1e-4);
+}
+
+// forEachRayKey lists exactly the keys octomap's computeRayKeys does, in its order: random rays,
+// rays from and to voxel borders and centres, axis-parallel and diagonal ones, short and long.
+TEST(RayKeys, SameKeysAsOctomapsComputeRayKeys) {
+  for (const double res : {0.1, 0.05, 0.2}) {
+    ::octomap::OcTree tree(res);
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> pos(-40.f, 40.f), off(-3.f, 3.f);
+    std::uniform_int_distribution<int> cell(-400, 400), kind(0, 5);
+    ::octomap::KeyRay ray;
+    std::vector<::octomap::OcTreeKey> mine;
+    size_t keys = 0;
+    for (int n = 0; n < 60000; ++n) {
+      auto on_grid = [&](float half) {  // a voxel border (half = 0) or centre (half = 0.5)
+        return ::octomap::point3d(float((cell(rng) + half) * res), float((cell(rng) + half) * res),
+                                  float((cell(rng) + half) * res));
+      };
+      ::octomap::point3d o(pos(rng), pos(rng), pos(rng)), e(pos(rng), pos(rng), pos(rng));
+      switch (kind(rng)) {
+        case 1: o = on_grid(0.f), e = on_grid(0.5f); break;
+        case 2: o = on_grid(0.5f), e = on_grid(0.f); break;
+        case 3: e = o + ::octomap::point3d(off(rng), 0.f, 0.f); break;  // axis-parallel
+        case 4: {  // diagonal
+          const float d = off(rng);
+          e = o + ::octomap::point3d(d, d, (n % 2) ? d : -d);
+          break;
+        }
+        case 5: e = o + ::octomap::point3d(off(rng), off(rng), off(rng)) * 0.05f; break;  // short
+        default: break;
+      }
+      ::octomap::OcTreeKey ok;
+      ASSERT_TRUE(tree.coordToKeyChecked(o, ok));
+      const bool expected = tree.computeRayKeys(o, e, ray);
+      mine.clear();
+      const bool got = forEachRayKey(tree, o, ok, e, [&](const ::octomap::OcTreeKey& k) { mine.push_back(k); });
+      ASSERT_EQ(got, expected);
+      ASSERT_EQ(mine.size(), ray.size()) << "ray " << n << " at " << res;
+      ASSERT_TRUE(std::equal(mine.begin(), mine.end(), ray.begin())) << "ray " << n << " at " << res;
+      keys += mine.size();
+    }
+    EXPECT_GT(keys, 300000u);
+  }
+}
+
+// A sweep's map is what octomap's own per-key updates make of the sweep: the keys of every ray
+// (computeRayKeys) miss once, endpoints hit once, each voxel once a sweep; several sweeps across
+// several tiles and blocks, tiles pruned between sweeps (updates expand them again).
+TEST(OccupancyMap, SweepsMakeWhatOctomapsPerKeyUpdatesMake) {
+  OctomapOptions o = options(false);
+  o.free_margin = 0.0;
+  o.min_range = 0.0;
+  o.max_range = 0.0;
+  o.tile_size = 1.6;
+  OccupancyMap map(o);
+  ::octomap::OcTree ref(o.resolution);
+  ref.setProbHit(o.prob_hit);
+  ref.setProbMiss(o.prob_miss);
+  ref.setClampingThresMin(o.clamping_min);
+  ref.setClampingThresMax(o.clamping_max);
+  ref.setOccupancyThres(o.occupancy_threshold);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> pos(-6.f, 6.f);
+  ::octomap::KeyRay ray;
+  for (int sweep = 0; sweep < 10; ++sweep) {
+    std::vector<OccupancyMap::Slice> slices(3);
+    std::vector<std::vector<Eigen::Vector3f>> points(slices.size());
+    ::octomap::KeySet free, hit;
+    for (size_t i = 0; i < slices.size(); ++i) {
+      slices[i].origin = Eigen::Vector3d(0.3 * sweep + 0.1 * double(i), 0.2, 0.4 * double(i));
+      slices[i].points = &points[i];
+      const ::octomap::point3d origin(float(slices[i].origin.x()), float(slices[i].origin.y()),
+                                      float(slices[i].origin.z()));
+      for (int k = 0; k < 3000; ++k) {
+        const Eigen::Vector3f p(pos(rng), pos(rng), 0.5f * pos(rng));
+        points[i].push_back(p);
+        const ::octomap::OcTreeKey key = ref.coordToKey(::octomap::point3d(p.x(), p.y(), p.z()));
+        hit.insert(key);
+        ASSERT_TRUE(ref.computeRayKeys(origin, ref.keyToCoord(key), ray));
+        free.insert(ray.begin(), ray.end());
+      }
+    }
+    map.insertSweep(slices);
+    for (int i = 0; i < 40; ++i) map.evictIdle();  // prunes resident tiles in turn: later updates expand them
+    for (const auto& k : free)
+      if (!hit.count(k)) ref.updateNode(k, ref.getProbMissLog(), true);
+    for (const auto& k : hit) ref.updateNode(k, ref.getProbHitLog(), true);
+  }
+  ref.updateInnerOccupancy();
+  std::istringstream in(map.fullBytes());
+  std::unique_ptr<::octomap::AbstractOcTree> read(::octomap::AbstractOcTree::read(in));
+  auto* tree = dynamic_cast<::octomap::OcTree*>(read.get());
+  ASSERT_NE(tree, nullptr);
+  tree->prune();
+  ref.prune();
+  EXPECT_EQ(tree->getNumLeafNodes(), ref.getNumLeafNodes());
+  size_t compared = 0;
+  for (auto it = ref.begin_leafs(), end = ref.end_leafs(); it != end; ++it) {
+    const ::octomap::OcTreeNode* n = tree->search(it.getKey());
+    ASSERT_NE(n, nullptr);
+    ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
+    ++compared;
+  }
+  EXPECT_GT(compared, 20000u);
 }
 
 TEST(OctomapConfig, FreeMarginAndRebuildToleranceAreReadAndChecked) {

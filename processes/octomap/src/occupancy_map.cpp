@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <functional>
+#include <iterator>
+#include <memory>
 #include <limits>
 #include <type_traits>
 
@@ -13,6 +15,7 @@
 #include <octomap/OcTree.h>
 
 #include "livo/file_output.hpp"
+#include "livo/octomap/ray_keys.hpp"
 #include "livo/spill_file.hpp"
 
 namespace livo::octomap {
@@ -28,60 +31,161 @@ void configure(Tree* t, const OctomapOptions& o) {
 }
 }  // namespace
 
-// Open-addressing set of packed voxel keys (3 x 16 bits), reused across sweeps: the ray casting's
-// inner loop, several times faster than octomap's KeySet (an unordered_set).
-class FlatKeySet {
+// The voxels a sweep touches, as bits: blocks of 16^3 voxels (found by their packed block key in an
+// open-addressing table, the last one cached: a ray's consecutive keys are neighbours), in each a
+// bit per voxel for "a ray crossed it", "an endpoint of the sweep", "an endpoint of the current
+// slice". A voxel's bit index in its block is its Morton code (x in the lowest bit, as octomap's
+// child index), and forEach() visits the blocks in Morton order of their keys: the voxels come in
+// the tree's depth-first order, so consecutive updates share most of their path down. Reused
+// across sweeps (blocks are kept and cleared, not freed).
+class SweepVoxels {
  public:
+  static constexpr int kBits = 4;  // a block spans 2^kBits keys per axis
+  static constexpr int kWords = (1 << (3 * kBits)) / 64;
+  static constexpr unsigned kMask = (1u << kBits) - 1;
+
   void clear() {
-    if (size_ == 0) return;
-    std::fill(slots_.begin(), slots_.end(), 0);
-    size_ = 0;
-    order_.clear();
+    for (size_t i = 0; i < used_; ++i) slots_[blocks_[i]->slot] = Slot{};
+    used_ = 0;
+    last_ = nullptr;
   }
-  // true if newly inserted
-  bool insert(uint64_t packed) {
-    if ((size_ + 1) * 2 > slots_.size()) grow();
-    const uint64_t v = packed + 1;
-    size_t i = hash(v) & (slots_.size() - 1);
-    while (slots_[i]) {
-      if (slots_[i] == v) return false;
-      i = (i + 1) & (slots_.size() - 1);
-    }
-    slots_[i] = v;
-    ++size_;
-    order_.push_back(packed);
+  __attribute__((always_inline)) void addFree(const ::octomap::OcTreeKey& k) { set(k, &Block::free); }
+  void addHit(const ::octomap::OcTreeKey& k) { set(k, &Block::hit); }
+  // true if k was not yet an endpoint of this slice
+  bool addEndpoint(const ::octomap::OcTreeKey& k) {
+    Block& b = block(k);
+    const unsigned i = local(k);
+    uint64_t& w = b.endpoint[i >> 6];
+    const uint64_t bit = uint64_t{1} << (i & 63);
+    if (w & bit) return false;
+    if (!w) endpoint_words_.push_back(&w);
+    w |= bit;
     return true;
   }
-  bool contains(uint64_t packed) const {
-    if (slots_.empty()) return false;
-    const uint64_t v = packed + 1;
-    size_t i = hash(v) & (slots_.size() - 1);
-    while (slots_[i]) {
-      if (slots_[i] == v) return true;
-      i = (i + 1) & (slots_.size() - 1);
-    }
-    return false;
+  void endSlice() {
+    for (uint64_t* w : endpoint_words_) *w = 0;
+    endpoint_words_.clear();
   }
-  const std::vector<uint64_t>& keys() const { return order_; }  // insertion order
+  // f(key, hit) for each voxel crossed or hit, in the tree's depth-first order
+  template <class F>
+  void forEach(F&& f) {
+    order_.clear();
+    for (size_t i = 0; i < used_; ++i) order_.emplace_back(morton(blocks_[i]->key), blocks_[i].get());
+    std::sort(order_.begin(), order_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [code, b] : order_) {
+      (void)code;
+      const unsigned x0 = unsigned(b->key >> 32) << kBits, y0 = unsigned((b->key >> 16) & 0xFFFF) << kBits,
+                     z0 = unsigned(b->key & 0xFFFF) << kBits;
+      for (int w = 0; w < kWords; ++w) {
+        uint64_t m = b->free[w] | b->hit[w];
+        while (m) {
+          const int bit = __builtin_ctzll(m);
+          m &= m - 1;
+          const unsigned c = tables().coords[(w << 6) | bit];
+          const ::octomap::OcTreeKey k(static_cast<::octomap::key_type>(x0 | (c & kMask)),
+                                      static_cast<::octomap::key_type>(y0 | ((c >> kBits) & kMask)),
+                                      static_cast<::octomap::key_type>(z0 | (c >> (2 * kBits))));
+          f(k, (b->hit[w] >> bit) & 1);
+        }
+      }
+    }
+  }
 
  private:
-  static size_t hash(uint64_t v) { return static_cast<size_t>((v * 0x9E3779B97F4A7C15ull) >> 20); }
-  void grow() {
-    std::vector<uint64_t> old = std::move(order_);
-    slots_.assign(std::max<size_t>(1 << 14, slots_.size() * 2), 0);
-    size_ = 0;
-    order_.clear();
-    order_.reserve(slots_.size() / 2);
-    for (uint64_t k : old) insert(k);
+  struct Block {
+    uint64_t key = 0;
+    size_t slot = 0;
+    uint64_t free[kWords];
+    uint64_t hit[kWords];
+    uint64_t endpoint[kWords];
+  };
+  struct Slot {
+    uint64_t key_plus1 = 0;  // 0: empty
+    Block* block = nullptr;
+  };
+  struct Tables {
+    std::array<uint16_t, 1 << kBits> spread{};         // kBits bits -> every third bit
+    std::array<uint16_t, 1 << (3 * kBits)> coords{};  // Morton index -> x | y << kBits | z << 2 kBits
+    Tables() {
+      for (unsigned v = 0; v < (1u << kBits); ++v)
+        for (int j = 0; j < kBits; ++j) spread[v] = uint16_t(spread[v] | (((v >> j) & 1u) << (3 * j)));
+      for (unsigned x = 0; x < (1u << kBits); ++x)
+        for (unsigned y = 0; y < (1u << kBits); ++y)
+          for (unsigned z = 0; z < (1u << kBits); ++z)
+            coords[spread[x] | (spread[y] << 1) | (spread[z] << 2)] = uint16_t(x | (y << kBits) | (z << (2 * kBits)));
+    }
+  };
+  static_assert(kBits >= 2 && kBits <= 5, "a block's voxel index and coordinates fit 16 bits");
+  static const Tables& tables() {
+    static const Tables t;
+    return t;
   }
-  std::vector<uint64_t> slots_;
-  std::vector<uint64_t> order_;
-  size_t size_ = 0;
+  __attribute__((always_inline)) static unsigned local(const ::octomap::OcTreeKey& k) {
+    const auto& s = tables().spread;
+    constexpr unsigned m = (1u << kBits) - 1;
+    return unsigned(s[k[0] & m]) | (unsigned(s[k[1] & m]) << 1) | (unsigned(s[k[2] & m]) << 2);
+  }
+  static uint64_t blockKey(const ::octomap::OcTreeKey& k) {
+    return (uint64_t(k[0] >> kBits) << 32) | (uint64_t(k[1] >> kBits) << 16) | uint64_t(k[2] >> kBits);
+  }
+  // interleaved block coordinates, highest level first, x in the lowest bit of each triple
+  static uint64_t morton(uint64_t key) {
+    const uint64_t x = key >> 32, y = (key >> 16) & 0xFFFF, z = key & 0xFFFF;
+    uint64_t code = 0;
+    for (int d = 16 - kBits - 1; d >= 0; --d) code = (code << 3) | ((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2);
+    return code;
+  }
+  __attribute__((always_inline)) void set(const ::octomap::OcTreeKey& k, uint64_t (Block::*bits)[kWords]) {
+    const unsigned i = local(k);
+    (block(k).*bits)[i >> 6] |= uint64_t{1} << (i & 63);
+  }
+  __attribute__((always_inline)) Block& block(const ::octomap::OcTreeKey& k) {
+    const uint64_t key = blockKey(k);
+    if (last_key_ == key && last_) return *last_;
+    return find(key);
+  }
+  __attribute__((noinline)) Block& find(uint64_t key) {
+    if ((used_ + 1) * 2 > slots_.size()) grow();
+    const size_t mask = slots_.size() - 1;
+    size_t i = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
+    while (slots_[i].key_plus1 && slots_[i].key_plus1 != key + 1) i = (i + 1) & mask;
+    if (!slots_[i].key_plus1) {
+      if (used_ == blocks_.size()) blocks_.push_back(std::make_unique<Block>());
+      Block* b = blocks_[used_++].get();
+      std::fill(std::begin(b->free), std::end(b->free), 0);
+      std::fill(std::begin(b->hit), std::end(b->hit), 0);
+      std::fill(std::begin(b->endpoint), std::end(b->endpoint), 0);
+      b->key = key;
+      b->slot = i;
+      slots_[i] = Slot{key + 1, b};
+    }
+    last_key_ = key;
+    last_ = slots_[i].block;
+    return *last_;
+  }
+  void grow() {
+    slots_.assign(std::max<size_t>(1 << 12, slots_.size() * 2), Slot{});
+    const size_t mask = slots_.size() - 1;
+    for (size_t j = 0; j < used_; ++j) {
+      Block* b = blocks_[j].get();
+      size_t i = static_cast<size_t>((b->key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
+      while (slots_[i].key_plus1) i = (i + 1) & mask;
+      slots_[i] = Slot{b->key + 1, b};
+      b->slot = i;
+    }
+  }
+
+  std::vector<Slot> slots_;
+  std::vector<std::unique_ptr<Block>> blocks_;  // [0, used_) in use this sweep
+  size_t used_ = 0;
+  Block* last_ = nullptr;
+  uint64_t last_key_ = 0;
+  std::vector<uint64_t*> endpoint_words_;  // endpoint words set in the current slice
+  std::vector<std::pair<uint64_t, Block*>> order_;
 };
 
 struct OccupancyMap::Scratch {
-  FlatKeySet free, hit, endpoints;
-  ::octomap::KeyRay ray;
+  SweepVoxels voxels;
 };
 
 // What the levels above the tiles need of a tile's root (the node at the tiles' depth), and the
@@ -113,27 +217,25 @@ struct OccupancyMap::Tile {
 };
 
 namespace {
-uint64_t pack(const ::octomap::OcTreeKey& k) { return (uint64_t(k[0]) << 32) | (uint64_t(k[1]) << 16) | uint64_t(k[2]); }
-::octomap::OcTreeKey unpack(uint64_t v) {
-  return ::octomap::OcTreeKey(uint16_t(v >> 32), uint16_t(v >> 16), uint16_t(v));
-}
 constexpr int kTreeDepth = 16;  // octomap's key depth
 
 // Log-odds updates of finest-level leaves, as octomap's updateNode(key, log_odds, lazy_eval = true)
-// makes them (same clamping and early abort, so the tree is the same), but walking down only from
-// the deepest node the key shares with the previous one: keys in ray or sweep order share most of
-// their path, so most updates cost a few pointer steps instead of two full descents (octomap's
-// search, then updateNodeRecurs). Missing nodes are created by octomap's updateNode.
+// makes them (same clamping and early abort, the same nodes created or expanded, so the tree is the
+// same), but walking down only from the deepest node the key shares with the previous one: keys in
+// depth-first order share most of their path, so most updates cost a few pointer steps instead of
+// two full descents (octomap's search, then updateNodeRecurs). Only an empty tree goes to octomap's
+// updateNode (it creates the root).
 template <class Tree>
 class LeafUpdater {
  public:
+  using Node = typename Tree::NodeType;
   explicit LeafUpdater(Tree& t) : t_(t), depth_(static_cast<int>(t.getTreeDepth())) {}
 
   void update(const ::octomap::OcTreeKey& key, float log_odds) {
-    using Node = typename Tree::NodeType;
     path_[0] = t_.getRoot();
     if (!path_[0]) {
-      fallback(key, log_odds, 0);
+      t_.updateNode(key, log_odds, true);
+      valid_ = 0;
       return;
     }
     // the node at depth d is fixed by the key bits above depth_ - 1 - d: shared up to the highest
@@ -144,49 +246,82 @@ class LeafUpdater {
       const int highest = diff ? 31 - __builtin_clz(diff) : -1;
       d = std::min(valid_, depth_ - 1 - highest);
     }
+    prev_ = key;
     for (; d < depth_; ++d) {
       const unsigned pos = ::octomap::computeChildIdx(key, depth_ - 1 - d);
       if (!t_.nodeChildExists(path_[d], pos)) {
-        fallback(key, log_odds, d);
+        grow(key, log_odds, d, pos);
         return;
       }
       path_[d + 1] = t_.getNodeChild(path_[d], pos);
     }
-    Node* leaf = path_[depth_];
-    const float v = leaf->getLogOdds();
-    if (!((log_odds >= 0 && v >= t_.getClampingThresMaxLog()) || (log_odds <= 0 && v <= t_.getClampingThresMinLog())))
-      t_.updateNodeLogOdds(leaf, log_odds);
-    prev_ = key;
     valid_ = depth_;
+    Node* leaf = path_[depth_];
+    if (!clamped(leaf->getLogOdds(), log_odds)) t_.updateNodeLogOdds(leaf, log_odds);
   }
 
  private:
-  void fallback(const ::octomap::OcTreeKey& key, float log_odds, int valid) {
-    t_.updateNode(key, log_odds, true);  // creates the missing nodes below path_[valid]
-    prev_ = key;
-    valid_ = valid;  // path_[0 .. valid] still hold (nodes are never moved or freed by an update)
+  // no change: the value is at the clamping bound the update goes to
+  bool clamped(float value, float log_odds) const {
+    return (log_odds >= 0 && value >= t_.getClampingThresMaxLog()) || (log_odds <= 0 && value <= t_.getClampingThresMinLog());
+  }
+  // path_[d] has no child `pos` on the key's way: as octomap's updateNode, a node without children
+  // (a pruned one: search() ends there) that is clamped is left as it is, else expanded; a node
+  // with other children gets the child, and so do the nodes created below it
+  void grow(const ::octomap::OcTreeKey& key, float log_odds, int d, unsigned pos) {
+    bool created = false;
+    Node* n = path_[d];
+    if (!t_.nodeHasChildren(n)) {
+      if (clamped(n->getLogOdds(), log_odds)) {
+        valid_ = d;
+        return;
+      }
+      t_.expandNode(n);
+    } else {
+      t_.createNodeChild(n, pos);
+      created = true;
+    }
+    path_[d + 1] = t_.getNodeChild(n, pos);
+    for (++d; d < depth_; ++d) {
+      n = path_[d];
+      pos = ::octomap::computeChildIdx(key, depth_ - 1 - d);
+      if (!t_.nodeChildExists(n, pos)) {
+        if (!created && !t_.nodeHasChildren(n)) {
+          t_.expandNode(n);
+        } else {
+          t_.createNodeChild(n, pos);
+          created = true;
+        }
+      }
+      path_[d + 1] = t_.getNodeChild(n, pos);
+    }
+    valid_ = depth_;
+    t_.updateNodeLogOdds(path_[depth_], log_odds);
   }
 
   Tree& t_;
   const int depth_;
-  std::array<typename Tree::NodeType*, 17> path_{};  // path_[d]: node at depth d (tree depth <= 16)
+  std::array<Node*, 17> path_{};  // path_[d]: node at depth d (tree depth <= 16)
   ::octomap::OcTreeKey prev_;
   int valid_ = 0;  // path_[0 .. valid_] matches prev_
 };
 
-// Casts the sweep into key sets (on the key arithmetic of `keys`), then updates the leaves in the
-// trees of their tiles (`tree_of(tile index)`).
+// Casts the sweep into the voxel sets (on the key arithmetic of `keys`), then updates the leaves in
+// the trees of their tiles (`tree_of(tile index)`): each voxel once a sweep, a hit if some ray ends
+// there, else a miss (the order of the updates does not change the tree: each is of another leaf).
 template <class Tree, class TreeOf, class TileOf>
 size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::Slice>& slices, const OctomapOptions& o,
                  OccupancyMap::Scratch& s, TreeOf tree_of, TileOf tile_of) {
-  s.free.clear();
-  s.hit.clear();
+  SweepVoxels& v = s.voxels;
+  v.clear();
   const double min2 = o.min_range * o.min_range;
   size_t rays = 0;
+  auto add_free = [&v](const ::octomap::OcTreeKey& k) { v.addFree(k); };
   for (const OccupancyMap::Slice& slice : slices) {
     if (!slice.points || !slice.origin.allFinite()) continue;
     const ::octomap::point3d origin(slice.origin.x(), slice.origin.y(), slice.origin.z());
-    s.endpoints.clear();
+    ::octomap::OcTreeKey origin_key;
+    const bool origin_in_range = keys.coordToKeyChecked(origin, origin_key);  // else no ray clears
     for (const Eigen::Vector3f& p : *slice.points) {
       if (!p.allFinite()) continue;
       const Eigen::Vector3d d = p.cast<double>() - slice.origin;
@@ -195,7 +330,7 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
       ::octomap::OcTreeKey key;
       if (!keys.coordToKeyChecked(::octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
       ++rays;
-      if (!s.endpoints.insert(pack(key))) continue;  // one ray per endpoint voxel and slice
+      if (!v.addEndpoint(key)) continue;  // one ray per endpoint voxel and slice
       // discretised: the ray ends at the endpoint voxel's centre
       ::octomap::point3d end = keys.keyToCoord(key);
       bool hit = true;
@@ -208,18 +343,18 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
         const double length = (end - origin).norm();
         end = origin + (end - origin) * float(std::max(0.0, length - o.free_margin) / std::max(length, 1e-9));
       }
-      if (hit) s.hit.insert(pack(key));
-      if (keys.computeRayKeys(origin, end, s.ray))
-        for (const ::octomap::OcTreeKey& k : s.ray) s.free.insert(pack(k));
+      if (hit) v.addHit(key);
+      if (origin_in_range) forEachRayKey(keys, origin, origin_key, end, add_free);
     }
+    v.endSlice();
   }
-  // one updater per tile (each keeps its own path), the last one cached: keys in ray order stay
-  // in a tile for long runs
+  // one updater per tile (each keeps its own path), the last one cached: in depth-first order the
+  // keys stay in a tile for long runs
   std::map<uint64_t, std::unique_ptr<LeafUpdater<Tree>>> updaters;
   uint64_t last_tile = ~uint64_t{0};
   LeafUpdater<Tree>* updater = nullptr;
-  auto update = [&](uint64_t packed, float log_odds) {
-    const ::octomap::OcTreeKey key = unpack(packed);
+  const float miss = keys.getProbMissLog(), hit = keys.getProbHitLog();
+  v.forEach([&](const ::octomap::OcTreeKey& key, bool is_hit) {
     const uint64_t tile = tile_of(key);
     if (tile != last_tile || !updater) {
       auto& u = updaters[tile];
@@ -227,12 +362,8 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
       updater = u.get();
       last_tile = tile;
     }
-    updater->update(key, log_odds);
-  };
-  const float miss = keys.getProbMissLog(), hit = keys.getProbHitLog();
-  for (uint64_t k : s.free.keys())
-    if (!s.hit.contains(k)) update(k, miss);
-  for (uint64_t k : s.hit.keys()) update(k, hit);
+    updater->update(key, is_hit ? hit : miss);
+  });
   return rays;
 }
 
