@@ -24,7 +24,7 @@
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
-#                           [--stop-grace S] [--overlay FILE,...] [--calibrate-camera]
+#                           [--stop-grace S] [--overlay FILE,...] [--calibrate-camera] [--max-lag N] [--serial]
 # Processes default to those of lio, vio, vio_feature, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
@@ -37,6 +37,10 @@
 # DIR/camera_calibration) measures the camera's rotation against the LiDAR-inertial body from image
 # pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
 # the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
+# --max-lag N (lockstep): colour, octomap and the recorder, whose outputs no estimator takes, may
+# fall up to N messages (4) behind the rest, so they run beside lio, vio and loop on the second
+# core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
+# before the next goes out (no lag, no quiet promises): slower, and the outputs are the same.
 set -euo pipefail
 # One brace group: bash reads all of it before running any of it, so editing this file during a
 # long run (a 30 min soak) cannot break that run.
@@ -45,10 +49,10 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,39p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,43p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0 max_lag=4 serial=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -69,6 +73,8 @@ while [ $# -gt 0 ]; do
     --stop-grace) stop_grace="$2"; shift 2 ;;
     --overlay) overlays+="${overlays:+,}$2"; shift 2 ;;
     --calibrate-camera) calibrate=1; shift ;;
+    --max-lag) max_lag="$2"; shift 2 ;;
+    --serial) serial=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
             exe="${2#*=}"
             # a path relative to where the script was called from (the processes run inside --out)
@@ -83,6 +89,7 @@ done
 [ -n "$respawn" ] || respawn=$realtime
 [[ "$max_restarts" =~ ^[0-9]+$ ]] || die "--max-restarts takes a whole number"
 [[ "$stop_grace" =~ ^[0-9]+$ ]] || die "--stop-grace takes whole seconds"
+[[ "$max_lag" =~ ^[0-9]+$ ]] || die "--max-lag takes a whole number"
 [ -f "$log" ] || die "no such log: $log"
 [ -f "$config" ] || die "no such config: $config"
 log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
@@ -146,7 +153,7 @@ if [ "$inside" = 0 ]; then
   rc=0
   "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
-    --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --kill "$kills" --stop-grace "$stop_grace" \
+    --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --max-lag "$max_lag" $([ "$serial" = 1 ] && echo --serial) --kill "$kills" --stop-grace "$stop_grace" \
     $([ "$respawn" = 1 ] && echo --respawn || echo --no-respawn) \
     $([ "$realtime" = 1 ] && echo --realtime) || rc=$?
 
@@ -185,7 +192,7 @@ if [ "$inside" = 0 ]; then
   [ "$rc" = 0 ] || warnings+=("the run failed: $(tail -n 1 "$out/logs/run.txt" 2>/dev/null)")
   # What the replay saw go wrong on the bus (messages lost, consumers away and back).
   while IFS= read -r line; do warnings+=("playback: ${line#*lockstep: }"); done \
-    < <(grep -E '^\[playback\] lockstep: ' "$out/logs/playback.log" 2>/dev/null | grep -v 'restarted\|exited;\|silent for\|heard again' || true)
+    < <(grep -E '^\[playback\] lockstep: ' "$out/logs/playback.log" 2>/dev/null | grep -v 'restarted\|exited;\|silent for\|heard again\|may lag\|in step' || true)
   read -r log_s wall_s < "$out/logs/replay_times.txt" 2>/dev/null || { log_s=0; wall_s=0; }
   joined_warnings=$(IFS=';'; echo "${warnings[*]:-}")
   injected=$(sed -n 's/^\[playback\] faults on \(.*\)$/\1/p' "$out/logs/playback.log" 2>/dev/null | paste -sd';' -)
@@ -254,6 +261,10 @@ if [ "$realtime" = 1 ]; then
   replay=(--speed 1 --consumers "$(IFS=,; echo "${selected[*]}"),record" --startup-timeout 60)
 else
   replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 60 --startup-timeout 60)
+  # the sinks (livo-playback checks from their PROGRESS that nothing but the recorder takes their outputs)
+  lag=(record); for p in "${selected[@]}"; do case "$p" in colour|octomap) lag+=("$p") ;; esac; done
+  [ "$max_lag" -gt 0 ] && replay+=(--lag "$(IFS=,; echo "${lag[*]}")" --max-lag "$max_lag")
+  [ "$serial" = 1 ] && replay+=(--serial)
   [ "$respawn" = 1 ] && replay+=(--respawn)
 fi
 [ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")

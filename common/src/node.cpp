@@ -176,7 +176,14 @@ void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscrip
   sub->latency.add(std::chrono::duration<double>(t1 - t0).count());
   ++sub->handled;
   node.current_ = nullptr;
-  if (node.options_.publish_progress) node.publishProgress(false);
+  if (!node.options_.publish_progress) return;
+  ++node.progress_deferred_;
+  if (!node.coalesce_progress_ || node.progress_deferred_ >= kMaxProgressDeferred || node.receiveQueueEmpty())
+    node.publishProgress(false);
+}
+
+void Node::flushProgress() {
+  if (progress_deferred_ > 0 && options_.publish_progress && receiveQueueEmpty()) publishProgress(false);
 }
 
 void Node::publishRaw(const std::string& channel, const void* data, int size) {
@@ -228,6 +235,7 @@ void Node::publishProgress(bool finished) {
   p.utime = last_utime_;
   p.node = options_.name;
   p.sequence = progress_sequence_++;
+  progress_deferred_ = 0;
   p.finished = finished ? 1 : 0;
   p.instance = instance_;
   p.idle = !finished && receiveQueueEmpty() ? 1 : 0;
@@ -243,6 +251,14 @@ void Node::publishProgress(bool finished) {
     p.published.push_back(n);
   }
   p.num_outputs = static_cast<int32_t>(p.output_channel.size());
+  p.quiet_from = p.quiet_before = 0;
+  if (quiet_window_ && !finished) {
+    if (const auto w = quiet_window_(); w && w->before > w->from) {
+      p.quiet_channel = w->channel;
+      p.quiet_from = w->from;
+      p.quiet_before = w->before;
+    }
+  }
   lcm_.publish(options_.progress_channel, &p);
 }
 
@@ -354,6 +370,7 @@ void Node::printSummary(std::ostream& os) const {
 
 int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, const std::function<bool()>& done) {
   installSignalHandlers();
+  node.setCoalesceProgress(true);
   node.announce();
   int rc = 0;
   while (!shutdownRequested() && !(done && done())) {
@@ -364,6 +381,7 @@ int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, co
       rc = 1;
       break;
     }
+    node.flushProgress();
     node.tick();
   }
   if (on_shutdown) on_shutdown();

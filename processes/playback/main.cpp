@@ -39,6 +39,11 @@ int main(int argc, char** argv) {
       .option("--loss-grace", "S",
               "lockstep: an idle consumer still lacking a message published S seconds ago lost it on the bus "
               "(reported, then not waited for)", "3")
+      .flag("--serial", "lockstep: wait for every consumer after every message, ignoring their quiet promises and --lag "
+                        "(the reference the default must equal)")
+      .option("--lag", "A,B,...",
+              "lockstep: consumers that may fall behind the rest (their outputs feed only recorders; checked)")
+      .option("--max-lag", "N", "lockstep: how many messages a --lag consumer may be behind", "4")
       .flag("--respawn", "lockstep: consumers may exit and be restarted by a supervisor; not waited for while away")
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
@@ -62,6 +67,10 @@ int main(int argc, char** argv) {
     o.startup_timeout_s = cli.getDouble("--startup-timeout");
     o.loss_grace_s = cli.getDouble("--loss-grace");
     o.respawn = cli.has("--respawn");
+    o.serial = cli.has("--serial");
+    o.may_lag = splitList(cli.get("--lag"));
+    o.max_lag_messages = static_cast<int>(cli.getInt("--max-lag"));
+    if (o.max_lag_messages < 0) throw std::invalid_argument("--max-lag must be >= 0");
     o.quiet = cli.has("--quiet");
     if (o.speed < 0) throw std::invalid_argument("--speed must be >= 0");
     if (!o.quiet)
@@ -74,7 +83,11 @@ int main(int argc, char** argv) {
     if (!o.quiet)
       std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
                 << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())
-                << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string()) << std::endl;
+                << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string())
+                << (r.not_waited > 0 ? "; " + std::to_string(r.not_waited) +
+                                           " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
+                                     : std::string())
+                << std::endl;
     if (!r.error.empty()) {
       std::cerr << "livo-playback: " << r.error << std::endl;
       return 1;

@@ -14,6 +14,7 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/lio/lio_node.hpp"
 #include "livo/messages.hpp"
+#include "livo/progress_t.hpp"
 #include "synthetic_messages.hpp"
 #include "synthetic_world.hpp"
 
@@ -51,6 +52,8 @@ struct RunSetup {
   LioNode::HandoffCounts* handoff = nullptr;  // filled after the run
   int64_t* rejected_posteriors = nullptr;     // filled after the run
   LioNode::SweepCounts* sweeps = nullptr;     // filled after the run
+  /// Called around each input message (published, then handled by every node before the next).
+  std::function<void(const Message&)> before_each, after_each;
 };
 
 constexpr int64_t kBaseTime = 1'000'000'000;  // the synthetic sequence's first stamp
@@ -74,7 +77,15 @@ Outputs runNode(const std::vector<Message>& messages, int64_t* rejected = nullpt
   });
   observer.subscribe<registered_scan_t>("REGISTERED_SCAN", [&](const registered_scan_t& m) { out.scans.push_back(m); });
   observer.subscribe<keyframe_t>("KEYFRAME", [&](const keyframe_t& m) { out.keyframes.push_back(m); });
-  livo_test::publishAll(lcm, messages);
+  if (setup.before_each || setup.after_each) {
+    for (const Message& m : messages) {
+      if (setup.before_each) setup.before_each(m);
+      livo_test::publishAll(lcm, {m});
+      if (setup.after_each) setup.after_each(m);
+    }
+  } else {
+    livo_test::publishAll(lcm, messages);
+  }
   if (rejected) {
     *rejected = 0;
     for (const auto& c : node.node().channelStats()) *rejected += c.rejected + c.decode_failures;
@@ -640,3 +651,82 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
   for (size_t i = 0; i < out.scans.size(); ++i) EXPECT_EQ(out.scans[i].epoch, out.odometry[i].epoch);
 }
 }  // namespace
+
+// The promise lio sends with every PROGRESS (progress_t.quiet_*), which lets lockstep playback send
+// IMU samples on without waiting for it, holds: no sample it covers makes lio publish anything.
+// And it is worth having: it covers most samples (not those that carry the filter past a sweep end
+// or an image time, nor those while a posterior is awaited).
+TEST(LioNode, QuietPromiseHoldsAndCoversMostImuSamples) {
+  struct Watcher {
+    progress_t last{};
+    bool have = false;
+    int64_t outputs = 0;
+    void onProgress(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      progress_t p;
+      if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) <= 0 || p.node == "fake_vio") return;
+      last = p;
+      have = true;
+    }
+    void onOutput(const lcm::ReceiveBuffer*, const std::string&) { ++outputs; }
+  };
+  // the plain run, with the camera hand-off, and with IMU samples swapped and duplicated
+  for (const int variant : {0, 1, 2}) {
+    const bool handoff = variant == 1;
+    Watcher w;
+    int64_t imu = 0, covered = 0, broken = 0, outputs_before = 0;
+    bool in_promise = false;
+    RunSetup setup;
+    if (handoff) setup.config = handoffConfig();
+    LioNode::HandoffCounts counts;
+    setup.handoff = &counts;
+    setup.attach = [&](Node& vio) {
+      vio.lcm().subscribe("PROGRESS", &Watcher::onProgress, &w);
+      for (const char* ch : {"ODOMETRY", "REGISTERED_SCAN", "KEYFRAME", "STATE_PRIOR"})
+        vio.lcm().subscribe(ch, &Watcher::onOutput, &w);
+      if (!handoff) return;
+      vio.subscribe<filter_state_t>("STATE_PRIOR", [&vio](const filter_state_t& prior) {
+        filter_state_t keep = prior;  // "kept the prior": the answer that changes nothing
+        keep.valid = 0;
+        keep.source = "fake_vio";
+        vio.publish("STATE_POSTERIOR", keep);
+      });
+      vio.announce();
+    };
+    setup.before_each = [&](const Message& m) {
+      in_promise = false;
+      if (m.channel != "IMU") return;
+      ++imu;
+      imu_t s;
+      ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
+      in_promise = w.have && w.last.quiet_channel == "IMU" && s.utime >= w.last.quiet_from && s.utime < w.last.quiet_before;
+      covered += in_promise;
+      outputs_before = w.outputs;
+    };
+    setup.after_each = [&](const Message&) { broken += in_promise && w.outputs != outputs_before; };
+    int64_t first_image = 0, last_image = 0;
+    std::vector<Message> in = handoff ? withImages(syntheticRun(), &first_image, &last_image) : syntheticRun();
+    if (variant == 2) {
+      std::vector<Message> disordered;
+      int64_t k = 0;
+      for (const Message& m : in) {
+        disordered.push_back(m);
+        if (m.channel != "IMU") continue;
+        if (++k % 11 == 0) disordered.push_back(m);
+        const size_t n = disordered.size();
+        if (k % 7 == 0 && n >= 2 && disordered[n - 2].channel == "IMU") std::swap(disordered[n - 2], disordered[n - 1]);
+      }
+      in.swap(disordered);
+    }
+    const Outputs out = runNode(in, nullptr, setup);
+    ASSERT_GE(out.odometry.size(), 25u);
+    if (handoff) {
+      EXPECT_GE(counts.kept_prior, 40);
+    }
+    EXPECT_EQ(broken, 0) << "variant " << variant;
+    // per 0.1 s sweep, 20 samples: the one past the sweep end (and with images, those past each image)
+    EXPECT_GT(covered, imu * (handoff ? 8 : 9) / 10) << covered << " of " << imu << " samples covered";
+    std::printf("%s: %lld of %lld IMU samples inside the quiet promise\n",
+                variant == 0 ? "LiDAR-only" : variant == 1 ? "camera hand-off" : "swapped and duplicated IMU",
+                static_cast<long long>(covered), static_cast<long long>(imu));
+  }
+}

@@ -212,3 +212,106 @@ TEST(LockstepGate, HoldsTheReplayWhileAConsumerRestarts) {
   g.onProgress(progress("vio", 0, {{"CAMERA", 0}}, {}, false, false, 2), 5.0);
   EXPECT_FALSE(g.awaitingRestart(5.0));
 }
+
+namespace {
+progress_t withQuiet(progress_t p, const std::string& channel, int64_t from, int64_t before) {
+  p.quiet_channel = channel;
+  p.quiet_from = from;
+  p.quiet_before = before;
+  return p;
+}
+}  // namespace
+
+// lio promises that IMU samples before its next sweep end publish nothing: playback sends them
+// without waiting, and waits again for one past the promise or on another channel.
+TEST(LockstepGate, AQuietPromiseLetsTheMessagesItCoversGoWithoutWaiting) {
+  LockstepGate g({"lio"});
+  g.onProgress(withQuiet(progress("lio", 0, {{"IMU", 0}, {"LIDAR", 0}}, {{"ODOMETRY", 0}}), "IMU", 0, 1000));
+  g.onPublished("IMU", 0.0, 100);
+  g.onPublished("IMU", 0.0, 999);
+  EXPECT_TRUE(g.caughtUp());
+  EXPECT_FALSE(g.idle());  // the end of the log still waits for everything
+  g.onPublished("IMU", 0.0, 1000);  // at the promise's end: not covered
+  EXPECT_FALSE(g.caughtUp());
+  g.onProgress(withQuiet(progress("lio", 1, {{"IMU", 3}, {"LIDAR", 0}}, {{"ODOMETRY", 0}}), "IMU", 0, 1000));
+  EXPECT_TRUE(g.caughtUp());
+  g.onPublished("LIDAR", 0.0, 500);  // another channel: never covered
+  EXPECT_FALSE(g.caughtUp());
+  g.onProgress(progress("lio", 2, {{"IMU", 3}, {"LIDAR", 1}}, {{"ODOMETRY", 0}}));  // no promise now
+  EXPECT_TRUE(g.caughtUp());
+  g.onPublished("IMU", 0.0, 1001);
+  EXPECT_FALSE(g.caughtUp());
+  g.onProgress(withQuiet(progress("lio", 3, {{"IMU", 3}, {"LIDAR", 1}}, {{"ODOMETRY", 0}}), "IMU", 900, 2000));
+  EXPECT_TRUE(g.caughtUp());
+  g.onPublished("IMU", 0.0, 800);  // before the promise's start (a clock step back): not covered
+  EXPECT_FALSE(g.caughtUp());
+}
+
+TEST(LockstepGate, APromiseCoversNeitherUnstampedMessagesNorChannelsNodesPublishNorASerialReplay) {
+  LockstepGate g({"lio", "sim"});
+  g.onProgress(withQuiet(progress("lio", 0, {{"IMU", 0}}, {}), "IMU", 0, 1000));
+  g.onProgress(progress("sim", 0, {}, {{"IMU", 0}}));
+  g.onPublished("IMU", 0.0, LockstepGate::kNoUtime);
+  EXPECT_FALSE(g.caughtUp());
+  g.onProgress(withQuiet(progress("lio", 1, {{"IMU", 1}}, {}), "IMU", 0, 1000));
+  g.onPublished("IMU", 0.0, 10);
+  EXPECT_TRUE(g.caughtUp());
+  g.onProgress(progress("sim", 1, {}, {{"IMU", 1}}));  // a node publishes IMU too: its stamps are unknown
+  EXPECT_FALSE(g.caughtUp());
+
+  LockstepGateOptions serial;
+  serial.honour_quiet_promises = false;
+  LockstepGate s({"lio"}, serial);
+  s.onProgress(withQuiet(progress("lio", 0, {{"IMU", 0}}, {}), "IMU", 0, 1000));
+  s.onPublished("IMU", 0.0, 10);
+  EXPECT_FALSE(s.caughtUp());
+}
+
+// colour and the recorder take what lio publishes but feed nothing back: they may fall a bounded
+// number of messages behind while lio goes on.
+TEST(LockstepGate, ALaggingConsumerFallsBehindByAtMostTheBound) {
+  LockstepGateOptions o;
+  o.may_lag = {"colour", "record"};
+  o.max_lag_messages = 2;
+  LockstepGate g({"lio", "colour", "record"}, o);
+  g.onProgress(progress("lio", 0, {{"LIDAR", 0}}, {{"REGISTERED_SCAN", 0}}));
+  g.onProgress(progress("colour", 0, {{"REGISTERED_SCAN", 0}, {"CAMERA", 0}}, {{"COLORED_CLOUD", 0}}));
+  g.onProgress(progress("record", 0, {{"REGISTERED_SCAN", 0}, {"COLORED_CLOUD", 0}}, {}));
+  EXPECT_EQ(g.lagging(), (std::vector<std::string>{"colour", "record"}));
+  g.onPublished("LIDAR", 0.0, 1);
+  EXPECT_FALSE(g.caughtUp());  // lio is in step
+  g.onProgress(progress("lio", 1, {{"LIDAR", 1}}, {{"REGISTERED_SCAN", 1}}));
+  EXPECT_TRUE(g.caughtUp());  // colour and record 1 behind
+  g.onPublished("CAMERA", 0.0, 2);
+  EXPECT_TRUE(g.caughtUp());  // colour 2 behind
+  g.onPublished("CAMERA", 0.0, 3);
+  EXPECT_FALSE(g.caughtUp());  // colour 3 behind
+  EXPECT_FALSE(g.idle());
+  g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 1}, {"CAMERA", 0}}, {{"COLORED_CLOUD", 1}}));
+  EXPECT_TRUE(g.caughtUp());  // colour 2 behind, the recorder 2 (a scan and a cloud)
+  g.onProgress(progress("colour", 2, {{"REGISTERED_SCAN", 1}, {"CAMERA", 2}}, {{"COLORED_CLOUD", 1}}));
+  g.onProgress(progress("record", 1, {{"REGISTERED_SCAN", 1}, {"COLORED_CLOUD", 1}}, {}));
+  EXPECT_TRUE(g.idle());
+}
+
+// octomap takes colour's clouds: colour lagging would hand them to octomap at positions that
+// depend on timing, so it is kept in step (and says so); the recorder taking them does not count.
+TEST(LockstepGate, AConsumerWhoseOutputAnotherActsOnIsKeptInStep) {
+  LockstepGateOptions o;
+  o.may_lag = {"colour", "octomap", "record"};
+  LockstepGate g({"lio", "colour", "octomap", "record"}, o);
+  g.onProgress(progress("lio", 0, {{"LIDAR", 0}}, {{"REGISTERED_SCAN", 0}}));
+  g.onProgress(progress("colour", 0, {{"REGISTERED_SCAN", 0}}, {{"COLORED_CLOUD", 0}}));
+  g.onProgress(progress("record", 0, {{"REGISTERED_SCAN", 0}, {"COLORED_CLOUD", 0}, {"OCTOMAP", 0}}, {}));
+  EXPECT_EQ(g.lagging(), (std::vector<std::string>{"colour", "record"}));  // octomap not heard yet
+  g.onProgress(progress("octomap", 0, {{"REGISTERED_SCAN", 0}, {"COLORED_CLOUD", 0}}, {{"OCTOMAP", 0}}));
+  EXPECT_EQ(g.lagging(), (std::vector<std::string>{"octomap", "record"}));
+  const auto events = g.takeEvents();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0], "consumer colour kept in step (it may not lag): octomap takes its COLORED_CLOUD");
+  g.onPublished("LIDAR", 0.0, 1);
+  g.onProgress(progress("lio", 1, {{"LIDAR", 1}}, {{"REGISTERED_SCAN", 1}}));
+  EXPECT_FALSE(g.caughtUp());  // colour must take the scan before the next message
+  g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 1}}, {{"COLORED_CLOUD", 1}}));
+  EXPECT_TRUE(g.caughtUp());  // octomap and the recorder behind, within the bound
+}

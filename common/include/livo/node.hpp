@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <random>
 #include <string>
@@ -105,6 +106,26 @@ class Node {
   /// Whether a live node other than this one subscribes to a watched channel.
   bool hasConsumers(const std::string& channel) const;
 
+  /// A node's promise to lockstep playback (progress_t.quiet_*): messages on `channel` stamped in
+  /// [from, before) make it publish nothing, from its current state.
+  struct QuietWindow {
+    std::string channel;
+    int64_t from = 0;
+    int64_t before = 0;
+  };
+  /// Asked for the promise whenever PROGRESS is published (after every handled message), so that
+  /// it always matches the counts it goes out with. An empty optional: no promise now.
+  void setQuietWindow(std::function<std::optional<QuietWindow>()> promise) { quiet_window_ = std::move(promise); }
+
+  /// Under spin(): a PROGRESS after a handled input goes out only once nothing more waits in the
+  /// receive queue (or after kMaxProgressDeferred inputs), one for a burst instead of one per
+  /// message: every process wakes for every datagram on a udpm bus. Off by default (tests that
+  /// drive handle() themselves get one PROGRESS per input).
+  void setCoalesceProgress(bool on) { coalesce_progress_ = on; }
+  /// Publishes a PROGRESS put off by coalescing once the receive queue is empty (spin() calls it).
+  void flushProgress();
+  static constexpr int kMaxProgressDeferred = 32;
+
   /// Publishes a PROGRESS with zero counts so lockstep playback knows the node is up and
   /// subscribed; spin() calls it first.
   void announce();
@@ -163,6 +184,9 @@ class Node {
   bool receiveQueueEmpty();
 
   int64_t progress_sequence_ = 0;
+  bool coalesce_progress_ = false;
+  int progress_deferred_ = 0;  // inputs handled since the last PROGRESS
+  std::function<std::optional<QuietWindow>()> quiet_window_;
   int64_t instance_ = 0;  // this start of the node (progress_t.instance)
   int64_t last_utime_ = 0;
   int8_t level_ = 0;

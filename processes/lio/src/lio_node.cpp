@@ -49,6 +49,7 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
     node_.watchConsumers(opts_.state_prior_channel);
     node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
   }
+  node_.setQuietWindow([this] { return quietWindow(); });
   node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
@@ -234,30 +235,15 @@ void LioNode::advance() {
                  ": going on LiDAR-only (" + std::to_string(handoff_.missing) + " so far)");
       pending_.reset();
     }
-    // the earlier of the next image time and the next sweep end; a sweep ending at the image first
-    if (!images_.empty() && (scans_.empty() || images_.front().utime < scans_.front().utime)) {
-      const int64_t t_image = images_.front().utime;
-      if (fed_imu_ <= t_image) break;  // no IMU past the image yet
-      // every sweep ending at or before the image must have been processed (the LiDAR watermark)
-      const bool lidar_past = newest_sweep_end_ >= t_image;
-      if (!lidar_past && fed_imu_ <= t_image + toUtime(opts_.image_lidar_wait_s)) break;
-      images_.popUntil(t_image, [](const auto&) {});
-      handOff(t_image);
+    const NextEvent next = nextEvent();
+    if (next.kind == NextEvent::kNone || fed_imu_ <= next.imu_after) break;
+    if (next.kind == NextEvent::kImage) {
+      images_.popUntil(next.utime, [](const auto&) {});
+      handOff(next.utime);
       continue;
     }
-    if (scans_.empty()) break;
-    const int64_t t_end = scans_.front().utime;
-    if (fed_imu_ <= t_end) break;  // no IMU past the sweep end yet
-    if (opts_.camera_handoff && newest_image_ >= 0 && t_end - newest_image_ < toUtime(1.0) &&
-        node_.hasConsumers(opts_.state_prior_channel)) {
-      // the images before the sweep end come first: wait until the next one is due after it
-      const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > t_end;
-      if (!images_past && fed_imu_ <= t_end + toUtime(opts_.image_max_wait_s)) break;
-    }
+    const int64_t t_end = next.utime;
     if (opts_.lio.wheel.enabled) {
-      const bool wheel_past = !wheel_.empty() && wheel_.back().utime > t_end;
-      const bool waited = fed_imu_ > t_end + toUtime(opts_.wheel_max_wait_s);
-      if (!wheel_past && !waited) break;
       // wheel readings up to the first one past the end
       int64_t upto = t_end;
       for (const auto& e : wheel_.entries())
@@ -282,6 +268,50 @@ void LioNode::advance() {
     });
     process(*p);
   }
+}
+
+LioNode::NextEvent LioNode::nextEvent() const {
+  NextEvent e;
+  // the earlier of the next image time and the next sweep end; a sweep ending at the image first
+  if (!images_.empty() && (scans_.empty() || images_.front().utime < scans_.front().utime)) {
+    e.kind = NextEvent::kImage;
+    e.utime = e.imu_after = images_.front().utime;
+    // every sweep ending at or before the image must have been processed (the LiDAR watermark)
+    const bool lidar_past = newest_sweep_end_ >= e.utime;
+    if (!lidar_past) e.imu_after += toUtime(opts_.image_lidar_wait_s);
+    return e;
+  }
+  if (scans_.empty()) return e;
+  e.kind = NextEvent::kSweep;
+  e.utime = e.imu_after = scans_.front().utime;
+  if (opts_.camera_handoff && newest_image_ >= 0 && e.utime - newest_image_ < toUtime(1.0) &&
+      node_.hasConsumers(opts_.state_prior_channel)) {
+    // the images before the sweep end come first: wait until the next one is due after it
+    const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > e.utime;
+    if (!images_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.image_max_wait_s));
+  }
+  if (opts_.lio.wheel.enabled) {
+    const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
+    if (!wheel_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.wheel_max_wait_s));
+  }
+  return e;
+}
+
+std::optional<Node::QuietWindow> LioNode::quietWindow() const {
+  // waiting for a posterior (or for the next sample to confirm a jumped clock): no promise
+  if (!has_imu_ || pending_ || held_jump_) return std::nullopt;
+  Node::QuietWindow w;
+  w.channel = opts_.imu_channel;
+  // a sample further back is a clock reset, one further ahead is held as a jump
+  w.from = newest_imu_ - toUtime(opts_.clock_reset_s);
+  w.before = newest_imu_ + toUtime(opts_.clock_jump_s);
+  // advance() acts only once the filter's newest sample is past the next event's threshold, and
+  // the filter gets samples imu_reorder_window_s behind the newest received; the sweeps, images
+  // and wheel readings that could move the threshold come on other channels, not covered
+  const NextEvent next = nextEvent();
+  if (next.kind != NextEvent::kNone)
+    w.before = std::min(w.before, next.imu_after + toUtime(opts_.imu_reorder_window_s) + 1);
+  return w;
 }
 
 void LioNode::process(const PendingScan& p) {

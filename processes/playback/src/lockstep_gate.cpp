@@ -8,6 +8,7 @@ namespace livo::playback {
 
 namespace {
 constexpr double kPublishHistoryS = 60.0;  // how far back publish times are kept (>> loss_grace_s)
+constexpr size_t kUtimeHistory = 1024;     // playback stamps kept per channel for quiet promises
 }  // namespace
 
 LockstepGate::LockstepGate(std::vector<std::string> consumers, LockstepGateOptions options)
@@ -21,6 +22,8 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
   const bool is_new = !nodes_.count(p.node);
   NodeState& n = nodes_[p.node];
   bool changed = is_new;
+  const size_t inputs_before = n.handled.size(), outputs_before = n.published.size();
+  const bool away_before = n.away;
   if (is_new) {
     n.instance = p.instance;
   } else if (p.instance != n.instance) {
@@ -60,6 +63,9 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     events_.push_back("consumer " + p.node + " is heard again");
   }
   n.sequence = p.sequence;
+  n.quiet_channel = p.quiet_before > p.quiet_from ? p.quiet_channel : std::string();
+  n.quiet_from = p.quiet_from;
+  n.quiet_before = p.quiet_before;
   for (int i = 0; i < p.num_inputs; ++i) {
     int64_t& v = n.handled[p.input_channel[i]];
     changed = changed || v != p.handled[i];
@@ -85,17 +91,23 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
   if (p.idle && !p.finished && isConsumer(p.node))
     detectLosses(p.node, n, std::isfinite(idle_checked_s) ? std::min(idle_checked_s, now_s) : now_s);
   updateWaiting(now_s);
+  // who may lag depends on who takes what (and who is away): worked out again when that changes
+  if (is_new || n.handled.size() != inputs_before || n.published.size() != outputs_before || n.away != away_before)
+    noteLagDecisions();
   return changed;
 }
 
-void LockstepGate::onPublished(const std::string& channel, double now_s) {
-  ++playback_published_[channel];
+void LockstepGate::onPublished(const std::string& channel, double now_s, int64_t utime) {
+  const int64_t index = ++playback_published_[channel];
+  auto& stamps = playback_utimes_[channel];
+  stamps.emplace_back(index, utime);
+  if (stamps.size() > kUtimeHistory) stamps.pop_front();
   notePublished(channel, now_s);
   updateWaiting(now_s);
 }
 
 void LockstepGate::notePublished(const std::string& channel, double now_s) {
-  const int64_t total = totalPublished(channel);
+  const int64_t total = countPublished(channel);
   int64_t& known = known_total_[channel];
   if (total <= known) return;
   known = total;
@@ -157,10 +169,12 @@ void LockstepGate::updateWaiting(double now_s) {
 
 void LockstepGate::checkSilent(double now_s) {
   if (!options_.tolerate_restarts) return;
+  bool someone_went = false;
   for (const auto& c : consumers_) {
     auto it = nodes_.find(c);
     if (it == nodes_.end() || it->second.away) continue;
     if (now_s - it->second.last_heard_s > options_.silent_after_s) {
+      someone_went = true;
       it->second.away = true;
       it->second.away_since_s = now_s;
       std::ostringstream os;
@@ -169,6 +183,7 @@ void LockstepGate::checkSilent(double now_s) {
       events_.push_back(os.str());
     }
   }
+  if (someone_went) noteLagDecisions();
   updateWaiting(now_s);
 }
 
@@ -191,6 +206,11 @@ std::vector<std::string> LockstepGate::finished() const {
 }
 
 int64_t LockstepGate::totalPublished(const std::string& channel) const {
+  auto it = known_total_.find(channel);
+  return it == known_total_.end() ? 0 : it->second;
+}
+
+int64_t LockstepGate::countPublished(const std::string& channel) const {
   int64_t n = 0;
   auto it = playback_published_.find(channel);
   if (it != playback_published_.end()) n += it->second;
@@ -211,6 +231,72 @@ bool LockstepGate::idle() const {
     for (const auto& [channel, handled] : it->second.handled)
       if (deficit(it->second, channel) > 0) return false;
   }
+  return true;
+}
+
+int64_t LockstepGate::behind(const NodeState& n) const {
+  int64_t total = 0;
+  for (const auto& [channel, handled] : n.handled) total += std::max<int64_t>(0, deficit(n, channel));
+  return total;
+}
+
+std::string LockstepGate::keptInStepBecause(const std::string& node) const {
+  auto it = nodes_.find(node);
+  if (it == nodes_.end()) return "it has not reported";
+  for (const auto& [channel, count] : it->second.published) {
+    for (const auto& c : consumers_) {
+      if (c == node) continue;
+      auto taker = nodes_.find(c);
+      if (taker == nodes_.end() || taker->second.away || taker->second.published.empty()) continue;  // recorder
+      if (taker->second.handled.count(channel)) return c + " takes its " + channel;
+    }
+  }
+  return "";
+}
+
+void LockstepGate::noteLagDecisions() {
+  lagging_.clear();
+  for (const auto& c : options_.may_lag)
+    if (isConsumer(c) && keptInStepBecause(c).empty()) lagging_.push_back(c);
+  for (const auto& c : options_.may_lag) {
+    if (!nodes_.count(c)) continue;
+    const std::string why = keptInStepBecause(c);
+    auto [it, is_new] = lag_decision_.emplace(c, why);
+    if (!is_new && it->second == why) continue;
+    it->second = why;
+    if (!why.empty()) events_.push_back("consumer " + c + " kept in step (it may not lag): " + why);
+  }
+}
+
+bool LockstepGate::caughtUp() const {
+  const std::vector<std::string>& lag = lagging_;
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end()) return false;
+    const NodeState& n = it->second;
+    if (n.away) continue;
+    if (std::find(lag.begin(), lag.end(), c) != lag.end()) {
+      if (behind(n) > options_.max_lag_messages) return false;
+      continue;
+    }
+    for (const auto& [channel, handled] : n.handled)
+      if (deficit(n, channel) > 0 && !promisedQuiet(n, channel)) return false;
+  }
+  return true;
+}
+
+bool LockstepGate::promisedQuiet(const NodeState& n, const std::string& channel) const {
+  if (!options_.honour_quiet_promises || n.quiet_channel != channel) return false;
+  auto pb = playback_published_.find(channel);
+  if (pb == playback_published_.end() || totalPublished(channel) != pb->second) return false;  // nodes publish it too
+  auto h = n.handled.find(channel);
+  auto o = n.offset.find(channel);
+  const int64_t first_unhandled =
+      (h == n.handled.end() ? 0 : h->second) + (o == n.offset.end() ? 0 : o->second) + 1;
+  const auto& stamps = playback_utimes_.at(channel);
+  if (stamps.empty() || stamps.front().first > first_unhandled) return false;  // older than the history
+  for (auto it = stamps.rbegin(); it != stamps.rend() && it->first >= first_unhandled; ++it)
+    if (it->second == kNoUtime || it->second < n.quiet_from || it->second >= n.quiet_before) return false;
   return true;
 }
 

@@ -9,6 +9,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "livo/message_registry.hpp"
 #include "livo/node.hpp"
 #include "livo/playback/lockstep_gate.hpp"
 
@@ -113,6 +114,7 @@ class PlaybackRun {
   std::string replay() {
     pace_start_ = Clock::now();  // real-time pacing (and the progress line) start once the consumers are up
     progress_line_.emplace(options_.quiet);
+    tellLagging();
     while (auto e = source_.next()) {
       if (shutdownRequested()) break;
       if (first_ < 0) first_ = e->utime;
@@ -125,6 +127,10 @@ class PlaybackRun {
     }
     for (const LogEvent& out : faults_.flush()) {
       const std::string err = publish(out);
+      if (!err.empty()) return err;
+    }
+    if (lockstep_ && result_.published > 0) {  // the lagging consumers finish too
+      const std::string err = waitUntilCaughtUp(/*all=*/true, nullptr);
       if (!err.empty()) return err;
     }
     progress_line_->update(result_.log_seconds, 1.0, result_.published, true);
@@ -170,6 +176,9 @@ class PlaybackRun {
     LockstepGateOptions g;
     g.loss_grace_s = options.loss_grace_s;
     g.tolerate_restarts = options.respawn;
+    g.honour_quiet_promises = !options.serial;
+    if (!options.serial) g.may_lag = options.may_lag;
+    g.max_lag_messages = options.max_lag_messages;
     return g;
   }
 
@@ -207,16 +216,37 @@ class PlaybackRun {
     sink_.emit(e);
     ++result_.published;
     if (!lockstep_) return "";
-    gate_.onPublished(e.channel, now_s());
-    const std::string err = waitUntilConsumersIdle(e);
+    // the message's own stamp (what a quiet promise is about), not the log event's
+    int64_t utime = LockstepGate::kNoUtime;
+    if (!messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
+    gate_.onPublished(e.channel, now_s(), utime);
+    if (!gate_.idle() && gate_.caughtUp()) ++result_.not_waited;
+    const std::string err = waitUntilCaughtUp(/*all=*/false, &e);
     if (!err.empty()) return err;
     tellEvents();
     return "";
   }
 
-  /// Lockstep: handles PROGRESS until every consumer has handled everything published so far.
-  std::string waitUntilConsumersIdle(const LogEvent& e) {
-    while (!gate_.idle() || gate_.awaitingRestart(now_s())) {
+  void tellLagging() {
+    if (!lockstep_ || options_.quiet) return;
+    if (options_.serial) {
+      std::cerr << "[playback] lockstep: serial (every consumer handles every message before the next)" << std::endl;
+      return;
+    }
+    if (options_.may_lag.empty()) return;
+    std::string names;
+    for (const auto& c : gate_.lagging()) names += (names.empty() ? "" : ", ") + c;
+    std::cerr << "[playback] lockstep: "
+              << (names.empty() ? std::string("every consumer in step")
+                                : names + " may lag up to " + std::to_string(options_.max_lag_messages) +
+                                      " messages behind the rest")
+              << std::endl;
+  }
+
+  /// Lockstep: handles PROGRESS until every consumer has handled everything published so far
+  /// (`all`), or until the gate lets the next message go (lagging consumers a bounded way behind).
+  std::string waitUntilCaughtUp(bool all, const LogEvent* last) {
+    while (!(all ? gate_.idle() : gate_.caughtUp()) || gate_.awaitingRestart(now_s())) {
       if (shutdownRequested()) return "interrupted";
       gate_.checkSilent(now_s());
       tellEvents();
@@ -226,8 +256,13 @@ class PlaybackRun {
       if (gate_.stalledFor(now_s()) > options_.stall_timeout_s) {
         std::ostringstream os;
         os << "lockstep: stalled: no progress for " << options_.stall_timeout_s
-           << " s on what is awaited after message " << result_.published << " (" << e.channel << " at " << std::fixed
-           << std::setprecision(3) << result_.log_seconds << " s of log); waiting for: " << gate_.pendingDescription();
+           << " s on what is awaited after ";
+        if (last)
+          os << "message " << result_.published << " (" << last->channel << " at " << std::fixed << std::setprecision(3)
+             << result_.log_seconds << " s of log)";
+        else
+          os << "the end of the log";
+        os << "; waiting for: " << gate_.pendingDescription();
         return os.str();
       }
       if (lcm_->handleTimeout(100) < 0) {

@@ -86,6 +86,16 @@ class LioNode {
   void onLoopCorrection(const loop_correction_t& m);
   /// Hands IMU (and wheel) to the filter up to the watermarks and processes every ready sweep.
   void advance();
+  /// What advance() acts on next (an image hand-off or a sweep), and the IMU stamp the filter's
+  /// newest sample must pass before it may (the waits for the LiDAR, the camera and the wheels).
+  struct NextEvent {
+    enum Kind { kNone, kImage, kSweep } kind = kNone;
+    int64_t utime = 0;
+    int64_t imu_after = 0;
+  };
+  NextEvent nextEvent() const;
+  /// The promise in PROGRESS (progress_t.quiet_*): IMU samples that cannot make advance() act.
+  std::optional<Node::QuietWindow> quietWindow() const;
   void process(const PendingScan& p);
   /// Propagates to an image time and publishes the prior (sets pending_).
   void handOff(int64_t utime);

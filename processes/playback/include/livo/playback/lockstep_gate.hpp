@@ -11,6 +11,22 @@
 //   behind; heartbeats and traffic on other channels do not hide it (stalledFor()).
 // - A restart (tolerate_restarts): a consumer that exits or goes silent is not waited for until a
 //   new instance of it reports; messages published while it was away are lost to it.
+//
+// Quiet promises (progress_t.quiet_*): a consumer may promise that messages on one channel stamped
+// in a window make it publish nothing (lio: IMU samples before its next sweep end or image time).
+// Playback then sends such messages without waiting for it: it handles them in order and nobody
+// waits for an output of them, so every node sees what the serial replay shows it.
+//
+// Lagging consumers (options.may_lag): waiting for the whole pipeline after every message runs the
+// processes one after another. A consumer whose outputs no other consumer acts on (colour, octomap,
+// the recorder) may instead fall up to max_lag_messages behind while the others handle the next
+// messages, on the second core. Its input order is unchanged: everything it takes comes from
+// playback and from consumers that are kept in step, which publish in the one order of the serial
+// replay, and the bus delivers each sender's messages in order. So its outputs are the serial
+// replay's. Which may lag is decided from the PROGRESS topology, not trusted: a listed consumer
+// whose declared outputs another consumer takes is kept in step (one taking its channel would see
+// them at positions that depend on timing), except where the taker is a recorder (a consumer that
+// publishes nothing: it keeps each channel's order, not the interleaving across channels).
 #pragma once
 
 #include <cmath>
@@ -30,6 +46,10 @@ struct LockstepGateOptions {
   bool tolerate_restarts = false;   // consumers may exit and come back (supervised runs)
   double silent_after_s = 5.0;      // tolerate_restarts: a consumer not heard for this long is away
   double restart_wait_s = 30.0;     // tolerate_restarts: how long a consumer away is waited for
+  bool honour_quiet_promises = true; // false: wait for every consumer after every message
+  std::vector<std::string> may_lag; // consumers that may fall behind (see above)
+  int max_lag_messages = 4;         // how far (messages not yet handled, all channels) they may:
+                                    // bounded by the UDP receive buffer (a 64-beam cloud is ~3 MB)
 };
 
 class LockstepGate {
@@ -43,8 +63,10 @@ class LockstepGate {
   /// anything on (a count changed, or the node is new, restarted or finished), false for a
   /// heartbeat that repeats what was known.
   bool onProgress(const progress_t& p, double now_s = 0.0, double idle_checked_s = std::nan(""));
-  /// Playback published one more message on `channel` at `now_s`.
-  void onPublished(const std::string& channel, double now_s = 0.0);
+  /// Playback published one more message on `channel` at `now_s`, stamped `utime` (the message's
+  /// own; kNoUtime: unknown, never covered by a quiet promise).
+  static constexpr int64_t kNoUtime = INT64_MIN;
+  void onPublished(const std::string& channel, double now_s = 0.0, int64_t utime = kNoUtime);
   /// tolerate_restarts: marks consumers not heard for silent_after_s as away (call periodically).
   void checkSilent(double now_s);
 
@@ -55,6 +77,12 @@ class LockstepGate {
   std::vector<std::string> finished() const;
   /// The pipeline has handled everything published so far (consumers away are not waited for).
   bool idle() const;
+  /// The next message may go out: every consumer kept in step has handled everything but messages
+  /// its quiet promise covers, and every lagging one is at most max_lag_messages behind.
+  bool caughtUp() const;
+  /// The consumers allowed to lag now: listed in may_lag, reported, and whose outputs are taken by
+  /// no consumer but recorders.
+  const std::vector<std::string>& lagging() const { return lagging_; }
   /// tolerate_restarts: a consumer went away less than restart_wait_s ago and has not come back
   /// (lockstep holds the replay so that it misses as little as possible).
   bool awaitingRestart(double now_s) const;
@@ -83,12 +111,16 @@ class LockstepGate {
     std::map<std::string, int64_t> published;
     std::map<std::string, int64_t> published_before;  // by earlier instances of this node
     std::map<std::string, int64_t> offset;  // counted as handled: lost, or published while away
+    std::string quiet_channel;              // the newest PROGRESS's promise (empty: none)
+    int64_t quiet_from = 0;
+    int64_t quiet_before = 0;
   };
   struct Waiting {
     int64_t handled = 0;
     double since_s = 0.0;
   };
-  int64_t totalPublished(const std::string& channel) const;
+  int64_t totalPublished(const std::string& channel) const;  // known_total_: kept up to date
+  int64_t countPublished(const std::string& channel) const;  // summed over playback and the nodes
   /// Messages on `channel` published at or before `t_s`.
   int64_t publishedBy(const std::string& channel, double t_s) const;
   int64_t deficit(const NodeState& n, const std::string& channel) const;
@@ -96,16 +128,25 @@ class LockstepGate {
   void detectLosses(const std::string& node, NodeState& n, double idle_at_s);
   void updateWaiting(double now_s);
   bool isConsumer(const std::string& node) const;
+  /// Why a consumer listed in may_lag is kept in step ("" if it may lag).
+  std::string keptInStepBecause(const std::string& node) const;
+  int64_t behind(const NodeState& n) const;  // messages not yet handled, all channels
+  /// The consumer's unhandled messages on `channel` are all playback's and inside its promise.
+  bool promisedQuiet(const NodeState& n, const std::string& channel) const;
+  void noteLagDecisions();
 
   std::vector<std::string> consumers_;
   LockstepGateOptions options_;
   std::map<std::string, NodeState> nodes_;  // every node seen, listed or not
   std::map<std::string, int64_t> playback_published_;
+  std::map<std::string, std::deque<std::pair<int64_t, int64_t>>> playback_utimes_;  // channel -> (index, utime), newest
   std::map<std::string, int64_t> known_total_;                       // channel -> total seen so far
   std::map<std::string, std::deque<std::pair<int64_t, double>>> reached_at_;  // channel -> (total, time)
   std::map<std::pair<std::string, std::string>, Waiting> waiting_;   // (consumer, channel)
   std::map<std::string, int64_t> lost_total_;
   std::vector<std::string> events_;
+  std::vector<std::string> lagging_;                  // lagging(), worked out when the topology changes
+  std::map<std::string, std::string> lag_decision_;  // may_lag consumer -> "" or why in step (last told)
   int restarts_ = 0;
 };
 

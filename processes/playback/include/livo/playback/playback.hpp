@@ -29,6 +29,10 @@ struct PlaybackOptions {
   bool respawn = false;                 // lockstep: consumers may exit and be restarted (supervised
                                         // runs); not waited for while away
   double startup_timeout_s = 30.0;      // lockstep: time for every consumer to report once
+  bool serial = false;                  // lockstep: wait for every consumer after every message (no
+                                        // quiet promises, nothing lags): the reference order
+  std::vector<std::string> may_lag;     // lockstep: consumers that may fall behind by up to max_lag
+  int max_lag_messages = 4;             // messages, while the rest handle the next ones (lockstep_gate.hpp)
   std::vector<Fault> faults;
   uint64_t seed = 1;
   std::string out_log;                  // write the (faulted) stream here instead of publishing
@@ -42,6 +46,9 @@ struct PlaybackResult {
   std::string error;                    // empty on success
   int64_t lost = 0;                     // lockstep: messages consumers never received (bus losses)
   int restarts = 0;                     // lockstep with respawn: consumers that came back
+  int64_t not_waited = 0;               // lockstep: messages after which the next went out at once
+                                        // (quiet promises, lagging consumers), not after the whole
+                                        // pipeline had handled them
 };
 
 /// Runs the replay to the end (or until SIGINT/SIGTERM). `lcm` may be null when out_log is set.
