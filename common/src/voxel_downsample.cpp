@@ -1,5 +1,7 @@
 #include "livo/voxel_downsample.hpp"
 
+#include <algorithm>
+
 #include "livo/flat_key_index.hpp"
 #include "livo/voxel_key.hpp"
 
@@ -8,11 +10,17 @@ namespace livo {
 std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
                                     double voxel_size) {
   const double inv = 1.0 / voxel_size;
-  FlatKeyIndex seen(subset.size());
+  // Sized for the voxels, not the points: a dense sweep has tens of points per voxel, and a table
+  // for all of them (8 MB for a 64-beam sweep) costs more to clear and misses the cache more than
+  // the few doublings it grows by.
+  FlatKeyIndex seen(std::min<size_t>(subset.size(), 1024));
   std::vector<size_t> out;
   out.reserve(subset.size() / 4 + 16);
+  VoxelKey last = kNoVoxel;  // a sweep's consecutive points often share a voxel: no lookup then
   for (size_t j : subset) {
     const VoxelKey key = voxelKeyOf(points[j], inv);
+    if (key == last) continue;
+    last = key;
     const int32_t next = static_cast<int32_t>(out.size());
     if (seen.insert(key, next) == next) out.push_back(j);
   }

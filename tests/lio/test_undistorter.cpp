@@ -2,6 +2,7 @@
 // at the sweep end, must match the true hit point seen from the true end pose.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "livo/lio/imu_propagator.hpp"
@@ -13,7 +14,8 @@ using namespace livo::lio;
 
 TEST(Undistorter, SmallAngleExpIsExact) {
   for (const Vec3& w : {Vec3(1e-9, 0, 0), Vec3(0.01, -0.02, 0.03), Vec3(0.03, 0.03, -0.02), Vec3(0.2, 0.1, 0.0)})
-    EXPECT_LT((expSmall(w) - so3::Exp(w)).cwiseAbs().maxCoeff(), 1e-15) << w.transpose();
+    for (const Vec3& v : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)})  // the columns of Exp(w)
+      EXPECT_LT((expSmallTimes(w, v) - so3::Exp(w) * v).cwiseAbs().maxCoeff(), 1e-15) << w.transpose();
 }
 
 TEST(Undistorter, SweepWithKnownMotion) {
@@ -58,4 +60,17 @@ TEST(Undistorter, SweepWithKnownMotion) {
   // Without undistortion points are off by up to decimetres; with it, by the integration error.
   EXPECT_GT(max_raw, 0.1);
   EXPECT_LT(max_err, 1e-3);
+
+  // A whole sweep (which reuses the previous point's IMU segment) moves each point as a single
+  // point is moved, in any point order.
+  std::vector<size_t> shuffled = all;
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  std::vector<Vec3> body_shuffled;
+  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), shuffled, &body_shuffled);
+  for (size_t k = 0; k < shuffled.size(); k += 7) {
+    const size_t j = shuffled[k];
+    const Vec3 single = und.toEnd(scan.points[j], scan.utime + static_cast<int64_t>(time_offset * 1e6), scan.time_offset[j]);
+    ASSERT_EQ(body_shuffled[k], single) << k;
+    ASSERT_EQ(body[j], single) << j;
+  }
 }

@@ -88,6 +88,32 @@ TEST(VoxelMap, KnnEqualsBruteForceWithSmallVoxels) {
   expectKnnEqualsBruteForce(map, 4, 100);
 }
 
+TEST(VoxelMap, KnnEqualsBruteForceAtTheLioDefaults) {
+  // The LIO's search (default map, k 5 within 1.5 m), which settles most queries in the voxels
+  // within half the radius: also queries on voxel faces, edges and corners, where the two stages'
+  // boxes and the settle test meet.
+  VoxelMap map;
+  map.insert(mapLikePoints(40000, 9));
+  const std::vector<Vec3> stored = map.points();
+  std::mt19937 rng(10);
+  std::uniform_real_distribution<double> u(-11.0, 11.0);
+  std::uniform_int_distribution<int> cell(-10, 10);
+  for (int i = 0; i < 600; ++i) {
+    Vec3 q(u(rng), u(rng), 0.3 * u(rng));
+    if (i % 3 == 1) q.x() = cell(rng);                                                    // on a face
+    if (i % 3 == 2) q = Vec3(cell(rng), cell(rng), std::round(q.z())) + Vec3(0, 0.5, 0);  // on an edge
+    if (i % 6 == 5) q.y() = std::round(q.y());                                            // on a corner
+    for (int k : {1, 5}) {
+      Vec3 out[32];
+      double d2[32];
+      const int n = map.knn(q, k, 1.5, out, d2);
+      const std::vector<double> bf = bruteForce(stored, q, k, 1.5);
+      ASSERT_EQ(n, static_cast<int>(bf.size())) << "query " << q.transpose() << " k " << k;
+      for (int j = 0; j < n; ++j) EXPECT_EQ(d2[j], bf[static_cast<size_t>(j)]) << "query " << q.transpose();
+    }
+  }
+}
+
 TEST(VoxelMap, DownsamplingRule) {
   VoxelMapOptions o;
   o.voxel_size = 1.0;
@@ -154,6 +180,9 @@ TEST(VoxelMap, ScanDownsamplingKeepsTheFirstPointPerVoxel) {
   EXPECT_EQ(idx, (std::vector<size_t>{0, 2, 3}));
   const auto sub = firstPointPerVoxel(pts, std::vector<size_t>{1, 4, 2}, 0.5);
   EXPECT_EQ(sub, (std::vector<size_t>{1, 2}));
+  // a voxel met again after others (not only by consecutive points) keeps its first point
+  const auto back = firstPointPerVoxel(pts, std::vector<size_t>{0, 2, 1, 3, 4, 0}, 0.5);
+  EXPECT_EQ(back, (std::vector<size_t>{0, 2, 3}));
 }
 
 namespace {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <stdexcept>
 
 namespace livo::lio {
@@ -17,9 +19,9 @@ bool VoxelMap::insert(const Vec3& p) { return insert(p, 0.0); }
 
 bool VoxelMap::insert(const Vec3& p, double range) {
   if (!p.allFinite()) return false;
-  const int64_t cx = static_cast<int64_t>(std::floor(p.x() * inv_size_));
-  const int64_t cy = static_cast<int64_t>(std::floor(p.y() * inv_size_));
-  const int64_t cz = static_cast<int64_t>(std::floor(p.z() * inv_size_));
+  const int64_t cx = floorToInt(p.x() * inv_size_);
+  const int64_t cy = floorToInt(p.y() * inv_size_);
+  const int64_t cz = floorToInt(p.z() * inv_size_);
   const VoxelKey key = packVoxel(cx, cy, cz);
   const int32_t next = static_cast<int32_t>(voxels_.size());
   const int32_t v = index_.insert(key, next);
@@ -74,55 +76,13 @@ size_t VoxelMap::insert(const std::vector<Vec3>& points, const Vec3& origin) {
 
 int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, double* out_sq_dist) const {
   if (k <= 0 || k > 32 || voxels_.empty() || !q.allFinite()) return 0;
-  const double r = max_distance;
-  const double r2 = r * r;
+  const double r2 = max_distance * max_distance;
   const double vs = opts_.voxel_size;
-  int64_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = static_cast<int64_t>(std::floor((q[a] - r) * inv_size_));
-    hi[a] = static_cast<int64_t>(std::floor((q[a] + r) * inv_size_));
-  }
-  // Candidate voxels intersecting the ball, visited nearest first and looked up
-  // lazily, so the search usually stops after the few nearest voxels.
-  struct Cand {
-    double d2;
-    int64_t x, y, z;
-  };
-  Cand small[64];
-  std::vector<Cand> large;
-  const int64_t ncand = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
-  Cand* cands = small;
-  if (ncand > 64) {
-    large.resize(static_cast<size_t>(ncand));
-    cands = large.data();
-  }
-  int nc = 0;
-  for (int64_t x = lo[0]; x <= hi[0]; ++x) {
-    const double dx = std::max({0.0, x * vs - q.x(), q.x() - (x + 1) * vs});
-    for (int64_t y = lo[1]; y <= hi[1]; ++y) {
-      const double dy = std::max({0.0, y * vs - q.y(), q.y() - (y + 1) * vs});
-      const double dxy = dx * dx + dy * dy;
-      if (dxy > r2) continue;
-      for (int64_t z = lo[2]; z <= hi[2]; ++z) {
-        const double dz = std::max({0.0, z * vs - q.z(), q.z() - (z + 1) * vs});
-        const double d2 = dxy + dz * dz;
-        if (d2 > r2) continue;
-        int i = nc++;
-        while (i > 0 && cands[i - 1].d2 > d2) {
-          cands[i] = cands[i - 1];
-          --i;
-        }
-        cands[i] = Cand{d2, x, y, z};
-      }
-    }
-  }
-
   int found = 0;
   double worst = r2;  // admit points with d2 <= worst
-  for (int c = 0; c < nc; ++c) {
-    if (cands[c].d2 > worst) break;
-    const int32_t v = index_.find(packVoxel(cands[c].x, cands[c].y, cands[c].z));
-    if (v < 0) continue;
+  auto scanVoxel = [&](int64_t x, int64_t y, int64_t z) {
+    const int32_t v = index_.find(packVoxel(x, y, z));
+    if (v < 0) return;
     const float* pts = voxelPoints(v);
     const int cnt = voxels_[static_cast<size_t>(v)].count;
     for (int i = 0; i < cnt; ++i) {
@@ -140,6 +100,93 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
       out_points[j] = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
       if (found == k) worst = out_sq_dist[k - 1];
     }
+  };
+
+  // The voxels meeting the ball are visited nearest first and looked up lazily, so the search
+  // stops after the few nearest (about 8 at the defaults). It runs in two stages: the voxels within
+  // half the radius (a fifth of the ball's 64 at the defaults), then, only if the k nearest are not
+  // settled by then, the rest; each stage orders its voxels with a min-heap, which pays only for
+  // those visited. The order decides only which voxel is looked up first: the result is exact.
+  // An entry of the heap is one integer, the voxel's distance as float bits (non-negative floats
+  // order as their bits) above its index in the stage's box, so a heap step moves 8 bytes; the stop
+  // test uses the double distance.
+  struct Box {
+    int64_t lo[3] = {1, 1, 1}, hi[3] = {0, 0, 0};  // empty
+    bool contains(int64_t x, int64_t y, int64_t z) const {
+      return lo[0] <= x && x <= hi[0] && lo[1] <= y && y <= hi[1] && lo[2] <= z && z <= hi[2];
+    }
+  };
+  Box inner;            // the previous stage's box ...
+  double inner2 = -1.0; // ... whose voxels with d2 <= inner2 were visited
+  uint64_t heap_small[64];
+  double d2_small[64];  // by index in the stage's box: (x, y, z) -> (x * ny + y) * nz + z
+  std::vector<uint64_t> heap_large;
+  std::vector<double> d2_large;
+  for (const double stage_r : {0.5 * max_distance, max_distance}) {
+    const double stage_r2 = stage_r * stage_r;
+    Box box;
+    double ax[3][8];  // per axis: the squared distance from q to each cell's slab (0 in q's own)
+    for (int a = 0; a < 3; ++a) {
+      box.lo[a] = floorToInt((q[a] - stage_r) * inv_size_);
+      box.hi[a] = floorToInt((q[a] + stage_r) * inv_size_);
+    }
+    const int64_t nx = box.hi[0] - box.lo[0] + 1, ny = box.hi[1] - box.lo[1] + 1, nz = box.hi[2] - box.lo[2] + 1;
+    const int64_t ncand = nx * ny * nz;
+    std::vector<double> ax_large;
+    double* axis[3] = {ax[0], ax[1], ax[2]};
+    if (std::max({nx, ny, nz}) > 8) {
+      ax_large.resize(static_cast<size_t>(nx + ny + nz));
+      axis[0] = ax_large.data(), axis[1] = axis[0] + nx, axis[2] = axis[1] + ny;
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int64_t c = box.lo[a]; c <= box.hi[a]; ++c) {
+        const double d = std::max({0.0, c * vs - q[a], q[a] - (c + 1) * vs});
+        axis[a][c - box.lo[a]] = d * d;
+      }
+    uint64_t* heap = heap_small;
+    double* cand_d2 = d2_small;
+    if (ncand > 64) {
+      heap_large.resize(static_cast<size_t>(ncand));
+      d2_large.resize(static_cast<size_t>(ncand));
+      heap = heap_large.data();
+      cand_d2 = d2_large.data();
+    }
+    int64_t nc = 0;
+    for (int64_t x = 0; x < nx; ++x)
+      for (int64_t y = 0; y < ny; ++y) {
+        const double dxy = axis[0][x] + axis[1][y];
+        if (dxy > stage_r2) continue;
+        for (int64_t z = 0; z < nz; ++z) {
+          const double d2 = dxy + axis[2][z];
+          if (d2 > stage_r2) continue;
+          if (d2 <= inner2 && inner.contains(box.lo[0] + x, box.lo[1] + y, box.lo[2] + z)) continue;  // visited
+          const uint32_t index = static_cast<uint32_t>((x * ny + y) * nz + z);
+          const float f = static_cast<float>(d2);
+          uint32_t bits;
+          std::memcpy(&bits, &f, sizeof bits);
+          cand_d2[index] = d2;
+          heap[nc++] = (uint64_t{bits} << 32) | index;
+        }
+      }
+    const std::greater<uint64_t> farther;  // std::*_heap with greater: a min-heap
+    std::make_heap(heap, heap + nc, farther);
+    for (int64_t left = nc; left > 0; --left) {
+      const uint32_t index = static_cast<uint32_t>(heap[0]);
+      if (cand_d2[index] > worst) break;  // this stage's others are farther still
+      std::pop_heap(heap, heap + left, farther);
+      scanVoxel(box.lo[0] + index / (nz * ny), box.lo[1] + (index / nz) % ny, box.lo[2] + index % nz);
+    }
+    // Settled when no unvisited voxel can hold a nearer point: those left are this stage's beyond
+    // worst, and those beyond stage_r or outside the box (whose faces are about stage_r from q; the
+    // exact distance guards rounding).
+    double unvisited2 = stage_r2;
+    for (int a = 0; a < 3; ++a) {
+      const double face = std::min(q[a] - box.lo[a] * vs, (box.hi[a] + 1) * vs - q[a]);
+      unvisited2 = std::min(unvisited2, face * face);
+    }
+    if (found == k && worst <= unvisited2) return found;
+    inner = box;
+    inner2 = stage_r2;
   }
   return found;
 }
@@ -189,26 +236,30 @@ size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& 
     // the voxels within the beam's radius of the ray up to `reach`: the cube of half-size
     // step / 2 + radius around every sample holds every voxel the ray passes within radius of
     const double half = 0.5 * step + o.beam_radius + o.beam_divergence * reach;
-    VoxelKey visited[16];  // the ray's last voxels (a point is flagged once a sweep anyway)
-    int filled = 0, cursor = 0;
+    // The samples whose cube holds a given voxel are consecutive (the cube's centre moves along
+    // a line, and the centres whose cube meets a voxel lie in a box around it): a voxel in the
+    // previous sample's cube has been visited, any other has not.
+    int64_t prev_lo[3] = {1, 1, 1}, prev_hi[3] = {0, 0, 0};  // empty
     for (double t = o.min_range; t < reach + step; t += step) {
       const Vec3 c = origin + std::min(t, reach) * dir;
       int64_t lo[3], hi[3];
       for (int a = 0; a < 3; ++a) {
-        lo[a] = static_cast<int64_t>(std::floor((c[a] - half) * inv_size_));
-        hi[a] = static_cast<int64_t>(std::floor((c[a] + half) * inv_size_));
+        lo[a] = floorToInt((c[a] - half) * inv_size_);
+        hi[a] = floorToInt((c[a] + half) * inv_size_);
       }
-      for (int64_t x = lo[0]; x <= hi[0]; ++x)
-        for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        const bool x_seen = prev_lo[0] <= x && x <= prev_hi[0];
+        for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+          const bool xy_seen = x_seen && prev_lo[1] <= y && y <= prev_hi[1];
           for (int64_t z = lo[2]; z <= hi[2]; ++z) {
-            const VoxelKey key = packVoxel(x, y, z);
-            if (std::find(visited, visited + filled, key) != visited + filled) continue;
-            visited[cursor] = key;
-            cursor = (cursor + 1) % 16;
-            filled = std::min(filled + 1, 16);
-            const int32_t v = index_.find(key);
+            if (xy_seen && prev_lo[2] <= z && z <= prev_hi[2]) continue;
+            const int32_t v = index_.find(packVoxel(x, y, z));
             if (v >= 0) markSeenThrough(v, origin, dir, reach, o, &touched);
           }
+        }
+      }
+      std::copy_n(lo, 3, prev_lo);
+      std::copy_n(hi, 3, prev_hi);
     }
   }
   // one miss per sweep for every point seen through; those with enough go

@@ -32,19 +32,23 @@ class Undistorter {
  private:
   struct Seg {
     double t0;       // start, s relative to the end
-    Mat3 R;          // R_end^T R_k
+    Mat3 R_L;        // R_k R_IL, with R_k = R_end^T R_k(world)
+    Vec3 t_L;        // R_k t_IL
     Vec3 p;          // R_end^T (p_k - p_end)
     Vec3 v;          // R_end^T v_k
     Vec3 a;          // R_end^T acc_world_k
-    Vec3 omega;      // body rate over the step
+    Vec3 omega;      // R_k times the body rate over the step
   };
+  /// Index of the segment holding time t (relative to the end).
+  size_t segmentAt(double t) const;
+  /// p_L measured at t, moved along segment `seg` into the body frame at the end.
+  Vec3 moveToEnd(const Vec3& p_L, double t, size_t seg) const;
+
   std::vector<Seg> segs_;
   int64_t end_utime_;
-  Mat3 R_IL_;
-  Vec3 t_IL_;
 };
 
-/// Exp(w) for the small angles of one IMU step (series to machine precision below 0.05 rad).
-Mat3 expSmall(const Vec3& w);
+/// Exp(w) v for the small angles of one IMU step (series to machine precision below 0.05 rad).
+Vec3 expSmallTimes(const Vec3& w, const Vec3& v);
 
 }  // namespace livo::lio
