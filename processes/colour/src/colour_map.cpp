@@ -85,6 +85,7 @@ void ColourMap::VoxelIndex::reset(size_t expected) {
   while (n < 2 * expected + 2) n *= 2;
   if (n != slots_.size()) std::vector<Slot>().swap(slots_);  // the old table goes before the new one comes
   slots_.assign(n, Slot{});
+  shift_ = 64 - __builtin_ctzll(n);
   size_ = 0;
 }
 

@@ -52,7 +52,10 @@ bool ColouringPipeline::ViewCone::contains(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d v = p - centre;
   const double r = v.norm();
   if (r <= travel) return true;
-  const double angle = std::atan2(v.cross(axis).norm(), v.dot(axis));
+  const double along = v.dot(axis);
+  if (along > cos_surely_inside * r) return true;                       // well inside
+  if (r >= far_range && along < cos_surely_outside * r) return false;  // well outside
+  const double angle = std::atan2(v.cross(axis).norm(), along);
   return angle <= half_angle + std::asin(std::min(1.0, travel / r));
 }
 
@@ -79,6 +82,14 @@ ColouringPipeline::ViewCone ColouringPipeline::viewCone(const RegisteredScanView
   const double turn = 1.5 * rate * window;
   cone.half_angle = field_half_angle_ + options_.view_margin_deg * M_PI / 180.0 + turn;
   cone.travel = 1.5 * speed * window + camera_.rig().T_I_C.translation().norm() * turn + 0.2;
+  // the shortcut's margin (1e-6 rad, a cosine margin of sin(angle) * 1e-6) dwarfs the rounding of
+  // either test, so it only ever says "inside" where the exact test does
+  constexpr double kMargin = 1e-6;
+  if (cone.half_angle - kMargin > 0.01 && cone.half_angle - kMargin < M_PI - 0.01)
+    cone.cos_surely_inside = std::cos(cone.half_angle - kMargin);
+  const double outside = cone.half_angle + std::asin(0.2) + kMargin;
+  cone.far_range = 5.0 * cone.travel;
+  if (outside > 0.01 && outside < M_PI - 0.01) cone.cos_surely_outside = std::cos(outside);
   return cone;
 }
 
@@ -99,11 +110,16 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   ++stats_.scans;
   const int64_t anchor = keyframes_.empty() ? -1 : keyframes_.rbegin()->first;
   map_.setTime(scan.utime);
-  ActiveScan active{++scan_seq_, INT64_MAX, INT64_MIN, {}};
+  ActiveScan active{++scan_seq_, INT64_MAX, INT64_MIN, std::move(spare_points_)};
+  spare_points_ = {};
+  active.points.clear();
   active.points.reserve(scan.num_points);
   const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
   const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
   const ViewCone cone = viewCone(scan);
+  // first the points the map takes, then into the map in scan order (the same ids), each point's
+  // voxel looked up a few points ahead
+  accepted_.clear();
   for (int j = 0; j < scan.num_points; ++j) {
     const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
@@ -119,6 +135,16 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
       ++stats_.points_out_of_view;
       continue;
     }
+    accepted_.push_back(j);
+  }
+  for (size_t k = 0; k < accepted_.size(); ++k) {
+    if (k + kReadAhead < accepted_.size()) {
+      const int ahead = accepted_[k + kReadAhead];
+      map_.prefetchVoxel(Eigen::Vector3f(scan.x[ahead], scan.y[ahead], scan.z[ahead]));
+    }
+    const int j = accepted_[k];
+    const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
+    const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));
     const uint32_t id = map_.addPoint(p, anchor);
     if (id >= last_scan_.size()) last_scan_.resize(map_.size(), 0);
@@ -131,7 +157,10 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   if (!active.points.empty()) active_.push_back(std::move(active));
   // keep the scans an image still to come may need (a generous second beyond the window)
   const int64_t keep_from = newest_scan_end_ - 2 * windowUs() - 1000000;
-  while (!active_.empty() && active_.front().t_max < keep_from) active_.pop_front();
+  while (!active_.empty() && active_.front().t_max < keep_from) {
+    spare_points_ = std::move(active_.front().points);
+    active_.pop_front();
+  }
   poses_.dropBefore(keep_from);
   if (last_prune_utime_ == INT64_MIN) {
     last_prune_utime_ = scan.utime;
@@ -188,31 +217,40 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   const Pose3 T_C_W = T_W_C.inverse();
   const int64_t t0 = image.utime - windowUs(), t1 = image.utime + windowUs();
 
-  struct Candidate {
-    uint32_t id;
-    Eigen::Vector2d pixel;
-    double z;
-  };
-  std::vector<Candidate> candidates;
-  // stamps older than this visit never equal it, whatever point they belonged to before a merge
-  visited_.resize(map_.size(), 0);
-  if (++visit_ == 0) {  // wrapped
-    std::fill(visited_.begin(), visited_.end(), 0);
-    visit_ = 1;
-  }
+  // the map points measured within the window, each once (in the order first measured), then
+  // projected; positions are read ahead (a map point is some 40 bytes anywhere in the map: the
+  // read, not the arithmetic, is what a point costs)
+  window_ids_.clear();
+  // a bit per map point, cleared per image: a few kB, so the test stays in the first-level cache
+  // (a stamp per point, as before, is 4 bytes a point and missed it)
+  window_seen_.assign((map_.size() + 63) / 64, 0);
+  // without branches: whether a point is taken is as good as random (a window cuts through its
+  // scans, and most points were measured by the scans before too)
+  size_t taken = 0;
   for (const ActiveScan& scan : active_) {
     if (scan.t_max < t0 || scan.t_min > t1) continue;
+    window_ids_.resize(taken + scan.points.size());
     for (const auto& [id, t] : scan.points) {
-      if (t < t0 || t > t1 || visited_[id] == visit_) continue;
-      visited_[id] = visit_;
-      const MapPoint& mp = map_.point(id);
-      const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
-      if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
-      Eigen::Vector2d px;
-      if (!camera_.project(p_C, &px, 0.0)) continue;
-      candidates.push_back({id, px, p_C.z()});
+      uint64_t& word = window_seen_[id >> 6];
+      const uint64_t bit = uint64_t{1} << (id & 63);
+      const bool take = (t >= t0) & (t <= t1) & !(word & bit);
+      word |= take ? bit : 0;
+      window_ids_[taken] = id;
+      taken += take;
     }
   }
+  window_ids_.resize(taken);
+  candidates_.clear();
+  for (size_t i = 0; i < window_ids_.size(); ++i) {
+    if (i + kReadAhead < window_ids_.size()) __builtin_prefetch(&map_.point(window_ids_[i + kReadAhead]));
+    const uint32_t id = window_ids_[i];
+    const Eigen::Vector3d p_C = T_C_W * map_.point(id).position.cast<double>();
+    if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
+    Eigen::Vector2d px;
+    if (!camera_.project(p_C, &px, 0.0)) continue;
+    candidates_.push_back({id, px, p_C.z()});
+  }
+  const std::vector<Candidate>& candidates = candidates_;
   stats_.projected += static_cast<int64_t>(candidates.size());
 
   depth_.clear();
@@ -224,8 +262,10 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
     exposure_scale = reference_exposure_ / image.exposure_time;
   }
   const double b = options_.border_px, w = camera_.rig().width - 1 - b, h = camera_.rig().height - 1 - b;
-  std::vector<uint32_t> ids;
-  std::vector<Eigen::Vector3f> observed, mapped;
+  std::vector<uint32_t>& ids = sampled_ids_;
+  std::vector<Eigen::Vector3f>& observed = observed_;
+  ids.clear();
+  observed.clear();
   for (const Candidate& c : candidates) {
     if (c.pixel.x() < b || c.pixel.y() < b || c.pixel.x() > w || c.pixel.y() > h) continue;
     if (!depth_.visible(c.pixel, c.z)) {
@@ -238,15 +278,18 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   }
   double gain = 1.0;
   if (options_.estimate_gain) {
-    std::vector<Eigen::Vector3f> obs_known;
+    gain_observed_.clear();
+    gain_mapped_.clear();
     for (size_t i = 0; i < ids.size(); ++i) {
+      if (i + kReadAhead < ids.size()) __builtin_prefetch(&map_.point(ids[i + kReadAhead]));
       const MapPoint& mp = map_.point(ids[i]);
       if (mp.count >= 2) {
-        obs_known.push_back(observed[i]);
-        mapped.push_back(mp.colour);
+        gain_observed_.push_back(observed[i]);
+        gain_mapped_.push_back(mp.colour);
       }
     }
-    const GainEstimate g = estimateGain(obs_known, mapped, options_.gain_min_pairs, options_.gain_min, options_.gain_max);
+    const GainEstimate g =
+        estimateGain(gain_observed_, gain_mapped_, options_.gain_min_pairs, options_.gain_min, options_.gain_max);
     if (g.valid) {
       gain = g.gain;
       ++stats_.gain_estimates;
@@ -257,6 +300,7 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   size_t k = 0;
   for (const Candidate& c : candidates) {
     if (k >= ids.size() || ids[k] != c.id) continue;
+    if (k + kReadAhead < ids.size()) __builtin_prefetch(&map_.point(ids[k + kReadAhead]));
     const Eigen::Vector3f col = (observed[k] / static_cast<float>(gain)).cwiseMin(255.0f);
     ++k;
     if (!map_.accumulate(c.id, col, acc)) {
@@ -304,6 +348,17 @@ void ColouringPipeline::settleMap() { afterTileChanges(map_.settleSpilledTiles()
 
 std::vector<uint32_t> ColouringPipeline::takeRecoloured() {
   std::vector<uint32_t> out;
+  if (recoloured_.size() * 16 >= recoloured_flag_.size()) {
+    // many (a sweep's worth): the flags, read in id order, are the sorted list without a sort
+    out.reserve(recoloured_.size());
+    for (uint32_t id = 0; id < recoloured_flag_.size(); ++id) {
+      if (!recoloured_flag_[id]) continue;
+      recoloured_flag_[id] = 0;
+      out.push_back(id);
+    }
+    recoloured_.clear();
+    return out;
+  }
   out.swap(recoloured_);
   for (uint32_t id : out) recoloured_flag_[id] = 0;
   std::sort(out.begin(), out.end());

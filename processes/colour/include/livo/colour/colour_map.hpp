@@ -64,6 +64,9 @@ class ColourMap {
   /// The point of the voxel containing p (created at p if the voxel is empty); a tile on disk
   /// comes back first.
   uint32_t addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created = nullptr);
+  /// Starts reading the index where addPoint(p) will look (a batch of points: a hint, no effect
+  /// on the map; the index is too large for the cache, so each point would otherwise wait for it).
+  void prefetchVoxel(const Eigen::Vector3f& p) const { index_.prefetch(key(p)); }
   /// Removes the resident points never coloured for which `drop(id)` is true (their voxels become
   /// empty: a scan that measures one again creates its point anew); returns how many. One pass
   /// over the resident points and tiles: call it now and then, not per scan.
@@ -125,6 +128,7 @@ class ColourMap {
    public:
     /// The id stored for key, after storing `id` for it if it had none (*inserted tells which).
     uint32_t findOrInsert(uint64_t key, uint32_t id, bool* inserted);
+    void prefetch(uint64_t key) const { __builtin_prefetch(&slots_[home(key)]); }
     /// Removes key (backward-shift deletion: no tombstones).
     void erase(uint64_t key);
     /// Empties the index, sized for `expected` keys.
@@ -136,10 +140,14 @@ class ColourMap {
       uint64_t key = kEmpty;
       uint32_t id = 0;
     };
-    size_t home(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 17) & (slots_.size() - 1); }
+    // Fibonacci hashing: the product's top bits, which every bit of the key reaches (its middle
+    // bits, as used before, saw nothing of z, the key's top field: a wall's voxels, one column of
+    // z each, shared their slots and probed through long runs)
+    size_t home(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_); }
     void grow();
     std::vector<Slot> slots_;
     size_t size_ = 0;
+    int shift_ = 63;  // 64 - log2(slots_.size()) (set by reset)
   };
   struct Tile {
     std::vector<uint32_t> ids;  // resident points

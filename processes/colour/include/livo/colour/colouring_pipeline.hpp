@@ -100,6 +100,14 @@ class ColouringPipeline {
     Eigen::Vector3d centre, axis;
     double half_angle = M_PI;  // rad, before the travel term
     double travel = 0.0;       // m: how far the camera may move over the window
+    // Shortcuts past the exact test (an atan2 and an asin a point): a point whose angle's cosine
+    // is above cos_surely_inside (cos(half_angle - 1e-6); 2: none) is inside, one at least
+    // far_range (5 travel) away whose cosine is below cos_surely_outside (cos(half_angle +
+    // asin(0.2) + 1e-6), asin(0.2) bounding the travel term there; -2: none) is outside,
+    // whatever the rounding of either test
+    double cos_surely_inside = 2.0;
+    double cos_surely_outside = -2.0;
+    double far_range = 0.0;
     bool contains(const Eigen::Vector3d& p) const;
   };
   ViewCone viewCone(const RegisteredScanView& scan);
@@ -124,7 +132,6 @@ class ColouringPipeline {
   int64_t last_scan_utime_ = INT64_MIN, last_image_utime_ = INT64_MIN;
   int64_t newest_scan_end_ = INT64_MIN;
   double reference_exposure_ = 0.0;
-  uint32_t visit_ = 0;
   uint32_t scan_seq_ = 0;
   std::vector<uint32_t> last_scan_;  // per map point: seq of the newest scan that measured it (0: none)
   int64_t last_prune_utime_ = INT64_MIN;
@@ -135,9 +142,25 @@ class ColouringPipeline {
   };
   std::deque<Motion> motion_;  // the last 2 s of scan poses
   std::optional<std::pair<int64_t, Pose3>> last_scan_pose_;
-  std::vector<uint32_t> visited_;  // per map point: the last visit_ that looked at it (dense: cache-friendly)
+  std::vector<uint64_t> window_seen_;  // per map point, a bit: taken for the image being coloured
   std::vector<uint8_t> recoloured_flag_;
   std::vector<uint32_t> recoloured_;
+  // per-image working sets, kept between images: sized ~10^5 points they would otherwise be
+  // allocated (fresh pages, page faults) and returned to the system for every image
+  struct Candidate {
+    uint32_t id;
+    Eigen::Vector2d pixel;
+    double z;
+  };
+  std::vector<uint32_t> window_ids_;  // the map points of the image's time window, once each
+  std::vector<Candidate> candidates_;
+  std::vector<uint32_t> sampled_ids_;
+  std::vector<Eigen::Vector3f> observed_, gain_observed_, gain_mapped_;
+  std::vector<std::pair<uint32_t, int64_t>> spare_points_;  // a dropped scan's buffer, for the next
+  std::vector<int> accepted_;  // the scan's points the map takes
+  // map reads are started this many points ahead of their use (the map and its index are far
+  // larger than the cache)
+  static constexpr size_t kReadAhead = 8;
   std::function<void(const Observation&)> observer_;
   ColouringStats stats_;
 };
