@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -17,6 +18,7 @@
 
 #include "livo/octomap/octomap_builder.hpp"
 #include "livo/octomap/octomap_config.hpp"
+#include "livo/octomap/morton_index.hpp"
 #include "livo/octomap/ray_keys.hpp"
 #include "temp_path.hpp"
 
@@ -463,6 +465,69 @@ TEST(RayKeys, SameKeysAsOctomapsComputeRayKeys) {
       keys += mine.size();
     }
     EXPECT_GT(keys, 300000u);
+  }
+}
+
+namespace {
+constexpr int kCheckBits = 4;
+struct StepChecker {  // a walkRayKeys walker
+  std::function<unsigned(const ::octomap::OcTreeKey&)> idx;
+  ::octomap::OcTreeKey prev;
+  unsigned i = 0;  // the index moved along with the steps
+  size_t steps = 0, crossings = 0, failures = 0;
+  void start(const ::octomap::OcTreeKey& k) {
+    prev = k;
+    i = idx(k);
+  }
+  template <int A>
+  void step(int dir, const ::octomap::OcTreeKey& k) {
+    ::octomap::OcTreeKey want = prev;
+    want[A] = static_cast<::octomap::key_type>(want[A] + dir);
+    const bool leaves = dir > 0 ? morton::atTop<A, kCheckBits>(i) : morton::atBottom<A, kCheckBits>(i);
+    crossings += leaves;
+    i = dir > 0 ? morton::up<A, kCheckBits>(i) : morton::down<A, kCheckBits>(i);
+    failures += !(k == want) || (dir != 1 && dir != -1) || i != idx(k) || leaves != ((prev[A] >> kCheckBits) != (k[A] >> kCheckBits));
+    prev = k;
+    ++steps;
+  }
+};
+}  // namespace
+
+// The ray walk's steps move the key by one along the axis they name, and the Morton index moved
+// along with them (morton::up/down, wrapping at a block's faces where atTop/atBottom say so) is the
+// index interleaved from the key, along random rays crossing many 16^3 blocks.
+TEST(RayKeys, StepsMoveTheKeyAndTheMortonIndexByOne) {
+  constexpr int kBits = kCheckBits;
+  constexpr unsigned kM = (1u << kBits) - 1;
+  auto idx = [](const ::octomap::OcTreeKey& k) { return morton::index<kBits>(k[0] & kM, k[1] & kM, k[2] & kM); };
+  ::octomap::OcTree tree(0.1);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> pos(-30.f, 30.f);
+  StepChecker w;
+  w.idx = idx;
+  for (int n = 0; n < 5000; ++n) {
+    const ::octomap::point3d o(pos(rng), pos(rng), pos(rng)), e(pos(rng), pos(rng), pos(rng));
+    ::octomap::OcTreeKey ok;
+    ASSERT_TRUE(tree.coordToKeyChecked(o, ok));
+    walkRayKeys(tree, o, ok, e, w);
+    ASSERT_EQ(w.failures, 0u) << "ray " << n;
+  }
+  EXPECT_GT(w.steps, 1000000u);
+  EXPECT_GT(w.crossings, 50000u);
+  // every lane value up and down, on each axis
+  for (unsigned i = 0; i < (1u << (3 * kBits)); ++i) {
+    const unsigned x = i & 0x249u, y = i & 0x492u, z = i & 0x924u;
+    auto coord = [](unsigned v, int a) {
+      unsigned c = 0;
+      for (int j = 0; j < kBits; ++j) c |= ((v >> (3 * j + a)) & 1u) << j;
+      return c;
+    };
+    const unsigned cx = coord(x, 0), cy = coord(y, 1), cz = coord(z, 2);
+    ASSERT_EQ((morton::up<0, kBits>(i)), (morton::index<kBits>((cx + 1) & kM, cy, cz)));
+    ASSERT_EQ((morton::down<1, kBits>(i)), (morton::index<kBits>(cx, (cy - 1) & kM, cz)));
+    ASSERT_EQ((morton::up<2, kBits>(i)), (morton::index<kBits>(cx, cy, (cz + 1) & kM)));
+    ASSERT_EQ((morton::atTop<0, kBits>(i)), cx == kM);
+    ASSERT_EQ((morton::atBottom<2, kBits>(i)), cz == 0u);
   }
 }
 

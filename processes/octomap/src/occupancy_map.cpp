@@ -15,6 +15,7 @@
 #include <octomap/OcTree.h>
 
 #include "livo/file_output.hpp"
+#include "livo/octomap/morton_index.hpp"
 #include "livo/octomap/ray_keys.hpp"
 #include "livo/spill_file.hpp"
 
@@ -49,7 +50,12 @@ class SweepVoxels {
     used_ = 0;
     last_ = nullptr;
   }
-  __attribute__((always_inline)) void addFree(const ::octomap::OcTreeKey& k) { set(k, &Block::free); }
+  // marks the voxels a ray crosses from origin (key origin_key) towards end (forEachRayKey's keys)
+  void addRay(const ::octomap::OcTree& keys, const ::octomap::point3d& origin, const ::octomap::OcTreeKey& origin_key,
+              const ::octomap::point3d& end) {
+    RayWalker w{*this};
+    walkRayKeys(keys, origin, origin_key, end, w);
+  }
   void addHit(const ::octomap::OcTreeKey& k) { set(k, &Block::hit); }
   // true if k was not yet an endpoint of this slice
   bool addEndpoint(const ::octomap::OcTreeKey& k) {
@@ -116,6 +122,32 @@ class SweepVoxels {
     }
   };
   static_assert(kBits >= 2 && kBits <= 5, "a block's voxel index and coordinates fit 16 bits");
+  // a step moves the key by one along one axis: the voxel's block and index follow by one add
+  // on that axis's index bits, the block looked up again only when the step leaves it (dir 0
+  // does not come: an axis the ray does not move along never has the nearest border; it would
+  // leave the voxel as it is)
+  struct RayWalker {
+    SweepVoxels& v;
+    Block* b = nullptr;
+    unsigned i = 0;
+    void start(const ::octomap::OcTreeKey& k) {
+      b = &v.block(k);
+      i = local(k);
+      mark();
+    }
+    template <int A>
+    __attribute__((always_inline)) void step(int dir, const ::octomap::OcTreeKey& k) {
+      if (dir > 0) {
+        if (morton::atTop<A, kBits>(i)) b = &v.block(k);
+        i = morton::up<A, kBits>(i);
+      } else if (dir < 0) {
+        if (morton::atBottom<A, kBits>(i)) b = &v.block(k);
+        i = morton::down<A, kBits>(i);
+      }
+      mark();
+    }
+    __attribute__((always_inline)) void mark() { b->free[i >> 6] |= uint64_t{1} << (i & 63); }
+  };
   static const Tables& tables() {
     static const Tables t;
     return t;
@@ -147,7 +179,7 @@ class SweepVoxels {
   __attribute__((noinline)) Block& find(uint64_t key) {
     if ((used_ + 1) * 2 > slots_.size()) grow();
     const size_t mask = slots_.size() - 1;
-    size_t i = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
+    size_t i = hash(key);
     while (slots_[i].key_plus1 && slots_[i].key_plus1 != key + 1) i = (i + 1) & mask;
     if (!slots_[i].key_plus1) {
       if (used_ == blocks_.size()) blocks_.push_back(std::make_unique<Block>());
@@ -163,12 +195,16 @@ class SweepVoxels {
     last_ = slots_[i].block;
     return *last_;
   }
+  // Fibonacci hashing: the product's top bits depend on every bit of the key (middle bits would
+  // barely see x, which sits in bits 32+ of the key, and a whole axis could collide)
+  size_t hash(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> slot_shift_); }
   void grow() {
     slots_.assign(std::max<size_t>(1 << 12, slots_.size() * 2), Slot{});
+    slot_shift_ = 64 - __builtin_ctzll(slots_.size());
     const size_t mask = slots_.size() - 1;
     for (size_t j = 0; j < used_; ++j) {
       Block* b = blocks_[j].get();
-      size_t i = static_cast<size_t>((b->key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
+      size_t i = hash(b->key);
       while (slots_[i].key_plus1) i = (i + 1) & mask;
       slots_[i] = Slot{b->key + 1, b};
       b->slot = i;
@@ -176,6 +212,7 @@ class SweepVoxels {
   }
 
   std::vector<Slot> slots_;
+  int slot_shift_ = 64;  // 64 - log2(slots_.size())
   std::vector<std::unique_ptr<Block>> blocks_;  // [0, used_) in use this sweep
   size_t used_ = 0;
   Block* last_ = nullptr;
@@ -256,8 +293,19 @@ class LeafUpdater {
       path_[d + 1] = t_.getNodeChild(path_[d], pos);
     }
     valid_ = depth_;
+    // the leaf's value is rarely in the cache (a node each, allocated as the tree grew): it is
+    // fetched now and updated kAhead updates later, the walk down meanwhile overlapping the miss
+    // (a leaf's update touches only the leaf, and a sweep updates each leaf once)
     Node* leaf = path_[depth_];
-    if (!clamped(leaf->getLogOdds(), log_odds)) t_.updateNodeLogOdds(leaf, log_odds);
+    __builtin_prefetch(leaf, 1);
+    Pending& p = pending_[queued_++ % kAhead];
+    if (queued_ > kAhead) apply(p);
+    p = Pending{leaf, log_odds};
+  }
+  // the updates still pending; due before the tree is used otherwise
+  void flush() {
+    for (size_t n = queued_ > kAhead ? queued_ - kAhead : 0; n < queued_; ++n) apply(pending_[n % kAhead]);
+    queued_ = 0;
   }
 
  private:
@@ -299,8 +347,19 @@ class LeafUpdater {
     t_.updateNodeLogOdds(path_[depth_], log_odds);
   }
 
+  struct Pending {
+    Node* leaf = nullptr;
+    float log_odds = 0.f;
+  };
+  static constexpr size_t kAhead = 8;
+  void apply(const Pending& p) {
+    if (!clamped(p.leaf->getLogOdds(), p.log_odds)) t_.updateNodeLogOdds(p.leaf, p.log_odds);
+  }
+
   Tree& t_;
   const int depth_;
+  std::array<Pending, kAhead> pending_{};
+  size_t queued_ = 0;  // updates queued; the last min(queued_, kAhead) are pending
   std::array<Node*, 17> path_{};  // path_[d]: node at depth d (tree depth <= 16)
   ::octomap::OcTreeKey prev_;
   int valid_ = 0;  // path_[0 .. valid_] matches prev_
@@ -316,7 +375,6 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
   v.clear();
   const double min2 = o.min_range * o.min_range;
   size_t rays = 0;
-  auto add_free = [&v](const ::octomap::OcTreeKey& k) { v.addFree(k); };
   for (const OccupancyMap::Slice& slice : slices) {
     if (!slice.points || !slice.origin.allFinite()) continue;
     const ::octomap::point3d origin(slice.origin.x(), slice.origin.y(), slice.origin.z());
@@ -344,7 +402,7 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
         end = origin + (end - origin) * float(std::max(0.0, length - o.free_margin) / std::max(length, 1e-9));
       }
       if (hit) v.addHit(key);
-      if (origin_in_range) forEachRayKey(keys, origin, origin_key, end, add_free);
+      if (origin_in_range) v.addRay(keys, origin, origin_key, end);
     }
     v.endSlice();
   }
@@ -364,6 +422,7 @@ size_t integrate(const ::octomap::OcTree& keys, const std::vector<OccupancyMap::
     }
     updater->update(key, is_hit ? hit : miss);
   });
+  for (auto& [tile, u] : updaters) u->flush();
   return rays;
 }
 

@@ -14,16 +14,19 @@
 
 namespace livo::octomap {
 
-/// Calls visit(key) for each voxel between origin (whose key is origin_key) and end: the origin's
-/// voxel first, the end's voxel not (nothing at all when both are one voxel). False (and no
-/// calls) when end lies outside the tree's key range, as computeRayKeys.
-template <class Visit>
-bool forEachRayKey(const ::octomap::OcTree& keys, const ::octomap::point3d& origin,
-                   const ::octomap::OcTreeKey& origin_key, const ::octomap::point3d& end, Visit&& visit) {
+/// Walks the voxels between origin (whose key is origin_key) and end: walker.start(origin_key)
+/// for the origin's voxel, then walker.template step<A>(dir, key) for each further voxel, the key
+/// having moved by dir (+1 or -1) along axis A from the one before (a DDA step changes one axis:
+/// a caller can address the voxel incrementally); the end's voxel is not walked, and nothing at all
+/// when both are one voxel. False (and no calls) when end lies outside the tree's key range, as
+/// computeRayKeys. The keys are computeRayKeys' keys in its order.
+template <class Walker>
+bool walkRayKeys(const ::octomap::OcTree& keys, const ::octomap::point3d& origin,
+                 const ::octomap::OcTreeKey& origin_key, const ::octomap::point3d& end, Walker&& walker) {
   ::octomap::OcTreeKey end_key;
   if (!keys.coordToKeyChecked(end, end_key)) return false;
   if (end_key == origin_key) return true;
-  visit(origin_key);
+  walker.start(origin_key);
 
   ::octomap::point3d dir = end - origin;
   const float length = static_cast<float>(dir.norm());
@@ -51,30 +54,59 @@ bool forEachRayKey(const ::octomap::OcTree& keys, const ::octomap::point3d& orig
   // visited) or, if rounding made it miss that voxel, once the next border lies past the end
   double tx = t_next[0], ty = t_next[1], tz = t_next[2];
   const double dx = t_delta[0], dy = t_delta[1], dz = t_delta[2];
+  const int sx = step[0], sy = step[1], sz = step[2];
   unsigned kx = origin_key[0], ky = origin_key[1], kz = origin_key[2];
   const unsigned ex = end_key[0], ey = end_key[1], ez = end_key[2];
   const double len = length;
+  // each branch ends in its own check and call: the stepped axis is known there at compile time
+  auto done = [&] { return (kx == ex && ky == ey && kz == ez) || std::min(std::min(tx, ty), tz) > len; };
+  auto key = [&] {
+    return ::octomap::OcTreeKey(static_cast<::octomap::key_type>(kx), static_cast<::octomap::key_type>(ky),
+                                static_cast<::octomap::key_type>(kz));
+  };
   while (true) {
     if (tx < ty) {
       if (tx < tz) {
-        kx = (kx + unsigned(step[0])) & 0xFFFFu;
+        kx = (kx + unsigned(sx)) & 0xFFFFu;
         tx += dx;
-      } else {
-        kz = (kz + unsigned(step[2])) & 0xFFFFu;
-        tz += dz;
+        if (done()) return true;
+        walker.template step<0>(sx, key());
+        continue;
       }
     } else if (ty < tz) {
-      ky = (ky + unsigned(step[1])) & 0xFFFFu;
+      ky = (ky + unsigned(sy)) & 0xFFFFu;
       ty += dy;
-    } else {
-      kz = (kz + unsigned(step[2])) & 0xFFFFu;
-      tz += dz;
+      if (done()) return true;
+      walker.template step<1>(sy, key());
+      continue;
     }
-    if (kx == ex && ky == ey && kz == ez) return true;
-    if (std::min(std::min(tx, ty), tz) > len) return true;
-    visit(::octomap::OcTreeKey(static_cast<::octomap::key_type>(kx), static_cast<::octomap::key_type>(ky),
-                               static_cast<::octomap::key_type>(kz)));
+    kz = (kz + unsigned(sz)) & 0xFFFFu;
+    tz += dz;
+    if (done()) return true;
+    walker.template step<2>(sz, key());
   }
+}
+
+namespace detail {
+template <class Visit>
+struct KeyWalker {  // the walk as keys only
+  Visit& visit;
+  void start(const ::octomap::OcTreeKey& k) { visit(k); }
+  template <int A>
+  void step(int, const ::octomap::OcTreeKey& k) {
+    visit(k);
+  }
+};
+}  // namespace detail
+
+/// Calls visit(key) for each voxel between origin (whose key is origin_key) and end: the origin's
+/// voxel first, the end's voxel not (nothing at all when both are one voxel). False (and no
+/// calls) when end lies outside the tree's key range, as computeRayKeys.
+template <class Visit>
+bool forEachRayKey(const ::octomap::OcTree& keys, const ::octomap::point3d& origin,
+                   const ::octomap::OcTreeKey& origin_key, const ::octomap::point3d& end, Visit&& visit) {
+  detail::KeyWalker<Visit> w{visit};
+  return walkRayKeys(keys, origin, origin_key, end, w);
 }
 
 }  // namespace livo::octomap
