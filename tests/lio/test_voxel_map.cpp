@@ -114,6 +114,39 @@ TEST(VoxelMap, KnnEqualsBruteForceAtTheLioDefaults) {
   }
 }
 
+TEST(VoxelMap, KnnStaysExactWhenTheOccupancyBitsFillUp) {
+  // more voxels than the map's occupancy bits (2^16): most bits are set, the index decides
+  VoxelMapOptions o;
+  o.voxel_size = 0.05;
+  o.max_points_per_voxel = 2;
+  o.min_point_distance = 0.0;
+  VoxelMap map(o);
+  auto expectExact = [&](unsigned seed) {
+    const std::vector<Vec3> stored = map.points();
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-10.0, 10.0);
+    int nonempty = 0;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 q(u(rng), u(rng), 0.02 * u(rng));  // near the floor
+      Vec3 out[5];
+      double d2[5];
+      const int n = map.knn(q, 5, 0.2, out, d2);
+      const std::vector<double> bf = bruteForce(stored, q, 5, 0.2);
+      ASSERT_EQ(n, static_cast<int>(bf.size())) << "query " << q.transpose();
+      for (int j = 0; j < n; ++j) EXPECT_EQ(d2[j], bf[static_cast<size_t>(j)]);
+      nonempty += n > 0;
+    }
+    EXPECT_GT(nonempty, 100);
+  };
+  map.insert(mapLikePoints(120000, 11));
+  EXPECT_GT(map.numVoxels(), 70000u);
+  expectExact(12);
+  // cleared and refilled: no bit of the old voxels hides or fakes a new one
+  map.clear();
+  map.insert(mapLikePoints(20000, 13));
+  expectExact(14);
+}
+
 TEST(VoxelMap, DownsamplingRule) {
   VoxelMapOptions o;
   o.voxel_size = 1.0;

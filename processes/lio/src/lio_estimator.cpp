@@ -137,8 +137,10 @@ double LioEstimator::scanEndOffset(const LidarScan& scan) const {
   return end;
 }
 
-int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const {
-  return scan.utime + toUtime(opts_.extrinsics.time_offset_s + scanEndOffset(scan));
+int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const { return scanEndUtime(scan, scanEndOffset(scan)); }
+
+int64_t LioEstimator::scanEndUtime(const LidarScan& scan, double end_offset) const {
+  return scan.utime + toUtime(opts_.extrinsics.time_offset_s + end_offset);
 }
 
 void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note) {
@@ -308,7 +310,8 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     res.message = "waiting for the IMU initialisation";
     return res;
   }
-  const int64_t t_end = scanEndUtime(scan);
+  const double end_offset = scanEndOffset(scan);
+  const int64_t t_end = scanEndUtime(scan, end_offset);
   const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
   if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
     // before the first output this is a sweep recorded during the IMU initialisation window
@@ -329,12 +332,15 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   Mat18 P = prop_.covariance();
 
   // 2. valid points, undistorted into the body frame at the end
-  const std::vector<size_t> valid = validPoints(scan, note);
+  validPoints(scan, end_offset, note);
+  const std::vector<size_t>& valid = valid_;
   res.num_points = static_cast<int>(valid.size());
-  const std::vector<Vec3> body = undistortToSweepEnd(scan, valid, x, t_first, t_end);
+  undistortToSweepEnd(scan, x, t_first, t_end);
+  const std::vector<Vec3>& body = body_;
 
   // 3. registration subset: stride, then voxel downsampling
-  const std::vector<Vec3> reg = registrationSubset(body);
+  registrationSubset();
+  const std::vector<Vec3>& reg = reg_;
   res.num_registered = static_cast<int>(reg.size());
 
   // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
@@ -375,10 +381,9 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   return res;
 }
 
-std::vector<size_t> LioEstimator::validPoints(const LidarScan& scan, std::string* note) const {
-  const double end_offset = scanEndOffset(scan);
-  std::vector<size_t> valid;
-  valid.reserve(scan.points.size());
+void LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::string* note) {
+  std::vector<size_t>& valid = valid_;
+  valid.clear();
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
   const double min_r2 = opts_.min_range * opts_.min_range, max_r2 = opts_.max_range * opts_.max_range;
   const bool has_intensity = scan.intensity.size() == scan.points.size();
@@ -392,32 +397,31 @@ std::vector<size_t> LioEstimator::validPoints(const LidarScan& scan, std::string
     valid.push_back(j);
   }
   if (scan.points.size() != scan.time_offset.size()) appendNote(note, "points and time offsets differ in number");
-  return valid;
 }
 
-std::vector<Vec3> LioEstimator::undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
-                                                    const FilterState& at_end, int64_t t_first, int64_t t_end) {
-  std::vector<Vec3> body;
+void LioEstimator::undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first,
+                                       int64_t t_end) {
   if (!prop_.segments().empty()) {
     const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, opts_.extrinsics.T_I_L);
-    und.undistort(scan, t_first, valid, &body);
+    und.undistort(scan, t_first, valid_, &body_);
   } else {
-    body.reserve(valid.size());
-    for (size_t j : valid) body.push_back(opts_.extrinsics.T_I_L * scan.points[j]);
+    body_.clear();
+    for (size_t j : valid_) body_.push_back(opts_.extrinsics.T_I_L * scan.points[j]);
   }
   prop_.clearSegments();
-  return body;
 }
 
-std::vector<Vec3> LioEstimator::registrationSubset(const std::vector<Vec3>& body) const {
-  std::vector<size_t> subset;
+void LioEstimator::registrationSubset() {
   const size_t stride = static_cast<size_t>(std::max(1, opts_.point_stride));
-  for (size_t i = 0; i < body.size(); i += stride) subset.push_back(i);
-  subset = firstPointPerVoxel(body, subset, opts_.scan_voxel_size);
-  std::vector<Vec3> reg;
-  reg.reserve(subset.size());
-  for (size_t i : subset) reg.push_back(body[i]);
-  return reg;
+  std::vector<size_t> subset;
+  if (stride == 1) {
+    subset = firstPointPerVoxel(body_, opts_.scan_voxel_size);
+  } else {
+    for (size_t i = 0; i < body_.size(); i += stride) subset.push_back(i);
+    subset = firstPointPerVoxel(body_, subset, opts_.scan_voxel_size);
+  }
+  reg_.clear();
+  for (size_t i : subset) reg_.push_back(body_[i]);
 }
 
 bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel,

@@ -8,6 +8,10 @@
 
 namespace livo::lio {
 
+namespace {
+constexpr int64_t kSortedCandidates = 16;  // knn: up to this many voxels in a stage are sorted, not heaped
+}  // namespace
+
 VoxelMap::VoxelMap(VoxelMapOptions options) : opts_(options) {
   if (!(opts_.voxel_size > 0.0) || opts_.max_points_per_voxel < 1)
     throw std::invalid_argument("VoxelMap: voxel_size > 0 and max_points_per_voxel >= 1 required");
@@ -26,6 +30,7 @@ bool VoxelMap::insert(const Vec3& p, double range) {
   const int32_t next = static_cast<int32_t>(voxels_.size());
   const int32_t v = index_.insert(key, next);
   if (v == next) {
+    markOccupied(key);
     voxels_.push_back(Voxel{key, 0, static_cast<int32_t>(cx), static_cast<int32_t>(cy), static_cast<int32_t>(cz)});
     pool_.resize(pool_.size() + stride_);
     misses_.resize(misses_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0);
@@ -80,8 +85,10 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
   const double vs = opts_.voxel_size;
   int found = 0;
   double worst = r2;  // admit points with d2 <= worst
-  auto scanVoxel = [&](int64_t x, int64_t y, int64_t z) {
-    const int32_t v = index_.find(packVoxel(x, y, z));
+  auto scanVoxel = [&](int64_t x, int64_t y, int64_t z) __attribute__((always_inline)) {
+    const VoxelKey key = packVoxel(x, y, z);
+    if (!mayHold(key)) return;
+    const int32_t v = index_.find(key);
     if (v < 0) return;
     const float* pts = voxelPoints(v);
     const int cnt = voxels_[static_cast<size_t>(v)].count;
@@ -106,7 +113,7 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
   // stops after the few nearest (about 8 at the defaults). It runs in two stages: the voxels within
   // half the radius (a fifth of the ball's 64 at the defaults), then, only if the k nearest are not
   // settled by then, the rest; each stage orders its voxels with a min-heap, which pays only for
-  // those visited. The order decides only which voxel is looked up first: the result is exact.
+  // those visited (or, up to kSortedCandidates of them, with an insertion sort). The order decides only which voxel is looked up first: the result is exact.
   // An entry of the heap is one integer, the voxel's distance as float bits (non-negative floats
   // order as their bits) above its index in the stage's box, so a heap step moves 8 bytes; the stop
   // test uses the double distance.
@@ -168,13 +175,31 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
           heap[nc++] = (uint64_t{bits} << 32) | index;
         }
       }
-    const std::greater<uint64_t> farther;  // std::*_heap with greater: a min-heap
-    std::make_heap(heap, heap + nc, farther);
-    for (int64_t left = nc; left > 0; --left) {
-      const uint32_t index = static_cast<uint32_t>(heap[0]);
-      if (cand_d2[index] > worst) break;  // this stage's others are farther still
-      std::pop_heap(heap, heap + left, farther);
+    auto visit = [&](uint32_t index) __attribute__((always_inline)) {
       scanVoxel(box.lo[0] + index / (nz * ny), box.lo[1] + (index / nz) % ny, box.lo[2] + index % nz);
+    };
+    if (nc <= kSortedCandidates) {
+      // a few candidates (the first stage's, usually): an insertion sort costs less than the heap
+      for (int64_t i = 1; i < nc; ++i) {
+        const uint64_t e = heap[i];
+        int64_t j = i;
+        for (; j > 0 && heap[j - 1] > e; --j) heap[j] = heap[j - 1];
+        heap[j] = e;
+      }
+      for (int64_t i = 0; i < nc; ++i) {
+        const uint32_t index = static_cast<uint32_t>(heap[i]);
+        if (cand_d2[index] > worst) break;  // this stage's others are farther still
+        visit(index);
+      }
+    } else {
+      const std::greater<uint64_t> farther;  // std::*_heap with greater: a min-heap
+      std::make_heap(heap, heap + nc, farther);
+      for (int64_t left = nc; left > 0; --left) {
+        const uint32_t index = static_cast<uint32_t>(heap[0]);
+        if (cand_d2[index] > worst) break;  // this stage's others are farther still
+        std::pop_heap(heap, heap + left, farther);
+        visit(index);
+      }
     }
     // Settled when no unvisited voxel can hold a nearer point: those left are this stage's beyond
     // worst, and those beyond stage_r or outside the box (whose faces are about stage_r from q; the
@@ -225,7 +250,10 @@ size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& 
                                    const SeenThroughOptions& o) {
   if (!o.enabled || voxels_.empty() || !origin.allFinite()) return 0;
   std::vector<int32_t> touched;  // voxels holding a point seen through in this sweep
-  const double step = 0.5 * opts_.voxel_size;
+  // Any step gives the same result (the cubes below hold every voxel within the beam's radius of
+  // the ray, and markSeenThrough tests the points themselves): one voxel walks the ray in half the
+  // samples of half a voxel, for a few more voxels tested.
+  const double step = opts_.voxel_size;
   const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));
   for (size_t e = 0; e < endpoints.size(); e += stride) {
     const Vec3 w = endpoints[e] - origin;
@@ -253,7 +281,9 @@ size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& 
           const bool xy_seen = x_seen && prev_lo[1] <= y && y <= prev_hi[1];
           for (int64_t z = lo[2]; z <= hi[2]; ++z) {
             if (xy_seen && prev_lo[2] <= z && z <= prev_hi[2]) continue;
-            const int32_t v = index_.find(packVoxel(x, y, z));
+            const VoxelKey key = packVoxel(x, y, z);
+            if (!mayHold(key)) continue;
+            const int32_t v = index_.find(key);
             if (v >= 0) markSeenThrough(v, origin, dir, reach, o, &touched);
           }
         }
@@ -311,7 +341,11 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   misses_.shrink_to_fit();
   ranges_.shrink_to_fit();
   index_.resetFor(kept);
-  for (size_t v = 0; v < kept; ++v) index_.insert(voxels_[v].key, static_cast<int32_t>(v));
+  std::fill(occupied_.begin(), occupied_.end(), 0);
+  for (size_t v = 0; v < kept; ++v) {
+    index_.insert(voxels_[v].key, static_cast<int32_t>(v));
+    markOccupied(voxels_[v].key);
+  }
   return removed;
 }
 
@@ -321,6 +355,7 @@ void VoxelMap::clear() {
   misses_.clear();
   ranges_.clear();
   index_.resetFor(0);
+  std::fill(occupied_.begin(), occupied_.end(), 0);
 }
 
 size_t VoxelMap::numPoints() const {

@@ -138,15 +138,18 @@ class LioEstimator {
 
  private:
   double scanEndOffset(const LidarScan& scan) const;
+  /// scanEndUtime with the sweep's scanEndOffset given (a pass over its points less).
+  int64_t scanEndUtime(const LidarScan& scan, double end_offset) const;
   // The stages of addScan, in order.
-  /// Indices of the sweep's usable points (finite, inside the sweep and the range limits).
-  std::vector<size_t> validPoints(const LidarScan& scan, std::string* note) const;
-  /// The valid points in the body frame at t_end (IMU-propagated motion undistortion); consumes
-  /// the propagation segments.
-  std::vector<Vec3> undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
-                                        const FilterState& at_end, int64_t t_first, int64_t t_end);
-  /// The points registered against the map: every point_stride-th, then one per scan voxel.
-  std::vector<Vec3> registrationSubset(const std::vector<Vec3>& body) const;
+  // The per-sweep point buffers are members (valid_, body_, reg_), reused from sweep to sweep.
+  /// Indices of the sweep's usable points (finite, inside the sweep [0, end_offset] and the range
+  /// limits) into valid_.
+  void validPoints(const LidarScan& scan, double end_offset, std::string* note);
+  /// The valid points in the body frame at t_end (IMU-propagated motion undistortion) into body_;
+  /// consumes the propagation segments.
+  void undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first, int64_t t_end);
+  /// The points registered against the map into reg_: every point_stride-th, then one per scan voxel.
+  void registrationSubset();
   /// Wheel speed update at the sweep end; returns whether `travel` holds the wheels' travel since
   /// the wheel-scale anchor.
   bool wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel, std::string* note);
@@ -205,6 +208,10 @@ class LioEstimator {
   OdometryFrame frame_;
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
+  // addScan's per-sweep buffers (kept for their capacity: a 64-beam sweep's are megabytes)
+  std::vector<size_t> valid_;  // indices of the valid input points
+  std::vector<Vec3> body_;     // those points undistorted, body frame at the sweep end
+  std::vector<Vec3> reg_;      // the registration subset of body_
   int64_t last_registered_utime_ = 0;  // last sweep that seeded the map or registered
   int64_t last_sweep_end_utime_ = -1;  // last sweep that reached the filter (any outcome)
   bool has_registered_ = false;

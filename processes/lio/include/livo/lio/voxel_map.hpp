@@ -89,6 +89,15 @@ class VoxelMap {
   uint8_t* voxelMisses(int32_t v) { return &misses_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
   float* voxelRanges(int32_t v) { return &ranges_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
   void removePoint(int32_t v, int i);
+  /// False if no voxel with this key is stored; true if one may be (see occupied_).
+  bool mayHold(VoxelKey key) const {
+    const uint64_t bit = (key * 0x9e3779b97f4a7c15ULL) >> (64 - kOccupiedBits);
+    return (occupied_[bit >> 6] >> (bit & 63)) & 1;
+  }
+  void markOccupied(VoxelKey key) {
+    const uint64_t bit = (key * 0x9e3779b97f4a7c15ULL) >> (64 - kOccupiedBits);
+    occupied_[bit >> 6] |= uint64_t{1} << (bit & 63);
+  }
   /// Flags voxel v's points that the ray origin + t dir (t <= reach) passes through this sweep.
   void markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach, const SeenThroughOptions& o,
                        std::vector<int32_t>* touched);
@@ -102,7 +111,11 @@ class VoxelMap {
                                  // the high bit marks "seen through in the current sweep"
   std::vector<float> ranges_;    // per point slot: the range it was seen from (refresh)
   FlatKeyIndex index_;
-  std::vector<int> offsets_; // 27 neighbour offsets as (dx, dy, dz) triples, search radius 1
+  // A bit per hashed key, set for every stored voxel: most voxels a beam or a kNN ball meets are
+  // empty, and a bit in a table that stays in the L1 cache rules those out without probing the
+  // index (a set bit may be another key's: then the index decides).
+  static constexpr int kOccupiedBits = 16;
+  std::vector<uint64_t> occupied_ = std::vector<uint64_t>(size_t{1} << (kOccupiedBits - 6), 0);
 };
 
 }  // namespace livo::lio
