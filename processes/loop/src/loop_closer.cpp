@@ -79,7 +79,8 @@ std::shared_ptr<const LoopCloser::Features> LoopCloser::deriveFeatures(const Poi
   auto f = std::make_shared<Features>();
   const Points levelled = transformed(cloud_I, rotationOnly(G_R_I));
   f->coarse = computeCoarseFeatures(levelled, options_.coarse);
-  f->fine = GicpCloud::build(centroidPerVoxel(levelled, options_.fine_voxel_size), options_.covariance_neighbors);
+  f->fine_points_ = centroidPerVoxel(levelled, options_.fine_voxel_size);
+  f->covariance_neighbors_ = options_.covariance_neighbors;
   return f;
 }
 
@@ -231,7 +232,9 @@ void LoopCloser::accept(const AcceptedLoop& loop, const Keyframe& from, AddResul
 
 LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, int64_t to_id,
                                                 const Features& to) const {
-  LoopRegistrationResult r = registerLoop(from.coarse, to.coarse, from.fine, to.fine, options_.registration);
+  LoopRegistrationResult r = registerLoop(
+      from.coarse, to.coarse, [&]() -> const GicpCloud& { return from.fine(); },
+      [&]() -> const GicpCloud& { return to.fine(); }, options_.registration);
   if (options_.registration_hook) options_.registration_hook(from_id, to_id, r);
   return r;
 }

@@ -14,6 +14,15 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const CoarseFeatures& target_coarse,
                                     const GicpCloud& source_fine, const GicpCloud& target_fine,
                                     const LoopRegistrationOptions& options) {
+  return registerLoop(
+      source_coarse, target_coarse, [&]() -> const GicpCloud& { return source_fine; },
+      [&]() -> const GicpCloud& { return target_fine; }, options);
+}
+
+LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const CoarseFeatures& target_coarse,
+                                    const std::function<const GicpCloud&()>& source_fine,
+                                    const std::function<const GicpCloud&()>& target_fine,
+                                    const LoopRegistrationOptions& options) {
   LoopRegistrationResult r;
   const auto t0 = std::chrono::steady_clock::now();
   const Correspondences matches = matchDescriptors(source_coarse.descriptors, target_coarse.descriptors, options.matching);
@@ -27,8 +36,10 @@ LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const C
     r.reason = why.str();
     return r;
   }
+  const GicpCloud& source = source_fine();
+  const GicpCloud& target = target_fine();
   const auto t1 = std::chrono::steady_clock::now();
-  r.fine = gicpRegister(source_fine, target_fine, r.coarse.T_target_source, options.gicp);
+  r.fine = gicpRegister(source, target, r.coarse.T_target_source, options.gicp);
   r.fine_ms = msSince(t1);
   r.T_target_source = r.fine.T_target_source;
   const Pose3 delta = r.coarse.T_target_source.inverse() * r.fine.T_target_source;

@@ -225,9 +225,17 @@ class LoopCloser {
     double from_path = 0.0;
   };
   /// What registration needs of a keyframe, derived from its stored cloud.
+  /// The fine cloud (kd-tree and covariances) is built when a registration first gets past the
+  /// coarse stage: most keyframes never do, and it costs more than the coarse features.
   struct Features {
     CoarseFeatures coarse;  // in G
-    GicpCloud fine;         // in G
+    const GicpCloud& fine() const {
+      if (!fine_) fine_ = GicpCloud::build(std::move(fine_points_), covariance_neighbors_);
+      return *fine_;
+    }
+    mutable Points fine_points_;  // in G, until fine() moves them into fine_
+    int covariance_neighbors_ = 10;
+    mutable std::optional<GicpCloud> fine_;
   };
   const Placement& placement(int64_t id) const;  // throws std::out_of_range for an unknown id
   /// Graph nodes of the keyframe's epoch older than exclude_recent_s with keypoints, nearest first,

@@ -3,6 +3,7 @@
 // agreement of the coarse and fine results. A wrong loop is worse than none.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "livo/loop/coarse_features.hpp"
@@ -46,6 +47,13 @@ struct LoopRegistrationResult {
 /// Registers `source` onto `target` (both in their own frames).
 LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const CoarseFeatures& target_coarse,
                                     const GicpCloud& source_fine, const GicpCloud& target_fine,
+                                    const LoopRegistrationOptions& options);
+
+/// The same, with the fine clouds asked for only once the coarse registration has passed (they
+/// cost more to build than the coarse step, and most candidates stop there).
+LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const CoarseFeatures& target_coarse,
+                                    const std::function<const GicpCloud&()>& source_fine,
+                                    const std::function<const GicpCloud&()>& target_fine,
                                     const LoopRegistrationOptions& options);
 
 }  // namespace livo::loop
