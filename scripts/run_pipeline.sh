@@ -218,7 +218,13 @@ fi
 
 # ---- inside the private bus --------------------------------------------------------------------
 exec 3>"$out/logs/run.txt"
-"$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
+# Lockstep with lagging sinks: they run niced, so that the processes on the replay's critical path
+# (playback, lio, vio, loop) get a core the moment they have work (scheduling, not order: the
+# outputs are the same).
+sink_nice=()
+[ "$realtime" = 0 ] && [ "$serial" = 0 ] && [ "$max_lag" -gt 0 ] && sink_nice=(nice -n 10)
+nice_of() { case "$1" in colour|octomap|record) echo "${sink_nice[@]}" ;; esac; }
+$(nice_of record) "$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
 logger=$!
 : > "$out/logs/restarts.tsv"
 declare -A pids=() restarts=() next_start=() died_at=() ended=()
@@ -228,10 +234,10 @@ start_process() {
   # a process may keep what must survive a restart in LIVO_STATE_DIR (lio: its epoch and keyframe
   # numbering), and LIVO_RESTARTS says how often it was restarted
   if [ "$respawn" = 1 ]; then
-    (cd "$out" && LIVO_STATE_DIR="$out/state" LIVO_RESTARTS="${restarts[$1]:-0}" exec "$(exe_of "$1")" \
+    (cd "$out" && LIVO_STATE_DIR="$out/state" LIVO_RESTARTS="${restarts[$1]:-0}" exec $(nice_of "$1") "$(exe_of "$1")" \
       --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
   else
-    (cd "$out" && exec "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+    (cd "$out" && exec $(nice_of "$1") "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
   fi
   pids[$1]=$!
 }
