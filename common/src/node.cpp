@@ -251,14 +251,15 @@ void Node::publishProgress(bool finished) {
     p.published.push_back(n);
   }
   p.num_outputs = static_cast<int32_t>(p.output_channel.size());
-  p.quiet_from = p.quiet_before = 0;
-  if (quiet_window_ && !finished) {
-    if (const auto w = quiet_window_(); w && w->before > w->from) {
-      p.quiet_channel = w->channel;
-      p.quiet_from = w->from;
-      p.quiet_before = w->before;
+  if (quiet_windows_ && !finished) {
+    for (const QuietWindow& w : quiet_windows_()) {
+      if (w.before <= w.from) continue;
+      p.quiet_channel.push_back(w.channel);
+      p.quiet_from.push_back(w.from);
+      p.quiet_before.push_back(w.before);
     }
   }
+  p.num_quiet = static_cast<int32_t>(p.quiet_channel.size());
   lcm_.publish(options_.progress_channel, &p);
 }
 

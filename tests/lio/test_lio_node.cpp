@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 
 #include "bus_messages.hpp"
 #include "livo/filter_state_message.hpp"
@@ -15,6 +16,7 @@
 #include "livo/lio/lio_node.hpp"
 #include "livo/messages.hpp"
 #include "livo/progress_t.hpp"
+#include "livo/wheel_odometry_t.hpp"
 #include "synthetic_messages.hpp"
 #include "synthetic_world.hpp"
 
@@ -652,11 +654,12 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
 }
 }  // namespace
 
-// The promise lio sends with every PROGRESS (progress_t.quiet_*), which lets lockstep playback send
-// IMU samples on without waiting for it, holds: no sample it covers makes lio publish anything.
-// And it is worth having: it covers most samples (not those that carry the filter past a sweep end
-// or an image time, nor those while a posterior is awaited).
-TEST(LioNode, QuietPromiseHoldsAndCoversMostImuSamples) {
+// The promises lio sends with every PROGRESS (progress_t.quiet_*), which let lockstep playback send
+// IMU samples and wheel readings on without waiting for it, hold: nothing they cover makes lio
+// publish anything. And they are worth having: they cover most samples (not those that carry the
+// filter past a sweep end or an image time, nor those while a posterior is awaited) and most wheel
+// readings (not the first past the end of a sweep waiting for one).
+TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesAndWheelReadings) {
   struct Watcher {
     progress_t last{};
     bool have = false;
@@ -668,15 +671,26 @@ TEST(LioNode, QuietPromiseHoldsAndCoversMostImuSamples) {
       have = true;
     }
     void onOutput(const lcm::ReceiveBuffer*, const std::string&) { ++outputs; }
+    bool covers(const std::string& channel, int64_t utime) const {
+      for (int i = 0; have && i < last.num_quiet; ++i)
+        if (last.quiet_channel[i] == channel && utime >= last.quiet_from[i] && utime < last.quiet_before[i]) return true;
+      return false;
+    }
   };
-  // the plain run, with the camera hand-off, and with IMU samples swapped and duplicated
-  for (const int variant : {0, 1, 2}) {
-    const bool handoff = variant == 1;
+  const synth::SyntheticSequence seq = syntheticSequence();
+  // the plain run, with the camera hand-off, with IMU samples swapped and duplicated, with wheels
+  for (const int variant : {0, 1, 2, 3}) {
+    const bool handoff = variant == 1, wheels = variant == 3;
     Watcher w;
-    int64_t imu = 0, covered = 0, broken = 0, outputs_before = 0;
+    std::map<std::string, int64_t> seen, covered;
+    int64_t broken = 0, outputs_before = 0;
     bool in_promise = false;
     RunSetup setup;
     if (handoff) setup.config = handoffConfig();
+    if (wheels) {
+      setup.config.insert(setup.config.find("  camera:"), "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.05, "
+                                                          "T_I_B: {translation: [0, 0, 0], rpy_deg: [0, 0, 0]}}\n");
+    }
     LioNode::HandoffCounts counts;
     setup.handoff = &counts;
     setup.attach = [&](Node& vio) {
@@ -694,12 +708,21 @@ TEST(LioNode, QuietPromiseHoldsAndCoversMostImuSamples) {
     };
     setup.before_each = [&](const Message& m) {
       in_promise = false;
-      if (m.channel != "IMU") return;
-      ++imu;
-      imu_t s;
-      ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
-      in_promise = w.have && w.last.quiet_channel == "IMU" && s.utime >= w.last.quiet_from && s.utime < w.last.quiet_before;
-      covered += in_promise;
+      int64_t utime = 0;
+      if (m.channel == "IMU") {
+        imu_t s;
+        ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
+        utime = s.utime;
+      } else if (m.channel == "WHEEL") {
+        wheel_odometry_t s;
+        ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
+        utime = s.utime;
+      } else {
+        return;
+      }
+      ++seen[m.channel];
+      in_promise = w.covers(m.channel, utime);
+      covered[m.channel] += in_promise;
       outputs_before = w.outputs;
     };
     setup.after_each = [&](const Message&) { broken += in_promise && w.outputs != outputs_before; };
@@ -717,16 +740,32 @@ TEST(LioNode, QuietPromiseHoldsAndCoversMostImuSamples) {
       }
       in.swap(disordered);
     }
+    if (wheels) {
+      // 50 Hz, the body's forward speed on both wheels (the content does not matter here)
+      for (int64_t t = kBaseTime; t <= kBaseTime + 3'000'000; t += 20'000) {
+        const Pose3 a = seq.truth(t), b = seq.truth(t + 10'000);
+        const double v = (a.linear().transpose() * (b.translation() - a.translation())).x() / 0.01;
+        wheel_odometry_t m{};
+        m.utime = t;
+        m.left_speed = m.right_speed = v;
+        in.push_back(encode(t, "WHEEL", m));
+      }
+      livo_test::sortByArrival(&in);
+    }
     const Outputs out = runNode(in, nullptr, setup);
-    ASSERT_GE(out.odometry.size(), 25u);
+    EXPECT_GE(out.odometry.size(), 20u) << "variant " << variant;  // the run goes on (24-29 of 30 sweeps)
     if (handoff) {
       EXPECT_GE(counts.kept_prior, 40);
     }
     EXPECT_EQ(broken, 0) << "variant " << variant;
     // per 0.1 s sweep, 20 samples: the one past the sweep end (and with images, those past each image)
-    EXPECT_GT(covered, imu * (handoff ? 8 : 9) / 10) << covered << " of " << imu << " samples covered";
-    std::printf("%s: %lld of %lld IMU samples inside the quiet promise\n",
-                variant == 0 ? "LiDAR-only" : variant == 1 ? "camera hand-off" : "swapped and duplicated IMU",
-                static_cast<long long>(covered), static_cast<long long>(imu));
+    EXPECT_GT(covered["IMU"], seen["IMU"] * (handoff ? 8 : 9) / 10) << covered["IMU"] << " of " << seen["IMU"];
+    if (wheels) {
+      EXPECT_GT(covered["WHEEL"], seen["WHEEL"] * 7 / 10) << covered["WHEEL"] << " of " << seen["WHEEL"];
+    }
+    std::printf("%s: %lld of %lld IMU samples, %lld of %lld wheel readings inside the quiet promises\n",
+                variant == 0 ? "LiDAR-only" : variant == 1 ? "camera hand-off" : variant == 2 ? "swapped and duplicated IMU" : "wheels",
+                static_cast<long long>(covered["IMU"]), static_cast<long long>(seen["IMU"]),
+                static_cast<long long>(covered["WHEEL"]), static_cast<long long>(seen["WHEEL"]));
   }
 }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "livo/playback/lockstep_gate.hpp"
 
 using livo::playback::LockstepGate;
@@ -215,9 +217,10 @@ TEST(LockstepGate, HoldsTheReplayWhileAConsumerRestarts) {
 
 namespace {
 progress_t withQuiet(progress_t p, const std::string& channel, int64_t from, int64_t before) {
-  p.quiet_channel = channel;
-  p.quiet_from = from;
-  p.quiet_before = before;
+  p.quiet_channel = {channel};
+  p.quiet_from = {from};
+  p.quiet_before = {before};
+  p.num_quiet = 1;
   return p;
 }
 }  // namespace
@@ -314,4 +317,26 @@ TEST(LockstepGate, AConsumerWhoseOutputAnotherActsOnIsKeptInStep) {
   EXPECT_FALSE(g.caughtUp());  // colour must take the scan before the next message
   g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 1}}, {{"COLORED_CLOUD", 1}}));
   EXPECT_TRUE(g.caughtUp());  // octomap and the recorder behind, within the bound
+}
+
+// vio promises every REGISTERED_SCAN (it only adds it to its map): lio's scans need no stamps to be
+// covered, but the backlog a whole-channel promise lets build up is bounded.
+TEST(LockstepGate, AWholeChannelPromiseCoversWhatNodesPublishUpToABacklog) {
+  LockstepGate g({"lio", "vio"});
+  g.onProgress(progress("lio", 0, {{"LIDAR", 0}}, {{"REGISTERED_SCAN", 0}}));
+  progress_t vio = progress("vio", 0, {{"REGISTERED_SCAN", 0}}, {{"STATE_POSTERIOR", 0}});
+  vio.quiet_channel = {"REGISTERED_SCAN"};
+  vio.quiet_from = {std::numeric_limits<int64_t>::min()};
+  vio.quiet_before = {std::numeric_limits<int64_t>::max()};
+  vio.num_quiet = 1;
+  g.onProgress(vio);
+  for (int k = 1; k <= 8; ++k) {
+    g.onPublished("LIDAR", 0.0, k);
+    g.onProgress(progress("lio", k, {{"LIDAR", k}}, {{"REGISTERED_SCAN", k}}));
+    EXPECT_TRUE(g.caughtUp()) << k << " scans behind";
+  }
+  g.onPublished("LIDAR", 0.0, 9);
+  g.onProgress(progress("lio", 9, {{"LIDAR", 9}}, {{"REGISTERED_SCAN", 9}}));
+  EXPECT_FALSE(g.caughtUp());  // 9 behind
+  EXPECT_FALSE(g.idle());
 }

@@ -226,7 +226,7 @@ TEST(LcmTypes, ColouredCloudOctomap) {
 }
 
 TEST(LcmTypes, ProgressHealth) {
-  progress_t p;
+  progress_t p{};
   p.utime = 9;
   p.node = "lio";
   p.sequence = 3;
@@ -237,8 +237,15 @@ TEST(LcmTypes, ProgressHealth) {
   p.num_outputs = 1;
   p.output_channel = {"ODOMETRY"};
   p.published = {10};
+  p.num_quiet = 1;
+  p.quiet_channel = {"IMU"};
+  p.quiet_from = {100};
+  p.quiet_before = {200};
   const progress_t pd = roundTrip(p);
   EXPECT_EQ(pd.input_channel[1], "LIDAR");
+  ASSERT_EQ(pd.num_quiet, 1);
+  EXPECT_EQ(pd.quiet_channel[0], "IMU");
+  EXPECT_EQ(pd.quiet_before[0], 200);
   EXPECT_EQ(pd.handled[0], 200);
 
   health_t h;

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -14,6 +15,7 @@
 
 #include "livo/filter_state_message.hpp"
 #include "livo/messages.hpp"
+#include "livo/progress_t.hpp"
 #include "livo/vio/vio_node.hpp"
 #include "sim_fixture.hpp"
 
@@ -458,4 +460,59 @@ TEST(VioNode, IdenticalInputsGiveIdenticalPosteriors) {
     run = h.posterior_bytes;
   }
   EXPECT_EQ(runs[0], runs[1]);
+}
+
+// The promises vio sends with its PROGRESS (lockstep playback does not wait for what they cover)
+// hold: a scan never makes it publish, nor an image while no prior waits; once a prior waits for
+// its image, CAMERA is no longer promised, and that image is answered.
+TEST(VioNode, QuietPromisesHold) {
+  struct Watcher {
+    progress_t last{};
+    bool have = false;
+    void on(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+      progress_t p;
+      if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) <= 0 || p.node != "vio") return;
+      last = p;
+      have = true;
+    }
+    bool covers(const std::string& channel) const {
+      for (int i = 0; have && i < last.num_quiet; ++i)
+        if (last.quiet_channel[i] == channel && last.quiet_from[i] == std::numeric_limits<int64_t>::min() &&
+            last.quiet_before[i] == std::numeric_limits<int64_t>::max())
+          return true;
+      return false;
+    }
+  };
+  Harness h;
+  Watcher w;
+  h.lcm.subscribe("PROGRESS", &Watcher::on, &w);
+  const auto& s = scene();
+  int covered = 0;
+  auto send = [&](const std::string& channel, const auto& m) {
+    const bool quiet = w.covers(channel);
+    const size_t before = h.posteriors.size();
+    h.send(channel, m);
+    if (quiet) {
+      ++covered;
+      EXPECT_EQ(h.posteriors.size(), before) << channel << " was promised quiet";
+    }
+  };
+  send("REGISTERED_SCAN", scanMsg(s.utime(kT0 - 0.1), s.sweep(kT0 - 0.2, 1), s.bodyPose(kT0 - 0.1)));
+  EXPECT_TRUE(w.covers("REGISTERED_SCAN"));
+  EXPECT_TRUE(w.covers("CAMERA"));
+  send("REGISTERED_SCAN", scanMsg(s.utime(kT0), s.sweep(kT0 - 0.1, 2), s.bodyPose(kT0)));
+  send("CAMERA", imageMsg(rendered(0), s.utime(kT0)));
+  send("STATE_PRIOR", priorMsg(s.utime(kT0), 1, s.trueState(kT0), seedP()));
+  ASSERT_EQ(h.posteriors.size(), 1u);
+  const FilterState truth = s.trueState(kT1);
+  send("STATE_PRIOR", priorMsg(s.utime(kT1), 2, offsetState(truth), priorP()));  // waits for its image
+  EXPECT_FALSE(w.covers("CAMERA"));
+  EXPECT_TRUE(w.covers("REGISTERED_SCAN"));
+  send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
+  ASSERT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(h.posteriors[1].valid, 1);
+  EXPECT_TRUE(w.covers("CAMERA"));
+  send("CAMERA", imageMsg(rendered(2), s.utime(kT2)));
+  EXPECT_EQ(h.posteriors.size(), 2u);
+  EXPECT_EQ(covered, 3);  // the second scan, the first and the third image (priors are never promised)
 }

@@ -11,6 +11,7 @@
 #include <deque>
 #include <functional>
 #include <iosfwd>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -112,10 +113,14 @@ class Node {
     std::string channel;
     int64_t from = 0;
     int64_t before = 0;
+    /// Every message on the channel, whatever its stamp and whoever publishes it.
+    static QuietWindow always(std::string channel) {
+      return {std::move(channel), std::numeric_limits<int64_t>::min(), std::numeric_limits<int64_t>::max()};
+    }
   };
-  /// Asked for the promise whenever PROGRESS is published (after every handled message), so that
-  /// it always matches the counts it goes out with. An empty optional: no promise now.
-  void setQuietWindow(std::function<std::optional<QuietWindow>()> promise) { quiet_window_ = std::move(promise); }
+  /// Asked for the promises whenever PROGRESS is published (after every handled message), so that
+  /// they always match the counts they go out with. None: no promise now.
+  void setQuietWindows(std::function<std::vector<QuietWindow>()> promises) { quiet_windows_ = std::move(promises); }
 
   /// Under spin(): a PROGRESS after a handled input goes out only once nothing more waits in the
   /// receive queue (or after kMaxProgressDeferred inputs), one for a burst instead of one per
@@ -186,7 +191,7 @@ class Node {
   int64_t progress_sequence_ = 0;
   bool coalesce_progress_ = false;
   int progress_deferred_ = 0;  // inputs handled since the last PROGRESS
-  std::function<std::optional<QuietWindow>()> quiet_window_;
+  std::function<std::vector<QuietWindow>()> quiet_windows_;
   int64_t instance_ = 0;  // this start of the node (progress_t.instance)
   int64_t last_utime_ = 0;
   int8_t level_ = 0;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "livo/file_output.hpp"
@@ -49,7 +50,7 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
     node_.watchConsumers(opts_.state_prior_channel);
     node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
   }
-  node_.setQuietWindow([this] { return quietWindow(); });
+  node_.setQuietWindows([this] { return quietWindows(); });
   node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
@@ -297,9 +298,9 @@ LioNode::NextEvent LioNode::nextEvent() const {
   return e;
 }
 
-std::optional<Node::QuietWindow> LioNode::quietWindow() const {
+std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   // waiting for a posterior (or for the next sample to confirm a jumped clock): no promise
-  if (!has_imu_ || pending_ || held_jump_) return std::nullopt;
+  if (!has_imu_ || pending_ || held_jump_) return {};
   Node::QuietWindow w;
   w.channel = opts_.imu_channel;
   // a sample further back is a clock reset, one further ahead is held as a jump
@@ -311,7 +312,19 @@ std::optional<Node::QuietWindow> LioNode::quietWindow() const {
   const NextEvent next = nextEvent();
   if (next.kind != NextEvent::kNone)
     w.before = std::min(w.before, next.imu_after + toUtime(opts_.imu_reorder_window_s) + 1);
-  return w;
+  std::vector<Node::QuietWindow> out{w};
+  if (opts_.lio.wheel.enabled) {
+    // a wheel reading matters only by letting the next sweep go without waiting for the wheels
+    // (one past its end): readings up to its end cannot, nor any once one past it has come, nor
+    // any while an image or nothing is next
+    const bool sweep_waits_for_wheels = next.kind == NextEvent::kSweep &&
+                                        !(!wheel_.empty() && wheel_.back().utime > next.utime);
+    if (sweep_waits_for_wheels)
+      out.push_back({opts_.wheel_channel, std::numeric_limits<int64_t>::min(), next.utime + 1});
+    else
+      out.push_back(Node::QuietWindow::always(opts_.wheel_channel));
+  }
+  return out;
 }
 
 void LioNode::process(const PendingScan& p) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 namespace livo::playback {
@@ -9,6 +10,7 @@ namespace livo::playback {
 namespace {
 constexpr double kPublishHistoryS = 60.0;  // how far back publish times are kept (>> loss_grace_s)
 constexpr size_t kUtimeHistory = 1024;     // playback stamps kept per channel for quiet promises
+constexpr int64_t kMaxAlwaysQuietBacklog = 8;  // messages a promise for a whole channel lets wait
 }  // namespace
 
 LockstepGate::LockstepGate(std::vector<std::string> consumers, LockstepGateOptions options)
@@ -63,9 +65,9 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     events_.push_back("consumer " + p.node + " is heard again");
   }
   n.sequence = p.sequence;
-  n.quiet_channel = p.quiet_before > p.quiet_from ? p.quiet_channel : std::string();
-  n.quiet_from = p.quiet_from;
-  n.quiet_before = p.quiet_before;
+  n.quiet.clear();
+  for (int i = 0; i < p.num_quiet; ++i)
+    if (p.quiet_before[i] > p.quiet_from[i]) n.quiet[p.quiet_channel[i]] = {p.quiet_from[i], p.quiet_before[i]};
   for (int i = 0; i < p.num_inputs; ++i) {
     int64_t& v = n.handled[p.input_channel[i]];
     changed = changed || v != p.handled[i];
@@ -286,7 +288,14 @@ bool LockstepGate::caughtUp() const {
 }
 
 bool LockstepGate::promisedQuiet(const NodeState& n, const std::string& channel) const {
-  if (!options_.honour_quiet_promises || n.quiet_channel != channel) return false;
+  if (!options_.honour_quiet_promises) return false;
+  auto q = n.quiet.find(channel);
+  if (q == n.quiet.end()) return false;
+  const auto [from, before] = q->second;
+  // every message on the channel: no stamp needed, nodes may publish it too; the backlog is
+  // bounded all the same (the receive buffer), as a lagging consumer's is
+  if (from == std::numeric_limits<int64_t>::min() && before == std::numeric_limits<int64_t>::max())
+    return deficit(n, channel) <= kMaxAlwaysQuietBacklog;
   auto pb = playback_published_.find(channel);
   if (pb == playback_published_.end() || totalPublished(channel) != pb->second) return false;  // nodes publish it too
   auto h = n.handled.find(channel);
@@ -296,7 +305,7 @@ bool LockstepGate::promisedQuiet(const NodeState& n, const std::string& channel)
   const auto& stamps = playback_utimes_.at(channel);
   if (stamps.empty() || stamps.front().first > first_unhandled) return false;  // older than the history
   for (auto it = stamps.rbegin(); it != stamps.rend() && it->first >= first_unhandled; ++it)
-    if (it->second == kNoUtime || it->second < n.quiet_from || it->second >= n.quiet_before) return false;
+    if (it->second == kNoUtime || it->second < from || it->second >= before) return false;
   return true;
 }
 

@@ -40,6 +40,14 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
                                     [this](const filter_state_t& m) { onCameraFreeState(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onCorrection(m); });
+  // lockstep playback need not wait for what publishes nothing here: a scan only joins the map,
+  // a gyro sample only its buffer, and an image is only buffered while no prior waits for one
+  node_.setQuietWindows([this] {
+    std::vector<Node::QuietWindow> w{Node::QuietWindow::always(opts_.registered_scan_channel)};
+    if (pending_.empty()) w.push_back(Node::QuietWindow::always(opts_.camera_channel));
+    if (vio_.needsGyro()) w.push_back(Node::QuietWindow::always(opts_.imu_channel));
+    return w;
+  });
   // the body rate places a rolling shutter's rows and moves the state by the image time offset
   // being estimated; a global shutter with a known time offset does not need the IMU
   if (vio_.needsGyro())

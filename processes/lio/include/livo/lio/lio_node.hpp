@@ -19,6 +19,11 @@
 // from their PROGRESS) nothing is handed off and the output is exactly LiDAR-only. Under lockstep
 // replay the answer always arrives first (playback waits for the whole pipeline to be quiescent),
 // so replays stay identical.
+//
+// Quiet promises (progress_t.quiet_*, quietWindows()): with every PROGRESS, lio tells lockstep
+// playback which IMU samples (stamped before the next event's threshold) and wheel readings (up to
+// the end of a sweep that waits for one past it, or any) cannot make it publish, so playback sends
+// them without waiting for it.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
@@ -95,7 +100,7 @@ class LioNode {
   };
   NextEvent nextEvent() const;
   /// The promise in PROGRESS (progress_t.quiet_*): IMU samples that cannot make advance() act.
-  std::optional<Node::QuietWindow> quietWindow() const;
+  std::vector<Node::QuietWindow> quietWindows() const;
   void process(const PendingScan& p);
   /// Propagates to an image time and publishes the prior (sets pending_).
   void handOff(int64_t utime);

@@ -12,8 +12,9 @@
 // - A restart (tolerate_restarts): a consumer that exits or goes silent is not waited for until a
 //   new instance of it reports; messages published while it was away are lost to it.
 //
-// Quiet promises (progress_t.quiet_*): a consumer may promise that messages on one channel stamped
-// in a window make it publish nothing (lio: IMU samples before its next sweep end or image time).
+// Quiet promises (progress_t.quiet_*): a consumer may promise that messages on a channel stamped
+// in a window make it publish nothing (lio: IMU samples before its next sweep end or image time),
+// or any message on it (vio: REGISTERED_SCAN; CAMERA while no prior waits for an image).
 // Playback then sends such messages without waiting for it: it handles them in order and nobody
 // waits for an output of them, so every node sees what the serial replay shows it.
 //
@@ -111,9 +112,7 @@ class LockstepGate {
     std::map<std::string, int64_t> published;
     std::map<std::string, int64_t> published_before;  // by earlier instances of this node
     std::map<std::string, int64_t> offset;  // counted as handled: lost, or published while away
-    std::string quiet_channel;              // the newest PROGRESS's promise (empty: none)
-    int64_t quiet_from = 0;
-    int64_t quiet_before = 0;
+    std::map<std::string, std::pair<int64_t, int64_t>> quiet;  // the newest PROGRESS's promises
   };
   struct Waiting {
     int64_t handled = 0;
