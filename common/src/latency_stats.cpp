@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <sys/resource.h>
+
 namespace livo {
 
 namespace {
@@ -66,6 +68,11 @@ double readStatusKb(const char* key) {
 }  // namespace
 
 double peakRssMb() { return readStatusKb("VmHWM:") / 1024.0; }
+double cpuSeconds() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return 0.0;
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-6;
+}
 double currentRssMb() { return readStatusKb("VmRSS:") / 1024.0; }
 
 }  // namespace livo

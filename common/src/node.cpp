@@ -356,7 +356,7 @@ int64_t Node::decodeFailures() const {
 
 void Node::printSummary(std::ostream& os) const {
   os << "[" << options_.name << "] processing time per message (peak RSS " << std::fixed << std::setprecision(1)
-     << peakRssMb() << " MB):\n";
+     << peakRssMb() << " MB, CPU " << std::setprecision(2) << cpuSeconds() << " s):\n";
   os << "  " << std::left << std::setw(22) << "channel" << std::right << std::setw(9) << "messages" << std::setw(11)
      << "median ms" << std::setw(9) << "p90 ms" << std::setw(9) << "max ms" << std::setw(9) << "decode!" << std::setw(10)
      << "rejected" << "\n";

@@ -88,6 +88,12 @@ int main(int argc, char** argv) {
                                            " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
                                      : std::string())
                 << std::endl;
+    if (!o.quiet) std::cerr << "[playback] CPU " << livo::cpuSeconds() << " s (user + system)" << std::endl;
+    if (!o.quiet && !r.waits.empty()) {
+      const auto lines = livo::playback::describeWaits(r.waits);
+      if (!lines.empty()) std::cerr << "[playback] lockstep waits, longest first (whose report ended them):\n";
+      for (const auto& l : lines) std::cerr << "[playback]   " << l << "\n";
+    }
     if (!r.error.empty()) {
       std::cerr << "livo-playback: " << r.error << std::endl;
       return 1;

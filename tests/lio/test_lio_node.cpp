@@ -659,7 +659,7 @@ TEST(LioNode, ResetStartsANewEpochAndRefusesOldCorrectionsAndPosteriors) {
 // publish anything. And they are worth having: they cover most samples (not those that carry the
 // filter past a sweep end or an image time, nor those while a posterior is awaited) and most wheel
 // readings (not the first past the end of a sweep waiting for one).
-TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesAndWheelReadings) {
+TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
   struct Watcher {
     progress_t last{};
     bool have = false;
@@ -671,16 +671,29 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesAndWheelReadings) {
       have = true;
     }
     void onOutput(const lcm::ReceiveBuffer*, const std::string&) { ++outputs; }
-    bool covers(const std::string& channel, int64_t utime) const {
-      for (int i = 0; have && i < last.num_quiet; ++i)
-        if (last.quiet_channel[i] == channel && utime >= last.quiet_from[i] && utime < last.quiet_before[i]) return true;
+    // Playback may send on while every message since a PROGRESS is inside its promises, however
+    // many states later: every such promise must hold for the whole run of messages it covers.
+    std::vector<progress_t> active;
+    static bool covers(const progress_t& p, const std::string& channel, int64_t utime) {
+      for (int i = 0; i < p.num_quiet; ++i)
+        if (p.quiet_channel[i] == channel && utime >= p.quiet_from[i] && utime < p.quiet_before[i]) return true;
       return false;
+    }
+    /// Drops the promises that do not cover this message; true if one still does.
+    bool keepCovering(const std::string& channel, int64_t utime) {
+      active.erase(std::remove_if(active.begin(), active.end(),
+                                  [&](const progress_t& p) { return !covers(p, channel, utime); }),
+                   active.end());
+      return !active.empty();
     }
   };
   const synth::SyntheticSequence seq = syntheticSequence();
-  // the plain run, with the camera hand-off, with IMU samples swapped and duplicated, with wheels
-  for (const int variant : {0, 1, 2, 3}) {
-    const bool handoff = variant == 1, wheels = variant == 3;
+  // the plain run, with the camera hand-off, with IMU samples swapped and duplicated, with wheels,
+  // with the hand-off from a camera whose stamps jitter by up to 24 ms and which misses images,
+  // from a camera whose images arrive 30 ms late (after the sweep that ends after them), and with
+  // each sweep arriving at its start (as livo-sim writes them), so that it waits for the images
+  for (const int variant : {0, 1, 2, 3, 4, 5, 6}) {
+    const bool handoff = variant == 1 || variant >= 4, wheels = variant == 3;
     Watcher w;
     std::map<std::string, int64_t> seen, covered;
     int64_t broken = 0, outputs_before = 0;
@@ -717,17 +730,47 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesAndWheelReadings) {
         wheel_odometry_t s;
         ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
         utime = s.utime;
+      } else if (m.channel == "CAMERA") {
+        image_t s;
+        ASSERT_GT(s.decode(m.bytes.data(), 0, static_cast<int>(m.bytes.size())), 0);
+        utime = s.utime;
       } else {
+        w.active.clear();  // never promised: playback waits for lio here
         return;
       }
       ++seen[m.channel];
-      in_promise = w.covers(m.channel, utime);
+      in_promise = w.keepCovering(m.channel, utime);
       covered[m.channel] += in_promise;
       outputs_before = w.outputs;
     };
-    setup.after_each = [&](const Message&) { broken += in_promise && w.outputs != outputs_before; };
+    setup.after_each = [&](const Message&) {
+      broken += in_promise && w.outputs != outputs_before;
+      if (w.have) w.active.push_back(w.last);
+    };
     int64_t first_image = 0, last_image = 0;
     std::vector<Message> in = handoff ? withImages(syntheticRun(), &first_image, &last_image) : syntheticRun();
+    if (variant == 5 || variant == 6) {
+      for (Message& m : in) {
+        if (variant == 5 && m.channel == "CAMERA") m.order_key += 30'000;
+        if (variant == 6 && m.channel == "LIDAR") m.order_key -= 100'000;
+      }
+      livo_test::sortByArrival(&in);
+    }
+    if (variant == 4) {
+      std::vector<Message> jittery;
+      int64_t k = 0;
+      for (const Message& m : in) {
+        if (m.channel != "CAMERA") {
+          jittery.push_back(m);
+          continue;
+        }
+        if (++k % 9 == 0) continue;  // missed
+        const int64_t t = m.order_key + ((k * 37) % 49 - 24) * 1000;
+        jittery.push_back(tinyImage(t));
+      }
+      livo_test::sortByArrival(&jittery);
+      in.swap(jittery);
+    }
     if (variant == 2) {
       std::vector<Message> disordered;
       int64_t k = 0;
@@ -763,9 +806,20 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesAndWheelReadings) {
     if (wheels) {
       EXPECT_GT(covered["WHEEL"], seen["WHEEL"] * 7 / 10) << covered["WHEEL"] << " of " << seen["WHEEL"];
     }
-    std::printf("%s: %lld of %lld IMU samples, %lld of %lld wheel readings inside the quiet promises\n",
-                variant == 0 ? "LiDAR-only" : variant == 1 ? "camera hand-off" : variant == 2 ? "swapped and duplicated IMU" : "wheels",
+    if (variant == 1 || variant == 6) {  // a regular camera: every image but the first (none due yet)
+      EXPECT_GT(covered["CAMERA"], seen["CAMERA"] * 9 / 10) << covered["CAMERA"] << " of " << seen["CAMERA"];
+    }
+    std::printf("%s: %lld of %lld IMU samples, %lld of %lld images, %lld of %lld wheel readings inside the quiet "
+                "promises\n",
+                variant == 0   ? "LiDAR-only"
+                : variant == 1 ? "camera hand-off"
+                : variant == 2 ? "swapped and duplicated IMU"
+                : variant == 3 ? "wheels"
+                : variant == 4 ? "hand-off, jittery camera"
+                : variant == 5 ? "hand-off, images 30 ms late"
+                               : "hand-off, sweeps at their start",
                 static_cast<long long>(covered["IMU"]), static_cast<long long>(seen["IMU"]),
+                static_cast<long long>(covered["CAMERA"]), static_cast<long long>(seen["CAMERA"]),
                 static_cast<long long>(covered["WHEEL"]), static_cast<long long>(seen["WHEEL"]));
   }
 }

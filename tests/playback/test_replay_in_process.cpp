@@ -35,3 +35,17 @@ TEST(ReplayInProcess, DeliversEverythingInLogOrderThroughNodes) {
   EXPECT_EQ(order[5], "IMU");
   EXPECT_EQ(order[6], "LIDAR");  // LIDAR at i % 10 == 5 follows its IMU sample
 }
+
+TEST(Playback, DescribesWhereTheLockstepWaitedLongestFirst) {
+  std::map<std::string, livo::playback::LockstepWaits> waits;
+  waits["IMU"] = {6001, 900, 4.05, {{"lio", 1.97}, {"vio", 0.92}}};
+  waits["LIDAR"] = {300, 300, 0.24, {{"lio", 0.24}}};
+  waits["GROUND_TRUTH"] = {3001, 0, 0.0, {}};  // never waited for: left out
+  waits["CAMERA"] = {600, 2, 0.004, {{"", 0.004}}};
+  const std::vector<std::string> lines = livo::playback::describeWaits(waits);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "IMU: 900 of 6001 waited for, 4.05 s (lio 1.97, vio 0.92)");
+  EXPECT_EQ(lines[1], "LIDAR: 300 of 300 waited for, 0.24 s (lio 0.24)");
+  EXPECT_EQ(lines[2], "CAMERA: 2 of 600 waited for, 0.00 s (? 0.00)");
+  EXPECT_EQ(livo::playback::describeWaits(waits, 1).size(), 1u);
+}

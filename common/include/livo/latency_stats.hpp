@@ -32,6 +32,8 @@ class LatencyStats {
 
 /// Peak resident set size of this process (VmHWM), MB; 0 if unknown.
 double peakRssMb();
+/// CPU time this process has used so far, user plus system (getrusage), in seconds.
+double cpuSeconds();
 /// Current resident set size (VmRSS), MB; 0 if unknown.
 double currentRssMb();
 

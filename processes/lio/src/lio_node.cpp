@@ -285,15 +285,16 @@ LioNode::NextEvent LioNode::nextEvent() const {
   if (scans_.empty()) return e;
   e.kind = NextEvent::kSweep;
   e.utime = e.imu_after = scans_.front().utime;
+  if (opts_.lio.wheel.enabled) {
+    const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
+    if (!wheel_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.wheel_max_wait_s));
+  }
+  e.imu_after_images_past = e.imu_after;
   if (opts_.camera_handoff && newest_image_ >= 0 && e.utime - newest_image_ < toUtime(1.0) &&
       node_.hasConsumers(opts_.state_prior_channel)) {
     // the images before the sweep end come first: wait until the next one is due after it
     const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > e.utime;
     if (!images_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.image_max_wait_s));
-  }
-  if (opts_.lio.wheel.enabled) {
-    const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
-    if (!wheel_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.wheel_max_wait_s));
   }
   return e;
 }
@@ -310,9 +311,37 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   // the filter gets samples imu_reorder_window_s behind the newest received; the sweeps, images
   // and wheel readings that could move the threshold come on other channels, not covered
   const NextEvent next = nextEvent();
-  if (next.kind != NextEvent::kNone)
-    w.before = std::min(w.before, next.imu_after + toUtime(opts_.imu_reorder_window_s) + 1);
+  int64_t threshold = next.kind != NextEvent::kNone ? next.imu_after : std::numeric_limits<int64_t>::max();
+  // Images: one stamped at or after `images_from` (IMU clock) becomes an event whose threshold is
+  // not below its own time; it may lower the next sweep's threshold, but not below what it would
+  // be with the images past its end. Both are at or after images_from, so such images cannot
+  // make advance() act, nor let a covered IMU sample do so, provided the filter is not past
+  // images_from and the IMU promise ends there too (the filter then stays at or before it).
+  // images_from is where the next image is due, so that the IMU up to where the image is handed
+  // off stays covered; an earlier image is not covered, nor, after a later one, the IMU between
+  // (playback then waits for lio once, which is merely slower). No promise before the first image, nor once the next is a period
+  // overdue (a camera that stopped must not hold the IMU promise back), nor when the filter is
+  // already past where it is due (the images come late).
+  std::optional<int64_t> images_from;
+  const int64_t period = toUtime(1.0 / opts_.camera_rate_hz);
+  const int64_t image_due = newest_image_ + period;
+  if (opts_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= image_due + period) {
+    images_from = image_due;
+    if (next.kind == NextEvent::kImage) images_from = std::min(*images_from, next.imu_after);
+    if (next.kind == NextEvent::kSweep) images_from = std::min(*images_from, next.imu_after_images_past);
+    if (fed_any_imu_ && fed_imu_ > *images_from)
+      images_from.reset();
+    else
+      threshold = std::min(threshold, *images_from);
+  }
+  if (threshold != std::numeric_limits<int64_t>::max())
+    w.before = std::min(w.before, threshold + toUtime(opts_.imu_reorder_window_s) + 1);
   std::vector<Node::QuietWindow> out{w};
+  if (images_from) {
+    // in the message's own clock; a period's worth (several images in one window are as safe)
+    const int64_t offset = toUtime(opts_.camera_time_offset_s);
+    out.push_back({opts_.camera_channel, *images_from - offset, *images_from + period - offset});
+  }
   if (opts_.lio.wheel.enabled) {
     // a wheel reading matters only by letting the next sweep go without waiting for the wheels
     // (one past its end): readings up to its end cannot, nor any once one past it has come, nor

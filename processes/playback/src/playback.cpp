@@ -1,5 +1,6 @@
 #include "livo/playback/playback.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <iomanip>
 #include <iostream>
@@ -79,7 +80,7 @@ class PlaybackRun {
         faults_(options.faults, options.seed),
         sink_(lcm, options.out_log),
         gate_(options.consumers, gateOptions(options)),
-        context_{&gate_, wall_start_} {
+        context_{&gate_, wall_start_, {}} {
     if (!sink_.toFile() && !lcm) throw std::invalid_argument("runPlayback: no bus and no output log");
     if (options.lockstep && options.consumers.empty())
       throw std::invalid_argument("--lockstep needs the consumer node names (--consumers a,b,...)");
@@ -130,8 +131,13 @@ class PlaybackRun {
       if (!err.empty()) return err;
     }
     if (lockstep_ && result_.published > 0) {  // the lagging consumers finish too
+      const Clock::time_point t0 = Clock::now();
       const std::string err = waitUntilCaughtUp(/*all=*/true, nullptr);
       if (!err.empty()) return err;
+      LockstepWaits& waits = result_.waits["(end of log)"];
+      waits.messages = waits.waited = 1;
+      waits.seconds = secondsSince(t0);
+      waits.seconds_by_last[context_.last_mover] = waits.seconds;
     }
     progress_line_->update(result_.log_seconds, 1.0, result_.published, true);
     return "";
@@ -170,6 +176,7 @@ class PlaybackRun {
   struct ProgressContext {
     LockstepGate* gate;
     Clock::time_point start;
+    std::string last_mover;  // the node whose PROGRESS last moved a count on
   };
 
   static LockstepGateOptions gateOptions(const PlaybackOptions& options) {
@@ -195,7 +202,8 @@ class PlaybackRun {
               p.idle_checked_us > 0
                   ? p.idle_checked_us * 1e-6 - std::chrono::duration<double>(c->start.time_since_epoch()).count()
                   : std::nan("");
-          c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count(), idle_checked_s);
+          if (c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count(), idle_checked_s))
+            c->last_mover = p.node;
         },
         &context_);
   }
@@ -220,9 +228,19 @@ class PlaybackRun {
     int64_t utime = LockstepGate::kNoUtime;
     if (!messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
     gate_.onPublished(e.channel, now_s(), utime);
-    if (!gate_.idle() && gate_.caughtUp()) ++result_.not_waited;
+    const bool must_wait = !gate_.caughtUp();
+    if (!must_wait && !gate_.idle()) ++result_.not_waited;
+    LockstepWaits& waits = result_.waits[e.channel];
+    ++waits.messages;
+    const Clock::time_point t0 = Clock::now();
     const std::string err = waitUntilCaughtUp(/*all=*/false, &e);
     if (!err.empty()) return err;
+    if (must_wait) {
+      const double waited_s = secondsSince(t0);
+      ++waits.waited;
+      waits.seconds += waited_s;
+      waits.seconds_by_last[context_.last_mover] += waited_s;
+    }
     tellEvents();
     return "";
   }
@@ -291,6 +309,27 @@ class PlaybackRun {
 };
 
 }  // namespace
+
+std::vector<std::string> describeWaits(const std::map<std::string, LockstepWaits>& waits, size_t max_lines) {
+  std::vector<std::pair<std::string, const LockstepWaits*>> order;
+  for (const auto& [channel, w] : waits) order.emplace_back(channel, &w);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.second->seconds > b.second->seconds; });
+  std::vector<std::string> lines;
+  for (const auto& [channel, w] : order) {
+    if (lines.size() >= max_lines || w->waited == 0) break;
+    std::vector<std::pair<std::string, double>> by(w->seconds_by_last.begin(), w->seconds_by_last.end());
+    std::stable_sort(by.begin(), by.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(2) << channel << ": " << w->waited << " of " << w->messages
+       << " waited for, " << w->seconds << " s (";
+    for (size_t i = 0; i < by.size(); ++i)
+      os << (i ? ", " : "") << (by[i].first.empty() ? "?" : by[i].first) << " " << by[i].second;
+    os << ")";
+    lines.push_back(os.str());
+  }
+  return lines;
+}
 
 PlaybackResult runPlayback(const PlaybackOptions& options, lcm::LCM* lcm) {
   PlaybackRun run(options, lcm);

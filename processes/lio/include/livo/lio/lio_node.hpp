@@ -21,9 +21,10 @@
 // so replays stay identical.
 //
 // Quiet promises (progress_t.quiet_*, quietWindows()): with every PROGRESS, lio tells lockstep
-// playback which IMU samples (stamped before the next event's threshold) and wheel readings (up to
-// the end of a sweep that waits for one past it, or any) cannot make it publish, so playback sends
-// them without waiting for it.
+// playback which IMU samples (stamped before the next event's threshold), images (stamped after
+// it, while no sweep waits for one) and wheel readings (up to the end of a sweep that waits for one
+// past it, or any) cannot make it publish, in any interleaving, so playback sends them without
+// waiting for it.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
@@ -97,9 +98,11 @@ class LioNode {
     enum Kind { kNone, kImage, kSweep } kind = kNone;
     int64_t utime = 0;
     int64_t imu_after = 0;
+    int64_t imu_after_images_past = 0;  // the threshold once an image past the sweep's end has come
   };
   NextEvent nextEvent() const;
-  /// The promise in PROGRESS (progress_t.quiet_*): IMU samples that cannot make advance() act.
+  /// The promises in PROGRESS (progress_t.quiet_*): IMU samples, images and wheel readings that
+  /// cannot make advance() act, even interleaved.
   std::vector<Node::QuietWindow> quietWindows() const;
   void process(const PendingScan& p);
   /// Propagates to an image time and publishes the prior (sets pending_).
