@@ -38,8 +38,8 @@
 # pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
 # the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
 # --max-lag N (lockstep): colour, octomap and the recorder, whose outputs no estimator takes, may
-# fall up to N messages (4) behind the rest, so they run beside lio, vio and loop on the second
-# core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
+# fall up to N messages (16; and 4 MB, livo-playback --max-lag-mb) behind the rest, so they run
+# beside lio, vio and loop on the second core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
 # before the next goes out (no lag, no quiet promises): slower, and the outputs are the same.
 set -euo pipefail
 # One brace group: bash reads all of it before running any of it, so editing this file during a
@@ -52,7 +52,7 @@ all_processes=(lio vio vio_feature loop colour octomap)
 usage() { sed -n '2,43p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0 max_lag=4 serial=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0 max_lag=16 serial=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do

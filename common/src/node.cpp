@@ -189,6 +189,7 @@ void Node::flushProgress() {
 void Node::publishRaw(const std::string& channel, const void* data, int size) {
   lcm_.publish(channel, data, static_cast<unsigned int>(size));
   ++published_[channel];
+  published_bytes_[channel] += size;
 }
 
 Node::Subscription* Node::find(const std::string& channel) const {
@@ -249,6 +250,8 @@ void Node::publishProgress(bool finished) {
   for (const auto& [ch, n] : published_) {
     p.output_channel.push_back(ch);
     p.published.push_back(n);
+    auto b = published_bytes_.find(ch);
+    p.published_bytes.push_back(b == published_bytes_.end() ? 0 : b->second);
   }
   p.num_outputs = static_cast<int32_t>(p.output_channel.size());
   if (quiet_windows_ && !finished) {

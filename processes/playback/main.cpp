@@ -43,7 +43,9 @@ int main(int argc, char** argv) {
                         "(the reference the default must equal)")
       .option("--lag", "A,B,...",
               "lockstep: consumers that may fall behind the rest (their outputs feed only recorders; checked)")
-      .option("--max-lag", "N", "lockstep: how many messages a --lag consumer may be behind", "4")
+      .option("--max-lag", "N", "lockstep: how many messages a --lag consumer may be behind", "16")
+      .option("--max-lag-mb", "MB",
+              "lockstep: and how many megabytes (at each channel's mean message size; within the receive buffer)", "4")
       .flag("--respawn", "lockstep: consumers may exit and be restarted by a supervisor; not waited for while away")
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
@@ -71,6 +73,9 @@ int main(int argc, char** argv) {
     o.may_lag = splitList(cli.get("--lag"));
     o.max_lag_messages = static_cast<int>(cli.getInt("--max-lag"));
     if (o.max_lag_messages < 0) throw std::invalid_argument("--max-lag must be >= 0");
+    const double max_lag_mb = cli.getDouble("--max-lag-mb");
+    if (!(max_lag_mb >= 0.0)) throw std::invalid_argument("--max-lag-mb must be >= 0");
+    o.max_lag_bytes = static_cast<int64_t>(max_lag_mb * 1048576.0);
     o.quiet = cli.has("--quiet");
     if (o.speed < 0) throw std::invalid_argument("--speed must be >= 0");
     if (!o.quiet)

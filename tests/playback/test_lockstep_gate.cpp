@@ -297,6 +297,31 @@ TEST(LockstepGate, ALaggingConsumerFallsBehindByAtMostTheBound) {
   EXPECT_TRUE(g.idle());
 }
 
+// The backlog is bounded in bytes too, at each channel's mean message size (what nodes publish
+// comes with their byte counts in PROGRESS): a receive buffer holds a few 64-beam clouds, not 16.
+TEST(LockstepGate, ALaggingConsumerFallsBehindByAtMostTheByteBound) {
+  LockstepGateOptions o;
+  o.may_lag = {"colour"};
+  o.max_lag_messages = 16;
+  o.max_lag_bytes = 5'000'000;
+  LockstepGate g({"lio", "colour"}, o);
+  g.onProgress(progress("lio", 0, {{"LIDAR", 0}}, {{"REGISTERED_SCAN", 0}}));
+  g.onProgress(progress("colour", 0, {{"REGISTERED_SCAN", 0}, {"CAMERA", 0}}, {{"COLORED_CLOUD", 0}}));
+  ASSERT_EQ(g.lagging(), (std::vector<std::string>{"colour"}));
+  g.onPublished("CAMERA", 0.0, 1, 900'000);
+  g.onPublished("CAMERA", 0.0, 2, 900'000);
+  EXPECT_TRUE(g.caughtUp());  // 1.8 MB behind
+  g.onPublished("LIDAR", 0.0, 3, 2'000'000);
+  progress_t lio = progress("lio", 1, {{"LIDAR", 1}}, {{"REGISTERED_SCAN", 1}});
+  lio.published_bytes = {3'000'000};
+  g.onProgress(lio);
+  EXPECT_TRUE(g.caughtUp());  // 4.8 MB behind (two images and lio's scan), 3 messages
+  g.onPublished("CAMERA", 0.0, 4, 900'000);
+  EXPECT_FALSE(g.caughtUp());  // 5.7 MB behind, 4 messages
+  g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 0}, {"CAMERA", 2}}, {{"COLORED_CLOUD", 0}}));
+  EXPECT_TRUE(g.caughtUp());   // 3.9 MB behind
+}
+
 // octomap takes colour's clouds: colour lagging would hand them to octomap at positions that
 // depend on timing, so it is kept in step (and says so); the recorder taking them does not count.
 TEST(LockstepGate, AConsumerWhoseOutputAnotherActsOnIsKeptInStep) {

@@ -237,6 +237,7 @@ TEST(LcmTypes, ProgressHealth) {
   p.num_outputs = 1;
   p.output_channel = {"ODOMETRY"};
   p.published = {10};
+  p.published_bytes = {1000};
   p.num_quiet = 1;
   p.quiet_channel = {"IMU"};
   p.quiet_from = {100};
@@ -247,6 +248,7 @@ TEST(LcmTypes, ProgressHealth) {
   EXPECT_EQ(pd.quiet_channel[0], "IMU");
   EXPECT_EQ(pd.quiet_before[0], 200);
   EXPECT_EQ(pd.handled[0], 200);
+  EXPECT_EQ(pd.published_bytes[0], 1000);
 
   health_t h;
   h.utime = 1;

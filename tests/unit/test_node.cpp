@@ -72,6 +72,8 @@ TEST(Node, DecodesCountsFailuresAndReportsProgress) {
     EXPECT_EQ(progress[i].output_channel[0], "ECHO");
   }
   EXPECT_EQ(progress.back().published[0], 2);
+  ASSERT_EQ(progress.back().published_bytes.size(), 1u);  // the echoes' encoded bytes
+  EXPECT_EQ(progress.back().published_bytes[0], 2 * imu_t{}.getEncodedSize());
 
   node.finish();
   node.finish();  // idempotent

@@ -80,8 +80,15 @@ class Node {
 
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
-    lcm_.publish(channel, &msg);
-    ++published_[channel];
+    // encoded into a buffer kept between messages: a fresh one for every cloud would be mapped
+    // and faulted in page by page (blocks of 256 kB and more are mapped, see the constructor)
+    const int size = msg.getEncodedSize();
+    if (publish_buffer_.size() < static_cast<size_t>(size)) publish_buffer_.resize(static_cast<size_t>(size));
+    if (msg.encode(publish_buffer_.data(), 0, size) != size) {
+      error("cannot encode a " + std::string(Msg::getTypeName()) + " for " + channel + "; not published");
+      return;
+    }
+    publishRaw(channel, publish_buffer_.data(), size);
   }
   void publishRaw(const std::string& channel, const void* data, int size);
   /// Declares an output channel so that PROGRESS lists it (with 0) before its first message.
@@ -184,6 +191,8 @@ class Node {
   std::deque<Subscription> subs_;  // stable addresses for LCM's callbacks
   std::vector<lcm::Subscription*> lcm_subs_;
   std::map<std::string, int64_t> published_;
+  std::map<std::string, int64_t> published_bytes_;
+  std::vector<uint8_t> publish_buffer_;
   std::map<std::string, LatencyStats> work_;
   /// Nothing is waiting in the LCM receive queue (the provider's descriptor is not readable).
   bool receiveQueueEmpty();

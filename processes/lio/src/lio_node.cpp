@@ -302,45 +302,60 @@ LioNode::NextEvent LioNode::nextEvent() const {
 std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   // waiting for a posterior (or for the next sample to confirm a jumped clock): no promise
   if (!has_imu_ || pending_ || held_jump_) return {};
+  constexpr int64_t kNever = std::numeric_limits<int64_t>::max();
+  const NextEvent next = nextEvent();
+  // advance() acts only once the filter's newest sample is past the next event's threshold, and
+  // the filter gets samples imu_reorder_window_s behind the newest received. Images and sweeps
+  // may be promised too: an image stamped at or after image_due, a sweep ending at or after the
+  // newest sweep end, becomes an event whose threshold is not below that time; and it may lower
+  // the next event's threshold only by ending its wait for images (a sweep) or for the LiDAR (an
+  // image). The lowest threshold covered messages can bring about is the floor below; they
+  // cannot make advance() act, in any interleaving, provided the filter is not past the floor and
+  // the IMU promise ends there too (the filter then stays at or before it).
+  // image_due is where the next image is due, so that the IMU up to where it is handed off stays
+  // covered; an earlier image is not covered (playback then waits for lio once, which is merely
+  // slower). No image promise before the first image, nor once the next is a period overdue (a
+  // camera that stopped must not hold the IMU promise back). Sweeps are promised where they
+  // arrive before the IMU passes the newest sweep end (a driver that stamps and sends a sweep at
+  // its start, or soon after its end).
+  const int64_t period = toUtime(1.0 / opts_.camera_rate_hz);
+  const int64_t image_due = newest_image_ + period;
+  const bool images_possible = opts_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= image_due + period;
+  const bool sweeps_possible = newest_sweep_end_ >= 0;
+  const auto floor = [&](bool images, bool sweeps) {
+    int64_t f = kNever;
+    if (next.kind == NextEvent::kImage) f = sweeps ? next.utime : next.imu_after;
+    if (next.kind == NextEvent::kSweep) f = images ? next.imu_after_images_past : next.imu_after;
+    if (images) f = std::min(f, image_due);
+    if (sweeps) f = std::min(f, newest_sweep_end_);
+    return f;
+  };
+  bool images = false, sweeps = false;
+  for (const auto& [try_images, try_sweeps] : {std::pair{true, true}, {true, false}, {false, true}}) {
+    if ((try_images && !images_possible) || (try_sweeps && !sweeps_possible)) continue;
+    if (fed_any_imu_ && floor(try_images, try_sweeps) < fed_imu_) continue;  // a covered one could act at once
+    images = try_images;
+    sweeps = try_sweeps;
+    break;
+  }
+  const int64_t threshold = floor(images, sweeps);
+
   Node::QuietWindow w;
   w.channel = opts_.imu_channel;
   // a sample further back is a clock reset, one further ahead is held as a jump
   w.from = newest_imu_ - toUtime(opts_.clock_reset_s);
   w.before = newest_imu_ + toUtime(opts_.clock_jump_s);
-  // advance() acts only once the filter's newest sample is past the next event's threshold, and
-  // the filter gets samples imu_reorder_window_s behind the newest received; the sweeps, images
-  // and wheel readings that could move the threshold come on other channels, not covered
-  const NextEvent next = nextEvent();
-  int64_t threshold = next.kind != NextEvent::kNone ? next.imu_after : std::numeric_limits<int64_t>::max();
-  // Images: one stamped at or after `images_from` (IMU clock) becomes an event whose threshold is
-  // not below its own time; it may lower the next sweep's threshold, but not below what it would
-  // be with the images past its end. Both are at or after images_from, so such images cannot
-  // make advance() act, nor let a covered IMU sample do so, provided the filter is not past
-  // images_from and the IMU promise ends there too (the filter then stays at or before it).
-  // images_from is where the next image is due, so that the IMU up to where the image is handed
-  // off stays covered; an earlier image is not covered, nor, after a later one, the IMU between
-  // (playback then waits for lio once, which is merely slower). No promise before the first image, nor once the next is a period
-  // overdue (a camera that stopped must not hold the IMU promise back), nor when the filter is
-  // already past where it is due (the images come late).
-  std::optional<int64_t> images_from;
-  const int64_t period = toUtime(1.0 / opts_.camera_rate_hz);
-  const int64_t image_due = newest_image_ + period;
-  if (opts_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= image_due + period) {
-    images_from = image_due;
-    if (next.kind == NextEvent::kImage) images_from = std::min(*images_from, next.imu_after);
-    if (next.kind == NextEvent::kSweep) images_from = std::min(*images_from, next.imu_after_images_past);
-    if (fed_any_imu_ && fed_imu_ > *images_from)
-      images_from.reset();
-    else
-      threshold = std::min(threshold, *images_from);
-  }
-  if (threshold != std::numeric_limits<int64_t>::max())
-    w.before = std::min(w.before, threshold + toUtime(opts_.imu_reorder_window_s) + 1);
+  if (threshold != kNever) w.before = std::min(w.before, threshold + toUtime(opts_.imu_reorder_window_s) + 1);
   std::vector<Node::QuietWindow> out{w};
-  if (images_from) {
-    // in the message's own clock; a period's worth (several images in one window are as safe)
+  // in the messages' own clocks; a period's worth of images (several in one window are as safe)
+  if (images) {
     const int64_t offset = toUtime(opts_.camera_time_offset_s);
-    out.push_back({opts_.camera_channel, *images_from - offset, *images_from + period - offset});
+    out.push_back({opts_.camera_channel, image_due - offset, image_due + period - offset});
+  }
+  if (sweeps) {
+    // a sweep ends at or after its stamp plus the LiDAR's time offset
+    const int64_t offset = toUtime(opts_.lio.extrinsics.time_offset_s);
+    out.push_back({opts_.lidar_channel, newest_sweep_end_ - offset, kNever});
   }
   if (opts_.lio.wheel.enabled) {
     // a wheel reading matters only by letting the next sweep go without waiting for the wheels

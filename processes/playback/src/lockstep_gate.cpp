@@ -32,7 +32,9 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     // A new process under the same name: its counts start again from zero. What the old instance
     // published stays published; what was published before the new one reported is lost to it.
     for (const auto& [channel, count] : n.published) n.published_before[channel] += count;
+    for (const auto& [channel, bytes] : n.published_bytes) n.published_bytes_before[channel] += bytes;
     n.published.clear();
+    n.published_bytes.clear();
     std::ostringstream lost;
     int64_t lost_total = 0;
     for (int i = 0; i < p.num_inputs; ++i) {
@@ -74,6 +76,7 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     v = p.handled[i];
   }
   for (int i = 0; i < p.num_outputs; ++i) {
+    if (static_cast<size_t>(i) < p.published_bytes.size()) n.published_bytes[p.output_channel[i]] = p.published_bytes[i];
     int64_t& v = n.published[p.output_channel[i]];
     if (v != p.published[i]) {
       changed = true;
@@ -99,8 +102,9 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
   return changed;
 }
 
-void LockstepGate::onPublished(const std::string& channel, double now_s, int64_t utime) {
+void LockstepGate::onPublished(const std::string& channel, double now_s, int64_t utime, int64_t bytes) {
   const int64_t index = ++playback_published_[channel];
+  playback_bytes_[channel] += bytes;
   auto& stamps = playback_utimes_[channel];
   stamps.emplace_back(index, utime);
   if (stamps.size() > kUtimeHistory) stamps.pop_front();
@@ -242,6 +246,23 @@ int64_t LockstepGate::behind(const NodeState& n) const {
   return total;
 }
 
+int64_t LockstepGate::behindBytes(const NodeState& n) const {
+  double total = 0.0;
+  for (const auto& [channel, handled] : n.handled) {
+    const int64_t d = deficit(n, channel);
+    if (d <= 0) continue;
+    int64_t bytes = 0;
+    if (auto pb = playback_bytes_.find(channel); pb != playback_bytes_.end()) bytes += pb->second;
+    for (const auto& [name, node] : nodes_) {
+      if (auto b = node.published_bytes.find(channel); b != node.published_bytes.end()) bytes += b->second;
+      if (auto b = node.published_bytes_before.find(channel); b != node.published_bytes_before.end()) bytes += b->second;
+    }
+    const int64_t count = totalPublished(channel);
+    if (count > 0) total += static_cast<double>(d) * static_cast<double>(bytes) / static_cast<double>(count);
+  }
+  return static_cast<int64_t>(total);
+}
+
 std::string LockstepGate::keptInStepBecause(const std::string& node) const {
   auto it = nodes_.find(node);
   if (it == nodes_.end()) return "it has not reported";
@@ -278,7 +299,7 @@ bool LockstepGate::caughtUp() const {
     const NodeState& n = it->second;
     if (n.away) continue;
     if (std::find(lag.begin(), lag.end(), c) != lag.end()) {
-      if (behind(n) > options_.max_lag_messages) return false;
+      if (behind(n) > options_.max_lag_messages || behindBytes(n) > options_.max_lag_bytes) return false;
       continue;
     }
     for (const auto& [channel, handled] : n.handled)

@@ -186,6 +186,7 @@ class PlaybackRun {
     g.honour_quiet_promises = !options.serial;
     if (!options.serial) g.may_lag = options.may_lag;
     g.max_lag_messages = options.max_lag_messages;
+    g.max_lag_bytes = options.max_lag_bytes;
     return g;
   }
 
@@ -227,7 +228,7 @@ class PlaybackRun {
     // the message's own stamp (what a quiet promise is about), not the log event's
     int64_t utime = LockstepGate::kNoUtime;
     if (!messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
-    gate_.onPublished(e.channel, now_s(), utime);
+    gate_.onPublished(e.channel, now_s(), utime, static_cast<int64_t>(e.data.size()));
     const bool must_wait = !gate_.caughtUp();
     if (!must_wait && !gate_.idle()) ++result_.not_waited;
     LockstepWaits& waits = result_.waits[e.channel];
@@ -254,11 +255,13 @@ class PlaybackRun {
     if (options_.may_lag.empty()) return;
     std::string names;
     for (const auto& c : gate_.lagging()) names += (names.empty() ? "" : ", ") + c;
-    std::cerr << "[playback] lockstep: "
-              << (names.empty() ? std::string("every consumer in step")
-                                : names + " may lag up to " + std::to_string(options_.max_lag_messages) +
-                                      " messages behind the rest")
-              << std::endl;
+    std::ostringstream os;
+    if (names.empty())
+      os << "every consumer in step";
+    else
+      os << names << " may lag up to " << options_.max_lag_messages << " messages (" << std::fixed
+         << std::setprecision(1) << options_.max_lag_bytes / 1048576.0 << " MB) behind the rest";
+    std::cerr << "[playback] lockstep: " << os.str() << std::endl;
   }
 
   /// Lockstep: handles PROGRESS until every consumer has handled everything published so far

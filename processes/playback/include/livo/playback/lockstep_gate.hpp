@@ -49,8 +49,9 @@ struct LockstepGateOptions {
   double restart_wait_s = 30.0;     // tolerate_restarts: how long a consumer away is waited for
   bool honour_quiet_promises = true; // false: wait for every consumer after every message
   std::vector<std::string> may_lag; // consumers that may fall behind (see above)
-  int max_lag_messages = 4;         // how far (messages not yet handled, all channels) they may:
-                                    // bounded by the UDP receive buffer (a 64-beam cloud is ~3 MB)
+  int max_lag_messages = 16;        // how far (messages not yet handled, all channels) they may,
+  int64_t max_lag_bytes = 4 << 20;  // and in bytes (estimated from each channel's mean size): the
+                                    // UDP receive buffer bounds it (a 64-beam cloud is ~3 MB)
 };
 
 class LockstepGate {
@@ -65,9 +66,9 @@ class LockstepGate {
   /// heartbeat that repeats what was known.
   bool onProgress(const progress_t& p, double now_s = 0.0, double idle_checked_s = std::nan(""));
   /// Playback published one more message on `channel` at `now_s`, stamped `utime` (the message's
-  /// own; kNoUtime: unknown, never covered by a quiet promise).
+  /// own; kNoUtime: unknown, never covered by a quiet promise), of `bytes`.
   static constexpr int64_t kNoUtime = INT64_MIN;
-  void onPublished(const std::string& channel, double now_s = 0.0, int64_t utime = kNoUtime);
+  void onPublished(const std::string& channel, double now_s = 0.0, int64_t utime = kNoUtime, int64_t bytes = 0);
   /// tolerate_restarts: marks consumers not heard for silent_after_s as away (call periodically).
   void checkSilent(double now_s);
 
@@ -110,7 +111,9 @@ class LockstepGate {
     double last_heard_s = 0.0;
     std::map<std::string, int64_t> handled;
     std::map<std::string, int64_t> published;
+    std::map<std::string, int64_t> published_bytes;
     std::map<std::string, int64_t> published_before;  // by earlier instances of this node
+    std::map<std::string, int64_t> published_bytes_before;
     std::map<std::string, int64_t> offset;  // counted as handled: lost, or published while away
     std::map<std::string, std::pair<int64_t, int64_t>> quiet;  // the newest PROGRESS's promises
   };
@@ -130,6 +133,7 @@ class LockstepGate {
   /// Why a consumer listed in may_lag is kept in step ("" if it may lag).
   std::string keptInStepBecause(const std::string& node) const;
   int64_t behind(const NodeState& n) const;  // messages not yet handled, all channels
+  int64_t behindBytes(const NodeState& n) const;  // their bytes, at each channel's mean size
   /// The consumer's unhandled messages on `channel` are all playback's and inside its promise.
   bool promisedQuiet(const NodeState& n, const std::string& channel) const;
   void noteLagDecisions();
@@ -138,6 +142,7 @@ class LockstepGate {
   LockstepGateOptions options_;
   std::map<std::string, NodeState> nodes_;  // every node seen, listed or not
   std::map<std::string, int64_t> playback_published_;
+  std::map<std::string, int64_t> playback_bytes_;
   std::map<std::string, std::deque<std::pair<int64_t, int64_t>>> playback_utimes_;  // channel -> (index, utime), newest
   std::map<std::string, int64_t> known_total_;                       // channel -> total seen so far
   std::map<std::string, std::deque<std::pair<int64_t, double>>> reached_at_;  // channel -> (total, time)
