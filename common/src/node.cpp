@@ -69,15 +69,22 @@ int NodeOptions::handlerDelayFromEnvironment() {
   return static_cast<int>(ms);
 }
 
+void keepLargeBlocksOnHeap() {
+#if defined(__GLIBC__)
+  // Blocks up to 32 MB (clouds, images, key sets, map arrays) come from the heap and are reused
+  // from message to message, and the top of the heap is not given back after every large free:
+  // mapping each large block on its own costs fresh zeroed pages, faulted in one by one, for every
+  // cloud and image (a fifth of lio's time, a sixth of vio's and colour's). Over an hours-long run
+  // of varying sizes the heap fragments instead, and resident memory crept up although nothing
+  // was kept (issue 16's soak): Node::tick() hands the free pages back every few seconds.
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+#endif
+}
+
 Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(options)) {
   if (options_.name.empty()) throw std::invalid_argument("livo::Node needs a name");
-#if defined(__GLIBC__)
-  // Blocks of 256 kB or more (clouds, key sets, features, map arrays) are mapped and unmapped on
-  // their own. glibc's default raises this threshold after the first such block is freed, and from
-  // then on serves them from the heap, where an hours-long run of different sizes fragments it
-  // and resident memory creeps up although nothing is kept (issue 16's soak).
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
-#endif
+  keepLargeBlocksOnHeap();
   if (options_.handler_delay_max_ms < 0) throw std::invalid_argument("livo::Node: handler_delay_max_ms < 0");
   // FNV-1a of the name: the same delays for the same node in every run (std::hash is not portable)
   uint32_t seed = 2166136261u;
@@ -322,8 +329,14 @@ void Node::publishHealth() {
 }
 
 void Node::tick() {
-  if (options_.health_period_s <= 0.0) return;
   const auto now = std::chrono::steady_clock::now();
+#if defined(__GLIBC__)
+  if (now - last_trim_ >= std::chrono::seconds(2)) {  // the free pages back to the system (constructor)
+    last_trim_ = now;
+    malloc_trim(0);
+  }
+#endif
+  if (options_.health_period_s <= 0.0) return;
   if (std::chrono::duration<double>(now - last_health_).count() >= options_.health_period_s) {
     last_health_ = now;
     publishHealth();
@@ -369,6 +382,7 @@ void Node::printSummary(std::ostream& os) const {
        << std::setw(9) << c.decode_failures << std::setw(10) << c.rejected << "\n";
   }
   for (const auto& [ch, n] : published_) os << "  published " << ch << ": " << n << "\n";
+  os << "  published " << options_.progress_channel << ": " << progress_sequence_ << "\n";
   os.flush();
 }
 

@@ -81,6 +81,7 @@ int main(int argc, char** argv) {
     if (!o.quiet)
       for (const auto& f : o.faults) std::cerr << "[playback] fault: " << livo::playback::describe(f) << "\n";
 
+    livo::keepLargeBlocksOnHeap();
     std::unique_ptr<lcm::LCM> lcm;
     if (o.out_log.empty()) lcm = livo::makeLcm(cli.get("--lcm-url"));
     livo::installSignalHandlers();

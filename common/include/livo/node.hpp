@@ -80,8 +80,7 @@ class Node {
 
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
-    // encoded into a buffer kept between messages: a fresh one for every cloud would be mapped
-    // and faulted in page by page (blocks of 256 kB and more are mapped, see the constructor)
+    // encoded into a buffer kept between messages, not a fresh one for every cloud
     const int size = msg.getEncodedSize();
     if (publish_buffer_.size() < static_cast<size_t>(size)) publish_buffer_.resize(static_cast<size_t>(size));
     if (msg.encode(publish_buffer_.data(), 0, size) != size) {
@@ -193,6 +192,7 @@ class Node {
   std::map<std::string, int64_t> published_;
   std::map<std::string, int64_t> published_bytes_;
   std::vector<uint8_t> publish_buffer_;
+  std::chrono::steady_clock::time_point last_trim_ = std::chrono::steady_clock::now();
   std::map<std::string, LatencyStats> work_;
   /// Nothing is waiting in the LCM receive queue (the provider's descriptor is not readable).
   bool receiveQueueEmpty();
@@ -228,6 +228,11 @@ bool shutdownRequested();
 /// Returns 0, or 1 if the LCM provider failed.
 int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown = {},
          const std::function<bool()>& done = {});
+
+/// glibc: large blocks (clouds, images) from the heap, reused between messages, instead of fresh
+/// mapped pages for each (node.cpp says why, and how memory is still given back). Every Node does
+/// it; a process without one (livo-playback) calls it at its start.
+void keepLargeBlocksOnHeap();
 
 /// Creates an LCM instance on `url` (empty: LCM_DEFAULT_URL or LCM's default) or throws.
 std::unique_ptr<lcm::LCM> makeLcm(const std::string& url);
