@@ -143,3 +143,63 @@ TEST(Node, WatchesConsumersOfAChannel) {
   drain(lcm);
   EXPECT_EQ(inputs, std::vector<std::string>{"STATE_PRIOR"});
 }
+
+// Under spin(), an input inside the last PROGRESS's promise owes no PROGRESS if handling it
+// published nothing: the count goes out with the next one that is owed, or once input pauses.
+TEST(Node, LeavesOutTheProgressOfInputsItsLastPromiseCovers) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  NodeOptions opts;
+  opts.name = "n";
+  opts.quiet = true;
+  Node node(lcm, opts);
+  node.declareOutput("ECHO");
+  node.setQuietWindows([] { return std::vector<Node::QuietWindow>{{"IMU", 0, 1000}, Node::QuietWindow::always("SCAN")}; });
+  node.subscribe<imu_t>("IMU", [&](const imu_t& m) {
+    if (m.utime == 500) node.publish("ECHO", m);  // a covered input that publishes after all
+  });
+  node.subscribe<imu_t>("SCAN", [](const imu_t&) {});
+  node.setCoalesceProgress(true);
+  std::vector<progress_t> progress;
+  Node observer(lcm, NodeOptions{"observer", "PROGRESS_OBS", "HEALTH_OBS", 0.0, false, true, {}});
+  observer.subscribe<progress_t>("PROGRESS", [&](const progress_t& p) { progress.push_back(p); });
+  const auto send = [&](const char* channel, int64_t utime) {
+    imu_t m{};
+    m.utime = utime;
+    lcm.publish(channel, &m);
+    drain(lcm);
+  };
+  const auto handled = [&](const std::string& channel) {
+    const progress_t& p = progress.back();
+    for (int i = 0; i < p.num_inputs; ++i)
+      if (p.input_channel[i] == channel) return p.handled[i];
+    return int64_t{-1};
+  };
+  node.announce();
+  drain(lcm);
+  ASSERT_EQ(progress.size(), 1u);
+  send("IMU", 100);
+  send("IMU", 200);
+  EXPECT_EQ(progress.size(), 1u);  // covered, nothing published: none owed
+  EXPECT_EQ(node.coveredSinceProgress(), 2);
+  send("IMU", 500);
+  ASSERT_EQ(progress.size(), 2u);  // it published
+  EXPECT_EQ(handled("IMU"), 3);
+  send("IMU", 2000);
+  ASSERT_EQ(progress.size(), 3u);  // outside the promise
+  EXPECT_EQ(handled("IMU"), 4);
+  for (int i = 0; i < Node::kMaxCoveredWithoutProgressOnAWholeChannel; ++i) send("SCAN", i);
+  EXPECT_EQ(progress.size(), 3u);
+  send("SCAN", 99);  // playback lets at most 8 wait on a whole-channel promise
+  ASSERT_EQ(progress.size(), 4u);
+  EXPECT_EQ(handled("SCAN"), Node::kMaxCoveredWithoutProgressOnAWholeChannel + 1);
+  send("IMU", 300);
+  EXPECT_EQ(progress.size(), 4u);
+  node.flushProgress(/*idle=*/false);  // more input may follow at once
+  drain(lcm);
+  EXPECT_EQ(progress.size(), 4u);
+  node.flushProgress(/*idle=*/true);  // the input paused
+  drain(lcm);
+  ASSERT_EQ(progress.size(), 5u);
+  EXPECT_EQ(handled("IMU"), 5);
+}

@@ -45,7 +45,9 @@ std::optional<LogEvent> LogSource::next() {
       done_ = true;
       break;
     }
-    if (!std::regex_match(ev->channel, pattern_)) continue;
+    auto match = matches_.find(ev->channel);
+    if (match == matches_.end()) match = matches_.emplace(ev->channel, std::regex_match(ev->channel, pattern_)).first;
+    if (!match->second) continue;
     LogEvent out;
     out.utime = ev->timestamp;
     out.channel = ev->channel;

@@ -6,6 +6,7 @@
 #include <optional>
 #include <regex>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace lcm {
@@ -43,6 +44,7 @@ class LogSource {
   std::string path_;
   LogSourceOptions options_;
   std::regex pattern_;
+  std::unordered_map<std::string, bool> matches_;  // channel -> pattern_ matches it (a regex per event is slow)
   std::unique_ptr<lcm::LogFile> log_;
   int64_t file_bytes_ = 0;
   int64_t first_utime_ = -1;
