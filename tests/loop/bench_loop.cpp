@@ -1,7 +1,11 @@
 // Per-candidate and pose-graph benchmarks of livo-loop (issue 8 bars) on real keyframe clouds: the
 // shared KITTI 07 keyframes (../shared/data/lidar/kitti_07_dump, graph.txt poses), registering
 // keyframe 1 onto keyframe 0 with the LoopCloser's default options. Stages:
-//   Features/Coarse         ISS keypoints + FPFH descriptors of one keyframe (once per keyframe)
+//   Features/Coarse         ISS keypoints + FPFH descriptors of one keyframe (once per registered keyframe)
+//   Features/Keypoints      its first stage (voxels, normals, ISS) and whether any keypoint will have a
+//                           descriptor: what a keyframe that might be registered costs before it is
+//   Features/Describe       the second stage: the keypoints' FPFH descriptors
+//   Features/Describable    of Features/Keypoints, the exact test whether any keypoint will have one
 //   Coarse/Cached           matching + max clique + Quatro (features cached per keyframe)   <= 5 ms
 //   Coarse/WithFpfh         the above plus computing the source keyframe's features         <= 60 ms
 //   Fine/Gicp               Nano-GICP from the coarse result (clouds, covariances, trees cached) <= 15 ms
@@ -66,6 +70,44 @@ void BM_Features(benchmark::State& state) {
   state.counters["raw_points"] = static_cast<double>(kf[1].levelled.size());
 }
 BENCHMARK(BM_Features)->Name("Features/Coarse")->Unit(benchmark::kMillisecond);
+
+void BM_FeaturesKeypoints(benchmark::State& state) {
+  const auto& kf = keyframes();
+  const LoopCloserOptions defaults;
+  size_t n = 0;
+  bool describable = false;
+  for (auto _ : state) {
+    const CoarseKeypoints k = detectCoarseKeypoints(kf[1].levelled, defaults.coarse);
+    describable = anyKeypointDescribable(k, defaults.coarse);
+    n = k.keys.size();
+    benchmark::DoNotOptimize(describable);
+  }
+  state.counters["keypoints"] = static_cast<double>(n);
+  state.counters["describable"] = describable;
+}
+BENCHMARK(BM_FeaturesKeypoints)->Name("Features/Keypoints")->Unit(benchmark::kMillisecond);
+
+void BM_FeaturesDescribe(benchmark::State& state) {
+  const auto& kf = keyframes();
+  const LoopCloserOptions defaults;
+  const CoarseKeypoints k = detectCoarseKeypoints(kf[1].levelled, defaults.coarse);
+  size_t n = 0;
+  for (auto _ : state) {
+    const CoarseFeatures f = describeCoarseKeypoints(k, defaults.coarse);
+    n = f.size();
+    benchmark::DoNotOptimize(f);
+  }
+  state.counters["keypoints"] = static_cast<double>(n);
+}
+BENCHMARK(BM_FeaturesDescribe)->Name("Features/Describe")->Unit(benchmark::kMillisecond);
+
+void BM_FeaturesDescribable(benchmark::State& state) {
+  const auto& kf = keyframes();
+  const LoopCloserOptions defaults;
+  const CoarseKeypoints k = detectCoarseKeypoints(kf[1].levelled, defaults.coarse);
+  for (auto _ : state) benchmark::DoNotOptimize(anyKeypointDescribable(k, defaults.coarse));
+}
+BENCHMARK(BM_FeaturesDescribable)->Name("Features/Describable")->Unit(benchmark::kMicrosecond);
 
 void BM_CoarseCached(benchmark::State& state) {
   const auto& kf = keyframes();

@@ -308,6 +308,34 @@ TEST(LoopCloser, ResultsDoNotDependOnTheFeatureCacheSize) {
   }
 }
 
+// Features are derived only where a registration might be tried: on the first lap no node older
+// than exclude_recent_s (15 keyframes) is within search_radius (12 m) until the lap nearly closes
+// (keyframe 31 of 36 on the 14 m circle), so until then no keyframe's features are derived; then
+// the loops are found.
+TEST(LoopCloser, FeaturesAreDerivedOnlyWhereAnOlderNodeIsNear) {
+  const Points scene = makeScene(41, 0.15);
+  const int per_lap = 36, total = per_lap + 6;
+  LoopCloserOptions o;
+  o.odometry_translation_per_m = 0.02;
+  o.odometry_rotation_per_m = 2.5e-3;
+  LoopCloser closer(o);
+  int first_derived = -1;
+  for (int i = 0; i < total; ++i) {
+    const double a = 2 * M_PI * i / per_lap;
+    const Pose3 truth = yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8));
+    KeyframeInput in;
+    in.id = i;
+    in.utime = 1000000 + i * 2000000;
+    in.pose = truth;
+    in.cloud = viewFrom(scene, truth.translation(), a + M_PI / 2, 20.0, 0.02, 100 + i);
+    closer.addKeyframe(in);
+    if (first_derived < 0 && closer.cachedFeatures() > 0) first_derived = i;
+  }
+  std::printf("[lazy] features first derived at keyframe %d of %d\n", first_derived, total);
+  EXPECT_GE(first_derived, 30);
+  EXPECT_GE(closer.loops().size(), 1u);
+}
+
 // Exact odometry around a loop and past the start: the loops are verified and kept in the graph,
 // but the estimate already satisfies them, so nothing is optimised or published; with the gate at
 // zero the same loops each publish a correction.

@@ -114,4 +114,39 @@ Features computeFpfh(const Points& points, const Points& normals, const PointTre
   return out;
 }
 
+bool anyNonZeroFpfh(const Points& points, const Points& normals, const PointTree& tree, double radius,
+                    const std::vector<int>& at) {
+  // A point's FPFH is non-zero iff its SPFH is (the weighted neighbour sum added to it is
+  // non-negative or NaN), iff computeFpfh's SPFH loop counts a valid pair for it (a bin then
+  // holds at least 100/11). That loop visits every needed point (within `radius` of a point `at`
+  // with a normal) that has a normal, with the same radius search as here, and takes a pair of
+  // two needed points only from the lower index, as ordered there (pairBins may find one order
+  // degenerate and not the other when both angles are equal). For a point i `at` with a normal,
+  // visited because its own search holds it, and a neighbour j with a normal (needed, being in
+  // i's neighbourhood), the pair is counted for i
+  //   j > i: when i is visited, iff pairBins(i, j);
+  //   j < i: when j is visited, iff i is in j's neighbourhood and pairBins(j, i).
+  std::vector<std::pair<size_t, double>> around, back;
+  int bins[3];
+  for (const int a : at) {
+    const size_t i = static_cast<size_t>(a);
+    if (normals[i].isZero()) continue;
+    tree.radius(points[i], radius, around, false);
+    if (std::none_of(around.begin(), around.end(), [&](const auto& nb) { return nb.first == i; })) continue;
+    for (const auto& [j, d2] : around)
+      if (j > i && !normals[j].isZero() && pairBins(points[i], normals[i], points[j], normals[j], bins)) return true;
+    for (const auto& [j, d2] : around) {
+      if (j >= i || normals[j].isZero() || !pairBins(points[j], normals[j], points[i], normals[i], bins)) continue;
+      tree.radius(points[j], radius, back, false);
+      if (std::any_of(back.begin(), back.end(), [&](const auto& nb) { return nb.first == i; })) return true;
+    }
+  }
+  // No point `at` has a pair counted from its own neighbourhood. Were neighbourhoods symmetric
+  // (j finds i iff i finds j) that would settle it, but nanoflann prunes with a rounded bound, so
+  // a point at the radius could be found from j and not from i. Rare (sparse or degenerate
+  // clouds), and then no dearer than before: the features themselves.
+  const Features features = computeFpfh(points, normals, tree, radius, at);
+  return std::any_of(features.begin(), features.end(), [](const Fpfh& f) { return !f.isZero(); });
+}
+
 }  // namespace livo::loop

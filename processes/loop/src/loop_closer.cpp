@@ -52,37 +52,71 @@ size_t LoopCloser::odometryEdgesAcrossEpochs() const {
   return n;
 }
 
-std::vector<std::pair<double, int64_t>> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
-                                                                   double radius) const {
+std::vector<int64_t> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
+                                                double radius) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
   for (const auto& [id, node] : nodes_) {
     if (id >= kf_id) break;
-    if (node.epoch != kf.epoch || kf.utime - node.utime < recent || !node.has_keypoints) continue;
+    if (node.epoch != kf.epoch || kf.utime - node.utime < recent) continue;
     const double d2 = (graph_.pose(id).translation() - p).squaredNorm();
     if (d2 <= radius * radius) near.push_back({d2, id});
   }
   std::sort(near.begin(), near.end());
-  return near;
-}
-
-std::vector<int64_t> LoopCloser::candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
-  // graph nodes only: a keyframe that joined one is represented by it
-  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.candidates.search_radius);
   std::vector<int64_t> out;
-  for (size_t i = 0; i < near.size() && static_cast<int>(i) < options_.candidates.max_candidates; ++i)
-    out.push_back(near[i].second);
+  out.reserve(near.size());
+  for (const auto& [d2, id] : near) out.push_back(id);
   return out;
 }
 
-std::shared_ptr<const LoopCloser::Features> LoopCloser::deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const {
-  auto f = std::make_shared<Features>();
-  const Points levelled = transformed(cloud_I, rotationOnly(G_R_I));
-  f->coarse = computeCoarseFeatures(levelled, options_.coarse);
-  f->fine_points_ = centroidPerVoxel(levelled, options_.fine_voxel_size);
-  f->covariance_neighbors_ = options_.covariance_neighbors;
-  return f;
+std::vector<int64_t> LoopCloser::withKeypoints(const std::vector<int64_t>& nodes, int count) {
+  // the nearest `count` of those with keypoints, as filtering them all first would give
+  std::vector<int64_t> out;
+  for (size_t i = 0; i < nodes.size() && static_cast<int>(out.size()) < count; ++i)
+    if (nodeHasKeypoints(nodes[i])) out.push_back(nodes[i]);
+  return out;
 }
+
+bool LoopCloser::nodeHasKeypoints(int64_t id) {
+  Keyframe& node = nodes_.at(id);
+  if (!node.has_keypoints) node.has_keypoints = features(id)->hasKeypoints();
+  return *node.has_keypoints;
+}
+
+bool LoopCloser::Features::hasKeypoints() const {
+  if (coarse_) return !coarse_->points.empty();
+  if (!has_keypoints_) has_keypoints_ = anyKeypointDescribable(keypoints_, options_);
+  return *has_keypoints_;
+}
+
+const CoarseFeatures& LoopCloser::Features::coarse() const {
+  if (!coarse_) {
+    // without keypoints there is nothing to describe (describing would find as much)
+    coarse_ = has_keypoints_ && !*has_keypoints_ ? CoarseFeatures{} : describeCoarseKeypoints(keypoints_, options_);
+    keypoints_ = CoarseKeypoints{};  // no longer needed, and a kd-tree and a normal per voxel
+  }
+  return *coarse_;
+}
+
+const GicpCloud& LoopCloser::Features::fine(const std::function<FloatCloud()>& cloud_I) const {
+  if (!fine_)
+    fine_ = GicpCloud::build(centroidPerVoxel(levelled(cloud_I(), G_R_I_), fine_voxel_size_), covariance_neighbors_);
+  return *fine_;
+}
+
+Points LoopCloser::Features::levelled(const FloatCloud& cloud_I, const Mat3& G_R_I) {
+  Points cloud;
+  cloud.reserve(cloud_I.size());
+  for (const Eigen::Vector3f& p : cloud_I) cloud.push_back(p.cast<double>());
+  return transformed(cloud, rotationOnly(G_R_I));
+}
+
+LoopCloser::Features::Features(const FloatCloud& cloud_I, const Mat3& G_R_I, const LoopCloserOptions& options)
+    : options_(options.coarse),
+      G_R_I_(G_R_I),
+      fine_voxel_size_(options.fine_voxel_size),
+      covariance_neighbors_(options.covariance_neighbors),
+      keypoints_(detectCoarseKeypoints(levelled(cloud_I, G_R_I), options.coarse)) {}
 
 void LoopCloser::cacheFeatures(int64_t id, std::shared_ptr<const Features> f) {
   for (auto it = cache_.begin(); it != cache_.end(); ++it)
@@ -100,9 +134,7 @@ std::shared_ptr<const LoopCloser::Features> LoopCloser::features(int64_t id) {
       cache_.splice(cache_.begin(), cache_, it);
       return it->second;
     }
-  Points cloud_I;
-  for (const Eigen::Vector3f& p : clouds_.get(id)) cloud_I.push_back(p.cast<double>());
-  std::shared_ptr<const Features> f = deriveFeatures(cloud_I, nodes_.at(id).G_R_I);
+  auto f = std::make_shared<const Features>(clouds_.get(id), nodes_.at(id).G_R_I, options_);
   cacheFeatures(id, f);
   return f;
 }
@@ -138,12 +170,6 @@ Pose3 LoopCloser::pose(int64_t id) const {
 
 void LoopCloser::forEachPose(const std::function<void(int64_t, const Pose3&)>& visit) const {
   for (const Placement& k : placements_) visit(k.id, k.node == k.id ? graph_.pose(k.id) : graph_.pose(k.node) * k.T_node_kf);
-}
-
-std::optional<int64_t> LoopCloser::mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const {
-  const std::vector<std::pair<double, int64_t>> near = olderNodesNear(kf_id, kf, p, options_.merge_distance);
-  if (near.empty()) return std::nullopt;
-  return near.front().second;
 }
 
 Mat6 LoopCloser::loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const {
@@ -230,11 +256,11 @@ void LoopCloser::accept(const AcceptedLoop& loop, const Keyframe& from, AddResul
   keyframes_since_loop_ = 0;
 }
 
-LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, int64_t to_id,
-                                                const Features& to) const {
+LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, const FloatCloud& from_cloud,
+                                                int64_t to_id, const Features& to) const {
   LoopRegistrationResult r = registerLoop(
-      from.coarse, to.coarse, [&]() -> const GicpCloud& { return from.fine(); },
-      [&]() -> const GicpCloud& { return to.fine(); }, options_.registration);
+      from.coarse(), to.coarse(), [&]() -> const GicpCloud& { return from.fine([&] { return from_cloud; }); },
+      [&]() -> const GicpCloud& { return to.fine([&] { return clouds_.get(to_id); }); }, options_.registration);
   if (options_.registration_hook) options_.registration_hook(from_id, to_id, r);
   return r;
 }
@@ -279,8 +305,7 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   return c;
 }
 
-void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate,
-                         const std::vector<Eigen::Vector3f>& cloud) {
+void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const FloatCloud& cloud) {
   graph_.addNode(id, estimate);
   nodes_.emplace(id, kf);
   clouds_.put(id, cloud);
@@ -296,16 +321,17 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
   // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
-  std::vector<Eigen::Vector3f> cloud_f;
+  FloatCloud cloud_f;
   cloud_f.reserve(input.cloud.size());
   for (const Vec3& p : input.cloud) cloud_f.push_back(p.cast<float>());
-  const auto deriveCurrent = [&] {
-    Points cloud_I;
-    cloud_I.reserve(cloud_f.size());
-    for (const Eigen::Vector3f& p : cloud_f) cloud_I.push_back(p.cast<double>());
-    std::shared_ptr<const Features> f = deriveFeatures(cloud_I, kf.G_R_I);
-    kf.has_keypoints = !f->coarse.points.empty();
-    return f;
+  // Its features are derived only when a registration with it might be tried (an older node is
+  // near), and only as far as needed; has_keypoints is found then, for kf and its node if it is one.
+  std::shared_ptr<const Features> cur_features;
+  const auto currentHasKeypoints = [&] {
+    if (!cur_features) cur_features = std::make_shared<const Features>(cloud_f, kf.G_R_I, options_);
+    kf.has_keypoints = cur_features->hasKeypoints();
+    if (const auto node = nodes_.find(input.id); node != nodes_.end()) node->second.has_keypoints = kf.has_keypoints;
+    return *kf.has_keypoints;
   };
   const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
   const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
@@ -314,12 +340,10 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;
-  std::shared_ptr<const Features> cur_features;
   if (first_of_epoch) {
     // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
     // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
     const bool first = placements_.empty();
-    cur_features = deriveCurrent();
     addNode(input.id, kf, kf.odometry, cloud_f);
     if (!first) graph_.holdFixed(input.id);
     chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
@@ -336,39 +360,43 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
       placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf});
       return result;
     }
-    cur_features = deriveCurrent();
-    if (options_.merge_distance > 0 && kf.has_keypoints) {
-      if (const std::optional<int64_t> near = mergeCandidate(input.id, kf, estimate.translation())) {
-        const Keyframe& target = nodes_.at(*near);
-        const std::shared_ptr<const Features> target_features = features(*near);
-        LoopRegistrationResult r = registerPair(input.id, *cur_features, *near, *target_features);
-        result.attempts.push_back(r);
-        std::optional<AcceptedLoop> loop;
-        if (r.accepted) {
-          loop = acceptedLoop(input.id, kf, *near, target, r);
-          loop->merged = true;
-          if (std::optional<RefusedLoop> refusal = inconsistency(*loop, kf, estimate)) {
-            refused_.push_back(*refusal);
-            result.refused.push_back(*refusal);
-            loop.reset();  // it becomes a node of its own (below)
-          }
+    // the nearest older node with keypoints within merge_distance, if the keyframe has keypoints
+    std::optional<int64_t> near;
+    if (options_.merge_distance > 0) {
+      const std::vector<int64_t> reach = olderNodesNear(input.id, kf, estimate.translation(), options_.merge_distance);
+      if (!reach.empty() && currentHasKeypoints())
+        if (const std::vector<int64_t> with = withKeypoints(reach, 1); !with.empty()) near = with.front();
+    }
+    if (near) {
+      const Keyframe& target = nodes_.at(*near);
+      const std::shared_ptr<const Features> target_features = features(*near);
+      LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, *near, *target_features);
+      result.attempts.push_back(r);
+      std::optional<AcceptedLoop> loop;
+      if (r.accepted) {
+        loop = acceptedLoop(input.id, kf, *near, target, r);
+        loop->merged = true;
+        if (std::optional<RefusedLoop> refusal = inconsistency(*loop, kf, estimate)) {
+          refused_.push_back(*refusal);
+          result.refused.push_back(*refusal);
+          loop.reset();  // it becomes a node of its own (below)
         }
-        if (loop) {
-          // the keyframe joins the older node; the graph gets the edge chain node -> that node
-          placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from});
-          PoseEdge e;  // none if the chain's node is the joined one (no new relation)
-          e.from = chain_.node;
-          e.to = *near;
-          e.T_from_to = T_node_kf * loop->T_to_from.inverse();
-          e.is_loop = true;
-          const Mat6 cov = composedCovariance(chainCovariance(kf), loop->T_to_from.inverse(),
-                                              inverseCovariance(loop->T_to_from, loop->covariance));
-          e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
-          result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &*loop);
-          accept(*loop, kf, result);
-          chain_ = Chain{*near, input.id, kf, loop->T_to_from, true, 0.0, loop->covariance};
-          return result;
-        }
+      }
+      if (loop) {
+        // the keyframe joins the older node; the graph gets the edge chain node -> that node
+        placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from});
+        PoseEdge e;  // none if the chain's node is the joined one (no new relation)
+        e.from = chain_.node;
+        e.to = *near;
+        e.T_from_to = T_node_kf * loop->T_to_from.inverse();
+        e.is_loop = true;
+        const Mat6 cov = composedCovariance(chainCovariance(kf), loop->T_to_from.inverse(),
+                                            inverseCovariance(loop->T_to_from, loop->covariance));
+        e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
+        result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &*loop);
+        accept(*loop, kf, result);
+        chain_ = Chain{*near, input.id, kf, loop->T_to_from, true, 0.0, loop->covariance};
+        return result;
       }
     }
     // a node of its own, with the chain's measurement from the node before
@@ -391,12 +419,17 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   }
 
   if (cooling) return result;
-  cacheFeatures(input.id, cur_features);
-  if (!kf.has_keypoints) return result;
-  for (int64_t cand : candidates(input.id, kf, graph_.pose(input.id).translation())) {
+  // graph nodes only (a keyframe that joined one is represented by it), nearest first
+  std::vector<int64_t> candidates;
+  const std::vector<int64_t> near =
+      olderNodesNear(input.id, kf, graph_.pose(input.id).translation(), options_.candidates.search_radius);
+  if (!near.empty() && options_.candidates.max_candidates > 0 && currentHasKeypoints())
+    candidates = withKeypoints(near, options_.candidates.max_candidates);
+  if (cur_features) cacheFeatures(input.id, cur_features);
+  for (int64_t cand : candidates) {
     const Keyframe& target = nodes_.at(cand);
     const std::shared_ptr<const Features> target_features = features(cand);
-    LoopRegistrationResult r = registerPair(input.id, *cur_features, cand, *target_features);
+    LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, cand, *target_features);
     result.attempts.push_back(r);
     if (!r.accepted) continue;
     AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);

@@ -14,4 +14,11 @@ namespace livo::loop {
 Features computeFpfh(const Points& points, const Points& normals, const PointTree& tree, double radius,
                      const std::vector<int>& at);
 
+/// Exactly whether computeFpfh(points, normals, tree, radius, at) has a non-zero feature, for the
+/// price of a radius search or two when one of the points `at` has a valid pair with a point of
+/// its neighbourhood (the usual case). Only if none has are the features computed: that decides it
+/// unless the kd-tree finds a pair at the radius from one end and not from the other.
+bool anyNonZeroFpfh(const Points& points, const Points& normals, const PointTree& tree, double radius,
+                    const std::vector<int>& at);
+
 }  // namespace livo::loop

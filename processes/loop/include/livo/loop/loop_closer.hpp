@@ -36,8 +36,9 @@ struct LoopCloserOptions {
   double fine_voxel_size = 0.4;     // m
   int covariance_neighbors = 10;
   double map_voxel_size = 0.2;      // m, clouds kept for the global map
-  /// Keyframes whose coarse features and GICP clouds stay in memory (the newest and the recent
-  /// loop candidates); the others are derived again from the stored cloud when a candidate.
+  /// Keyframes whose coarse features and GICP clouds (as far as derived) stay in memory (the newest
+  /// ones near an older node and the recent loop candidates); the others are derived again from the
+  /// stored cloud when needed.
   int feature_cache_keyframes = 32;
   std::string spill_directory;      // where the keyframe clouds go ("" : the temp directory)
   CandidateOptions candidates;
@@ -195,7 +196,9 @@ class LoopCloser {
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     double path = 0.0;                  // m of odometry from the first keyframe of its epoch
-    bool has_keypoints = false;         // its coarse features are not empty
+    /// Its coarse features are not empty: unknown until a registration with it might be tried
+    /// (most keyframes never come near an older node), then kept.
+    std::optional<bool> has_keypoints;
   };
   /// What every keyframe keeps (the reduced pose graph's keyframes are mostly not nodes): where it
   /// is relative to its node. About 170 bytes, so a keyframe that joined an older node costs next to
@@ -224,27 +227,41 @@ class LoopCloser {
     Pose3 from_odometry = Pose3::Identity();  // raw odometry of the loop's from keyframe
     double from_path = 0.0;
   };
-  /// What registration needs of a keyframe, derived from its stored cloud.
-  /// The fine cloud (kd-tree and covariances) is built when a registration first gets past the
-  /// coarse stage: most keyframes never do, and it costs more than the coarse features.
-  struct Features {
-    CoarseFeatures coarse;  // in G
-    const GicpCloud& fine() const {
-      if (!fine_) fine_ = GicpCloud::build(std::move(fine_points_), covariance_neighbors_);
-      return *fine_;
-    }
-    mutable Points fine_points_;  // in G, until fine() moves them into fine_
-    int covariance_neighbors_ = 10;
+  using FloatCloud = std::vector<Eigen::Vector3f>;
+  /// What registration needs of a keyframe, derived from its cloud (body frame, float as stored)
+  /// in stages, each when first needed: the coarse keypoints (a registration with the keyframe
+  /// might be tried: whether it has coarse features at all), their FPFH descriptors (one is tried:
+  /// two thirds of the coarse time), the fine cloud with its kd-tree and covariances (one gets
+  /// past the coarse stage: most never do, and it costs more than the coarse features). Each stage
+  /// is what deriving everything at once gives: the same floats in, the same computation.
+  class Features {
+   public:
+    Features(const FloatCloud& cloud_I, const Mat3& G_R_I, const LoopCloserOptions& options);
+    /// !coarse().points.empty(), without the descriptors if they are not there yet.
+    bool hasKeypoints() const;
+    const CoarseFeatures& coarse() const;  // in G
+    /// In G; `cloud_I` gives the keyframe's cloud again, called only the first time.
+    const GicpCloud& fine(const std::function<FloatCloud()>& cloud_I) const;
+
+   private:
+    static Points levelled(const FloatCloud& cloud_I, const Mat3& G_R_I);
+    CoarseFeatureOptions options_;
+    Mat3 G_R_I_;
+    double fine_voxel_size_;
+    int covariance_neighbors_;
+    mutable CoarseKeypoints keypoints_;  // until coarse() describes them
+    mutable std::optional<bool> has_keypoints_;
+    mutable std::optional<CoarseFeatures> coarse_;
     mutable std::optional<GicpCloud> fine_;
   };
   const Placement& placement(int64_t id) const;  // throws std::out_of_range for an unknown id
-  /// Graph nodes of the keyframe's epoch older than exclude_recent_s with keypoints, nearest first,
-  /// within `radius` of p.
-  std::vector<std::pair<double, int64_t>> olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
-                                                         double radius) const;
-  std::vector<int64_t> candidates(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
-  /// The nearest older node (not within exclude_recent_s) of the epoch within merge_distance of p.
-  std::optional<int64_t> mergeCandidate(int64_t kf_id, const Keyframe& kf, const Vec3& p) const;
+  /// Graph nodes of the keyframe's epoch older than exclude_recent_s within `radius` of p, nearest
+  /// first, whether they have keypoints or not (that may take deriving their features).
+  std::vector<int64_t> olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p, double radius) const;
+  /// The first `count` of `nodes` that have keypoints (looked at in order, only as far as needed).
+  std::vector<int64_t> withKeypoints(const std::vector<int64_t>& nodes, int count);
+  /// Whether graph node `id` has keypoints (derived the first time it is asked).
+  bool nodeHasKeypoints(int64_t id);
   /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts), right
   /// perturbation of T_node_to.
   Mat6 chainCovariance(const Keyframe& to) const;
@@ -255,8 +272,10 @@ class LoopCloser {
   /// if it must not: the consistency check.
   std::optional<RefusedLoop> inconsistency(const AcceptedLoop& loop, const Keyframe& from, const Pose3& W_T_from) const;
   void accept(const AcceptedLoop& loop, const Keyframe& from, AddResult& result);
-  /// Runs the registration of from_id against to_id (and the test hook).
-  LoopRegistrationResult registerPair(int64_t from_id, const Features& from, int64_t to_id, const Features& to) const;
+  /// Runs the registration of from_id (its cloud: from_cloud) against the graph node to_id (and the
+  /// test hook). Both have keypoints.
+  LoopRegistrationResult registerPair(int64_t from_id, const Features& from, const FloatCloud& from_cloud,
+                                      int64_t to_id, const Features& to) const;
   /// Adds a loop edge (if any); unless the odometry already satisfies the loop, optimises and returns the
   /// correction for keyframe `current` (loop gets its residual and `corrected`).
   /// A verified registration of keyframe from_id (source) against to_id (target) as a loop.
@@ -264,8 +283,7 @@ class LoopCloser {
                             const LoopRegistrationResult& r) const;
   std::optional<Correction> addLoopEdge(const PoseEdge* edge, int64_t current, const Keyframe& cur, AcceptedLoop* loop);
   /// Makes keyframe `id` a graph node at `estimate` (its cloud goes to the store).
-  void addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const std::vector<Eigen::Vector3f>& cloud);
-  std::shared_ptr<const Features> deriveFeatures(const Points& cloud_I, const Mat3& G_R_I) const;
+  void addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const FloatCloud& cloud);
   /// The keyframe's features: from the cache, else derived from the stored cloud and cached.
   std::shared_ptr<const Features> features(int64_t id);
   void cacheFeatures(int64_t id, std::shared_ptr<const Features> f);
