@@ -218,11 +218,12 @@ fi
 
 # ---- inside the private bus --------------------------------------------------------------------
 exec 3>"$out/logs/run.txt"
-# Lockstep with lagging sinks: they run niced, so that the processes on the replay's critical path
-# (playback, lio, vio, loop) get a core the moment they have work (scheduling, not order: the
-# outputs are the same).
+# Lockstep with lagging sinks: their handler threads run niced (LIVO_HANDLER_NICE), so that the
+# processes on the replay's critical path (playback, lio, vio, loop) get a core the moment they
+# have work (scheduling, not order: the outputs are the same). Not their LCM receive threads: those
+# keep draining the sockets, or the bus would overflow them while the sinks wait for a core.
 sink_nice=()
-[ "$realtime" = 0 ] && [ "$serial" = 0 ] && [ "$max_lag" -gt 0 ] && sink_nice=(nice -n 10)
+[ "$realtime" = 0 ] && [ "$serial" = 0 ] && [ "$max_lag" -gt 0 ] && sink_nice=(env LIVO_HANDLER_NICE=10)
 nice_of() { case "$1" in colour|octomap|record) echo "${sink_nice[@]}" ;; esac; }
 $(nice_of record) "$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
 logger=$!

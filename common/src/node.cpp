@@ -13,6 +13,10 @@
 #include <stdexcept>
 #include <thread>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <cstring>
+#include <cerrno>
 #include <poll.h>
 #include <unistd.h>
 #if defined(__GLIBC__)
@@ -415,8 +419,29 @@ void Node::printSummary(std::ostream& os) const {
   os.flush();
 }
 
+namespace {
+// LIVO_HANDLER_NICE=N: the thread that handles messages runs at niceness N, while LCM's receive
+// thread (started with the first subscription) keeps the process's own. A lagging sink niced as a
+// whole lets the bus fill its socket while it waits for a core, and the kernel then drops what the
+// pipeline sends; niced this way it still drains the socket at once and only its work waits.
+void niceTheHandlerThread(Node& node) {
+  const char* value = std::getenv("LIVO_HANDLER_NICE");
+  if (!value || !*value) return;
+  char* end = nullptr;
+  const long n = std::strtol(value, &end, 10);
+  if (*end != '\0' || n < 0 || n > 19) {
+    node.warn(std::string("LIVO_HANDLER_NICE='") + value + "': expected 0 to 19; ignored");
+    return;
+  }
+  // on Linux the nice value belongs to the thread: this one only
+  if (setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), static_cast<int>(n)) != 0)
+    node.warn(std::string("LIVO_HANDLER_NICE: setpriority failed: ") + std::strerror(errno));
+}
+}  // namespace
+
 int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, const std::function<bool()>& done) {
   installSignalHandlers();
+  niceTheHandlerThread(node);
   node.setCoalesceProgress(true);
   node.announce();
   int rc = 0;
