@@ -38,7 +38,7 @@
 # pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
 # the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
 # --max-lag N (lockstep): colour, octomap and the recorder, whose outputs no estimator takes, may
-# fall up to N messages (16; and 4 MB, livo-playback --max-lag-mb) behind the rest, so they run
+# fall up to N messages (16; and 16 MB, livo-playback --max-lag-mb) behind the rest, so they run
 # beside lio, vio and loop on the second core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
 # before the next goes out (no lag, no quiet promises): slower, and the outputs are the same.
 set -euo pipefail

@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
               "lockstep: consumers that may fall behind the rest (their outputs feed only recorders; checked)")
       .option("--max-lag", "N", "lockstep: how many messages a --lag consumer may be behind", "16")
       .option("--max-lag-mb", "MB",
-              "lockstep: and how many megabytes (at each channel's mean message size; within the receive buffer)", "4")
+              "lockstep: and how many megabytes (at each channel's mean message size)", "16")
       .flag("--respawn", "lockstep: consumers may exit and be restarted by a supervisor; not waited for while away")
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")

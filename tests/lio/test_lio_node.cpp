@@ -692,8 +692,9 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
   // with the hand-off from a camera whose stamps jitter by up to 24 ms and which misses images,
   // from a camera whose images arrive 30 ms late (after the sweep that ends after them), and with
   // each sweep arriving at its start (as livo-sim writes them), so that it waits for the images
-  for (const int variant : {0, 1, 2, 3, 4, 5, 6}) {
-    const bool handoff = variant == 1 || variant >= 4, wheels = variant == 3;
+  // and all of it at once: camera, wheels, sweeps arriving at their start
+  for (const int variant : {0, 1, 2, 3, 4, 5, 6, 7}) {
+    const bool handoff = variant == 1 || variant >= 4, wheels = variant == 3 || variant == 7;
     Watcher w;
     std::map<std::string, int64_t> seen, covered;
     int64_t broken = 0, outputs_before = 0;
@@ -753,10 +754,10 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
     };
     int64_t first_image = 0, last_image = 0;
     std::vector<Message> in = handoff ? withImages(syntheticRun(), &first_image, &last_image) : syntheticRun();
-    if (variant == 5 || variant == 6) {
+    if (variant >= 5) {
       for (Message& m : in) {
         if (variant == 5 && m.channel == "CAMERA") m.order_key += 30'000;
-        if (variant == 6 && m.channel == "LIDAR") m.order_key -= 100'000;
+        if (variant >= 6 && m.channel == "LIDAR") m.order_key -= 100'000;
       }
       livo_test::sortByArrival(&in);
     }
@@ -814,7 +815,7 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
     if (variant == 1 || variant == 6) {  // a regular camera: every image but the first (none due yet)
       EXPECT_GT(covered["CAMERA"], seen["CAMERA"] * 9 / 10) << covered["CAMERA"] << " of " << seen["CAMERA"];
     }
-    if (variant == 6) {  // sweeps that arrive before the IMU passes the previous one's end
+    if (variant >= 6) {  // sweeps that arrive before the IMU passes the previous one's end
       EXPECT_GT(covered["LIDAR"], seen["LIDAR"] * 9 / 10) << covered["LIDAR"] << " of " << seen["LIDAR"];
     }
     std::printf("%s: %lld of %lld IMU samples, %lld of %lld images, %lld of %lld sweeps, %lld of %lld wheel readings "
@@ -825,7 +826,8 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
                 : variant == 3 ? "wheels"
                 : variant == 4 ? "hand-off, jittery camera"
                 : variant == 5 ? "hand-off, images 30 ms late"
-                               : "hand-off, sweeps at their start",
+                : variant == 6 ? "hand-off, sweeps at their start"
+                               : "hand-off, wheels, sweeps at their start",
                 static_cast<long long>(covered["IMU"]), static_cast<long long>(seen["IMU"]),
                 static_cast<long long>(covered["CAMERA"]), static_cast<long long>(seen["CAMERA"]),
                 static_cast<long long>(covered["LIDAR"]), static_cast<long long>(seen["LIDAR"]),

@@ -287,15 +287,15 @@ LioNode::NextEvent LioNode::nextEvent() const {
   e.utime = e.imu_after = scans_.front().utime;
   if (opts_.lio.wheel.enabled) {
     const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
-    if (!wheel_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.wheel_max_wait_s));
+    if (!wheel_past) e.wheel_wait = toUtime(opts_.wheel_max_wait_s);
   }
-  e.imu_after_images_past = e.imu_after;
   if (opts_.camera_handoff && newest_image_ >= 0 && e.utime - newest_image_ < toUtime(1.0) &&
       node_.hasConsumers(opts_.state_prior_channel)) {
     // the images before the sweep end come first: wait until the next one is due after it
     const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > e.utime;
-    if (!images_past) e.imu_after = std::max(e.imu_after, e.utime + toUtime(opts_.image_max_wait_s));
+    if (!images_past) e.image_wait = toUtime(opts_.image_max_wait_s);
   }
+  e.imu_after = e.utime + std::max(e.wheel_wait, e.image_wait);
   return e;
 }
 
@@ -309,7 +309,8 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   // may be promised too: an image stamped at or after image_due, a sweep ending at or after the
   // newest sweep end, becomes an event whose threshold is not below that time; and it may lower
   // the next event's threshold only by ending its wait for images (a sweep) or for the LiDAR (an
-  // image). The lowest threshold covered messages can bring about is the floor below; they
+  // image); wheel readings only by ending a sweep's wait for them. The lowest threshold covered
+  // messages can bring about is the floor below; they
   // cannot make advance() act, in any interleaving, provided the filter is not past the floor and
   // the IMU promise ends there too (the filter then stays at or before it).
   // image_due is where the next image is due, so that the IMU up to where it is handed off stays
@@ -322,23 +323,28 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   const int64_t image_due = newest_image_ + period;
   const bool images_possible = opts_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= image_due + period;
   const bool sweeps_possible = newest_sweep_end_ >= 0;
-  const auto floor = [&](bool images, bool sweeps) {
+  const bool wheels_possible = opts_.lio.wheel.enabled;
+  const auto floor = [&](bool images, bool sweeps, bool wheels) {
     int64_t f = kNever;
     if (next.kind == NextEvent::kImage) f = sweeps ? next.utime : next.imu_after;
-    if (next.kind == NextEvent::kSweep) f = images ? next.imu_after_images_past : next.imu_after;
+    if (next.kind == NextEvent::kSweep)
+      f = next.utime + std::max(images ? 0 : next.image_wait, wheels ? 0 : next.wheel_wait);
     if (images) f = std::min(f, image_due);
     if (sweeps) f = std::min(f, newest_sweep_end_);
     return f;
   };
-  bool images = false, sweeps = false;
-  for (const auto& [try_images, try_sweeps] : {std::pair{true, true}, {true, false}, {false, true}}) {
-    if ((try_images && !images_possible) || (try_sweeps && !sweeps_possible)) continue;
-    if (fed_any_imu_ && floor(try_images, try_sweeps) < fed_imu_) continue;  // a covered one could act at once
-    images = try_images;
-    sweeps = try_sweeps;
+  // the most channels whose floor the filter is not past (a covered message could act at once)
+  bool images = false, sweeps = false, wheels = false;
+  for (int mask = 7; mask > 0; --mask) {
+    const bool i = mask & 4, s = mask & 2, w = mask & 1;
+    if ((i && !images_possible) || (s && !sweeps_possible) || (w && !wheels_possible)) continue;
+    if (fed_any_imu_ && floor(i, s, w) < fed_imu_) continue;
+    images = i;
+    sweeps = s;
+    wheels = w;
     break;
   }
-  const int64_t threshold = floor(images, sweeps);
+  const int64_t threshold = floor(images, sweeps, wheels);
 
   Node::QuietWindow w;
   w.channel = opts_.imu_channel;
@@ -357,10 +363,11 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
     const int64_t offset = toUtime(opts_.lio.extrinsics.time_offset_s);
     out.push_back({opts_.lidar_channel, newest_sweep_end_ - offset, kNever});
   }
-  if (opts_.lio.wheel.enabled) {
-    // a wheel reading matters only by letting the next sweep go without waiting for the wheels
-    // (one past its end): readings up to its end cannot, nor any once one past it has come, nor
-    // any while an image or nothing is next
+  if (wheels) {
+    out.push_back(Node::QuietWindow::always(opts_.wheel_channel));
+  } else if (opts_.lio.wheel.enabled) {
+    // the filter is past the sweep's end and it waits for the wheels: a reading past its end would
+    // let it go; readings up to its end cannot
     const bool sweep_waits_for_wheels = next.kind == NextEvent::kSweep &&
                                         !(!wheel_.empty() && wheel_.back().utime > next.utime);
     if (sweep_waits_for_wheels)

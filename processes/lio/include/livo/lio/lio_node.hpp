@@ -98,7 +98,8 @@ class LioNode {
     enum Kind { kNone, kImage, kSweep } kind = kNone;
     int64_t utime = 0;
     int64_t imu_after = 0;
-    int64_t imu_after_images_past = 0;  // the threshold once an image past the sweep's end has come
+    int64_t image_wait = 0;  // a sweep: how far imu_after lies past its end for the images' sake
+    int64_t wheel_wait = 0;  // ... and for the wheels' (imu_after is the later of both)
   };
   NextEvent nextEvent() const;
   /// The promises in PROGRESS (progress_t.quiet_*): IMU samples, images and wheel readings that

@@ -50,8 +50,9 @@ struct LockstepGateOptions {
   bool honour_quiet_promises = true; // false: wait for every consumer after every message
   std::vector<std::string> may_lag; // consumers that may fall behind (see above)
   int max_lag_messages = 16;        // how far (messages not yet handled, all channels) they may,
-  int64_t max_lag_bytes = 4 << 20;  // and in bytes (estimated from each channel's mean size): the
-                                    // UDP receive buffer bounds it (a 64-beam cloud is ~3 MB)
+  int64_t max_lag_bytes = 16 << 20; // and in bytes (estimated from each channel's mean size): what
+                                    // a sink's LCM receive thread queues for it (a 64-beam cloud
+                                    // is ~3 MB, an RGB image ~1 MB)
 };
 
 class LockstepGate {

@@ -34,7 +34,7 @@ struct PlaybackOptions {
                                         // quiet promises, nothing lags): the reference order
   std::vector<std::string> may_lag;     // lockstep: consumers that may fall behind by up to max_lag
   int max_lag_messages = 16;            // messages, while the rest handle the next ones (lockstep_gate.hpp)
-  int64_t max_lag_bytes = 4 << 20;      // and bytes (at each channel's mean message size)
+  int64_t max_lag_bytes = 16 << 20;      // and bytes (at each channel's mean message size)
   std::vector<Fault> faults;
   uint64_t seed = 1;
   std::string out_log;                  // write the (faulted) stream here instead of publishing
