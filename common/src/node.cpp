@@ -1,7 +1,5 @@
 #include "livo/node.hpp"
 
-#include "livo/message_registry.hpp"
-
 #include <algorithm>
 #include <atomic>
 #include <csignal>
@@ -180,7 +178,6 @@ void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscrip
   }
   node.current_ = sub;
   const auto t0 = std::chrono::steady_clock::now();
-  const int64_t outputs_before = node.outputs_total_;
   try {
     sub->handler(rbuf->data, static_cast<int>(rbuf->data_size));
   } catch (const std::exception& e) {
@@ -191,41 +188,19 @@ void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscrip
   ++sub->handled;
   node.current_ = nullptr;
   if (!node.options_.publish_progress) return;
-  if (node.coalesce_progress_ && node.outputs_total_ == outputs_before && node.progress_deferred_ == 0 &&
-      node.coveredBySentPromise(sub->channel, rbuf->data, static_cast<int>(rbuf->data_size))) {
-    ++node.covered_since_progress_;
-    return;
-  }
   ++node.progress_deferred_;
   if (!node.coalesce_progress_ || node.progress_deferred_ >= kMaxProgressDeferred || node.receiveQueueEmpty())
     node.publishProgress(false);
 }
 
-void Node::flushProgress(bool idle) {
-  if (!options_.publish_progress || !receiveQueueEmpty()) return;
-  if (progress_deferred_ > 0 || (idle && covered_since_progress_ > 0)) publishProgress(false);
-}
-
-bool Node::coveredBySentPromise(const std::string& channel, const void* data, int size) {
-  if (covered_since_progress_ >= kMaxCoveredWithoutProgress) return false;
-  for (const QuietWindow& w : sent_promises_) {
-    if (w.channel != channel) continue;
-    if (w.from == std::numeric_limits<int64_t>::min() && w.before == std::numeric_limits<int64_t>::max()) {
-      if (covered_whole_channel_ >= kMaxCoveredWithoutProgressOnAWholeChannel) return false;
-      ++covered_whole_channel_;
-      return true;
-    }
-    int64_t utime = 0;
-    return messageUtime(data, size, &utime) && utime >= w.from && utime < w.before;
-  }
-  return false;
+void Node::flushProgress() {
+  if (progress_deferred_ > 0 && options_.publish_progress && receiveQueueEmpty()) publishProgress(false);
 }
 
 void Node::publishRaw(const std::string& channel, const void* data, int size) {
   lcm_.publish(channel, data, static_cast<unsigned int>(size));
   ++published_[channel];
   published_bytes_[channel] += size;
-  ++outputs_total_;
 }
 
 Node::Subscription* Node::find(const std::string& channel) const {
@@ -273,9 +248,6 @@ void Node::publishProgress(bool finished) {
   p.node = options_.name;
   p.sequence = progress_sequence_++;
   progress_deferred_ = 0;
-  covered_since_progress_ = 0;
-  covered_whole_channel_ = 0;
-  sent_promises_.clear();
   p.finished = finished ? 1 : 0;
   p.instance = instance_;
   p.idle = !finished && receiveQueueEmpty() ? 1 : 0;
@@ -294,12 +266,11 @@ void Node::publishProgress(bool finished) {
   }
   p.num_outputs = static_cast<int32_t>(p.output_channel.size());
   if (quiet_windows_ && !finished) {
-    for (QuietWindow& w : quiet_windows_()) {
+    for (const QuietWindow& w : quiet_windows_()) {
       if (w.before <= w.from) continue;
       p.quiet_channel.push_back(w.channel);
       p.quiet_from.push_back(w.from);
       p.quiet_before.push_back(w.before);
-      sent_promises_.push_back(std::move(w));
     }
   }
   p.num_quiet = static_cast<int32_t>(p.quiet_channel.size());
@@ -446,15 +417,14 @@ int spin(lcm::LCM& lcm, Node& node, const std::function<void()>& on_shutdown, co
   node.announce();
   int rc = 0;
   while (!shutdownRequested() && !(done && done())) {
-    // shorter while a PROGRESS was left out for covered inputs: it goes out once the input pauses
-    const int r = lcm.handleTimeout(node.coveredSinceProgress() > 0 ? Node::kIdleProgressMs : 100);
+    const int r = lcm.handleTimeout(100);
     if (r < 0 && shutdownRequested()) break;  // a signal interrupted the wait
     if (r < 0) {
       node.error("LCM provider failed; shutting down");
       rc = 1;
       break;
     }
-    node.flushProgress(/*idle=*/r == 0);
+    node.flushProgress();
     node.tick();
   }
   if (on_shutdown) on_shutdown();

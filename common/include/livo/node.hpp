@@ -134,19 +134,8 @@ class Node {
   /// drive handle() themselves get one PROGRESS per input).
   void setCoalesceProgress(bool on) { coalesce_progress_ = on; }
   /// Publishes a PROGRESS put off by coalescing once the receive queue is empty (spin() calls it).
-  /// With `idle` (spin()'s wait for a message timed out), also one left out for covered inputs.
-  void flushProgress(bool idle = false);
+  void flushProgress();
   static constexpr int kMaxProgressDeferred = 32;
-  /// Under spin(), no PROGRESS is owed for an input the last PROGRESS's promise covers, if handling
-  /// it published nothing: playback does not wait for it, and the promise still holds after it.
-  /// The count goes out with the next PROGRESS (an input not covered, an output, a heartbeat, or
-  /// kIdleProgressMs without input), and at the latest after this many such inputs in a row (a
-  /// whole-channel promise after fewer: playback lets at most 8 wait on one).
-  static constexpr int kMaxCoveredWithoutProgress = 256;
-  static constexpr int kMaxCoveredWithoutProgressOnAWholeChannel = 4;
-  static constexpr int kIdleProgressMs = 5;
-  /// Inputs handled since the last PROGRESS that it did not owe (spin() then waits shorter).
-  int coveredSinceProgress() const { return covered_since_progress_; }
 
   /// Publishes a PROGRESS with zero counts so lockstep playback knows the node is up and
   /// subscribed; spin() calls it first.
@@ -211,12 +200,6 @@ class Node {
   int64_t progress_sequence_ = 0;
   bool coalesce_progress_ = false;
   int progress_deferred_ = 0;  // inputs handled since the last PROGRESS
-  int covered_since_progress_ = 0;        // of them, inside sent_promises_ (no PROGRESS owed)
-  int covered_whole_channel_ = 0;         // of them, under a whole-channel promise
-  int64_t outputs_total_ = 0;             // messages published (did a handler publish?)
-  std::vector<QuietWindow> sent_promises_;  // those of the last PROGRESS
-  /// The input on `channel` (encoded `data`) lies inside the last PROGRESS's promises.
-  bool coveredBySentPromise(const std::string& channel, const void* data, int size);
   std::function<std::vector<QuietWindow>()> quiet_windows_;
   int64_t instance_ = 0;  // this start of the node (progress_t.instance)
   int64_t last_utime_ = 0;
