@@ -107,6 +107,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("scan_voxel_size", l.scan_voxel_size);
   c.readOptional("min_points", l.min_points);
   c.readOptional("min_residuals", l.min_residuals);
+  c.readOptional("search_threads", l.search_threads);
   c.readOptional("max_imu_gap_s", l.max_imu_gap_s);
   c.readOptional("reset_imu_gap_s", l.reset_imu_gap_s);
   c.readOptional("gap_rate_std", l.gap_rate_std);
@@ -197,6 +198,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
                st.misses_to_remove <= 100 && st.ray_stride >= 1,
            "map.seen_through");
   positive(l.scan_voxel_size > 0 && l.point_stride > 0, "scan_voxel_size");
+  if (!(l.search_threads >= 1 && l.search_threads <= 64)) throw ConfigError(c.where("search_threads") + ": must be 1 to 64");
   positive(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors");
   positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
   positive(l.init.window_s > 0, "init.window_s");
@@ -237,7 +239,8 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << l.map_radius << " m\n"
      << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
      << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
-     << "; degeneracy threshold " << l.matching.degeneracy_threshold << "\n"
+     << "; degeneracy threshold " << l.matching.degeneracy_threshold << "; " << l.search_threads
+     << (l.search_threads == 1 ? " search thread" : " search threads") << "\n"
      << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
      << (o.camera_handoff && o.camera_free_state ? "; camera-free filter beside it -> " + o.camera_free_state_channel : std::string())
      << "\n"

@@ -39,6 +39,7 @@ LioEstimator::LioEstimator(LioOptions options)
     : opts_(options),
       prop_(options.imu_noise),
       map_(options.map),
+      search_threads_(options.search_threads > 1 ? std::make_shared<WorkerThreads>(options.search_threads) : nullptr),
       keyframe_selector_(options.keyframe),
       wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {}
 
@@ -490,7 +491,7 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
 ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, Mat18* P,
                                                ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, reg, opts_.matching);
+  ScanToMap s2m(map_, reg, opts_.matching, search_threads_.get());
   FilterState post;
   Mat18 P_post;
   EsikfResult er = iteratedUpdate(
@@ -506,7 +507,7 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, Fil
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, reg, opts_.matching);
+    s2m_still.emplace(map_, reg, opts_.matching, search_threads_.get());
     FilterState post_still;
     Mat18 P_still;
     const EsikfResult er_still = iteratedUpdate(

@@ -22,8 +22,21 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
   return o;
 }
 
-ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options)
-    : map_(map), points_(body_points), opts_(options), matches_(body_points.size()), gate_(body_points.size()) {
+namespace {
+// Fewer searches than this per thread are not worth waking another thread for (a search and its
+// plane fit take about a microsecond; a wake-up tens of them).
+constexpr size_t kMinSearchesPerThread = 256;
+}  // namespace
+
+ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
+                     WorkerThreads* threads)
+    : map_(map),
+      points_(body_points),
+      opts_(options),
+      threads_(threads),
+      matches_(body_points.size()),
+      gate_(body_points.size()),
+      world_(body_points.size()) {
   for (size_t i = 0; i < points_.size(); ++i)
     gate_[i] = opts_.residual_range_factor * std::sqrt(points_[i].norm());
 }
@@ -36,21 +49,38 @@ int ScanToMap::numMatched() const {
 
 bool ScanToMap::evaluate(const FilterState& x, int iteration, PoseInformation* info) {
   const int k = opts_.plane.num_neighbors;
-  Vec3 nb[32];
-  double d2[32];
   const double research2 = opts_.research_distance * opts_.research_distance;
   const double w = 1.0 / (opts_.point_noise_std * opts_.point_noise_std);
   const double inv_lever = 1.0 / opts_.degeneracy_lever_arm;
-  rows_.clear();
+  // 1. the points' images, and which of them moved enough to search their neighbours anew
+  to_search_.clear();
   for (size_t i = 0; i < points_.size(); ++i) {
-    const Vec3 pw = x.rot * points_[i] + x.pos;
-    Match& m = matches_[i];
-    if (iteration == 0 || !((pw - m.searched_at).squaredNorm() <= research2)) {
-      m.searched_at = pw;
-      m.has_plane = map_.knn(pw, k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
+    world_[i] = x.rot * points_[i] + x.pos;
+    if (iteration == 0 || !((world_[i] - matches_[i].searched_at).squaredNorm() <= research2))
+      to_search_.push_back(static_cast<uint32_t>(i));
+  }
+  // 2. the searches and plane fits: each point's own, so they may run on several threads
+  auto search = [&](size_t begin, size_t end) {
+    Vec3 nb[32];
+    double d2[32];
+    for (size_t j = begin; j < end; ++j) {
+      const uint32_t i = to_search_[j];
+      Match& m = matches_[i];
+      m.searched_at = world_[i];
+      m.has_plane = map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
                     fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity);
     }
+  };
+  if (threads_)
+    threads_->forEachShare(to_search_.size(), search, kMinSearchesPerThread);
+  else
+    search(0, to_search_.size());
+  // 3. the residuals, in the points' order (the sums below do not depend on the threads)
+  rows_.clear();
+  for (size_t i = 0; i < points_.size(); ++i) {
+    const Match& m = matches_[i];
     if (!m.has_plane) continue;
+    const Vec3& pw = world_[i];
     const double r = m.plane.distance(pw);
     if (!(std::abs(r) <= gate_[i])) continue;
     rows_.push_back(Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x.rot), r});

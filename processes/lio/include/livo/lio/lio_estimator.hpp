@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -189,6 +190,9 @@ class LioEstimator {
   LioOptions opts_;
   ImuPropagator prop_;
   VoxelMap map_;
+  // the registration's neighbour searches beyond the calling thread (null: LioOptions::search_threads
+  // is 1); shared by copies of the estimator, which take turns
+  std::shared_ptr<WorkerThreads> search_threads_;
   KeyframeSelector keyframe_selector_;
   bool initialized_ = false;
   std::vector<ImuSample> init_window_;

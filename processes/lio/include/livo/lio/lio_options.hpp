@@ -33,6 +33,8 @@ struct LioOptions {
   double map_radius = 100.0;           // m, local window kept around the body
   double map_prune_distance = 10.0;    // m travelled between window prunings
   ScanToMapOptions matching;
+  int search_threads = 1;              // threads sharing the neighbour searches of a registration
+                                       // (the same result for any number; livo-lio's default: 2)
   EsikfOptions esikf;
   int min_residuals = 30;              // fewer: the update is skipped and flagged degenerate
 

@@ -11,6 +11,7 @@
 #include "livo/esikf_update.hpp"
 #include "livo/lio/point_to_plane.hpp"
 #include "livo/lio/voxel_map.hpp"
+#include "livo/worker_threads.hpp"
 
 namespace livo::lio {
 
@@ -38,8 +39,10 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
 
 class ScanToMap {
  public:
-  /// `map` must outlive this object and stay unchanged while it is used.
-  ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options);
+  /// `map` must outlive this object and stay unchanged while it is used. With `threads`, the
+  /// neighbour searches of an iterate are shared among them; the result is the same bit for bit.
+  ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
+            WorkerThreads* threads = nullptr);
 
   /// PoseMeasurement for iteratedUpdate.
   bool evaluate(const FilterState& x, int iteration, PoseInformation* info);
@@ -66,8 +69,11 @@ class ScanToMap {
   const VoxelMap& map_;
   const std::vector<Vec3>& points_;
   ScanToMapOptions opts_;
+  WorkerThreads* threads_;
   std::vector<Match> matches_;
   std::vector<double> gate_;  // per point: max |r|
+  std::vector<Vec3> world_;           // per point: its image at the current iterate
+  std::vector<uint32_t> to_search_;   // the points whose planes are fitted anew at this iterate
   std::vector<Row> rows_;     // accepted residuals of the current iterate
   std::vector<double> abs_r_;
   DegeneracyReport degeneracy_;
