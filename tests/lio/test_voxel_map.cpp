@@ -322,6 +322,38 @@ TEST(VoxelMap, PointsSeenThroughInThreeSweepsLeaveTheMap) {
   EXPECT_EQ(kept.removeSeenThrough(start, sweepFrom(start, false), o), 0u);
 }
 
+TEST(VoxelMap, BeamsCastOnSeveralThreadsRemoveTheSamePoints) {
+  // The same walk past the box as above, on maps whose beams are cast on 1, 2 and 3 threads: after
+  // every sweep the maps hold the same points in the same order, with the same counts removed.
+  const Vec3 start(0.0, 0.3, 1.5);
+  std::vector<VoxelMap> maps(3);
+  for (auto& m : maps) {
+    m.insert(sweepFrom(start, true));
+    m.insert(sweepFrom(start + Vec3(0.2, 0.0, 0.0), true));
+  }
+  WorkerThreads two(2), three(3);
+  WorkerThreads* threads[3] = {nullptr, &two, &three};
+  SeenThroughOptions o;
+  o.ray_stride = 1;
+  size_t total = 0;
+  for (int sweep = 0; sweep < 12; ++sweep) {
+    const Vec3 origin = start + Vec3(0.3 + 0.05 * sweep, -0.03 * sweep, 0.04 * std::sin(1.3 * sweep));
+    const std::vector<Vec3> endpoints = sweepFrom(origin, false);
+    ASSERT_GE(endpoints.size(), 3 * 128u);  // enough beams for every thread to take a share
+    size_t removed[3];
+    for (int t = 0; t < 3; ++t) {
+      removed[t] = maps[t].removeSeenThrough(origin, endpoints, o, threads[t]);
+      maps[t].insert(endpoints);
+    }
+    total += removed[0];
+    for (int t = 1; t < 3; ++t) {
+      EXPECT_EQ(removed[t], removed[0]) << "sweep " << sweep << ", " << t + 1 << " threads";
+      EXPECT_EQ(maps[t].points(), maps[0].points()) << "sweep " << sweep << ", " << t + 1 << " threads";
+    }
+  }
+  EXPECT_GT(total, 15u);  // the box went
+}
+
 TEST(VoxelMap, BetterObservedPointsReplaceWorseOnes) {
   VoxelMapOptions o;
   o.voxel_size = 1.0;

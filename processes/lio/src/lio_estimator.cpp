@@ -292,7 +292,7 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
   // the beams leave the LiDAR where it is at the sweep end (the frame the sweep is undistorted to)
   const Vec3 lidar = x.rot * opts_.extrinsics.T_I_L.translation() + x.pos;
-  const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through);
+  const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through, search_threads_.get());
   map_.insert(world, lidar);
   return removed;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 
 namespace livo::lio {
@@ -249,33 +250,40 @@ namespace {
 constexpr uint8_t kSeenThroughThisSweep = 0x80;
 }  // namespace
 
+namespace {
+/// Whether the beam from the origin along dir, reaching `reach`, passes through the point at q
+/// (relative to the origin): within the beam's radius of the ray, between min_range and reach.
+bool beamPassesThrough(const Vec3& q, const Vec3& dir, double reach, const SeenThroughOptions& o) {
+  const double along = q.dot(dir);
+  if (along < o.min_range || along > reach) return false;
+  const double radius = o.beam_radius + o.beam_divergence * along;
+  return q.squaredNorm() - along * along < radius * radius;
+}
+}  // namespace
+
 void VoxelMap::markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach,
                                const SeenThroughOptions& o, std::vector<int32_t>* touched) {
   const float* pts = voxelPoints(v);
   uint8_t* misses = voxelMisses(v);
   for (int i = 0; i < voxels_[static_cast<size_t>(v)].count; ++i) {
     if (misses[i] & kSeenThroughThisSweep) continue;
-    const Vec3 q = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]) - origin;
-    const double along = q.dot(dir);
-    if (along < o.min_range || along > reach) continue;
-    const double radius = o.beam_radius + o.beam_divergence * along;
-    if (q.squaredNorm() - along * along >= radius * radius) continue;
+    if (!beamPassesThrough(Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]) - origin, dir, reach, o)) continue;
     touched->push_back(v);
     misses[i] |= kSeenThroughThisSweep;
   }
 }
 
-size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints,
-                                   const SeenThroughOptions& o) {
-  if (!o.enabled || voxels_.empty() || !origin.allFinite()) return 0;
-  std::vector<int32_t> touched;  // voxels holding a point seen through in this sweep
+template <typename VisitVoxel>
+void VoxelMap::forEachVoxelNearBeams(const Vec3& origin, const std::vector<Vec3>& endpoints,
+                                     const SeenThroughOptions& o, size_t first_beam, size_t end_beam,
+                                     VisitVoxel visit) const {
   // Any step gives the same result (the cubes below hold every voxel within the beam's radius of
-  // the ray, and markSeenThrough tests the points themselves): one voxel walks the ray in half the
-  // samples of half a voxel, for a few more voxels tested.
+  // the ray, and the points themselves are tested): one voxel walks the ray in half the samples of
+  // half a voxel, for a few more voxels tested.
   const double step = opts_.voxel_size;
   const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));
-  for (size_t e = 0; e < endpoints.size(); e += stride) {
-    const Vec3 w = endpoints[e] - origin;
+  for (size_t beam = first_beam; beam < end_beam; ++beam) {
+    const Vec3 w = endpoints[beam * stride] - origin;
     const double range = w.norm();
     if (!(range > o.min_range) || range > o.max_range) continue;
     const Vec3 dir = w / range;
@@ -303,13 +311,55 @@ size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& 
             const VoxelKey key = packVoxel(x, y, z);
             if (!mayHold(key)) continue;
             const int32_t v = index_.find(key);
-            if (v >= 0) markSeenThrough(v, origin, dir, reach, o, &touched);
+            if (v >= 0) visit(v, dir, reach);
           }
         }
       }
       std::copy_n(lo, 3, prev_lo);
       std::copy_n(hi, 3, prev_hi);
     }
+  }
+}
+
+size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints,
+                                   const SeenThroughOptions& o, WorkerThreads* threads) {
+  if (!o.enabled || voxels_.empty() || !origin.allFinite()) return 0;
+  std::vector<int32_t> touched;  // voxels holding a point seen through in this sweep
+  const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));
+  const size_t beams = (endpoints.size() + stride - 1) / stride;
+  constexpr size_t kMinBeamsPerThread = 128;
+  if (!threads || threads->threads() == 1 || beams < 2 * kMinBeamsPerThread) {
+    forEachVoxelNearBeams(origin, endpoints, o, 0, beams, [&](int32_t v, const Vec3& dir, double reach) {
+      markSeenThrough(v, origin, dir, reach, o, &touched);
+    });
+  } else {
+    // Shared among threads, the beams only find the points they pass through (the map is read
+    // only); the marks are then set here, in share order. The points marked are the same as on
+    // one thread, so the result is too.
+    std::mutex found_mutex;
+    std::vector<std::pair<size_t, std::vector<std::pair<int32_t, int32_t>>>> found;  // by a share's first beam
+    threads->forEachShare(
+        beams,
+        [&](size_t begin, size_t end) {
+          std::vector<std::pair<int32_t, int32_t>> mine;
+          forEachVoxelNearBeams(origin, endpoints, o, begin, end, [&](int32_t v, const Vec3& dir, double reach) {
+            const float* pts = voxelPoints(v);
+            for (int i = 0; i < voxels_[static_cast<size_t>(v)].count; ++i)
+              if (beamPassesThrough(Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]) - origin, dir, reach, o))
+                mine.emplace_back(v, i);
+          });
+          std::lock_guard<std::mutex> lock(found_mutex);
+          found.emplace_back(begin, std::move(mine));
+        },
+        kMinBeamsPerThread);
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& share : found)
+      for (const auto& [v, i] : share.second) {
+        uint8_t& miss = voxelMisses(v)[i];
+        if (miss & kSeenThroughThisSweep) continue;
+        miss |= kSeenThroughThisSweep;
+        touched.push_back(v);
+      }
   }
   // one miss per sweep for every point seen through; those with enough go
   std::sort(touched.begin(), touched.end());

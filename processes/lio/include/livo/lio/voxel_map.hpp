@@ -9,6 +9,7 @@
 
 #include "livo/flat_key_index.hpp"
 #include "livo/voxel_downsample.hpp"
+#include "livo/worker_threads.hpp"
 
 namespace livo::lio {
 
@@ -64,7 +65,9 @@ class VoxelMap {
   /// Casts the beams from `origin` (world) to every `ray_stride`-th of `endpoints` (one sweep)
   /// and removes the points seen through in `misses_to_remove` sweeps (see SeenThroughOptions).
   /// Returns how many points were removed.
-  size_t removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& options);
+  /// With `threads`, the beams are cast on them (the same points are removed).
+  size_t removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& options,
+                           WorkerThreads* threads = nullptr);
 
   /// Drops voxels whose centre is farther than radius from centre (the local window); returns
   /// how many voxels were removed.
@@ -101,6 +104,11 @@ class VoxelMap {
   /// Flags voxel v's points that the ray origin + t dir (t <= reach) passes through this sweep.
   void markSeenThrough(int32_t v, const Vec3& origin, const Vec3& dir, double reach, const SeenThroughOptions& o,
                        std::vector<int32_t>* touched);
+  /// Calls visit(v, dir, reach) for every stored voxel v within the radius of beams [first_beam,
+  /// end_beam) (every ray_stride-th endpoint); a voxel may come more than once.
+  template <typename VisitVoxel>
+  void forEachVoxelNearBeams(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& o,
+                             size_t first_beam, size_t end_beam, VisitVoxel visit) const;
 
   VoxelMapOptions opts_;
   double inv_size_;
