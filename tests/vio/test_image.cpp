@@ -3,8 +3,11 @@
 // affine warp between views, and the depth grid's occlusion and depth-edge tests.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
+#include <random>
 #include <vector>
 
 #include "livo/vio/grey_image.hpp"
@@ -117,6 +120,89 @@ TEST(VioImage, StoredPatchAndIdentityWarpReproduceTheImage) {
   // a warp scaling by 2 needs offsets up to 7 > the stored margin
   EXPECT_FALSE(warpReferencePatch(stored.data(), 2.0 * Eigen::Matrix2d::Identity(), warped));
   EXPECT_FALSE(extractStoredPatches(pyr, Eigen::Vector2d(10.0, 60.0), 3, stored.data()));  // too near the border
+}
+
+// The sampling the update runs on is written so that the compiler vectorises it; each sample must
+// still be the scalar formula, evaluated in the same order, to the bit (the VIO's outputs are
+// reproducible across such changes). The references below are the formulas as first written.
+TEST(VioImage, VectorisedSamplingIsTheScalarFormulaBitForBit) {
+  const cv::Mat img = pattern(160, 120);
+  ImagePyramid pyr;
+  pyr.build(img, 3);
+  auto gridReference = [&](int level, const Eigen::Vector2d& centre, int n, std::vector<float>* out) {
+    const cv::Mat& l = pyr.level(level);
+    const double half = 0.5 * (n - 1);
+    const double x0 = centre.x() - half, y0 = centre.y() - half;
+    const int ix = static_cast<int>(x0), iy = static_cast<int>(y0);
+    const float ax = static_cast<float>(x0 - ix), ay = static_cast<float>(y0 - iy);
+    const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
+    out->assign(static_cast<size_t>(n * n), 0.0f);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const uint8_t* r0 = l.ptr<uint8_t>(iy + j) + ix + i;
+        const uint8_t* r1 = r0 + l.step[0];
+        (*out)[static_cast<size_t>(j * n + i)] = w00 * r0[0] + w10 * r0[1] + w01 * r1[0] + w11 * r1[1];
+      }
+  };
+  auto warpReference = [](const uint8_t* stored, const Eigen::Matrix2d& A, float* out) {
+    const double c = 0.5 * (kStored - 1), h = 0.5 * (kPatch - 1);
+    for (int j = 0; j < kPatch; ++j)
+      for (int i = 0; i < kPatch; ++i) {
+        const double dx = i - h, dy = j - h;
+        const double x = c + A(0, 0) * dx + A(0, 1) * dy, y = c + A(1, 0) * dx + A(1, 1) * dy;
+        const int ix = std::min(static_cast<int>(x), kStored - 2), iy = std::min(static_cast<int>(y), kStored - 2);
+        const float ax = static_cast<float>(x - ix), ay = static_cast<float>(y - iy);
+        const uint8_t* r0 = stored + iy * kStored + ix;
+        const uint8_t* r1 = r0 + kStored;
+        out[j * kPatch + i] =
+            (1 - ax) * (1 - ay) * r0[0] + ax * (1 - ay) * r0[1] + (1 - ax) * ay * r1[0] + ax * ay * r1[1];
+      }
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<float> got, want;
+  int grids = 0, warps = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int level = trial % 3;
+    const Eigen::Vector2d centre(12.0 + u(rng) * (pyr.level(level).cols - 24.0) * 0.9,
+                                 12.0 + u(rng) * (pyr.level(level).rows - 24.0) * 0.9);
+    for (const int n : {kWindow, kStored, 5}) {  // the two vectorised sizes and the generic path
+      got.assign(static_cast<size_t>(n * n), -1.0f);
+      if (!pyr.sampleGrid(level, centre, n, got.data())) continue;
+      gridReference(level, centre, n, &want);
+      ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size() * sizeof(float)), 0)
+          << "level " << level << " centre " << centre.transpose() << " n " << n;
+      ++grids;
+    }
+    // a stored patch here, warped by a random affine map that mostly stays inside it
+    std::vector<uint8_t> stored(3 * kStoredArea);
+    if (!extractStoredPatches(pyr, centre * static_cast<double>(1 << level), 1, stored.data())) continue;
+    Eigen::Matrix2d A;
+    A << 0.7 + 0.6 * u(rng), 0.4 * (u(rng) - 0.5), 0.4 * (u(rng) - 0.5), 0.7 + 0.6 * u(rng);
+    float warped[kPatchArea], scalar[kPatchArea];
+    if (!warpReferencePatch(stored.data(), A, warped)) continue;
+    warpReference(stored.data(), A, scalar);
+    ASSERT_EQ(std::memcmp(warped, scalar, sizeof(warped)), 0) << "A\n" << A;
+    ++warps;
+  }
+  EXPECT_GT(grids, 600);  // the trials did exercise both paths
+  EXPECT_GT(warps, 100);
+
+  // the pyramid's averaging, in blocks with a remainder (an odd width: 37 pixels at level 1)
+  const cv::Mat odd = pattern(75, 61);
+  ImagePyramid p2;
+  p2.build(odd, 3);
+  for (int l = 1; l < 3; ++l) {
+    const cv::Mat& src = p2.level(l - 1);
+    const cv::Mat& dst = p2.level(l);
+    ASSERT_EQ(dst.cols, src.cols / 2);
+    for (int y = 0; y < dst.rows; ++y)
+      for (int x = 0; x < dst.cols; ++x) {
+        const int sum = src.at<uint8_t>(2 * y, 2 * x) + src.at<uint8_t>(2 * y, 2 * x + 1) +
+                        src.at<uint8_t>(2 * y + 1, 2 * x) + src.at<uint8_t>(2 * y + 1, 2 * x + 1);
+        ASSERT_EQ(dst.at<uint8_t>(y, x), (sum + 2) >> 2) << "level " << l << " at " << x << ", " << y;
+      }
+  }
 }
 
 TEST(VioImage, AffineWarpBetweenViews) {

@@ -11,24 +11,36 @@ namespace livo::vio {
 
 namespace {
 
-// Measurement over the active patches at iterate x; returns the number of patches used.
-int measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
-            const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
-            const PhotometricOptions& o, const RollingShutter& shutter, PoseInformation* info,
-            const Vec6& motion, CalibrationInformation* ci) {
-  PatchResidual e;
+// The information of a set of patches at one iterate (with the calibration's, if estimated).
+struct Measurement {
+  PoseInformation info;
+  CalibrationInformation ci;
   int used = 0;
-  for (size_t i = 0; i < patches.size(); ++i) {
-    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e, shutter)) continue;
-    if (ci)
-      accumulate(e, o, info, motion, ci);
-    else
-      accumulate(e, o, info);
-    ++used;
-  }
-  return used;
+};
+
+// Adds an evaluated patch to the measurement; returns its Huber cost.
+double add(const PatchResidual& e, const PhotometricOptions& o, const Vec6& motion, bool with_calibration,
+           Measurement* m) {
+  ++m->used;
+  return with_calibration ? accumulate(e, o, &m->info, motion, &m->ci) : accumulate(e, o, &m->info);
 }
 
+// Measurement over the active patches at iterate x; `costs` (if given) gets each patch's Huber
+// cost, -1 for one not used.
+Measurement measure(const std::vector<TrackedPatch>& patches, const std::vector<char>& active, int level,
+                    const ImagePyramid& pyramid, const CameraProjection& camera, const Pose3& T_I_C,
+                    const FilterState& x, const PhotometricOptions& o, const RollingShutter& shutter,
+                    const Vec6& motion, bool with_calibration, std::vector<double>* costs) {
+  Measurement m;
+  PatchResidual e;
+  if (costs) costs->assign(patches.size(), -1.0);
+  for (size_t i = 0; i < patches.size(); ++i) {
+    if (!active[i] || !evaluatePatch(pyramid, level, camera, T_I_C, x, patches[i], o, &e, shutter)) continue;
+    const double cost = add(e, o, motion, with_calibration, &m);
+    if (costs) (*costs)[i] = cost;
+  }
+  return m;
+}
 
 }  // namespace
 
@@ -105,16 +117,27 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   auto stateAt = [&](const FilterState& xi, const CalibrationVector& f) {
     return calib ? advanced(xi, calib->omega_I, calib->time_offset + f[6]) : xi;
   };
-  // one Gauss-Newton step at `level` from the iterate x (the floors applied if `with_floor`)
-  enum class Step { kStepped, kConverged, kTooFew, kDiverged };
-  auto gaussNewtonStep = [&](int level, bool with_floor) {
-    PoseInformation info;
-    CalibrationInformation ci;
-    const FilterState xs = stateAt(x, c);
+  // d pixel / d δt needs the body's motion at the iterate
+  auto motionAt = [&](const FilterState& xs) {
     Vec6 motion = Vec6::Zero();
     if (calib) motion << calib->omega_I, xs.vel;
-    const int used = measure(patches, active, level, pyramid, camera, cameraAt(c), xs, po, shutter, &info, motion,
-                             calib ? &ci : nullptr);
+    return motion;
+  };
+  // one Gauss-Newton step at `level` from the iterate x (the floors applied if `with_floor`), on
+  // `given` (the measurement already taken at this iterate) or measured now (each patch's cost into
+  // `costs`, if given)
+  enum class Step { kStepped, kConverged, kTooFew, kDiverged };
+  auto gaussNewtonStep = [&](int level, bool with_floor, const Measurement* given, std::vector<double>* costs) {
+    Measurement measured;
+    if (!given) {
+      const FilterState xs = stateAt(x, c);
+      measured = measure(patches, active, level, pyramid, camera, cameraAt(c), xs, po, shutter, motionAt(xs),
+                         calib != nullptr, costs);
+    }
+    const Measurement& m = given ? *given : measured;
+    const PoseInformation& info = m.info;
+    const CalibrationInformation& ci = m.ci;
+    const int used = m.used;
     if (used < uo.min_patches) return Step::kTooFew;
     Vec18 delta;
     Mat6 S = info.HtRinvH;
@@ -155,20 +178,25 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
     // the measurement of this level: patches that project (and, once a coarser level has aligned
     // the image, correlate) at the current iterate; at the first level the prior may be off by more
     // than a fine texture's correlation length, so only the robust weights guard it
+    // (the patches so chosen are the first step's measurement: it is taken at this same iterate)
     const bool gate = res.iterations > 0;
-    int n_active = 0;
+    const Pose3 T_I_C_level = cameraAt(c);
+    const FilterState x_level = stateAt(x, c);
+    const Vec6 motion = motionAt(x_level);
+    Measurement first;
     for (size_t i = 0; i < patches.size(); ++i) {
-      active[i] = evaluatePatch(pyramid, level, camera, cameraAt(c), stateAt(x, c), patches[i], po, &e, shutter) &&
+      active[i] = evaluatePatch(pyramid, level, camera, T_I_C_level, x_level, patches[i], po, &e, shutter) &&
                   (!gate || e.ncc >= po.min_ncc);
-      n_active += active[i];
+      if (active[i]) add(e, po, motion, calib != nullptr, &first);
     }
+    const int n_active = first.used;
     if (n_active < uo.min_patches) {
       if (level > 0) continue;  // a finer level may still have enough
       res.why = "too few patches correlate (" + std::to_string(n_active) + " < " + std::to_string(uo.min_patches) + ")";
       return res;
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
-      const Step st = gaussNewtonStep(level, false);
+      const Step st = gaussNewtonStep(level, false, it == 0 ? &first : nullptr, nullptr);
       if (st == Step::kTooFew) break;
       if (st == Step::kDiverged) return res;
       if (st == Step::kConverged) break;
@@ -181,10 +209,9 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   // the floors: the alignment above found where the image puts the pose; its measurement of the
   // pose, though, is only as good as the calibration and the references' poses allow, so the
   // fusion with the prior is one more step from there with the floored information
-  const FilterState x_aligned = x;
-  const CalibrationVector c_aligned = c;
+  std::vector<double> aligned_cost;  // each patch's Huber cost at the aligned pose (-1: not evaluated)
   if (floored) {
-    const Step st = gaussNewtonStep(0, true);
+    const Step st = gaussNewtonStep(0, true, nullptr, &aligned_cost);
     if (st == Step::kDiverged) return res;
     if (st == Step::kTooFew) {
       res.why = "too few patches project at the aligned pose";
@@ -198,21 +225,23 @@ DirectUpdateResult directUpdate(const FilterState& prior, const Mat18& P_prior, 
   // some of that back where the prior is surer)
   double cost_prior = 0.0, cost_post = 0.0;
   int n_cost = 0;
-  PatchResidual ep, ea;
+  // (at the aligned pose the floored step measured them: its costs are those)
+  PatchResidual ep;
+  const FilterState prior_at_image = stateAt(prior, CalibrationVector::Zero());
+  const Pose3 T_I_C_post = cameraAt(c);
+  const FilterState x_post = stateAt(x, c);
   for (size_t i = 0; i < patches.size(); ++i) {
     TrackedPatch& t = patches[i];
     t.active = false;
     if (!active[i]) continue;
-    if (!evaluatePatch(pyramid, 0, camera, T_I_C, stateAt(prior, CalibrationVector::Zero()), t, po, &ep, shutter) ||
-        !evaluatePatch(pyramid, 0, camera, cameraAt(c), stateAt(x, c), t, po, &e, shutter) ||
-        (floored && !evaluatePatch(pyramid, 0, camera, cameraAt(c_aligned), stateAt(x_aligned, c_aligned), t, po,
-                                   &ea, shutter)))
+    if (!evaluatePatch(pyramid, 0, camera, T_I_C, prior_at_image, t, po, &ep, shutter) ||
+        !evaluatePatch(pyramid, 0, camera, T_I_C_post, x_post, t, po, &e, shutter) || (floored && aligned_cost[i] < 0.0))
       continue;
     t.active = true;
     t.ncc = static_cast<float>(e.ncc);
     t.rms = static_cast<float>(std::sqrt(e.r.squaredNorm() / kPatchArea));
     cost_prior += huberCost(ep, po.huber_threshold);
-    cost_post += huberCost(floored ? ea : e, po.huber_threshold);
+    cost_post += floored ? aligned_cost[i] : huberCost(e, po.huber_threshold);
     n_cost += kPatchArea;
   }
   if (n_cost > 0) {

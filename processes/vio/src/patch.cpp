@@ -1,5 +1,6 @@
 #include "livo/vio/patch.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/LU>
@@ -35,21 +36,39 @@ bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pos
 }
 
 bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, float* out) {
+  // In three passes, each the scalar formula evaluated the same way per pixel: the warped
+  // coordinates (vectorised), the bounds, then the bilinear samples (the four taps gathered, the
+  // weighting vectorised).
   constexpr double c = 0.5 * (kStored - 1), h = 0.5 * (kPatch - 1);
   const double lim = kStored - 1;
+  const double a00 = A(0, 0), a01 = A(0, 1), a10 = A(1, 0), a11 = A(1, 1);
+  double x[kPatchArea], y[kPatchArea];
   for (int j = 0; j < kPatch; ++j) {
+#pragma GCC unroll 8
     for (int i = 0; i < kPatch; ++i) {
       const double dx = i - h, dy = j - h;
-      const double x = c + A(0, 0) * dx + A(0, 1) * dy, y = c + A(1, 0) * dx + A(1, 1) * dy;
-      if (!(x >= 0.0 && y >= 0.0 && x <= lim && y <= lim)) return false;
-      const int ix = std::min(static_cast<int>(x), kStored - 2), iy = std::min(static_cast<int>(y), kStored - 2);
-      const float ax = static_cast<float>(x - ix), ay = static_cast<float>(y - iy);
-      const uint8_t* r0 = stored + iy * kStored + ix;
-      const uint8_t* r1 = r0 + kStored;
-      out[j * kPatch + i] =
-          (1 - ax) * (1 - ay) * r0[0] + ax * (1 - ay) * r0[1] + (1 - ax) * ay * r1[0] + ax * ay * r1[1];
+      x[j * kPatch + i] = c + a00 * dx + a01 * dy;
+      y[j * kPatch + i] = c + a10 * dx + a11 * dy;
     }
   }
+  bool inside = true;
+  for (int k = 0; k < kPatchArea; ++k) inside &= x[k] >= 0.0 && y[k] >= 0.0 && x[k] <= lim && y[k] <= lim;
+  if (!inside) return false;
+  float ax[kPatchArea], ay[kPatchArea], v00[kPatchArea], v10[kPatchArea], v01[kPatchArea], v11[kPatchArea];
+  for (int k = 0; k < kPatchArea; ++k) {
+    const int ix = std::min(static_cast<int>(x[k]), kStored - 2), iy = std::min(static_cast<int>(y[k]), kStored - 2);
+    ax[k] = static_cast<float>(x[k] - ix);
+    ay[k] = static_cast<float>(y[k] - iy);
+    const uint8_t* r0 = stored + iy * kStored + ix;
+    const uint8_t* r1 = r0 + kStored;
+    v00[k] = r0[0];
+    v10[k] = r0[1];
+    v01[k] = r1[0];
+    v11[k] = r1[1];
+  }
+  for (int k = 0; k < kPatchArea; ++k)
+    out[k] = (1 - ax[k]) * (1 - ay[k]) * v00[k] + ax[k] * (1 - ay[k]) * v10[k] + (1 - ax[k]) * ay[k] * v01[k] +
+             ax[k] * ay[k] * v11[k];
   return true;
 }
 

@@ -33,32 +33,42 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
   out->B = pixelPoseJacobian(s, shutter, T_I_C) * (1.0 / static_cast<double>(1 << level));
   // p_C = Exp(-φ) (p_C0 - ρ): d p_C / d φ = [p_C]x, d p_C / d ρ = -I
   const double scale = 1.0 / static_cast<double>(1 << level);
-  out->Bc.leftCols<3>() = s.J_proj * so3::hat(T_I_C.inverse() * s.p_I) * scale;
+  out->Bc.leftCols<3>() = s.J_proj * so3::hat(s.p_C) * scale;
   out->Bc.rightCols<3>() = -s.J_proj * scale;
 
   const float* Q = patch.reference.data() + static_cast<size_t>(level) * kPatchArea;
-  // current intensities and gradients on the 8x8 interior of the 10x10 window
+  // current intensities and gradients on the 8x8 interior of the 10x10 window: the per-pixel
+  // arithmetic in fixed-size rows the compiler vectorises, the sums after it in the original
+  // pixel order (a floating-point sum depends on its order)
   double I[kPatchArea];
-  double sum_i = 0.0, sum_q = 0.0;
-  for (int j = 0; j < kPatch; ++j)
+  double* Gx = out->G.col(0).data();
+  double* Gy = out->G.col(1).data();
+  for (int j = 0; j < kPatch; ++j) {
+    const float* c = w + (j + 1) * kWindow + 1;
+#pragma GCC unroll 8
     for (int i = 0; i < kPatch; ++i) {
       const int k = j * kPatch + i;
-      const float* c = w + (j + 1) * kWindow + (i + 1);
-      I[k] = c[0];
-      out->G(k, 0) = 0.5 * (c[1] - c[-1]);
-      out->G(k, 1) = 0.5 * (c[kWindow] - c[-kWindow]);
-      sum_i += I[k];
-      sum_q += Q[k];
+      I[k] = c[i];
+      Gx[k] = 0.5 * (c[i + 1] - c[i - 1]);
+      Gy[k] = 0.5 * (c[i + kWindow] - c[i - kWindow]);
     }
+  }
+  double sum_i = 0.0, sum_q = 0.0;
+  for (int k = 0; k < kPatchArea; ++k) {
+    sum_i += I[k];
+    sum_q += Q[k];
+  }
   const double mean_i = sum_i / kPatchArea, mean_q = sum_q / kPatchArea;
-  double sqq = 0.0, sii = 0.0, sqi = 0.0;
-  double q[kPatchArea];
+  double q[kPatchArea], di[kPatchArea];
   for (int k = 0; k < kPatchArea; ++k) {
     q[k] = Q[k] - mean_q;
-    const double di = I[k] - mean_i;
+    di[k] = I[k] - mean_i;
+  }
+  double sqq = 0.0, sii = 0.0, sqi = 0.0;
+  for (int k = 0; k < kPatchArea; ++k) {
     sqq += q[k] * q[k];
-    sii += di * di;
-    sqi += q[k] * di;
+    sii += di[k] * di[k];
+    sqi += q[k] * di[k];
   }
   out->ncc = sqq > 1e-9 && sii > 1e-9 ? sqi / std::sqrt(sqq * sii) : 0.0;
   // brightness fit: gain free within bounds (projection onto span{q, 1}), else offset only
@@ -84,12 +94,15 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
   return true;
 }
 
+namespace {
+// One residual's Huber cost; accumulate()'s sum is huberCost()'s, bit for bit (the direct update
+// reuses it as such).
+inline double huberTerm(double a, double d) { return a <= d ? 0.5 * a * a : d * (a - 0.5 * d); }
+}  // namespace
+
 double huberCost(const PatchResidual& e, double d) {
   double cost = 0.0;
-  for (int k = 0; k < kPatchArea; ++k) {
-    const double a = std::abs(e.r[k]);
-    cost += a <= d ? 0.5 * a * a : d * (a - 0.5 * d);
-  }
+  for (int k = 0; k < kPatchArea; ++k) cost += huberTerm(std::abs(e.r[k]), d);
   return cost;
 }
 
@@ -103,7 +116,7 @@ double accumulateTerms(const PatchResidual& e, const PhotometricOptions& o, Pose
   for (int k = 0; k < kPatchArea; ++k) {
     const double r = e.r[k], a = std::abs(r);
     const double wk = a <= d ? 1.0 : d / a;
-    cost += a <= d ? 0.5 * a * a : d * (a - 0.5 * d);
+    cost += huberTerm(a, d);
     const double gx = e.G(k, 0), gy = e.G(k, 1);
     M(0, 0) += wk * gx * gx;
     M(0, 1) += wk * gx * gy;

@@ -9,14 +9,11 @@ PointPatchMap::PointPatchMap(const MapOptions& options) : options_(options), inv
 
 uint64_t PointPatchMap::keyOf(const Vec3& p) const { return voxelKeyOf(p, inv_voxel_); }
 
-int PointPatchMap::find(const Vec3& p) const {
-  const auto it = index_.find(keyOf(p));
-  return it == index_.end() ? -1 : it->second;
-}
+int PointPatchMap::find(const Vec3& p) const { return index_.find(keyOf(p)); }
 
 int PointPatchMap::add(const Vec3& p, int64_t utime, PatchObservation observation) {
   const int index = static_cast<int>(points_.size());
-  if (!index_.emplace(keyOf(p), index).second) return -1;
+  if (index_.insert(keyOf(p), index) != index) return -1;  // the voxel's point is another
   MapPoint m;
   m.id = next_id_++;
   m.position = p;
@@ -95,9 +92,8 @@ void PointPatchMap::clear() {
 }
 
 void PointPatchMap::reindex() {
-  index_.clear();
-  index_.reserve(points_.size());
-  for (size_t i = 0; i < points_.size(); ++i) index_.emplace(keyOf(points_[i].position), static_cast<int>(i));
+  index_.resetFor(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) index_.insert(keyOf(points_[i].position), static_cast<int>(i));
 }
 
 size_t PointPatchMap::observationCount() const {
@@ -107,8 +103,8 @@ size_t PointPatchMap::observationCount() const {
 }
 
 size_t PointPatchMap::memoryBytes() const {
-  size_t bytes = points_.capacity() * sizeof(MapPoint) + index_.size() * (sizeof(uint64_t) + sizeof(int) + 16) +
-                 index_.bucket_count() * sizeof(void*);
+  // the index's slots: a key and an index each, padded to two keys
+  size_t bytes = points_.capacity() * sizeof(MapPoint) + index_.capacity() * 2 * sizeof(VoxelKey);
   for (const auto& m : points_) {
     bytes += m.observations.capacity() * sizeof(PatchObservation);
     for (const auto& o : m.observations) bytes += o.pixels.capacity();

@@ -12,12 +12,13 @@ namespace livo::vio {
 
 DepthGrid::DepthGrid(int width, int height, int cell_px)
     : cell_(std::max(1, cell_px)), cols_((width + cell_ - 1) / cell_), rows_((height + cell_ - 1) / cell_) {
-  clear();
+  cells_.assign(static_cast<size_t>(cols_) * rows_, kEmpty);
 }
 
 void DepthGrid::clear() {
-  constexpr float inf = std::numeric_limits<float>::infinity();
-  cells_.assign(static_cast<size_t>(cols_) * rows_, Cell{inf, 0.0f, 0.0f, -inf, 0.0f, 0.0f});
+  // only the cells points went into: most of the grid stays empty from image to image
+  for (const int i : filled_) cells_[static_cast<size_t>(i)] = kEmpty;
+  filled_.clear();
 }
 
 int DepthGrid::index(const Eigen::Vector2d& pixel) const {
@@ -30,6 +31,7 @@ void DepthGrid::add(const Eigen::Vector2d& pixel, float z) {
   const int i = index(pixel);
   if (i < 0) return;
   Cell& c = cells_[static_cast<size_t>(i)];
+  if (c.far_z < c.near_z) filled_.push_back(i);  // the first point in the cell
   if (z < c.near_z) c.near_z = z, c.near_u = static_cast<float>(pixel.x()), c.near_v = static_cast<float>(pixel.y());
   if (z > c.far_z) c.far_z = z, c.far_u = static_cast<float>(pixel.x()), c.far_v = static_cast<float>(pixel.y());
 }
@@ -152,11 +154,13 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     }
   }
   std::vector<TrackedPatch> out;
+  out.reserve(static_cast<size_t>(
+      std::count_if(grid.begin(), grid.end(), [](const Candidate& c) { return c.point >= 0; })));
   for (const Candidate& c : grid) {
     if (c.point < 0) continue;
     const MapPoint& m = map.point(c.point);
     const PatchObservation& obs = m.observations[static_cast<size_t>(c.observation)];
-    TrackedPatch t;
+    TrackedPatch& t = out.emplace_back();  // filled in place: a TrackedPatch is over 1 kB
     t.point = c.point;
     t.observation = c.observation;
     t.p_W = m.position;
@@ -168,10 +172,9 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     for (int l = 0; l < levels && ok; ++l)
       ok = warpReferencePatch(obs.level(l), c.A, t.reference.data() + static_cast<size_t>(l) * kPatchArea);
     if (!ok) {
+      out.pop_back();
       ++st.no_reference;
-      continue;
     }
-    out.push_back(t);
   }
   st.selected = static_cast<int>(out.size());
   if (stats) *stats = st;

@@ -16,7 +16,8 @@ RollingShutter RollingShutter::fromReadout(double readout_s, int rows) {
 Mat3 RollingShutter::rotationSince(double dt) const { return so3::Exp(omega_I * dt); }
 
 bool projectThroughShutter(const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
-                           const RollingShutter& shutter, const Vec3& p_W, ShutterProjection* out, double border) {
+                           const RollingShutter& shutter, const Vec3& p_W, ShutterProjection* out, double border,
+                           bool with_jacobian) {
   const Pose3 T_C_I = T_I_C.inverse();
   out->dt = 0.0;
   out->R_W_I = x.rot;
@@ -24,7 +25,10 @@ bool projectThroughShutter(const CameraProjection& camera, const Pose3& T_I_C, c
   const int steps = shutter.active() ? kFixedPointSteps : 0;
   for (int k = 0;; ++k) {
     out->p_I = out->R_W_I.transpose() * (p_W - out->p_W_I);
-    if (!camera.projectWithJacobian(T_C_I * out->p_I, &out->pixel, &out->J_proj)) return false;
+    out->p_C = T_C_I * out->p_I;
+    const bool projects = with_jacobian ? camera.projectWithJacobian(out->p_C, &out->pixel, &out->J_proj)
+                                        : camera.project(out->p_C, &out->pixel);
+    if (!projects) return false;
     if (k == steps) break;
     out->dt = shutter.rowTime(out->pixel.y());
     out->R_W_I = x.rot * shutter.rotationSince(out->dt);

@@ -266,7 +266,9 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
   const Vec3 c_W = T_W_C.translation();
   // where a point is seen (its row's pose under a rolling shutter) and that row's camera pose
   ShutterProjection sp;
-  auto seen = [&](const Vec3& p_W) { return projectThroughShutter(camera_, T_I_C_, x, shutter, p_W, &sp, border); };
+  auto seen = [&](const Vec3& p_W) {
+    return projectThroughShutter(camera_, T_I_C_, x, shutter, p_W, &sp, border, /*with_jacobian=*/false);
+  };
   auto rowCamera = [&](double dt) { return dt == 0.0 ? T_W_C : cameraPoseAt(x, shutter, dt, T_I_C_); };
   // the pose covariance the references cut now carry, rotation in the world frame
   Mat6 J = Mat6::Identity();

@@ -5,9 +5,9 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
+#include "livo/flat_key_index.hpp"
 #include "livo/so3.hpp"
 #include "livo/vio/patch.hpp"
 #include "livo/voxel_key.hpp"
@@ -71,7 +71,7 @@ class PointPatchMap {
   MapOptions options_;
   double inv_voxel_;
   std::vector<MapPoint> points_;
-  std::unordered_map<uint64_t, int> index_;  // voxel key -> index into points_ (lookup only)
+  FlatKeyIndex index_;  // voxel key -> index into points_ (lookup only)
   int64_t next_id_ = 0;
   bool pruned_once_ = false;
   Vec3 pruned_at_ = Vec3::Zero();

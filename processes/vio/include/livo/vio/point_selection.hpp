@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,9 +44,12 @@ class DepthGrid {
     float near_z, near_u, near_v;
     float far_z, far_u, far_v;
   };
+  static constexpr Cell kEmpty{std::numeric_limits<float>::infinity(), 0.0f, 0.0f,
+                               -std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
   int index(const Eigen::Vector2d& pixel) const;
   int cell_, cols_, rows_;
   std::vector<Cell> cells_;
+  std::vector<int> filled_;  // cells with a point since the last clear()
 };
 
 struct SelectionStats {
