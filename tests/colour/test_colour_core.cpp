@@ -2,6 +2,7 @@
 // the time window, accumulation and exposure normalisation, loop corrections, the colour image
 // (decoding itself is the shared livo_camera_image, tested in tests/unit/test_camera_image.cpp) and
 // the PLY/PCD files.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -11,8 +12,10 @@
 #include "livo/camera_projection.hpp"
 #include "livo/colour/colour_map.hpp"
 #include "livo/colour/colouring_pipeline.hpp"
+#include "livo/colour/depth_buffer.hpp"
 #include "livo/colour/exposure_gain.hpp"
 #include "livo/colour/map_files.hpp"
+#include "livo/colour/view_cone.hpp"
 #include "scene_fixtures.hpp"
 #include "temp_path.hpp"
 
@@ -697,4 +700,127 @@ TEST(ColourMapTiles, ACorrectionMovesTilesOnDiskWhenTheyComeBack) {
   EXPECT_FALSE(created);
   EXPECT_EQ(map.point(id).anchor, 1);
   EXPECT_FLOAT_EQ(map.point(id).colour.z(), 150.f);
+}
+
+// The cone's shortcuts decide every point as the exact test (an atan2 and an asin) does, also right
+// at the bound, at the travel radius, at the centre, and for cones up to and beyond pi.
+TEST(ViewCone, TheShortcutsDecideAsTheExactTest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), frac(0.0, 1.0);
+  int mismatches = 0, inside = 0, outside = 0, at_bound_inside = 0, at_bound_outside = 0;
+  const double half_angles[] = {0.0, 1e-7, 0.005, 0.3, 0.785, 1.05, 1.5, M_PI_2, 1.6, 2.5, 3.0, M_PI - 0.02,
+                                M_PI - 0.005, M_PI - 1e-9, M_PI, 4.0};
+  const double travels[] = {0.0, 1e-6, 0.2, 0.8, 3.0, 40.0};
+  for (const double half_angle : half_angles) {
+    for (const double travel : travels) {
+      ViewCone cone;
+      cone.centre = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+      cone.axis = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+      cone.half_angle = half_angle;
+      cone.travel = travel;
+      cone.prepare();
+      // a frame around the axis: points at a chosen angle and range
+      const Eigen::Vector3d side = cone.axis.unitOrthogonal();
+      auto at = [&](double angle, double r, double roll) {
+        const Eigen::Vector3d dir = Eigen::AngleAxisd(roll, cone.axis) * (std::cos(angle) * cone.axis + std::sin(angle) * side);
+        return Eigen::Vector3d(cone.centre + r * dir);
+      };
+      auto check = [&](const Eigen::Vector3d& p) {
+        const bool exact = cone.containsExactly(p);
+        if (cone.contains(p) != exact && ++mismatches <= 5)
+          ADD_FAILURE() << "half angle " << half_angle << " travel " << travel << " point " << p.transpose();
+        ++(exact ? inside : outside);
+        return exact;
+      };
+      check(cone.centre);
+      for (int i = 0; i < 2000; ++i) {
+        const double r = travel * 6.0 * frac(rng) + 0.05 * frac(rng);
+        check(at(M_PI * frac(rng), r, 2 * M_PI * frac(rng)));
+        // on and next to the bound (half_angle + asin(travel / r)), and at the travel radius
+        const double r_out = travel + 0.01 + 10.0 * frac(rng);
+        const double bound = half_angle + std::asin(std::min(1.0, travel / r_out));
+        if (bound < M_PI) {
+          for (const double off : {-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6}) {
+            const bool in = check(at(std::clamp(bound + off, 0.0, M_PI), r_out, 2 * M_PI * frac(rng)));
+            if (off == -1e-6 && bound > 1e-6) at_bound_inside += in;
+            if (off == 1e-6 && bound + 1e-6 < M_PI) at_bound_outside += !in;
+          }
+        }
+        for (const double dr : {-1e-12, 0.0, 1e-12}) check(at(M_PI * frac(rng), travel + dr, 0.0));
+      }
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  // both answers came, also a hair either side of the bound
+  EXPECT_GT(inside, 10000);
+  EXPECT_GT(outside, 10000);
+  EXPECT_GT(at_bound_inside, 1000);
+  EXPECT_GT(at_bound_outside, 1000);
+}
+
+// Splatting only each cell's nearest centred point leaves the buffer splatting every point does.
+TEST(DepthBuffer, SplattingTheNearestPerCellLeavesTheBufferOfEverySplat) {
+  DepthBufferOptions o;
+  DepthBuffer every(640, 480, 500.0, o), nearest(640, 480, 500.0, o);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 639.0), v(0.0, 479.0), depth(0.2, 30.0);
+  std::vector<std::pair<Eigen::Vector2d, double>> points;
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector2d px(u(rng), v(rng));
+    points.emplace_back(px, depth(rng));
+    // crowd cells: more points in the same cell, nearer, farther and at the same depth
+    for (const double dz : {-0.05, 0.0, 0.0, 0.3}) points.emplace_back(px + Eigen::Vector2d(0.4, -0.3), std::max(0.2, points.back().second + dz));
+  }
+  for (int image = 0; image < 2; ++image) {  // twice: the buffer's working set is reset between images
+    every.clear();
+    nearest.clear();
+    for (const auto& [px, z] : points) every.splat(px, z);
+    nearest.splatNearest(points, [](const std::pair<Eigen::Vector2d, double>& p) { return p; });
+    for (int y = 0; y < 480; y += 2)
+      for (int x = 0; x < 640; x += 2) {
+        const Eigen::Vector2d px(x, y);
+        ASSERT_EQ(nearest.nearest(px), every.nearest(px)) << x << " " << y;
+      }
+    points.resize(points.size() / 3);
+  }
+}
+
+// A batch of points gives the ids and the map of one addPoint each (free slots, tiles, repeats).
+TEST(ColourMap, AddPointsMatchesOneAddPointEach) {
+  ColourMap one(0.05, TileOptions{2.0, 1.0, ""}), batch(0.05, TileOptions{2.0, 1.0, ""});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-4.f, 4.f);
+  AccumulationOptions acc;
+  for (int scan = 0; scan < 6; ++scan) {
+    std::vector<Eigen::Vector3f> pts;
+    for (int i = 0; i < 4000; ++i) {
+      pts.emplace_back(u(rng) + 10.f * float(scan % 3), u(rng), 0.3f * u(rng));  // a region comes back every third
+      if (i % 5 == 0) pts.push_back(pts.back());  // the same voxel again
+    }
+    const int64_t utime = 1000000 + scan * 800000;
+    one.setTime(utime);
+    batch.setTime(utime);
+    std::vector<uint32_t> ids_one, ids_batch;
+    for (const Eigen::Vector3f& p : pts) ids_one.push_back(one.addPoint(p, scan));
+    batch.addPoints(pts, scan, &ids_batch);
+    ASSERT_EQ(ids_batch, ids_one);
+    for (size_t k = 0; k < ids_one.size(); k += 3) {
+      one.accumulate(ids_one[k], Eigen::Vector3f(10, 20, 30), acc);
+      batch.accumulate(ids_batch[k], Eigen::Vector3f(10, 20, 30), acc);
+    }
+    // free slots for the next batch to reuse, and tiles to disk and back
+    auto odd = [](uint32_t id) { return id % 2 == 1; };
+    EXPECT_EQ(batch.removeUncoloured(odd), one.removeUncoloured(odd));
+    EXPECT_EQ(batch.evictIdle(utime), one.evictIdle(utime));
+  }
+  ASSERT_EQ(batch.size(), one.size());
+  for (uint32_t id = 0; id < one.size(); ++id) {
+    const MapPoint &a = one.point(id), &b = batch.point(id);
+    ASSERT_EQ(a.position, b.position);
+    ASSERT_EQ(a.colour, b.colour);
+    ASSERT_EQ(a.count, b.count);
+    ASSERT_EQ(a.rejected, b.rejected);
+    ASSERT_EQ(a.anchor, b.anchor);
+  }
+  EXPECT_GT(batch.spilledTiles(), 0u);
 }

@@ -104,21 +104,23 @@ ColourMap::ColourMap(double voxel_size, TileOptions tiles)
   index_.reset(0);
 }
 
-uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
+ColourMap::Voxel ColourMap::voxelOf(const Eigen::Vector3f& p) const {
   // the voxel coordinate by division (not by the inverse size, as the LIO's and VIO's maps): a
   // point exactly on a voxel face stays in the voxel the map files were written with
-  auto voxel = [this](float v) { return static_cast<int64_t>(std::floor(v / voxel_)); };
-  return packVoxel(voxel(p.x()), voxel(p.y()), voxel(p.z()));
+  return {floorToInt(p.x() / voxel_), floorToInt(p.y() / voxel_), floorToInt(p.z() / voxel_)};
 }
 
-uint64_t ColourMap::tileKey(const Eigen::Vector3f& p) const {
-  // the tile of the voxel (not of the point), so that a voxel lies in exactly one tile
-  auto t = [this](float v) {
-    const int64_t voxel = static_cast<int64_t>(std::floor(v / voxel_));
+uint64_t ColourMap::key(const Eigen::Vector3f& p) const {
+  const Voxel v = voxelOf(p);
+  return packVoxel(v.x, v.y, v.z);
+}
+
+uint64_t ColourMap::tileKeyOf(const Voxel& v) const {
+  auto t = [this](int64_t voxel) {
     const int64_t tile = voxel >= 0 ? voxel / voxels_per_tile_ : -((-voxel + voxels_per_tile_ - 1) / voxels_per_tile_);
     return static_cast<uint64_t>(static_cast<uint32_t>(static_cast<int32_t>(tile)));
   };
-  return (t(p.x()) << 32) | t(p.y());
+  return (t(v.x) << 32) | t(v.y);
 }
 
 uint32_t ColourMap::insertMerged(const MapPoint& p, Tile* tile, uint32_t slot) {
@@ -153,10 +155,38 @@ ColourMap::Tile& ColourMap::residentTile(uint64_t tile_key) {
 }
 
 uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created) {
-  Tile& tile = residentTile(tileKey(p));
+  const Voxel v = voxelOf(p);
+  Tile& tile = residentTile(tileKeyOf(v));
+  return addToVoxel(packVoxel(v.x, v.y, v.z), p, anchor, &tile, created);
+}
+
+void ColourMap::addPoints(const std::vector<Eigen::Vector3f>& points, int64_t anchor, std::vector<uint32_t>* ids) {
+  batch_keys_.resize(points.size());
+  batch_tiles_.resize(points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    const Voxel v = voxelOf(points[k]);
+    batch_keys_[k] = packVoxel(v.x, v.y, v.z);
+    batch_tiles_[k] = tileKeyOf(v);
+  }
+  ids->resize(points.size());
+  // within the batch no tile leaves memory (only evictIdle and settleSpilledTiles send tiles to
+  // disk) and the time is fixed, so a tile found resident and marked used stays so
+  Tile* tile = nullptr;
+  uint64_t tile_key = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (k + kReadAhead < points.size()) index_.prefetch(batch_keys_[k + kReadAhead]);
+    if (!tile || batch_tiles_[k] != tile_key) {
+      tile_key = batch_tiles_[k];
+      tile = &residentTile(tile_key);  // unordered_map: the reference stays valid as tiles are added
+    }
+    (*ids)[k] = addToVoxel(batch_keys_[k], points[k], anchor, tile, nullptr);
+  }
+}
+
+uint32_t ColourMap::addToVoxel(uint64_t voxel_key, const Eigen::Vector3f& p, int64_t anchor, Tile* tile, bool* created) {
   const uint32_t next = free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
   bool inserted = false;
-  const uint32_t id = index_.findOrInsert(key(p), next, &inserted);
+  const uint32_t id = index_.findOrInsert(voxel_key, next, &inserted);
   if (inserted) {
     MapPoint mp;
     mp.position = p;
@@ -167,7 +197,7 @@ uint32_t ColourMap::addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* cre
       free_.pop_back();
       points_[id] = mp;
     }
-    tile.ids.push_back(id);
+    tile->ids.push_back(id);
   }
   if (created) *created = inserted;
   return id;

@@ -47,19 +47,7 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
   field_half_angle_ = widest > 0.0 ? widest : M_PI_2;
 }
 
-bool ColouringPipeline::ViewCone::contains(const Eigen::Vector3d& p) const {
-  if (half_angle >= M_PI) return true;
-  const Eigen::Vector3d v = p - centre;
-  const double r = v.norm();
-  if (r <= travel) return true;
-  const double along = v.dot(axis);
-  if (along > cos_surely_inside * r) return true;                       // well inside
-  if (r >= far_range && along < cos_surely_outside * r) return false;  // well outside
-  const double angle = std::atan2(v.cross(axis).norm(), along);
-  return angle <= half_angle + std::asin(std::min(1.0, travel / r));
-}
-
-ColouringPipeline::ViewCone ColouringPipeline::viewCone(const RegisteredScanView& scan) {
+ViewCone ColouringPipeline::viewCone(const RegisteredScanView& scan) {
   // the body's motion from the scan poses of the last 2 s (a loop correction's jump only widens it)
   if (last_scan_pose_) {
     const double dt = (scan.utime - last_scan_pose_->first) * 1e-6;
@@ -82,14 +70,7 @@ ColouringPipeline::ViewCone ColouringPipeline::viewCone(const RegisteredScanView
   const double turn = 1.5 * rate * window;
   cone.half_angle = field_half_angle_ + options_.view_margin_deg * M_PI / 180.0 + turn;
   cone.travel = 1.5 * speed * window + camera_.rig().T_I_C.translation().norm() * turn + 0.2;
-  // the shortcut's margin (1e-6 rad, a cosine margin of sin(angle) * 1e-6) dwarfs the rounding of
-  // either test, so it only ever says "inside" where the exact test does
-  constexpr double kMargin = 1e-6;
-  if (cone.half_angle - kMargin > 0.01 && cone.half_angle - kMargin < M_PI - 0.01)
-    cone.cos_surely_inside = std::cos(cone.half_angle - kMargin);
-  const double outside = cone.half_angle + std::asin(0.2) + kMargin;
-  cone.far_range = 5.0 * cone.travel;
-  if (outside > 0.01 && outside < M_PI - 0.01) cone.cos_surely_outside = std::cos(outside);
+  cone.prepare();
   return cone;
 }
 
@@ -117,9 +98,9 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
   const Eigen::Vector3f body = scan.T_W_I.translation().cast<float>();
   const float reach = static_cast<float>(options_.max_depth + options_.map_margin);
   const ViewCone cone = viewCone(scan);
-  // first the points the map takes, then into the map in scan order (the same ids), each point's
-  // voxel looked up a few points ahead
+  // first the points the map takes, then into the map in scan order (the same ids)
   accepted_.clear();
+  accepted_points_.clear();
   for (int j = 0; j < scan.num_points; ++j) {
     const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
@@ -136,18 +117,15 @@ bool ColouringPipeline::addScan(const RegisteredScanView& scan, std::string* err
       continue;
     }
     accepted_.push_back(j);
+    accepted_points_.push_back(p);
   }
+  map_.addPoints(accepted_points_, anchor, &accepted_ids_);
+  if (last_scan_.size() < map_.size()) last_scan_.resize(map_.size(), 0);
   for (size_t k = 0; k < accepted_.size(); ++k) {
-    if (k + kReadAhead < accepted_.size()) {
-      const int ahead = accepted_[k + kReadAhead];
-      map_.prefetchVoxel(Eigen::Vector3f(scan.x[ahead], scan.y[ahead], scan.z[ahead]));
-    }
     const int j = accepted_[k];
-    const Eigen::Vector3f p(scan.x[j], scan.y[j], scan.z[j]);
     const float dt = scan.time_offset ? scan.time_offset[j] : 0.0f;
     const int64_t t = scan.cloud_utime + static_cast<int64_t>(std::llround(double(dt) * 1e6));
-    const uint32_t id = map_.addPoint(p, anchor);
-    if (id >= last_scan_.size()) last_scan_.resize(map_.size(), 0);
+    const uint32_t id = accepted_ids_[k];
     last_scan_[id] = active.seq;
     active.points.emplace_back(id, t);
     active.t_min = std::min(active.t_min, t);
@@ -227,24 +205,39 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   // without branches: whether a point is taken is as good as random (a window cuts through its
   // scans, and most points were measured by the scans before too)
   size_t taken = 0;
-  for (const ActiveScan& scan : active_) {
-    if (scan.t_max < t0 || scan.t_min > t1) continue;
-    window_ids_.resize(taken + scan.points.size());
+  auto gather = [&](const ActiveScan& scan, auto in_window) {
     for (const auto& [id, t] : scan.points) {
       uint64_t& word = window_seen_[id >> 6];
       const uint64_t bit = uint64_t{1} << (id & 63);
-      const bool take = (t >= t0) & (t <= t1) & !(word & bit);
+      const bool take = in_window(t) & !(word & bit);
       word |= take ? bit : 0;
       window_ids_[taken] = id;
       taken += take;
     }
+  };
+  for (const ActiveScan& scan : active_) {
+    if (scan.t_max < t0 || scan.t_min > t1) continue;
+    window_ids_.resize(taken + scan.points.size());
+    // most of the window's scans lie in it whole: their points need no time test
+    if (scan.t_min >= t0 && scan.t_max <= t1)
+      gather(scan, [](int64_t) { return true; });
+    else
+      gather(scan, [t0, t1](int64_t t) { return (t >= t0) & (t <= t1); });
   }
   window_ids_.resize(taken);
   candidates_.clear();
+  // each point's address is found once (a deque's indexing is no single add), for the read-ahead,
+  // and kept in a ring until its turn
+  const MapPoint* ahead[kReadAhead];
+  for (size_t i = 0; i < std::min(kReadAhead, window_ids_.size()); ++i) ahead[i] = &map_.point(window_ids_[i]);
   for (size_t i = 0; i < window_ids_.size(); ++i) {
-    if (i + kReadAhead < window_ids_.size()) __builtin_prefetch(&map_.point(window_ids_[i + kReadAhead]));
+    const MapPoint& mp = *ahead[i % kReadAhead];
+    if (i + kReadAhead < window_ids_.size()) {
+      ahead[i % kReadAhead] = &map_.point(window_ids_[i + kReadAhead]);
+      __builtin_prefetch(ahead[i % kReadAhead]);
+    }
     const uint32_t id = window_ids_[i];
-    const Eigen::Vector3d p_C = T_C_W * map_.point(id).position.cast<double>();
+    const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
     if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
     Eigen::Vector2d px;
     if (!camera_.project(p_C, &px, 0.0)) continue;
@@ -254,7 +247,7 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   stats_.projected += static_cast<int64_t>(candidates.size());
 
   depth_.clear();
-  for (const Candidate& c : candidates) depth_.splat(c.pixel, c.z);
+  depth_.splatNearest(candidates, [](const Candidate& c) { return std::make_pair(c.pixel, c.z); });
 
   double exposure_scale = 1.0;
   if (options_.use_exposure_time && image.exposure_time > 0) {

@@ -13,6 +13,7 @@ DepthBuffer::DepthBuffer(int width, int height, double focal_px, const DepthBuff
       focal_(focal_px) {
   options_.cell_px = std::max(1, options_.cell_px);
   depth_.assign(static_cast<size_t>(cols_) * rows_, std::numeric_limits<float>::infinity());
+  nearest_centred_.assign(depth_.size(), kNoCentre);
 }
 
 void DepthBuffer::clear() { std::fill(depth_.begin(), depth_.end(), std::numeric_limits<float>::infinity()); }
@@ -26,6 +27,10 @@ int DepthBuffer::cellIndex(const Eigen::Vector2d& pixel, int* cx, int* cy) const
 void DepthBuffer::splat(const Eigen::Vector2d& pixel, double z) {
   int cx, cy;
   cellIndex(pixel, &cx, &cy);
+  splatCell(cx, cy, z);
+}
+
+void DepthBuffer::splatCell(int cx, int cy, double z) {
   const double radius_px = focal_ * options_.occluder_radius / std::max(z, 1e-3);
   const int r = std::min(options_.max_splat_cells, static_cast<int>(radius_px / options_.cell_px));
   const float zf = static_cast<float>(z);

@@ -64,9 +64,10 @@ class ColourMap {
   /// The point of the voxel containing p (created at p if the voxel is empty); a tile on disk
   /// comes back first.
   uint32_t addPoint(const Eigen::Vector3f& p, int64_t anchor, bool* created = nullptr);
-  /// Starts reading the index where addPoint(p) will look (a batch of points: a hint, no effect
-  /// on the map; the index is too large for the cache, so each point would otherwise wait for it).
-  void prefetchVoxel(const Eigen::Vector3f& p) const { index_.prefetch(key(p)); }
+  /// addPoint(points[k], anchor) for every k in order, the ids into `ids` (the same map and ids as
+  /// one call per point). A scan's worth at once: each voxel is hashed once, the index (too large
+  /// for the cache) is read a few points ahead, and a run of points in one tile finds it once.
+  void addPoints(const std::vector<Eigen::Vector3f>& points, int64_t anchor, std::vector<uint32_t>* ids);
   /// Removes the resident points never coloured for which `drop(id)` is true (their voxels become
   /// empty: a scan that measures one again creates its point anew); returns how many. One pass
   /// over the resident points and tiles: call it now and then, not per scan.
@@ -161,9 +162,18 @@ class ColourMap {
     uint64_t epoch = 0;             // transform()s before its first record was written (behind epoch_: stale)
   };
 
+  struct Voxel {
+    int64_t x, y, z;
+  };
+  Voxel voxelOf(const Eigen::Vector3f& p) const;
   uint64_t key(const Eigen::Vector3f& p) const;
-  uint64_t tileKey(const Eigen::Vector3f& p) const;
+  uint64_t tileKey(const Eigen::Vector3f& p) const { return tileKeyOf(voxelOf(p)); }
+  /// The tile of a voxel (not of a point), so that a voxel lies in exactly one tile.
+  uint64_t tileKeyOf(const Voxel& v) const;
+  /// addPoint's insertion once the voxel's key and its (resident, used) tile are known.
+  uint32_t addToVoxel(uint64_t voxel_key, const Eigen::Vector3f& p, int64_t anchor, Tile* tile, bool* created);
   static constexpr uint32_t kNewSlot = ~uint32_t{0};
+  static constexpr size_t kReadAhead = 8;  // addPoints starts each index read this many points early
   /// Inserts a point (a new voxel, or merged into the voxel's point); its tile must be resident.
   /// A new voxel's point goes to `slot` (overwritten; kNewSlot: a free slot or the end).
   uint32_t insertMerged(const MapPoint& p, Tile* tile, uint32_t slot = kNewSlot);
@@ -195,6 +205,7 @@ class ColourMap {
   std::map<int64_t, Pose3> anchor_poses_;
   std::unique_ptr<SpillFile> spill_;
   std::vector<uint32_t> remap_;
+  std::vector<uint64_t> batch_keys_, batch_tiles_;  // addPoints' working set, kept between scans
   std::vector<uint32_t> moved_on_reload_;
   uint64_t epoch_ = 0;                          // transform()s so far
   size_t evicted_for_memory_ = 0;

@@ -28,6 +28,7 @@
 #include "livo/colour/colour_options.hpp"
 #include "livo/colour/depth_buffer.hpp"
 #include "livo/colour/pose_history.hpp"
+#include "livo/colour/view_cone.hpp"
 
 namespace livo::colour {
 
@@ -94,22 +95,8 @@ class ColouringPipeline {
     int64_t t_min, t_max;
     std::vector<std::pair<uint32_t, int64_t>> points;  // map point, measurement time
   };
-  /// The cone around the camera's axis at the scan pose within which an image of the scan's time
-  /// window may see a point (see ColourOptions::view_margin_deg).
-  struct ViewCone {
-    Eigen::Vector3d centre, axis;
-    double half_angle = M_PI;  // rad, before the travel term
-    double travel = 0.0;       // m: how far the camera may move over the window
-    // Shortcuts past the exact test (an atan2 and an asin a point): a point whose angle's cosine
-    // is above cos_surely_inside (cos(half_angle - 1e-6); 2: none) is inside, one at least
-    // far_range (5 travel) away whose cosine is below cos_surely_outside (cos(half_angle +
-    // asin(0.2) + 1e-6), asin(0.2) bounding the travel term there; -2: none) is outside,
-    // whatever the rounding of either test
-    double cos_surely_inside = 2.0;
-    double cos_surely_outside = -2.0;
-    double far_range = 0.0;
-    bool contains(const Eigen::Vector3d& p) const;
-  };
+  /// The cone within which an image of the scan's time window may see a point (camera at the
+  /// scan pose; see ColourOptions::view_margin_deg).
   ViewCone viewCone(const RegisteredScanView& scan);
   void processReady(bool flushing);
   bool processImage(const ColourImage& image);
@@ -157,7 +144,9 @@ class ColouringPipeline {
   std::vector<uint32_t> sampled_ids_;
   std::vector<Eigen::Vector3f> observed_, gain_observed_, gain_mapped_;
   std::vector<std::pair<uint32_t, int64_t>> spare_points_;  // a dropped scan's buffer, for the next
-  std::vector<int> accepted_;  // the scan's points the map takes
+  std::vector<int> accepted_;  // the scan's points the map takes: their indices, ...
+  std::vector<Eigen::Vector3f> accepted_points_;  // ... positions ...
+  std::vector<uint32_t> accepted_ids_;            // ... and map ids
   // map reads are started this many points ahead of their use (the map and its index are far
   // larger than the cache)
   static constexpr size_t kReadAhead = 8;
