@@ -152,9 +152,6 @@ class PlaybackRun {
 
   /// The end-of-run warnings and counts.
   PlaybackResult finish() {
-    if (source_.skippedBytes() > 0 && !options_.quiet)
-      std::cerr << "[playback] warning: skipped " << source_.skippedBytes() << " bytes between events of "
-                << options_.log << " that did not start an event (damaged log?)" << std::endl;
     if (source_.trailingBytes() > 0 && !options_.quiet)
       std::cerr << "[playback] warning: " << source_.trailingBytes() << " unreadable bytes at the end of "
                 << options_.log << " (truncated log?)" << std::endl;
