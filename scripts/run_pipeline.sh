@@ -29,7 +29,8 @@
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
 # every restart. Without it a process that dies stops the run. --kill P:SIG:AT_S sends SIG to
-# process P AT_S seconds of wall time after the replay starts (for supervision tests). At the end
+# process P once AT_S seconds of the log have been replayed (for supervision tests; log time, so a
+# faster pipeline still meets it at the same point of the recording). At the end
 # every process gets SIGINT and --stop-grace seconds (60) to write its files before SIGKILL.
 # --overlay FILE,...: YAML files merged over the config in order (livo-config merge: maps key by
 # key, other values replaced) into DIR/config.yaml, which every process then reads.
@@ -190,6 +191,7 @@ if [ "$inside" = 0 ]; then
   "$bin/livo-report" pictures --dir "$out" >/dev/null 2>>"$out/logs/report.log" \
     || warnings+=("livo-report pictures failed (no Maps section): $(tail -n 1 "$out/logs/report.log")")
   [ "$rc" = 0 ] || warnings+=("the run failed: $(tail -n 1 "$out/logs/run.txt" 2>/dev/null)")
+  while IFS= read -r line; do warnings+=("$line"); done < <(grep -E '^--kill .* was never sent' "$out/logs/run.txt" 2>/dev/null || true)
   # What the replay saw go wrong on the bus (messages lost, consumers away and back).
   while IFS= read -r line; do warnings+=("playback: ${line#*lockstep: }"); done \
     < <(grep -E '^\[playback\] lockstep: ' "$out/logs/playback.log" 2>/dev/null | grep -v 'restarted\|exited;\|silent for\|heard again\|may lag\|in step' || true)
@@ -261,7 +263,7 @@ lost_on_restart() {
   esac
 }
 # the newest "[playback] X s of log" figure, for the restart table
-log_time() { sed -n 's/^\[playback\] \([0-9.]*\) s of log.*/\1/p' "$out/logs/playback.log" 2>/dev/null | tail -n 1; }
+log_time() { cat "$out/logs/log_clock" 2>/dev/null || echo '?'; }
 
 start=$(date +%s%N)
 if [ "$realtime" = 1 ]; then
@@ -276,6 +278,7 @@ else
 fi
 [ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")
 rc=0
+replay+=(--clock-file "$out/logs/log_clock")  # the log seconds replayed so far: --kill, the restart table
 "$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
 playback=$!
 t0=$(now_ms)
@@ -285,11 +288,12 @@ IFS=, read -ra kill_plan <<<"$kills"
 # otherwise wait for its stall timeout); with it, the process is restarted after a back-off.
 while kill -0 "$playback" 2>/dev/null; do
   now=$(now_ms)
-  for i in "${!kill_plan[@]}"; do  # --kill P:SIG:AT_S
+  clock=$(cat "$out/logs/log_clock" 2>/dev/null || true)
+  for i in "${!kill_plan[@]}"; do  # --kill P:SIG:AT_S (log seconds, from playback's --clock-file)
     IFS=: read -r kp ksig kat <<<"${kill_plan[$i]}"
-    if [ -n "$kp" ] && [ -n "${pids[$kp]:-}" ] && \
-       [ "$(awk -v n="$now" -v t="$t0" -v a="$kat" 'BEGIN { print (n - t >= a * 1000) }')" = 1 ]; then
-      echo "run_pipeline.sh: --kill: SIG$ksig to $kp" >>"$out/logs/playback.log"
+    if [ -n "$kp" ] && [ -n "${pids[$kp]:-}" ] && [ -n "$clock" ] && \
+       [ "$(awk -v c="$clock" -v a="$kat" 'BEGIN { print (c >= a) }')" = 1 ]; then
+      echo "run_pipeline.sh: --kill: SIG$ksig to $kp at $clock s of log" >>"$out/logs/playback.log"
       kill "-$ksig" "${pids[$kp]}" 2>/dev/null || true
       unset "kill_plan[$i]"
     fi
@@ -334,9 +338,13 @@ while kill -0 "$playback" 2>/dev/null; do
       gave_up=1
     fi
   done
-  sleep 0.2
+  # a kill to come is aimed within a few tenths of a log second even at 5x real time
+  if [ ${#kill_plan[@]} -gt 0 ]; then sleep 0.05; else sleep 0.2; fi
 done
 wait "$playback" || rc=$?
+for k in "${kill_plan[@]}"; do
+  echo "--kill $k was never sent: the replay ended at $(cat "$out/logs/log_clock" 2>/dev/null || echo '?') s of log" >&3
+done
 end=$(date +%s%N)
 log_s=$(sed -n 's/.*messages, \([0-9.e+-]*\) s of log in.*/\1/p' "$out/logs/playback.log" | tail -n 1)
 ms=$(( (end - start) / 1000000 ))

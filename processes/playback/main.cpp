@@ -33,6 +33,8 @@ int main(int argc, char** argv) {
               "nan:CH:FRAC jump:CH:AT_S:JUMP_S cut:CH:FROM_S:TO_S")
       .option("--seed", "N", "seed of the fault injector", "1")
       .option("--out", "LOG", "write the (faulted) stream to this log instead of publishing")
+      .option("--clock-file", "FILE",
+              "keep the log seconds replayed so far in FILE (rewritten every 20 ms; for supervisors that act at log times)")
       .option("--progress-channel", "CH", "channel of the nodes' PROGRESS messages", "PROGRESS")
       .option("--stall-timeout", "S",
               "lockstep: give up when a consumer is behind on a channel and its count has not moved for S seconds", "30")
@@ -65,6 +67,7 @@ int main(int argc, char** argv) {
     o.seed = static_cast<uint64_t>(cli.getInt("--seed"));
     o.out_log = cli.get("--out");
     o.progress_channel = cli.get("--progress-channel");
+    o.clock_file = cli.get("--clock-file");
     o.stall_timeout_s = cli.getDouble("--stall-timeout");
     o.startup_timeout_s = cli.getDouble("--startup-timeout");
     o.loss_grace_s = cli.getDouble("--loss-grace");

@@ -27,7 +27,7 @@ matrix=(
   # an outage). Measured: 11 cm off for half a second, then within 1 cm of the clean run; ATE
   # 0.021 m against 0.004 m clean.
   "jump|--faults jump:IMU:6:0.5,jump:LIDAR:6:0.5,jump:CAMERA:6:0.5,jump:GROUND_TRUTH:6:0.5|0.03|IMU: .*time-shifted [1-9]"
-  "kill-vio|--respawn --kill vio:KILL:3|0.01|RESTART vio"
+  "kill-vio|--respawn --kill vio:KILL:8|0.01|RESTART vio"
 )
 
 "$bin/livo-sim" --config "$config" --out "$dir/room.lcmlog" --duration 16 --seed 17 --quiet || fail "livo-sim failed"

@@ -24,7 +24,7 @@ ATE_MARGIN_M=0.01
 for p in "${processes[@]}"; do
   out="$dir/$p"
   "$root/scripts/run_pipeline.sh" --log "$dir/room.lcmlog" --config "$config" --out "$out" --respawn \
-    --kill "$p:TERM:2,$p:KILL:5" >/dev/null 2>"$out.err" || { cat "$out.err"; fail "$p: the supervised run failed"; }
+    --kill "$p:TERM:6,$p:KILL:13" >/dev/null 2>"$out.err" || { cat "$out.err"; fail "$p: the supervised run failed"; }
   "$bin/livo-loginfo" --nonfinite "$out/outputs.lcmlog" >"$out.loginfo" 2>&1 || { cat "$out.loginfo"; fail "$p: NaN in the outputs"; }
   /usr/bin/python3 - "$dir/clean" "$out" "$p" "$MAX_GAP_S" "$ATE_MARGIN_M" <<'PY' || exit 1
 import json, math, re, sys

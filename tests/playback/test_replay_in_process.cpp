@@ -1,4 +1,6 @@
 // In-process replay on memq:// runs every handler to completion before the next message.
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "livo/node.hpp"
@@ -48,4 +50,25 @@ TEST(Playback, DescribesWhereTheLockstepWaitedLongestFirst) {
   EXPECT_EQ(lines[1], "LIDAR: 300 of 300 waited for, 0.24 s (lio 0.24)");
   EXPECT_EQ(lines[2], "CAMERA: 2 of 600 waited for, 0.00 s (? 0.00)");
   EXPECT_EQ(livo::playback::describeWaits(waits, 1).size(), 1u);
+}
+
+// --clock-file: a supervisor (run_pipeline.sh --kill) reads the log seconds replayed so far.
+TEST(Playback, KeepsTheLogSecondsReplayedInTheClockFile) {
+  const std::string path = playback_test::makeLog("clock", 2.0);
+  PlaybackOptions o;
+  o.log = path;
+  o.out_log = livo_test::tempPath("clock_out.lcmlog");
+  o.clock_file = livo_test::tempPath("clock.txt");
+  o.quiet = true;
+  const PlaybackResult r = runPlayback(o, nullptr);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.published, 220);
+  std::ifstream f(o.clock_file);
+  double log_s = -1.0;
+  ASSERT_TRUE(f >> log_s) << "no number in " << o.clock_file;
+  EXPECT_DOUBLE_EQ(log_s, 1.99);  // the last event, 199 IMU periods after the first
+  EXPECT_FALSE(std::ifstream(o.clock_file + ".tmp").good()) << "the temporary file was renamed";
+
+  o.clock_file = "/nonexistent-dir/clock.txt";  // a clock nobody can write is an error, not a silent gap
+  EXPECT_THROW(runPlayback(o, nullptr), std::runtime_error);
 }

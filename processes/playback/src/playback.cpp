@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include <lcm/lcm-cpp.hpp>
@@ -68,6 +71,31 @@ class ProgressLine {
   Clock::time_point start_, last_;
 };
 
+// --clock-file: the log seconds replayed so far, for a supervisor that acts at log times (the
+// --kill of run_pipeline.sh). Rewritten at most every 20 ms of wall time and at the end; written
+// to FILE.tmp and renamed, so a reader never sees half a number.
+class LogClockFile {
+ public:
+  explicit LogClockFile(std::string path) : path_(std::move(path)) {}
+  void update(double log_s, bool force = false) {
+    if (path_.empty() || (!force && written_ && secondsSince(last_) < 0.02)) return;
+    written_ = true;
+    last_ = Clock::now();
+    const std::string tmp = path_ + ".tmp";
+    {
+      std::ofstream f(tmp, std::ios::trunc);
+      f << std::fixed << std::setprecision(3) << log_s << "\n";
+      if (!f) throw std::runtime_error("--clock-file: cannot write " + tmp);
+    }
+    if (std::rename(tmp.c_str(), path_.c_str()) != 0) throw std::runtime_error("--clock-file: cannot rename " + tmp + " to " + path_);
+  }
+
+ private:
+  std::string path_;
+  bool written_ = false;
+  Clock::time_point last_;
+};
+
 // One replay: the log, the fault injector, where events go and, with consumers, the lockstep gate
 // fed by their PROGRESS messages.
 class PlaybackRun {
@@ -125,6 +153,7 @@ class PlaybackRun {
         if (!err.empty()) return err;
       }
       progress_line_->update(result_.log_seconds, source_.fractionRead(), result_.published);
+      clock_file_.update(result_.log_seconds);
     }
     for (const LogEvent& out : faults_.flush()) {
       const std::string err = publish(out);
@@ -140,6 +169,7 @@ class PlaybackRun {
       waits.seconds_by_last[context_.last_mover] = waits.seconds;
     }
     progress_line_->update(result_.log_seconds, 1.0, result_.published, true);
+    clock_file_.update(result_.log_seconds, /*force=*/true);
     return "";
   }
 
@@ -302,6 +332,7 @@ class PlaybackRun {
   EventSink sink_;
   LockstepGate gate_;
   std::optional<ProgressLine> progress_line_;
+  LogClockFile clock_file_{options_.clock_file};
   ProgressContext context_;
   lcm::Subscription* subscription_ = nullptr;
   bool lockstep_ = false;

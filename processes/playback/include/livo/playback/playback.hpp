@@ -38,6 +38,7 @@ struct PlaybackOptions {
   std::vector<Fault> faults;
   uint64_t seed = 1;
   std::string out_log;                  // write the (faulted) stream here instead of publishing
+  std::string clock_file;               // keep the log seconds replayed so far in this file (supervisors)
   bool quiet = false;
 };
 
