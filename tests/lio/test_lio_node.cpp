@@ -8,12 +8,14 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "bus_messages.hpp"
 #include "livo/filter_state_message.hpp"
 #include "livo/image_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/lio/lio_node.hpp"
+#include "livo/message_registry.hpp"
 #include "livo/messages.hpp"
 #include "livo/progress_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
@@ -353,6 +355,32 @@ double alignedError(const Outputs& out, const synth::SyntheticSequence& seq) {
   return synth::alignedRmse(est, gt);
 }
 
+/// A fake VIO's answer: a pose measurement of the truth `T` (1 mm, 1 mrad) through the same
+/// iterated ESIKF update.
+filter_state_t posteriorFromTruth(const filter_state_t& prior, const Pose3& T) {
+  FilterState x, x_post;
+  Mat18 P, P_post;
+  EXPECT_TRUE(fromFilterState(prior, &x, &P));
+  const PoseMeasurement measure = [&](const FilterState& xi, int, PoseInformation* info) {
+    Vec6 z;
+    z.head<3>() = so3::Log(Mat3(T.linear().transpose() * xi.rot));
+    z.tail<3>() = xi.pos - T.translation();
+    Mat6 H = Mat6::Identity();
+    H.topLeftCorner<3, 3>() = so3::rightJacobianInverse(z.head<3>());
+    info->HtRinvH = H.transpose() * H / 1e-6;
+    info->HtRinvz = H.transpose() * z / 1e-6;
+    info->count = 6;
+    return true;
+  };
+  const EsikfResult r = iteratedUpdate(x, P, measure, EsikfOptions{}, &x_post, &P_post);
+  EXPECT_TRUE(r.valid);
+  filter_state_t post = toFilterState(prior.utime, x_post, P_post, prior.request_id, "fake_vio");
+  post.valid = 1;
+  post.iterations = r.iterations;
+  post.num_measurements = r.info.count;
+  return post;
+}
+
 }  // namespace
 
 // With lio.camera_free_state the LiDAR-inertial-only filter's state goes out at every hand-off
@@ -422,29 +450,7 @@ TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
     vio.subscribe<filter_state_t>("STATE_PRIOR", [&](const filter_state_t& prior) {
       if (priors.empty()) T_lio_truth = poseOf(prior.position, prior.orientation) * seq.truth(prior.utime).inverse();
       priors.push_back(prior);
-      // a pose measurement of the truth (1 mm, 1 mrad) through the same iterated ESIKF update
-      FilterState x, x_post;
-      Mat18 P, P_post;
-      ASSERT_TRUE(fromFilterState(prior, &x, &P));
-      const Pose3 T = T_lio_truth * seq.truth(prior.utime);
-      const PoseMeasurement measure = [&](const FilterState& xi, int, PoseInformation* info) {
-        Vec6 z;
-        z.head<3>() = so3::Log(Mat3(T.linear().transpose() * xi.rot));
-        z.tail<3>() = xi.pos - T.translation();
-        Mat6 H = Mat6::Identity();
-        H.topLeftCorner<3, 3>() = so3::rightJacobianInverse(z.head<3>());
-        info->HtRinvH = H.transpose() * H / 1e-6;
-        info->HtRinvz = H.transpose() * z / 1e-6;
-        info->count = 6;
-        return true;
-      };
-      const EsikfResult r = iteratedUpdate(x, P, measure, EsikfOptions{}, &x_post, &P_post);
-      ASSERT_TRUE(r.valid);
-      filter_state_t post = toFilterState(prior.utime, x_post, P_post, prior.request_id, "fake_vio");
-      post.valid = 1;
-      post.iterations = r.iterations;
-      post.num_measurements = r.info.count;
-      vio.publish("STATE_POSTERIOR", post);
+      vio.publish("STATE_POSTERIOR", posteriorFromTruth(prior, T_lio_truth * seq.truth(prior.utime)));
     });
     vio.announce();  // lio hands off only while a STATE_PRIOR subscriber is alive
   };
@@ -832,5 +838,120 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
                 static_cast<long long>(covered["CAMERA"]), static_cast<long long>(seen["CAMERA"]),
                 static_cast<long long>(covered["LIDAR"]), static_cast<long long>(seen["LIDAR"]),
                 static_cast<long long>(covered["WHEEL"]), static_cast<long long>(seen["WHEEL"]));
+  }
+}
+
+namespace {
+struct LioProgress {
+  progress_t last{};
+  void onProgress(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    progress_t p;
+    if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) > 0 && p.node == "lio") last = p;
+  }
+};
+}  // namespace
+
+// While lio waits for a posterior it promises STATE_POSTERIOR quiet, and the IMU samples up to the
+// next event: lockstep playback then sends those on while vio is still working on the image (an
+// answer in flight, LockstepGate::mayPublish). The answer may arrive anywhere among them: the
+// odometry, scans and keyframes are byte for byte those of an answer that came at once.
+TEST(LioNode, AnAnswerArrivingAmongTheQuietSamplesChangesNothing) {
+  const synth::SyntheticSequence seq = syntheticSequence();
+  int64_t first_image = 0, last_image = 0;
+  std::vector<Message> in;
+  struct Run {
+    Outputs out;
+    LioNode::HandoffCounts counts;
+    int64_t sent_while_held = 0;  // messages lio took while an answer was held back
+  };
+  // held_for(request id): how many covered messages an answer is held for (at most: it goes out
+  // before the first message lio's promises do not cover, where playback would wait for vio)
+  std::string config;
+  auto run = [&](const std::function<int(int64_t)>& held_for) {
+    Run r;
+    Pose3 T_lio_truth = Pose3::Identity();
+    bool have_frame = false;
+    Node* fake_vio = nullptr;
+    std::optional<filter_state_t> held;
+    int held_left = 0;
+    LioProgress lio_progress;
+    RunSetup setup;
+    setup.config = config;
+    setup.handoff = &r.counts;
+    setup.attach = [&](Node& vio) {
+      fake_vio = &vio;
+      vio.subscribe<filter_state_t>("STATE_PRIOR", [&](const filter_state_t& prior) {
+        if (!have_frame) T_lio_truth = poseOf(prior.position, prior.orientation) * seq.truth(prior.utime).inverse();
+        have_frame = true;
+        held = posteriorFromTruth(prior, T_lio_truth * seq.truth(prior.utime));
+        held_left = held_for(prior.request_id);
+        if (held_left == 0) {
+          vio.publish("STATE_POSTERIOR", *held);
+          held.reset();
+        }
+      });
+      // on the bus itself: a node's input would make the fake VIO report progress on each PROGRESS
+      vio.lcm().subscribe("PROGRESS", &LioProgress::onProgress, &lio_progress);
+      vio.announce();
+    };
+    setup.before_each = [&](const Message& m) {
+      if (!held) return;
+      int64_t utime = 0;
+      ASSERT_TRUE(messageUtime(m.bytes.data(), static_cast<int>(m.bytes.size()), &utime));
+      bool posterior_quiet = false, covered = false;
+      const progress_t& p = lio_progress.last;
+      for (int i = 0; i < p.num_quiet; ++i) {
+        const std::string& ch = p.quiet_channel[i];
+        posterior_quiet |= ch == "STATE_POSTERIOR" && p.quiet_from[i] == INT64_MIN && p.quiet_before[i] == INT64_MAX;
+        covered |= ch == m.channel && utime >= p.quiet_from[i] && utime < p.quiet_before[i];
+      }
+      // playback sends m before the answer only if lio promised both quiet (LockstepGate::mayPublish)
+      if (posterior_quiet && covered && held_left-- > 0) {
+        ++r.sent_while_held;
+        return;
+      }
+      fake_vio->publish("STATE_POSTERIOR", *held);  // handled before m
+      held.reset();
+    };
+    r.out = runNode(in, nullptr, setup);
+    return r;
+  };
+  // sweeps arriving at their end (an image then waits for the sweep past it: two go out at once)
+  // and at their start (as livo-sim writes them); and with lio giving up on an answer 30 ms past
+  // the image, before the next event (the promises then end there)
+  for (const int variant : {0, 1, 2}) {
+  const bool at_start = variant >= 1;
+  config = handoffConfig() + (variant == 2 ? "  posterior_max_wait_s: 0.03\n" : "");
+  in = withImages(syntheticRun(), &first_image, &last_image);
+  if (at_start) {
+    for (Message& m : in)
+      if (m.channel == "LIDAR") m.order_key -= 100'000;
+    livo_test::sortByArrival(&in);
+  }
+  const Run at_once = run([](int64_t) { return 0; });
+  const Run latest = run([](int64_t) { return 1000; });  // until playback would have to wait for vio
+  const Run mixed = run([](int64_t id) { return static_cast<int>(id % 4); });
+  ASSERT_GE(at_once.counts.adopted, 40);
+  // the samples between the image time (and its 20 ms reorder window) and the next event go while
+  // vio works: at least 2 an image (sweeps at their end: none for the first of each pair)
+  EXPECT_GT(latest.sent_while_held, (variant == 1 ? 4 : 1) * at_once.counts.adopted) << latest.sent_while_held;
+  EXPECT_GT(mixed.sent_while_held, at_once.counts.adopted / 2) << mixed.sent_while_held;
+  for (const Run* r : {&latest, &mixed}) {
+    EXPECT_EQ(r->counts.adopted, at_once.counts.adopted);
+    EXPECT_EQ(r->counts.missing, 0);
+    EXPECT_EQ(r->out.odometry_bytes, at_once.out.odometry_bytes);
+    ASSERT_EQ(r->out.scans.size(), at_once.out.scans.size());
+    for (size_t i = 0; i < r->out.scans.size(); ++i) {
+      EXPECT_EQ(r->out.scans[i].cloud.x, at_once.out.scans[i].cloud.x) << "scan " << i;
+      EXPECT_EQ(r->out.scans[i].cloud.y, at_once.out.scans[i].cloud.y) << "scan " << i;
+      EXPECT_EQ(r->out.scans[i].cloud.z, at_once.out.scans[i].cloud.z) << "scan " << i;
+    }
+    EXPECT_EQ(r->out.keyframes.size(), at_once.out.keyframes.size());
+  }
+  std::printf("sweeps arriving at their %s%s: messages lio took while an answer was in flight: %lld (held to the "
+              "last), %lld (mixed), %lld images\n", at_start ? "start" : "end",
+              variant == 2 ? ", posterior_max_wait_s 0.03" : "",
+              static_cast<long long>(latest.sent_while_held), static_cast<long long>(mixed.sent_while_held),
+              static_cast<long long>(at_once.counts.adopted));
   }
 }

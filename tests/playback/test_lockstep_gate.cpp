@@ -365,3 +365,98 @@ TEST(LockstepGate, AWholeChannelPromiseCoversWhatNodesPublishUpToABacklog) {
   EXPECT_FALSE(g.caughtUp());  // 9 behind
   EXPECT_FALSE(g.idle());
 }
+
+namespace {
+constexpr int64_t kAny = std::numeric_limits<int64_t>::min(), kEver = std::numeric_limits<int64_t>::max();
+/// lio waiting for a posterior: IMU before `imu_before` and STATE_POSTERIOR (any) promised quiet.
+progress_t lioWaiting(int64_t seq, int64_t imu, int64_t posteriors, int64_t priors, bool posterior_quiet = true,
+                      int64_t imu_before = 1000) {
+  progress_t p = progress("lio", seq, {{"IMU", imu}, {"STATE_POSTERIOR", posteriors}}, {{"STATE_PRIOR", priors}});
+  p.quiet_channel = {"IMU"};
+  p.quiet_from = {0};
+  p.quiet_before = {imu_before};
+  if (posterior_quiet) {
+    p.quiet_channel.push_back("STATE_POSTERIOR");
+    p.quiet_from.push_back(kAny);
+    p.quiet_before.push_back(kEver);
+  }
+  p.num_quiet = static_cast<int32_t>(p.quiet_channel.size());
+  return p;
+}
+}  // namespace
+
+// An answer in flight: while vio works on a prior, playback may send what vio does not take and
+// what is quiet for everyone else, as long as vio's answer reaches only a consumer that promised it
+// quiet (lio, waiting for it) and recorders. Anything else waits for vio, as caughtUp() always does.
+TEST(LockstepGate, AnAnswerInFlightLetsOnlyQuietMessagesForOthersGo) {
+  LockstepGateOptions o;
+  o.may_lag = {"record"};
+  LockstepGate g({"lio", "vio", "record"}, o);
+  g.onProgress(lioWaiting(0, 0, 0, 0));
+  g.onProgress(progress("vio", 0, {{"CAMERA", 0}, {"STATE_PRIOR", 0}}, {{"STATE_POSTERIOR", 0}}));
+  g.onProgress(progress("record", 0, {{"STATE_POSTERIOR", 0}, {"IMU", 0}}, {}));
+  ASSERT_EQ(g.lagging(), std::vector<std::string>{"record"});
+  g.onPublished("IMU", 0.0, 100);
+  g.onProgress(lioWaiting(1, 1, 0, 1));  // lio handed an image off: vio owes an answer
+  EXPECT_FALSE(g.caughtUp());             // (the rule that does not know the next message)
+  EXPECT_TRUE(g.mayPublish("IMU", 500));   // quiet for lio, not vio's
+  EXPECT_FALSE(g.mayPublish("IMU", 1000));  // lio would act on it: wait for the answer
+  EXPECT_FALSE(g.mayPublish("IMU", LockstepGate::kNoUtime));
+  EXPECT_FALSE(g.mayPublish("CAMERA", 500));  // vio takes it
+  EXPECT_TRUE(g.mayPublish("GROUND_TRUTH", 500));  // nobody in step takes it
+  g.onPublished("IMU", 0.0, 500);
+  EXPECT_TRUE(g.mayPublish("IMU", 600));  // lio has not handled the last one: still quiet
+  g.onProgress(lioWaiting(2, 2, 0, 1, /*posterior_quiet=*/false));  // it would act on the answer now
+  EXPECT_FALSE(g.mayPublish("IMU", 600));
+
+  // the answer comes: lio owes its handling; quiet messages go, one lio would act on waits for it
+  // (the answer and the message come from different senders, in no fixed order)
+  g.onProgress(lioWaiting(3, 2, 0, 1));
+  g.onProgress(progress("vio", 1, {{"CAMERA", 0}, {"STATE_PRIOR", 1}}, {{"STATE_POSTERIOR", 1}}));
+  EXPECT_TRUE(g.caughtUp());
+  EXPECT_TRUE(g.mayPublish("IMU", 600));
+  EXPECT_TRUE(g.mayPublish("CAMERA", 600));
+  EXPECT_FALSE(g.mayPublish("IMU", 1000));
+  g.onProgress(lioWaiting(4, 2, 1, 1, false));
+  EXPECT_TRUE(g.mayPublish("IMU", 1000));
+}
+
+TEST(LockstepGate, AnAnswerIsNotInFlightWithLaggingOrBusyTakersNorInASerialReplay) {
+  auto start = [](LockstepGate& g, bool colour_takes_posterior) {
+    g.onProgress(lioWaiting(0, 0, 0, 0));
+    g.onProgress(progress("vio", 0, {{"CAMERA", 0}, {"STATE_PRIOR", 0}}, {{"STATE_POSTERIOR", 0}}));
+    if (colour_takes_posterior)  // even promising it quiet: a promise about a state it may be far behind
+      g.onProgress(withQuiet(progress("colour", 0, {{"STATE_POSTERIOR", 0}, {"CAMERA", 0}}, {{"COLORED_CLOUD", 0}}),
+                             "STATE_POSTERIOR", kAny, kEver));
+    g.onPublished("IMU", 0.0, 100);
+    g.onProgress(lioWaiting(1, 1, 0, 1));
+  };
+  {  // a lagging consumer that takes the answer would see it among playback's messages by timing
+    LockstepGateOptions o;
+    o.may_lag = {"colour"};
+    LockstepGate g({"lio", "vio", "colour"}, o);
+    start(g, true);
+    ASSERT_EQ(g.lagging(), std::vector<std::string>{"colour"});
+    EXPECT_FALSE(g.mayPublish("IMU", 500));
+  }
+  {  // a serial replay honours no promise
+    LockstepGateOptions o;
+    o.honour_quiet_promises = false;
+    LockstepGate g({"lio", "vio"}, o);
+    start(g, false);
+    EXPECT_FALSE(g.mayPublish("IMU", 500));
+  }
+  {  // lio itself busy with something it did not promise quiet (a loop correction)
+    LockstepGate g({"lio", "vio", "loop"});
+    g.onProgress(progress("loop", 0, {}, {{"LOOP_CORRECTION", 0}}));
+    start(g, false);
+    EXPECT_TRUE(g.mayPublish("IMU", 500));
+    progress_t p = lioWaiting(2, 1, 0, 1);
+    p.input_channel.push_back("LOOP_CORRECTION");
+    p.handled.push_back(0);
+    p.num_inputs = static_cast<int32_t>(p.input_channel.size());
+    g.onProgress(p);
+    g.onProgress(progress("loop", 1, {}, {{"LOOP_CORRECTION", 1}}));
+    EXPECT_FALSE(g.mayPublish("IMU", 500));
+  }
+}

@@ -300,8 +300,9 @@ LioNode::NextEvent LioNode::nextEvent() const {
 }
 
 std::vector<Node::QuietWindow> LioNode::quietWindows() const {
-  // waiting for a posterior (or for the next sample to confirm a jumped clock): no promise
-  if (!has_imu_ || pending_ || held_jump_) return {};
+  // waiting for the next sample to confirm a jumped clock: no promise; nor while a posterior is
+  // out with no vio there to answer it (advance() then gives up on it at the next sample)
+  if (!has_imu_ || held_jump_ || (pending_ && !node_.hasConsumers(opts_.state_prior_channel))) return {};
   constexpr int64_t kNever = std::numeric_limits<int64_t>::max();
   const NextEvent next = nextEvent();
   // advance() acts only once the filter's newest sample is past the next event's threshold, and
@@ -344,7 +345,15 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
     wheels = w;
     break;
   }
-  const int64_t threshold = floor(images, sweeps, wheels);
+  int64_t threshold = floor(images, sweeps, wheels);
+  // Waiting for a posterior: advance() also acts once the filter is posterior_max_wait_s past the
+  // image (it gives up on the answer), and the filter propagates on its own once its IMU queue
+  // spans max_imu_backlog_s (the posterior could then not be adopted): the promises end before.
+  if (pending_) {
+    threshold = std::min(threshold, pending_->utime + toUtime(opts_.posterior_max_wait_s));
+    if (const int64_t queued = lio_.oldestQueuedImu(); queued != kNever)
+      threshold = std::min(threshold, queued + toUtime(opts_.lio.max_imu_backlog_s));
+  }
 
   Node::QuietWindow w;
   w.channel = opts_.imu_channel;
@@ -353,6 +362,12 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   w.before = newest_imu_ + toUtime(opts_.clock_jump_s);
   if (threshold != kNever) w.before = std::min(w.before, threshold + toUtime(opts_.imu_reorder_window_s) + 1);
   std::vector<Node::QuietWindow> out{w};
+  // The posterior being waited for: adopting it publishes nothing while the filter is not past the
+  // next event's threshold (covered messages keep it there), and it commutes with the covered IMU
+  // samples, which only join the filter's queue after the image time it sets the state at. So
+  // lockstep playback may send them while vio is still working on the image.
+  if (pending_ && (!fed_any_imu_ || fed_imu_ <= threshold))
+    out.push_back(Node::QuietWindow::always(opts_.state_posterior_channel));
   // in the messages' own clocks; a period's worth of images (several in one window are as safe)
   if (images) {
     const int64_t offset = toUtime(opts_.camera_time_offset_s);

@@ -308,6 +308,77 @@ bool LockstepGate::caughtUp() const {
   return true;
 }
 
+bool LockstepGate::mayPublish(const std::string& channel, int64_t utime) const {
+  for (const auto& c : consumers_) {
+    auto it = nodes_.find(c);
+    if (it == nodes_.end()) return false;
+    const NodeState& n = it->second;
+    if (n.away) continue;
+    if (isLagging(c)) {
+      if (behind(n) > options_.max_lag_messages || behindBytes(n) > options_.max_lag_bytes) return false;
+      continue;
+    }
+    if (busyLoudly(n)) {
+      if (!answerMayBeInFlight(c, n, channel, utime)) return false;
+      continue;
+    }
+    if (n.handled.count(channel) && !quietFor(n, channel, utime) && awaitsNodeMessages(n)) return false;
+  }
+  return true;
+}
+
+bool LockstepGate::answerMayBeInFlight(const std::string& c, const NodeState& n, const std::string& channel,
+                                       int64_t utime) const {
+  if (!options_.honour_quiet_promises) return false;
+  if (n.handled.count(channel)) return false;  // (1) it takes the message
+  for (const auto& d : consumers_) {
+    if (d == c) continue;
+    auto it = nodes_.find(d);
+    if (it == nodes_.end()) return false;
+    const NodeState& m = it->second;
+    if (m.away) continue;
+    const bool recorder = m.published.empty();
+    // (2) the message makes no consumer in step publish (lagging ones are bounded as ever)
+    if (m.handled.count(channel) && !isLagging(d) && (busyLoudly(m) || !quietFor(m, channel, utime))) return false;
+    // (3) what it answers with reaches only recorders and consumers in step that promise it quiet
+    for (const auto& [output, count] : n.published) {
+      if (!m.handled.count(output) || recorder) continue;
+      if (isLagging(d) || busyLoudly(m) || !quietFor(m, output, kNoUtime, /*whole_channel=*/true)) return false;
+    }
+  }
+  return true;
+}
+
+bool LockstepGate::busyLoudly(const NodeState& n) const {
+  for (const auto& [channel, handled] : n.handled)
+    if (deficit(n, channel) > 0 && !promisedQuiet(n, channel)) return true;
+  return false;
+}
+
+bool LockstepGate::quietFor(const NodeState& n, const std::string& channel, int64_t utime, bool whole_channel) const {
+  if (!options_.honour_quiet_promises) return false;
+  auto q = n.quiet.find(channel);
+  if (q == n.quiet.end()) return false;
+  const auto [from, before] = q->second;
+  if (whole_channel)
+    return from == std::numeric_limits<int64_t>::min() && before == std::numeric_limits<int64_t>::max();
+  if (from == std::numeric_limits<int64_t>::min() && before == std::numeric_limits<int64_t>::max()) return true;
+  return utime != kNoUtime && utime >= from && utime < before;
+}
+
+bool LockstepGate::awaitsNodeMessages(const NodeState& n) const {
+  for (const auto& [channel, handled] : n.handled) {
+    if (deficit(n, channel) <= 0) continue;
+    auto pb = playback_published_.find(channel);
+    if (pb == playback_published_.end() || totalPublished(channel) != pb->second) return true;
+  }
+  return false;
+}
+
+bool LockstepGate::isLagging(const std::string& node) const {
+  return std::find(lagging_.begin(), lagging_.end(), node) != lagging_.end();
+}
+
 bool LockstepGate::promisedQuiet(const NodeState& n, const std::string& channel) const {
   if (!options_.honour_quiet_promises) return false;
   auto q = n.quiet.find(channel);

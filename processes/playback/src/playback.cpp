@@ -161,7 +161,7 @@ class PlaybackRun {
     }
     if (lockstep_ && result_.published > 0) {  // the lagging consumers finish too
       const Clock::time_point t0 = Clock::now();
-      const std::string err = waitUntilCaughtUp(/*all=*/true, nullptr);
+      const std::string err = waitUntilCaughtUp(nullptr, LockstepGate::kNoUtime);
       if (!err.empty()) return err;
       LockstepWaits& waits = result_.waits["(end of log)"];
       waits.messages = waits.waited = 1;
@@ -246,32 +246,37 @@ class PlaybackRun {
     result_.restarts = gate_.restarts();
   }
 
-  /// One event out: paced in real time, or (lockstep) followed by the wait for the consumers.
+  /// One event out: paced in real time, or (lockstep) once the consumers let it go.
   std::string publish(const LogEvent& e) {
     if (!lockstep_ && !sink_.toFile() && options_.speed > 0.0) {
       const auto target = pace_start_ + std::chrono::microseconds(static_cast<int64_t>((e.utime - first_) / options_.speed));
       std::this_thread::sleep_until(target);
     }
+    // the message's own stamp (what a quiet promise is about), not the log event's
+    int64_t utime = LockstepGate::kNoUtime;
+    if (lockstep_ && !messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
+    if (lockstep_ && result_.published > 0) {
+      // the wait after the previous message, until this one may go (counted for the previous one)
+      const bool must_wait = !gate_.mayPublish(e.channel, utime);
+      if (!must_wait && !gate_.idle()) ++result_.not_waited;
+      const Clock::time_point t0 = Clock::now();
+      const std::string err = waitUntilCaughtUp(&e.channel, utime);
+      if (!err.empty()) return err;
+      if (must_wait) {
+        LockstepWaits& waits = result_.waits[last_channel_];
+        const double waited_s = secondsSince(t0);
+        ++waits.waited;
+        waits.seconds += waited_s;
+        waits.seconds_by_last[context_.last_mover] += waited_s;
+      }
+    }
     sink_.emit(e);
     ++result_.published;
     if (!lockstep_) return "";
-    // the message's own stamp (what a quiet promise is about), not the log event's
-    int64_t utime = LockstepGate::kNoUtime;
-    if (!messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
     gate_.onPublished(e.channel, now_s(), utime, static_cast<int64_t>(e.data.size()));
-    const bool must_wait = !gate_.caughtUp();
-    if (!must_wait && !gate_.idle()) ++result_.not_waited;
-    LockstepWaits& waits = result_.waits[e.channel];
-    ++waits.messages;
-    const Clock::time_point t0 = Clock::now();
-    const std::string err = waitUntilCaughtUp(/*all=*/false, &e);
-    if (!err.empty()) return err;
-    if (must_wait) {
-      const double waited_s = secondsSince(t0);
-      ++waits.waited;
-      waits.seconds += waited_s;
-      waits.seconds_by_last[context_.last_mover] += waited_s;
-    }
+    ++result_.waits[e.channel].messages;
+    last_channel_ = e.channel;
+    last_log_seconds_ = result_.log_seconds;
     tellEvents();
     return "";
   }
@@ -294,10 +299,12 @@ class PlaybackRun {
     std::cerr << "[playback] lockstep: " << os.str() << std::endl;
   }
 
-  /// Lockstep: handles PROGRESS until every consumer has handled everything published so far
-  /// (`all`), or until the gate lets the next message go (lagging consumers a bounded way behind).
-  std::string waitUntilCaughtUp(bool all, const LogEvent* last) {
-    while (!(all ? gate_.idle() : gate_.caughtUp()) || gate_.awaitingRestart(now_s())) {
+  /// Lockstep: handles PROGRESS until the next message (on `next_channel`, stamped `next_utime`)
+  /// may go out (LockstepGate::mayPublish), or, without one, until the pipeline has handled
+  /// everything published so far.
+  std::string waitUntilCaughtUp(const std::string* next_channel, int64_t next_utime) {
+    while (!(next_channel ? gate_.mayPublish(*next_channel, next_utime) : gate_.idle()) ||
+           gate_.awaitingRestart(now_s())) {
       if (shutdownRequested()) return "interrupted";
       gate_.checkSilent(now_s());
       tellEvents();
@@ -308,9 +315,9 @@ class PlaybackRun {
         std::ostringstream os;
         os << "lockstep: stalled: no progress for " << options_.stall_timeout_s
            << " s on what is awaited after ";
-        if (last)
-          os << "message " << result_.published << " (" << last->channel << " at " << std::fixed << std::setprecision(3)
-             << result_.log_seconds << " s of log)";
+        if (next_channel)
+          os << "message " << result_.published << " (" << last_channel_ << " at " << std::fixed << std::setprecision(3)
+             << last_log_seconds_ << " s of log)";
         else
           os << "the end of the log";
         os << "; waiting for: " << gate_.pendingDescription();
@@ -333,6 +340,8 @@ class PlaybackRun {
   LockstepGate gate_;
   std::optional<ProgressLine> progress_line_;
   LogClockFile clock_file_{options_.clock_file};
+  std::string last_channel_;        // lockstep: of the message published last
+  double last_log_seconds_ = 0.0;
   ProgressContext context_;
   lcm::Subscription* subscription_ = nullptr;
   bool lockstep_ = false;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,6 +102,11 @@ class LioEstimator {
   /// IMU samples waiting for a sweep and IMU steps kept for undistortion (bounded; diagnostics).
   size_t imuBacklog() const { return imu_.size(); }
   size_t undistortionSegments() const { return prop_.segments().size(); }
+  /// The stamp of the oldest IMU sample waiting for a sweep (INT64_MAX: none): once a sample
+  /// max_imu_backlog_s after it is added, the filter propagates the backlog on its own.
+  int64_t oldestQueuedImu() const {
+    return imu_.empty() ? std::numeric_limits<int64_t>::max() : imu_.front().utime;
+  }
 
   /// Camera hand-off: propagates the filter with the added IMU samples to `utime` (STATE_PRIOR).
   bool propagateTo(int64_t utime, std::string* why = nullptr);

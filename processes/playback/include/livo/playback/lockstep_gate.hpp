@@ -83,6 +83,20 @@ class LockstepGate {
   /// The next message may go out: every consumer kept in step has handled everything but messages
   /// its quiet promise covers, and every lagging one is at most max_lag_messages behind.
   bool caughtUp() const;
+  /// Whether the next message, on `channel` and stamped `utime`, may go out now. As caughtUp(),
+  /// with two refinements that need to know the message:
+  /// - A message that is not quiet for a consumer waits until it has handled what nodes published
+  ///   to it (those arrive from other senders, so in no fixed order with the message).
+  /// - An answer in flight: a consumer still working on messages that are not quiet (vio on a
+  ///   STATE_PRIOR) need not be waited for while (1) it does not take the message, (2) the
+  ///   message is quiet for every consumer in step that takes it (it makes nobody publish), and
+  ///   (3) every consumer that takes one of its outputs is a recorder or a consumer in step,
+  ///   itself not working on anything but quiet messages, that promises that output quiet for
+  ///   any stamp (lio, while it waits for a posterior, promises STATE_POSTERIOR: it only adopts
+  ///   it; its effect commutes with the quiet IMU samples around it). While an answer is in flight
+  ///   nothing but it is published, so every consumer sees its inputs in the serial replay's order
+  ///   (the answer's place among quiet messages aside, which its takers promised not to matter).
+  bool mayPublish(const std::string& channel, int64_t utime) const;
   /// The consumers allowed to lag now: listed in may_lag, reported, and whose outputs are taken by
   /// no consumer but recorders.
   const std::vector<std::string>& lagging() const { return lagging_; }
@@ -137,6 +151,15 @@ class LockstepGate {
   int64_t behindBytes(const NodeState& n) const;  // their bytes, at each channel's mean size
   /// The consumer's unhandled messages on `channel` are all playback's and inside its promise.
   bool promisedQuiet(const NodeState& n, const std::string& channel) const;
+  /// It has unhandled messages no promise covers (it is working on something that may publish).
+  bool busyLoudly(const NodeState& n) const;
+  /// Its promise covers a message on `channel` stamped `utime` (any stamp: a whole-channel promise).
+  bool quietFor(const NodeState& n, const std::string& channel, int64_t utime, bool whole_channel = false) const;
+  /// It has unhandled messages on a channel nodes publish (they race with playback's messages).
+  bool awaitsNodeMessages(const NodeState& n) const;
+  bool isLagging(const std::string& node) const;
+  /// mayPublish's answer-in-flight rule for consumer `c` (see there).
+  bool answerMayBeInFlight(const std::string& c, const NodeState& n, const std::string& channel, int64_t utime) const;
   void noteLagDecisions();
 
   std::vector<std::string> consumers_;
