@@ -58,7 +58,7 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
         << " s of scans: " << map.residentPoints()
         << " points in " << map.residentTiles() << " tiles in memory, " << map.spilledTiles() << " tiles on disk ("
         << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB), " << map.tilesEvictedForMemory()
-        << " sent early for memory";
+        << " sent early for memory; voxel index " << map.indexBytes() / 1e6 << " MB";
       node_.info(s.str());
     }
   });

@@ -108,6 +108,8 @@ class ColourMap {
   size_t colouredCount() const;
   size_t residentPoints() const { return points_.size() - free_.size(); }
   size_t residentTiles() const;
+  /// The voxel index's bytes (16 a slot, a power of two of slots).
+  size_t indexBytes() const { return index_.bytes(); }
   size_t spilledTiles() const { return tiles_.size() - residentTiles(); }
   /// Tiles that went to disk before they were idle_s idle (max_resident_points), so far.
   size_t tilesEvictedForMemory() const { return evicted_for_memory_; }
@@ -132,8 +134,10 @@ class ColourMap {
     void prefetch(uint64_t key) const { __builtin_prefetch(&slots_[home(key)]); }
     /// Removes key (backward-shift deletion: no tombstones).
     void erase(uint64_t key);
-    /// Empties the index, sized for `expected` keys.
-    void reset(size_t expected);
+    /// Empties the index, sized for `expected` keys at half load, but (most > 0: the resident
+    /// points' budget) no larger than `most` keys need below the load it grows at.
+    void reset(size_t expected, size_t most = 0);
+    size_t bytes() const { return slots_.size() * sizeof(Slot); }
 
    private:
     static constexpr uint64_t kEmpty = ~uint64_t{0};  // voxel keys use 63 bits
