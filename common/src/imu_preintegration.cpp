@@ -79,7 +79,7 @@ void ImuPreintegration::integrate(const Vec3& gyro, const Vec3& accel, double dt
   q << Vec3::Constant(noise_.gyro_noise_density * noise_.gyro_noise_density / dt),
       Vec3::Constant(noise_.accel_noise_density * noise_.accel_noise_density / dt);
   covariance_ = A * covariance_ * A.transpose() + B * q.asDiagonal() * B.transpose();
-  covariance_ = 0.5 * (covariance_ + covariance_.transpose());
+  covariance_ = (0.5 * (covariance_ + covariance_.transpose())).eval();  // (aliasing)
 
   // Bias Jacobians: a bias change δb acts as the constant noise n = -δb (old values first).
   const Mat3 dv_dbg_step = dv_dphi * dR_dbg_ - dv_dng;

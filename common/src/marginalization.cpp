@@ -223,7 +223,7 @@ std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const do
   const Eigen::MatrixXd Hrm = H.bottomLeftCorner(k, m);
   Eigen::MatrixXd Hp = H.bottomRightCorner(k, k) - Hrm * Hmm_inv * Hrm.transpose();
   const Eigen::VectorXd gp = g.tail(k) - Hrm * Hmm_inv * g.head(m);
-  Hp = 0.5 * (Hp + Hp.transpose());
+  Hp = (0.5 * (Hp + Hp.transpose())).eval();  // .eval(): the right side reads what the left writes
 
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ep(Hp);
   const double pmax = std::max(ep.eigenvalues().maxCoeff(), 0.0);

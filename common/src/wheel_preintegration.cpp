@@ -46,7 +46,7 @@ void WheelPreintegration::integrate(double v_left0, double v_right0, double v_le
   q << rp2, rp2, 2.0 * s2 / (track_width_ * track_width_), 0.5 * s2,
       noise_.lateral_speed_std * noise_.lateral_speed_std, noise_.vertical_speed_std * noise_.vertical_speed_std;
   covariance_ = A * covariance_ * A.transpose() + B * (scale * q).asDiagonal() * B.transpose();
-  covariance_ = 0.5 * (covariance_ + covariance_.transpose());
+  covariance_ = (0.5 * (covariance_ + covariance_.transpose())).eval();  // (aliasing)
 
   // Scale Jacobians: v = v0 + [v_l, v_r]/2 δs and w = w0 + [-v_l, v_r]/b δs about z; the step
   // ΔR_k Exp(J_R δs) Exp(½θ + ½ dθ) (u + du) moves Δp by -mid_R [u]x (half_R^T J_R δs + Jr(½θ) ½ dθ) + mid_R du.
