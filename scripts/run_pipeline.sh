@@ -24,7 +24,7 @@
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
-#                           [--stop-grace S] [--overlay FILE,...] [--calibrate-camera] [--max-lag N] [--serial]
+#                           [--stop-grace S] [--overlay FILE,...] [--max-lag N] [--serial]
 # Processes default to those of lio, vio, vio_feature, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
@@ -34,10 +34,8 @@
 # every process gets SIGINT and --stop-grace seconds (60) to write its files before SIGKILL.
 # --overlay FILE,...: YAML files merged over the config in order (livo-config merge: maps key by
 # key, other values replaced) into DIR/config.yaml, which every process then reads.
-# --calibrate-camera: a first pass (lio + vio, config/overlays/camera_rotation_calibration.yaml, in
-# DIR/camera_calibration) measures the camera's rotation against the LiDAR-inertial body from image
-# pairs; its DIR/camera_calibration/camera_rotation.yaml (the rig's T_I_C with it) is merged over
-# the config of the run proper. For recordings: a live run cannot use what it has not yet seen.
+# lio writes DIR/calibration.csv and DIR/calibration.yaml (the rig as its filter estimated it, an
+# overlay for --overlay) when the config says lio.output_dir: . (every shipped sim config does).
 # --max-lag N (lockstep): colour, octomap and the recorder, whose outputs no estimator takes, may
 # fall up to N messages (16; and 16 MB, livo-playback --max-lag-mb) behind the rest, so they run
 # beside lio, vio and loop on the second core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
@@ -50,10 +48,10 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,43p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,42p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" calibrate=0 max_lag=16 serial=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -73,7 +71,6 @@ while [ $# -gt 0 ]; do
     --kill) kills="$2"; shift 2 ;;
     --stop-grace) stop_grace="$2"; shift 2 ;;
     --overlay) overlays+="${overlays:+,}$2"; shift 2 ;;
-    --calibrate-camera) calibrate=1; shift ;;
     --max-lag) max_lag="$2"; shift 2 ;;
     --serial) serial=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
@@ -103,20 +100,6 @@ done
 
 # The config the processes read: the file with the overlays merged over it (outside the bus only;
 # inside, --config is already the merged file).
-if [ "$inside" = 0 ] && [ "$calibrate" = 1 ]; then
-  grep -Eq '^vio:' "$config" || die "--calibrate-camera needs a vio: section (and a camera in the rig) in $config"
-  echo "run_pipeline.sh: calibration pass: the camera's rotation from image pairs -> $out/camera_calibration" >&2
-  "$0" --log "$log" --config "$config" --out "$out/camera_calibration" --processes lio,vio \
-    --overlay "${overlays:+$overlays,}$root/config/overlays/camera_rotation_calibration.yaml" \
-    --record ODOMETRY,HEALTH,GROUND_TRUTH --stop-grace "$stop_grace" >/dev/null \
-    || die "the calibration pass failed (see $out/camera_calibration/logs/)"
-  if [ -f "$out/camera_calibration/camera_rotation.yaml" ]; then
-    overlays+="${overlays:+,}$out/camera_calibration/camera_rotation.yaml"
-    grep -E '^# (The pairs|fused)' "$out/camera_calibration/camera_rotation.yaml" | sed 's/^# /run_pipeline.sh: /' >&2
-  else
-    echo "run_pipeline.sh: warning: the calibration pass found no camera rotation (too few image pairs); the rig's is used" >&2
-  fi
-fi
 if [ "$inside" = 0 ] && [ -n "$overlays" ]; then
   [ -x "$bin/livo-config" ] || die "$bin/livo-config missing: run scripts/build.sh"
   "$bin/livo-config" merge "$config" --overlay "$overlays" --out "$out/config.yaml" || die "cannot merge $overlays over $config"

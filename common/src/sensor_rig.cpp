@@ -45,6 +45,26 @@ ImuRig readImu(const Config& c) {
   return imu;
 }
 
+CalibrationUncertainty readCalibrationUncertainty(const Config& sensor) {
+  CalibrationUncertainty u;
+  if (!sensor.has("calibration_std")) return u;
+  const Config c = sensor.section("calibration_std");
+  c.readOptional("rotation_deg", u.rotation_deg);
+  c.readOptional("translation", u.translation);
+  c.readOptional("time_offset_s", u.time_offset_s);
+  c.checkAllUsed();
+  if (!(u.rotation_deg >= 0.0 && u.rotation_deg <= 10.0)) throw ConfigError(c.where("rotation_deg") + ": must be in [0, 10] deg");
+  if (!(u.translation >= 0.0 && u.translation <= 1.0)) throw ConfigError(c.where("translation") + ": must be in [0, 1] m");
+  if (!(u.time_offset_s >= 0.0 && u.time_offset_s <= 0.1))
+    throw ConfigError(c.where("time_offset_s") + ": must be in [0, 0.1] s");
+  return u;
+}
+
+void printCalibrationUncertainty(std::ostream& os, const CalibrationUncertainty& u) {
+  if (!u.any()) return;
+  os << ", known to " << u.rotation_deg << " deg / " << u.translation << " m / " << u.time_offset_s * 1e3 << " ms";
+}
+
 LidarRig readLidar(const Config& c) {
   LidarRig l;
   c.read("model", l.model);
@@ -59,6 +79,7 @@ LidarRig readLidar(const Config& c) {
   c.read("range_noise_std", l.range_noise_std);
   c.readOptional("dropout_probability", l.dropout_probability);
   c.read("T_I_L", l.T_I_L);
+  l.calibration_std = readCalibrationUncertainty(c);
   requirePositive(c, "rate_hz", l.rate_hz);
   requireNonNegative(c, "min_range", l.min_range);
   if (!(l.max_range > l.min_range)) throw ConfigError(c.where("max_range") + ": must be greater than min_range");
@@ -96,6 +117,7 @@ CameraRig readCamera(const Config& c) {
   c.readOptional("time_offset_s", cam.time_offset_s);
   if (!(std::abs(cam.time_offset_s) < 1.0)) throw ConfigError(c.where("time_offset_s") + ": must be within (-1, 1) s");
   c.readOptional("rolling_shutter_s", cam.rolling_shutter_s);
+  cam.calibration_std = readCalibrationUncertainty(c);
   if (cam.width <= 0 || cam.width > 10000) throw ConfigError(c.where("width") + ": must be in 1..10000");
   if (cam.height <= 0 || cam.height > 10000) throw ConfigError(c.where("height") + ": must be in 1..10000");
   requirePositive(c, "fx", cam.fx);
@@ -162,6 +184,7 @@ void printSensorRig(const SensorRig& r, std::ostream& os) {
        << ".." << l.max_range << " m, noise " << l.range_noise_std << " m, dropout " << l.dropout_probability
        << "\n          T_I_L ";
     printPose(os, l.T_I_L);
+    printCalibrationUncertainty(os, l.calibration_std);
     os << "\n";
   }
   if (r.camera) {
@@ -173,6 +196,7 @@ void printSensorRig(const SensorRig& r, std::ostream& os) {
     if (c.depth) os << "\n          depth images registered to it on " << r.channels.depth;
     os << "\n          T_I_C ";
     printPose(os, c.T_I_C);
+    printCalibrationUncertainty(os, c.calibration_std);
     os << "\n";
   }
   if (r.wheel) {

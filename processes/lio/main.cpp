@@ -36,7 +36,10 @@ int main(int argc, char** argv) {
     livo::lio::LioNode node(*lcm, opts, quiet);
     livo::installSignalHandlers();
     const int rc = livo::spin(*lcm, node.node());
+    node.writeCalibrationFiles();
     if (!quiet) std::cerr << "[" << opts.name << "] " << node.sweepSummary() << "\n";
+    if (const std::string c = node.calibrationSummary(); !quiet && !c.empty())
+      std::cerr << "[" << opts.name << "] " << c << "\n";
     if (!quiet && opts.lio.wheel.enabled) std::cerr << "[" << opts.name << "] " << node.wheelSummary() << "\n";
     if (!quiet && opts.camera_handoff) {
       const auto& h = node.handoffCounts();

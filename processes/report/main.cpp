@@ -131,6 +131,7 @@ int markdown(int argc, char** argv) {
     in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
+  if (std::ifstream c(dir + "/calibration.csv"); c) in.calibration = livo::report::readCalibrationCsv(dir + "/calibration.csv");
   if (std::ifstream p(dir + "/pictures.json"); p) in.pictures = livo::report::picturesFromJson(nlohmann::json::parse(p));
   if (std::ifstream w(dir + "/weak_spots.json"); w)
     in.weak_spots = livo::report::weakSpotsFromJson(nlohmann::json::parse(w));

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/file_output.hpp"
 #include "livo/sim/log_writer.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
@@ -16,6 +17,8 @@ int main(int argc, char** argv) {
       .option("--duration", "S", "seconds to simulate (default: sim.duration_s)")
       .option("--seed", "N", "random seed (default: sim.seed)")
       .option("--threads", "N", "worker threads (default: sim.threads; the log does not depend on it)")
+      .option("--truth", "FILE", "also write the run's truth as JSON: the calibration errors drawn and the rig as "
+                                 "rendered (for evaluation scripts; no estimator reads it)")
       .flag("--quiet", "no progress output");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config") || !cli.has("--out")) {
@@ -39,6 +42,11 @@ int main(int argc, char** argv) {
     livo::sim::SimulationSetup setup = livo::sim::loadSimulation(cli.get("--config"), overrides);
     if (!quiet) livo::sim::printSimulation(setup, std::cerr);
 
+    if (cli.has("--truth")) {
+      std::string error;
+      if (!livo::writeFileAtomically(cli.get("--truth"), {livo::sim::truthJson(setup)}, &error))
+        throw std::runtime_error("--truth: " + error);
+    }
     livo::sim::LogWriter writer(cli.get("--out"), setup.rig.channels);
     livo::sim::Simulator simulator(setup);
     double next_report = 0.0;

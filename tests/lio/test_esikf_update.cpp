@@ -1,12 +1,19 @@
-// The iterated ESIKF update: the information form against the textbook gain of eqs. (16)-(18),
-// a single-scan registration with a known offset converging to the truth, and the degeneracy
-// analysis on a corridor (two walls and a floor) against a room.
+// The iterated ESIKF update: the information form against the textbook gain of eqs. (16)-(18) on the
+// 32-dim state (pose alone, or pose and a sensor's calibration block; a calibration held fixed left
+// exactly), the chi-square consistency gate against simulated linear-Gaussian measurements, a
+// single-scan registration with a known offset converging to the truth, and the degeneracy analysis
+// on a corridor (two walls and a floor) against a room.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "livo/lio/degeneracy.hpp"
 #include "livo/esikf_update.hpp"
@@ -17,24 +24,54 @@ using namespace livo;
 using namespace livo::lio;
 
 namespace {
-Mat18 randomCovariance(unsigned seed) {
+StateCovariance randomCovariance(unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01;
-  Mat18 A;
-  for (int i = 0; i < 18; ++i)
-    for (int j = 0; j < 18; ++j) A(i, j) = 0.1 * n01(rng);
-  return A * A.transpose() + Mat18::Identity() * 0.01;
+  StateCovariance A;
+  for (int i = 0; i < FilterState::kDim; ++i)
+    for (int j = 0; j < FilterState::kDim; ++j) A(i, j) = 0.1 * n01(rng);
+  return A * A.transpose() + StateCovariance::Identity() * 0.01;
 }
 
-// A linearised pose measurement z + H δ with H = [H6 0] (m rows), a prior covariance P̂ and an
-// iterate x̌ != x̂ (so J of eq. 12 is not the identity), with the textbook's P = J^-1 P̂ J^-T.
-struct LinearisedPoseMeasurement {
+// The error-state indices a measurement touches: the pose [0, 6) and, for block >= 0, the
+// calibration block [block, block + 7) (MeasurementInformation's order).
+std::vector<int> measuredStates(int block) {
+  std::vector<int> idx = {0, 1, 2, 3, 4, 5};
+  if (block >= 0)
+    for (int k = 0; k < FilterState::kCalibrationDim; ++k) idx.push_back(block + k);
+  return idx;
+}
+
+// A linearised measurement z + H δ with H nonzero on the measured states only (m rows), a prior
+// covariance P̂ and an iterate x̌ != x̂ (so J of eq. 12 is not the identity), with the textbook's
+// P = J^-1 P̂ J^-T.
+struct LinearisedMeasurement {
   FilterState prior, x;
-  Mat18 Phat, P;
+  StateCovariance Phat, P;
   Eigen::MatrixXd H, R;
   Eigen::VectorXd z;
+  int block = -1;  // the calibration block measured (-1: the pose alone)
+
+  // H on the measured columns (MeasurementInformation's order)
+  Eigen::MatrixXd measuredColumns() const {
+    const std::vector<int> idx = measuredStates(block);
+    Eigen::MatrixXd HE(H.rows(), static_cast<int>(idx.size()));
+    for (size_t k = 0; k < idx.size(); ++k) HE.col(static_cast<int>(k)) = H.col(idx[k]);
+    return HE;
+  }
   Mat6 S() const { return H.leftCols<6>().transpose() * R.inverse() * H.leftCols<6>(); }
   Vec6 g() const { return H.leftCols<6>().transpose() * R.inverse() * z; }
+  MeasurementInformation info() const {
+    MeasurementInformation m;
+    const Eigen::MatrixXd HE = measuredColumns();
+    const Eigen::MatrixXd S = HE.transpose() * R.inverse() * HE;
+    const Eigen::VectorXd g = HE.transpose() * R.inverse() * z;
+    m.HtRinvH.topLeftCorner(S.rows(), S.cols()) = S;
+    m.HtRinvz.head(g.size()) = g;
+    if (block >= 0) m.calibration_block = block;
+    m.count = static_cast<int>(z.size());
+    return m;
+  }
   // the gain K = (H^T R^-1 H + P^-1)^-1 H^T R^-1 of eq. (17)
   Eigen::MatrixXd gain() const {
     const Eigen::MatrixXd Rinv = R.inverse();
@@ -42,79 +79,172 @@ struct LinearisedPoseMeasurement {
   }
 };
 
-// `moved` marks the error states the iterate has moved from the prior.
-LinearisedPoseMeasurement randomPoseMeasurement(unsigned seed, int m, const Vec18& moved, const Vec3& rot,
-                                                const Vec3& pos) {
+// A prior with non-trivial calibration rotations, so that all three rotation blocks of J differ
+// from the identity once the iterate moves them.
+FilterState calibratedPrior(const Vec3& rot, const Vec3& pos) {
+  FilterState x;
+  x.rot = so3::Exp(rot);
+  x.pos = pos;
+  x.lidar = SensorCalibration{so3::Exp(Vec3(0.1, -0.3, 1.4)), Vec3(0.05, 0.0, 0.1), 0.002};
+  x.camera = SensorCalibration{so3::Exp(Vec3(-1.2, 1.2, -1.2)), Vec3(0.08, -0.01, 0.02), -0.004};
+  return x;
+}
+
+// `moved` marks the error states the iterate has moved from the prior; `block` the calibration
+// block the measurement also sees (-1: none).
+LinearisedMeasurement randomMeasurement(unsigned seed, int m, const StateVector& moved, const Vec3& rot,
+                                        const Vec3& pos, int block = -1) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01;
-  LinearisedPoseMeasurement lm;
-  lm.prior.rot = so3::Exp(rot);
-  lm.prior.pos = pos;
-  Vec18 d0;
-  for (int i = 0; i < 18; ++i) d0[i] = 0.05 * n01(rng) * moved[i];
+  LinearisedMeasurement lm;
+  lm.block = block;
+  lm.prior = calibratedPrior(rot, pos);
+  StateVector d0;
+  for (int i = 0; i < FilterState::kDim; ++i) d0[i] = 0.05 * n01(rng) * moved[i];
   lm.x = lm.prior.boxplus(d0);
   lm.Phat = randomCovariance(seed - 4);
-  lm.H = Eigen::MatrixXd::Zero(m, 18);
+  lm.H = Eigen::MatrixXd::Zero(m, FilterState::kDim);
   for (int i = 0; i < m; ++i)
-    for (int j = 0; j < 6; ++j) lm.H(i, j) = n01(rng);
+    for (int j : measuredStates(block)) lm.H(i, j) = n01(rng);
   lm.z.resize(m);
   for (int i = 0; i < m; ++i) lm.z[i] = 0.1 * n01(rng);
   lm.R = Eigen::MatrixXd::Zero(m, m);
   for (int i = 0; i < m; ++i) lm.R(i, i) = 0.01 * (1 + i);
-  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  const StateCovariance Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
   lm.P = Jinv * lm.Phat * Jinv.transpose();
   return lm;
 }
 }  // namespace
 
 TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
-  const LinearisedPoseMeasurement lm =
-      randomPoseMeasurement(7, 9, Vec18::Ones(), Vec3(0.2, 0.1, -0.4), Vec3(1, 2, 3));
+  const LinearisedMeasurement lm =
+      randomMeasurement(7, 9, StateVector::Ones(), Vec3(0.2, 0.1, -0.4), Vec3(1, 2, 3));
   // textbook: K of eq. (17), the step and covariance of eqs. (17) and (18)
   const Eigen::MatrixXd K = lm.gain();
-  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
-  const Vec18 delta_ref = -K * lm.z - (Mat18::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
-  const Mat18 Ppost_ref = (Mat18::Identity() - K * lm.H) * lm.P;
-  Vec18 delta;
-  Mat18 Ppost;
+  const StateCovariance Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  const StateVector delta_ref = -K * lm.z - (StateCovariance::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+  const StateCovariance Ppost_ref = (StateCovariance::Identity() - K * lm.H) * lm.P;
+  StateVector delta;
+  StateCovariance Ppost;
   informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta, &Ppost);
   EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
 }
 
+// The same with the measurement seeing a sensor's calibration: H nonzero on the pose and the 7
+// states of the block, every state (three rotation blocks) moved by the iterate.
+TEST(EsikfUpdate, InformationFormWithACalibrationBlockEqualsTextbookGain) {
+  for (const int block : {FilterState::kLidar, FilterState::kCamera}) {
+    SCOPED_TRACE(block == FilterState::kLidar ? "LiDAR block" : "camera block");
+    const LinearisedMeasurement lm =
+        randomMeasurement(17 + block, 16, StateVector::Ones(), Vec3(-0.3, 0.2, 0.5), Vec3(-1, 4, 0.5), block);
+    for (const int b : FilterState::kRotationBlocks)
+      ASSERT_GT((FilterState::boxminusJacobian(lm.x, lm.prior).block<3, 3>(b, b) - Mat3::Identity()).norm(), 1e-3);
+    const Eigen::MatrixXd K = lm.gain();
+    const StateCovariance Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+    const StateVector delta_ref =
+        -K * lm.z - (StateCovariance::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+    const StateCovariance Ppost_ref = (StateCovariance::Identity() - K * lm.H) * lm.P;
+    StateVector delta;
+    StateCovariance Ppost;
+    informationStep(lm.x, lm.prior, lm.Phat, lm.info(), &delta, &Ppost);
+    EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
+    EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
+    // the other sensor's calibration is stepped through its correlations only
+    const int other = block == FilterState::kLidar ? FilterState::kCamera : FilterState::kLidar;
+    EXPECT_GT(delta.segment<FilterState::kCalibrationDim>(other).cwiseAbs().maxCoeff(), 1e-4);
+  }
+}
+
+// A calibration the rig states as exact (zero prior variance: zero rows and columns) gets no gain:
+// the update leaves it exactly where it is, its covariance rows stay exactly zero, and the other
+// states step as the textbook filter over the estimated states alone.
+TEST(EsikfUpdate, CalibrationWithZeroPriorVarianceIsLeftExactlyUnchanged) {
+  for (const int block : {FilterState::kLidar, FilterState::kCamera}) {
+    SCOPED_TRACE(block == FilterState::kLidar ? "LiDAR block" : "camera block");
+    StateVector estimated = StateVector::Ones();
+    estimated.segment<FilterState::kCalibrationDim>(block).setZero();
+    // the iterate has not moved the fixed block (it never does: its delta is zero)
+    LinearisedMeasurement lm =
+        randomMeasurement(23 + block, 16, estimated, Vec3(0.4, -0.1, 0.2), Vec3(2, -1, 0.3), block);
+    lm.Phat = estimated.asDiagonal() * lm.Phat * estimated.asDiagonal();
+    const StateCovariance Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+    lm.P = Jinv * lm.Phat * Jinv.transpose();
+    ASSERT_TRUE(isUsableCovariance(lm.Phat));
+    ASSERT_GT(lm.H.middleCols<FilterState::kCalibrationDim>(block).cwiseAbs().maxCoeff(), 0.1);  // it is measured
+    StateVector delta;
+    StateCovariance Ppost;
+    informationStep(lm.x, lm.prior, lm.Phat, lm.info(), &delta, &Ppost);
+    EXPECT_EQ(delta.segment<FilterState::kCalibrationDim>(block), (Eigen::Matrix<double, 7, 1>::Zero()));
+    EXPECT_EQ(Ppost.middleRows<FilterState::kCalibrationDim>(block).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ(Ppost.middleCols<FilterState::kCalibrationDim>(block).cwiseAbs().maxCoeff(), 0.0);
+    const FilterState post = lm.x.boxplus(delta);
+    const SensorCalibration &c0 = lm.prior.calibration(block), &c1 = post.calibration(block);
+    EXPECT_EQ(c1.rot, c0.rot);
+    EXPECT_EQ(c1.pos, c0.pos);
+    EXPECT_EQ(c1.dt, c0.dt);
+    // the estimated states: the textbook filter on them alone (the fixed ones are known constants)
+    std::vector<int> idx;
+    for (int i = 0; i < FilterState::kDim; ++i)
+      if (estimated[i] > 0.0) idx.push_back(i);
+    const int n = static_cast<int>(idx.size());
+    Eigen::MatrixXd Pr(n, n), Jr(n, n), Hr(lm.H.rows(), n);
+    Eigen::VectorXd er(n);
+    const StateVector e0 = lm.x.boxminus(lm.prior);
+    for (int r = 0; r < n; ++r) {
+      er[r] = e0[idx[r]];
+      Hr.col(r) = lm.H.col(idx[r]);
+      for (int c = 0; c < n; ++c) {
+        Pr(r, c) = lm.P(idx[r], idx[c]);
+        Jr(r, c) = Jinv(idx[r], idx[c]);
+      }
+    }
+    const Eigen::MatrixXd Rinv = lm.R.inverse();
+    const Eigen::MatrixXd K = (Hr.transpose() * Rinv * Hr + Pr.inverse()).inverse() * Hr.transpose() * Rinv;
+    const Eigen::MatrixXd I_KH = Eigen::MatrixXd::Identity(n, n) - K * Hr;
+    const Eigen::VectorXd delta_ref = -K * lm.z - I_KH * Jr * er;
+    const Eigen::MatrixXd Ppost_ref = I_KH * Pr;
+    for (int r = 0; r < n; ++r) {
+      EXPECT_NEAR(delta[idx[r]], delta_ref[r], 1e-10) << "state " << idx[r];
+      for (int c = 0; c < n; ++c) EXPECT_NEAR(Ppost(idx[r], idx[c]), Ppost_ref(r, c), 1e-10) << idx[r] << "," << idx[c];
+    }
+  }
+}
+
 TEST(EsikfUpdate, ConsiderStepEqualsTheSchmidtKalmanFilter) {
   // the gyro bias (and only it) considered: against the textbook Schmidt-Kalman filter, K' = M K
   // with M zero on the considered rows and P+ = (I - K'H) P (I - K'H)^T + K' R K'^T
-  Vec18 keep = Vec18::Ones();
+  StateVector keep = StateVector::Ones();
   keep.segment<3>(FilterState::kGyroBias).setZero();
   // the iterate has moved everything but the considered states
-  const LinearisedPoseMeasurement lm = randomPoseMeasurement(9, 8, keep, Vec3(-0.1, 0.3, 0.2), Vec3(-1, 0.5, 2));
+  const LinearisedMeasurement lm = randomMeasurement(9, 8, keep, Vec3(-0.1, 0.3, 0.2), Vec3(-1, 0.5, 2));
   const Eigen::MatrixXd Ks = keep.asDiagonal() * lm.gain();
-  const Mat18 Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
-  const Vec18 delta_ref = -Ks * lm.z - (Mat18::Identity() - Ks * lm.H) * Jinv * lm.x.boxminus(lm.prior);
-  const Mat18 I_KH = Mat18::Identity() - Ks * lm.H;
-  const Mat18 Ppost_ref = I_KH * lm.P * I_KH.transpose() + Ks * lm.R * Ks.transpose();
-  Vec18 delta;
-  Mat18 Ppost;
+  const StateCovariance Jinv = FilterState::boxminusJacobian(lm.x, lm.prior).inverse();
+  const StateVector delta_ref =
+      -Ks * lm.z - (StateCovariance::Identity() - Ks * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+  const StateCovariance I_KH = StateCovariance::Identity() - Ks * lm.H;
+  const StateCovariance Ppost_ref = I_KH * lm.P * I_KH.transpose() + Ks * lm.R * Ks.transpose();
+  StateVector delta;
+  StateCovariance Ppost;
   informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta, &Ppost, &keep);
   EXPECT_LT((delta - delta_ref).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_LT((Ppost - Ppost_ref).cwiseAbs().maxCoeff(), 1e-10);
   // the considered states keep their value and their variance; the rest steps as the full filter
   EXPECT_TRUE(delta.segment<3>(FilterState::kGyroBias).isZero());
   EXPECT_LT((Ppost.block<3, 3>(9, 9) - lm.P.block<3, 3>(9, 9)).cwiseAbs().maxCoeff(), 1e-12);
-  Vec18 delta_full;
-  Mat18 Pfull;
+  StateVector delta_full;
+  StateCovariance Pfull;
   informationStep(lm.x, lm.prior, lm.Phat, lm.S(), lm.g(), &delta_full, &Pfull);
   EXPECT_LT((delta - keep.asDiagonal() * delta_full).cwiseAbs().maxCoeff(), 1e-12);
   // and it never claims more than the optimal filter: P+ - P_full is positive semi-definite
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat18>(Ppost - Pfull).eigenvalues().minCoeff(), -1e-12);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<StateCovariance>(Ppost - Pfull).eigenvalues().minCoeff(), -1e-12);
 }
 
 TEST(EsikfUpdate, InformationBeyondPriorKeepsTheLargerInformationPerDirection) {
   // diagonal case: per axis max(0, s_i - 1/p_i)
   const Vec6 p = (Vec6() << 1e-4, 4e-4, 1e-2, 1e-6, 1.0, 0.25).finished();
   const Vec6 si = (Vec6() << 5e3, 1e3, 1e3, 1e5, 10.0, 0.0).finished();
-  const Mat6 E = informationBeyondPrior(si.asDiagonal(), p.asDiagonal());
+  const Mat6 E = informationBeyondPrior(Mat6(si.asDiagonal()), Mat6(p.asDiagonal()));
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(E(i, i), std::max(0.0, si[i] - 1.0 / p[i]), 1e-9 * (1.0 + si[i])) << i;
   EXPECT_LT((E - Mat6(E.diagonal().asDiagonal())).cwiseAbs().maxCoeff(), 1e-9);
   // general case: in the prior's whitened frame the posterior information is max(I, W) per
@@ -140,6 +270,206 @@ TEST(EsikfUpdate, InformationBeyondPriorKeepsTheLargerInformationPerDirection) {
   EXPECT_LT(informationBeyondPrior(1e-3 * P.inverse(), P).norm(), 1e-9 * P.inverse().norm());
 }
 
+// Over a pose and a calibration block: the same per-direction maximum in the prior's whitened frame;
+// with the calibration held fixed (zero prior variance) it gets nothing and the pose gets what the
+// pose-only version gives.
+TEST(EsikfUpdate, InformationBeyondPriorOverACalibrationBlock) {
+  std::mt19937 rng(13);
+  std::normal_distribution<double> n01;
+  Eigen::Matrix<double, kMeasuredDim, 9> Hs;
+  for (int i = 0; i < Hs.size(); ++i) Hs.data()[i] = 10.0 * n01(rng);
+  const Mat13 S = Hs * Hs.transpose();  // rank 9
+  const Mat13 P = measuredCovariance(randomCovariance(14), FilterState::kCamera);
+  const Mat13 B = informationBeyondPrior(S, P);
+  const Mat13 L = Eigen::LLT<Mat13>(P).matrixL();
+  const Eigen::SelfAdjointEigenSolver<Mat13> w(L.transpose() * S * L);
+  const Mat13 expected = w.eigenvectors() * w.eigenvalues().cwiseMax(1.0).asDiagonal() * w.eigenvectors().transpose();
+  EXPECT_LT((L.transpose() * (P.inverse() + B) * L - expected).norm(), 1e-6 * expected.norm());
+  EXPECT_LE(Eigen::FullPivLU<Mat13>(B).rank(), 9);
+  // the calibration held fixed
+  StateCovariance P32 = randomCovariance(15);
+  setCalibrationPrior(FilterState::kLidar, CalibrationStd{}, &P32);
+  const Mat13 Pf = measuredCovariance(P32, FilterState::kLidar);
+  const Mat13 Bf = informationBeyondPrior(S, Pf);
+  EXPECT_EQ((Bf.bottomRows<7>().cwiseAbs().maxCoeff()), 0.0);
+  EXPECT_EQ((Bf.rightCols<7>().cwiseAbs().maxCoeff()), 0.0);
+  const Mat6 pose_only = informationBeyondPrior(Mat6(S.topLeftCorner<6, 6>()), Mat6(Pf.topLeftCorner<6, 6>()));
+  EXPECT_LT((Bf.topLeftCorner<6, 6>() - pose_only).norm(), 1e-9 * pose_only.norm());
+}
+
+namespace {
+// Draws of a linear-Gaussian measurement of the 13 measured states (MeasurementInformation's order)
+// tested by consistencyTest: a prior error δ ~ N(0, P), a measurement y = H (δ + offset) + v with
+// v ~ N(0, I) (whitened rows), evaluated at a fixed iterate e (x ⊟ prior; zero on fixed states):
+// z = H (e - δ - offset) - v, S = H^T H, g = H^T z, so ν = e - S^-1 g = δ + offset + S^-1 H^T v.
+struct ConsistencyRun {
+  double acceptance = 0.0;
+  double mean_nis = 0.0;
+  int min_dof = 1000, max_dof = -1;
+};
+
+ConsistencyRun simulateConsistency(const Mat13& P, const Eigen::MatrixXd& H, const Vec13& offset, int draws,
+                                   double probability, double min_information, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01;
+  const Eigen::SelfAdjointEigenSolver<Mat13> es(P);
+  const Mat13 A = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();  // P = A A^T
+  Vec13 e;
+  for (int i = 0; i < kMeasuredDim; ++i) e[i] = P(i, i) > 0.0 ? 0.3 * std::sqrt(P(i, i)) * n01(rng) : 0.0;
+  const Mat13 S = H.transpose() * H;
+  ConsistencyRun run;
+  int accepted = 0;
+  for (int k = 0; k < draws; ++k) {
+    Vec13 n;
+    for (int i = 0; i < kMeasuredDim; ++i) n[i] = n01(rng);
+    const Vec13 delta = A * n;
+    Eigen::VectorXd v(H.rows());
+    for (int i = 0; i < H.rows(); ++i) v[i] = n01(rng);
+    const Eigen::VectorXd z = H * (e - delta - offset) - v;
+    const Vec13 g = H.transpose() * z;
+    const ConsistencyTest t = consistencyTest(e, S, g, P, probability, min_information);
+    accepted += t.passed;
+    run.mean_nis += t.nis / draws;
+    run.min_dof = std::min(run.min_dof, t.dof);
+    run.max_dof = std::max(run.max_dof, t.dof);
+  }
+  run.acceptance = static_cast<double>(accepted) / draws;
+  return run;
+}
+
+Eigen::MatrixXd randomRows(unsigned seed, int m, double scale) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01;
+  Eigen::MatrixXd H(m, kMeasuredDim);
+  for (int i = 0; i < H.size(); ++i) H.data()[i] = scale * n01(rng);
+  return H;
+}
+}  // namespace
+
+// A measurement that agrees with the prior: the NIS is chi-square with 13 degrees of freedom, so
+// the 0.99 gate accepts 99 % of the draws (binomial standard error over 4000: 0.16 %) and the mean
+// NIS is 13 (standard error sqrt(2 13 / 4000) = 0.08).
+TEST(EsikfUpdate, ConsistencyTestAcceptsAConsistentMeasurementAtItsProbability) {
+  const Mat13 P = measuredCovariance(randomCovariance(31), FilterState::kLidar);
+  // prior variances 0.01 to 0.5: rows of information ~20 put the measurement's information in the
+  // prior's units (λ of consistencyTest) between about 0.2 and 10, where λ / (1 + λ) matters
+  const Eigen::MatrixXd H = randomRows(32, 20, 1.0);
+  const ConsistencyRun run = simulateConsistency(P, H, Vec13::Zero(), 4000, 0.99, 0.01, 33);
+  RecordProperty("acceptance", std::to_string(run.acceptance));
+  RecordProperty("mean_nis", std::to_string(run.mean_nis));
+  EXPECT_EQ(run.min_dof, kMeasuredDim);
+  EXPECT_EQ(run.max_dof, kMeasuredDim);
+  EXPECT_NEAR(run.acceptance, 0.99, 0.005);
+  EXPECT_NEAR(run.mean_nis, 13.0, 0.3);
+  // at 0.9 one in ten is refused
+  const ConsistencyRun run90 = simulateConsistency(P, H, Vec13::Zero(), 4000, 0.9, 0.01, 34);
+  EXPECT_NEAR(run90.acceptance, 0.9, 0.015);
+
+  // one draw by hand: with every direction tested the NIS is ν^T (P + S^-1)^-1 ν
+  std::mt19937 rng(35);
+  std::normal_distribution<double> n01;
+  Vec13 e, g;
+  for (int i = 0; i < kMeasuredDim; ++i) e[i] = 0.1 * n01(rng), g[i] = 10.0 * n01(rng);
+  const Mat13 S = H.transpose() * H;
+  const Vec13 nu = e - S.ldlt().solve(g);
+  const double nis = nu.dot((P + S.inverse()).ldlt().solve(nu));
+  const ConsistencyTest t = consistencyTest(e, S, g, P, 0.99);
+  EXPECT_NEAR(t.nis, nis, 1e-9 * nis);
+  EXPECT_EQ(t.dof, kMeasuredDim);
+  EXPECT_NEAR(t.threshold, 27.688, 1e-3);  // chi-square 0.99 quantile, 13 dof
+  EXPECT_EQ(t.passed, nis <= t.threshold);
+}
+
+// A measurement 6 sigma off the prior in one direction (of P + S^-1) is refused: alone its NIS is
+// exactly 36 > 27.69; with the noise on top the NIS is non-central chi-square (13 dof, non-centrality
+// 36: mean 49) and beyond the 0.99 quantile in 96.4 % of the draws (2e5 simulated draws).
+TEST(EsikfUpdate, ConsistencyTestRejectsAPlantedInconsistentMeasurement) {
+  const Mat13 P = measuredCovariance(randomCovariance(41), FilterState::kCamera);
+  const Eigen::MatrixXd H = randomRows(42, 20, 1.0);
+  const Mat13 S = H.transpose() * H;
+  const Mat13 C = P + S.inverse();  // the covariance of ν when the two agree
+  Vec13 u;
+  for (int i = 0; i < kMeasuredDim; ++i) u[i] = std::cos(1.0 + 2.0 * i);
+  u.normalize();
+  const Vec13 offset = 6.0 * C * u / std::sqrt(u.dot(C * u));  // Mahalanobis length 6
+  // the offset alone (no prior error, no noise), at the prior
+  const Vec13 g = H.transpose() * (H * (-offset));
+  const ConsistencyTest alone = consistencyTest(Vec13::Zero(), S, g, P, 0.99);
+  EXPECT_NEAR(alone.nis, 36.0, 1e-8);
+  EXPECT_EQ(alone.dof, kMeasuredDim);
+  EXPECT_FALSE(alone.passed);
+  // with the prior's error and the measurement's noise
+  const ConsistencyRun run = simulateConsistency(P, H, offset, 4000, 0.99, 0.01, 43);
+  RecordProperty("rejection", std::to_string(1.0 - run.acceptance));
+  RecordProperty("mean_nis", std::to_string(run.mean_nis));
+  EXPECT_NEAR(run.mean_nis, 49.0, 0.8);  // standard error sqrt(2 (13 + 2 36) / 4000) = 0.21
+  EXPECT_NEAR(1.0 - run.acceptance, 0.964, 0.012);
+}
+
+// Directions where the measurement knows less than min_information of what the prior knows (λ of
+// W = L^T S L below it) are not tested: they are not counted in the degrees of freedom, and the NIS
+// over the rest is still chi-square with that many.
+TEST(EsikfUpdate, ConsistencyTestLeavesOutDirectionsTheMeasurementBarelySees) {
+  const Mat13 P = measuredCovariance(randomCovariance(51), FilterState::kLidar);
+  const Mat13 L = Eigen::LLT<Mat13>(P).matrixL();
+  // a random orthonormal basis of the whitened space and the information along each of its vectors
+  std::mt19937 rng(52);
+  std::normal_distribution<double> n01;
+  Mat13 M;
+  for (int i = 0; i < M.size(); ++i) M.data()[i] = n01(rng);
+  const Mat13 V = Eigen::HouseholderQR<Mat13>(M).householderQ();
+  Vec13 lambda;
+  lambda << 0.0, 0.002, 0.005, 0.0099, 0.0101, 0.02, 0.5, 1.0, 3.0, 10.0, 100.0, 1e3, 1e4;
+  // H = Λ^1/2 V^T L^-1: S = H^T H = L^-T V Λ V^T L^-1, i.e. W = V Λ V^T
+  const Mat13 Linv = L.triangularView<Eigen::Lower>().solve(Mat13::Identity());
+  const Eigen::MatrixXd H = lambda.cwiseSqrt().asDiagonal() * V.transpose() * Linv;
+  const ConsistencyRun tested = simulateConsistency(P, H, Vec13::Zero(), 4000, 0.99, 0.01, 53);
+  RecordProperty("acceptance", std::to_string(tested.acceptance));
+  RecordProperty("mean_nis", std::to_string(tested.mean_nis));
+  EXPECT_EQ(tested.min_dof, 9);  // λ >= 0.01
+  EXPECT_EQ(tested.max_dof, 9);
+  EXPECT_NEAR(tested.mean_nis, 9.0, 0.25);  // standard error sqrt(2 9 / 4000) = 0.067
+  EXPECT_NEAR(tested.acceptance, 0.99, 0.005);
+  const ConsistencyRun wider = simulateConsistency(P, H, Vec13::Zero(), 4000, 0.99, 0.001, 54);
+  EXPECT_EQ(wider.min_dof, 12);  // λ >= 0.001: all but the direction without information
+  EXPECT_EQ(wider.max_dof, 12);
+  EXPECT_NEAR(wider.mean_nis, 12.0, 0.3);
+  // a planted error along the weakest untested direction does not count at min_information 0.01
+  // (the measurement says almost nothing there), but does once that direction is tested
+  const Vec13 weak = L * V.col(3);  // λ = 0.0099
+  const Vec13 offset = 50.0 * weak * std::sqrt(1.0 + 1.0 / lambda[3]);  // 50 sigma of P + S^-1 along it
+  const Vec13 g = H.transpose() * (H * (-offset));
+  const ConsistencyTest strict = consistencyTest(Vec13::Zero(), Mat13(H.transpose() * H), g, P, 0.99, 0.01);
+  EXPECT_EQ(strict.dof, 9);
+  EXPECT_LT(strict.nis, 1e-6);
+  EXPECT_TRUE(strict.passed);
+  const ConsistencyTest loose = consistencyTest(Vec13::Zero(), Mat13(H.transpose() * H), g, P, 0.99, 0.001);
+  EXPECT_EQ(loose.dof, 12);
+  EXPECT_NEAR(loose.nis, 2500.0, 1e-6 * 2500.0);
+  EXPECT_FALSE(loose.passed);
+}
+
+// States held fixed (zero prior variance) are not tested: a measurement of the pose and a fixed
+// calibration block has the pose's 6 degrees of freedom.
+TEST(EsikfUpdate, ConsistencyTestLeavesOutFixedStates) {
+  StateCovariance P32 = randomCovariance(61);
+  setCalibrationPrior(FilterState::kLidar, CalibrationStd{}, &P32);
+  const Mat13 P = measuredCovariance(P32, FilterState::kLidar);
+  ASSERT_EQ((P.bottomRightCorner<7, 7>().cwiseAbs().maxCoeff()), 0.0);
+  const Eigen::MatrixXd H = randomRows(62, 20, 1.0);
+  const ConsistencyRun run = simulateConsistency(P, H, Vec13::Zero(), 4000, 0.99, 0.01, 63);
+  RecordProperty("acceptance", std::to_string(run.acceptance));
+  RecordProperty("mean_nis", std::to_string(run.mean_nis));
+  EXPECT_EQ(run.min_dof, 6);
+  EXPECT_EQ(run.max_dof, 6);
+  EXPECT_NEAR(run.mean_nis, 6.0, 0.2);  // standard error sqrt(2 6 / 4000) = 0.055
+  EXPECT_NEAR(run.acceptance, 0.99, 0.005);
+  // nothing estimated: nothing tested, passed
+  const ConsistencyTest none = consistencyTest(Vec13::Ones(), Mat13::Identity(), Vec13::Ones(), Mat13::Zero(), 0.99);
+  EXPECT_EQ(none.dof, 0);
+  EXPECT_TRUE(none.passed);
+}
+
 TEST(EsikfUpdate, DirectPoseMeasurementConvergesToTheMapEstimate) {
   // Measure the pose directly (z = T ⊟ T_meas) with a tight noise: the iterated update must land
   // on the measurement (to the prior's small weight) and shrink the pose covariance.
@@ -148,18 +478,18 @@ TEST(EsikfUpdate, DirectPoseMeasurementConvergesToTheMapEstimate) {
   prior.pos = Vec3(1.0, 0.5, -0.2);
   const Pose3 meas = se3::boxplus(prior.pose(), (Vec6() << 0.05, -0.03, 0.08, 0.3, -0.2, 0.1).finished());
   const double sigma = 1e-3;
-  const Mat18 Phat = Mat18::Identity() * 0.1;
-  auto measure = [&](const FilterState& x, int, PoseInformation* info) {
+  const StateCovariance Phat = StateCovariance::Identity() * 0.1;
+  auto measure = [&](const FilterState& x, int, MeasurementInformation* info) {
     const Vec6 z = se3::boxminus(x.pose(), meas);
     Mat6 H = Mat6::Identity();
     H.topLeftCorner<3, 3>() = so3::rightJacobianInverse(z.head<3>());
-    info->HtRinvH = H.transpose() * H / (sigma * sigma);
-    info->HtRinvz = H.transpose() * z / (sigma * sigma);
+    info->HtRinvH.topLeftCorner<6, 6>() = H.transpose() * H / (sigma * sigma);
+    info->HtRinvz.head<6>() = H.transpose() * z / (sigma * sigma);
     info->count = 6;
     return true;
   };
   FilterState post;
-  Mat18 Ppost;
+  StateCovariance Ppost;
   EsikfOptions opts;
   opts.max_iterations = 10;
   const EsikfResult r = iteratedUpdate(prior, Phat, measure, opts, &post, &Ppost);
@@ -170,6 +500,7 @@ TEST(EsikfUpdate, DirectPoseMeasurementConvergesToTheMapEstimate) {
   EXPECT_LT(se3::boxminus(post.pose(), meas).norm(), 1e-5);
   EXPECT_LT(Ppost(3, 3), 1.1e-6);
   EXPECT_NEAR(Ppost(9, 9), 0.1, 1e-12);  // states the measurement does not touch keep their variance
+  EXPECT_NEAR(Ppost(FilterState::kLidar + FilterState::kCalDt, FilterState::kLidar + FilterState::kCalDt), 0.1, 1e-12);
 }
 
 namespace {
@@ -215,8 +546,11 @@ FilterState offsetPrior(const Pose3& truth, const Vec6& offset) {
   return x;
 }
 
-Mat18 looseCovariance() {
-  Mat18 P = Mat18::Identity() * 1e-2;
+// the navigation state loose, the sensors' calibration held fixed (the registration tests are about the pose)
+StateCovariance looseCovariance() {
+  StateCovariance P = StateCovariance::Zero();
+  P.topLeftCorner<FilterState::kNavDim, FilterState::kNavDim>().setIdentity();
+  P *= 1e-2;
   P.topLeftCorner<3, 3>() *= 1.0;           // 0.1 rad
   P.block<3, 3>(3, 3) = Mat3::Identity();   // 1 m
   return P;
@@ -235,9 +569,9 @@ TEST(EsikfUpdate, SingleScanRegistrationWithKnownOffsetConverges) {
   EsikfOptions eo;
   eo.max_iterations = 15;
   FilterState post;
-  Mat18 Ppost;
+  StateCovariance Ppost;
   const EsikfResult r = iteratedUpdate(prior, looseCovariance(),
-                                       [&](const FilterState& x, int it, PoseInformation* info) {
+                                       [&](const FilterState& x, int it, MeasurementInformation* info) {
                                          return s2m.evaluate(x, it, info);
                                        },
                                        eo, &post, &Ppost);
@@ -264,10 +598,10 @@ TEST(EsikfUpdate, CorridorIsFlaggedDegenerateAlongItsAxis) {
   EsikfOptions eo;
   eo.max_iterations = 10;
   FilterState post;
-  Mat18 Ppost;
-  const Mat18 P0 = looseCovariance();
+  StateCovariance Ppost;
+  const StateCovariance P0 = looseCovariance();
   const EsikfResult r = iteratedUpdate(prior, P0,
-                                       [&](const FilterState& x, int it, PoseInformation* info) {
+                                       [&](const FilterState& x, int it, MeasurementInformation* info) {
                                          return s2m.evaluate(x, it, info);
                                        },
                                        eo, &post, &Ppost);
@@ -325,4 +659,72 @@ TEST(EsikfUpdate, PoseMeasurementFloorAddsItsCovarianceAndKeepsTheMeasuredPose) 
   EXPECT_TRUE(S1.allFinite());
   EXPECT_LT(S1.row(5).cwiseAbs().maxCoeff(), 1e-12 * S1.norm());
   EXPECT_NEAR(g1[5], 0.0, 1e-12);
+}
+
+// The floor over a pose and a calibration block: the measurement of covariance S^-1 + F around the
+// same measured states S^-1 g.
+TEST(EsikfUpdate, MeasurementFloorOverACalibrationBlock) {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix<double, kMeasuredDim, 20> J;
+  for (int i = 0; i < J.size(); ++i) J.data()[i] = n(rng);
+  const Mat13 S = 1e4 * J * J.transpose();
+  Vec13 g;
+  for (int i = 0; i < kMeasuredDim; ++i) g[i] = n(rng);
+  Vec13 f;
+  f << 1e-6, 2e-6, 1e-6, 1e-4, 4e-4, 1e-4, 3e-6, 3e-6, 3e-6, 1e-4, 1e-4, 1e-4, 1e-6;
+  const Mat13 F = f.asDiagonal();
+  Mat13 Sf = S;
+  Vec13 gf = g;
+  applyMeasurementFloor(F, &Sf, &gf);
+  const Mat13 expected = (S.inverse() + F).inverse();
+  EXPECT_LT((Sf - expected).norm(), 1e-9 * expected.norm());
+  EXPECT_LT((Sf.ldlt().solve(gf) - S.ldlt().solve(g)).norm(), 1e-9 * S.ldlt().solve(g).norm());
+  EXPECT_EQ(Sf, Sf.transpose());
+}
+
+TEST(EsikfUpdate, CalibrationShareKeepsTheOptimumAndScalesTheCalibrationInformation) {
+  // a measurement of the pose and a calibration block: its share of the calibration's information
+  // keeps where the measurement on its own puts the measured states (-S^-1 g) and scales the
+  // calibration's information with the pose eliminated by the share, the pose's with the
+  // calibration eliminated not at all when they are uncorrelated
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  Eigen::Matrix<double, 40, kMeasuredDim> H;
+  for (int i = 0; i < H.size(); ++i) H.data()[i] = n01(rng);
+  MeasurementInformation m;
+  m.calibration_block = FilterState::kCamera;
+  m.HtRinvH = H.transpose() * H;
+  for (int i = 0; i < kMeasuredDim; ++i) m.HtRinvz[i] = n01(rng);
+  const Vec13 optimum = -m.HtRinvH.ldlt().solve(m.HtRinvz);
+  const auto calibrationInformation = [](const Mat13& S) {
+    const Mat6 Spp = S.topLeftCorner<6, 6>();
+    const Eigen::Matrix<double, 6, 7> Spc = S.topRightCorner<6, 7>();
+    return Eigen::Matrix<double, 7, 7>(S.bottomRightCorner<7, 7>() - Spc.transpose() * Spp.ldlt().solve(Spc));
+  };
+  const Mat13 P = Mat13::Identity() * 1e-2;  // every measured state estimated
+  MeasurementInformation scaled = m;
+  scaleCalibrationInformation(0.2, P, &scaled);
+  EXPECT_LT((-scaled.HtRinvH.ldlt().solve(scaled.HtRinvz) - optimum).norm(), 1e-9 * optimum.norm());
+  EXPECT_LT((calibrationInformation(scaled.HtRinvH) - 0.2 * calibrationInformation(m.HtRinvH)).norm(),
+            1e-9 * calibrationInformation(m.HtRinvH).norm());
+  EXPECT_LT((scaled.HtRinvH - scaled.HtRinvH.transpose()).cwiseAbs().maxCoeff(), 1e-12 * m.HtRinvH.norm());
+  // the share 1 changes nothing, nor any share when the calibration is held fixed
+  for (const double share : {1.0, 0.2}) {
+    Mat13 held = P;
+    if (share != 1.0) held.bottomRightCorner<7, 7>().setZero();
+    MeasurementInformation same = m;
+    scaleCalibrationInformation(share, held, &same);
+    EXPECT_EQ(same.HtRinvH, m.HtRinvH);
+    EXPECT_EQ(same.HtRinvz, m.HtRinvz);
+  }
+  // with only the rotation estimated, the optimum over the estimated states is kept, the held
+  // ones staying where they are
+  Mat13 rotation_only = P;
+  rotation_only.block<4, 4>(9, 9).setZero();
+  MeasurementInformation part = m;
+  scaleCalibrationInformation(0.2, rotation_only, &part);
+  const Eigen::Matrix<double, 9, 9> S9 = m.HtRinvH.topLeftCorner<9, 9>(), S9p = part.HtRinvH.topLeftCorner<9, 9>();
+  const Eigen::Matrix<double, 9, 1> g9 = m.HtRinvz.head<9>(), g9p = part.HtRinvz.head<9>();
+  EXPECT_LT((S9p.ldlt().solve(g9p) - S9.ldlt().solve(g9)).norm(), 1e-9 * S9.ldlt().solve(g9).norm());
 }

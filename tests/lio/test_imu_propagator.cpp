@@ -23,14 +23,17 @@ FilterState someState() {
   return x;
 }
 
-// δx_{i+1} as a function of (δx_i, w_i): (x̂ ⊞ δx) ⊞ (dt f(x̂ ⊞ δx, u, w)) ⊟ (x̂ ⊞ dt f(x̂, u, 0))
+// δx_{i+1} as a function of (δx_i, w_i): (x̂ ⊞ δx) ⊞ (dt f(x̂ ⊞ δx, u, w)) ⊟ (x̂ ⊞ dt f(x̂, u, 0)), over the
+// navigation states (the first 18)
 Vec18 errorMap(const FilterState& xh, const Vec18& dx, const Eigen::Matrix<double, 12, 1>& w, const Vec3& gyro,
                const Vec3& accel, double dt) {
-  const FilterState x = xh.boxplus(dx);
+  StateVector d = StateVector::Zero();
+  d.head<FilterState::kNavDim>() = dx;
+  const FilterState x = xh.boxplus(d);
   FilterState next = propagateState(x, gyro - w.segment<3>(0), accel - w.segment<3>(3), dt);
   next.gyro_bias += w.segment<3>(6) * dt;
   next.accel_bias += w.segment<3>(9) * dt;
-  return next.boxminus(propagateState(xh, gyro, accel, dt));
+  return next.boxminus(propagateState(xh, gyro, accel, dt)).head<FilterState::kNavDim>();
 }
 }  // namespace
 
@@ -79,7 +82,7 @@ Vec6 propagationError(double rate_hz, double t0, double t1) {
   std::mt19937 rng(1);
   const auto imu = synth::simulateImu(traj, t0, t1, rate_hz, base, synth::ImuErrorModel::exact(), &rng);
   ImuPropagator prop;
-  prop.reset(traj.state(t0), Mat18::Identity() * 1e-6, imu.front());
+  prop.reset(traj.state(t0), StateCovariance::Identity() * 1e-6, imu.front());
   for (size_t i = 1; i < imu.size(); ++i) EXPECT_TRUE(prop.addSample(imu[i]));
   EXPECT_EQ(prop.utime(), base + static_cast<int64_t>(std::llround(t1 * 1e6)));
   const FilterState truth = traj.state(t1);
@@ -115,7 +118,7 @@ TEST(ImuPropagator, PropagateToInterpolatesBetweenSamples) {
   std::mt19937 rng(1);
   const auto imu = synth::simulateImu(traj, 1.0, 1.1, 200.0, base, synth::ImuErrorModel::exact(), &rng);
   ImuPropagator a, b;
-  a.reset(traj.state(1.0), Mat18::Identity() * 1e-6, imu[0]);
+  a.reset(traj.state(1.0), StateCovariance::Identity() * 1e-6, imu[0]);
   b = a;
   // a: to the sample at 1.05 s; b: to 1.0525 then on to 1.055 through the next sample
   for (int i = 1; i <= 10; ++i) a.addSample(imu[i]);
@@ -155,7 +158,7 @@ TEST(ImuPropagator, CovarianceMatchesMonteCarlo) {
   s0.utime = 0;
   s0.gyro = gyro;
   s0.accel = accel;
-  prop.reset(x0, Mat18::Identity() * 1e-12, s0);
+  prop.reset(x0, StateCovariance::Identity() * 1e-12, s0);
   for (int k = 1; k <= steps; ++k) {
     ImuSample s = s0;
     s.utime = k * 5000;
@@ -178,16 +181,69 @@ TEST(ImuPropagator, CovarianceMatchesMonteCarlo) {
       x.gyro_bias += nbg * dt;
       x.accel_bias += nba * dt;
     }
-    const Vec18 e = x.boxminus(prop.state());
+    const Vec18 e = x.boxminus(prop.state()).head<FilterState::kNavDim>();
     C += e * e.transpose() / runs;
   }
-  const Mat18& P = prop.covariance();
+  const Mat18 P = prop.covariance().topLeftCorner<FilterState::kNavDim, FilterState::kNavDim>();
   // variances within 15 % (the standard error of a variance from 1500 runs is ~3.7 %)
   for (int i = 0; i < 15; ++i) EXPECT_NEAR(C(i, i) / P(i, i), 1.0, 0.15) << "state " << i;
   // the rotation-velocity and position-velocity correlations
   auto corr = [](const Mat18& M, int i, int j) { return M(i, j) / std::sqrt(M(i, i) * M(j, j)); };
   for (int i : {0, 1, 3, 4})
     for (int j : {6, 7, 8}) EXPECT_NEAR(corr(C, i, j), corr(P, i, j), 0.1) << i << "," << j;
+}
+
+// The sensors' calibration is constant: propagation keeps its values and its own covariance block
+// exactly and carries its correlation with the navigation state through F_x, P = [A B; B^T C] ->
+// [F_x A F_x^T + F_w Q F_w^T, F_x B; (F_x B)^T, C].
+TEST(ImuPropagator, CalibrationIsConstantAndItsCorrelationFollowsTheNavigationState) {
+  const ImuNoise noise{0.01, 0.1, 0.001, 0.01};
+  const double dt = 0.005;
+  const int steps = 20;
+  FilterState x0 = someState();
+  x0.lidar = SensorCalibration{so3::Exp(Vec3(0.1, -0.2, 1.5)), Vec3(0.1, 0.0, 0.2), 0.003};
+  x0.camera = SensorCalibration{so3::Exp(Vec3(-1.5, 0.1, 0.0)), Vec3(0.05, -0.02, 0.0), -0.01};
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01;
+  StateCovariance A0;
+  for (int i = 0; i < A0.size(); ++i) A0.data()[i] = 0.05 * n01(rng);
+  const StateCovariance P0 = A0 * A0.transpose() + 1e-4 * StateCovariance::Identity();
+  const Vec3 gyro(0.3, -0.4, 0.8), accel(0.3, 0.5, 9.9);
+  ImuPropagator prop(noise);
+  ImuSample s0;
+  s0.utime = 0;
+  s0.gyro = gyro;
+  s0.accel = accel;
+  prop.reset(x0, P0, s0);
+  constexpr int n = FilterState::kNavDim, c = FilterState::kDim - FilterState::kNavDim;
+  FilterState x = x0;
+  Mat18 A = P0.topLeftCorner<n, n>();
+  Eigen::Matrix<double, n, c> B = P0.topRightCorner<n, c>();
+  for (int k = 1; k <= steps; ++k) {
+    ImuSample s = s0;
+    s.utime = k * 5000;
+    ASSERT_TRUE(prop.addSample(s));
+    Mat18 Fx;
+    Mat18x12 Fw;
+    propagationJacobians(x, gyro, accel, dt, &Fx, &Fw);
+    A = Fx * A * Fx.transpose() + Fw * discreteNoiseCovariance(noise, dt) * Fw.transpose();
+    B = Fx * B;
+    x = propagateState(x, gyro, accel, dt);
+  }
+  const FilterState& xp = prop.state();
+  EXPECT_EQ(xp.lidar.rot, x0.lidar.rot);
+  EXPECT_EQ(xp.lidar.pos, x0.lidar.pos);
+  EXPECT_EQ(xp.lidar.dt, x0.lidar.dt);
+  EXPECT_EQ(xp.camera.rot, x0.camera.rot);
+  EXPECT_EQ(xp.camera.pos, x0.camera.pos);
+  EXPECT_EQ(xp.camera.dt, x0.camera.dt);
+  const StateCovariance& P = prop.covariance();
+  EXPECT_EQ((P.bottomRightCorner<c, c>()), (P0.bottomRightCorner<c, c>()));
+  EXPECT_LT((P.topLeftCorner<n, n>() - A).cwiseAbs().maxCoeff(), 1e-12 * A.cwiseAbs().maxCoeff());
+  EXPECT_LT((P.topRightCorner<n, c>() - B).cwiseAbs().maxCoeff(), 1e-12 * B.cwiseAbs().maxCoeff());
+  EXPECT_EQ((P.bottomLeftCorner<c, n>()), (P.topRightCorner<n, c>().transpose()));
+  // the correlation moved: a rotation-calibration correlation reaches the position through the velocity
+  EXPECT_GT((B - P0.topRightCorner<n, c>()).cwiseAbs().maxCoeff(), 1e-4);
 }
 
 // The gyro's scale and misalignment errors are modelled as a rate noise whose density makes the
@@ -210,7 +266,7 @@ TEST(ImuPropagator, ScaleAndMisalignmentSpreadMatchesDrawnGyrosOverOneWindow) {
   ImuSample s0;
   s0.gyro = gyro;
   s0.accel = Vec3(0.0, 0.0, 9.81);
-  prop.reset(x0, Mat18::Identity() * 1e-14, s0);
+  prop.reset(x0, StateCovariance::Identity() * 1e-14, s0);
   for (int k = 1; k <= steps; ++k) {
     ImuSample s = s0;
     s.utime = k * 5000;
@@ -244,7 +300,7 @@ TEST(ImuPropagator, TransformSegmentsKeepsTheTrajectoryRelativeToTheState) {
   std::mt19937 rng(2);
   const auto imu = synth::simulateImu(traj, 2.0, 2.1, 200.0, 0, synth::ImuErrorModel::exact(), &rng);
   ImuPropagator p;
-  p.reset(traj.state(2.0), Mat18::Identity() * 1e-6, imu[0]);
+  p.reset(traj.state(2.0), StateCovariance::Identity() * 1e-6, imu[0]);
   for (size_t i = 1; i < imu.size(); ++i) p.addSample(imu[i]);
   const std::vector<ImuSegment> before = p.segments();
   const FilterState x0 = p.state();

@@ -79,7 +79,7 @@ std::vector<Vec3> undistort(const LidarScan& scan, const SweepMotion& m, bool to
   x0.vel = m.velocity;
   x0.gravity.setZero();
   ImuPropagator prop;
-  prop.reset(x0, Mat18::Identity(), m.imu.front());
+  prop.reset(x0, StateCovariance::Identity(), m.imu.front());
   for (size_t k = 1; k < m.imu.size(); ++k) prop.addSample(m.imu[k]);
   const FilterState& ref = to_end ? prop.state() : x0;
   const Undistorter und(prop.segments(), ref.rot, ref.pos, to_end ? prop.utime() : m.imu.front().utime,

@@ -37,7 +37,7 @@ TEST(Undistorter, SweepWithKnownMotion) {
   ImuPropagator prop;
   size_t i = 0;
   while (imu[i + 1].utime <= base + static_cast<int64_t>(t0 * 1e6)) ++i;
-  prop.reset(traj.state(imu[i].utime * 1e-6 - base * 1e-6), Mat18::Identity() * 1e-9, imu[i]);
+  prop.reset(traj.state(imu[i].utime * 1e-6 - base * 1e-6), StateCovariance::Identity() * 1e-9, imu[i]);
   const int64_t t_end = base + static_cast<int64_t>(std::llround(t1 * 1e6));
   for (++i; imu[i].utime <= t_end; ++i) prop.addSample(imu[i]);
   prop.propagateTo(t_end, imu[i]);

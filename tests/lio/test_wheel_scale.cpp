@@ -176,14 +176,14 @@ TEST(WheelScale, CorrectedWheelUpdateIsChiSquareConsistent) {
   o.T_I_B = kTIB;
   o.track_width = kTrack;
   o.speed_noise_std = kSpeedNoise;
-  Mat18 P = Mat18::Zero();
+  StateCovariance P = StateCovariance::Zero();  // the calibration held fixed
   P.diagonal().segment<3>(FilterState::kRot).setConstant(1e-6);
   P.diagonal().segment<3>(FilterState::kPos).setConstant(1e-4);
   P.diagonal().segment<3>(FilterState::kVel).setConstant(1e-4);  // 1 cm/s: a LiDAR-tracked filter
   P.diagonal().segment<3>(FilterState::kGyroBias).setConstant(1e-8);
   P.diagonal().segment<3>(FilterState::kAccelBias).setConstant(1e-4);
   P.diagonal().segment<3>(FilterState::kGravity).setConstant(1e-6);
-  const Mat18 L = P.llt().matrixL();
+  const Mat18 L = P.topLeftCorner<FilterState::kNavDim, FilterState::kNavDim>().llt().matrixL();
 
   std::mt19937 rng(7);
   std::normal_distribution<double> n01(0.0, 1.0);
@@ -204,10 +204,12 @@ TEST(WheelScale, CorrectedWheelUpdateIsChiSquareConsistent) {
                           truth.y() * (v + 0.5 * kTrack * w) + kSpeedNoise * n01(rng)};
     Vec18 e;
     for (int k = 0; k < 18; ++k) e[k] = n01(rng);
-    const FilterState estimate = truth_state.boxplus(L * e);
+    StateVector d = StateVector::Zero();
+    d.head<FilterState::kNavDim>() = L * e;
+    const FilterState estimate = truth_state.boxplus(d);
     for (const WheelScaleEstimator* est : std::array<const WheelScaleEstimator*, 2>{&learned, &unlearned}) {
       FilterState x = estimate;
-      Mat18 Pi = P;
+      StateCovariance Pi = P;
       const WheelSample c = est->correct(raw);
       const WheelUpdateResult r =
           wheelVelocityUpdate(&x, &Pi, gyro, 0.5 * (c.left_speed + c.right_speed), o, est->meanSpeedVariance(raw));

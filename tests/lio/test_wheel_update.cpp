@@ -22,10 +22,10 @@ const Pose3 kTIB = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.05)), 
 TEST(WheelUpdate, JacobianMatchesNumericDifferentiation) {
   const FilterState x = movingState();
   const Vec3 gyro(0.05, -0.02, 0.4);
-  const Mat3x18 H = wheelVelocityJacobian(x, gyro, kTIB);
+  const Mat3xState H = wheelVelocityJacobian(x, gyro, kTIB);
   const double h = 1e-6;
-  for (int i = 0; i < 18; ++i) {
-    Vec18 d = Vec18::Zero();
+  for (int i = 0; i < FilterState::kDim; ++i) {
+    StateVector d = StateVector::Zero();
     d[i] = h;
     const Vec3 num = (wheelFrameVelocity(x.boxplus(d), gyro, kTIB) - wheelFrameVelocity(x.boxplus(-d), gyro, kTIB)) / (2 * h);
     EXPECT_LT((H.col(i) - num).norm(), 1e-8) << "state " << i;
@@ -42,7 +42,7 @@ TEST(WheelUpdate, CorrectsVelocityAndGatesSlip) {
   ASSERT_LT((wheelFrameVelocity(truth, gyro, kTIB) - Vec3(speed, 0, 0)).norm(), 1e-12);
   FilterState x = truth;
   x.vel += truth.rot * Vec3(0.3, 0.2, -0.1);  // wrong forward, lateral and vertical velocity
-  Mat18 P = Mat18::Identity() * 1e-4;
+  StateCovariance P = StateCovariance::Identity() * 1e-4;
   P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * 0.25;
   WheelOptions o;
   o.enabled = true;
@@ -58,7 +58,7 @@ TEST(WheelUpdate, CorrectsVelocityAndGatesSlip) {
 
   // a 3 m/s discrepancy with a confident filter is slip: rejected, state untouched
   FilterState y = truth;
-  Mat18 Py = Mat18::Identity() * 1e-4;
+  StateCovariance Py = StateCovariance::Identity() * 1e-4;
   const WheelUpdateResult slip = wheelVelocityUpdate(&y, &Py, gyro, speed + 3.0, o);
   EXPECT_FALSE(slip.applied);
   EXPECT_GT(slip.chi2, o.gate_chi2);

@@ -159,12 +159,26 @@ TEST(LcmTypes, FilterState) {
   s.request_id = 77;
   s.source = "livo-lio";
   s.orientation[0] = 1;
-  for (int i = 0; i < 324; ++i) s.covariance[i] = i * 1e-3;
+  s.angular_velocity[2] = 0.5;
+  s.lidar_orientation[0] = 1;
+  s.lidar_position[1] = -0.2;
+  s.lidar_time_shift = 0.004;
+  s.camera_orientation[3] = 1;
+  s.camera_position[0] = 0.1;
+  s.camera_time_shift = -0.012;
+  for (int i = 0; i < 1024; ++i) s.covariance[i] = i * 1e-3;  // 32x32
   s.valid = 1;
   s.iterations = 3;
   const filter_state_t d = roundTrip(s);
   EXPECT_EQ(d.request_id, 77);
   EXPECT_DOUBLE_EQ(d.covariance[323], 0.323);
+  EXPECT_DOUBLE_EQ(d.covariance[1023], 1.023);
+  EXPECT_DOUBLE_EQ(d.angular_velocity[2], 0.5);
+  EXPECT_DOUBLE_EQ(d.lidar_position[1], -0.2);
+  EXPECT_DOUBLE_EQ(d.lidar_time_shift, 0.004);
+  EXPECT_DOUBLE_EQ(d.camera_orientation[3], 1.0);
+  EXPECT_DOUBLE_EQ(d.camera_position[0], 0.1);
+  EXPECT_DOUBLE_EQ(d.camera_time_shift, -0.012);
 }
 
 TEST(LcmTypes, RegisteredScanKeyframeLoopCorrection) {

@@ -31,7 +31,8 @@ double cpuSeconds() {
 struct Frame {
   double t;
   GreyImage image;
-  FilterState prior;
+  FilterState prior;       // with the rig's camera calibration
+  Vec3 body_rate = Vec3::Zero();
   std::vector<Vec3> scan;  // the sweep that ended just before the image, if one did
   int64_t scan_utime = 0;
 };
@@ -46,10 +47,11 @@ const std::vector<Frame>& frames() {
       Frame fr;
       fr.t = t0 + 0.05 * k;
       fr.image = s.image(fr.t, static_cast<uint64_t>(k));
-      Vec18 d = Vec18::Zero();
+      StateVector d = StateVector::Zero();
       d.head<3>() = Vec3(std::sin(1.3 * k), std::cos(0.7 * k), std::sin(0.4 * k + 1.0)).normalized() * (0.2 * M_PI / 180.0);
       d.segment<3>(3) = Vec3(std::cos(1.1 * k), std::sin(0.9 * k), std::cos(0.3 * k + 2.0)).normalized() * 0.01;
       fr.prior = s.trueState(fr.t).boxplus(d);
+      fr.body_rate = s.bodyRate(fr.t);
       if (k % 2 == 0) {
         fr.scan = s.sweep(fr.t - 0.1, static_cast<uint64_t>(k));
         fr.scan_utime = s.utime(fr.t);
@@ -76,7 +78,7 @@ void BM_VioImage(benchmark::State& state) {
   VioOptions options;
   options.selection.grid_cell_px = options.maintenance.new_point_cell_px = static_cast<int>(state.range(0));
   const int warmup = 20;
-  const Mat18 P = livo_test::priorCovariance(0.005, 0.02);
+  const StateCovariance P = livo_test::priorCovariance(0.005, 0.02);  // the calibration held fixed
   const CameraRig camera = livo_test::SimScene("config/sim/room.yaml", 512).camera();
   std::unique_ptr<VioEstimator> vio;
   size_t next = fr.size();
@@ -90,13 +92,13 @@ void BM_VioImage(benchmark::State& state) {
       vio = std::make_unique<VioEstimator>(options, camera);
       for (next = 0; next < static_cast<size_t>(warmup); ++next) {
         feed(fr[next]);
-        vio->processImage(fr[next].image, fr[next].prior, P);
+        vio->processImage(fr[next].image, fr[next].prior, P, fr[next].body_rate);
       }
     }
     const Frame& f = fr[next++];
     feed(f);
     const double t0 = cpuSeconds();
-    const ImageResult r = vio->processImage(f.image, f.prior, P);
+    const ImageResult r = vio->processImage(f.image, f.prior, P, f.body_rate);
     const double dt = cpuSeconds() - t0;
     state.SetIterationTime(dt);
     ms.push_back(dt * 1e3);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,22 +52,30 @@ class SimScene {
   int64_t utime(double t) const { return setup_.start_utime + static_cast<int64_t>(std::llround(t * 1e6)); }
 
   livo::Pose3 bodyPose(double t) const { return setup_.trajectory->at(t).T_W_I; }
+  /// The body's angular rate at t (frame I): what lio sends with a prior (filter_state_t.angular_velocity).
+  livo::Vec3 bodyRate(double t) const { return setup_.trajectory->at(t).angular_velocity; }
+  /// The true body state at t with the rig's calibration (the camera's T_I_C and the LiDAR's T_I_L,
+  /// no time shift): what a prior carries when the rig is exact.
   livo::FilterState trueState(double t) const {
     const auto s = setup_.trajectory->at(t);
     livo::FilterState x;
     x.rot = s.T_W_I.linear();
     x.pos = s.T_W_I.translation();
     x.vel = s.velocity;
+    x.lidar = livo::SensorCalibration::fromPose(setup_.rig.lidar->T_I_L);
+    x.camera = livo::SensorCalibration::fromPose(camera_.T_I_C);
     return x;
   }
 
-  /// The simulator's image (8-bit grey) at trajectory time t, noise stream k.
-  livo::sim::CameraImage rendered(double t, uint64_t k) const {
-    return renderer_->render(*setup_.scene, *setup_.trajectory, t, utime(t),
+  /// The simulator's image (8-bit grey) at trajectory time t, noise stream k; with `time_shift` the
+  /// image is taken at t + time_shift but stamped t (a camera whose clock is off by -time_shift:
+  /// FilterState::camera.dt = time_shift is the truth).
+  livo::sim::CameraImage rendered(double t, uint64_t k, double time_shift = 0.0) const {
+    return renderer_->render(*setup_.scene, *setup_.trajectory, t + time_shift, utime(t),
                              livo::sim::Random(setup_.options.seed, 7, k));
   }
-  livo::vio::GreyImage image(double t, uint64_t k) const {
-    const livo::sim::CameraImage c = rendered(t, k);
+  livo::vio::GreyImage image(double t, uint64_t k, double time_shift = 0.0) const {
+    const livo::sim::CameraImage c = rendered(t, k, time_shift);
     livo::vio::GreyImage g;
     g.utime = c.utime;
     g.exposure_time = c.exposure_time;
@@ -97,9 +106,12 @@ class SimScene {
   std::unique_ptr<livo::sim::LidarScanner> scanner_;
 };
 
-/// A prior covariance: rotation std rot_std (rad), position pos_std (m), the rest loose.
-inline livo::Mat18 priorCovariance(double rot_std, double pos_std) {
-  livo::Mat18 P = livo::Mat18::Identity() * 1e-2;
+/// A prior covariance: rotation std rot_std (rad), position pos_std (m), the rest of the navigation
+/// state loose; the LiDAR's and the camera's calibration held fixed (zero rows and columns: the rig's
+/// values are exact unless a test gives them a prior, livo::setCalibrationPrior).
+inline livo::StateCovariance priorCovariance(double rot_std, double pos_std) {
+  livo::StateCovariance P = livo::StateCovariance::Zero();
+  P.topLeftCorner<livo::FilterState::kNavDim, livo::FilterState::kNavDim>() = livo::Mat18::Identity() * 1e-2;
   P.block<3, 3>(0, 0) = livo::Mat3::Identity() * rot_std * rot_std;
   P.block<3, 3>(3, 3) = livo::Mat3::Identity() * pos_std * pos_std;
   P.block<3, 3>(6, 6) = livo::Mat3::Identity() * 0.05;

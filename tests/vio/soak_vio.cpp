@@ -46,6 +46,7 @@
 #include "livo/lio/lio_estimator.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/message_checks.hpp"
+#include "livo/messages.hpp"
 #include "livo/time.hpp"
 #include "livo/vio/grey_image.hpp"
 #include "livo/vio/vio_config.hpp"
@@ -108,12 +109,14 @@ class LivoDriver : public livo_soak::SimLioDriver {
       resetAll("propagation to the image time failed" + (note.empty() ? std::string() : " (" + note + ")"));
       return;
     }
-    const filter_state_t prior = livo::toFilterState(t, lio.state(), lio.covariance(), next_request_id_++, lio_name_);
+    // with the body rate at the image (the camera's time shift and a rolling shutter need it)
+    const filter_state_t prior =
+        livo::toFilterState(t, lio.state(), lio.covariance(), next_request_id_++, lio_name_, lio.bodyRate());
     ++priors_;
     ++period_.priors;
     const filter_state_t posterior = answer(prior, image);
     livo::FilterState x;
-    livo::Mat18 P;
+    livo::StateCovariance P;
     std::string why;
     if (posterior.valid && livo::fromFilterState(posterior, &x, &P) && lio.adoptPosterior(posterior.utime, x, P, &why)) {
       ++adopted_;
@@ -143,11 +146,11 @@ class LivoDriver : public livo_soak::SimLioDriver {
     grey.utime = c.utime + vio_offset_us_;
     if (std::llabs(grey.utime - prior.utime) > tolerance_us_) return keep(prior, "no image at the prior's time");
     livo::FilterState x;
-    livo::Mat18 P;
+    livo::StateCovariance P;
     std::string why;
     if (!livo::vio::priorFromMessage(prior, &x, &P, &why)) return keep(prior, why);
     const auto t0 = std::chrono::steady_clock::now();
-    const livo::vio::ImageResult r = vio_.processImage(grey, x, P);
+    const livo::vio::ImageResult r = vio_.processImage(grey, x, P, livo::vec3From(prior.angular_velocity));
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     period_.image.add(s);
     image_total_.add(s);

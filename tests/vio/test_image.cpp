@@ -111,14 +111,36 @@ TEST(VioImage, StoredPatchAndIdentityWarpReproduceTheImage) {
   ASSERT_TRUE(extractStoredPatches(pyr, u0, 3, stored.data()));
   float warped[kPatchArea];
   for (int l = 0; l < 3; ++l) {
-    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), warped));
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero(),
+                                   warped));
     const Eigen::Vector2d ul = ImagePyramid::toLevel(u0, l);
     for (int j = 0; j < kPatch; ++j)
       for (int i = 0; i < kPatch; ++i)
         EXPECT_NEAR(warped[j * kPatch + i], pyr.sample(l, ul.x() + i - 3.5, ul.y() + j - 3.5), 0.51);
+    // re-centred by a whole-pixel shift (level pixels): the image around the shifted point (the
+    // stored samples themselves: a fractional shift interpolates between them, not the image)
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(),
+                                   Eigen::Vector2d(2.0, -3.0), warped));
+    for (int j = 0; j < kPatch; ++j)
+      for (int i = 0; i < kPatch; ++i)
+        EXPECT_NEAR(warped[j * kPatch + i], pyr.sample(l, ul.x() + 2.0 + i - 3.5, ul.y() - 3.0 + j - 3.5), 0.51);
+    // the derivative of each sample along a (fractional) shift: that of the bilinear interpolant
+    const Eigen::Vector2d shift(1.6, -2.3);
+    float gx[kPatchArea], gy[kPatchArea], ahead[kPatchArea];
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), shift, warped, gx, gy));
+    const double h = 0.01;  // within one bilinear cell: the interpolant is linear in each coordinate
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(),
+                                   shift + Eigen::Vector2d(h, 0.0), ahead));
+    for (int k = 0; k < kPatchArea; ++k) EXPECT_NEAR(gx[k], (ahead[k] - warped[k]) / h, 1e-2) << k;
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(),
+                                   shift + Eigen::Vector2d(0.0, h), ahead));
+    for (int k = 0; k < kPatchArea; ++k) EXPECT_NEAR(gy[k], (ahead[k] - warped[k]) / h, 1e-2) << k;
   }
-  // a warp scaling by 2 needs offsets up to 7 > the stored margin
-  EXPECT_FALSE(warpReferencePatch(stored.data(), 2.0 * Eigen::Matrix2d::Identity(), warped));
+  // the stored patch leaves a margin of (kStored - kPatch) / 2 = 4 pixels: a warp scaling by 2.5
+  // needs offsets up to 8.75 > 7.5 from its centre, and so does a shift of 4.5 with the identity
+  EXPECT_FALSE(warpReferencePatch(stored.data(), 2.5 * Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero(), warped));
+  EXPECT_TRUE(warpReferencePatch(stored.data(), Eigen::Matrix2d::Identity(), Eigen::Vector2d(-4.0, 4.0), warped));
+  EXPECT_FALSE(warpReferencePatch(stored.data(), Eigen::Matrix2d::Identity(), Eigen::Vector2d(4.5, 0.0), warped));
   EXPECT_FALSE(extractStoredPatches(pyr, Eigen::Vector2d(10.0, 60.0), 3, stored.data()));  // too near the border
 }
 
@@ -144,18 +166,23 @@ TEST(VioImage, VectorisedSamplingIsTheScalarFormulaBitForBit) {
         (*out)[static_cast<size_t>(j * n + i)] = w00 * r0[0] + w10 * r0[1] + w01 * r1[0] + w11 * r1[1];
       }
   };
-  auto warpReference = [](const uint8_t* stored, const Eigen::Matrix2d& A, float* out) {
+  // (the shift re-centring the reference, and the samples' derivatives along it, added since)
+  auto warpReference = [](const uint8_t* stored, const Eigen::Matrix2d& A, const Eigen::Vector2d& shift, float* out,
+                          float* gx, float* gy) {
     const double c = 0.5 * (kStored - 1), h = 0.5 * (kPatch - 1);
+    const double cx = c + shift.x(), cy = c + shift.y();
     for (int j = 0; j < kPatch; ++j)
       for (int i = 0; i < kPatch; ++i) {
         const double dx = i - h, dy = j - h;
-        const double x = c + A(0, 0) * dx + A(0, 1) * dy, y = c + A(1, 0) * dx + A(1, 1) * dy;
+        const double x = cx + A(0, 0) * dx + A(0, 1) * dy, y = cy + A(1, 0) * dx + A(1, 1) * dy;
         const int ix = std::min(static_cast<int>(x), kStored - 2), iy = std::min(static_cast<int>(y), kStored - 2);
         const float ax = static_cast<float>(x - ix), ay = static_cast<float>(y - iy);
         const uint8_t* r0 = stored + iy * kStored + ix;
         const uint8_t* r1 = r0 + kStored;
         out[j * kPatch + i] =
             (1 - ax) * (1 - ay) * r0[0] + ax * (1 - ay) * r0[1] + (1 - ax) * ay * r1[0] + ax * ay * r1[1];
+        gx[j * kPatch + i] = (1 - ay) * (r0[1] - r0[0]) + ay * (r1[1] - r1[0]);
+        gy[j * kPatch + i] = (1 - ax) * (r1[0] - r0[0]) + ax * (r1[1] - r0[1]);
       }
   };
   std::mt19937 rng(7);
@@ -179,10 +206,19 @@ TEST(VioImage, VectorisedSamplingIsTheScalarFormulaBitForBit) {
     if (!extractStoredPatches(pyr, centre * static_cast<double>(1 << level), 1, stored.data())) continue;
     Eigen::Matrix2d A;
     A << 0.7 + 0.6 * u(rng), 0.4 * (u(rng) - 0.5), 0.4 * (u(rng) - 0.5), 0.7 + 0.6 * u(rng);
-    float warped[kPatchArea], scalar[kPatchArea];
-    if (!warpReferencePatch(stored.data(), A, warped)) continue;
-    warpReference(stored.data(), A, scalar);
-    ASSERT_EQ(std::memcmp(warped, scalar, sizeof(warped)), 0) << "A\n" << A;
+    // half the trials re-centred by a shift of up to 1.5 pixels
+    const Eigen::Vector2d shift = trial % 2 == 0 ? Eigen::Vector2d::Zero()
+                                                 : Eigen::Vector2d(3.0 * (u(rng) - 0.5), 3.0 * (u(rng) - 0.5));
+    float warped[kPatchArea], scalar[kPatchArea], gx[kPatchArea], gy[kPatchArea], sgx[kPatchArea], sgy[kPatchArea];
+    if (!warpReferencePatch(stored.data(), A, shift, warped, gx, gy)) continue;
+    warpReference(stored.data(), A, shift, scalar, sgx, sgy);
+    ASSERT_EQ(std::memcmp(warped, scalar, sizeof(warped)), 0) << "A\n" << A << "\nshift " << shift.transpose();
+    ASSERT_EQ(std::memcmp(gx, sgx, sizeof(gx)), 0) << "A\n" << A << "\nshift " << shift.transpose();
+    ASSERT_EQ(std::memcmp(gy, sgy, sizeof(gy)), 0) << "A\n" << A << "\nshift " << shift.transpose();
+    // without the derivatives: the same samples
+    float plain[kPatchArea];
+    ASSERT_TRUE(warpReferencePatch(stored.data(), A, shift, plain));
+    ASSERT_EQ(std::memcmp(plain, warped, sizeof(plain)), 0);
     ++warps;
   }
   EXPECT_GT(grids, 600);  // the trials did exercise both paths

@@ -82,26 +82,28 @@ registered_scan_t scanMsg(int64_t utime, const std::vector<Vec3>& points, const 
   return s;
 }
 
-filter_state_t priorMsg(int64_t utime, int64_t id, const FilterState& x, const Mat18& P) {
-  return toFilterState(utime, x, P, id, "lio");
+// A prior as lio sends it: with the body rate at its time (the true one here).
+filter_state_t priorMsg(int64_t utime, int64_t id, const FilterState& x, const StateCovariance& P) {
+  const double t = static_cast<double>(utime - scene().utime(0.0)) * 1e-6;
+  return toFilterState(utime, x, P, id, "lio", scene().bodyRate(t));
 }
 
 FilterState offsetState(const FilterState& x) {
-  Vec18 d = Vec18::Zero();
+  StateVector d = StateVector::Zero();
   d.head<3>() = Vec3(0.2, 0.3, -0.1).normalized() * (0.4 * M_PI / 180.0);
   d.segment<3>(3) = Vec3(-0.01, 0.02, 0.01).normalized() * 0.025;
   return x.boxplus(d);
 }
 
-const Mat18& priorP() {
-  static const Mat18 P = livo_test::priorCovariance(1.0 * M_PI / 180.0, 0.05);
+const StateCovariance& priorP() {
+  static const StateCovariance P = livo_test::priorCovariance(1.0 * M_PI / 180.0, 0.05);
   return P;
 }
 
 // The seed's prior is the truth, and its covariance says so (0.03 deg, 1 mm): the references cut
 // there carry it (vio.update.reference_floor).
-const Mat18& seedP() {
-  static const Mat18 P = livo_test::priorCovariance(5e-4, 0.001);
+const StateCovariance& seedP() {
+  static const StateCovariance P = livo_test::priorCovariance(5e-4, 0.001);
   return P;
 }
 
@@ -175,9 +177,7 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
       "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3, covariance: full}\n"
-      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n"
-      "  calibration: {camera_rotation_std_deg: 0.3, camera_rotation_walk_deg: 0.002, camera_translation_std: 0.01,\n"
-      "                time_offset_std: 0.002, time_offset_walk: 0.0002}\n")));
+      "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n")));
   EXPECT_EQ(o.name, "vio2");
   EXPECT_EQ(o.state_prior_channel, "PRIOR2");
   EXPECT_DOUBLE_EQ(o.vio.map.voxel_size, 0.25);
@@ -188,48 +188,40 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_DOUBLE_EQ(o.vio.maintenance.min_gradient, 4.0);
   EXPECT_DOUBLE_EQ(o.vio.maintenance.refresh_angle_deg, 12.0);
   EXPECT_DOUBLE_EQ(o.vio.selection.depth_edge_radius_px, 20.0);
-  EXPECT_DOUBLE_EQ(d.vio.calibration.camera_rotation_std_deg, 0.0);  // off unless asked for
-  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_std_deg, 0.3);
-  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_rotation_walk_deg, 0.002);
-  EXPECT_DOUBLE_EQ(o.vio.calibration.camera_translation_std, 0.01);
-  EXPECT_DOUBLE_EQ(o.vio.calibration.time_offset_std, 0.002);
-  EXPECT_DOUBLE_EQ(o.vio.calibration.time_offset_walk, 0.0002);
-  EXPECT_FALSE(d.vio.calibration.any());
   EXPECT_EQ(d.vio.update.covariance, CovarianceUpdate::kBeyondPrior);
   EXPECT_EQ(o.vio.update.covariance, CovarianceUpdate::kFull);
   EXPECT_DOUBLE_EQ(d.vio.map.plane_snap_max_rms, 0.0);  // off unless asked for
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  update: {covariance: half}\n"))), ConfigError);
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {time_offset_std: 0.5}\n"))),
-               ConfigError);
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  calibration: {camera_rotation_std_deg: -1}\n"))),
-               ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
-  // the camera rotation from image pairs: off unless asked for, strict, and not beside the
-  // photometric rotation estimate
-  EXPECT_FALSE(d.vio.rotation_calibration.enabled);
-  const VioNodeOptions rc = readVioNodeOptions(Config::fromString(
-      roomConfig("vio:\n  rotation_calibration: {enabled: true, min_baseline: 0.2, window_pairs: 500, apply_std_deg: 0.04}\n")));
-  EXPECT_TRUE(rc.vio.rotation_calibration.enabled);
-  EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.min_baseline, 0.2);
-  EXPECT_EQ(rc.vio.rotation_calibration.window_pairs, 500);
-  EXPECT_DOUBLE_EQ(rc.vio.rotation_calibration.apply_std_deg, 0.04);
-  EXPECT_EQ(rc.vio.rotation_calibration.against, RotationCalibrationOptions::Against::kCameraFree);
-  EXPECT_FALSE(rc.vio.rotation_calibration.adopt);  // reported, not used, unless asked for
-  EXPECT_EQ(rc.camera_free_state_channel, "STATE_CAMERA_FREE");
-  const VioNodeOptions rf = readVioNodeOptions(Config::fromString(
-      roomConfig("vio:\n  channels: {camera_free_state: FREE2}\n  rotation_calibration: {against: filter, adopt: true}\n")));
-  EXPECT_EQ(rf.vio.rotation_calibration.against, RotationCalibrationOptions::Against::kFilter);
-  EXPECT_TRUE(rf.vio.rotation_calibration.adopt);
-  EXPECT_EQ(rf.camera_free_state_channel, "FREE2");
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {against: lidar}\n"))),
-               ConfigError);
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {min_pairs: 400}\n"))),
-               ConfigError);
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig(
-                   "vio:\n  rotation_calibration: {enabled: true}\n  calibration: {camera_rotation_std_deg: 0.3}\n"))),
-               ConfigError);
-  EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  rotation_calibration: {enable: true}\n"))),
-               ConfigError);
+  // the map points are LiDAR returns: known to the rig's range noise unless vio.photometric.point_std says
+  EXPECT_DOUBLE_EQ(d.vio.photometric.point_std, 0.01);  // rig.lidar.range_noise_std
+  // the consistency gate and the calibration's share of an image's information
+  const VioNodeOptions g = readVioNodeOptions(Config::fromString(roomConfig(
+      "vio:\n  photometric: {point_std: 0.02, reference_rotation_std_deg: 0.05, reference_translation_std: 0.002,\n"
+      "                reference_translation_per_m: 0.01}\n"
+      "  update: {gate_probability: 0.99, calibration_information_scale: 0.1}\n")));
+  EXPECT_DOUBLE_EQ(g.vio.photometric.point_std, 0.02);
+  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_rotation_std_deg, 0.05);
+  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_translation_std, 0.002);
+  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_translation_per_m, 0.01);
+  EXPECT_DOUBLE_EQ(g.vio.update.gate_probability, 0.99);
+  EXPECT_DOUBLE_EQ(g.vio.update.calibration_information_scale, 0.1);
+  EXPECT_DOUBLE_EQ(d.vio.update.gate_probability, 0.999);
+  // the keys of what was removed (the camera's calibration is now the filter's state, the body rate
+  // comes with the prior, the Mahalanobis test is the consistency gate) are unknown keys: refused
+  for (const char* removed :
+       {"vio:\n  calibration: {camera_rotation_std_deg: 0.3}\n", "vio:\n  calibration: {time_offset_std: 0.002}\n",
+        "vio:\n  rotation_calibration: {enabled: true}\n", "vio:\n  rotation_calibration: {against: filter}\n",
+        "vio:\n  update: {calibration_rotation_std_deg: 0.3}\n", "vio:\n  update: {max_mahalanobis: 50}\n",
+        "vio:\n  channels: {imu: IMU}\n", "vio:\n  channels: {camera_free_state: STATE_CAMERA_FREE}\n"}) {
+    try {
+      readVioNodeOptions(Config::fromString(roomConfig(removed)));
+      ADD_FAILURE() << "accepted a removed key: " << removed;
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("unknown key"), std::string::npos) << removed << " -> " << what;
+    }
+  }
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  photometric: {pyramid_levels: 7}\n"))),
                ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  image_buffer_s: -1\n"))), ConfigError);
@@ -262,6 +254,10 @@ TEST(VioNode, AnswersEveryPriorOnceWithItsRequestIdAndUpdates) {
   EXPECT_EQ(h.posteriors[0].valid, 0);  // nothing in the map yet
   EXPECT_EQ(h.posteriors[0].source, "vio");
   EXPECT_GT(h.vio->estimator().map().size(), 50u);
+  // the body rate is the prior's (filter_state_t.angular_velocity): the patches cut keep it
+  const Vec3 rate = vec3From(priorMsg(s.utime(kT0), 41, s.trueState(kT0), seedP()).angular_velocity);
+  EXPECT_GT(rate.norm(), 0.0);
+  for (const MapPoint& m : h.vio->estimator().map().points()) EXPECT_EQ(m.observations[0].view.omega_I, rate);
 
   const FilterState truth = s.trueState(kT1), prior = offsetState(truth);
   h.send("CAMERA", imageMsg(rendered(1), s.utime(kT1)));
@@ -278,10 +274,18 @@ TEST(VioNode, AnswersEveryPriorOnceWithItsRequestIdAndUpdates) {
   EXPECT_LT(positionError(post, truth), 0.005);
   EXPECT_LT(so3::Log(truth.rot.transpose() * quatFromWxyz(post.orientation).toRotationMatrix()).norm(),
             0.1 * M_PI / 180.0);
-  // the covariance shrank on the pose
-  const Mat18 P = matrixFrom<18>(post.covariance);
+  // the covariance shrank on the pose; the calibration the prior holds fixed (zero rows and columns)
+  // is left so, and the camera's extrinsic and time shift come back as the prior's
+  const StateCovariance P = matrixFrom<FilterState::kDim>(post.covariance);
   const double trace_post = P.topLeftCorner<6, 6>().trace(), trace_prior = priorP().topLeftCorner<6, 6>().trace();
   EXPECT_LT(trace_post, 0.5 * trace_prior);
+  EXPECT_TRUE(P.rightCols<2 * FilterState::kCalibrationDim>().isZero(0.0));
+  EXPECT_TRUE(isUsableCovariance(P));
+  FilterState x_post;
+  StateCovariance P_post;
+  ASSERT_TRUE(fromFilterState(post, &x_post, &P_post));
+  EXPECT_TRUE(x_post.camera.pose().isApprox(s.camera().T_I_C, 1e-12));
+  EXPECT_EQ(x_post.camera.dt, 0.0);
   EXPECT_EQ(h.vio->counts().priors, 2);
   EXPECT_EQ(h.vio->counts().updated, 1);
   EXPECT_EQ(h.vio->counts().kept, 1);
@@ -315,8 +319,8 @@ TEST(VioNode, APriorWithoutItsImageIsKeptWhenANewerImageOrPriorComes) {
   EXPECT_EQ(h.posteriors[1].valid, 0);
   EXPECT_EQ(h.posteriors[1].utime, s.utime(kT1));
   // the kept prior is echoed
-  EXPECT_EQ(std::vector<double>(h.posteriors[1].covariance, h.posteriors[1].covariance + 324),
-            std::vector<double>(priorP().data(), priorP().data() + 324));
+  EXPECT_EQ(std::vector<double>(h.posteriors[1].covariance, h.posteriors[1].covariance + FilterState::kDim * FilterState::kDim),
+            std::vector<double>(priorP().data(), priorP().data() + FilterState::kDim * FilterState::kDim));
   // the image of kT2 still serves its own prior
   h.send("STATE_PRIOR", priorMsg(s.utime(kT2), 3, offsetState(s.trueState(kT2)), priorP()));
   ASSERT_EQ(h.posteriors.size(), 3u);

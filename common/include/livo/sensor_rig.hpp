@@ -36,6 +36,16 @@ struct ImuRig {
   double gravity = 9.81;                // m/s^2, world z up
 };
 
+/// How well a sensor's calibration is known (1-sigma per axis; 0: exact): the extrinsic's rotation
+/// and translation and the time offset. livo-lio estimates what is not exact, with this as the
+/// prior (design.md, "Calibration in the filter"). Key `calibration_std` of a lidar or camera.
+struct CalibrationUncertainty {
+  double rotation_deg = 0.0;
+  double translation = 0.0;    // m
+  double time_offset_s = 0.0;  // s
+  bool any() const { return rotation_deg > 0.0 || translation > 0.0 || time_offset_s > 0.0; }
+};
+
 struct LidarRig {
   std::string model = "VLP-16";  // one of kLidarModels
   double rate_hz = 10.0;
@@ -44,6 +54,7 @@ struct LidarRig {
   double range_noise_std = 0.01;      // m
   double dropout_probability = 0.0;
   Pose3 T_I_L = Pose3::Identity();    // p_I = T_I_L * p_L
+  CalibrationUncertainty calibration_std;  // of T_I_L and the LiDAR's time offset (0: exact)
 };
 
 /// The lens distortion of a CameraRig, as OpenCV and Kalibr name them.
@@ -69,6 +80,7 @@ struct CameraRig {
   double time_offset_s = 0.0;         // image utime + time_offset_s = the same instant on the IMU clock
   double rolling_shutter_s = 0.0;     // readout time, first to last row (0: global shutter); the
                                       // stamp is the centre row's
+  CalibrationUncertainty calibration_std;  // of T_I_C and time_offset_s (0: exact)
 };
 
 /// Differential-drive wheel encoder; base frame B: x forward, z up.

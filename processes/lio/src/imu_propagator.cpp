@@ -4,7 +4,7 @@ namespace livo::lio {
 
 FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt) {
   // f(x, u, 0) of eq. (4), applied with ⊞ as eq. (3)/(5).
-  Vec18 f = Vec18::Zero();
+  StateVector f = StateVector::Zero();
   f.segment<3>(FilterState::kRot) = gyro - x.gyro_bias;
   f.segment<3>(FilterState::kPos) = x.vel;
   f.segment<3>(FilterState::kVel) = x.rot * (accel - x.accel_bias) + x.gravity;
@@ -48,14 +48,14 @@ Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt, const Vec3& omega) {
   return Q;
 }
 
-void ImuPropagator::reset(const FilterState& x, const Mat18& P, const ImuSample& last) {
+void ImuPropagator::reset(const FilterState& x, const StateCovariance& P, const ImuSample& last) {
   x_ = x;
   P_ = P;
   last_ = last;
   segments_.clear();
 }
 
-void ImuPropagator::setState(const FilterState& x, const Mat18& P) {
+void ImuPropagator::setState(const FilterState& x, const StateCovariance& P) {
   x_ = x;
   P_ = P;
 }
@@ -79,8 +79,14 @@ void ImuPropagator::step(const ImuSample& next) {
     Mat18x12 Fw;
     propagationJacobians(x_, gyro, accel, dt, &Fx, &Fw);
     x_ = propagateState(x_, gyro, accel, dt);
-    P_ = Fx * P_ * Fx.transpose() + Fw * discreteNoiseCovariance(noise_, dt, seg.omega) * Fw.transpose();
-    P_ = 0.5 * (P_ + P_.transpose());
+    // [A B; B^T C] -> [F A F^T + Fw Q Fw^T, F B; (F B)^T, C]: the calibration is constant
+    constexpr int n = FilterState::kNavDim, c = FilterState::kDim - FilterState::kNavDim;
+    Mat18 A = Fx * P_.topLeftCorner<n, n>() * Fx.transpose() +
+              Fw * discreteNoiseCovariance(noise_, dt, seg.omega) * Fw.transpose();
+    P_.topLeftCorner<n, n>() = 0.5 * (A + A.transpose());
+    const Eigen::Matrix<double, n, c> B = Fx * P_.topRightCorner<n, c>();
+    P_.topRightCorner<n, c>() = B;
+    P_.bottomLeftCorner<c, n>() = B.transpose();
   }
   last_ = next;
 }

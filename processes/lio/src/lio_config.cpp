@@ -1,6 +1,8 @@
 #include "livo/lio/lio_config.hpp"
 
+#include <cmath>
 #include <ostream>
+#include <sstream>
 
 #include "livo/sensor_rig.hpp"
 
@@ -11,7 +13,15 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   LioOptions& l = o->lio;
   // The rig is validated as every other process validates it (a model name, ranges and noise the
   // LIO itself does not read are still errors here); the LIO then reads what it uses.
-  (void)readSensorRig(rig);
+  const SensorRig sensors = readSensorRig(rig);
+  auto stdOf = [](const CalibrationUncertainty& u) {
+    return CalibrationStd{u.rotation_deg * M_PI / 180.0, u.translation, u.time_offset_s};
+  };
+  if (sensors.lidar) l.lidar_calibration_std = stdOf(sensors.lidar->calibration_std);
+  if (sensors.camera) {
+    l.camera_T_I_C = sensors.camera->T_I_C;
+    l.camera_calibration_std = stdOf(sensors.camera->calibration_std);
+  }
   const Config ch = rig.optionalSection("channels");
   ch.readOptional("imu", o->imu_channel);
   ch.readOptional("lidar", o->lidar_channel);
@@ -75,7 +85,7 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("imu_max_acceleration", o->imu_max_acceleration);
   c.readOptional("max_pending_scans", o->max_pending_scans);
   c.readOptional("camera_handoff", o->camera_handoff);
-  c.readOptional("camera_free_state", o->camera_free_state);
+  c.readOptional("output_dir", o->output_dir);
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
   c.readOptional("image_lidar_wait_s", o->image_lidar_wait_s);
   c.readOptional("image_max_wait_s", o->image_max_wait_s);
@@ -87,7 +97,6 @@ void readLio(const Config& c, LioNodeOptions* o) {
   out.readOptional("registered_scan", o->registered_scan_channel);
   out.readOptional("keyframe", o->keyframe_channel);
   out.readOptional("state_prior", o->state_prior_channel);
-  out.readOptional("camera_free_state", o->camera_free_state_channel);
 
   const Config init = c.optionalSection("init");
   std::string mode;
@@ -103,6 +112,13 @@ void readLio(const Config& c, LioNodeOptions* o) {
   init.readOptional("moving_vel_std", l.init.moving_vel_std);
 
   c.readOptional("lidar_time_offset_s", l.extrinsics.time_offset_s);
+  const Config cal = c.optionalSection("calibration").optionalSection("estimate");
+  cal.readOptional("lidar_rotation", l.calibration.lidar_rotation);
+  cal.readOptional("lidar_translation", l.calibration.lidar_translation);
+  cal.readOptional("lidar_time", l.calibration.lidar_time);
+  cal.readOptional("camera_rotation", l.calibration.camera_rotation);
+  cal.readOptional("camera_translation", l.calibration.camera_translation);
+  cal.readOptional("camera_time", l.calibration.camera_time);
   c.readOptional("point_stride", l.point_stride);
   c.readOptional("scan_voxel_size", l.scan_voxel_size);
   c.readOptional("min_points", l.min_points);
@@ -220,6 +236,15 @@ LioNodeOptions readLioNodeOptions(const Config& root) {
   return o;
 }
 
+namespace {
+std::string describe(const CalibrationStd& s) {
+  if (!s.any()) return "held at the rig's";
+  std::ostringstream os;
+  os << s.rotation * 180.0 / M_PI << " / " << s.translation << " / " << s.time * 1e3;
+  return os.str();
+}
+}  // namespace
+
 void printOptions(const LioNodeOptions& o, std::ostream& os) {
   const LioOptions& l = o.lio;
   const Vec3 t = l.extrinsics.T_I_L.translation();
@@ -234,6 +259,8 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << ", init window " << l.init.window_s << " s\n"
      << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["
      << l.min_range << ", " << l.max_range << "] m\n"
+     << "  calibration in the filter (1-sigma rotation deg / translation m / time ms): LiDAR "
+     << describe(l.lidar_calibration_std) << ", camera " << describe(l.camera_calibration_std) << "\n"
      << "  scan voxel " << l.scan_voxel_size << " m, stride " << l.point_stride << "; map voxel " << l.map.voxel_size
      << " m x " << l.map.max_points_per_voxel << " points, spacing " << l.map.min_point_distance << " m, radius "
      << l.map_radius << " m\n"
@@ -242,7 +269,6 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "; " << l.search_threads
      << (l.search_threads == 1 ? " search thread" : " search threads") << "\n"
      << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
-     << (o.camera_handoff && o.camera_free_state ? "; camera-free filter beside it -> " + o.camera_free_state_channel : std::string())
      << "\n"
      << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
      << (l.wheel.enabled ? "on" : "off");

@@ -44,6 +44,13 @@ LioEstimator::LioEstimator(LioOptions options)
       wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {}
 
 void LioEstimator::reset() {
+  if (initialized_ && prop_.state().lidar.rot.allFinite() && prop_.state().camera.rot.allFinite() &&
+      prop_.covariance().bottomRightCorner<14, 14>().allFinite()) {
+    // the calibration belongs to the rig, not to an odometry epoch: the next one starts from it
+    kept_calibration_ = prop_.state();
+    kept_calibration_cov_ = prop_.covariance();
+    has_kept_calibration_ = true;
+  }
   frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
   prop_ = ImuPropagator(opts_.imu_noise);
   map_.clear();
@@ -122,11 +129,47 @@ void LioEstimator::tryInitialize(std::string* note) {
                        std::find_if(init_window_.begin(), init_window_.end(), [&](const ImuSample& s) { return s.utime >= cut; }));
     return;
   }
-  prop_.reset(r.state, r.covariance, r.last);
+  prop_.reset(initialState(r), initialCovariance(r), r.last);
   initialized_ = true;
   init_window_.clear();
   imu_.clear();
   last_prune_position_ = r.state.pos;
+}
+
+void calibrationPrior(const CalibrationStd& l, const CalibrationStd& c, const CalibrationEstimation& e,
+                      CalibrationStd* lidar, CalibrationStd* camera) {
+  // a camera part estimated against a LiDAR part held: the camera against the LiDAR-registered body
+  auto against = [](bool camera_estimated, bool lidar_estimated, double cs, double ls) {
+    return camera_estimated ? (lidar_estimated ? cs : std::hypot(cs, ls)) : 0.0;
+  };
+  lidar->rotation = e.lidar_rotation ? l.rotation : 0.0;
+  lidar->translation = e.lidar_translation ? l.translation : 0.0;
+  lidar->time = e.lidar_time ? l.time : 0.0;
+  camera->rotation = against(e.camera_rotation, e.lidar_rotation, c.rotation, l.rotation);
+  camera->translation = against(e.camera_translation, e.lidar_translation, c.translation, l.translation);
+  camera->time = against(e.camera_time, e.lidar_time, c.time, l.time);
+}
+
+FilterState LioEstimator::initialState(const ImuInitResult& r) const {
+  FilterState x = r.state;
+  x.lidar = has_kept_calibration_ ? kept_calibration_.lidar : SensorCalibration::fromPose(opts_.extrinsics.T_I_L);
+  x.camera = has_kept_calibration_ ? kept_calibration_.camera : SensorCalibration::fromPose(opts_.camera_T_I_C);
+  return x;
+}
+
+StateCovariance LioEstimator::initialCovariance(const ImuInitResult& r) const {
+  constexpr int n = FilterState::kNavDim, c = FilterState::kDim - FilterState::kNavDim;
+  StateCovariance P = StateCovariance::Zero();
+  P.topLeftCorner<n, n>() = r.covariance;
+  if (has_kept_calibration_) {
+    P.bottomRightCorner<c, c>() = kept_calibration_cov_.bottomRightCorner<c, c>();
+  } else {
+    CalibrationStd lidar, camera;
+    calibrationPrior(opts_.lidar_calibration_std, opts_.camera_calibration_std, opts_.calibration, &lidar, &camera);
+    setCalibrationPrior(FilterState::kLidar, lidar, &P);
+    setCalibrationPrior(FilterState::kCamera, camera, &P);
+  }
+  return P;
 }
 
 double LioEstimator::scanEndOffset(const LidarScan& scan) const {
@@ -152,7 +195,7 @@ void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note
   // the velocity the LiDAR saw between the last two registered sweeps, if recent
   if (has_prev_post_ && prop_.utime() - prev_post_utime_ > 0 && prop_.utime() - prev_post_utime_ < 500'000)
     x.vel = (x.pos - prev_post_pos_) / (static_cast<double>(prop_.utime() - prev_post_utime_) * 1e-6);
-  Mat18 P = prop_.covariance();
+  StateCovariance P = prop_.covariance();
   P.middleRows<3>(FilterState::kVel).setZero();
   P.middleCols<3>(FilterState::kVel).setZero();
   const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
@@ -167,7 +210,7 @@ void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note
 void LioEstimator::widenForGap(double gap_s) {
   // a bridged gap: the interpolated IMU says little about the motion, so widen the pose and the
   // velocity by what the body may have done meanwhile
-  Mat18 P = prop_.covariance();
+  StateCovariance P = prop_.covariance();
   const double v = opts_.init.moving_vel_std;
   const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * gap_s);
   P.block<3, 3>(FilterState::kPos, FilterState::kPos) += Mat3::Identity() * v * v * gap_s * gap_s;
@@ -291,7 +334,7 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   std::vector<Vec3> world(body.size());
   for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
   // the beams leave the LiDAR where it is at the sweep end (the frame the sweep is undistorted to)
-  const Vec3 lidar = x.rot * opts_.extrinsics.T_I_L.translation() + x.pos;
+  const Vec3 lidar = x.rot * x.lidar.pos + x.pos;
   const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through, search_threads_.get());
   map_.insert(world, lidar);
   return removed;
@@ -330,7 +373,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     return res;
   }
   FilterState x = prop_.state();
-  Mat18 P = prop_.covariance();
+  StateCovariance P = prop_.covariance();
 
   // 2. valid points, undistorted into the body frame at the end
   validPoints(scan, end_offset, note);
@@ -351,7 +394,10 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
 
   // 5. LiDAR update or map seeding
   reseedAfterOutage(t_end, &x, &P, note);
+  const SensorCalibration undistorted_with = x.lidar;
+  body_rate_ = prop_.lastSample().gyro - x.gyro_bias;
   res.status = lidarStage(reg, valid.size(), &x, &P, &res);
+  toBodyAtSweepEnd(undistorted_with, x);
   noteRegistration(res.status, x, t_end);
   prop_.setState(x, P);
   res.utime = t_end;
@@ -402,14 +448,26 @@ void LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::st
 
 void LioEstimator::undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first,
                                        int64_t t_end) {
+  const Pose3 T_I_L = at_end.lidar.pose();
   if (!prop_.segments().empty()) {
-    const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, opts_.extrinsics.T_I_L);
+    const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, T_I_L);
     und.undistort(scan, t_first, valid_, &body_);
   } else {
     body_.clear();
-    for (size_t j : valid_) body_.push_back(opts_.extrinsics.T_I_L * scan.points[j]);
+    for (size_t j : valid_) body_.push_back(T_I_L * scan.points[j]);
   }
   prop_.clearSegments();
+}
+
+void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x) {
+  // body_ and reg_ hold the points through the calibration of the undistortion, as if taken at the
+  // filter's time; the sweep was seen through x's extrinsic at the state's time plus the time shift
+  // (ScanToMap): A = T_W_I^-1 T_W_I(end) T_I_L(x) T_I_L(undistortion)^-1
+  const bool same = x.lidar.dt == 0.0 && x.lidar.rot == undistorted_with.rot && x.lidar.pos == undistorted_with.pos;
+  if (same) return;
+  const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate_) * x.lidar.pose() * undistorted_with.pose().inverse();
+  for (Vec3& p : body_) p = A * p;
+  for (Vec3& p : reg_) p = A * p;
 }
 
 void LioEstimator::registrationSubset() {
@@ -425,7 +483,7 @@ void LioEstimator::registrationSubset() {
   for (size_t i : subset) reg_.push_back(body_[i]);
 }
 
-bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel,
+bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel,
                                       std::string* note) {
   bool has_travel = false;
   if (opts_.wheel_scale.enabled && has_scale_anchor_)
@@ -447,7 +505,7 @@ bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, W
   return has_travel;
 }
 
-void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, Mat18* P, std::string* note) {
+void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, StateCovariance* P, std::string* note) {
   // After reseed_after_s without a registration (a LiDAR outage, lost track) the map no longer
   // fits the predicted pose: a new one is seeded there, so the trajectory goes on from the
   // prediction instead of restarting at the origin.
@@ -464,7 +522,7 @@ void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, Mat18* P, st
   appendNote(note, "no registration for " + formatSignificant(lost_s) + " s: map re-seeded at the predicted pose");
 }
 
-ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, Mat18* P,
+ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, StateCovariance* P,
                                             ScanResult* res) {
   std::string* note = &res->message;
   ScanResult::Status status;
@@ -488,14 +546,15 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
   return status;
 }
 
-ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, Mat18* P,
+ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P,
                                                ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, reg, opts_.matching, search_threads_.get());
+  ScanToMap s2m(map_, reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
   FilterState post;
-  Mat18 P_post;
+  StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
-      *x, *P, [&](const FilterState& xi, int it, PoseInformation* info) { return s2m.evaluate(xi, it, info); },
+      *x, *P,
+      [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m.evaluate(xi, it, info); },
       opts_.esikf, &post, &P_post);
   const ScanToMap* fitted = &s2m;
   std::optional<ScanToMap> s2m_still;
@@ -507,12 +566,12 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, Fil
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, reg, opts_.matching, search_threads_.get());
+    s2m_still.emplace(map_, reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
     FilterState post_still;
-    Mat18 P_still;
+    StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(
         still, *P,
-        [&](const FilterState& xi, int it, PoseInformation* info) { return s2m_still->evaluate(xi, it, info); },
+        [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m_still->evaluate(xi, it, info); },
         opts_.esikf, &post_still, &P_still);
     if (er_still.valid && er_still.info.count > (er.valid ? er.info.count : 0) * 11 / 10) {
       appendNote(note, "after the IMU gap the sweep fits the map better as if no time had passed (" +
@@ -563,7 +622,7 @@ void LioEstimator::noteRegistration(ScanResult::Status status, const FilterState
 }
 
 Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid,
-                                    const std::vector<Vec3>& body, const FilterState& x, const Mat18& P, int64_t t_end) {
+                                    const std::vector<Vec3>& body, const FilterState& x, const StateCovariance& P, int64_t t_end) {
   Keyframe kf;
   kf.id = next_keyframe_id_++;
   kf.utime = t_end;
@@ -594,7 +653,7 @@ bool LioEstimator::propagateTo(int64_t utime, std::string* why) {
   return ok;
 }
 
-bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat18& P, std::string* why) {
+bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const StateCovariance& P, std::string* why) {
   auto fail = [&](const char* w) {
     if (why) *why = w;
     return false;
@@ -602,18 +661,24 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Mat
   if (!initialized_) return fail("not initialised");
   if (utime != prop_.utime()) return fail("posterior time differs from the filter time");
   if (!x.rot.allFinite() || !x.pos.allFinite() || !x.vel.allFinite() || !x.gyro_bias.allFinite() ||
-      !x.accel_bias.allFinite() || !x.gravity.allFinite() || !P.allFinite())
+      !x.accel_bias.allFinite() || !x.gravity.allFinite() || !x.lidar.rot.allFinite() || !x.lidar.pos.allFinite() ||
+      !std::isfinite(x.lidar.dt) || !x.camera.rot.allFinite() || !x.camera.pos.allFinite() ||
+      !std::isfinite(x.camera.dt) || !P.allFinite())
     return fail("non-finite posterior");
-  if ((x.rot.transpose() * x.rot - Mat3::Identity()).norm() > 1e-6) return fail("posterior rotation not orthonormal");
-  if (Eigen::LLT<Mat18>(0.5 * (P + P.transpose())).info() != Eigen::Success)
-    return fail("posterior covariance not positive definite");
+  for (const Mat3* R : {&x.rot, &x.lidar.rot, &x.camera.rot})
+    if ((R->transpose() * *R - Mat3::Identity()).norm() > 1e-6) return fail("posterior rotation not orthonormal");
+  const StateCovariance Ps = 0.5 * (P + P.transpose());
+  if (!isUsableCovariance(Ps)) return fail("posterior covariance not positive definite");
+  // a calibration the filter holds fixed stays fixed: a posterior may not start estimating it
+  for (int i = FilterState::kNavDim; i < FilterState::kDim; ++i)
+    if ((prop_.covariance()(i, i) == 0.0) != (Ps(i, i) == 0.0)) return fail("posterior estimates a calibration the filter holds fixed");
   // the sweep in progress is undistorted along the recorded segments: move them with the state
   const FilterState& prior = prop_.state();
   Pose3 T = Pose3::Identity();
   T.linear() = x.rot * prior.rot.transpose();
   T.translation() = x.pos - T.linear() * prior.pos;
   prop_.transformSegments(T);
-  prop_.setState(x, 0.5 * (P + P.transpose()));
+  prop_.setState(x, Ps);
   return true;
 }
 
@@ -634,7 +699,7 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
     x.pos = Rc * x.pos + T.translation();
     x.vel = Rc * x.vel;
     x.gravity = Rc * x.gravity;
-    Mat18 Tm = Mat18::Identity();
+    StateCovariance Tm = StateCovariance::Identity();  // the calibration is in the body frames: unmoved
     Tm.block<3, 3>(FilterState::kPos, FilterState::kPos) = Rc;
     Tm.block<3, 3>(FilterState::kVel, FilterState::kVel) = Rc;
     Tm.block<3, 3>(FilterState::kGravity, FilterState::kGravity) = Rc;
@@ -643,10 +708,11 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
   }
   // rebuild the local map from the corrected keyframes around the new position
   map_.clear();
+  const Vec3 lidar_position = initialized_ ? prop_.state().lidar.pos : opts_.extrinsics.T_I_L.translation();
   const Vec3 here = initialized_ ? prop_.state().pos : T.translation();
   for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
     if ((it->pose.translation() - here).norm() > opts_.map_radius) continue;
-    const Vec3 lidar = it->pose * opts_.extrinsics.T_I_L.translation();
+    const Vec3 lidar = it->pose * lidar_position;
     for (const auto& p : it->cloud) {
       const Vec3 w = it->pose * p;
       map_.insert(w, (w - lidar).norm());

@@ -17,6 +17,8 @@ namespace livo::lio {
 
 namespace {
 constexpr double kWheelLogPeriodS = 30.0;  // sensor time between wheel summaries in the log
+constexpr double kCalibrationRowS = 1.0;   // ... between calibration.csv rows
+constexpr int kCalibrationLogRows = 10;    // ... rows between calibration lines in the log
 
 NodeOptions nodeOptions(const LioNodeOptions& o, bool quiet) {
   NodeOptions n;
@@ -42,10 +44,6 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
   if (opts_.lio.wheel.enabled)
     node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   if (opts_.camera_handoff) {
-    if (opts_.camera_free_state) {
-      camera_free_.emplace(opts_.lio);
-      node_.declareOutput(opts_.camera_free_state_channel);
-    }
     node_.declareOutput(opts_.state_prior_channel);
     node_.watchConsumers(opts_.state_prior_channel);
     node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
@@ -81,7 +79,6 @@ void LioNode::saveNumbering() {
 
 void LioNode::resetAll(const std::string& why) {
   lio_.reset();
-  if (camera_free_) camera_free_->reset();
   announceReset(why);
   imu_.clear();
   wheel_.clear();
@@ -219,7 +216,6 @@ void LioNode::advance() {
     imu_.popUntil(settled, [&](const TimeBuffer<ImuSample>::Entry& e) {
       std::string why;
       if (!lio_.addImu(e.value, &why)) node_.warn("IMU sample refused by the filter: " + why);
-      if (camera_free_) camera_free_->addImu(e.value);
       fed_imu_ = e.utime;
       fed_any_imu_ = true;
     });
@@ -254,7 +250,6 @@ void LioNode::advance() {
         }
       wheel_.popUntil(upto, [&](const TimeBuffer<WheelSample>::Entry& e) {
         lio_.addWheel(e.value);
-        if (camera_free_) camera_free_->addWheel(e.value);
         fed_wheel_ = e.utime;
         fed_any_wheel_ = true;
       });
@@ -398,7 +393,6 @@ void LioNode::process(const PendingScan& p) {
   const auto t0 = std::chrono::steady_clock::now();
   const int32_t epoch_before = lio_.frame().epoch;
   ScanResult r = lio_.addScan(p.scan);
-  if (camera_free_ && camera_free_->acceptsSweepEnding(camera_free_->scanEndUtime(p.scan))) camera_free_->addScan(p.scan);
   if (lio_.frame().epoch != epoch_before) announceReset(r.message.empty() ? "the filter re-initialised" : r.message);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ++sweeps_;
@@ -408,6 +402,7 @@ void LioNode::process(const PendingScan& p) {
     if (last_wheel_log_ != 0) node_.info(wheelSummary());
     last_wheel_log_ = r.utime;
   }
+  if (r.hasOutput()) reportCalibration(r.utime);
   if (!r.hasOutput()) return;
   const odometry_t odo = toOdometry(r, lio_.frame());
   if (!finiteOdometry(odo)) {
@@ -434,6 +429,47 @@ std::string LioNode::sweepSummary() const {
   return "odometry of " + std::to_string(c.published) + " sweeps: " + std::to_string(c.tracked) + " tracked, " +
          std::to_string(c.predicted) + " predicted without a LiDAR update, " + std::to_string(c.degenerate) +
          " degenerate (report.md: \"Where the estimate was weak\")";
+}
+
+bool LioNode::estimatesCalibration() const {
+  CalibrationStd lidar, camera;
+  calibrationPrior(opts_.lio.lidar_calibration_std, opts_.lio.camera_calibration_std, opts_.lio.calibration, &lidar,
+                   &camera);
+  return lidar.any() || (opts_.camera_handoff && camera.any());
+}
+
+CalibrationEstimate LioNode::calibrationEstimate() const {
+  return calibrationAgainstRig(lio_.state(), lio_.covariance(), opts_.lio.extrinsics.T_I_L, opts_.lio.camera_T_I_C);
+}
+
+std::string LioNode::calibrationSummary() const {
+  if (!lio_.initialized()) return "";
+  return "calibration: " + describe(calibrationEstimate(), opts_.camera_handoff);
+}
+
+void LioNode::reportCalibration(int64_t utime) {
+  if (!estimatesCalibration() || utime - last_calibration_log_ < toUtime(kCalibrationRowS)) return;
+  if (calibration_csv_.empty()) {
+    calibration_csv_ = calibrationCsvHeader();
+    calibration_t0_ = utime;
+  }
+  calibration_csv_ += calibrationCsvRow(toSeconds(utime - calibration_t0_), calibrationEstimate());
+  if (++calibration_rows_ % kCalibrationLogRows == 0) node_.info(calibrationSummary());
+  last_calibration_log_ = utime;
+}
+
+void LioNode::writeCalibrationFiles() {
+  if (opts_.output_dir.empty() || !estimatesCalibration() || !lio_.initialized()) return;
+  const CalibrationEstimate e = calibrationEstimate();
+  std::string error;
+  const std::string csv = opts_.output_dir + "/calibration.csv", yaml = opts_.output_dir + "/calibration.yaml";
+  if (!writeFileAtomically(csv, {calibration_csv_.empty() ? calibrationCsvHeader() : calibration_csv_}, &error) ||
+      !writeFileAtomically(yaml, {calibrationOverlay(lio_.state(), opts_.lio.extrinsics.time_offset_s,
+                                                     opts_.camera_time_offset_s, opts_.camera_handoff, e)},
+                           &error))
+    node_.error("calibration files: " + error);
+  else
+    node_.info("wrote " + csv + " and " + yaml);
 }
 
 std::string LioNode::wheelSummary() const {
@@ -471,13 +507,7 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
-  if (camera_free_ && camera_free_->tracking() && utime >= camera_free_->utime() && camera_free_->propagateTo(utime)) {
-    filter_state_t free = toFilterState(utime, camera_free_->state(), camera_free_->covariance(), id, opts_.name);
-    free.epoch = camera_free_->frame().epoch;
-    free.correction_id = camera_free_->frame().correction_id;
-    node_.publish(opts_.camera_free_state_channel, free);
-  }
-  filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name);
+  filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name, lio_.bodyRate());
   prior.epoch = lio_.frame().epoch;
   prior.correction_id = lio_.frame().correction_id;
   node_.publish(opts_.state_prior_channel, prior);
@@ -498,7 +528,7 @@ void LioNode::onPosterior(const filter_state_t& m) {
   }
   pending_.reset();
   FilterState x;
-  Mat18 P;
+  StateCovariance P;
   std::string why;
   if (!m.valid) {
     ++handoff_.kept_prior;  // the VIO kept the prior (it says why on its own HEALTH)

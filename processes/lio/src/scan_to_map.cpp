@@ -29,16 +29,20 @@ constexpr size_t kMinSearchesPerThread = 256;
 }  // namespace
 
 ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
-                     WorkerThreads* threads)
+                     WorkerThreads* threads, const SensorCalibration& undistorted_with, const Vec3& body_rate)
     : map_(map),
-      points_(body_points),
+      points_(body_points.size()),
+      body_rate_(body_rate),
       opts_(options),
       threads_(threads),
       matches_(body_points.size()),
       gate_(body_points.size()),
       world_(body_points.size()) {
-  for (size_t i = 0; i < points_.size(); ++i)
-    gate_[i] = opts_.residual_range_factor * std::sqrt(points_[i].norm());
+  const Mat3 R_LI = undistorted_with.rot.transpose();
+  for (size_t i = 0; i < points_.size(); ++i) {
+    points_[i] = R_LI * (body_points[i] - undistorted_with.pos);
+    gate_[i] = opts_.residual_range_factor * std::sqrt(body_points[i].norm());
+  }
 }
 
 int ScanToMap::numMatched() const {
@@ -47,15 +51,19 @@ int ScanToMap::numMatched() const {
   return n;
 }
 
-bool ScanToMap::evaluate(const FilterState& x, int iteration, PoseInformation* info) {
+bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInformation* info) {
   const int k = opts_.plane.num_neighbors;
   const double research2 = opts_.research_distance * opts_.research_distance;
   const double w = 1.0 / (opts_.point_noise_std * opts_.point_noise_std);
   const double inv_lever = 1.0 / opts_.degeneracy_lever_arm;
+  // the body pose at the sweep's true end and the LiDAR's mounting at the iterate
+  const Pose3 sweep_end = sweepEndPose(x, body_rate_);
+  const Mat3 R_WL = sweep_end.linear() * x.lidar.rot;
+  const Vec3 t_WL = sweep_end * x.lidar.pos;
   // 1. the points' images, and which of them moved enough to search their neighbours anew
   to_search_.clear();
   for (size_t i = 0; i < points_.size(); ++i) {
-    world_[i] = x.rot * points_[i] + x.pos;
+    world_[i] = R_WL * points_[i] + t_WL;
     if (iteration == 0 || !((world_[i] - matches_[i].searched_at).squaredNorm() <= research2))
       to_search_.push_back(static_cast<uint32_t>(i));
   }
@@ -80,10 +88,9 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, PoseInformation* i
   for (size_t i = 0; i < points_.size(); ++i) {
     const Match& m = matches_[i];
     if (!m.has_plane) continue;
-    const Vec3& pw = world_[i];
-    const double r = m.plane.distance(pw);
+    const double r = m.plane.distance(world_[i]);
     if (!(std::abs(r) <= gate_[i])) continue;
-    rows_.push_back(Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x.rot), r});
+    rows_.push_back(Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x, sweep_end, body_rate_), r});
   }
   const int count = static_cast<int>(rows_.size());
   last_count_ = count;
@@ -101,22 +108,35 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, PoseInformation* i
     const double c = std::max(opts_.robust_scale, 3.0 * 1.4826 * *mid);
     c2 = c * c;
   }
-  Mat6 S = Mat6::Zero(), G = Mat6::Zero();
-  Vec6 g = Vec6::Zero();
+  Mat13 S = Mat13::Zero();
+  Mat6 G = Mat6::Zero();
+  Vec13 g = Vec13::Zero();
   for (const Row& row : rows_) {
     const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
     S.noalias() += rw * row.h.transpose() * row.h;
     g.noalias() += rw * row.h.transpose() * row.r;
-    Row6 hs = row.h;
+    Row6 hs = row.h.head<6>();
     hs.head<3>() *= inv_lever;
     G.noalias() += hs.transpose() * hs;
   }
   S *= w;
   g *= w;
   info->geometry = G / static_cast<double>(count);
-  min_information_eigenvalue_ = Eigen::SelfAdjointEigenSolver<Mat6>(S, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  info->calibration_block = FilterState::kLidar;
+  min_information_eigenvalue_ =
+      Eigen::SelfAdjointEigenSolver<Mat6>(Mat6(S.topLeftCorner<6, 6>()), Eigen::EigenvaluesOnly).eigenvalues()[0];
   degeneracy_ = analyzeDegeneracy(info->geometry, opts_.degeneracy_threshold);
-  if (opts_.remove_degenerate) removeDegenerateInformation(degeneracy_, &S, &g);
+  if (opts_.remove_degenerate && degeneracy_.degenerate) {
+    // the pose off its degenerate directions; the calibration, which the same rows would measure
+    // along them (the extrinsic translation's column is the position's), not at all
+    Mat6 Sp = S.topLeftCorner<6, 6>();
+    Vec6 gp = g.head<6>();
+    removeDegenerateInformation(degeneracy_, &Sp, &gp);
+    S.setZero();
+    g.setZero();
+    S.topLeftCorner<6, 6>() = Sp;
+    g.head<6>() = gp;
+  }
   info->HtRinvH = S;
   info->HtRinvz = g;
   return true;

@@ -142,6 +142,8 @@ std::string reportMarkdown(const ReportInputs& in) {
   }
   md << "\n";
 
+  if (!in.calibration.empty()) md << calibrationMarkdown(in.calibration);
+
   if (!in.sensor_use.empty()) {
     md << "## Sensor use\n\n";
     md << "What the estimators did with their inputs, from their summaries at exit:\n\n";

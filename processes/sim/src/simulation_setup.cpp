@@ -493,3 +493,58 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
 }
 
 }  // namespace livo::sim
+
+namespace livo::sim {
+
+namespace {
+void jsonVec(std::ostream& os, const Vec3& v) { os << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]"; }
+void jsonPose(std::ostream& os, const Pose3& T) {
+  const Quat q(T.linear());
+  os << "{\"translation\": ";
+  jsonVec(os, T.translation());
+  os << ", \"rotation_wxyz\": [" << q.w() << ", " << q.x() << ", " << q.y() << ", " << q.z() << "]}";
+}
+void jsonError(std::ostream& os, const ExtrinsicError& e, double time_offset_s) {
+  os << "{\"rotation_vector\": ";
+  jsonVec(os, so3::Log(Mat3(e.transform().linear())));
+  os << ", \"translation\": ";
+  jsonVec(os, e.translation);
+  os << ", \"time_offset_s\": " << time_offset_s << "}";
+}
+}  // namespace
+
+std::string truthJson(const SimulationSetup& s) {
+  std::ostringstream os;
+  os << std::setprecision(12) << "{\"seed\": " << s.options.seed << ", \"calibration_errors\": {\"lidar\": ";
+  const CalibrationErrors& e = s.calibration_errors;
+  jsonError(os, e.lidar, e.lidar_time_offset_s);
+  os << ", \"camera\": ";
+  jsonError(os, e.camera, e.camera_time_offset_s);
+  os << "}, \"nominal\": {";
+  const SensorRig truth = trueRig(s.rig, e);
+  const char* sep = "";
+  if (s.rig.lidar) {
+    os << "\"T_I_L\": ";
+    jsonPose(os, s.rig.lidar->T_I_L);
+    sep = ", ";
+  }
+  if (s.rig.camera) {
+    os << sep << "\"T_I_C\": ";
+    jsonPose(os, s.rig.camera->T_I_C);
+  }
+  os << "}, \"true\": {";
+  sep = "";
+  if (truth.lidar) {
+    os << "\"T_I_L\": ";
+    jsonPose(os, truth.lidar->T_I_L);
+    sep = ", ";
+  }
+  if (truth.camera) {
+    os << sep << "\"T_I_C\": ";
+    jsonPose(os, truth.camera->T_I_C);
+  }
+  os << "}}\n";
+  return os.str();
+}
+
+}  // namespace livo::sim

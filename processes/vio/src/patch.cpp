@@ -35,11 +35,13 @@ bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pos
   return A->allFinite();
 }
 
-bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, float* out) {
+bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, const Eigen::Vector2d& shift, float* out,
+                        float* gx, float* gy) {
   // In three passes, each the scalar formula evaluated the same way per pixel: the warped
   // coordinates (vectorised), the bounds, then the bilinear samples (the four taps gathered, the
   // weighting vectorised).
-  constexpr double c = 0.5 * (kStored - 1), h = 0.5 * (kPatch - 1);
+  constexpr double h = 0.5 * (kPatch - 1);
+  const double cx = 0.5 * (kStored - 1) + shift.x(), cy = 0.5 * (kStored - 1) + shift.y();
   const double lim = kStored - 1;
   const double a00 = A(0, 0), a01 = A(0, 1), a10 = A(1, 0), a11 = A(1, 1);
   double x[kPatchArea], y[kPatchArea];
@@ -47,8 +49,8 @@ bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, float* 
 #pragma GCC unroll 8
     for (int i = 0; i < kPatch; ++i) {
       const double dx = i - h, dy = j - h;
-      x[j * kPatch + i] = c + a00 * dx + a01 * dy;
-      y[j * kPatch + i] = c + a10 * dx + a11 * dy;
+      x[j * kPatch + i] = cx + a00 * dx + a01 * dy;
+      y[j * kPatch + i] = cy + a10 * dx + a11 * dy;
     }
   }
   bool inside = true;
@@ -69,6 +71,11 @@ bool warpReferencePatch(const uint8_t* stored, const Eigen::Matrix2d& A, float* 
   for (int k = 0; k < kPatchArea; ++k)
     out[k] = (1 - ax[k]) * (1 - ay[k]) * v00[k] + ax[k] * (1 - ay[k]) * v10[k] + (1 - ax[k]) * ay[k] * v01[k] +
              ax[k] * ay[k] * v11[k];
+  if (gx && gy)
+    for (int k = 0; k < kPatchArea; ++k) {
+      gx[k] = (1 - ay[k]) * (v10[k] - v00[k]) + ay[k] * (v11[k] - v01[k]);
+      gy[k] = (1 - ax[k]) * (v01[k] - v00[k]) + ax[k] * (v11[k] - v10[k]);
+    }
   return true;
 }
 

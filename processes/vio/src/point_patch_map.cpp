@@ -78,7 +78,8 @@ void PointPatchMap::transform(const Pose3& T) {
   for (auto& m : points_) {
     m.position = T * m.position;
     for (auto& o : m.observations) {
-      o.T_W_C = T * o.T_W_C;
+      o.view.T_W_I = T * o.view.T_W_I;
+      o.view.vel_W = T.linear() * o.view.vel_W;
       o.pose_cov_W = J * o.pose_cov_W * J.transpose();
     }
   }

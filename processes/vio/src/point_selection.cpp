@@ -88,7 +88,7 @@ int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const Sel
   double best_score = std::numeric_limits<double>::infinity();
   for (size_t j = 0; j < m.observations.size(); ++j) {
     const PatchObservation& obs = m.observations[j];
-    const double angle = angleBetweenDeg(ray, m.position - obs.T_W_C.translation());
+    const double angle = angleBetweenDeg(ray, m.position - obs.cameraCentre());
     if (angle > o.max_view_angle_deg) continue;
     const double age = std::max(0.0, toSeconds(utime - obs.utime));
     const double score = o.view_angle_weight * angle + o.error_weight * obs.error + o.age_weight * age;
@@ -101,8 +101,9 @@ int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const Sel
 }
 
 std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
-                                        int64_t utime, float exposure_time, const DepthGrid& depth, int levels,
-                                        const SelectionOptions& o, SelectionStats* stats) {
+                                        const SensorCalibration& calibration, int64_t utime, float exposure_time,
+                                        const DepthGrid& depth, int levels, const SelectionOptions& o,
+                                        SelectionStats* stats) {
   SelectionStats st;
   const CameraRig& rig = camera.rig();
   const int cell = std::max(8, o.grid_cell_px);
@@ -111,6 +112,7 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     int point = -1, observation = -1;
     float gradient = -1.0f;
     Eigen::Matrix2d A;
+    Eigen::Vector2d shift;  // level 0: the reference's projection through `calibration`, from the patch centre
   };
   std::vector<Candidate> grid(static_cast<size_t>(cols) * rows);
   const Pose3 T_C_W = T_W_C.inverse();
@@ -134,11 +136,21 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     }
     const int ref = chooseReference(m, c_W, utime, o);
     Eigen::Matrix2d A;
-    bool ok = ref >= 0 && affineWarp(camera, T_W_C, m.observations[static_cast<size_t>(ref)].T_W_C, m.position, &A);
-    // the warped 8x8 patch must stay inside the stored one: check its corners
+    Eigen::Vector2d u_ref, shift = Eigen::Vector2d::Zero();
+    bool ok = ref >= 0;
+    if (ok) {
+      // the reference view through the calibration in the state (reference_view.hpp)
+      const ReferenceView& view = m.observations[static_cast<size_t>(ref)].view;
+      ok = projectIntoReference(camera, view, calibration, m.position, &u_ref) &&
+           affineWarp(camera, T_W_C, view.T_W_I * calibration.pose(), m.position, &A);
+      shift = u_ref - view.pixel;
+    }
+    // the warped 8x8 patch (with a pixel's room for the update to move it) must stay inside the
+    // stored one at every level: check its corners
+    const double max_shift = shift.cwiseAbs().maxCoeff();
     for (int k = 0; ok && k < 4; ++k) {
       const Eigen::Vector2d d((k & 1) ? corner : -corner, (k & 2) ? corner : -corner);
-      ok = (A * d).cwiseAbs().maxCoeff() <= reach;
+      ok = (A * d).cwiseAbs().maxCoeff() + max_shift + 1.0 <= reach;
     }
     if (!ok) {
       ++st.no_reference;
@@ -151,6 +163,7 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
       c.observation = ref;
       c.gradient = obs.gradient;
       c.A = A;
+      c.shift = shift;
     }
   }
   std::vector<TrackedPatch> out;
@@ -165,12 +178,17 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     t.observation = c.observation;
     t.p_W = m.position;
     t.gradient = c.gradient;
-    t.reference_centre = obs.T_W_C.translation();
+    t.view = obs.view;
     t.reference_cov_W = obs.pose_cov_W.cast<double>();
     t.gain0 = exposure_time > 0.0f && obs.exposure_time > 0.0f ? exposure_time / obs.exposure_time : 1.0f;
+    t.shift0 = c.shift;
+    t.warp = c.A;
     bool ok = true;
-    for (int l = 0; l < levels && ok; ++l)
-      ok = warpReferencePatch(obs.level(l), c.A, t.reference.data() + static_cast<size_t>(l) * kPatchArea);
+    for (int l = 0; l < levels && ok; ++l) {
+      const size_t at = static_cast<size_t>(l) * kPatchArea;
+      ok = warpReferencePatch(obs.level(l), c.A, c.shift / static_cast<double>(1 << l), t.reference.data() + at,
+                              t.reference_dx.data() + at, t.reference_dy.data() + at);
+    }
     if (!ok) {
       out.pop_back();
       ++st.no_reference;

@@ -12,12 +12,10 @@ void readVio(const Config& c, VioNodeOptions* n) {
   c.readOptional("name", n->name);
   const Config ch = c.optionalSection("channels");
   ch.readOptional("camera", n->camera_channel);
-  ch.readOptional("imu", n->imu_channel);
   ch.readOptional("state_prior", n->state_prior_channel);
   ch.readOptional("state_posterior", n->state_posterior_channel);
   ch.readOptional("registered_scan", n->registered_scan_channel);
   ch.readOptional("loop_correction", n->loop_correction_channel);
-  ch.readOptional("camera_free_state", n->camera_free_state_channel);
   c.readOptional("time_tolerance_s", n->time_tolerance_s);
   c.readOptional("image_buffer_s", n->image_buffer_s);
   c.readOptional("max_buffered_images", n->max_buffered_images);
@@ -60,16 +58,20 @@ void readVio(const Config& c, VioNodeOptions* n) {
   ph.readOptional("min_gain", o.photometric.min_gain);
   ph.readOptional("max_gain", o.photometric.max_gain);
   ph.readOptional("min_ncc", o.photometric.min_ncc);
+  ph.readOptional("point_std", o.photometric.point_std);
+  ph.readOptional("reference_rotation_std_deg", o.photometric.reference_rotation_std_deg);
+  ph.readOptional("reference_translation_std", o.photometric.reference_translation_std);
+  ph.readOptional("reference_translation_per_m", o.photometric.reference_translation_per_m);
 
   const Config up = c.optionalSection("update");
   up.readOptional("max_iterations", o.update.max_iterations);
   up.readOptional("convergence_rot", o.update.convergence_rot);
   up.readOptional("convergence_pos", o.update.convergence_pos);
   up.readOptional("min_patches", o.update.min_patches);
-  up.readOptional("max_mahalanobis", o.update.max_mahalanobis);
+  up.readOptional("gate_probability", o.update.gate_probability);
+  up.readOptional("calibration_information_scale", o.update.calibration_information_scale);
   up.readOptional("max_step_pos", o.update.max_step_pos);
   up.readOptional("max_step_rot_deg", o.update.max_step_rot_deg);
-  up.readOptional("calibration_rotation_std_deg", o.update.calibration_rotation_std_deg);
   up.readOptional("reference_floor", o.update.reference_floor);
   up.readOptional("gyro_bias_std_to_update", o.update.gyro_bias_std_to_update);
   if (up.has("covariance")) {
@@ -93,44 +95,6 @@ void readVio(const Config& c, VioNodeOptions* n) {
   rf.readOptional("error", o.maintenance.refresh_error);
   rf.readOptional("min_ncc", o.maintenance.outlier_ncc);
 
-  const Config cal = c.optionalSection("calibration");
-  cal.readOptional("camera_rotation_std_deg", o.calibration.camera_rotation_std_deg);
-  cal.readOptional("camera_rotation_walk_deg", o.calibration.camera_rotation_walk_deg);
-  cal.readOptional("camera_translation_std", o.calibration.camera_translation_std);
-  cal.readOptional("camera_translation_walk", o.calibration.camera_translation_walk);
-  cal.readOptional("time_offset_std", o.calibration.time_offset_std);
-  cal.readOptional("time_offset_walk", o.calibration.time_offset_walk);
-
-  const Config rc = c.optionalSection("rotation_calibration");
-  RotationCalibrationOptions& r = o.rotation_calibration;
-  rc.readOptional("enabled", r.enabled);
-  rc.readOptional("adopt", r.adopt);
-  if (rc.has("against")) {
-    const std::string a = rc.get<std::string>("against");
-    if (a == "camera_free")
-      r.against = RotationCalibrationOptions::Against::kCameraFree;
-    else if (a == "filter")
-      r.against = RotationCalibrationOptions::Against::kFilter;
-    else
-      throw ConfigError(rc.where("against") + ": '" + a + "' is neither camera_free nor filter");
-  }
-  rc.readOptional("max_corners", r.max_corners);
-  rc.readOptional("min_corner_distance_px", r.min_corner_distance_px);
-  rc.readOptional("corner_quality", r.corner_quality);
-  rc.readOptional("klt_window_px", r.klt_window_px);
-  rc.readOptional("klt_levels", r.klt_levels);
-  rc.readOptional("max_track_error_px", r.max_track_error_px);
-  rc.readOptional("min_baseline", r.min_baseline);
-  rc.readOptional("max_pair_time", r.max_pair_time);
-  rc.readOptional("min_tracks", r.min_tracks);
-  rc.readOptional("ransac_threshold_px", r.ransac_threshold_px);
-  rc.readOptional("cauchy_px", r.cauchy_px);
-  rc.readOptional("window_pairs", r.window_pairs);
-  rc.readOptional("min_pairs", r.min_pairs);
-  rc.readOptional("apply_std_deg", r.apply_std_deg);
-  rc.readOptional("overlay_file", r.overlay_file);
-  rc.readOptional("reapply_deg", r.reapply_deg);
-
   auto require = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
@@ -153,7 +117,8 @@ VioNodeOptions readVioNodeOptions(const Config& root) {
   n.camera = *sensor_rig.camera;
   n.camera_time_offset_s = n.camera.time_offset_s;
   n.camera_channel = sensor_rig.channels.camera;
-  n.imu_channel = sensor_rig.channels.imu;
+  // the map points are LiDAR returns: known to the LiDAR's range noise
+  if (sensor_rig.lidar) n.vio.photometric.point_std = sensor_rig.lidar->range_noise_std;
   const Config vio = root.optionalSection("vio");
   if (!vio.isNull()) {
     readVio(vio, &n);
@@ -185,27 +150,16 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << "  photometric: " << o.photometric.pyramid_levels << " levels, noise " << o.photometric.noise_std
      << ", Huber " << o.photometric.huber_threshold << ", "
      << (o.photometric.affine_brightness ? "gain + offset" : "offset") << " per patch, min NCC "
-     << o.photometric.min_ncc << "\n"
+     << o.photometric.min_ncc << ", map points known to " << o.photometric.point_std << " m\n"
      << "  update: " << o.update.max_iterations << " iterations per level, min " << o.update.min_patches
-     << " patches, Mahalanobis^2 <= " << o.update.max_mahalanobis << ", step <= " << o.update.max_step_pos << " m / "
+     << " patches, consistency gate at " << o.update.gate_probability << ", step <= " << o.update.max_step_pos << " m / "
      << o.update.max_step_rot_deg << " deg, covariance counts "
      << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
-     << ", calibration floor " << o.update.calibration_rotation_std_deg << " deg x baseline, gyro bias updated while its 1-sigma > "
+     << ", reference floor x" << o.update.reference_floor << ", gyro bias updated while its 1-sigma > "
      << o.update.gyro_bias_std_to_update << " rad/s\n"
      << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
      << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"
      << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << "\n";
-  const CalibrationOptions& cal = o.calibration;
-  if (cal.any())
-    os << "  online calibration (1-sigma, walk per sqrt(s)): rotation " << cal.camera_rotation_std_deg << " deg ("
-       << cal.camera_rotation_walk_deg << "), translation " << cal.camera_translation_std << " m ("
-       << cal.camera_translation_walk << "), time offset " << cal.time_offset_std << " s (" << cal.time_offset_walk
-       << ")\n";
-  const RotationCalibrationOptions& rc = o.rotation_calibration;
-  if (rc.enabled)
-    os << "  camera rotation from image pairs: " << rc.max_corners << " KLT corners, pairs " << rc.min_baseline
-       << " m apart, used once every axis is known to " << rc.apply_std_deg << " deg (" << rc.min_pairs << ".."
-       << rc.window_pairs << " pairs)\n";
   os << std::flush;
 }
 

@@ -11,10 +11,6 @@ namespace livo::vio {
 
 namespace {
 constexpr int kMaxCandidatesPerCell = 8;  // gradient evaluations per new-point cell
-constexpr double kMaxRateInterval = 0.25; // s: the body rate from two images farther apart is not used
-constexpr int64_t kGyroWindow = 15000;    // us: gyro samples this close to the image give its body rate
-constexpr int64_t kGyroKept = 200000;     // us: samples kept behind the newest
-
 }  // namespace
 
 std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& o) {
@@ -57,52 +53,15 @@ std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, si
 VioEstimator::VioEstimator(const VioOptions& options, const CameraRig& camera)
     : options_(options),
       camera_(camera),
-      T_I_C_(camera.T_I_C),
       map_(options.map),
       depth_(camera.width, camera.height, options.selection.depth_cell_px),
       shutter_(RollingShutter::fromReadout(camera.rolling_shutter_s, camera.height)) {
   validate(options_);
-  const CalibrationOptions& cal = options_.calibration;
-  const double rot = cal.camera_rotation_std_deg * M_PI / 180.0;
-  CalibrationVector var;
-  var << Vec3::Constant(rot * rot), Vec3::Constant(cal.camera_translation_std * cal.camera_translation_std),
-      cal.time_offset_std * cal.time_offset_std;
-  calibration_cov_ = var.asDiagonal();
-  if (options_.rotation_calibration.enabled) rotation_calibration_.emplace(options_.rotation_calibration, camera_, camera.T_I_C);
 }
 
 void VioEstimator::reset() {
   map_.clear();
   scans_.clear();
-  last_utime_ = -1;
-  if (rotation_calibration_) rotation_calibration_->reset();
-  T_I_C_ = camera_.rig().T_I_C;
-  adopted_rotation_.setZero();
-  rotation_adopted_ = false;
-}
-
-void VioEstimator::addGyro(int64_t utime, const Vec3& w) {
-  if (!needsGyro() || !w.allFinite()) return;
-  if (!gyro_.empty() && utime < gyro_.back().first) gyro_.clear();  // time went back: a new replay
-  gyro_.emplace_back(utime, w);
-  while (gyro_.front().first < utime - kGyroKept) gyro_.pop_front();
-}
-
-Vec3 VioEstimator::bodyRateAt(int64_t utime, const FilterState& x) const {
-  Vec3 sum = Vec3::Zero();
-  int n = 0;
-  for (const auto& g : gyro_)
-    if (std::abs(g.first - utime) <= kGyroWindow) sum += g.second, ++n;
-  if (n > 0) return sum / n - x.gyro_bias;
-  const double dt = 1e-6 * static_cast<double>(utime - last_utime_);
-  if (last_utime_ >= 0 && dt > 0.0 && dt <= kMaxRateInterval) return so3::Log(last_rot_.transpose() * x.rot) / dt;
-  return Vec3::Zero();
-}
-
-RollingShutter VioEstimator::shutterAt(int64_t utime, const FilterState& x) const {
-  RollingShutter s = shutter_;
-  if (s.active()) s.omega_I = bodyRateAt(utime, x);
-  return s;
 }
 
 void VioEstimator::addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n) {
@@ -133,10 +92,6 @@ size_t VioEstimator::recentScanPoints() const {
 
 void VioEstimator::applyCorrection(const Pose3& T) {
   map_.transform(T);
-  last_utime_ = -1;
-  // (lio's camera-free filter takes no loop corrections: its pairs need none)
-  if (rotation_calibration_ && options_.rotation_calibration.against == RotationCalibrationOptions::Against::kFilter)
-    rotation_calibration_->applyCorrection(T);
   for (auto& s : scans_)
     for (auto& p : s.points) p = T * p;
 }
@@ -155,14 +110,15 @@ void VioEstimator::fillDepth(const Pose3& T_W_C) {
   for (const auto& m : map_.points()) add(m.position);
 }
 
-bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const Pose3& T_W_C,
+bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const ReferenceView& view,
                                    const Mat6& pose_cov_W, PatchObservation* obs) const {
   const int levels = pyramid_.levels();
   obs->pixels.resize(static_cast<size_t>(levels) * kStoredArea);
   if (!extractStoredPatches(pyramid_, pixel, levels, obs->pixels.data())) return false;
   const int gl = std::min(1, levels - 1);
   obs->utime = image.utime;
-  obs->T_W_C = T_W_C;
+  obs->view = view;
+  obs->view.pixel = pixel;
   obs->pose_cov_W = pose_cov_W.cast<float>();
   obs->exposure_time = image.exposure_time;
   obs->gradient = patchGradient(pyramid_, gl, ImagePyramid::toLevel(pixel, gl));
@@ -170,71 +126,32 @@ bool VioEstimator::makeObservation(const Eigen::Vector2d& pixel, const GreyImage
   return true;
 }
 
-ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState& prior, const Mat18& P,
-                                       const FilterState* camera_free) {
+ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState& prior, const StateCovariance& P,
+                                       const Vec3& body_rate) {
   ImageResult r;
   r.state = prior;
   r.covariance = P;
   const int levels = options_.photometric.pyramid_levels;
   pyramid_.build(image.pixels, levels);
-  const RollingShutter shutter = shutterAt(image.utime, prior);
-  // the state at the image's true time (the estimated offset; the update refines it)
-  const Vec3 omega = options_.calibration.time_offset_std > 0.0 ? bodyRateAt(image.utime, prior) : Vec3::Zero();
-  const FilterState at_image = advanced(prior, omega, time_offset_);
-  // the body the image pairs are measured against (RotationCalibrationOptions::against)
-  const bool against_filter = options_.rotation_calibration.against == RotationCalibrationOptions::Against::kFilter;
-  const FilterState* body = against_filter ? &at_image : camera_free;
-  if (rotation_calibration_ && !body) rotation_calibration_->restartTracks();
-  if (rotation_calibration_ && body &&
-      rotation_calibration_->addImage(image.pixels, image.utime, body->pose(), body->vel, shutter) &&
-      options_.rotation_calibration.adopt && rotation_calibration_->converged()) {
-    // adopted, or moved far enough from what is in use: the references cut through the old
-    // rotation would pull the pose by it, so the map starts afresh from the recent scans
-    const Vec3 phi = rotation_calibration_->estimate().correction;
-    if (!rotation_adopted_ ||
-        (phi - adopted_rotation_).norm() * 180.0 / M_PI > options_.rotation_calibration.reapply_deg) {
-      T_I_C_ = rotation_calibration_->calibratedExtrinsic();
-      adopted_rotation_ = phi;
-      rotation_adopted_ = true;
-      map_.clear();
-      r.camera_rotation_changed = true;
-    }
-  }
-  const Pose3 T_W_C = at_image.pose() * T_I_C_;
+  RollingShutter shutter = shutter_;
+  shutter.omega_I = body_rate;
+  // the camera when the image was really taken: the stamp plus the camera's time shift
+  const Pose3 T_W_C = advanced(prior, body_rate, prior.camera.dt).pose() * prior.camera.pose();
   fillDepth(T_W_C);
-  std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, image.utime, image.exposure_time, depth_,
-                                                    levels, options_.selection, &r.selection);
+  std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, prior.camera, image.utime, image.exposure_time,
+                                                    depth_, levels, options_.selection, &r.selection);
   bool updated = false;
   if (static_cast<int>(tracked.size()) < options_.update.min_patches) {
     r.why = map_.size() == 0 ? std::string("the point-patch map is empty")
                              : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
                                    std::to_string(options_.update.min_patches) + ")";
   } else {
-    const CalibrationOptions& cal = options_.calibration;
-    CalibrationPrior calibration;
-    if (cal.any() && last_utime_ >= 0 && image.utime > last_utime_) {
-      const double dt = 1e-6 * static_cast<double>(image.utime - last_utime_);
-      const double walk_rot = cal.camera_rotation_std_deg > 0.0 ? cal.camera_rotation_walk_deg * M_PI / 180.0 : 0.0;
-      const double walk_pos = cal.camera_translation_std > 0.0 ? cal.camera_translation_walk : 0.0;
-      const double walk_time = cal.time_offset_std > 0.0 ? cal.time_offset_walk : 0.0;
-      CalibrationVector walk;
-      walk << Vec3::Constant(walk_rot * walk_rot), Vec3::Constant(walk_pos * walk_pos), walk_time * walk_time;
-      calibration_cov_.diagonal() += walk * dt;
-    }
-    calibration.covariance = calibration_cov_;
-    calibration.omega_I = omega;
-    calibration.time_offset = time_offset_;
-    const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, T_I_C_, options_.photometric,
-                                              options_.update, &tracked, shutter, cal.any() ? &calibration : nullptr);
-    if (cal.any() && u.valid) {
-      T_I_C_ = T_I_C_ * se3::fromRotationTranslation(so3::Exp(u.calibration.head<3>()), u.calibration.segment<3>(3));
-      time_offset_ += u.calibration[6];
-      calibration_cov_ = 0.5 * (u.calibration_cov + u.calibration_cov.transpose());
-    }
+    const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, options_.photometric, options_.update,
+                                              &tracked, shutter);
     r.iterations = u.iterations;
     r.num_measurements = u.num_measurements;
     r.patches = u.patches;
-    r.mahalanobis = u.mahalanobis;
+    r.consistency = u.consistency;
     r.cost_prior = u.cost_prior;
     r.cost_post = u.cost_post;
     r.valid = updated = u.valid;
@@ -244,10 +161,8 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
       r.covariance = u.covariance;
     }
   }
-  maintain(image, advanced(r.state, omega, time_offset_), shutter, updated, tracked, &r);
-  map_.prune((r.state.pose() * T_I_C_).translation());
-  last_utime_ = image.utime;
-  last_rot_ = r.state.rot;
+  maintain(image, r.state, shutter, updated, tracked, &r);
+  map_.prune((r.state.pose() * r.state.camera.pose()).translation());
   r.map_points = map_.size();
   return r;
 }
@@ -261,15 +176,27 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
   const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
   std::vector<char> occupied(static_cast<size_t>(cols) * rows, 0);
   const double border = patchBorder(pyramid_.levels());
-  const Pose3 T_W_C = x.pose() * T_I_C_;
+  // the body when the image was really taken (the camera's time shift) and the camera there
+  const FilterState at_image = advanced(x, shutter.omega_I, x.camera.dt);
+  const Pose3 T_I_C = x.camera.pose();
+  const Pose3 T_W_C = at_image.pose() * T_I_C;
   const Pose3 T_C_W = T_W_C.inverse();
   const Vec3 c_W = T_W_C.translation();
-  // where a point is seen (its row's pose under a rolling shutter) and that row's camera pose
+  // where a point is seen (its row's pose under a rolling shutter) and the view a patch cut there
+  // is in: that row's body pose and motion, and the calibration in use
   ShutterProjection sp;
   auto seen = [&](const Vec3& p_W) {
-    return projectThroughShutter(camera_, T_I_C_, x, shutter, p_W, &sp, border, /*with_jacobian=*/false);
+    return projectThroughShutter(camera_, T_I_C, at_image, shutter, p_W, &sp, border, /*with_jacobian=*/false);
   };
-  auto rowCamera = [&](double dt) { return dt == 0.0 ? T_W_C : cameraPoseAt(x, shutter, dt, T_I_C_); };
+  auto viewAt = [&](double row_dt) {
+    ReferenceView v;
+    v.T_W_I = advanced(at_image, shutter.omega_I, row_dt).pose();
+    v.omega_I = shutter.omega_I;
+    v.vel_W = x.vel;
+    v.T_I_C = T_I_C;
+    v.time_shift = x.camera.dt;
+    return v;
+  };
   // the pose covariance the references cut now carry, rotation in the world frame
   Mat6 J = Mat6::Identity();
   J.topLeftCorner<3, 3>() = x.rot;
@@ -293,7 +220,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
     const Vec3 ray = m.position - c_W;
     double min_angle = std::numeric_limits<double>::infinity(), ratio = 1.0;
     for (const auto& obs : m.observations) {
-      const Vec3 ray_obs = m.position - obs.T_W_C.translation();
+      const Vec3 ray_obs = m.position - obs.cameraCentre();
       const double a = angleBetweenDeg(ray, ray_obs);
       if (a < min_angle) {
         min_angle = a;
@@ -303,7 +230,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
     ratio = std::max(ratio, 1.0 / ratio);
     if (min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || t.rms > mo.refresh_error) {
       PatchObservation obs;
-      if (makeObservation(px, image, rowCamera(sp.dt), pose_cov_W, &obs)) {
+      if (makeObservation(px, image, viewAt(sp.dt), pose_cov_W, &obs)) {
         map_.addObservation(t.point, std::move(obs));
         ++r->new_patches;
       }
@@ -351,7 +278,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
       continue;
     }
     PatchObservation obs;
-    if (!makeObservation(b.px, image, rowCamera(b.dt), pose_cov_W, &obs)) continue;
+    if (!makeObservation(b.px, image, viewAt(b.dt), pose_cov_W, &obs)) continue;
     if (map_.add(b.p, image.utime, std::move(obs)) >= 0) ++r->new_points;
   }
 }

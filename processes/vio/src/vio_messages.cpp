@@ -9,22 +9,21 @@
 
 namespace livo::vio {
 
-bool priorFromMessage(const filter_state_t& m, FilterState* x, Mat18* P, std::string* why) {
+bool priorFromMessage(const filter_state_t& m, FilterState* x, StateCovariance* P, std::string* why) {
   if (!fromFilterState(m, x, P)) {
     *why = "prior has non-finite numbers or a degenerate quaternion";
     return false;
   }
-  *P = 0.5 * (*P + P->transpose());
-  const Eigen::LLT<Mat6> llt(P->topLeftCorner<6, 6>());
-  if (llt.info() != Eigen::Success) {
-    *why = "prior pose covariance is not positive definite";
+  *P = (0.5 * (*P + P->transpose())).eval();  // .eval(): the right side reads what the left writes
+  if (!isUsableCovariance(*P)) {
+    *why = "prior covariance is not positive definite";
     return false;
   }
   return true;
 }
 
 filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
-                           const Mat18& P, bool valid, int iterations, int num_measurements) {
+                           const StateCovariance& P, bool valid, int iterations, int num_measurements) {
   filter_state_t m = toFilterState(prior.utime, x, P, prior.request_id, source);
   m.epoch = prior.epoch;
   m.correction_id = prior.correction_id;

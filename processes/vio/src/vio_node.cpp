@@ -9,6 +9,7 @@
 #include "livo/correction_frames.hpp"
 #include "livo/message_checks.hpp"
 #include "livo/time.hpp"
+#include "livo/messages.hpp"
 #include "livo/vio/vio_messages.hpp"
 
 namespace livo::vio {
@@ -34,26 +35,15 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
   node_.subscribe<image_t>(opts_.camera_channel, [this](const image_t& m) { onImage(m); });
   node_.subscribe<filter_state_t>(opts_.state_prior_channel, [this](const filter_state_t& m) { onPrior(m); });
   node_.subscribe<registered_scan_t>(opts_.registered_scan_channel, [this](const registered_scan_t& m) { onScan(m); });
-  const RotationCalibrationOptions& rc = opts_.vio.rotation_calibration;
-  if (rc.enabled && rc.against == RotationCalibrationOptions::Against::kCameraFree)
-    node_.subscribe<filter_state_t>(opts_.camera_free_state_channel,
-                                    [this](const filter_state_t& m) { onCameraFreeState(m); });
   node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onCorrection(m); });
   // lockstep playback need not wait for what publishes nothing here: a scan only joins the map,
-  // a gyro sample only its buffer, and an image is only buffered while no prior waits for one
+  // and an image is only buffered while no prior waits for one
   node_.setQuietWindows([this] {
     std::vector<Node::QuietWindow> w{Node::QuietWindow::always(opts_.registered_scan_channel)};
     if (pending_.empty()) w.push_back(Node::QuietWindow::always(opts_.camera_channel));
-    if (vio_.needsGyro()) w.push_back(Node::QuietWindow::always(opts_.imu_channel));
     return w;
   });
-  // the body rate places a rolling shutter's rows and moves the state by the image time offset
-  // being estimated; a global shutter with a known time offset does not need the IMU
-  if (vio_.needsGyro())
-    node_.subscribe<imu_t>(opts_.imu_channel, [this](const imu_t& m) {
-      vio_.addGyro(m.utime, Vec3(m.angular_velocity[0], m.angular_velocity[1], m.angular_velocity[2]));
-    });
 }
 
 void VioNode::onImage(const image_t& m) {
@@ -158,34 +148,16 @@ void VioNode::trimImages() {
 
 void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
   FilterState x;
-  Mat18 P;
+  StateCovariance P;
   std::string why;
   if (!priorFromMessage(prior, &x, &P, &why)) {
     node_.reject(opts_.state_prior_channel, why);
     keep(prior, why);
     return;
   }
-  // lio's camera-free state for this image (published just before the prior, same request id)
-  FilterState free_x;
-  bool have_free = false;
-  for (const filter_state_t& m : camera_free_)
-    if (m.request_id == prior.request_id && m.utime == prior.utime) {
-      Mat18 free_P;
-      std::string free_why;
-      have_free = priorFromMessage(m, &free_x, &free_P, &free_why);
-      break;
-    }
-  const RotationCalibrationOptions& rc = opts_.vio.rotation_calibration;
-  if (rc.enabled && rc.against == RotationCalibrationOptions::Against::kCameraFree && !have_free &&
-      !warned_no_camera_free_ && counts_.priors >= 50) {
-    warned_no_camera_free_ = true;
-    node_.warn("no " + opts_.camera_free_state_channel + " for the images so far: the camera rotation calibration "
-               "waits for lio's camera-free filter (lio.camera_free_state: true)");
-  }
   const auto t0 = std::chrono::steady_clock::now();
-  const ImageResult r = vio_.processImage(image.image, x, P, have_free ? &free_x : nullptr);
+  const ImageResult r = vio_.processImage(image.image, x, P, vec3From(prior.angular_velocity));
   node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  if (const CameraRotationCalibration* cal = vio_.rotationCalibration()) reportRotationCalibration(*cal, r);
   if (!r.valid) {
     keep(prior, r.why);
     return;
@@ -196,28 +168,6 @@ void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
   if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
   ++counts_.priors;
   ++counts_.updated;
-}
-
-void VioNode::reportRotationCalibration(const CameraRotationCalibration& cal, const ImageResult& r) {
-  // a line when the estimate is adopted, and every 50 image pairs
-  const RotationEstimate& e = cal.estimate();
-  const int closed = cal.pairsClosed();
-  if (!r.camera_rotation_changed && closed < reported_pairs_ + 50 && closed >= reported_pairs_) return;
-  reported_pairs_ = closed;
-  const Vec3 deg = e.correction * 180.0 / M_PI;
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(3) << "camera rotation from the newest " << e.pairs << " of " << closed << " image pairs: the rig's turned by ("
-    << deg.x() << ", " << deg.y() << ", " << deg.z() << ") deg, 1-sigma <= " << e.maxStdDeg() << " deg, Sampson RMS "
-    << std::setprecision(2) << e.rms_px << " px"
-    << (r.camera_rotation_changed ? "; adopted, the point-patch map starts afresh" : "");
-  if (cal.hasEstimate()) {
-    const Pose3 T = cal.calibratedExtrinsic();
-    const Eigen::Quaterniond q(T.linear());
-    s << std::setprecision(6) << "; the rig as estimated: camera T_I_C {translation: [" << T.translation().x() << ", "
-      << T.translation().y() << ", " << T.translation().z() << "], rotation: [" << q.w() << ", " << q.x() << ", " << q.y()
-      << ", " << q.z() << "]}";
-  }
-  node_.info(s.str());
 }
 
 void VioNode::keep(const filter_state_t& prior, const std::string& why) {
@@ -259,11 +209,6 @@ void VioNode::onScan(const registered_scan_t& m) {
     vio_.addScan(m.utime, c.x.data(), c.y.data(), c.z.data(), static_cast<size_t>(c.num_points));
   }
   ++counts_.scans;
-}
-
-void VioNode::onCameraFreeState(const filter_state_t& m) {
-  camera_free_.push_back(m);
-  while (camera_free_.size() > kAnsweredIds) camera_free_.pop_front();
 }
 
 void VioNode::onCorrection(const loop_correction_t& m) {

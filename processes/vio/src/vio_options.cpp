@@ -32,38 +32,16 @@ void validate(const VioOptions& o) {
   require(o.photometric.huber_threshold > 0.0, "photometric.huber_threshold must be > 0");
   require(o.photometric.min_gain > 0.0 && o.photometric.max_gain >= o.photometric.min_gain,
           "photometric: need 0 < min_gain <= max_gain");
+  require(o.photometric.point_std >= 0.0 && o.photometric.point_std <= 1.0, "photometric.point_std must be in [0, 1]");
   require(o.photometric.min_ncc >= -1.0 && o.photometric.min_ncc < 1.0, "photometric.min_ncc must be in [-1, 1)");
   require(o.update.max_iterations >= 1, "update.max_iterations must be >= 1");
   require(o.update.min_patches >= 1, "update.min_patches must be >= 1");
-  require(o.update.max_mahalanobis > 0.0, "update.max_mahalanobis must be > 0");
+  require(o.update.calibration_information_scale > 0.0 && o.update.calibration_information_scale <= 1.0,
+          "update.calibration_information_scale must be in (0, 1]");
+  require(o.update.gate_probability > 0.0 && o.update.gate_probability < 1.0, "update.gate_probability must be in (0, 1)");
   require(o.update.max_step_pos > 0.0 && o.update.max_step_rot_deg > 0.0, "update: step bounds must be > 0");
-  require(o.update.calibration_rotation_std_deg >= 0.0 && o.update.calibration_rotation_std_deg <= 10.0,
-          "update.calibration_rotation_std_deg must be in [0, 10]");
   require(o.update.reference_floor >= 0.0, "update.reference_floor must be >= 0");
   require(o.update.gyro_bias_std_to_update >= 0.0, "update.gyro_bias_std_to_update must be >= 0");
-  require(o.calibration.camera_rotation_std_deg >= 0.0 && o.calibration.camera_rotation_std_deg <= 10.0,
-          "calibration.camera_rotation_std_deg must be in [0, 10]");
-  require(o.calibration.camera_rotation_walk_deg >= 0.0, "calibration.camera_rotation_walk_deg must be >= 0");
-  require(o.calibration.camera_translation_std >= 0.0 && o.calibration.camera_translation_std <= 0.5,
-          "calibration.camera_translation_std must be in [0, 0.5]");
-  require(o.calibration.camera_translation_walk >= 0.0, "calibration.camera_translation_walk must be >= 0");
-  require(o.calibration.time_offset_std >= 0.0 && o.calibration.time_offset_std <= 0.1,
-          "calibration.time_offset_std must be in [0, 0.1]");
-  require(o.calibration.time_offset_walk >= 0.0, "calibration.time_offset_walk must be >= 0");
-  const RotationCalibrationOptions& rc = o.rotation_calibration;
-  require(!(rc.enabled && o.calibration.camera_rotation_std_deg > 0.0),
-          "rotation_calibration and calibration.camera_rotation_std_deg both estimate the camera rotation: use one");
-  require(rc.max_corners >= 8 && rc.min_tracks >= 8 && rc.min_tracks <= rc.max_corners,
-          "rotation_calibration: need 8 <= min_tracks <= max_corners");
-  require(rc.min_corner_distance_px > 0.0 && rc.corner_quality > 0.0 && rc.corner_quality < 1.0,
-          "rotation_calibration: need min_corner_distance_px > 0 and corner_quality in (0, 1)");
-  require(rc.klt_window_px >= 5 && rc.klt_levels >= 0 && rc.max_track_error_px > 0.0,
-          "rotation_calibration: need klt_window_px >= 5, klt_levels >= 0, max_track_error_px > 0");
-  require(rc.min_baseline > 0.0 && rc.max_pair_time > 0.0, "rotation_calibration: need min_baseline, max_pair_time > 0");
-  require(rc.ransac_threshold_px > 0.0 && rc.cauchy_px > 0.0,
-          "rotation_calibration: need ransac_threshold_px, cauchy_px > 0");
-  require(rc.min_pairs >= 3 && rc.window_pairs >= rc.min_pairs, "rotation_calibration: need 3 <= min_pairs <= window_pairs");
-  require(rc.apply_std_deg > 0.0 && rc.reapply_deg >= 0.0, "rotation_calibration: need apply_std_deg > 0, reapply_deg >= 0");
   require(o.maintenance.new_point_cell_px >= 8, "new_points.cell_px must be >= 8");
   require(o.maintenance.max_new_points >= 0, "new_points.max_per_image must be >= 0");
   require(o.maintenance.refresh_angle_deg > 0.0 && o.maintenance.refresh_distance_ratio >= 1.0,

@@ -1,6 +1,7 @@
 // IMU forward propagation of the ESIKF (paper eqs. 3-8): the state x_{i+1} = x_i ⊞ (Δt f(x_i, u_i, 0))
 // on SO(3) x R^15 with gravity in the state, and the covariance P_{i+1} = F_x P F_x^T + F_w Q F_w^T
-// for the right-perturbation error state [rot pos vel bg ba g] (FilterState's order).
+// for the right-perturbation error state [rot pos vel bg ba g] (FilterState's order). The sensors'
+// calibration is constant: propagation moves only its correlation with the navigation state.
 // The input u_i of a step is the mean of the two IMU samples that bound it.
 #pragma once
 
@@ -58,9 +59,9 @@ class ImuPropagator {
   explicit ImuPropagator(ImuNoise noise = {}) : noise_(noise) {}
 
   /// Sets the state at `last.utime`; `last` is the IMU sample at that instant (first input half).
-  void reset(const FilterState& x, const Mat18& P, const ImuSample& last);
+  void reset(const FilterState& x, const StateCovariance& P, const ImuSample& last);
   /// Replaces state and covariance at the current time (after an update).
-  void setState(const FilterState& x, const Mat18& P);
+  void setState(const FilterState& x, const StateCovariance& P);
 
   /// Propagates through one sample later than utime() (eq. 5-6 with u = mean of the bounding
   /// samples). Samples at or before utime() are ignored (returns false).
@@ -71,7 +72,7 @@ class ImuPropagator {
   void propagateTo(int64_t utime, const ImuSample& next);
 
   const FilterState& state() const { return x_; }
-  const Mat18& covariance() const { return P_; }
+  const StateCovariance& covariance() const { return P_; }
   int64_t utime() const { return last_.utime; }
   const ImuSample& lastSample() const { return last_; }
   const ImuNoise& noise() const { return noise_; }
@@ -91,7 +92,7 @@ class ImuPropagator {
 
   ImuNoise noise_;
   FilterState x_;
-  Mat18 P_ = Mat18::Identity();
+  StateCovariance P_ = StateCovariance::Identity();
   ImuSample last_;
   std::vector<ImuSegment> segments_;
 };

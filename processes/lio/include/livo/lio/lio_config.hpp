@@ -32,7 +32,6 @@ struct LioNodeOptions {
   std::string registered_scan_channel = "REGISTERED_SCAN";
   std::string keyframe_channel = "KEYFRAME";
   std::string state_prior_channel = "STATE_PRIOR";
-  std::string camera_free_state_channel = "STATE_CAMERA_FREE";
   bool publish_registered_scan = true;
 
   double imu_reorder_window_s = 0.02;  // IMU is handed to the filter this far behind the newest
@@ -42,6 +41,8 @@ struct LioNodeOptions {
   // `continue_numbering` starts at the next epoch and the next id. Empty: not kept.
   std::string numbering_file;
   bool continue_numbering = false;
+  // Where calibration.csv and calibration.yaml go at exit (LioNode::writeCalibrationFiles; "" none)
+  std::string output_dir;
 
   double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
   double clock_jump_s = 1.0;           // an IMU stamp this far after the newest is a clock jump
@@ -56,12 +57,6 @@ struct LioNodeOptions {
   // Camera hand-off (design.md): at each image time publish STATE_PRIOR and adopt the
   // STATE_POSTERIOR that answers it; nothing later than the image is processed meanwhile.
   bool camera_handoff = false;
-  // A second, LiDAR-inertial-only filter beside the one the camera updates (the same IMU, sweeps
-  // and wheel, never a posterior), its state published at every image hand-off on
-  // camera_free_state_channel with the prior's request id, just before the prior: a relative motion
-  // the camera has not pulled, for the VIO's camera rotation from image pairs
-  // (processes/vio/README.md). Doubles the filter's time and memory.
-  bool camera_free_state = false;
   double camera_time_offset_s = 0.0;   // rig.camera.time_offset_s: image utime + offset = IMU time
   double camera_rate_hz = 20.0;        // rig.camera.rate_hz: when the next image is due
   double posterior_max_wait_s = 0.1;   // IMU time past an image after which lio goes on without its posterior

@@ -42,7 +42,7 @@ struct ScanResult {
   int64_t utime = 0;  // end of the sweep, IMU clock: the time of state and points
   int64_t sweep_start_utime = 0;  // start of the sweep, IMU clock (input utime + extrinsic time offset)
   FilterState state;
-  Mat18 covariance = Mat18::Zero();
+  StateCovariance covariance = StateCovariance::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
 
   int num_points = 0;       // valid points of the sweep
@@ -95,7 +95,9 @@ class LioEstimator {
     return !initialized_ || t_end > prop_.utime() || (t_end == prop_.utime() && t_end != last_sweep_end_utime_);
   }
   const FilterState& state() const { return prop_.state(); }
-  const Mat18& covariance() const { return prop_.covariance(); }
+  const StateCovariance& covariance() const { return prop_.covariance(); }
+  /// The bias-corrected angular rate at the filter's time (frame I).
+  Vec3 bodyRate() const { return prop_.lastSample().gyro - prop_.state().gyro_bias; }
   const VoxelMap& map() const { return map_; }
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
   const LioOptions& options() const { return opts_; }
@@ -111,7 +113,7 @@ class LioEstimator {
   /// Camera hand-off: propagates the filter with the added IMU samples to `utime` (STATE_PRIOR).
   bool propagateTo(int64_t utime, std::string* why = nullptr);
   /// Adopts an external update of the state at the filter's current time (STATE_POSTERIOR).
-  bool adoptPosterior(int64_t utime, const FilterState& x, const Mat18& P, std::string* why = nullptr);
+  bool adoptPosterior(int64_t utime, const FilterState& x, const StateCovariance& P, std::string* why = nullptr);
 
   // livo/odometry_frame.hpp (livo-lio-graph adopts corrections the same way)
   using KeyframePose = livo::KeyframePose;
@@ -152,26 +154,33 @@ class LioEstimator {
   /// Indices of the sweep's usable points (finite, inside the sweep [0, end_offset] and the range
   /// limits) into valid_.
   void validPoints(const LidarScan& scan, double end_offset, std::string* note);
-  /// The valid points in the body frame at t_end (IMU-propagated motion undistortion) into body_;
-  /// consumes the propagation segments.
+  /// The valid points in the body frame at t_end (IMU-propagated motion undistortion through the
+  /// state's LiDAR calibration) into body_; consumes the propagation segments.
   void undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first, int64_t t_end);
+  /// After the update: body_ and reg_ re-expressed through the posterior's LiDAR calibration
+  /// (extrinsic and time shift), so that x's pose maps them where the registration put them.
+  void toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x);
+  /// The first state and covariance of an epoch: the IMU's, with the calibration the last epoch
+  /// ended with (or the rig's, with its stated uncertainty).
+  FilterState initialState(const ImuInitResult& r) const;
+  StateCovariance initialCovariance(const ImuInitResult& r) const;
   /// The points registered against the map into reg_: every point_stride-th, then one per scan voxel.
   void registrationSubset();
   /// Wheel speed update at the sweep end; returns whether `travel` holds the wheels' travel since
   /// the wheel-scale anchor.
-  bool wheelVelocityStage(int64_t t_end, FilterState* x, Mat18* P, WheelTravel* travel, std::string* note);
+  bool wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel, std::string* note);
   /// After reseed_after_s without a registration: drops the map (seeded anew at the prediction).
-  void reseedAfterOutage(int64_t t_end, FilterState* x, Mat18* P, std::string* note);
+  void reseedAfterOutage(int64_t t_end, FilterState* x, StateCovariance* P, std::string* note);
   /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis.
-  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, Mat18* P,
+  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, StateCovariance* P,
                                 ScanResult* res);
   /// The iterated point-to-plane update (and the no-time-passed hypothesis after a bridged gap).
-  ScanResult::Status registerSweep(const std::vector<Vec3>& reg, FilterState* x, Mat18* P, ScanResult* res);
+  ScanResult::Status registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P, ScanResult* res);
   /// Remembers the last registration (re-seeding, velocity after IMU gaps).
   void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
   /// A new keyframe from the sweep (kept in the bounded keyframe store).
   Keyframe makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid, const std::vector<Vec3>& body,
-                        const FilterState& x, const Mat18& P, int64_t t_end);
+                        const FilterState& x, const StateCovariance& P, int64_t t_end);
   void tryInitialize(std::string* note);
   bool propagateThrough(int64_t t_end, std::string* note);
   /// One IMU sample into the propagation (gaps bridged or soft-reset).
@@ -222,6 +231,11 @@ class LioEstimator {
   std::vector<size_t> valid_;  // indices of the valid input points
   std::vector<Vec3> body_;     // those points undistorted, body frame at the sweep end
   std::vector<Vec3> reg_;      // the registration subset of body_
+  Vec3 body_rate_ = Vec3::Zero();  // bias-corrected angular rate at the sweep end
+  // the calibration an odometry reset carries into the next epoch (it belongs to the rig)
+  bool has_kept_calibration_ = false;
+  FilterState kept_calibration_;
+  StateCovariance kept_calibration_cov_ = StateCovariance::Zero();
   int64_t last_registered_utime_ = 0;  // last sweep that seeded the map or registered
   int64_t last_sweep_end_utime_ = -1;  // last sweep that reached the filter (any outcome)
   bool has_registered_ = false;

@@ -31,6 +31,7 @@
 #include <memory>
 #include <optional>
 
+#include "livo/lio/calibration_report.hpp"
 #include "livo/lio/lio_config.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/node.hpp"
@@ -71,6 +72,12 @@ class LioNode {
   /// l +/- sl, right r +/- sr (L intervals learnt from, O gated as slip, U unobservable)", or the
   /// calibration being off. Printed every wheel_log_period_s of sensor time and at exit.
   std::string wheelSummary() const;
+  /// The sensors' calibration in the filter against the rig's (calibration_report.hpp), "" before
+  /// the filter is initialised. Printed every 10 s of sensor time while any is estimated, and at exit.
+  std::string calibrationSummary() const;
+  /// At exit: output_dir/calibration.csv (the course, a row per second) and calibration.yaml (the
+  /// rig as estimated, a config overlay), when output_dir is set and a calibration is estimated.
+  void writeCalibrationFiles();
   /// Odometry resets so far (= the current epoch).
   int64_t resets() const { return resets_; }
   const OdometryFrame& frame() const { return lio_.frame(); }
@@ -111,11 +118,14 @@ class LioNode {
   void resetAll(const std::string& why);
   /// Warns (HEALTH, stderr) "odometry reset to epoch N: why" after the estimator was reset.
   void announceReset(const std::string& why);
+  /// Every second of sensor time: a calibration.csv row; every 10 s a log line.
+  void reportCalibration(int64_t utime);
+  bool estimatesCalibration() const;
+  CalibrationEstimate calibrationEstimate() const;
 
   LioNodeOptions opts_;
   Node node_;
   LioEstimator lio_;
-  std::optional<LioEstimator> camera_free_;  // options.camera_free_state: never takes a posterior
   TimeBuffer<ImuSample> imu_;
   TimeBuffer<WheelSample> wheel_;
   TimeBuffer<std::shared_ptr<PendingScan>> scans_;  // keyed by the sweep end (IMU clock)
@@ -129,6 +139,10 @@ class LioNode {
   int64_t sweeps_ = 0;
   SweepCounts sweep_counts_;
   int64_t last_wheel_log_ = 0;  // IMU time of the last periodic wheel summary
+  int64_t last_calibration_log_ = 0;  // ... and of the last calibration.csv row
+  int64_t calibration_t0_ = 0;        // the first row's time (its t_s is 0)
+  int64_t calibration_rows_ = 0;
+  std::string calibration_csv_;       // calibration.csv so far (output_dir)
 
   struct PendingPrior {
     int64_t request_id;

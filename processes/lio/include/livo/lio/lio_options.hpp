@@ -15,10 +15,37 @@
 
 namespace livo::lio {
 
+/// Which parts of the sensors' calibration the filter estimates (where the rig states an
+/// uncertainty). The defaults are what every platform observes (README, "Calibration in the
+/// filter"): the LiDAR's time shift, and the camera's rotation and time shift against the LiDAR;
+/// the LiDAR's rotation (unobservable in roll and pitch on a vehicle driving on the flat, and
+/// confused with the gyro's scale errors in turns) and the translations are held. A camera part
+/// estimated while the LiDAR's is held takes the LiDAR's uncertainty into its prior: it is then
+/// the camera against the LiDAR-registered body.
+struct CalibrationEstimation {
+  bool lidar_rotation = false;
+  bool lidar_translation = false;
+  bool lidar_time = true;
+  bool camera_rotation = true;
+  bool camera_translation = false;
+  bool camera_time = true;
+};
+
+/// The prior 1-sigmas of the LiDAR's and the camera's calibration blocks for what `estimate` says.
+void calibrationPrior(const CalibrationStd& lidar, const CalibrationStd& camera, const CalibrationEstimation& estimate,
+                      CalibrationStd* lidar_prior, CalibrationStd* camera_prior);
+
 struct LioOptions {
   ImuNoise imu_noise;
   ImuInitOptions init;
-  LidarExtrinsics extrinsics;
+  // The sensors' calibration (FilterState::lidar / camera): the rig's values are the filter's prior
+  // and its stated uncertainty (rig.*.calibration_std) the prior's 1-sigmas; `calibration` says
+  // which parts are estimated (the others are held at the rig's values).
+  LidarExtrinsics extrinsics;             // rig.lidar.T_I_L and lidar_time_offset_s
+  CalibrationStd lidar_calibration_std;   // rig.lidar.calibration_std
+  Pose3 camera_T_I_C = Pose3::Identity(); // rig.camera.T_I_C (carried for livo-vio's image updates)
+  CalibrationStd camera_calibration_std;  // rig.camera.calibration_std
+  CalibrationEstimation calibration;
 
   // scan preprocessing
   double min_range = 0.5;        // m

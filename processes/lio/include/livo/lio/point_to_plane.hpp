@@ -1,13 +1,19 @@
-// Point-to-plane residuals (paper eq. 9): a body point p, its world image R p + t and a plane
-// n^T x + d = 0 fitted to its nearest map neighbours; r = n^T (R p + t) + d.
+// Point-to-plane residuals (paper eq. 9) with the LiDAR's calibration in the state: a point q of the
+// undistorted sweep in the LiDAR frame, its world image w seen from the body pose of the sweep's
+// true end (the state's time plus the LiDAR's time shift dt: R Exp(ω dt), p + v dt) through the
+// state's extrinsic, and a plane n^T x + d = 0 fitted to its nearest map neighbours:
+//   w = R Exp(ω dt) (R_IL q + t_IL) + p + v dt,   r = n^T w + d.
 #pragma once
 
+#include "livo/esikf_update.hpp"
+#include "livo/filter_state.hpp"
 #include "livo/plane.hpp"
 #include "livo/so3.hpp"
 
 namespace livo::lio {
 
 using Row6 = Eigen::Matrix<double, 1, 6>;
+using Row13 = Eigen::Matrix<double, 1, kMeasuredDim>;
 
 struct PlaneFitOptions {
   int num_neighbors = 5;              // k of the kNN search
@@ -17,16 +23,34 @@ struct PlaneFitOptions {
                                       // nearly collinear neighbours of one far ring
 };
 
-struct PointToPlaneResidual {
-  Vec3 p_body;  // point in the body frame I
-  Plane plane;  // world frame
+/// The body pose of the sweep's true end, R Exp(ω dt) and p + v dt (ω: the body rate, frame I).
+inline Pose3 sweepEndPose(const FilterState& x, const Vec3& body_rate) {
+  const double dt = x.lidar.dt;
+  return se3::fromRotationTranslation(dt != 0.0 ? Mat3(x.rot * so3::Exp(body_rate * dt)) : x.rot, x.pos + x.vel * dt);
+}
 
-  double value(const Mat3& R, const Vec3& t) const { return plane.distance(R * p_body + t); }
-  /// ∂r/∂[δr δp] with x ⊞ δ = (R Exp(δr), t + δp): [-(n^T R [p]x), n^T].
-  Row6 jacobian(const Mat3& R) const {
-    Row6 J;
-    J.head<3>() = (p_body.cross(R.transpose() * plane.normal)).transpose();
-    J.tail<3>() = plane.normal.transpose();
+struct PointToPlaneResidual {
+  Vec3 q_lidar;  // point in the LiDAR frame at the sweep end
+  Plane plane;   // world frame
+
+  /// r at state x; `end` = sweepEndPose(x, body_rate).
+  double value(const FilterState& x, const Pose3& end) const {
+    return plane.distance(end * (x.lidar.rot * q_lidar + x.lidar.pos));
+  }
+  /// ∂r/∂[δθ δp δφ δρ δdt] (MeasurementInformation's order, calibration block FilterState::kLidar):
+  /// with p_I = R_IL q + t_IL and n_I = R_end^T n,
+  ///   [(p_I x n_I)^T, n^T, (q x R_IL^T n_I)^T, n_I^T, n_I . (ω x p_I) + n . v].
+  /// (The rotation columns take Exp(ω dt) as commuting with the perturbation: dt is milliseconds.)
+  Row13 jacobian(const FilterState& x, const Pose3& end, const Vec3& body_rate) const {
+    const Vec3& n = plane.normal;
+    const Vec3 n_I = end.linear().transpose() * n;
+    const Vec3 p_I = x.lidar.rot * q_lidar + x.lidar.pos;
+    Row13 J;
+    J.segment<3>(0) = p_I.cross(n_I).transpose();
+    J.segment<3>(3) = n.transpose();
+    J.segment<3>(6) = q_lidar.cross(x.lidar.rot.transpose() * n_I).transpose();
+    J.segment<3>(9) = n_I.transpose();
+    J[12] = n_I.dot(body_rate.cross(p_I)) + n.dot(x.vel);
     return J;
   }
 };

@@ -1,7 +1,12 @@
 // The LiDAR measurement of the ESIKF: point-to-plane residuals of a scan (undistorted, body frame)
-// against the voxel map at each iterate, reduced to the 6x6 information H^T R^-1 H and the
-// vector H^T R^-1 z of the pose. Planes are re-fitted only for points whose world image moved
-// more than `research_distance` since their last neighbour search (usually once or twice a scan).
+// against the voxel map at each iterate, reduced to the information H^T R^-1 H and the vector
+// H^T R^-1 z of the pose and the LiDAR's calibration (extrinsic and time shift, FilterState::kLidar).
+// A point undistorted through the extrinsic T0 is q = T0^-1 p in the LiDAR frame; at an iterate x
+// it is seen at x's extrinsic, from the body pose of the sweep's true end (the state's time plus
+// the LiDAR's time shift dt, along the body rate ω and the velocity v):
+//   w = R Exp(ω dt) (R_IL q + t_IL) + p + v dt,   r = n^T w + d.
+// Planes are re-fitted only for points whose world image moved more than `research_distance` since
+// their last neighbour search (usually once or twice a scan).
 #pragma once
 
 #include <limits>
@@ -39,13 +44,16 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
 
 class ScanToMap {
  public:
-  /// `map` must outlive this object and stay unchanged while it is used. With `threads`, the
-  /// neighbour searches of an iterate are shared among them; the result is the same bit for bit.
+  /// `map` must outlive this object and stay unchanged while it is used; `body_points` were
+  /// undistorted through the LiDAR calibration `undistorted_with` and `body_rate` is the bias-corrected
+  /// angular rate at the sweep end (frame I). With `threads`, the neighbour searches of an iterate
+  /// are shared among them; the result is the same bit for bit.
   ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
-            WorkerThreads* threads = nullptr);
+            WorkerThreads* threads = nullptr, const SensorCalibration& undistorted_with = {},
+            const Vec3& body_rate = Vec3::Zero());
 
-  /// PoseMeasurement for iteratedUpdate.
-  bool evaluate(const FilterState& x, int iteration, PoseInformation* info);
+  /// Measurement for iteratedUpdate.
+  bool evaluate(const FilterState& x, int iteration, MeasurementInformation* info);
 
   /// Residuals accepted at the last evaluate().
   int numResiduals() const { return last_count_; }
@@ -63,11 +71,12 @@ class ScanToMap {
     bool has_plane = false;
   };
   struct Row {
-    Row6 h;
+    Eigen::Matrix<double, 1, kMeasuredDim> h;
     double r;
   };
   const VoxelMap& map_;
-  const std::vector<Vec3>& points_;
+  std::vector<Vec3> points_;          // the points in the LiDAR frame (q above)
+  Vec3 body_rate_;
   ScanToMapOptions opts_;
   WorkerThreads* threads_;
   std::vector<Match> matches_;

@@ -13,7 +13,7 @@
 
 namespace livo::lio {
 
-using Mat3x18 = Eigen::Matrix<double, 3, 18>;
+using Mat3xState = Eigen::Matrix<double, 3, FilterState::kDim>;
 
 struct WheelOptions {
   bool enabled = false;
@@ -28,8 +28,8 @@ struct WheelOptions {
 
 /// Predicted velocity of B in B.
 Vec3 wheelFrameVelocity(const FilterState& x, const Vec3& gyro_measured, const Pose3& T_I_B);
-/// Its Jacobian with respect to the 18-dim error state (rotation, velocity and gyro-bias blocks).
-Mat3x18 wheelVelocityJacobian(const FilterState& x, const Vec3& gyro_measured, const Pose3& T_I_B);
+/// Its Jacobian with respect to the error state (rotation, velocity and gyro-bias blocks).
+Mat3xState wheelVelocityJacobian(const FilterState& x, const Vec3& gyro_measured, const Pose3& T_I_B);
 
 struct WheelUpdateResult {
   bool applied = false;
@@ -40,7 +40,7 @@ struct WheelUpdateResult {
 /// Updates (x, P) with the forward speed (mean of the wheels) and zero lateral/vertical velocity.
 /// extra_forward_variance (m²/s²) adds to the forward speed's variance (e.g. the uncertainty of
 /// the wheel scales, wheel_scale.hpp).
-WheelUpdateResult wheelVelocityUpdate(FilterState* x, Mat18* P, const Vec3& gyro_measured, double forward_speed,
+WheelUpdateResult wheelVelocityUpdate(FilterState* x, StateCovariance* P, const Vec3& gyro_measured, double forward_speed,
                                       const WheelOptions& options, double extra_forward_variance = 0.0);
 
 }  // namespace livo::lio

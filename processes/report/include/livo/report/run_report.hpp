@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "livo/report/calibration_course.hpp"
 #include "livo/report/picture_set.hpp"
 #include "livo/report/pipeline_outputs.hpp"
 #include "livo/report/weak_spots.hpp"
@@ -58,6 +59,7 @@ struct ReportInputs {
   nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
   std::optional<WeakSpots> weak_spots;       // weak_spots.json: the "Where the estimate was weak" section
   std::optional<PictureSet> pictures;        // pictures.json (livo-report pictures): the "Maps" section
+  std::vector<CalibrationRow> calibration;   // lio's calibration.csv: the "Calibration" section (none: no section)
   const PipelineOutputs* outputs = nullptr;
 };
 

@@ -88,4 +88,9 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
 
 void printSimulation(const SimulationSetup& setup, std::ostream& os);
 
+/// The run's truth as JSON (livo-sim --truth): the seed, the calibration errors (extrinsic errors
+/// as rotation vectors in the sensor frame, rad, and translations, m: T_I_X_true = T_I_X_rig * T_err;
+/// time offset errors, s) and the nominal and true T_I_L / T_I_C (rotation as [w, x, y, z]).
+std::string truthJson(const SimulationSetup& setup);
+
 }  // namespace livo::sim

@@ -1,6 +1,7 @@
-// Image patches of the point-patch map: the 8x8 patch the residual is computed on, the 12x12
+// Image patches of the point-patch map: the 8x8 patch the residual is computed on, the 16x16
 // patch stored per observation and level (a margin so the reference can be warped into the
-// current view), and the affine warp between two views of a map point.
+// current view and re-centred where the state's camera calibration projects the point into the
+// reference image), and the affine warp between two views of a map point.
 //
 // Warp model: the fronto-parallel approximation. The surface around the point is taken as the
 // plane through it perpendicular to the reference camera's ray, and the warp is that plane's
@@ -23,7 +24,7 @@ namespace livo::vio {
 constexpr int kPatch = 8;                        // residual patch side (pixels of a level)
 constexpr int kPatchArea = kPatch * kPatch;
 constexpr int kWindow = kPatch + 2;              // with a one-pixel margin for gradients
-constexpr int kStored = 12;                      // stored reference patch side
+constexpr int kStored = 16;                      // stored reference patch side
 constexpr int kStoredArea = kStored * kStored;
 constexpr int kMaxLevels = 4;
 
@@ -40,8 +41,12 @@ bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pos
                 Eigen::Matrix2d* A);
 
 /// The reference patch warped into the current view: out[j*kPatch + i] is the stored patch
-/// (one level) at offset A (i - 3.5, j - 3.5) from its centre. False if that leaves the stored patch.
-bool warpReferencePatch(const uint8_t* stored_level, const Eigen::Matrix2d& A, float* out);
+/// (one level) at `shift` + A (i - 3.5, j - 3.5) from its centre (shift: where the reference image
+/// sees the point now, relative to where the patch was cut, in the level's pixels). With gx, gy
+/// also the derivative of each sample with respect to the shift (the bilinear interpolant's
+/// gradient). False if that leaves the stored patch.
+bool warpReferencePatch(const uint8_t* stored_level, const Eigen::Matrix2d& A, const Eigen::Vector2d& shift, float* out,
+                        float* gx = nullptr, float* gy = nullptr);
 
 /// Mean |dI/dx| + |dI/dy| (central differences) over the kPatch x kPatch patch at u (level
 /// coordinates of `level`); -1 if it does not fit.

@@ -10,6 +10,7 @@
 #include "livo/flat_key_index.hpp"
 #include "livo/so3.hpp"
 #include "livo/vio/patch.hpp"
+#include "livo/vio/reference_view.hpp"
 #include "livo/voxel_key.hpp"
 #include "livo/vio/vio_options.hpp"
 
@@ -17,7 +18,7 @@ namespace livo::vio {
 
 struct PatchObservation {
   int64_t utime = 0;               // image time (IMU clock)
-  Pose3 T_W_C = Pose3::Identity(); // camera pose it was seen from
+  ReferenceView view;              // the body pose, motion and calibration it was cut in
   // covariance of that pose's error [rotation (world frame), position] as the filter had it
   Eigen::Matrix<float, 6, 6> pose_cov_W = Eigen::Matrix<float, 6, 6>::Zero();
   float exposure_time = 0.0f;      // s, 0 if unknown
@@ -26,6 +27,7 @@ struct PatchObservation {
   std::vector<uint8_t> pixels;     // levels x kStored x kStored
 
   const uint8_t* level(int l) const { return pixels.data() + static_cast<size_t>(l) * kStoredArea; }
+  Vec3 cameraCentre() const { return view.T_W_I * view.T_I_C.translation(); }
 };
 
 struct MapPoint {

@@ -63,9 +63,12 @@ struct SelectionStats {
 /// The reference observation for a point seen from camera centre c_W at time utime, or -1.
 int chooseReference(const MapPoint& point, const Vec3& c_W, int64_t utime, const SelectionOptions& options);
 
-/// The tracked patches of the image at camera pose T_W_C (reference patches warped into it).
+/// The tracked patches of the image at camera pose T_W_C with the camera calibration `calibration`
+/// (reference patches re-centred where the reference images see the points through it, and warped
+/// into this view).
 std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
-                                        int64_t utime, float exposure_time, const DepthGrid& depth, int levels,
-                                        const SelectionOptions& options, SelectionStats* stats);
+                                        const SensorCalibration& calibration, int64_t utime, float exposure_time,
+                                        const DepthGrid& depth, int levels, const SelectionOptions& options,
+                                        SelectionStats* stats);
 
 }  // namespace livo::vio

@@ -17,12 +17,10 @@ struct VioNodeOptions {
   std::string name = "vio";
   // channels
   std::string camera_channel = "CAMERA";  // rig.channels.camera unless vio.channels.camera
-  std::string imu_channel = "IMU";        // rig.channels.imu unless vio.channels.imu (rolling shutter only)
   std::string state_prior_channel = "STATE_PRIOR";
   std::string state_posterior_channel = "STATE_POSTERIOR";
   std::string registered_scan_channel = "REGISTERED_SCAN";
   std::string loop_correction_channel = "LOOP_CORRECTION";
-  std::string camera_free_state_channel = "STATE_CAMERA_FREE";  // rotation_calibration against camera_free
   // time
   double camera_time_offset_s = 0.0;  // rig.camera.time_offset_s: image utime + offset = IMU time
   double time_tolerance_s = 0.0005;   // a prior and an image this close in time belong together

@@ -12,11 +12,11 @@ namespace livo::vio {
 
 /// The state and covariance (symmetrised) of a STATE_PRIOR; false with the reason if a number is
 /// not finite, the quaternion is degenerate or the pose covariance is not positive definite.
-bool priorFromMessage(const filter_state_t& m, FilterState* x, Mat18* P, std::string* why);
+bool priorFromMessage(const filter_state_t& m, FilterState* x, StateCovariance* P, std::string* why);
 
 /// A STATE_POSTERIOR answering `prior` (same utime and request id) with state x and covariance P.
 filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
-                           const Mat18& P, bool valid, int iterations, int num_measurements);
+                           const StateCovariance& P, bool valid, int iterations, int num_measurements);
 /// valid = 0: the prior's own numbers echoed.
 filter_state_t keptPrior(const filter_state_t& prior, const std::string& source);
 

@@ -21,7 +21,6 @@
 #include "livo/correction_frames.hpp"
 #include "livo/filter_state_t.hpp"
 #include "livo/image_t.hpp"
-#include "livo/imu_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/reason_counts.hpp"
@@ -65,12 +64,10 @@ class VioNode {
   void onPrior(const filter_state_t& m);
   void onScan(const registered_scan_t& m);
   void onCorrection(const loop_correction_t& m);
-  void onCameraFreeState(const filter_state_t& m);
   /// Answers every waiting prior that can be answered now, then trims the image buffer.
   void resolve();
   void process(const filter_state_t& prior, const BufferedImage& image);
   void keep(const filter_state_t& prior, const std::string& why);
-  void reportRotationCalibration(const CameraRotationCalibration& calibration, const ImageResult& result);
   void trimImages();
   /// Where a pose of (epoch, correction) goes in the map; a newer epoch (a LIO reset) first drops
   /// the map, the waiting priors and the corrections of the old epoch.
@@ -88,9 +85,6 @@ class VioNode {
   MapFrame frame_;  // the map's odometry epoch and loop correction
   ReasonCounts kept_reasons_;
   std::map<std::string, int64_t> last_warned_;  // reason -> sensor time of its last warning
-  std::deque<filter_state_t> camera_free_;  // lio's camera-free states, newest last (by request id)
-  bool warned_no_camera_free_ = false;
-  int reported_pairs_ = 0;  // image pairs of the rotation calibration at its last progress line
 };
 
 }  // namespace livo::vio

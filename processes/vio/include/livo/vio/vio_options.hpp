@@ -49,6 +49,16 @@ struct PhotometricOptions {
   double min_gain = 0.5;           // gain bounds, relative to the exposure-time ratio (1 if unknown)
   double max_gain = 2.0;
   double min_ncc = 0.3;            // a patch correlating worse at the start of a level is dropped
+  double point_std = 0.0;          // m per axis: how well a map point's position is known (the
+                                   // LiDAR's range noise: rig.lidar.range_noise_std unless set); each
+                                   // patch's point is eliminated against it (accumulate()); 0: exact
+  // How well the body's motion from a reference image to the current one is known (the LIO's
+  // relative accuracy): each patch's reference pose is a nuisance with this uncertainty,
+  // eliminated likewise; otherwise a relative error of the trajectory over a patch's baseline b
+  // looks like a camera rotation of about error / b and would be taken for one. 0: exact.
+  double reference_rotation_std_deg = 0.02;  // deg per axis
+  double reference_translation_std = 0.001;  // m per axis, plus ...
+  double reference_translation_per_m = 0.005;// ... this fraction of the baseline
 };
 
 /// What the posterior covariance of a photometric update counts (the step always uses all the
@@ -64,16 +74,20 @@ struct UpdateOptions {
   double convergence_rot = 1e-4;   // rad
   double convergence_pos = 1e-4;   // m
   int min_patches = 15;            // fewer usable patches: no update (valid = 0)
-  double max_mahalanobis = 50.0;   // chi-square of the pose step against the prior covariance
+  // The consistency gate: the image's measurement of the pose and the camera's calibration (where
+  // it says at least a hundredth of what the prior knows), tested against prior plus measurement
+  // covariance (chi-square, as many degrees of freedom as such directions, livo::consistencyTest);
+  // an update beyond this quantile is not adopted.
+  double gate_probability = 0.999;
+  // The share of an image's information on the camera's calibration that the update takes: the
+  // images of a second reuse the same map points and reference patches, whose errors they share,
+  // so their information on the constant calibration is not independent from image to image
+  // (about one in `1 / scale` is new). The calibration then accumulates what is new, as a Kalman
+  // filter of a constant should. 1: every image counted in full.
+  double calibration_information_scale = 0.2;
   double max_step_pos = 0.3;       // m
   double max_step_rot_deg = 5.0;
   CovarianceUpdate covariance = CovarianceUpdate::kBeyondPrior;  // "full" or "beyond_prior"
-  // 1-sigma of the camera's rotation against the LiDAR-registered body, per axis (the rig
-  // calibration's accuracy; 0: taken as exact). A reference patch seen again after the camera
-  // moved by b is off by about ε × b, alike for every patch with that baseline, so more patches do
-  // not average it away: an image's position measurement gets the floor
-  // σ² mean_i([b_i]× [b_i]×ᵀ) over its patches (calibrationFloor, livo::applyPoseMeasurementFloor)
-  double calibration_rotation_std_deg = 0.3;
   // Scale of the reference floor: a reference patch was cut at the pose the filter had then, so
   // the image measures the current pose only as well as its references' poses were known. Each
   // observation keeps that pose covariance; an image's pose measurement gets the floor
@@ -101,66 +115,12 @@ struct MaintenanceOptions {
   double outlier_ncc = 0.5;        // no new patch from a view correlating worse (occluded, moved)
 };
 
-/// Online correction of the camera's calibration against the LiDAR-registered body: its rotation
-/// and translation (T_I_C (Exp(φ), ρ)) and its time offset δt, estimated from the photometric
-/// residuals against the LiDAR-anchored map with the LIO's pose as prior (direct_update.hpp,
-/// CalibrationPrior). A 1-sigma of 0 leaves that part as the rig states it.
-struct CalibrationOptions {
-  double camera_rotation_std_deg = 0.0;   // prior 1-sigma of the rig's T_I_C rotation
-  double camera_rotation_walk_deg = 0.01; // random walk, deg per sqrt(s)
-  double camera_translation_std = 0.0;    // m, prior 1-sigma of the rig's T_I_C translation
-  double camera_translation_walk = 0.001; // m per sqrt(s)
-  double time_offset_std = 0.0;           // s, prior 1-sigma of the image time against the LIO's
-  double time_offset_walk = 1e-4;         // s per sqrt(s)
-  bool any() const { return camera_rotation_std_deg > 0.0 || camera_translation_std > 0.0 || time_offset_std > 0.0; }
-};
-
-/// The camera's rotation against the body the LIO estimates, from the geometry of image pairs
-/// (camera_rotation_calibration.hpp): corners tracked with KLT between two images the LIO placed a
-/// baseline apart must satisfy the epipolar constraint of the LIO's relative pose seen through
-/// T_I_C. Unlike the photometric residuals, that does not depend on references cut through the
-/// same rotation. Once every axis is known to `apply_std_deg`, the VIO uses the estimated rotation
-/// (and starts its point-patch map afresh, the old references having been cut through the rig's).
-struct RotationCalibrationOptions {
-  bool enabled = false;
-  // The body poses the pairs are measured against. kCameraFree: lio's LiDAR-inertial-only filter
-  // (lio.camera_free_state, STATE_CAMERA_FREE); kFilter: the prior, which the camera's own
-  // updates have already turned toward the camera's view (README: it then misses the tilt).
-  enum class Against { kCameraFree, kFilter };
-  Against against = Against::kCameraFree;
-  // Use the estimate in the VIO once known (true), or only report it (false: the log gives the
-  // rig's T_I_C to write into the config). Adopting it mid-run starts the point-patch map afresh,
-  // which has cost more than the better rotation gained (README).
-  bool adopt = false;
-  int max_corners = 150;              // tracked corners (Shi-Tomasi), topped up at every pair
-  double min_corner_distance_px = 20.0;
-  double corner_quality = 0.01;       // relative to the strongest corner
-  int klt_window_px = 21;
-  int klt_levels = 3;
-  double max_track_error_px = 0.5;    // forward-backward KLT disagreement beyond this: lost
-  double min_baseline = 0.1;          // m the LIO moved between the two images of a pair
-  double max_pair_time = 1.5;         // s: no baseline by then, the tracks start again
-  int min_tracks = 30;                // inliers a pair needs
-  double ransac_threshold_px = 1.0;   // essential-matrix RANSAC (moving objects, bad tracks)
-  double cauchy_px = 1.0;             // robust loss on the Sampson error
-  int window_pairs = 300;             // the estimate is over the newest pairs
-  int min_pairs = 30;
-  double apply_std_deg = 0.06;        // every axis this well known: used
-  double reapply_deg = 0.03;          // used again when it moved this far from the value in use
-  // At exit: the rig's camera extrinsic with the estimate fused in, as a config overlay
-  // (cameraRotationOverlay; scripts/run_pipeline.sh --calibrate-camera), relative to the working
-  // directory ("": none). Written once the estimate has min_pairs pairs.
-  std::string overlay_file = "camera_rotation.yaml";
-};
-
 struct VioOptions {
   MapOptions map;
   SelectionOptions selection;
   PhotometricOptions photometric;
   UpdateOptions update;
   MaintenanceOptions maintenance;
-  CalibrationOptions calibration;
-  RotationCalibrationOptions rotation_calibration;
 };
 
 /// Throws std::invalid_argument naming the first option out of range.
