@@ -188,7 +188,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const StateCovariance&
     scaleCalibrationInformation(uo.calibration_information_scale, P_measured, &gated);
     if (floored) applyMeasurementFloor(floor, &gated.HtRinvH, &gated.HtRinvz);
     res.consistency = consistencyTest(measuredDifference(x, prior), gated.HtRinvH, gated.HtRinvz,
-                                      measuredCovariance(P_prior, FilterState::kCamera), uo.gate_probability);
+                                      P_measured, uo.gate_probability);
   }
   // the pose the image aligned to, with the prior's calibration: the cost test's (below)
   FilterState aligned_pose = x;
@@ -248,7 +248,7 @@ DirectUpdateResult directUpdate(const FilterState& prior, const StateCovariance&
       // the covariance counts only the photometric information beyond the prior's (UpdateOptions)
       MeasurementInformation beyond;
       beyond.calibration_block = FilterState::kCamera;
-      beyond.HtRinvH = covarianceInformation(S_last, measuredCovariance(P_prior, FilterState::kCamera));
+      beyond.HtRinvH = covarianceInformation(S_last, P_measured);
       StateVector unused;
       informationStep(x_lin, prior, P_prior, beyond, &unused, &res.covariance, estimated);
     }
