@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "livo/filter_state.hpp"
 #include "livo/filter_state_message.hpp"
@@ -166,7 +169,23 @@ TEST(FilterState, MessageRoundTripKeepsTheCalibrationAndTheWholeCovariance) {
   filter_state_t bad = m;
   for (double& q : bad.camera_orientation) q = 0.0;
   EXPECT_FALSE(fromFilterState(bad, &y, &Q));
-  bad = m;
-  bad.lidar_time_shift = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(fromFilterState(bad, &y, &Q));
+  // a NaN in any of the hand-off's calibration fields or in the body rate is refused, whatever
+  // the field (the VIO would otherwise render its references through it)
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<const char*, std::function<void(filter_state_t&)>>> poison = {
+      {"angular_velocity", [&](filter_state_t& b) { b.angular_velocity[1] = nan; }},
+      {"lidar_orientation", [&](filter_state_t& b) { b.lidar_orientation[2] = nan; }},
+      {"lidar_position", [&](filter_state_t& b) { b.lidar_position[0] = nan; }},
+      {"lidar_time_shift", [&](filter_state_t& b) { b.lidar_time_shift = nan; }},
+      {"camera_orientation", [&](filter_state_t& b) { b.camera_orientation[3] = nan; }},
+      {"camera_position", [&](filter_state_t& b) { b.camera_position[2] = nan; }},
+      {"camera_time_shift", [&](filter_state_t& b) { b.camera_time_shift = nan; }},
+      {"covariance (a calibration entry)", [&](filter_state_t& b) { b.covariance[(FilterState::kDim - 1) * FilterState::kDim + FilterState::kDim - 2] = nan; }},
+  };
+  for (const auto& [field, spoil] : poison) {
+    bad = m;
+    spoil(bad);
+    EXPECT_FALSE(fromFilterState(bad, &y, &Q)) << field;
+  }
+  ASSERT_TRUE(fromFilterState(m, &y, &Q));  // and the message they were spoiled from still reads
 }
