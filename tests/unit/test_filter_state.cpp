@@ -172,6 +172,7 @@ TEST(FilterState, MessageRoundTripKeepsTheCalibrationAndTheWholeCovariance) {
   // a NaN in any of the hand-off's calibration fields or in the body rate is refused, whatever
   // the field (the VIO would otherwise render its references through it)
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  constexpr int kCameraDt = FilterState::kDim - 1, kCameraDtRow = kCameraDt * FilterState::kDim;
   const std::vector<std::pair<const char*, std::function<void(filter_state_t&)>>> poison = {
       {"angular_velocity", [&](filter_state_t& b) { b.angular_velocity[1] = nan; }},
       {"lidar_orientation", [&](filter_state_t& b) { b.lidar_orientation[2] = nan; }},
@@ -180,7 +181,7 @@ TEST(FilterState, MessageRoundTripKeepsTheCalibrationAndTheWholeCovariance) {
       {"camera_orientation", [&](filter_state_t& b) { b.camera_orientation[3] = nan; }},
       {"camera_position", [&](filter_state_t& b) { b.camera_position[2] = nan; }},
       {"camera_time_shift", [&](filter_state_t& b) { b.camera_time_shift = nan; }},
-      {"covariance (a calibration entry)", [&](filter_state_t& b) { b.covariance[(FilterState::kDim - 1) * FilterState::kDim + FilterState::kDim - 2] = nan; }},
+      {"covariance (a calibration entry)", [&](filter_state_t& b) { b.covariance[kCameraDtRow + kCameraDt - 1] = nan; }},
   };
   for (const auto& [field, spoil] : poison) {
     bad = m;
