@@ -48,7 +48,7 @@ registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime
 }
 
 keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const Mat6& pose_covariance,
-                           const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
+                           int64_t relative_to_id, const Mat6& relative_covariance, const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
                            const OutputFrame& frame) {
   keyframe_t m;
   m.id = id;
@@ -57,6 +57,8 @@ keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const M
   m.utime = utime;
   poseTo(pose, m.position, m.orientation);
   matrixTo<6>(pose_covariance, m.pose_covariance);
+  m.relative_to_id = relative_to_id;
+  matrixTo<6>(relative_covariance, m.relative_covariance);
   point_cloud_t& c = m.cloud;
   c.utime = utime;
   c.frame = "I";

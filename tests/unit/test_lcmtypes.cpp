@@ -195,8 +195,12 @@ TEST(LcmTypes, RegisteredScanKeyframeLoopCorrection) {
   k.orientation[0] = 1;
   k.cloud = makeCloud(20);
   k.cloud.frame = "I";
+  k.relative_to_id = 11;
+  k.relative_covariance[7] = 2.5e-5;
   const keyframe_t kd = roundTrip(k);
   EXPECT_EQ(kd.id, 12);
+  EXPECT_EQ(kd.relative_to_id, 11);
+  EXPECT_EQ(kd.relative_covariance[7], 2.5e-5);
   EXPECT_EQ(kd.cloud.frame, "I");
 
   loop_correction_t l{};

@@ -30,8 +30,10 @@ registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime
                                         const OutputFrame& frame);
 
 /// A keyframe's body-frame cloud (frame "I", time offsets zero: undistorted to `utime`).
+/// relative_to_id / relative_covariance: the increment from the previous keyframe (keyframe_t; -1:
+/// none given).
 keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const Mat6& pose_covariance,
-                           const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
+                           int64_t relative_to_id, const Mat6& relative_covariance, const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
                            const OutputFrame& frame);
 
 }  // namespace livo

@@ -51,6 +51,7 @@ Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt, const Vec3& omega) {
 void ImuPropagator::reset(const FilterState& x, const StateCovariance& P, const ImuSample& last) {
   x_ = x;
   P_ = P;
+  clone_cross_.setZero();
   last_ = last;
   segments_.clear();
 }
@@ -87,6 +88,7 @@ void ImuPropagator::step(const ImuSample& next) {
     const Eigen::Matrix<double, n, c> B = Fx * P_.topRightCorner<n, c>();
     P_.topRightCorner<n, c>() = B;
     P_.bottomLeftCorner<c, n>() = B.transpose();
+    clone_cross_.topRows<n>() = (Fx * clone_cross_.topRows<n>()).eval();
   }
   last_ = next;
 }

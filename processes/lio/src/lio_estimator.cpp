@@ -62,6 +62,7 @@ void LioEstimator::reset() {
   has_imu_ = has_wheel_ = false;
   has_scale_anchor_ = false;
   keyframes_.clear();
+  clone_ = KeyframeClone{};
   last_registered_body_.clear();
   has_last_post_ = has_prev_post_ = false;
   has_registered_ = false;
@@ -204,6 +205,7 @@ void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note
   const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * skipped);
   P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
   prop_.reset(x, P, s);
+  clone_.valid = false;  // the velocity starts again: no increment from the last keyframe
   appendNote(note, "IMU gap of " + formatSignificant(gap_s) + " s: velocity re-initialised");
 }
 
@@ -374,6 +376,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   }
   FilterState x = prop_.state();
   StateCovariance P = prop_.covariance();
+  const StateCovariance P_predicted = P;
 
   // 2. valid points, undistorted into the body frame at the end
   validPoints(scan, end_offset, note);
@@ -400,6 +403,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   toBodyAtSweepEnd(undistorted_with, x);
   noteRegistration(res.status, x, t_end);
   prop_.setState(x, P);
+  if (clone_.valid) prop_.setCloneCross(carriedThroughUpdate(P_predicted, P, prop_.cloneCross()));
   res.utime = t_end;
   if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
 
@@ -628,6 +632,14 @@ Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<siz
   kf.utime = t_end;
   kf.pose = x.pose();
   kf.pose_covariance = P.topLeftCorner<6, 6>();
+  if (clone_.valid) {
+    kf.relative_to_id = clone_.keyframe_id;
+    kf.relative_covariance = relativePoseCovariance(clone_.pose, kf.pose, clone_.covariance, kf.pose_covariance,
+                                                    prop_.cloneCross().topRows<6>());
+  }
+  // the next keyframe's increment starts here: Cov(δx, δpose) is P's pose columns
+  clone_ = KeyframeClone{true, kf.id, kf.pose, kf.pose_covariance};
+  prop_.setCloneCross(P.leftCols<6>());
   const bool has_intensity = scan.intensity.size() == scan.points.size();
   for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
     kf.cloud.push_back(body[i]);
@@ -678,6 +690,7 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Sta
   T.linear() = x.rot * prior.rot.transpose();
   T.translation() = x.pos - T.linear() * prior.pos;
   prop_.transformSegments(T);
+  if (clone_.valid) prop_.setCloneCross(carriedThroughUpdate(prop_.covariance(), Ps, prop_.cloneCross()));
   prop_.setState(x, Ps);
   return true;
 }
@@ -705,6 +718,14 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
     Tm.block<3, 3>(FilterState::kGravity, FilterState::kGravity) = Rc;
     prop_.setState(x, Tm * prop_.covariance() * Tm.transpose());
     keyframe_selector_.setReference(x.pose());
+    if (clone_.valid) {
+      // the clone moves with the frame: the relative pose and its covariance do not change
+      Mat6 Tc = Mat6::Identity();
+      Tc.bottomRightCorner<3, 3>() = Rc;
+      clone_.pose = T * clone_.pose;
+      clone_.covariance = Tc * clone_.covariance * Tc.transpose();
+      prop_.setCloneCross(Tm * prop_.cloneCross() * Tc.transpose());
+    }
   }
   // rebuild the local map from the corrected keyframes around the new position
   map_.clear();

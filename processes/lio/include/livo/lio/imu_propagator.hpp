@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "livo/filter_state.hpp"
+#include "livo/lio/keyframe_clone.hpp"
 #include "livo/sensor_samples.hpp"
 
 namespace livo::lio {
@@ -62,6 +63,10 @@ class ImuPropagator {
   void reset(const FilterState& x, const StateCovariance& P, const ImuSample& last);
   /// Replaces state and covariance at the current time (after an update).
   void setState(const FilterState& x, const StateCovariance& P);
+  /// The state's cross-covariance with a cloned pose (KeyframeClone): every step carries it with
+  /// the state's transition (the clone is constant). reset() zeroes it; setState() leaves it.
+  void setCloneCross(const CloneCrossCovariance& C) { clone_cross_ = C; }
+  const CloneCrossCovariance& cloneCross() const { return clone_cross_; }
 
   /// Propagates through one sample later than utime() (eq. 5-6 with u = mean of the bounding
   /// samples). Samples at or before utime() are ignored (returns false).
@@ -93,6 +98,7 @@ class ImuPropagator {
   ImuNoise noise_;
   FilterState x_;
   StateCovariance P_ = StateCovariance::Identity();
+  CloneCrossCovariance clone_cross_ = CloneCrossCovariance::Zero();
   ImuSample last_;
   std::vector<ImuSegment> segments_;
 };

@@ -24,6 +24,12 @@ struct Keyframe {
   int64_t utime = 0;                  // IMU clock
   Pose3 pose = Pose3::Identity();     // W_T_I
   Mat6 pose_covariance = Mat6::Zero();// [rotation; position]
+  /// The odometry increment from keyframe relative_to_id (the previous one of the epoch; -1: none,
+  /// the first keyframe or the first after an IMU re-initialisation) to this one: covariance of
+  /// the right perturbation of T_prev^-1 T_this ([rotation; translation in this frame]), from the
+  /// filter's cloned pose (keyframe_clone.hpp).
+  int64_t relative_to_id = -1;
+  Mat6 relative_covariance = Mat6::Zero();
   std::vector<Vec3> cloud;            // body frame I, downsampled
   std::vector<float> intensity;       // one per cloud point, from the input sweep (0 if it had none)
 };
@@ -224,6 +230,7 @@ class LioEstimator {
   int64_t scale_anchor_utime_ = 0;
   Vec3 last_prune_position_ = Vec3::Zero();
   std::deque<Keyframe> keyframes_;
+  KeyframeClone clone_;  // the last keyframe's pose, for the next one's relative covariance
   OdometryFrame frame_;
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)

@@ -1,0 +1,47 @@
+#include "livo/lio/keyframe_clone.hpp"
+
+#include <vector>
+
+#include "livo/so3.hpp"
+
+namespace livo::lio {
+
+Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb,
+                            const Mat6& P_ba) {
+  // R_a = R̂_a Exp(δa_r), p_a = p̂_a + δa_p (and b alike); T_rel = T_a^-1 T_b:
+  //   phi = δb_r - R_rel^T δa_r
+  //   tau = R_rel^T [p_rel]x δa_r + R_b^T (δb_p - δa_p)
+  const Mat3 Ra = T_a.linear(), Rb = T_b.linear();
+  const Mat3 R_rel = Ra.transpose() * Rb;
+  const Vec3 p_rel = Ra.transpose() * (T_b.translation() - T_a.translation());
+  Mat6 Ja = Mat6::Zero(), Jb = Mat6::Zero();
+  Ja.topLeftCorner<3, 3>() = -R_rel.transpose();
+  Ja.bottomLeftCorner<3, 3>() = R_rel.transpose() * so3::hat(p_rel);
+  Ja.bottomRightCorner<3, 3>() = -Rb.transpose();
+  Jb.topLeftCorner<3, 3>() = Mat3::Identity();
+  Jb.bottomRightCorner<3, 3>() = Rb.transpose();
+  const Mat6 cross = Jb * P_ba * Ja.transpose();
+  const Mat6 cov = Ja * P_aa * Ja.transpose() + Jb * P_bb * Jb.transpose() + cross + cross.transpose();
+  return 0.5 * (cov + cov.transpose());
+}
+
+CloneCrossCovariance carriedThroughUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
+                                          const CloneCrossCovariance& C) {
+  std::vector<int> idx;
+  for (int i = 0; i < FilterState::kDim; ++i)
+    if (P_prior(i, i) > 0.0) idx.push_back(i);
+  const int n = static_cast<int>(idx.size());
+  Eigen::MatrixXd Pr(n, n), Cr(n, 6);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) Pr(r, c) = P_prior(idx[r], idx[c]);
+    Cr.row(r) = C.row(idx[r]);
+  }
+  // P_post P_prior^-1 C: the solve over the estimated states, then P_post's columns over them
+  const Eigen::MatrixXd Y = Pr.ldlt().solve(Cr);
+  CloneCrossCovariance out = CloneCrossCovariance::Zero();
+  for (int r = 0; r < FilterState::kDim; ++r)
+    for (int k = 0; k < n; ++k) out.row(r) += P_post(r, idx[k]) * Y.row(k);
+  return out;
+}
+
+}  // namespace livo::lio
