@@ -157,6 +157,93 @@ TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
   EXPECT_GT(planted_unchecked.worst, 3 * clean.worst);
 }
 
+// The odometry's own covariance (keyframe_t.relative_covariance) in the graph and in the correction
+// gate: a loop the odometry satisfies within its covariance changes nothing; one that it does not
+// corrects; an increment without a covariance (or not from the previous keyframe) gets the drift
+// model, as before.
+constexpr double kChi2SixP99 = 16.812;  // 6 degrees of freedom, p = 0.99
+
+struct GivenCovariance {
+  double rotation_sigma = 0.0;     // rad per increment (0: none given)
+  double translation_sigma = 0.0;  // m per increment
+  bool from_previous = true;       // relative_to_id is the previous keyframe's id
+};
+
+std::unique_ptr<LoopCloser> runWithGivenCovariance(const std::vector<Pose3>& truth, const std::vector<Pose3>& odometry,
+                                                   const Points& scene, const GivenCovariance& given,
+                                                   bool from_filter = true) {
+  LoopCloserOptions o;
+  o.merge_distance = 0.0;
+  o.odometry_covariance_from_filter = from_filter;
+  o.correction_chi2 = kChi2SixP99;
+  auto closer = std::make_unique<LoopCloser>(o);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    KeyframeInput in;
+    in.id = static_cast<int64_t>(i);
+    in.utime = 1000000 + in.id * 2000000;
+    in.pose = odometry[i];
+    if (given.rotation_sigma > 0.0) {
+      in.relative_to_id = given.from_previous ? in.id - 1 : in.id - 2;
+      in.relative_covariance.setZero();
+      in.relative_covariance.diagonal() << Vec3::Constant(given.rotation_sigma * given.rotation_sigma),
+          Vec3::Constant(given.translation_sigma * given.translation_sigma);
+    }
+    const Pose3& T = truth[i];
+    in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    closer->addKeyframe(in);
+  }
+  return closer;
+}
+
+double worstAgainst(const LoopCloser& closer, const std::vector<Pose3>& reference) {
+  double worst = 0.0;
+  closer.forEachPose([&](int64_t id, const Pose3& pose) { worst = std::max(worst, translationError(pose, reference[id])); });
+  return worst;
+}
+
+size_t corrections(const LoopCloser& closer) {
+  size_t n = 0;
+  for (const AcceptedLoop& l : closer.loops()) n += l.corrected;
+  return n;
+}
+
+TEST(LoopConsistency, TheOdometrysCovarianceDecidesWhetherALoopCorrects) {
+  const Points scene = makeScene(41, 0.15);
+  const DriftingLaps laps(2 * DriftingLaps::kPerLap + 6);
+  // an exact odometry that says so (0.01 deg, 2 mm per 2.4 m increment): the loops it satisfies
+  // within that and the registrations' own uncertainty change nothing
+  const auto exact = runWithGivenCovariance(laps.truth, laps.truth, scene, {1.75e-4, 2e-3});
+  ASSERT_GE(exact->loops().size(), 8u);
+  EXPECT_EQ(corrections(*exact), 0u);
+  EXPECT_LT(worstAgainst(*exact, laps.truth), 1e-9);
+  for (const AcceptedLoop& l : exact->loops()) {
+    EXPECT_LE(l.correction_chi2, kChi2SixP99) << l.from_id << " -> " << l.to_id;
+    EXPECT_GT(l.odometry_covariance(5, 5), 0.0);
+  }
+  // the drift model alone would have corrected it with these loops (their residuals pass 2 cm / 0.1 deg)
+  const auto drift_model = runWithGivenCovariance(laps.truth, laps.truth, scene, {}, false);
+  std::printf("[loop-covariance] exact odometry: %zu loops, %zu corrections with its covariance, %zu with the drift model\n",
+              exact->loops().size(), corrections(*exact), corrections(*drift_model));
+
+  // the drifting odometry (0.34 m; 3e-4 rad and 7 mm off per increment) saying so: the loops
+  // disagree with it beyond what that adds up to (a random walk: 2.5e-3 rad over a lap against the
+  // 0.011 rad it drifts), correct it, and the graph bends it back
+  const auto drifting = runWithGivenCovariance(laps.truth, laps.odometry, scene, {3e-4, 7e-3});
+  const double drift = translationError(laps.odometry.back(), laps.truth.back());
+  std::printf("[loop-covariance] drifting odometry %.2f m: %zu loops, %zu corrections, worst %.3f m\n", drift,
+              drifting->loops().size(), corrections(*drifting), worstAgainst(*drifting, laps.truth));
+  EXPECT_GT(drift, 0.3);
+  EXPECT_GE(corrections(*drifting), 1u);
+  EXPECT_LT(worstAgainst(*drifting, laps.truth), 0.5 * drift);
+
+  // a covariance not from the previous keyframe is not used: the run is the drift model's
+  const auto skipped = runWithGivenCovariance(laps.truth, laps.odometry, scene, {3e-4, 7e-3, false});
+  const auto model = runWithGivenCovariance(laps.truth, laps.odometry, scene, {}, false);
+  EXPECT_EQ(pairs(*skipped), pairs(*model));
+  for (const auto& [id, pose] : model->graph().poses())
+    EXPECT_LT(translationError(skipped->graph().pose(id), pose), 1e-12) << id;
+}
+
 // The drift model: a heading drift's lever arm dominates the translation over long paths.
 TEST(LoopConsistency, DriftCovarianceGrowsWithThePath) {
   const DriftModel m;

@@ -30,6 +30,7 @@ LoopInformationOptions unbounded() {
   LoopInformationOptions o;
   o.min_rotation_sigma = o.min_translation_sigma = 1e-12;
   o.max_rotation_sigma = o.max_translation_sigma = 1e6;
+  o.roll_pitch_sigma = 0.0;  // what the registration supports, nothing added
   return o;
 }
 
@@ -97,7 +98,8 @@ TEST(LoopInformation, CorridorAxisKeepsOnlyTheCapsInformation) {
   truth.translation() = Vec3(5.0, 0, 0);
   const GicpResult r = gicpRegister(source, target, truth, {});
   ASSERT_TRUE(r.converged);
-  const LoopInformationOptions o;
+  LoopInformationOptions o;
+  o.roll_pitch_sigma = 0.0;  // the registration's own
   const Mat6 cov = registrationCovariance(r, r.T_target_source, o);
   const double along = std::sqrt(cov(3, 3));
   const double across = std::max(std::sqrt(cov(4, 4)), std::sqrt(cov(5, 5)));
@@ -112,10 +114,21 @@ TEST(LoopInformation, CorridorAxisKeepsOnlyTheCapsInformation) {
   for (int i = 0; i < 3; ++i) EXPECT_LT(std::sqrt(cov(i, i)), 2 * o.min_rotation_sigma) << i;
 }
 
+// A registration far surer than any floor: what the floors and the added terms leave.
+GicpResult confidentRegistration(double fitness = 0.0) {
+  GicpResult sure;
+  sure.plane_information = Mat6::Identity() * 1e16;
+  sure.plane_correspondences = 1000;
+  sure.plane_residual_variance = 1e-4;
+  sure.fitness = fitness;
+  return sure;
+}
+
 // Floors and caps: an empty registration (no information) gets the caps (plus the floors), an
 // absurdly confident one the floors.
 TEST(LoopInformation, FloorsAndCapsBoundEveryAxis) {
-  const LoopInformationOptions o;
+  LoopInformationOptions o;
+  o.roll_pitch_sigma = 0.0;  // below
   GicpResult none;
   const Mat6 capped = registrationCovariance(none, Pose3::Identity(), o);
   for (int i = 0; i < 6; ++i) {
@@ -123,16 +136,46 @@ TEST(LoopInformation, FloorsAndCapsBoundEveryAxis) {
     const double floor = i < 3 ? o.min_rotation_sigma : o.min_translation_sigma;
     EXPECT_NEAR(std::sqrt(capped(i, i)), std::hypot(cap, floor), 1e-9) << i;
   }
-  GicpResult sure;
-  sure.plane_information = Mat6::Identity() * 1e16;
-  sure.plane_correspondences = 1000;
-  sure.plane_residual_variance = 1e-4;
+  const GicpResult sure = confidentRegistration();
   const Pose3 T = yawPose(0.7, Vec3(3, -2, 0.5));
   const Mat6 floored = registrationCovariance(sure, T, o);
   for (int i = 0; i < 6; ++i) {
     const double floor = i < 3 ? o.min_rotation_sigma : o.min_translation_sigma;
     EXPECT_NEAR(std::sqrt(floored(i, i)), floor, 1e-3 * floor) << i;
   }
+}
+
+// loop_roll_pitch_sigma: roll and pitch (the levelled frame's x and y rotations) widened by it in
+// quadrature; yaw and the translation unchanged.
+TEST(LoopInformation, RollAndPitchWidenedYawKept) {
+  const GicpResult sure = confidentRegistration();
+  const Pose3 T = yawPose(0.7, Vec3(3, -2, 0.5));
+  LoopInformationOptions o;
+  o.roll_pitch_sigma = 0.0;
+  const Mat6 without = registrationCovariance(sure, T, o);
+  o.roll_pitch_sigma = 0.02;
+  const Mat6 with = registrationCovariance(sure, T, o);
+  EXPECT_NEAR(with(0, 0) - without(0, 0), 4e-4, 1e-15);
+  EXPECT_NEAR(with(1, 1) - without(1, 1), 4e-4, 1e-15);
+  Mat6 rest = with - without;
+  rest(0, 0) = rest(1, 1) = 0.0;
+  EXPECT_LT(rest.norm(), 1e-15);
+}
+
+// loop_fitness_rotation_sigma: a rotation standard deviation in proportion to the fine fitness,
+// added in quadrature per axis to what the registration and the floor give; translations unchanged.
+TEST(LoopInformation, FitnessWidensTheRotationOnly) {
+  const GicpResult sure = confidentRegistration(0.14);  // m^2
+  const Pose3 T = yawPose(0.7, Vec3(3, -2, 0.5));
+  LoopInformationOptions o;
+  o.fitness_rotation_sigma = 0.0;
+  const Mat6 without = registrationCovariance(sure, T, o);
+  o.fitness_rotation_sigma = 0.036;
+  const Mat6 with = registrationCovariance(sure, T, o);
+  const double added = 0.036 * 0.14;  // 5.0e-3 rad, 0.29 deg
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(with(i, i) - without(i, i), added * added, 1e-12) << i;
+  EXPECT_LT((with.bottomRightCorner<3, 3>() - without.bottomRightCorner<3, 3>()).norm(), 1e-15);
+  EXPECT_LT((with.topRightCorner<3, 3>() - without.topRightCorner<3, 3>()).norm(), 1e-15);
 }
 
 // The edge convention: the pose graph's residual [Log(R_m^T R); t - t_m] of T Exp(xi) around

@@ -214,6 +214,52 @@ TEST(PoseGraph, CopiesOptimiseIndependently) {
   EXPECT_LT(translationError(g.pose(39), copy.pose(39)), 1e-9);
 }
 
+// A loop that asks for a pitch the odometry does not have (its measured relative pose pitched by
+// 1 deg, as the loops' levelling errors are): without gravity priors the graph tilts the nodes;
+// with them every node keeps the odometry's roll and pitch to within a small fraction of that,
+// while the loop's yaw and translation still correct the drift.
+TEST(PoseGraph, GravityPriorsKeepRollAndPitch) {
+  const std::vector<Pose3> truth = circle(40);
+  const std::vector<Pose3> odo = driftedOdometry(truth, 0.002);
+  Pose3 loop = truth[39].inverse() * truth[0];
+  loop.linear() = loop.linear() * Eigen::AngleAxisd(0.0175, Vec3::UnitY()).toRotationMatrix();
+  const auto tilt = [](const Pose3& a, const Pose3& b) {  // angle between the two up axes seen in the body
+    const Vec3 ua = a.linear().transpose() * Vec3::UnitZ(), ub = b.linear().transpose() * Vec3::UnitZ();
+    return std::acos(std::min(1.0, ua.dot(ub)));
+  };
+  double worst_tilt[2] = {0.0, 0.0}, end_error[2] = {0.0, 0.0};
+  for (int with_prior = 0; with_prior < 2; ++with_prior) {
+    PoseGraph g;
+    for (int i = 0; i < 40; ++i) {
+      g.addNode(i, odo[i]);
+      if (with_prior) g.addGravityPrior(i, odo[i].linear().transpose() * Vec3::UnitZ(), 1e-4);
+    }
+    Mat6 odo_info = Mat6::Identity();
+    odo_info.topLeftCorner<3, 3>() *= 1e6;   // 1 mrad
+    odo_info.bottomRightCorner<3, 3>() *= 1e4;  // 1 cm
+    for (int i = 1; i < 40; ++i) g.addEdge({i - 1, i, odo[i - 1].inverse() * odo[i], odo_info, false});
+    g.addEdge({39, 0, loop, Mat6::Identity() * 1e4, true});
+    g.optimize();
+    for (int i = 0; i < 40; ++i) worst_tilt[with_prior] = std::max(worst_tilt[with_prior], tilt(g.pose(i), odo[i]));
+    end_error[with_prior] = translationError(g.pose(39), truth[39]);
+  }
+  const double drift = translationError(odo[39], truth[39]);
+  std::printf("[pose-graph] tilt from the odometry's attitude: %.3f deg without priors, %.4f deg with; end %.3f / %.3f m "
+              "(odometry %.3f m)\n", worst_tilt[0] * 180 / M_PI, worst_tilt[1] * 180 / M_PI, end_error[0], end_error[1], drift);
+  EXPECT_GT(worst_tilt[0], 0.2 * 0.0175);  // 0.28 deg: the odometry edges take part of the 1 deg
+  EXPECT_LT(worst_tilt[1], 0.05 * 0.0175);
+  EXPECT_LT(end_error[1], 0.5 * drift);
+}
+
+TEST(PoseGraph, GravityPriorNeedsAKnownNodeAndAPositiveSigma) {
+  PoseGraph g;
+  g.addNode(0, Pose3::Identity());
+  EXPECT_THROW(g.addGravityPrior(1, Vec3::UnitZ(), 1e-3), std::invalid_argument);
+  EXPECT_THROW(g.addGravityPrior(0, Vec3::UnitZ(), 0.0), std::invalid_argument);
+  EXPECT_THROW(g.addGravityPrior(0, Vec3::Zero(), 1e-3), std::invalid_argument);
+  EXPECT_NO_THROW(g.addGravityPrior(0, Vec3::UnitZ(), 1e-3));
+}
+
 TEST(PoseGraph, UnknownNodeIsRejected) {
   PoseGraph g;
   g.addNode(0, Pose3::Identity());

@@ -10,6 +10,11 @@
 namespace livo::loop {
 
 namespace {
+// A covariance an edge can use: finite, symmetric to rounding, positive definite.
+bool isCovariance(const Mat6& C) {
+  if (!C.allFinite() || (C - C.transpose()).norm() > 1e-9 * C.norm()) return false;
+  return Eigen::LLT<Mat6>(C).info() == Eigen::Success;
+}
 // Rotation that levels the body frame: R_rp with W_R_I = Rz(yaw) * R_rp.
 Mat3 rollPitch(const Mat3& W_R_I) {
   const Vec3 x = W_R_I.col(0);
@@ -265,15 +270,34 @@ LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features&
   return r;
 }
 
+Mat6 LoopCloser::chainOdometryCovariance(const Keyframe& to) const {
+  if (options_.odometry_covariance_from_filter && chain_.filter_covariance) return chain_.odometry_covariance;
+  // the drift model: the increment's covariance from the absolute ones, floored by the drift
+  // model over the path
+  return relativeInformation(chain_.start_keyframe.covariance, to.covariance,
+                             std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+                             std::hypot(options_.odometry_translation_floor,
+                                        options_.odometry_translation_per_m * chain_.path))
+      .inverse();
+}
+
+std::optional<Mat6> LoopCloser::odometryBetween(const Keyframe& a, const Keyframe& b) const {
+  const Keyframe& early = a.path <= b.path ? a : b;
+  const Keyframe& late = a.path <= b.path ? b : a;
+  if (!options_.odometry_covariance_from_filter || !early.cumulative_from_filter || !late.cumulative_from_filter ||
+      a.epoch != b.epoch)
+    return std::nullopt;
+  // the left perturbation of the later pose given the earlier one, then as the right one of T_a^-1 T_b
+  const Mat6 D = late.cumulative_covariance - early.cumulative_covariance;
+  const Mat6 A = se3::adjoint(b.odometry.inverse());
+  const Mat6 cov = A * D * A.transpose();
+  return 0.5 * (cov + cov.transpose());
+}
+
 Mat6 LoopCloser::chainCovariance(const Keyframe& to) const {
-  // the odometry part: the increment's covariance from the absolute ones, floored by the drift
-  // model over the path; the loop part (if the chain starts with one) adds its covariance
+  // the odometry part, then the loop part (if the chain starts with one) adds its covariance
   // (carried to the end of the chain)
-  const Mat6 odometry =
-      relativeInformation(chain_.start_keyframe.covariance, to.covariance,
-                          std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
-                          std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
-          .inverse();
+  const Mat6 odometry = chainOdometryCovariance(to);
   if (!chain_.via_loop) return odometry;
   // T_node_to = T_node_start (the loop) * the odometry increment from start to `to`
   return composedCovariance(chain_.loop_covariance, chain_.start_keyframe.odometry.inverse() * to.odometry, odometry);
@@ -288,11 +312,27 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   const Pose3 discrepancy = implied.inverse() * odometry;
   loop->residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
   loop->residual_translation = discrepancy.translation().norm();
-  loop->corrected = loop->residual_translation >= options_.min_correction_translation ||
-                    loop->residual_rotation >= options_.min_correction_rotation;
-  if (edge) graph_.addEdge(*edge);
+  // the discrepancy against what the odometry between the two keyframes and the loop allow
+  // (only with the odometry's own covariance: the drift model is loose by design, to refuse only
+  // what no drift explains)
+  const std::optional<Mat6> between = odometryBetween(nodes_.at(loop->to_id), cur);
+  if (between) {
+    loop->odometry_covariance = *between;
+    loop->correction_chi2 =
+        poseChi2(graph_.pose(loop->to_id).inverse() * odometry, *between, loop->T_to_from, loop->covariance);
+  }
+  const bool resolved = loop->residual_translation >= options_.min_correction_translation ||
+                        loop->residual_rotation >= options_.min_correction_rotation;
+  const bool significant =
+      !between || options_.correction_chi2 <= 0.0 || loop->correction_chi2 > options_.correction_chi2;
+  loop->corrected = resolved && significant;
+  if (edge) {
+    graph_.addEdge(*edge);
+    ++loops_since_optimization_;
+  }
   if (!loop->corrected) return std::nullopt;
   graph_.optimize();
+  loops_since_optimization_ = 0;
   // The odometry adopts T_Ck_O = corrected * raw^-1 of this keyframe (the whole epoch's raw frame
   // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
   Correction c;
@@ -305,8 +345,17 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   return c;
 }
 
+bool LoopCloser::optimizePendingLoops() {
+  if (loops_since_optimization_ == 0) return false;
+  graph_.optimize();
+  loops_since_optimization_ = 0;
+  return true;
+}
+
 void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const FloatCloud& cloud) {
   graph_.addNode(id, estimate);
+  if (options_.gravity_prior_sigma > 0.0)
+    graph_.addGravityPrior(id, kf.odometry.linear().transpose() * Vec3::UnitZ(), options_.gravity_prior_sigma);
   nodes_.emplace(id, kf);
   clouds_.put(id, cloud);
   placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity()});
@@ -315,6 +364,7 @@ void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, 
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
   Keyframe kf;
+  kf.id = input.id;
   kf.utime = input.utime;
   kf.epoch = input.epoch;
   kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
@@ -337,6 +387,19 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
   const Pose3 previous_odometry = newest_.odometry;
   kf.path = first_of_epoch ? 0.0 : newest_.path + (previous_odometry.inverse() * kf.odometry).translation().norm();
+  // the increment from the previous keyframe, with the odometry's covariance if it came with one
+  const Pose3 step = previous_odometry.inverse() * kf.odometry;
+  std::optional<Mat6> step_covariance;
+  if (!first_of_epoch) {
+    if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id &&
+        isCovariance(input.relative_covariance))
+      step_covariance = options_.odometry_covariance_scale * input.relative_covariance;
+    const Mat6 cov = step_covariance ? *step_covariance : driftCovariance(step.translation().norm(), driftModel());
+    const Mat6 Ad = se3::adjoint(kf.odometry);
+    const Mat6 W = newest_.cumulative_covariance + Ad * cov * Ad.transpose();
+    kf.cumulative_covariance = 0.5 * (W + W.transpose());
+    kf.cumulative_from_filter = newest_.cumulative_from_filter && step_covariance.has_value();
+  }
   newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;
@@ -348,7 +411,11 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     if (!first) graph_.holdFixed(input.id);
     chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
   } else {
-    chain_.path += (previous_odometry.inverse() * kf.odometry).translation().norm();
+    chain_.path += step.translation().norm();
+    if (step_covariance)
+      chain_.odometry_covariance = composedCovariance(chain_.odometry_covariance, step, *step_covariance);
+    else
+      chain_.filter_covariance = false;
     // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
     const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
     const Pose3 estimate = graph_.pose(chain_.node) * T_node_kf;
@@ -405,7 +472,8 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.to = input.id;
     e.T_from_to = T_node_kf;
     e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
-    e.information = chain_.via_loop
+    const bool from_filter = options_.odometry_covariance_from_filter && chain_.filter_covariance;
+    e.information = chain_.via_loop || from_filter
                         ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
                         : relativeInformation(chain_.start_keyframe.covariance, kf.covariance,
                                               std::hypot(options_.odometry_rotation_floor,

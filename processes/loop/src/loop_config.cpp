@@ -41,6 +41,8 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("loop_translation_sigma", c.loop_translation_sigma);
   s.readOptional("registration_information", c.registration_information);
   s.readOptional("loop_min_rotation_sigma", c.loop_information.min_rotation_sigma);
+  s.readOptional("loop_fitness_rotation_sigma", c.loop_information.fitness_rotation_sigma);
+  s.readOptional("loop_roll_pitch_sigma", c.loop_information.roll_pitch_sigma);
   s.readOptional("loop_min_translation_sigma", c.loop_information.min_translation_sigma);
   s.readOptional("loop_max_rotation_sigma", c.loop_information.max_rotation_sigma);
   s.readOptional("loop_max_translation_sigma", c.loop_information.max_translation_sigma);
@@ -49,6 +51,13 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("consistency_chi2", c.consistency_chi2);
   s.readOptional("min_correction_translation", c.min_correction_translation);
   s.readOptional("min_correction_rotation", c.min_correction_rotation);
+  s.readOptional("correction_chi2", c.correction_chi2);
+  s.readOptional("optimize_at_exit", c.optimize_at_exit);
+  s.readOptional("gravity_prior_sigma", c.gravity_prior_sigma);
+  if (!(c.gravity_prior_sigma >= 0)) throw ConfigError(s.where("gravity_prior_sigma") + ": must be >= 0 (0: off)");
+  s.readOptional("odometry_covariance_from_filter", c.odometry_covariance_from_filter);
+  s.readOptional("odometry_covariance_scale", c.odometry_covariance_scale);
+  if (!(c.odometry_covariance_scale > 0)) throw ConfigError(s.where("odometry_covariance_scale") + ": must be > 0");
   s.readOptional("merge_distance", c.merge_distance);
   s.checkAllUsed();
   if (c.coarse.voxel_size <= 0 || c.fine_voxel_size <= 0 || c.candidates.search_radius <= 0 ||
@@ -56,9 +65,11 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
     throw ConfigError(s.where("coarse_voxel") + ": voxel sizes, search_radius and noise_bound must be > 0");
   if (c.merge_distance < 0 || c.min_correction_translation < 0 || c.min_correction_rotation < 0)
     throw ConfigError(s.where("merge_distance") + ": merge_distance and min_correction_* must be >= 0");
+  if (!(c.correction_chi2 >= 0)) throw ConfigError(s.where("correction_chi2") + ": must be >= 0 (0: off)");
   const LoopInformationOptions& li = c.loop_information;
   if (!(li.min_rotation_sigma > 0 && li.min_translation_sigma > 0 && li.max_rotation_sigma > li.min_rotation_sigma &&
         li.max_translation_sigma > li.min_translation_sigma && li.min_constrained_fraction >= 0 &&
+        li.fitness_rotation_sigma >= 0 && li.roll_pitch_sigma >= 0 &&
         li.min_constrained_fraction < 1))
     throw ConfigError(s.where("loop_min_rotation_sigma") +
                       ": loop_min_*_sigma must be > 0, loop_max_*_sigma greater than them and "
@@ -83,7 +94,10 @@ void printOptions(const LoopNodeOptions& o, std::ostream& os) {
      << a.min_coarse_inliers << " coarse inliers, fitness <= " << a.max_fitness << ", overlap >= " << a.min_overlap
      << "; consistency check " << (c.consistency_check ? "on" : "off") << " (chi2 " << c.consistency_chi2
      << "); a correction only beyond " << c.min_correction_translation << " m / " << c.min_correction_rotation
-     << " rad\n";
+     << " rad and chi2 " << c.correction_chi2 << "; odometry edges weighted by "
+     << (c.odometry_covariance_from_filter ? "the odometry's increment covariances (the drift model where none)"
+                                           : "the drift model")
+     << "\n";
 }
 
 }  // namespace livo::loop

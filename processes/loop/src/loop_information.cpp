@@ -45,7 +45,10 @@ Mat6 registrationCovariance(const GicpResult& fine, const Pose3& T_target_source
   const Vec6 values = es.eigenvalues().cwiseMax(1.0);
   // covariance of x_n: V diag(1 / values) V^T, of x: D (...) D
   Mat6 cov = D * es.eigenvectors() * values.cwiseInverse().asDiagonal() * es.eigenvectors().transpose() * D;
-  for (int i = 0; i < 3; ++i) cov(i, i) += o.min_rotation_sigma * o.min_rotation_sigma;
+  cov(0, 0) += o.roll_pitch_sigma * o.roll_pitch_sigma;
+  cov(1, 1) += o.roll_pitch_sigma * o.roll_pitch_sigma;
+  const double fitness_sigma = o.fitness_rotation_sigma * fine.fitness;
+  for (int i = 0; i < 3; ++i) cov(i, i) += o.min_rotation_sigma * o.min_rotation_sigma + fitness_sigma * fitness_sigma;
   for (int i = 3; i < 6; ++i) cov(i, i) += o.min_translation_sigma * o.min_translation_sigma;
   return symmetric(cov);
 }

@@ -49,6 +49,8 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
                " (the LIO was reset): a new graph segment, no odometry edge to the previous keyframe");
   in.pose = poseFrom(m.position, m.orientation);
   in.covariance = matrixFrom<6>(m.pose_covariance);
+  in.relative_to_id = m.relative_to_id;
+  in.relative_covariance = matrixFrom<6>(m.relative_covariance);
   in.cloud.reserve(c.x.size());
   size_t non_finite = 0;
   for (size_t i = 0; i < c.x.size(); ++i) {
@@ -123,6 +125,8 @@ void LoopNode::writeOutputs() {
     node_.info(summary());
     return;
   }
+  if (options_.closer.optimize_at_exit && closer_.optimizePendingLoops())
+    node_.info("optimised the graph once more with the loops accepted since the last correction");
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" + summary() + "; " +
              std::to_string(closer_.graph().poses().size()) + " graph nodes, " + std::to_string(closer_.size()) +

@@ -13,9 +13,19 @@
 #include "livo/spill_file.hpp"
 #include "livo/time.hpp"
 #include "livo/trajectory_io.hpp"
+#include "livo/loop/loop_information.hpp"
 #include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
+
+namespace {
+std::vector<double> rowMajor(const Mat6& M) {
+  std::vector<double> v(36);
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) v[6 * r + c] = M(r, c);
+  return v;
+}
+}  // namespace
 
 void writeKeyframeTrajectory(const std::string& path, const LoopCloser& closer) {
   Trajectory t;
@@ -33,11 +43,18 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"from_time", toSeconds(l.from_utime)},
                      {"to_time", toSeconds(l.to_utime)},
                      {"T_to_from", {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
+                     {"information", rowMajor(informationFromCovariance(l.covariance))},
                      {"coarse_inliers", l.coarse_inliers},
                      {"fitness", l.fitness},
                      {"overlap", l.overlap},
                      {"residual_translation", l.residual_translation},
                      {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
+                     {"correction_chi2", l.correction_chi2},
+                     {"odometry_sigma_rotation_deg", {std::sqrt(l.odometry_covariance(0, 0)) * 180.0 / M_PI,
+                                                      std::sqrt(l.odometry_covariance(1, 1)) * 180.0 / M_PI,
+                                                      std::sqrt(l.odometry_covariance(2, 2)) * 180.0 / M_PI}},
+                     {"odometry_sigma_translation", {std::sqrt(l.odometry_covariance(3, 3)), std::sqrt(l.odometry_covariance(4, 4)),
+                                                     std::sqrt(l.odometry_covariance(5, 5))}},
                      {"corrected", l.corrected},
                      {"merged", l.merged},
                      {"sigma_rotation_deg", {std::sqrt(l.covariance(0, 0)) * 180.0 / M_PI, std::sqrt(l.covariance(1, 1)) * 180.0 / M_PI,

@@ -96,6 +96,30 @@ class RelativePoseCost final : public ceres::SizedCostFunction<6, 7, 7> {
   Mat6 sqrt_info_;
 };
 
+// r = (R^T e_z - u) / sigma: the world's up axis in the node's frame against the prior's u. With
+// R Exp(dtheta): Exp(-dtheta) v = v + hat(v) dtheta, so dr/dtheta = hat(R^T e_z) / sigma.
+class GravityPriorCost final : public ceres::SizedCostFunction<3, 7> {
+ public:
+  GravityPriorCost(const Vec3& up_in_body, double sigma) : up_(up_in_body.normalized()), inv_sigma_(1.0 / sigma) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    Eigen::Map<const Quat> q(parameters[0] + 3);
+    const Vec3 v = q.toRotationMatrix().transpose() * Vec3::UnitZ();
+    Eigen::Map<Vec3> r(residuals);
+    r = inv_sigma_ * (v - up_);
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 3, 7, Eigen::RowMajor>> J(jacobians[0]);
+      J.setZero();
+      J.block<3, 3>(0, 3) = inv_sigma_ * so3::hat(v);
+    }
+    return true;
+  }
+
+ private:
+  Vec3 up_;
+  double inv_sigma_;
+};
+
 Mat6 sqrtInformation(const Mat6& info) {
   Eigen::LLT<Mat6> llt(0.5 * (info + info.transpose()));
   if (llt.info() != Eigen::Success) return Mat6::Identity();
@@ -133,7 +157,8 @@ PoseGraph::PoseGraph(const PoseGraph& other)
       blocks_(other.blocks_),
       edges_(other.edges_),
       loop_edges_(other.loop_edges_),
-      held_fixed_(other.held_fixed_) {
+      held_fixed_(other.held_fixed_),
+      gravity_priors_(other.gravity_priors_) {
   for (auto& [id, b] : blocks_) b.in_problem = false;
 }
 
@@ -148,6 +173,7 @@ PoseGraph& PoseGraph::operator=(const PoseGraph& other) {
 void PoseGraph::resetProblem() {
   problem_.reset();
   edges_in_problem_ = 0;
+  priors_in_problem_ = 0;
   for (auto& [id, b] : blocks_) b.in_problem = false;
 }
 
@@ -155,6 +181,13 @@ void PoseGraph::addNode(int64_t id, const Pose3& initial) {
   poses_[id] = initial;
   Block& b = blocks_[id];
   b.x = toBlock(initial);
+}
+
+void PoseGraph::addGravityPrior(int64_t id, const Vec3& up_in_body, double sigma) {
+  if (!hasNode(id)) throw std::invalid_argument("pose graph gravity prior names an unknown node " + std::to_string(id));
+  if (!(sigma > 0.0) || !up_in_body.allFinite() || up_in_body.norm() < 0.5)
+    throw std::invalid_argument("pose graph gravity prior: sigma must be > 0 and the up axis a unit vector");
+  gravity_priors_.push_back(GravityPrior{id, up_in_body, sigma});
 }
 
 bool PoseGraph::addEdge(const PoseEdge& edge) {
@@ -225,6 +258,10 @@ PoseGraphSummary PoseGraph::optimize() {
     ceres::LossFunction* loss =
         (e.is_loop && options_.robust_loops) ? new ceres::CauchyLoss(options_.loop_loss_scale) : nullptr;
     problem.AddResidualBlock(new RelativePoseCost(e.T_from_to, sqrtInformation(e.information)), loss, a, b);
+  }
+  for (; priors_in_problem_ < gravity_priors_.size(); ++priors_in_problem_) {
+    const GravityPrior& g = gravity_priors_[priors_in_problem_];
+    problem.AddResidualBlock(new GravityPriorCost(g.up_in_body, g.sigma), nullptr, ensureBlock(g.id));
   }
 
   ceres::Solver::Options sopts;

@@ -44,11 +44,19 @@ struct LoopCloserOptions {
   CandidateOptions candidates;
   LoopRegistrationOptions registration;
   PoseGraphOptions graph;
-  // Odometry edge noise, added to the relative covariance of the keyframes' absolute ones (which,
-  // from a filter with a map, barely grow and say little about the increment): a floor plus a part
-  // proportional to the distance travelled, the usual drift model of LiDAR odometry (0.5 % and
-  // 0.01 deg/m; the old 2 cm / 2 mrad per edge made 1,450 edges of a 300 s drive worth 0.8 m of
-  // random walk and let every loop's noise through).
+  /// The odometry edges' covariance: (true) the odometry's own, from each keyframe's increment from
+  /// the previous one (keyframe_t.relative_covariance: livo-lio's filter with a cloned pose),
+  /// composed along the edge; or (false, and for any increment that comes without one) the drift
+  /// model below.
+  bool odometry_covariance_from_filter = true;
+  /// The increments' covariances are used times this (1: as the odometry states them).
+  double odometry_covariance_scale = 1.0;
+  // The drift model: odometry edge noise added to the relative covariance of the keyframes'
+  // absolute ones (which, from a filter with a map, barely grow and say little about the
+  // increment): a floor plus a part proportional to the distance travelled, the usual drift model
+  // of LiDAR odometry (0.5 % and 0.01 deg/m; the old 2 cm / 2 mrad per edge made 1,450 edges of a
+  // 300 s drive worth 0.8 m of random walk and let every loop's noise through). The consistency
+  // check below always uses it (a loose model, to refuse only what no drift explains).
   double odometry_rotation_floor = 2e-4;       // rad
   double odometry_translation_floor = 2e-3;    // m
   double odometry_rotation_per_m = 2e-4;       // rad per metre travelled
@@ -79,6 +87,13 @@ struct LoopCloserOptions {
   /// and re-solved the whole graph each time. The edge still counts in the next optimisation.
   double min_correction_translation = 0.02;  // m
   double min_correction_rotation = 1.75e-3;  // rad (0.1 deg: 5 cm at 30 m range)
+  /// ... nor is one whose discrepancy the odometry's own uncertainty explains: the squared
+  /// Mahalanobis distance of the loop's T_to_from to the estimate's, with the loop's covariance and
+  /// the odometry's over the path between the two keyframes (the increments' covariances carried
+  /// to one frame and summed), at most this (6 degrees of freedom; 16.81: p = 0.99). 0: off; not
+  /// applied where an increment came without a covariance (the drift model is loose by design)
+  /// nor without odometry_covariance_from_filter.
+  double correction_chi2 = 16.812;
   /// Reduced pose graph (Johannsson et al., "Temporally scalable visual SLAM using a reduced pose
   /// graph", 2013): where the route passes again, a keyframe within this distance of an older
   /// graph node joins that node instead of becoming a node of its own (registered to it, or, near
@@ -86,6 +101,13 @@ struct LoopCloserOptions {
   /// The graph, and the cost and memory of a solve, then grow with the area mapped, not with the
   /// time driven. 0: every keyframe is a node.
   double merge_distance = 2.0;  // m
+  /// At exit, optimise once more if loops entered the graph since the last correction
+  /// (optimizePendingLoops), so the exit files hold the estimate with every accepted loop.
+  bool optimize_at_exit = true;
+  /// Every graph node's roll and pitch held to the odometry's (PoseGraph::addGravityPrior) to
+  /// within this (rad): a LiDAR-inertial odometry knows its attitude to gravity, the loops only
+  /// relative to it. 0: no prior.
+  double gravity_prior_sigma = 1e-3;
 };
 
 struct KeyframeInput {
@@ -95,6 +117,11 @@ struct KeyframeInput {
   int64_t correction_id = 0;         // the correction of this closer the pose includes (0: none)
   Pose3 pose = Pose3::Identity();    // odometry W_T_I, as published (in correction correction_id)
   Mat6 covariance = Mat6::Zero();    // [rotation; position]
+  /// The odometry increment from keyframe relative_to_id (keyframe_t): covariance of the right
+  /// perturbation of T_prev^-1 T_this. Used for the odometry edges when it is from the previous
+  /// keyframe of the epoch and positive definite; otherwise the drift model stands in.
+  int64_t relative_to_id = -1;
+  Mat6 relative_covariance = Mat6::Zero();
   Points cloud;                      // body frame I
 };
 
@@ -109,6 +136,11 @@ struct AcceptedLoop {
   /// where the loop puts it (the older keyframe's pose and T_to_from), before optimising, as
   /// rotation angle (rad) and translation (m): the correction gate's measure.
   double residual_rotation = 0.0, residual_translation = 0.0;
+  /// correction_chi2's measure (the squared Mahalanobis distance of the discrepancy above) and the
+  /// odometry covariance of the estimate it was measured against (right perturbation; both 0 where
+  /// the odometry gave no covariance).
+  double correction_chi2 = 0.0;
+  Mat6 odometry_covariance = Mat6::Zero();
   bool corrected = false;  // the graph was optimised and a correction published for it
   /// The new keyframe joined the older one (reduced pose graph): the edge went from the node the
   /// odometry came from to `to_id`, and the residual is that edge's.
@@ -161,6 +193,11 @@ class LoopCloser {
   /// previous epoch, held fixed in its raw pose; loops are searched only within an epoch.
   AddResult addKeyframe(const KeyframeInput& input);
 
+  /// Optimises the graph if loops entered it since the last optimisation without one (the gate
+  /// above): the final estimate with every accepted loop. No correction is published (the odometry
+  /// has moved on); keyframes.tum and global_map.ply then hold it. Returns whether it optimised.
+  bool optimizePendingLoops();
+
   /// Graph nodes are a subset of the keyframes (merge_distance); every keyframe has a pose.
   const PoseGraph& graph() const { return graph_; }
   /// A keyframe's corrected pose: its node's, or its node's composed with its offset from it.
@@ -190,12 +227,18 @@ class LoopCloser {
   /// What the closer knows of a keyframe when it arrives, and keeps for graph nodes (registration
   /// targets, the global map) and for the start of the chain the newest keyframe hangs from.
   struct Keyframe {
+    int64_t id = -1;
     int64_t utime = 0;
     int32_t epoch = 0;
     Pose3 odometry = Pose3::Identity();   // in the raw odometry frame of its epoch (no correction)
     Mat6 covariance = Mat6::Zero();
     Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
     double path = 0.0;                  // m of odometry from the first keyframe of its epoch
+    /// Covariance of `odometry` given the epoch's first keyframe, as a left perturbation in the
+    /// odometry frame: the increments' covariances carried there (Ad(T_k) cov_k Ad(T_k)^T) and
+    /// summed, so the odometry's covariance between two keyframes is a difference of two of these.
+    Mat6 cumulative_covariance = Mat6::Zero();
+    bool cumulative_from_filter = true;  // every increment of it came with the odometry's covariance
     /// Its coarse features are not empty: unknown until a registration with it might be tried
     /// (most keyframes never come near an older node), then kept.
     std::optional<bool> has_keypoints;
@@ -220,6 +263,10 @@ class LoopCloser {
     bool via_loop = false;  // T_node_start is a loop measurement (else start == node)
     double path = 0.0;      // m of odometry from start
     Mat6 loop_covariance = Mat6::Zero();  // of T_node_start (right perturbation), if via_loop
+    /// The raw odometry from start: covariance of the right perturbation of T_start^-1 T_newest,
+    /// composed from the increments' own (valid while every increment had one).
+    Mat6 odometry_covariance = Mat6::Zero();
+    bool filter_covariance = true;
   };
   /// What the consistency check needs of an accepted loop besides AcceptedLoop (parallel to loops_).
   struct LoopAnchor {
@@ -265,6 +312,12 @@ class LoopCloser {
   /// Covariance of the chain's measurement of `to` (the chain's odometry and loop parts), right
   /// perturbation of T_node_to.
   Mat6 chainCovariance(const Keyframe& to) const;
+  /// The chain's raw odometry part (start to `to`): the composed increments' covariance if every
+  /// increment had one (odometry_covariance_from_filter), else the drift model over the path.
+  Mat6 chainOdometryCovariance(const Keyframe& to) const;
+  /// The odometry's covariance of T_a^-1 T_b (right perturbation) for two keyframes of an epoch,
+  /// if every increment between them came with one (odometry_covariance_from_filter).
+  std::optional<Mat6> odometryBetween(const Keyframe& a, const Keyframe& b) const;
   /// A loop's covariance (right perturbation of T_to_from in the body frames) from its registration.
   Mat6 loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const;
   DriftModel driftModel() const;
@@ -292,7 +345,8 @@ class LoopCloser {
   PoseGraph graph_;
   std::vector<Placement> placements_;  // every keyframe, in id order
   std::map<int64_t, Keyframe> nodes_;  // the graph nodes' keyframes
-  Keyframe newest_;                    // the newest keyframe (valid if placements_ is not empty)
+  Keyframe newest_;
+  size_t loops_since_optimization_ = 0;  // loop edges added to the graph since it was last optimised                    // the newest keyframe (valid if placements_ is not empty)
   KeyframeCloudStore clouds_;  // the nodes' clouds, body frame I, float as received (lossless)
   std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;

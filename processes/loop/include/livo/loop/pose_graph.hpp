@@ -74,6 +74,12 @@ class PoseGraph {
   /// is fused into it (fuse_parallel_loops); returns false then.
   bool addEdge(const PoseEdge& edge);
 
+  /// A prior on a node's roll and pitch: the world's up axis seen in the node's frame, R^T e_z,
+  /// is `up_in_body` to within `sigma` (rad) per horizontal axis. An odometry that measures
+  /// gravity knows its attitude to gravity absolutely; relative edges alone would let the graph
+  /// trade it for whatever a loop asks.
+  void addGravityPrior(int64_t id, const Vec3& up_in_body, double sigma);
+
   /// Minimises the whole graph from the current estimates (the previous solution for old nodes).
   PoseGraphSummary optimize();
 
@@ -100,6 +106,13 @@ class PoseGraph {
   size_t edges_in_problem_ = 0;
   int64_t fixed_id_ = 0;  // the node held constant in problem_
   std::set<int64_t> held_fixed_;  // first nodes of later segments (holdFixed)
+  struct GravityPrior {
+    int64_t id = 0;
+    Vec3 up_in_body = Vec3::UnitZ();
+    double sigma = 1.0;
+  };
+  std::vector<GravityPrior> gravity_priors_;
+  size_t priors_in_problem_ = 0;
 };
 
 /// The information of a relative edge from two absolute covariances (cov_to - cov_from,
