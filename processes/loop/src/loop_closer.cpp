@@ -345,6 +345,20 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   return c;
 }
 
+std::optional<Mat6> LoopCloser::accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) const {
+  // the odometry's covariance of the increment, if it came with one from the previous keyframe
+  std::optional<Mat6> given;
+  if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id &&
+      isCovariance(input.relative_covariance))
+    given = options_.odometry_covariance_scale * input.relative_covariance;
+  const Mat6 cov = given ? *given : driftCovariance(step.translation().norm(), driftModel());
+  const Mat6 Ad = se3::adjoint(kf->odometry);
+  const Mat6 W = newest_.cumulative_covariance + Ad * cov * Ad.transpose();
+  kf->cumulative_covariance = 0.5 * (W + W.transpose());
+  kf->cumulative_from_filter = newest_.cumulative_from_filter && given.has_value();
+  return given;
+}
+
 bool LoopCloser::optimizePendingLoops() {
   if (loops_since_optimization_ == 0) return false;
   graph_.optimize();
@@ -386,20 +400,9 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
   const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
   const Pose3 previous_odometry = newest_.odometry;
-  kf.path = first_of_epoch ? 0.0 : newest_.path + (previous_odometry.inverse() * kf.odometry).translation().norm();
-  // the increment from the previous keyframe, with the odometry's covariance if it came with one
-  const Pose3 step = previous_odometry.inverse() * kf.odometry;
-  std::optional<Mat6> step_covariance;
-  if (!first_of_epoch) {
-    if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id &&
-        isCovariance(input.relative_covariance))
-      step_covariance = options_.odometry_covariance_scale * input.relative_covariance;
-    const Mat6 cov = step_covariance ? *step_covariance : driftCovariance(step.translation().norm(), driftModel());
-    const Mat6 Ad = se3::adjoint(kf.odometry);
-    const Mat6 W = newest_.cumulative_covariance + Ad * cov * Ad.transpose();
-    kf.cumulative_covariance = 0.5 * (W + W.transpose());
-    kf.cumulative_from_filter = newest_.cumulative_from_filter && step_covariance.has_value();
-  }
+  const Pose3 step = previous_odometry.inverse() * kf.odometry;  // the increment from the previous keyframe
+  kf.path = first_of_epoch ? 0.0 : newest_.path + step.translation().norm();
+  const std::optional<Mat6> step_covariance = first_of_epoch ? std::nullopt : accumulateIncrement(input, step, &kf);
   newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;

@@ -315,6 +315,10 @@ class LoopCloser {
   /// The chain's raw odometry part (start to `to`): the composed increments' covariance if every
   /// increment had one (odometry_covariance_from_filter), else the drift model over the path.
   Mat6 chainOdometryCovariance(const Keyframe& to) const;
+  /// The increment `step` from the newest keyframe to kf: kf's cumulative covariance from the
+  /// newest one's, and the increment's covariance if the input gave a usable one (else nullopt;
+  /// the drift model stands in for the cumulative sum).
+  std::optional<Mat6> accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) const;
   /// The odometry's covariance of T_a^-1 T_b (right perturbation) for two keyframes of an epoch,
   /// if every increment between them came with one (odometry_covariance_from_filter).
   std::optional<Mat6> odometryBetween(const Keyframe& a, const Keyframe& b) const;
