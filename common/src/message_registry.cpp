@@ -137,7 +137,7 @@ int64_t nonFiniteIn(const registered_scan_t& m) {
 }
 int64_t nonFiniteIn(const keyframe_t& m) {
   return nonFinite(m.position) + nonFinite(m.orientation) + nonFinite(m.pose_covariance) +
-         nonFinite(m.relative_covariance) + nonFiniteIn(m.cloud);
+         nonFinite(m.relative_covariance) + nonFinite(m.relative_covariance_held_calibration) + nonFiniteIn(m.cloud);
 }
 int64_t nonFiniteIn(const loop_correction_t& m) {
   int64_t n = nonFinite(m.loop_fitness) + nonFinite(m.correction_position) + nonFinite(m.correction_orientation);

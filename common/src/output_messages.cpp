@@ -48,8 +48,8 @@ registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime
 }
 
 keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const Mat6& pose_covariance,
-                           int64_t relative_to_id, const Mat6& relative_covariance, const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
-                           const OutputFrame& frame) {
+                           const KeyframeIncrement& increment, const std::vector<Vec3>& cloud,
+                           const std::vector<float>& intensity, int16_t num_rings, const OutputFrame& frame) {
   keyframe_t m;
   m.id = id;
   m.epoch = frame.epoch;
@@ -57,8 +57,9 @@ keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const M
   m.utime = utime;
   poseTo(pose, m.position, m.orientation);
   matrixTo<6>(pose_covariance, m.pose_covariance);
-  m.relative_to_id = relative_to_id;
-  matrixTo<6>(relative_covariance, m.relative_covariance);
+  m.relative_to_id = increment.from_id;
+  matrixTo<6>(increment.covariance, m.relative_covariance);
+  matrixTo<6>(increment.held_calibration, m.relative_covariance_held_calibration);
   point_cloud_t& c = m.cloud;
   c.utime = utime;
   c.frame = "I";

@@ -151,3 +151,60 @@ TEST(KeyframeClone, PropagationCarriesTheCrossCovarianceWithTheStateTransition) 
                                           P.topLeftCorner<6, 6>(), P.topLeftCorner<6, 6>());
   EXPECT_LT(rel.norm(), 1e-15);
 }
+
+// The held calibration's consider covariance against the errors themselves: the body increment a
+// LiDAR mounted at X Exp(c) reports through the nominal X (numeric differentiation in c), and a
+// gyro with scale and misalignment errors M turning the increment's rotation by M theta.
+TEST(KeyframeClone, HeldCalibrationCovarianceMatchesTheErrorsItStandsFor) {
+  const Pose3 X = somePose(Vec3(0.02, -0.05, 0.3), Vec3(0.1, -0.05, 0.15));
+  const Pose3 T_rel = somePose(Vec3(0.01, -0.02, 0.25), Vec3(1.4, 0.2, -0.05));
+  const Pose3 lidar_motion = X.inverse() * T_rel * X;  // what the LiDAR registers
+  const double h = 1e-6;
+  Mat6 J;
+  for (int i = 0; i < 6; ++i) {
+    Vec6 c = Vec6::Zero();
+    c[i] = h;
+    Pose3 E = Pose3::Identity();  // the true mount: X's right perturbation by c
+    E.linear() = so3::Exp(c.head<3>());
+    E.translation() = c.tail<3>();
+    const Pose3 X_true = X * E;
+    const Pose3 truth = X_true * lidar_motion * X_true.inverse();
+    Vec6 xi;  // the truth as T_rel's right perturbation (relativePoseCovariance's convention)
+    xi.head<3>() = so3::Log(Mat3(T_rel.linear().transpose() * truth.linear()));
+    xi.tail<3>() = T_rel.linear().transpose() * (truth.translation() - T_rel.translation());
+    J.col(i) = xi / h;
+  }
+  HeldCalibration held;
+  held.T_I_L = X;
+  held.lidar_rotation_std = 0.005;
+  held.lidar_translation_std = 0.01;
+  Vec6 var;
+  var << Vec3::Constant(0.005 * 0.005), Vec3::Constant(0.01 * 0.01);
+  const Mat6 expected = J * var.asDiagonal() * J.transpose();
+  const Mat6 got = heldCalibrationCovariance(T_rel, held);
+  EXPECT_LT((got - expected).norm(), 1e-6 * expected.norm()) << got << "\n\n" << expected;
+  // a rotation error of the mount turns the increment's 1.4 m: about 7 mm across it, 7 mm up
+  EXPECT_NEAR(std::sqrt(got(5, 5)), 0.005 * 1.4, 0.0015);
+
+  // the gyro: M theta with independent scale and misalignment entries
+  HeldCalibration gyro;
+  gyro.gyro_scale_std = 0.01;
+  gyro.gyro_misalignment_std = 0.007;
+  const Vec3 theta = so3::Log(Mat3(T_rel.linear()));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0.0, 1.0);
+  Mat3 sample_cov = Mat3::Zero();
+  const int n = 20000;
+  for (int k = 0; k < n; ++k) {
+    Mat3 M;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) M(r, c) = g(rng) * (r == c ? gyro.gyro_scale_std : gyro.gyro_misalignment_std);
+    const Vec3 e = M * theta;
+    sample_cov += e * e.transpose() / n;
+  }
+  const Mat6 gyro_cov = heldCalibrationCovariance(T_rel, gyro);
+  const bool rotation_only = gyro_cov.bottomRows(3).isZero() && gyro_cov.topRightCorner(3, 3).isZero();
+  EXPECT_TRUE(rotation_only);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(gyro_cov(i, i), sample_cov(i, i), 0.05 * sample_cov.trace());
+  EXPECT_TRUE(heldCalibrationCovariance(T_rel, HeldCalibration{}).isZero());
+}

@@ -197,10 +197,12 @@ TEST(LcmTypes, RegisteredScanKeyframeLoopCorrection) {
   k.cloud.frame = "I";
   k.relative_to_id = 11;
   k.relative_covariance[7] = 2.5e-5;
+  k.relative_covariance_held_calibration[35] = 4.0e-5;
   const keyframe_t kd = roundTrip(k);
   EXPECT_EQ(kd.id, 12);
   EXPECT_EQ(kd.relative_to_id, 11);
   EXPECT_EQ(kd.relative_covariance[7], 2.5e-5);
+  EXPECT_EQ(kd.relative_covariance_held_calibration[35], 4.0e-5);
   EXPECT_EQ(kd.cloud.frame, "I");
 
   loop_correction_t l{};

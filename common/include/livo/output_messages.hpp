@@ -29,11 +29,17 @@ registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime
                                         const std::vector<uint32_t>& input_index, const point_cloud_t& input,
                                         const OutputFrame& frame);
 
-/// A keyframe's body-frame cloud (frame "I", time offsets zero: undistorted to `utime`).
-/// relative_to_id / relative_covariance: the increment from the previous keyframe (keyframe_t; -1:
-/// none given).
+/// The odometry increment a keyframe carries from the previous one (keyframe_t.relative_*).
+struct KeyframeIncrement {
+  int64_t from_id = -1;                       // the previous keyframe (-1: no increment given)
+  Mat6 covariance = Mat6::Zero();             // [rotation; translation in this frame], all of it
+  Mat6 held_calibration = Mat6::Zero();       // the part of `covariance` held calibration adds
+};
+
+/// A keyframe's body-frame cloud (frame "I", time offsets zero: undistorted to `utime`) and its
+/// increment from the previous keyframe.
 keyframe_t keyframeMessage(int64_t id, int64_t utime, const Pose3& pose, const Mat6& pose_covariance,
-                           int64_t relative_to_id, const Mat6& relative_covariance, const std::vector<Vec3>& cloud, const std::vector<float>& intensity, int16_t num_rings,
-                           const OutputFrame& frame);
+                           const KeyframeIncrement& increment, const std::vector<Vec3>& cloud,
+                           const std::vector<float>& intensity, int16_t num_rings, const OutputFrame& frame);
 
 }  // namespace livo

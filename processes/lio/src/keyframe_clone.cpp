@@ -25,6 +25,26 @@ Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa
   return 0.5 * (cov + cov.transpose());
 }
 
+Mat6 heldCalibrationCovariance(const Pose3& T_rel, const HeldCalibration& held) {
+  Mat6 cov = Mat6::Zero();
+  if (held.lidar_rotation_std > 0.0 || held.lidar_translation_std > 0.0) {
+    const Mat6 J = (se3::adjoint(T_rel.inverse()) - Mat6::Identity()) * se3::adjoint(held.T_I_L);
+    Vec6 extrinsic_var;
+    extrinsic_var << Vec3::Constant(held.lidar_rotation_std * held.lidar_rotation_std),
+        Vec3::Constant(held.lidar_translation_std * held.lidar_translation_std);
+    cov += J * extrinsic_var.asDiagonal() * J.transpose();
+  }
+  if (held.gyro_scale_std > 0.0 || held.gyro_misalignment_std > 0.0) {
+    const Vec3 theta = so3::Log(Mat3(T_rel.linear()));
+    const Vec3 theta2 = theta.cwiseAbs2();
+    const double s2 = held.gyro_scale_std * held.gyro_scale_std;
+    const double m2 = held.gyro_misalignment_std * held.gyro_misalignment_std;
+    // (M theta)_i = s_i theta_i + sum_{j != i} m_ij theta_j, all independent
+    for (int i = 0; i < 3; ++i) cov(i, i) += s2 * theta2(i) + m2 * (theta2.sum() - theta2(i));
+  }
+  return cov;
+}
+
 CloneCrossCovariance carriedThroughUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
                                           const CloneCrossCovariance& C) {
   std::vector<int> idx;

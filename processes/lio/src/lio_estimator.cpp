@@ -625,6 +625,16 @@ void LioEstimator::noteRegistration(ScanResult::Status status, const FilterState
   }
 }
 
+HeldCalibration LioEstimator::heldCalibration(const FilterState& x) const {
+  HeldCalibration held;
+  held.T_I_L = x.lidar.pose();
+  held.lidar_rotation_std = opts_.calibration.lidar_rotation ? 0.0 : opts_.lidar_calibration_std.rotation;
+  held.lidar_translation_std = opts_.calibration.lidar_translation ? 0.0 : opts_.lidar_calibration_std.translation;
+  held.gyro_scale_std = opts_.imu_noise.gyro_scale_std;
+  held.gyro_misalignment_std = opts_.imu_noise.gyro_misalignment_std;
+  return held;
+}
+
 Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid,
                                     const std::vector<Vec3>& body, const FilterState& x, const StateCovariance& P, int64_t t_end) {
   Keyframe kf;
@@ -636,6 +646,8 @@ Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<siz
     kf.relative_to_id = clone_.keyframe_id;
     kf.relative_covariance = relativePoseCovariance(clone_.pose, kf.pose, clone_.covariance, kf.pose_covariance,
                                                     prop_.cloneCross().topRows<6>());
+    kf.relative_covariance_held_calibration = heldCalibrationCovariance(clone_.pose.inverse() * kf.pose, heldCalibration(x));
+    kf.relative_covariance += kf.relative_covariance_held_calibration;
   }
   // the next keyframe's increment starts here: Cov(δx, δpose) is P's pose columns
   clone_ = KeyframeClone{true, kf.id, kf.pose, kf.pose_covariance};

@@ -33,7 +33,8 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in,
 }
 
 keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings, const OdometryFrame& frame) {
-  return keyframeMessage(k.id, k.utime, k.pose, k.pose_covariance, k.relative_to_id, k.relative_covariance, k.cloud, k.intensity, num_rings,
+  const KeyframeIncrement increment{k.relative_to_id, k.relative_covariance, k.relative_covariance_held_calibration};
+  return keyframeMessage(k.id, k.utime, k.pose, k.pose_covariance, increment, k.cloud, k.intensity, num_rings,
                          OutputFrame{frame.epoch, frame.correction_id});
 }
 

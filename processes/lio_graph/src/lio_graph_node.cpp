@@ -169,7 +169,7 @@ void LioGraphNode::process(const PendingSweep& p) {
   if (r.is_keyframe)
     node_.publish(opts_.keyframe_channel,
                   keyframeMessage(r.keyframe.id, r.keyframe.utime, r.keyframe.pose, r.keyframe.pose_covariance,
-                                  /*relative_to_id=*/-1, Mat6::Zero(), r.keyframe.cloud, r.keyframe.intensity, p.msg.num_rings, frame));
+                                  KeyframeIncrement{}, r.keyframe.cloud, r.keyframe.intensity, p.msg.num_rings, frame));
 }
 
 std::string LioGraphNode::summary() const {

@@ -30,6 +30,37 @@ struct KeyframeClone {
 Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb,
                             const Mat6& P_ba);
 
+/// What the filter's covariance cannot contain: calibration it holds at the rig's values (the
+/// parts of rig.lidar.calibration_std that livo-lio does not estimate; the gyro's scale and axis
+/// misalignment, rig.imu.gyro_scale_std / gyro_misalignment_std, which are never states). Their
+/// errors are the same through a whole run, so no update reveals them and the filter's increments
+/// are too confident by what they cause: on campus_loop_hard (LiDAR-IMU 0.3 deg / 1 cm, gyro 1 % /
+/// 7 mrad) the increments' NEES is 134 against 6 (README, "The increment between keyframes").
+struct HeldCalibration {
+  Pose3 T_I_L = Pose3::Identity();     // the LiDAR-IMU extrinsic in use
+  double lidar_rotation_std = 0.0;     // rad per axis (0: estimated, or not stated)
+  double lidar_translation_std = 0.0;  // m per axis (0: estimated, or not stated)
+  double gyro_scale_std = 0.0;         // relative, per axis
+  double gyro_misalignment_std = 0.0;  // rad, per off-diagonal element
+  bool any() const {
+    return lidar_rotation_std > 0.0 || lidar_translation_std > 0.0 || gyro_scale_std > 0.0 ||
+           gyro_misalignment_std > 0.0;
+  }
+};
+
+/// The covariance the held calibration adds to the increment T_rel = T_prev^-1 T_this (Schmidt's
+/// consider covariance), in relativePoseCovariance's convention:
+/// - LiDAR-IMU extrinsic X off by the right perturbation c = [rotation; translation]: the LiDAR's
+///   motion is registered, so the body increment reported is X L X^-1 where the truth is
+///   X Exp(c) L Exp(-c) X^-1. The truth is then T_rel Exp(xi) with xi = (Ad(T_rel^-1) - I) Ad(X) c
+///   to first order: a rotation error of the mount turns each increment's translation by it (a
+///   lateral and vertical error of rotation_std times the distance), a translation error matters
+///   in turns.
+/// - Gyro scale and misalignment M (diagonal scale_std, off-diagonal misalignment_std): the
+///   increment's rotation theta = Log(R_rel) comes out as (I + M) theta, a rotation error M theta.
+/// The LiDAR's time offset is not here: livo-lio estimates it by default (calibration.lidar_time).
+Mat6 heldCalibrationCovariance(const Pose3& T_rel, const HeldCalibration& held);
+
 /// A cross-covariance C = Cov(δx, δy) carried through updates of x that took its covariance from
 /// P_prior to P_post without touching y: C <- A C with P_post = A P_prior, A = Π (I - K_i H_i),
 /// i.e. P_post P_prior^-1 C (exact for Kalman updates and compositions of them). States of zero

@@ -14,6 +14,7 @@
 
 #include "livo/lio/degeneracy.hpp"
 #include "livo/lio/imu_propagator.hpp"
+#include "livo/lio/keyframe_clone.hpp"
 #include "livo/lio/lio_options.hpp"
 #include "livo/odometry_frame.hpp"
 
@@ -27,9 +28,11 @@ struct Keyframe {
   /// The odometry increment from keyframe relative_to_id (the previous one of the epoch; -1: none,
   /// the first keyframe or the first after an IMU re-initialisation) to this one: covariance of
   /// the right perturbation of T_prev^-1 T_this ([rotation; translation in this frame]), from the
-  /// filter's cloned pose (keyframe_clone.hpp).
+  /// filter's cloned pose (keyframe_clone.hpp), plus what the calibration the filter holds at the
+  /// rig's values adds (relative_covariance_held_calibration, heldCalibrationCovariance()).
   int64_t relative_to_id = -1;
   Mat6 relative_covariance = Mat6::Zero();
+  Mat6 relative_covariance_held_calibration = Mat6::Zero();
   std::vector<Vec3> cloud;            // body frame I, downsampled
   std::vector<float> intensity;       // one per cloud point, from the input sweep (0 if it had none)
 };
@@ -184,6 +187,8 @@ class LioEstimator {
   ScanResult::Status registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P, ScanResult* res);
   /// Remembers the last registration (re-seeding, velocity after IMU gaps).
   void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
+  /// The calibration the filter holds at the rig's values, with the rig's stated uncertainty.
+  HeldCalibration heldCalibration(const FilterState& x) const;
   /// A new keyframe from the sweep (kept in the bounded keyframe store).
   Keyframe makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid, const std::vector<Vec3>& body,
                         const FilterState& x, const StateCovariance& P, int64_t t_end);
