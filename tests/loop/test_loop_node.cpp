@@ -331,9 +331,16 @@ TEST(LoopCloser, FeaturesAreDerivedOnlyWhereAnOlderNodeIsNear) {
     closer.addKeyframe(in);
     if (first_derived < 0 && closer.cachedFeatures() > 0) first_derived = i;
   }
-  std::printf("[lazy] features first derived at keyframe %d of %d\n", first_derived, total);
+  std::printf("[lazy] features first derived at keyframe %d of %d; %lld registrations, %lld rejected\n", first_derived,
+              total, static_cast<long long>(closer.registrations()),
+              static_cast<long long>(closer.rejectedRegistrations().total()));
   EXPECT_GE(first_derived, 30);
   EXPECT_GE(closer.loops().size(), 1u);
+  // every candidate registered is counted: accepted (a loop, or refused by the consistency check)
+  // or rejected by the registration's own tests
+  EXPECT_EQ(closer.registrations(),
+            static_cast<int64_t>(closer.loops().size() + closer.refusedLoops().size()) +
+                closer.rejectedRegistrations().total());
 }
 
 // Exact odometry around a loop and past the start: the loops are verified and kept in the graph,

@@ -261,6 +261,12 @@ void LoopCloser::accept(const AcceptedLoop& loop, const Keyframe& from, AddResul
   keyframes_since_loop_ = 0;
 }
 
+void LoopCloser::noteAttempt(const LoopRegistrationResult& r, AddResult& result) {
+  ++registrations_;
+  if (!r.accepted) rejected_registrations_.add(r.rejected_by.empty() ? r.reason : r.rejected_by);
+  result.attempts.push_back(r);
+}
+
 LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features& from, const FloatCloud& from_cloud,
                                                 int64_t to_id, const Features& to) const {
   LoopRegistrationResult r = registerLoop(
@@ -441,7 +447,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
       const Keyframe& target = nodes_.at(*near);
       const std::shared_ptr<const Features> target_features = features(*near);
       LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, *near, *target_features);
-      result.attempts.push_back(r);
+      noteAttempt(r, result);
       std::optional<AcceptedLoop> loop;
       if (r.accepted) {
         loop = acceptedLoop(input.id, kf, *near, target, r);
@@ -501,7 +507,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     const Keyframe& target = nodes_.at(cand);
     const std::shared_ptr<const Features> target_features = features(cand);
     LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, cand, *target_features);
-    result.attempts.push_back(r);
+    noteAttempt(r, result);
     if (!r.accepted) continue;
     AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);
     if (std::optional<RefusedLoop> refusal = inconsistency(loop, kf, graph_.pose(input.id))) {

@@ -115,7 +115,10 @@ std::string LoopNode::summary() const {
   size_t by_odometry = 0;
   for (const RefusedLoop& f : closer_.refusedLoops()) by_odometry += f.against == "odometry";
   const size_t refused = closer_.refusedLoops().size();
-  return std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
+  const ReasonCounts& rejected = closer_.rejectedRegistrations();
+  std::string registered = std::to_string(closer_.registrations()) + " candidates registered";
+  if (!rejected.empty()) registered += " (" + rejected.summary(std::to_string(rejected.total()) + " rejected") + ")";
+  return registered + ", " + std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
          " corrections, " + std::to_string(refused) + " refused as inconsistent (" + std::to_string(by_odometry) +
          " with the odometry, " + std::to_string(refused - by_odometry) + " with an earlier loop)";
 }

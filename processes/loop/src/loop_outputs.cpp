@@ -90,6 +90,8 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
   out << nlohmann::json{{"num_keyframes", closer.size()},
                         {"loops", loops},
                         {"corrections", closer.corrections()},
+                        {"registrations", closer.registrations()},
+                        {"registrations_rejected", closer.rejectedRegistrations().counts()},
                         {"refused_loops", refused},
                         {"num_refused_loops", closer.refusedLoops().size()},
                         {"refused_against_odometry", refused_by_odometry},

@@ -34,6 +34,7 @@ LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const C
     why << "coarse: " << r.coarse.num_inliers << " inliers of " << r.coarse.num_correspondences << " (need "
         << a.min_coarse_inliers << ")";
     r.reason = why.str();
+    r.rejected_by = "too few coarse inliers";
     return r;
   }
   const GicpCloud& source = source_fine();
@@ -45,16 +46,26 @@ LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const C
   const Pose3 delta = r.coarse.T_target_source.inverse() * r.fine.T_target_source;
   const double drot = so3::Log(Mat3(delta.linear())).norm() * 180.0 / M_PI;
   const double dtrans = delta.translation().norm();
-  if (!r.fine.converged) why << "fine did not converge";
-  else if (r.fine.fitness > a.max_fitness) why << "fitness " << r.fine.fitness << " > " << a.max_fitness;
-  else if (r.fine.overlap < a.min_overlap) why << "overlap " << r.fine.overlap << " < " << a.min_overlap;
-  else if (drot > a.max_coarse_fine_rotation_deg || dtrans > a.max_coarse_fine_translation)
+  if (!r.fine.converged) {
+    why << "fine did not converge";
+    r.rejected_by = "fine did not converge";
+  } else if (r.fine.fitness > a.max_fitness) {
+    why << "fitness " << r.fine.fitness << " > " << a.max_fitness;
+    r.rejected_by = "fitness";
+  } else if (r.fine.overlap < a.min_overlap) {
+    why << "overlap " << r.fine.overlap << " < " << a.min_overlap;
+    r.rejected_by = "overlap";
+  } else if (drot > a.max_coarse_fine_rotation_deg || dtrans > a.max_coarse_fine_translation) {
     why << "coarse and fine disagree by " << drot << " deg, " << dtrans << " m";
-  else if (r.fine.min_translation_eigenvalue < a.min_translation_eigenvalue)
+    r.rejected_by = "coarse and fine disagree";
+  } else if (r.fine.min_translation_eigenvalue < a.min_translation_eigenvalue) {
     why << "degenerate (translation eigenvalue " << r.fine.min_translation_eigenvalue << ")";
-  else if (r.fine.translation_eigenvalue_ratio < a.min_translation_eigenvalue_ratio)
+    r.rejected_by = "degenerate";
+  } else if (r.fine.translation_eigenvalue_ratio < a.min_translation_eigenvalue_ratio) {
     why << "degenerate (translation eigenvalue ratio " << r.fine.translation_eigenvalue_ratio << " < "
         << a.min_translation_eigenvalue_ratio << ")";
+    r.rejected_by = "degenerate";
+  }
   r.reason = why.str();
   r.accepted = r.reason.empty();
   return r;

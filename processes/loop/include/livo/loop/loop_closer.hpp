@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "livo/reason_counts.hpp"
 #include "livo/loop/coarse_features.hpp"
 #include "livo/correction_frames.hpp"
 #include "livo/loop/gicp.hpp"
@@ -209,6 +210,10 @@ class LoopCloser {
   int64_t newestId() const { return placements_.empty() ? -1 : placements_.back().id; }
   const std::vector<AcceptedLoop>& loops() const { return loops_; }
   const std::vector<RefusedLoop>& refusedLoops() const { return refused_; }
+  /// Candidates registered (coarse, then fine if the coarse step passed) and, of them, those the
+  /// registration rejected, by the test that did (LoopRegistrationResult::rejected_by).
+  int64_t registrations() const { return registrations_; }
+  const ReasonCounts& rejectedRegistrations() const { return rejected_registrations_; }
   /// Accepted loops that were optimised and published as a correction.
   size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
   int64_t utime(int64_t id) const { return placement(id).utime; }
@@ -331,6 +336,8 @@ class LoopCloser {
   void accept(const AcceptedLoop& loop, const Keyframe& from, AddResult& result);
   /// Runs the registration of from_id (its cloud: from_cloud) against the graph node to_id (and the
   /// test hook). Both have keypoints.
+  /// Keeps a registration among the keyframe's attempts and counts it (registrations()).
+  void noteAttempt(const LoopRegistrationResult& r, AddResult& result);
   LoopRegistrationResult registerPair(int64_t from_id, const Features& from, const FloatCloud& from_cloud,
                                       int64_t to_id, const Features& to) const;
   /// Adds a loop edge (if any); unless the odometry already satisfies the loop, optimises and returns the
@@ -356,6 +363,8 @@ class LoopCloser {
   std::vector<AcceptedLoop> loops_;
   std::vector<LoopAnchor> anchors_;    // parallel to loops_
   std::vector<RefusedLoop> refused_;
+  int64_t registrations_ = 0;
+  ReasonCounts rejected_registrations_;
   int64_t keyframes_since_loop_ = 1000000;
   CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch
   int64_t next_correction_id_ = 1;

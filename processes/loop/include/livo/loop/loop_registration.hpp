@@ -40,6 +40,7 @@ struct LoopRegistrationResult {
   Pose3 T_target_source = Pose3::Identity();
   bool accepted = false;
   std::string reason;       // why it was rejected ("" if accepted)
+  std::string rejected_by;  // the test that rejected it, in a few words ("" if accepted)
   double coarse_ms = 0.0;   // matching + clique + rotation + translation (features cached)
   double fine_ms = 0.0;
 };
