@@ -12,19 +12,20 @@ import argparse, bisect, json, math, struct, sys
 def read_channel(path, channel):
     """(utime, payload) of every event on one channel of an LCM log."""
     out = []
-    with open(path, "rb") as f:
-        data = f.read()
-    i = 0
-    while i + 28 <= len(data):
-        sync, _, utime, clen, dlen = struct.unpack_from(">IqqII", data, i)
-        if sync != 0xEDA1DA01:
-            raise SystemExit("%s: bad sync at byte %d" % (path, i))
-        i += 28
-        ch = data[i:i + clen].decode()
-        i += clen
-        if ch == channel:
-            out.append((utime, data[i:i + dlen]))
-        i += dlen
+    want = channel.encode()
+    with open(path, "rb") as f:  # streamed: a run's outputs log can be gigabytes of clouds
+        while True:
+            at = f.tell()
+            head = f.read(28)
+            if len(head) < 28:
+                break
+            sync, _, utime, clen, dlen = struct.unpack(">IqqII", head)
+            if sync != 0xEDA1DA01:
+                raise SystemExit("%s: bad sync at byte %d" % (path, at))
+            if f.read(clen) == want:
+                out.append((utime, f.read(dlen)))
+            else:
+                f.seek(dlen, 1)
     return out
 
 

@@ -3,9 +3,10 @@
 # 120 s campus_loop log with seed 4343 that once stalled for ever at 62-65 s when a 28 MB
 # COLORED_CLOUD was lost on the bus, one a 64-beam LiDAR (OS1-64, parking) with a camera. Each must
 # finish within its time limit; a message lost on the bus, if any, must be reported in report.md
-# (never a silent hang); and every output must be finite. The runs record what the checks read (not
-# REGISTERED_SCAN), and each run's folder goes once it passed: the campus run alone writes 1.8 GB of
-# log and 1.4 GB of outputs.
+# (never a silent hang); every output must be finite; and no accepted loop may be false
+# (tests/loop/check_loops.py against the recorded ground truth). The runs record what the checks
+# read (not REGISTERED_SCAN), and each run's folder goes once it passed: the campus run alone writes
+# 1.8 GB of log and 1.4 GB of outputs.
 #   long_lockstep_test.sh ROOT BIN
 set -uo pipefail
 root="$1"; bin="$2"
@@ -41,6 +42,10 @@ assert len(odo) >= 1150, f'{name}: {len(odo)} odometry poses for 120 s of 10 Hz 
 print(f'{name}: 120 s of log in {took} s wall, {len(odo)} poses, {len(lost)} bus losses reported')
 PY
   grep -q '^COLORED_CLOUD ' "$dir/$name.loginfo" || fail "$name: no COLORED_CLOUD recorded (colour did not run?)"
+  # no false loop in a parking lot's rows of look-alike cars or on the campus (ground truth recorded)
+  /usr/bin/python3 "$root/tests/loop/check_loops.py" --log "$dir/$name/outputs.lcmlog" --loops "$dir/$name/loops.json" \
+    >"$dir/$name.loops" 2>&1 || { cat "$dir/$name.loops"; fail "$name: false loops"; }
+  echo "$name: $(head -n 1 "$dir/$name.loops"), $(tail -n 1 "$dir/$name.loops")"
   rm -rf "$dir/$name"
 }
 
