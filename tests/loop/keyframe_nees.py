@@ -36,7 +36,7 @@ def read_keyframes(path, filter_only=False):
     out = []
     for _, payload in cl.read_channel(path, "KEYFRAME"):
         o = 8
-        kid, utime = struct.unpack_from(">qq", payload, o); o += 16
+        utime, kid = struct.unpack_from(">qq", payload, o); o += 16
         p = struct.unpack_from(">3d", payload, o); o += 24
         q = struct.unpack_from(">4d", payload, o); o += 32
         o += 36 * 8  # pose_covariance

@@ -311,14 +311,17 @@ TEST(LcmTypes, LeadingUtimeReadAndWrittenInPlace) {
   imu_t d;
   ASSERT_EQ(d.decode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
   EXPECT_EQ(d.utime, -42);
-  // keyframe_t starts with its id, channel_stats_t has no utime
+  // every stamped type leads with its utime (a recorder stamps its log events with it: a KEYFRAME
+  // stamped with whatever came last on the bus made two replays' logs differ); channel_stats_t has none
   keyframe_t k{};
   k.utime = 5;
+  k.id = 9;
   const auto kb = encode(k);
-  EXPECT_FALSE(messageUtime(kb.data(), static_cast<int>(kb.size()), &t));
+  ASSERT_TRUE(messageUtime(kb.data(), static_cast<int>(kb.size()), &t));
+  EXPECT_EQ(t, 5);
   int with_utime = 0;
   for (const auto& type : messageTypes()) with_utime += type.leading_utime;
-  EXPECT_EQ(with_utime, 14);  // all but keyframe_t and channel_stats_t
+  EXPECT_EQ(with_utime, 15);  // all but channel_stats_t
 }
 
 // countNonFinite sees a NaN or an infinity in any floating-point field, nested ones included.
