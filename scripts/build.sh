@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures and builds livo-lcm into build/ (RelWithDebInfo: -O2 -g, debug sections compressed). Executables: build/bin/livo-*.
+# Configures and builds livo-lcm into build/ (RelWithDebInfo: -O2, debug line tables, -DLIVO_DEBUG_INFO=full for -g;
+# debug sections compressed). Executables: build/bin/livo-*.
 #   scripts/build.sh [extra cmake args...]      e.g. -DCMAKE_BUILD_TYPE=Release
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
