@@ -8,16 +8,14 @@
 #include "livo/health_t.hpp"
 #include "livo/node.hpp"
 #include "livo/odometry_t.hpp"
+#include "bus_messages.hpp"
 #include "livo/record/recorder.hpp"
 #include "temp_path.hpp"
 
 namespace livo::record {
 namespace {
 
-void drain(lcm::LCM& lcm) {
-  while (lcm.handleTimeout(0) > 0) {
-  }
-}
+using livo_test::drain;
 
 struct Event {
   int64_t timestamp;
@@ -56,6 +54,8 @@ TEST(Recorder, EventsBeforeTheFirstStampTakeItAndNoneGoesBackToZero) {
     early.utime = 0;  // a node that has seen no sensor time yet
     early.node = "lio";
     lcm.publish("HEALTH", &early);
+    const uint8_t junk[5] = {9, 9, 9, 9, 9};  // no type of ours, no stamp: held as well
+    lcm.publish("HEALTH", junk, sizeof(junk));
     drain(lcm);
     EXPECT_EQ(recorder.written(), 0);  // held until a stamp comes
     odometry_t odo{};
@@ -66,21 +66,27 @@ TEST(Recorder, EventsBeforeTheFirstStampTakeItAndNoneGoesBackToZero) {
     idle.utime = 0;  // a node that still has none, later in the run
     idle.node = "octomap";
     lcm.publish("HEALTH", &idle);
+    odo.utime = -3;  // a malformed stamp does not move the log's clock either
+    lcm.publish("ODOMETRY", &odo);
     odo.utime = 1700000000600000;
     lcm.publish("ODOMETRY", &odo);
     drain(lcm);
     recorder.finish();
-    EXPECT_EQ(recorder.written(), 4);
+    EXPECT_EQ(recorder.written(), 6);
   }
   const std::vector<Event> events = readBack(path);
-  ASSERT_EQ(events.size(), 5u);  // the four, then the recorder's own final HEALTH
+  ASSERT_EQ(events.size(), 7u);  // the six, then the recorder's own final HEALTH
   EXPECT_EQ(events[0].channel, "HEALTH");
   EXPECT_EQ(events[0].message_utime, 0);
   EXPECT_EQ(events[0].timestamp, 1700000000500000);  // held, then written with the first stamp
+  EXPECT_EQ(events[1].message_utime, -1);            // the junk, kept as it came
   EXPECT_EQ(events[1].timestamp, 1700000000500000);
-  EXPECT_EQ(events[2].channel, "HEALTH");
-  EXPECT_EQ(events[2].timestamp, 1700000000500000);  // the last stamp, not 0
-  EXPECT_EQ(events[3].timestamp, 1700000000600000);
+  EXPECT_EQ(events[2].timestamp, 1700000000500000);
+  EXPECT_EQ(events[3].channel, "HEALTH");
+  EXPECT_EQ(events[3].timestamp, 1700000000500000);  // the last stamp, not 0
+  EXPECT_EQ(events[4].message_utime, -3);
+  EXPECT_EQ(events[4].timestamp, 1700000000500000);  // nor a negative one
+  EXPECT_EQ(events[5].timestamp, 1700000000600000);
   for (size_t i = 1; i < events.size(); ++i) EXPECT_GE(events[i].timestamp, events[i - 1].timestamp) << i;
 }
 
