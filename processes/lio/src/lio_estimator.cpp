@@ -729,6 +729,8 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
     Tm.block<3, 3>(FilterState::kVel, FilterState::kVel) = Rc;
     Tm.block<3, 3>(FilterState::kGravity, FilterState::kGravity) = Rc;
     prop_.setState(x, Tm * prop_.covariance() * Tm.transpose());
+    // the sweep in progress is undistorted along the recorded segments: they move with the frame
+    prop_.transformSegments(T);
     keyframe_selector_.setReference(x.pose());
     if (clone_.valid) {
       // the clone moves with the frame: the relative pose and its covariance do not change
