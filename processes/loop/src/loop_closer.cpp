@@ -21,6 +21,13 @@ Mat3 rollPitch(const Mat3& W_R_I) {
   const double yaw = std::atan2(x.y(), x.x());
   return Eigen::AngleAxisd(-yaw, Vec3::UnitZ()).toRotationMatrix() * W_R_I;
 }
+// The pose T turned about a horizontal axis (the least rotation) so that the world's up axis seen
+// in its frame is up_in_body: the odometry's attitude to gravity, kept under a new yaw and position.
+Pose3 withUpInBody(const Pose3& T, const Vec3& up_in_body) {
+  Pose3 out = T;
+  out.linear() = so3::normalize(Quat::FromTwoVectors(T.linear() * up_in_body, Vec3::UnitZ()).toRotationMatrix() * T.linear());
+  return out;
+}
 Pose3 rotationOnly(const Mat3& R) {
   Pose3 T = Pose3::Identity();
   T.linear() = R;
@@ -168,13 +175,21 @@ AcceptedLoop LoopCloser::acceptedLoop(int64_t from_id, const Keyframe& from, int
   return loop;
 }
 
-Pose3 LoopCloser::pose(int64_t id) const {
-  const Placement& k = placement(id);
-  return k.node == id ? graph_.pose(id) : graph_.pose(k.node) * k.T_node_kf;
+Pose3 LoopCloser::pose(const Placement& k) const {
+  const Pose3 T = k.node == k.id ? graph_.pose(k.id) : graph_.pose(k.node) * k.T_node_kf;
+  return levelled(T, k.up_in_body);
 }
 
+Pose3 LoopCloser::levelled(const Pose3& T, const Vec3& up_in_body) const {
+  // roll and pitch are the odometry's (it measures gravity); a loop registration's tilt, carried by
+  // T_node_kf or by a node's estimate within its gravity prior, would tilt a consumer's state and map
+  return options_.gravity_prior_sigma > 0.0 ? withUpInBody(T, up_in_body) : T;
+}
+
+Pose3 LoopCloser::pose(int64_t id) const { return pose(placement(id)); }
+
 void LoopCloser::forEachPose(const std::function<void(int64_t, const Pose3&)>& visit) const {
-  for (const Placement& k : placements_) visit(k.id, k.node == k.id ? graph_.pose(k.id) : graph_.pose(k.node) * k.T_node_kf);
+  for (const Placement& k : placements_) visit(k.id, pose(k));
 }
 
 Mat6 LoopCloser::loopCovariance(const LoopRegistrationResult& r, const Keyframe& from) const {
@@ -313,7 +328,7 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
                                                   AcceptedLoop* loop) {
   // where the loop puts the keyframe (the joined or loop node's pose and the measured offset)
   // against where the odometry has it now (in the newest correction it was sent)
-  const Pose3 implied = graph_.pose(loop->to_id) * loop->T_to_from;
+  const Pose3 implied = levelled(graph_.pose(loop->to_id) * loop->T_to_from, upInBody(cur));
   const Pose3 odometry = *published_.odometryToCorrected(cur.epoch, published_.newest(cur.epoch)) * cur.odometry;
   const Pose3 discrepancy = implied.inverse() * odometry;
   loop->residual_rotation = so3::Log(Mat3(discrepancy.linear())).norm();
@@ -378,7 +393,7 @@ void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, 
     graph_.addGravityPrior(id, kf.odometry.linear().transpose() * Vec3::UnitZ(), options_.gravity_prior_sigma);
   nodes_.emplace(id, kf);
   clouds_.put(id, cloud);
-  placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity()});
+  placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity(), upInBody(kf)});
 }
 
 AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
@@ -427,13 +442,13 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
       chain_.filter_covariance = false;
     // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
     const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
-    const Pose3 estimate = graph_.pose(chain_.node) * T_node_kf;
+    const Pose3 estimate = levelled(graph_.pose(chain_.node) * T_node_kf, upInBody(kf));
     const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
     const bool older_node = kf.utime - nodes_.at(chain_.node).utime >= recent;
     if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
       // passing again near the older node the odometry hangs from: the keyframe joins it (its
       // cloud and features are not needed: the node represents it)
-      placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf});
+      placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf, upInBody(kf)});
       return result;
     }
     // the nearest older node with keypoints within merge_distance, if the keyframe has keypoints
@@ -460,7 +475,7 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
       }
       if (loop) {
         // the keyframe joins the older node; the graph gets the edge chain node -> that node
-        placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from});
+        placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from, upInBody(kf)});
         PoseEdge e;  // none if the chain's node is the joined one (no new relation)
         e.from = chain_.node;
         e.to = *near;

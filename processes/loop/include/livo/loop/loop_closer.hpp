@@ -257,7 +257,13 @@ class LoopCloser {
     int32_t epoch = 0;
     int64_t node = 0;                     // the graph node it belongs to (its own id if it is one)
     Pose3 T_node_kf = Pose3::Identity();  // its pose in that node's frame (identity for a node)
+    Vec3 up_in_body = Vec3::UnitZ();       // the odometry's world up axis in its frame (kept)
   };
+  /// The odometry's world up axis seen in a keyframe's frame: what its corrected pose keeps.
+  static Vec3 upInBody(const Keyframe& kf) { return kf.odometry.linear().transpose() * Vec3::UnitZ(); }
+  /// T with the attitude to gravity up_in_body (with the gravity priors on; T itself otherwise).
+  Pose3 levelled(const Pose3& T, const Vec3& up_in_body) const;
+  Pose3 pose(const Placement& k) const;
   /// Where the newest keyframe hangs from: a graph node, through an optional loop measurement to
   /// keyframe `start`, then raw odometry from `start` on.
   struct Chain {
