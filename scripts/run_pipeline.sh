@@ -144,8 +144,14 @@ if [ "$inside" = 0 ]; then
   # Files for the user, whatever happened above (outputs so far are kept).
   warnings=()
   if [ -f "$out/outputs.lcmlog" ]; then
-    "$bin/livo-report" extract "$out/outputs.lcmlog" --dir "$out" 2>>"$out/logs/report.log" \
-      || warnings+=("no odometry was produced (see logs/)")
+    extract_rc=0
+    "$bin/livo-report" extract "$out/outputs.lcmlog" --dir "$out" 2>"$out/logs/report_extract.log" || extract_rc=$?
+    cat "$out/logs/report_extract.log" >>"$out/logs/report.log"
+    [ "$extract_rc" = 0 ] || warnings+=("no odometry was produced (see logs/)")
+    # what extract found wrong in the outputs (a trajectory it could not correct, undecodable messages)
+    while IFS= read -r line; do warnings+=("${line#livo-report: warning: }"); done \
+      < <(grep -E '^livo-report: warning: ' "$out/logs/report_extract.log" || true)
+    rm -f "$out/logs/report_extract.log"
   else
     warnings+=("nothing was recorded")
   fi

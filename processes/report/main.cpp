@@ -62,7 +62,8 @@ int extract(int argc, char** argv) {
   const livo::report::PipelineOutputs out = livo::report::readPipelineOutputs(cli.get("OUTPUTS"), ch);
   const std::string dir = cli.get("--dir");
   livo::writeTum(dir + "/odometry.tum", out.odometry);
-  livo::writeTum(dir + "/trajectory.tum", livo::report::loopCorrectedTrajectory(out));
+  std::vector<std::string> trajectory_warnings;
+  livo::writeTum(dir + "/trajectory.tum", livo::report::loopCorrectedTrajectory(out, &trajectory_warnings));
   writeText(dir + "/timing.json", livo::report::timingJson(out.final_health).dump(2) + "\n");
   writeText(dir + "/resets.json", livo::report::resetsJson(out.resets));
   const livo::report::WeakSpots weak = livo::report::findWeakSpots(out, ch.camera);
@@ -70,6 +71,7 @@ int extract(int argc, char** argv) {
   std::cerr << "livo-report: " << out.odometry.size() << " odometry poses, " << out.keyframes.size() << " keyframes, "
             << out.loop_corrections << " loop corrections, health of " << out.final_health.size() << " processes; "
             << weak.degenerate << " degenerate and " << weak.predicted << " predicted sweeps\n";
+  for (const std::string& w : trajectory_warnings) std::cerr << "livo-report: warning: " << w << "\n";
   if (out.undecodable) std::cerr << "livo-report: warning: " << out.undecodable << " messages did not decode\n";
   if (out.non_finite) std::cerr << "livo-report: warning: " << out.non_finite << " odometry poses were not finite\n";
   if (out.odometry.empty()) {

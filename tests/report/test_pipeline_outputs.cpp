@@ -36,10 +36,11 @@ Pose3 poseAt(int i) {
 // 20 scans, keyframes at scans 0, 5, 10, 15; a loop correction for keyframes 0..2.
 // With adopted_tail, that many more scans follow the correction, published by a LIO that adopted
 // it (already corrected by correction_kf2), the first of them a keyframe.
+// Without keyframes, no KEYFRAME is written (a run that did not record them).
 std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2, bool with_loop, bool with_nan,
-                        int adopted_tail = 0) {
+                        int adopted_tail = 0, bool with_keyframes = true) {
   const std::string path = livo_test::tempPath("outputs_") + std::to_string(with_loop) + std::to_string(with_nan) +
-                           std::to_string(adopted_tail) + ".lcmlog";
+                           std::to_string(adopted_tail) + std::to_string(with_keyframes) + ".lcmlog";
   lcm::LogFile log(path, "w");
   for (int i = 0; i < 20; ++i) {
     const int64_t t = 1000000 + i * 100000;
@@ -48,7 +49,7 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
     poseTo(poseAt(i), o.position, o.orientation);
     if (with_nan && i == 7) o.position[1] = std::nan("");
     write(log, "ODOMETRY", t, o);
-    if (i % 5 == 0) {
+    if (with_keyframes && i % 5 == 0) {
       keyframe_t k{};
       k.id = i / 5;
       k.utime = t;
@@ -81,7 +82,7 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
       o.correction_id = 1;  // lio adopted correction 1
       poseTo(correction_kf2 * poseAt(i), o.position, o.orientation);
       write(log, "ODOMETRY", t, o);
-      if (i == 20) {
+      if (with_keyframes && i == 20) {
         keyframe_t k{};
         k.id = 4;
         k.utime = t;
@@ -142,6 +143,30 @@ TEST(PipelineOutputs, LoopCorrectionMovesEachSpanByItsKeyframe) {
     const Pose3 expected = c * poseAt(i);
     EXPECT_NEAR((t[i].pose.matrix() - expected.matrix()).norm(), 0.0, 1e-9) << i;
   }
+}
+
+// A run that recorded LOOP_CORRECTION but no KEYFRAME: no pose can be tied to a keyframe's
+// correction, so trajectory.tum is the odometry as published (each pose in the correction lio had
+// adopted: the online trajectory) and a warning says so. Before, every pose was moved by the last
+// correction's overall transform, which looked final and was worse than the odometry.
+TEST(PipelineOutputs, CorrectionsWithoutKeyframesLeaveTheOdometryAndWarn) {
+  Vec6 a, b;
+  a << 0.0, 0.0, 0.02, 0.3, -0.1, 0.0;
+  b << 0.0, 0.0, -0.03, -0.5, 0.4, 0.1;
+  const PipelineOutputs out = readPipelineOutputs(makeOutputs(se3::Exp(a), se3::Exp(b), true, false, 6, false));
+  ASSERT_TRUE(out.keyframes.empty());
+  ASSERT_EQ(out.last_loop.size(), 1u);
+  std::vector<std::string> warnings;
+  const Trajectory t = loopCorrectedTrajectory(out, &warnings);
+  ASSERT_EQ(t.size(), out.odometry.size());
+  for (size_t i = 0; i < t.size(); ++i) EXPECT_TRUE(t[i].pose.isApprox(out.odometry[i].pose, 1e-12)) << i;
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("no KEYFRAME"), std::string::npos) << warnings[0];
+  // with the keyframes the same log gives the corrected trajectory and no warning
+  warnings.clear();
+  const PipelineOutputs with = readPipelineOutputs(makeOutputs(se3::Exp(a), se3::Exp(b), true, false, 6, true));
+  loopCorrectedTrajectory(with, &warnings);
+  EXPECT_TRUE(warnings.empty());
 }
 
 // livo-lio adopts a loop correction: what it publishes after it is already corrected and is not

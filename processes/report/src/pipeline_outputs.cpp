@@ -153,7 +153,7 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
   return out;
 }
 
-Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
+Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs, std::vector<std::string>* warnings) {
   if (outputs.last_loop.empty()) return outputs.odometry;
   auto rawPose = [&](const Pose3& published, const PublishedFrame& f) {
     if (f.correction_id == 0) return published;
@@ -175,6 +175,16 @@ Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
     if (const std::string why = correctedKeyframePoses(lc, &corrected); !why.empty())
       throw std::runtime_error("loop correction " + std::to_string(lc.correction_id) + ": " + why);
     const Pose3 overall = outputs.corrections.at(lc.correction_id).second;
+    const bool has_keyframes = std::any_of(outputs.keyframes.begin(), outputs.keyframes.end(),
+                                           [&](const KeyframePose& k) { return k.frame.epoch == epoch; });
+    if (!has_keyframes) {
+      // nothing ties a pose to a keyframe's correction: the poses stay as published (online)
+      if (warnings)
+        warnings->push_back("loop corrections of odometry epoch " + std::to_string(epoch) +
+                            " but no KEYFRAME recorded for it: trajectory.tum holds the online odometry there, "
+                            "not the loop-corrected trajectory (record KEYFRAME)");
+      continue;
+    }
     std::vector<Anchor>& a = anchors[epoch];
     for (const KeyframePose& k : outputs.keyframes) {
       if (k.frame.epoch != epoch) continue;
@@ -182,7 +192,6 @@ Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs) {
       a.push_back({k.stamp, it != corrected.end() ? Pose3(it->second * rawPose(k.pose, k.frame).inverse()) : overall});
     }
     std::stable_sort(a.begin(), a.end(), [](const Anchor& x, const Anchor& y) { return x.stamp < y.stamp; });
-    if (a.empty()) a.push_back({0.0, overall});
   }
 
   Trajectory out;

@@ -98,7 +98,9 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
 /// the last loop correction of that epoch (keyframes newer than it take its odometry_to_corrected).
 /// Identical to the odometry when there was no loop correction. Epochs stay separate (each in its
 /// own frame). Throws std::runtime_error for a pose in a correction the log does not hold.
-Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs);
+/// An epoch with loop corrections but no recorded KEYFRAME cannot be anchored: its poses are kept
+/// as published (the online trajectory) and a line is added to `warnings` if given.
+Trajectory loopCorrectedTrajectory(const PipelineOutputs& outputs, std::vector<std::string>* warnings = nullptr);
 
 /// The resets as JSON: [{"time": s, "epoch": n, "reason": "..."}].
 std::string resetsJson(const std::vector<OdometryReset>& resets);
