@@ -354,6 +354,36 @@ TEST(VoxelMap, BeamsCastOnSeveralThreadsRemoveTheSamePoints) {
   EXPECT_GT(total, 15u);  // the box went
 }
 
+// A change of world frame (lio's map.on_loop_correction: move): every point moved by T, found
+// where T puts it, and still remembering the range it was seen from.
+TEST(VoxelMap, TransformMovesThePointsAndKeepsTheirRanges) {
+  VoxelMapOptions o;
+  o.voxel_size = 1.0;
+  o.max_points_per_voxel = 4;
+  o.min_point_distance = 0.2;
+  o.refresh_range_ratio = 0.5;
+  VoxelMap map(o);
+  const Vec3 origin(-10.0, 0.0, 0.0);  // every point seen from about 10 m
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 50; ++i) pts.push_back(Vec3(0.3 * i, 0.7 * (i % 5), 0.45 * (i % 3)));
+  ASSERT_EQ(map.insert(pts, origin), pts.size());
+  const Pose3 T = se3::fromRotationTranslation(so3::Exp(Vec3(0.01, -0.02, 0.4)), Vec3(3.3, -1.7, 0.25));
+  map.transform(T);
+  EXPECT_EQ(map.numPoints(), pts.size());
+  Vec3 nb[1];
+  double d2[1];
+  for (const Vec3& p : pts) {
+    ASSERT_EQ(map.knn(T * p, 1, 0.5, nb, d2), 1);
+    EXPECT_LT(std::sqrt(d2[0]), 1e-5);
+  }
+  // the ranges came along: a point beside pts[10] (seen from 13 m) seen from 8 m does not replace
+  // it (not within half)...
+  const Vec3 q = T * pts[10];
+  EXPECT_FALSE(map.insert(q + T.linear() * Vec3(0.05, 0, 0), 8.0));
+  // ...one seen from a quarter of it does
+  EXPECT_TRUE(map.insert(q + T.linear() * Vec3(0.05, 0, 0), 2.0));
+}
+
 TEST(VoxelMap, BetterObservedPointsReplaceWorseOnes) {
   VoxelMapOptions o;
   o.voxel_size = 1.0;

@@ -139,6 +139,12 @@ void readLio(const Config& c, LioNodeOptions* o) {
   map.readOptional("refresh_range_ratio", l.map.refresh_range_ratio);
   map.readOptional("radius", l.map_radius);
   map.readOptional("prune_distance", l.map_prune_distance);
+  std::string on_correction = l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "move" : "rebuild";
+  map.readOptional("on_loop_correction", on_correction);
+  if (on_correction != "move" && on_correction != "rebuild")
+    throw ConfigError(map.where("on_loop_correction") + ": must be move or rebuild (not " + on_correction + ")");
+  l.map_on_loop_correction =
+      on_correction == "move" ? LioOptions::OnLoopCorrection::kMove : LioOptions::OnLoopCorrection::kRebuild;
   const Config seen = map.optionalSection("seen_through");
   seen.readOptional("enabled", l.seen_through.enabled);
   seen.readOptional("beam_radius", l.seen_through.beam_radius);
@@ -263,7 +269,9 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << describe(l.lidar_calibration_std) << ", camera " << describe(l.camera_calibration_std) << "\n"
      << "  scan voxel " << l.scan_voxel_size << " m, stride " << l.point_stride << "; map voxel " << l.map.voxel_size
      << " m x " << l.map.max_points_per_voxel << " points, spacing " << l.map.min_point_distance << " m, radius "
-     << l.map_radius << " m\n"
+     << l.map_radius << " m, "
+     << (l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "moved" : "rebuilt from keyframes")
+     << " on a loop correction\n"
      << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
      << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "; " << l.search_threads

@@ -741,6 +741,11 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
       prop_.setCloneCross(Tm * prop_.cloneCross() * Tc.transpose());
     }
   }
+  if (opts_.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove) {
+    map_.transform(T);
+    last_prune_position_ = T * last_prune_position_;
+    return;
+  }
   // rebuild the local map from the corrected keyframes around the new position
   map_.clear();
   const Vec3 lidar_position = initialized_ ? prop_.state().lidar.pos : opts_.extrinsics.T_I_L.translation();

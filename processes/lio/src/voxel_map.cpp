@@ -418,6 +418,19 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   return removed;
 }
 
+void VoxelMap::transform(const Pose3& T) {
+  std::vector<std::pair<Vec3, double>> stored;
+  stored.reserve(numPoints());
+  for (size_t v = 0; v < voxels_.size(); ++v) {
+    const float* pts = voxelPoints(static_cast<int32_t>(v));
+    const float* ranges = &ranges_[v * static_cast<size_t>(opts_.max_points_per_voxel)];
+    for (int i = 0; i < voxels_[v].count; ++i)
+      stored.emplace_back(T * Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]), ranges[i]);
+  }
+  clear();
+  for (const auto& [p, range] : stored) insert(p, range);
+}
+
 void VoxelMap::clear() {
   voxels_.clear();
   pool_.clear();

@@ -354,6 +354,15 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   if (!loop->corrected) return std::nullopt;
   graph_.optimize();
   loops_since_optimization_ = 0;
+  if (options_.correction_from_optimum) {
+    // what the optimum changes for the consumers: the keyframe's pose against theirs
+    const Pose3 shift = odometry.inverse() * pose(current);
+    loop->optimum_shift_rotation = so3::Log(Mat3(shift.linear())).norm();
+    loop->optimum_shift_translation = shift.translation().norm();
+    loop->corrected = loop->optimum_shift_translation >= options_.min_correction_translation ||
+                      loop->optimum_shift_rotation >= options_.min_correction_rotation;
+    if (!loop->corrected) return std::nullopt;
+  }
   // The odometry adopts T_Ck_O = corrected * raw^-1 of this keyframe (the whole epoch's raw frame
   // onto the optimised one); T_Ck_Cj is what it applies if it is in the previous correction j.
   Correction c;

@@ -52,6 +52,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   s.readOptional("min_correction_translation", c.min_correction_translation);
   s.readOptional("min_correction_rotation", c.min_correction_rotation);
   s.readOptional("correction_chi2", c.correction_chi2);
+  s.readOptional("correction_from_optimum", c.correction_from_optimum);
   s.readOptional("optimize_at_exit", c.optimize_at_exit);
   s.readOptional("gravity_prior_sigma", c.gravity_prior_sigma);
   if (!(c.gravity_prior_sigma >= 0)) throw ConfigError(s.where("gravity_prior_sigma") + ": must be >= 0 (0: off)");
@@ -94,7 +95,9 @@ void printOptions(const LoopNodeOptions& o, std::ostream& os) {
      << a.min_coarse_inliers << " coarse inliers, fitness <= " << a.max_fitness << ", overlap >= " << a.min_overlap
      << "; consistency check " << (c.consistency_check ? "on" : "off") << " (chi2 " << c.consistency_chi2
      << "); a correction only beyond " << c.min_correction_translation << " m / " << c.min_correction_rotation
-     << " rad and chi2 " << c.correction_chi2 << "; odometry edges weighted by "
+     << " rad and chi2 " << c.correction_chi2
+     << (c.correction_from_optimum ? ", where the optimum moves the keyframe as much" : "")
+     << "; odometry edges weighted by "
      << (c.odometry_covariance_from_filter ? "the odometry's increment covariances (the drift model where none)"
                                            : "the drift model")
      << "\n";

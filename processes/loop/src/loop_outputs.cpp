@@ -50,6 +50,8 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
                      {"residual_translation", l.residual_translation},
                      {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
                      {"correction_chi2", l.correction_chi2},
+                     {"optimum_shift_translation", l.optimum_shift_translation},
+                     {"optimum_shift_rotation_deg", l.optimum_shift_rotation * 180.0 / M_PI},
                      {"odometry_sigma_rotation_deg", {std::sqrt(l.odometry_covariance(0, 0)) * 180.0 / M_PI,
                                                       std::sqrt(l.odometry_covariance(1, 1)) * 180.0 / M_PI,
                                                       std::sqrt(l.odometry_covariance(2, 2)) * 180.0 / M_PI}},

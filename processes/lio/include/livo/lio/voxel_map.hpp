@@ -73,6 +73,11 @@ class VoxelMap {
   /// how many voxels were removed.
   size_t removeFarFrom(const Vec3& centre, double radius);
 
+  /// Moves every stored point by T (a change of world frame), keeping the range each was seen
+  /// from; the seen-through counts start again. Points that land in one new voxel closer than
+  /// min_point_distance are thinned as on insertion.
+  void transform(const Pose3& T);
+
   void clear();
   bool empty() const { return voxels_.empty(); }
   size_t numVoxels() const { return voxels_.size(); }

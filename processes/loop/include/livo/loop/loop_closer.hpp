@@ -91,10 +91,19 @@ struct LoopCloserOptions {
   /// ... nor is one whose discrepancy the odometry's own uncertainty explains: the squared
   /// Mahalanobis distance of the loop's T_to_from to the estimate's, with the loop's covariance and
   /// the odometry's over the path between the two keyframes (the increments' covariances carried
-  /// to one frame and summed), at most this (6 degrees of freedom; 16.81: p = 0.99). 0: off; not
-  /// applied where an increment came without a covariance (the drift model is loose by design)
-  /// nor without odometry_covariance_from_filter.
-  double correction_chi2 = 16.812;
+  /// to one frame and summed), at most this (6 degrees of freedom; 16.81: p = 0.99). 0: off (the
+  /// default: correction_from_optimum below asks the better question; over a long lap the
+  /// odometry's covariance grows as large as the drift a loop should remove, and this gate then
+  /// let the 30 min soak publish one correction); not applied where an increment came without a
+  /// covariance (the drift model is loose by design) nor without odometry_covariance_from_filter.
+  double correction_chi2 = 0.0;
+  /// ... nor one after which the optimised graph leaves the new keyframe where the odometry has it
+  /// (in the newest correction sent) to within min_correction_translation / min_correction_rotation:
+  /// the graph is optimised with every loop that passes the gates above, and a correction is
+  /// published only if the optimum moves what the consumers hold. The loop's residual says whether
+  /// the loop disagrees with the odometry; the optimum says whether, weighed against everything
+  /// else the graph knows, that changes the estimate. false: the gates above decide alone.
+  bool correction_from_optimum = true;
   /// Reduced pose graph (Johannsson et al., "Temporally scalable visual SLAM using a reduced pose
   /// graph", 2013): where the route passes again, a keyframe within this distance of an older
   /// graph node joins that node instead of becoming a node of its own (registered to it, or, near
@@ -142,6 +151,10 @@ struct AcceptedLoop {
   /// the odometry gave no covariance).
   double correction_chi2 = 0.0;
   Mat6 odometry_covariance = Mat6::Zero();
+  /// How far the optimised graph moved the new keyframe from the odometry's pose of it (rotation
+  /// angle, rad; translation, m): correction_from_optimum's measure (0 if the graph was not
+  /// optimised for this loop).
+  double optimum_shift_rotation = 0.0, optimum_shift_translation = 0.0;
   bool corrected = false;  // the graph was optimised and a correction published for it
   /// The new keyframe joined the older one (reduced pose graph): the edge went from the node the
   /// odometry came from to `to_id`, and the residual is that edge's.
