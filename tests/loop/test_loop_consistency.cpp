@@ -39,6 +39,18 @@ struct DriftingLaps {
   }
 };
 
+// Keyframe i of a run: the odometry's pose, a keyframe every 2 s, the scene seen from the truth.
+KeyframeInput lapKeyframe(const std::vector<Pose3>& truth, const std::vector<Pose3>& odometry, const Points& scene,
+                          size_t i) {
+  KeyframeInput in;
+  in.id = static_cast<int64_t>(i);
+  in.utime = 1000000 + in.id * 2000000;
+  in.pose = odometry[i];
+  const Pose3& T = truth[i];
+  in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+  return in;
+}
+
 struct LapRun {
   std::unique_ptr<LoopCloser> closer;
   std::shared_ptr<std::set<std::pair<int64_t, int64_t>>> planted =
@@ -85,12 +97,7 @@ LapRun runLaps(const DriftingLaps& laps, const Points& scene, bool check, Far fa
     };
   run.closer = std::make_unique<LoopCloser>(o);
   for (size_t i = 0; i < laps.truth.size(); ++i) {
-    KeyframeInput in;
-    in.id = static_cast<int64_t>(i);
-    in.utime = 1000000 + in.id * 2000000;
-    in.pose = laps.odometry[i];
-    const Pose3& T = laps.truth[i];
-    in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    const KeyframeInput in = lapKeyframe(laps.truth, laps.odometry, scene, i);
     run.closer->addKeyframe(in);
   }
   run.closer->forEachPose(
@@ -181,18 +188,13 @@ std::unique_ptr<LoopCloser> runWithGivenCovariance(const std::vector<Pose3>& tru
   if (adjust) adjust(o);
   auto closer = std::make_unique<LoopCloser>(o);
   for (size_t i = 0; i < truth.size(); ++i) {
-    KeyframeInput in;
-    in.id = static_cast<int64_t>(i);
-    in.utime = 1000000 + in.id * 2000000;
-    in.pose = odometry[i];
+    KeyframeInput in = lapKeyframe(truth, odometry, scene, i);
     if (given.rotation_sigma > 0.0) {
       in.relative_to_id = given.from_previous ? in.id - 1 : in.id - 2;
       in.relative_covariance.setZero();
       in.relative_covariance.diagonal() << Vec3::Constant(given.rotation_sigma * given.rotation_sigma),
           Vec3::Constant(given.translation_sigma * given.translation_sigma);
     }
-    const Pose3& T = truth[i];
-    in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
     closer->addKeyframe(in);
   }
   return closer;
@@ -312,19 +314,13 @@ struct TiltedRun {
 TiltedRun runWithTiltedLoops(const DriftingLaps& laps, const Points& scene, double gravity_prior_sigma) {
   TiltedRun run;
   LoopCloserOptions o;
-  o.correction_chi2 = 0.0;  // every loop that moves the estimate corrects: as many as there can be
   o.gravity_prior_sigma = gravity_prior_sigma;
   o.registration_hook = [](int64_t, int64_t, LoopRegistrationResult& r) {
     if (r.accepted) r.T_target_source.linear() = r.T_target_source.linear() * so3::Exp(Vec3(0.3 * M_PI / 180, 0, 0));
   };
   run.closer = std::make_unique<LoopCloser>(o);
   for (size_t i = 0; i < laps.truth.size(); ++i) {
-    KeyframeInput in;
-    in.id = static_cast<int64_t>(i);
-    in.utime = 1000000 + in.id * 2000000;
-    in.pose = laps.odometry[i];
-    const Pose3& T = laps.truth[i];
-    in.cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    const KeyframeInput in = lapKeyframe(laps.truth, laps.odometry, scene, i);
     const AddResult r = run.closer->addKeyframe(in);
     if (!r.correction) continue;
     run.corrections.push_back(*r.correction);

@@ -423,7 +423,7 @@ void VoxelMap::transform(const Pose3& T) {
   stored.reserve(numPoints());
   for (size_t v = 0; v < voxels_.size(); ++v) {
     const float* pts = voxelPoints(static_cast<int32_t>(v));
-    const float* ranges = &ranges_[v * static_cast<size_t>(opts_.max_points_per_voxel)];
+    const float* ranges = voxelRanges(static_cast<int32_t>(v));
     for (int i = 0; i < voxels_[v].count; ++i)
       stored.emplace_back(T * Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]), ranges[i]);
   }

@@ -399,7 +399,7 @@ bool LoopCloser::optimizePendingLoops() {
 void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const FloatCloud& cloud) {
   graph_.addNode(id, estimate);
   if (options_.gravity_prior_sigma > 0.0)
-    graph_.addGravityPrior(id, kf.odometry.linear().transpose() * Vec3::UnitZ(), options_.gravity_prior_sigma);
+    graph_.addGravityPrior(id, upInBody(kf), options_.gravity_prior_sigma);
   nodes_.emplace(id, kf);
   clouds_.put(id, cloud);
   placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity(), upInBody(kf)});
