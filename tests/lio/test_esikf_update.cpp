@@ -588,6 +588,41 @@ TEST(EsikfUpdate, SingleScanRegistrationWithKnownOffsetConverges) {
   EXPECT_LT(Ppost(0, 0), 1e-4);
 }
 
+TEST(EsikfUpdate, TheRegistrationFloorBoundsWhatASweepSaysAboutThePose) {
+  // Without a floor, a sweep's pose variance falls as 1 / (number of residuals): doubling the points
+  // halves it, as if every point's error were its own. With the registration floor (the map's error,
+  // shared by all residuals) the variance stays above the floor's and more points barely change it.
+  auto setup = makeRegistration(synth::roomScene(), synth::roomTrajectory(0.0), 6.0, 0.01);
+  std::vector<Vec3> half;
+  for (size_t i = 0; i < setup.body.size(); i += 2) half.push_back(setup.body[i]);
+  const FilterState prior = offsetPrior(setup.truth, Vec6::Zero());
+  auto posterior = [&](const std::vector<Vec3>& body, double floor_rot, double floor_trans) {
+    ScanToMapOptions mo;
+    mo.registration_floor_rotation = floor_rot;
+    mo.registration_floor_translation = floor_trans;
+    ScanToMap s2m(setup.map, body, mo);
+    FilterState post;
+    StateCovariance P;
+    const EsikfResult r = iteratedUpdate(prior, looseCovariance(),
+                                         [&](const FilterState& x, int it, MeasurementInformation* info) {
+                                           return s2m.evaluate(x, it, info);
+                                         },
+                                         EsikfOptions{}, &post, &P);
+    EXPECT_TRUE(r.valid);
+    return Mat6(P.topLeftCorner<6, 6>());
+  };
+  const Mat6 all = posterior(setup.body, 0.0, 0.0), some = posterior(half, 0.0, 0.0);
+  const double kRot = 2e-3, kTrans = 0.02;  // a floor well above what the points say
+  const Mat6 all_f = posterior(setup.body, kRot, kTrans), some_f = posterior(half, kRot, kTrans);
+  for (int i = 0; i < 6; ++i) {
+    const double floor2 = i < 3 ? kRot * kRot : kTrans * kTrans;
+    EXPECT_NEAR(some(i, i) / all(i, i), 2.0, 0.4) << i;          // independent errors: twice the points, half the variance
+    EXPECT_GT(all_f(i, i), 0.9 * floor2) << i;                     // never surer than the floor
+    EXPECT_LT(all_f(i, i), floor2 + 2.0 * all(i, i)) << i;         // the floor plus what the points say
+    EXPECT_NEAR(some_f(i, i) / all_f(i, i), 1.0, 0.1) << i;       // more points, hardly a change
+  }
+}
+
 TEST(EsikfUpdate, CorridorIsFlaggedDegenerateAlongItsAxis) {
   auto setup = makeRegistration(synth::corridorScene(), synth::corridorTrajectory(0.0), 4.0, 0.01);
   const Vec6 offset = (Vec6() << 0.0, 0.0, 0.02, 0.3, 0.05, 0.0).finished();

@@ -168,6 +168,15 @@ void readLio(const Config& c, LioNodeOptions* o) {
   m.readOptional("degeneracy_threshold", l.matching.degeneracy_threshold);
   m.readOptional("degeneracy_lever_arm", l.matching.degeneracy_lever_arm);
   m.readOptional("remove_degenerate", l.matching.remove_degenerate);
+  const Config floor = m.optionalSection("registration_floor");
+  double floor_rotation_deg = l.matching.registration_floor_rotation * 180.0 / M_PI;
+  floor.readOptional("rotation_deg", floor_rotation_deg);
+  floor.readOptional("translation", l.matching.registration_floor_translation);
+  l.matching.registration_floor_rotation = floor_rotation_deg * M_PI / 180.0;
+  if (!(floor_rotation_deg >= 0.0 && floor_rotation_deg <= 1.0))
+    throw ConfigError(floor.where("rotation_deg") + ": must be in [0, 1] deg");
+  if (!(l.matching.registration_floor_translation >= 0.0 && l.matching.registration_floor_translation <= 0.1))
+    throw ConfigError(floor.where("translation") + ": must be in [0, 0.1] m");
 
   const Config e = c.optionalSection("esikf");
   e.readOptional("max_iterations", l.esikf.max_iterations);
@@ -273,7 +282,9 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << (l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "moved" : "rebuilt from keyframes")
      << " on a loop correction\n"
      << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
-     << " m; residual sigma " << l.matching.point_noise_std << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
+     << " m; residual sigma " << l.matching.point_noise_std << " m, registration floor "
+     << l.matching.registration_floor_rotation * 180.0 / M_PI << " deg / " << l.matching.registration_floor_translation
+     << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "; " << l.search_threads
      << (l.search_threads == 1 ? " search thread" : " search threads") << "\n"
      << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))

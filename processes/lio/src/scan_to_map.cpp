@@ -43,6 +43,8 @@ ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, 
     points_[i] = R_LI * (body_points[i] - undistorted_with.pos);
     gate_[i] = opts_.residual_range_factor * std::sqrt(body_points[i].norm());
   }
+  floor_.diagonal().head<3>().setConstant(opts_.registration_floor_rotation * opts_.registration_floor_rotation);
+  floor_.diagonal().segment<3>(3).setConstant(opts_.registration_floor_translation * opts_.registration_floor_translation);
 }
 
 int ScanToMap::numMatched() const {
@@ -137,6 +139,8 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
     S.topLeftCorner<6, 6>() = Sp;
     g.head<6>() = gp;
   }
+  if (opts_.registration_floor_rotation > 0.0 || opts_.registration_floor_translation > 0.0)
+    applyMeasurementFloor(floor_, &S, &g);
   info->HtRinvH = S;
   info->HtRinvz = g;
   return true;

@@ -31,6 +31,13 @@ struct ScanToMapOptions {
   double degeneracy_lever_arm = 1.0;    // m, L of the degeneracy test (degeneracy.hpp)
   double degeneracy_threshold = 0.01;   // eigenvalue of G below which a direction is degenerate
   bool remove_degenerate = true;        // drop the information of degenerate directions
+  // The accuracy floor of one sweep's registration (1 sigma; rotation in rad, translation in m): the
+  // map's own error (planes fitted to points that earlier, imperfect poses placed), shared by every
+  // residual of the sweep, which no number of points averages away. The residuals' covariance is
+  // point_noise_std^2 W^-1 + H_pose F H_pose^T (W: the robust weights, F: this floor), so a sweep
+  // with thousands of residuals measures the pose no better than F (applyMeasurementFloor). 0: none.
+  double registration_floor_rotation = 4e-5;  // 0.0023 deg
+  double registration_floor_translation = 6.5e-4;
 };
 
 /// The matching options for a LiDAR whose range noise (1 sigma, along the beam) is `range_noise_std`,
@@ -83,6 +90,7 @@ class ScanToMap {
   std::vector<double> gate_;  // per point: max |r|
   std::vector<Vec3> world_;           // per point: its image at the current iterate
   std::vector<uint32_t> to_search_;   // the points whose planes are fitted anew at this iterate
+  Mat13 floor_ = Mat13::Zero();       // the registration floor over the measured states
   std::vector<Row> rows_;     // accepted residuals of the current iterate
   std::vector<double> abs_r_;
   DegeneracyReport degeneracy_;
