@@ -27,7 +27,7 @@ the other (each uses both cores). --build DIR picks the executables of the runs 
 always this tree's: LIVO_BUILD_DIR or build/): with --config-dir of the same era, the same command
 measures an older build on the same logs.
 """
-import argparse, csv, hashlib, json, math, os, shutil, subprocess, sys
+import argparse, csv, json, math, os, shutil, subprocess, sys
 
 import sim_variants as sv
 
@@ -87,32 +87,6 @@ def camera_lidar_truth_deg(truth):
     return [math.degrees(x) for x in log_so3(mul(tr(R_LC), mul(tr(E_L), mul(R_LC, E_C))))]
 
 
-# --- caching ---
-def file_hash(path, h=None):
-    h = h or hashlib.sha256()
-    with open(path, 'rb') as f:
-        for block in iter(lambda: f.read(1 << 20), b''):
-            h.update(block)
-    return h
-
-
-def key_of(*parts):
-    h = hashlib.sha256()
-    for p in parts:
-        h.update(repr(p).encode())
-        h.update(b'\0')
-    return h.hexdigest()
-
-
-def cached(path, key):
-    kf = path + '.key'
-    return os.path.exists(path) and os.path.exists(kf) and open(kf).read().strip() == key
-
-
-def mark(path, key):
-    open(path + '.key', 'w').write(key + '\n')
-
-
 def calibration_errors(csv_path, truth, after_s=30.0):
     """Worst camera-LiDAR rotation error (deg) and camera time offset error (ms) from after_s on,
     and both at the end; None without a calibration.csv."""
@@ -157,9 +131,9 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     logs = a.logs or os.path.join(a.out, 'logs')
     os.makedirs(logs, exist_ok=True)
-    sim_hash = file_hash(sim).hexdigest()
-    run_hash = key_of(*[file_hash(os.path.join(bin_dir, t)).hexdigest() for t in RUN_EXECUTABLES],
-                      file_hash(os.path.join(ROOT, 'scripts', 'run_pipeline.sh')).hexdigest())
+    sim_hash = sv.file_hash(sim).hexdigest()
+    run_hash = sv.key_of(*[sv.file_hash(os.path.join(bin_dir, t)).hexdigest() for t in RUN_EXECUTABLES],
+                         sv.file_hash(os.path.join(ROOT, 'scripts', 'run_pipeline.sh')).hexdigest())
     overlay_bytes = open(a.overlay, 'rb').read() if a.overlay else b''
     variants = a.variants.split(',')
     rows, failures = [], []
@@ -177,9 +151,9 @@ def main():
             os.makedirs(base, exist_ok=True)
             log = os.path.join(logs, '%s_%gs.lcmlog' % (tag, duration))
             truth_file = log + '.truth.json'
-            log_key = key_of(config_bytes, seed, duration, sim_hash)
+            log_key = sv.key_of(config_bytes, seed, duration, sim_hash)
             made_log = False
-            if not (cached(log, log_key) and os.path.exists(truth_file)):
+            if not (sv.cached(log, log_key) and os.path.exists(truth_file)):
                 print('%s: simulating %g s' % (tag, duration), file=sys.stderr, flush=True)
                 part = log + '.part'
                 if not sv.run([sim, '--config', config, '--out', part, '--seed', seed,
@@ -187,15 +161,15 @@ def main():
                     failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                     continue
                 os.replace(part, log)
-                mark(log, log_key)
+                sv.mark(log, log_key)
                 made_log = True
             truth = json.load(open(truth_file))
             row = {'config': name, 'seed': seed, 'duration': duration}
             for v in variants:
                 run_dir = os.path.join(base, v)
                 done_file = os.path.join(run_dir, 'evaluation_odometry.json')
-                run_key = key_of(config_bytes, overlay_bytes, seed, duration, log_key, run_hash, v)
-                if not cached(done_file, run_key):
+                run_key = sv.key_of(config_bytes, overlay_bytes, seed, duration, log_key, run_hash, v)
+                if not sv.cached(done_file, run_key):
                     print('%s: %s' % (tag, v), file=sys.stderr, flush=True)
                     if os.path.exists(run_dir):
                         shutil.rmtree(run_dir)
@@ -211,7 +185,7 @@ def main():
                     if not ok or not os.path.exists(done_file):
                         failures.append('%s: the %s run failed (%s/%s.txt)' % (tag, v, base, v))
                         continue
-                    mark(done_file, run_key)
+                    sv.mark(done_file, run_key)
                 e = json.load(open(done_file))
                 row[v] = e['ate']['rmse']
                 row[v + '_coverage'] = e['ate']['coverage']

@@ -7,7 +7,7 @@ reused), then scripts/run_pipeline.sh runs each variant on it, recording only wh
 reads, and the row gets per variant the ATE (RMSE after an SE(3) alignment), the end-point drift
 and the share of the run with odometry.
 """
-import json, os, subprocess, sys
+import hashlib, json, os, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -19,6 +19,33 @@ class Variant:
 
     def __init__(self, name, processes='lio', swaps=None, overlay=None, record=()):
         self.name, self.processes, self.swaps, self.overlay, self.record = name, processes, swaps or {}, overlay, record
+
+
+# --- results reused only for the same inputs: a key over everything a result depends on ---
+def file_hash(path, h=None):
+    h = h or hashlib.sha256()
+    with open(path, 'rb') as f:
+        for block in iter(lambda: f.read(1 << 20), b''):
+            h.update(block)
+    return h
+
+
+def key_of(*parts):
+    h = hashlib.sha256()
+    for p in parts:
+        h.update(repr(p).encode())
+        h.update(b'\0')
+    return h.hexdigest()
+
+
+def cached(path, key):
+    """Whether path exists with the key `mark` recorded beside it."""
+    kf = path + '.key'
+    return os.path.exists(path) and os.path.exists(kf) and open(kf).read().strip() == key
+
+
+def mark(path, key):
+    open(path + '.key', 'w').write(key + '\n')
 
 
 def run(cmd, log, env=None):

@@ -2,7 +2,7 @@
 """The loop-closure drift bar: loop closure against LIO alone on the same simulated log.
 
     tests/loop/drift_bar.py --log SIM.lcmlog --lio-only RUN_A --with-loop RUN_B [--bin BUILD/bin]
-                            [--max-ate-ratio 1.0] [--max-drift-ratio 0.5]
+                            [--max-ate-ratio 1.0] [--max-drift-ratio 0.5] [--json OUT.json]
 
 RUN_A is a scripts/run_pipeline.sh output folder made with `--without loop`, RUN_B one with loop
 closure. For each trajectory: ATE RMSE (livo-evaluate, SE(3)-aligned, against the log's
@@ -11,7 +11,8 @@ displacement from the first pose, in its frame, against the ground truth's; issu
 drift). The bar is checked on RUN_B's keyframes.tum, the optimised keyframe trajectory livo-loop
 writes: its drift at most max-drift-ratio of the LIO's, its ATE at most max-ate-ratio of the LIO's
 (loop closure must not make the trajectory worse); trajectory.tum (livo-report's loop-corrected
-odometry) is printed beside it. Exit status 1 if a bar is missed. Pure Python; GROUND_TRUTH is read
+odometry) is printed beside it. --json writes every trajectory's ATE and drift. Exit status 1 if a
+bar is missed. Pure Python; GROUND_TRUTH is read
 as check_loops.py reads it.
 """
 import argparse, json, math, os, subprocess, sys, tempfile
@@ -39,6 +40,7 @@ def main():
     ap.add_argument('--bin', default=os.path.join(os.path.dirname(__file__), '../../build/bin'))
     ap.add_argument('--max-ate-ratio', type=float, default=1.0)
     ap.add_argument('--max-drift-ratio', type=float, default=0.5)
+    ap.add_argument('--json', help='every trajectory\'s ATE and drift, and whether the bar is met')
     a = ap.parse_args()
     evaluate = os.path.join(a.bin, 'livo-evaluate')
     gt = cl.read_ground_truth(a.log)
@@ -61,6 +63,10 @@ def main():
     ok = ate <= a.max_ate_ratio * base_ate and end <= a.max_drift_ratio * base_end  # nan (no return): missed
     print('bar (keyframes.tum): ATE ratio %.3f <= %.2f, drift ratio %.3f <= %.2f: %s' % (
         ate / base_ate, a.max_ate_ratio, end / base_end, a.max_drift_ratio, 'met' if ok else 'NOT met'))
+    if a.json:
+        keys = ('lio', 'online', 'report', 'keyframes')
+        json.dump({'trajectories': {k: {'ate': v[0], 'drift': v[1], 'poses': v[4]} for k, v in zip(keys, rows.values())},
+                   'bar_met': bool(ok)}, open(a.json, 'w'), indent=1)
     return 0 if ok else 1
 
 
