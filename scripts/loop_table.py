@@ -137,17 +137,11 @@ def main():
     a = ap.parse_args()
     build = a.build or sv.build_dir()
     bin_dir = os.path.join(build, 'bin')
-    sim = os.path.join(sv.build_dir(), 'bin', 'livo-sim')
-    for tool in [sim] + [os.path.join(bin_dir, t) for t in RUN_EXECUTABLES]:
-        if not os.access(tool, os.X_OK):
-            raise SystemExit('loop_table.py: %s missing: run scripts/build.sh' % tool)
+    sim, sim_hash, run_hash = sv.keyed_executables('loop_table.py', build, RUN_EXECUTABLES, SCRIPTS)
     env = dict(os.environ, LIVO_BUILD_DIR=build)
     os.makedirs(a.out, exist_ok=True)
     logs = a.logs or os.path.join(a.out, 'logs')
     os.makedirs(logs, exist_ok=True)
-    sim_hash = sv.file_hash(sim).hexdigest()
-    run_hash = sv.key_of(*[sv.file_hash(os.path.join(bin_dir, t)).hexdigest() for t in RUN_EXECUTABLES],
-                         *[sv.file_hash(s).hexdigest() for s in SCRIPTS])
     overlay_bytes = open(a.overlay, 'rb').read() if a.overlay else b''
     rows, failures = [], []
     for name in a.configs.split(','):

@@ -48,6 +48,20 @@ def mark(path, key):
     open(path + '.key', 'w').write(key + '\n')
 
 
+def keyed_executables(script, build, executables, scripts):
+    """The simulator (always this tree's: the logs come from it, whichever build runs), its hash and
+    the key of what a run executes (`executables` in build/bin, `scripts` by path); exits naming a
+    missing executable."""
+    bin_dir = os.path.join(build, 'bin')
+    sim = os.path.join(build_dir(), 'bin', 'livo-sim')
+    for tool in [sim] + [os.path.join(bin_dir, t) for t in executables]:
+        if not os.access(tool, os.X_OK):
+            raise SystemExit('%s: %s missing: run scripts/build.sh' % (script, tool))
+    run_key = key_of(*[file_hash(os.path.join(bin_dir, t)).hexdigest() for t in executables],
+                     *[file_hash(s).hexdigest() for s in scripts])
+    return sim, file_hash(sim).hexdigest(), run_key
+
+
 def run(cmd, log, env=None):
     with open(log, 'w') as f:
         return subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, env=env).returncode == 0
