@@ -3,7 +3,7 @@
 
     tests/loop/keyframe_nees.py --log SIM.lcmlog --outputs RUN/outputs.lcmlog [--band 0.95]
                                 [--skip-s 5] [--filter-only] [--json OUT.json]
-                                [--check | --check-not-overconfident]
+                                [--check | --check-not-overconfident | --check-below X]
 
 For every KEYFRAME whose relative_to_id is the previous keyframe (livo-lio's increment from its
 cloned pose, keyframe_t), the error xi of T_prev^-1 T_this against the ground truth's relative body
@@ -13,7 +13,9 @@ Printed: the mean NEES over the N increments and the two-sided band (--band) of 
 an honest covariance with independent increments keeps it in, the share of increments below the
 chi2(6) 95 % quantile (12.59), and the rotation / translation parts alone (3 degrees of freedom each).
 The first --skip-s seconds (the filter's start-up) are left out. --check: exit 1 outside the band;
---check-not-overconfident: exit 1 above it only (a covariance that is honest or cautious passes).
+--check-not-overconfident: exit 1 above it only (a covariance that is honest or cautious passes);
+--check-below X: exit 1 if the mean NEES exceeds X (a run whose mean moves with something drawn once
+per run, such as a hard config's calibration error, where one run's band says little).
 
 The covariance judged is the message's whole relative_covariance: the filter's part and what the
 calibration livo-lio holds at the rig's values adds (relative_covariance_held_calibration, the rig's
@@ -139,6 +141,7 @@ def main():
     ap.add_argument("--json")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--check-not-overconfident", action="store_true")
+    ap.add_argument("--check-below", type=float, metavar="X")
     a = ap.parse_args()
     rows = nees_of_run(a.log, a.outputs, a.skip_s, a.filter_only)
     if not rows:
@@ -156,6 +159,8 @@ def main():
     if a.check and not s["in_band"]:
         sys.exit(1)
     if a.check_not_overconfident and s["mean_nees"] > s["band"][1]:
+        sys.exit(1)
+    if a.check_below is not None and not s["mean_nees"] <= a.check_below:
         sys.exit(1)
 
 

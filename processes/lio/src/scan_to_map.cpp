@@ -14,11 +14,13 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
   const double growth = std::min(1.0, (sigma - kTunedNoise) / (2.0 * kTunedNoise));  // 0 at 1 cm, 1 from 3 cm
   o.plane.num_neighbors = base.plane.num_neighbors + static_cast<int>(std::lround(3.0 * growth));
   o.plane.max_plane_thickness = std::max(base.plane.max_plane_thickness, 2.0 * sigma);
+  // the model error of the tuning (curvature, discretisation), as large as the planes it accepts are thick
   const double tuned_k = base.plane.num_neighbors;
-  const double floor2 = std::max(0.0, base.point_noise_std * base.point_noise_std -
-                                          (1.0 + 1.0 / tuned_k) * kTunedNoise * kTunedNoise);
-  o.point_noise_std = std::max(base.point_noise_std,
-                               std::sqrt(floor2 + (1.0 + 1.0 / o.plane.num_neighbors) * sigma * sigma));
+  const double tuned_floor2 = std::max(0.0, base.point_noise_std * base.point_noise_std -
+                                                (1.0 + 1.0 / tuned_k) * kTunedNoise * kTunedNoise);
+  const double thicker = o.plane.max_plane_thickness / base.plane.max_plane_thickness;
+  o.point_noise_std = std::max(base.point_noise_std, std::sqrt(thicker * thicker * tuned_floor2 +
+                                                               (1.0 + 1.0 / o.plane.num_neighbors) * sigma * sigma));
   return o;
 }
 

@@ -22,7 +22,7 @@ namespace livo::lio {
 
 struct ScanToMapOptions {
   PlaneFitOptions plane;
-  double point_noise_std = 0.03;        // m, standard deviation of one residual
+  double point_noise_std = 0.02;        // m, standard deviation of one residual
   double residual_range_factor = 0.11;  // gate: |r| <= factor * sqrt(range) (FAST-LIO's test)
   double research_distance = 0.1;       // m, see above
   double robust_scale = 0.05;           // m, Cauchy kernel scale near the optimum (weight
@@ -36,17 +36,19 @@ struct ScanToMapOptions {
   // residual of the sweep, which no number of points averages away. The residuals' covariance is
   // point_noise_std^2 W^-1 + H_pose F H_pose^T (W: the robust weights, F: this floor), so a sweep
   // with thousands of residuals measures the pose no better than F (applyMeasurementFloor). 0: none.
-  double registration_floor_rotation = 4e-5;  // 0.0023 deg
-  double registration_floor_translation = 6.5e-4;
+  double registration_floor_rotation = 5e-5;  // 0.00286 deg
+  double registration_floor_translation = 8e-4;
 };
 
 /// The matching options for a LiDAR whose range noise (1 sigma, along the beam) is `range_noise_std`,
-/// from `base` (the options tuned at 1 cm): one residual's standard deviation is the model floor of
-/// the 1 cm tuning (plane curvature, discretisation: sqrt(0.03^2 - 1.2 * 0.01^2) = 2.8 cm) combined with
-/// the point's noise and that of a plane fitted to k noisy neighbours, sqrt(floor^2 + (1 + 1/k) sigma^2),
-/// never below base's; a plane's neighbours may lie 2 sigma from it (never thinner than base's); and k
-/// grows from base's (5) at 1 cm to base + 3 at 3 cm and more, so the fitted plane averages the noise.
-/// At 1 cm and below the result is `base`.
+/// from `base` (the options tuned at 1 cm): a plane's neighbours may lie 2 sigma from it (never thinner
+/// than base's), and k grows from base's (5) at 1 cm to base + 3 at 3 cm and more, so the fitted plane
+/// averages the noise. One residual's standard deviation combines the model error of the accepted
+/// planes (curvature, discretisation: sqrt(0.02^2 - 1.2 * 0.01^2) = 1.7 cm at the 1 cm tuning, scaled
+/// with the plane thickness the options accept, since a thicker gate lets more curved neighbourhoods
+/// pass) with the noise of the point and of a plane fitted to k noisy neighbours:
+/// sqrt((thickness / base thickness)^2 floor^2 + (1 + 1/k) sigma^2), never below base's (3.1 cm at
+/// sigma = 2 cm, 4.6 cm at 3 cm). At 1 cm and below the result is `base`.
 ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOptions& base = {});
 
 class ScanToMap {
