@@ -33,6 +33,8 @@ ImuRig readImu(const Config& c) {
   c.read("accel_random_walk", imu.accel_random_walk);
   c.readOptional("gyro_scale_std", imu.gyro_scale_std);
   c.readOptional("gyro_misalignment_std", imu.gyro_misalignment_std);
+  c.readOptional("accel_scale_std", imu.accel_scale_std);
+  c.readOptional("accel_misalignment_std", imu.accel_misalignment_std);
   c.readOptional("gravity", imu.gravity);
   requirePositive(c, "rate_hz", imu.rate_hz);
   requireNonNegative(c, "gyro_noise_density", imu.gyro_noise_density);
@@ -41,6 +43,8 @@ ImuRig readImu(const Config& c) {
   requireNonNegative(c, "accel_random_walk", imu.accel_random_walk);
   requireNonNegative(c, "gyro_scale_std", imu.gyro_scale_std);
   requireNonNegative(c, "gyro_misalignment_std", imu.gyro_misalignment_std);
+  requireNonNegative(c, "accel_scale_std", imu.accel_scale_std);
+  requireNonNegative(c, "accel_misalignment_std", imu.accel_misalignment_std);
   requirePositive(c, "gravity", imu.gravity);
   return imu;
 }

@@ -89,6 +89,19 @@ struct ImuErrorModel {
 std::vector<ImuSample> simulateImu(const Trajectory& traj, double t0, double t1, double rate_hz,
                                    int64_t base_utime, const ImuErrorModel& err, std::mt19937* rng);
 
+/// A state away from every special case (turned on all axes, moving, biased, gravity tilted), for
+/// Jacobian tests.
+inline FilterState someState() {
+  FilterState x;
+  x.rot = so3::Exp(Vec3(0.3, -0.5, 1.2));
+  x.pos = Vec3(1.0, -2.0, 0.5);
+  x.vel = Vec3(0.7, 0.2, -0.1);
+  x.gyro_bias = Vec3(0.01, -0.02, 0.015);
+  x.accel_bias = Vec3(0.05, -0.03, 0.08);
+  x.gravity = Vec3(0.1, -0.2, -9.8);
+  return x;
+}
+
 /// Positions of est aligned onto gt by the best rigid transform (Umeyama, no scale); RMSE.
 double alignedRmse(const std::vector<Vec3>& est, const std::vector<Vec3>& gt);
 

@@ -12,17 +12,6 @@ using namespace livo;
 using namespace livo::lio;
 
 namespace {
-FilterState someState() {
-  FilterState x;
-  x.rot = so3::Exp(Vec3(0.3, -0.5, 1.2));
-  x.pos = Vec3(1.0, -2.0, 0.5);
-  x.vel = Vec3(0.7, 0.2, -0.1);
-  x.gyro_bias = Vec3(0.01, -0.02, 0.015);
-  x.accel_bias = Vec3(0.05, -0.03, 0.08);
-  x.gravity = Vec3(0.1, -0.2, -9.8);
-  return x;
-}
-
 // δx_{i+1} as a function of (δx_i, w_i): (x̂ ⊞ δx) ⊞ (dt f(x̂ ⊞ δx, u, w)) ⊟ (x̂ ⊞ dt f(x̂, u, 0)), over the
 // navigation states (the first 18)
 Vec18 errorMap(const FilterState& xh, const Vec18& dx, const Eigen::Matrix<double, 12, 1>& w, const Vec3& gyro,
@@ -38,7 +27,7 @@ Vec18 errorMap(const FilterState& xh, const Vec18& dx, const Eigen::Matrix<doubl
 }  // namespace
 
 TEST(ImuPropagator, JacobiansMatchNumericDifferentiation) {
-  const FilterState x = someState();
+  const FilterState x = synth::someState();
   const Vec3 gyro(0.4, -0.9, 1.7), accel(0.5, 2.0, 9.4);
   for (double dt : {0.005, 0.05}) {
     Mat18 Fx;
@@ -151,7 +140,7 @@ TEST(ImuPropagator, CovarianceMatchesMonteCarlo) {
   const ImuNoise noise{0.01, 0.1, 0.001, 0.01};
   const double dt = 0.005;
   const int steps = 50, runs = 1500;
-  const FilterState x0 = someState();
+  const FilterState x0 = synth::someState();
   const Vec3 gyro(0.3, -0.4, 0.8), accel(0.3, 0.5, 9.9);
   ImuPropagator prop(noise);
   ImuSample s0;
@@ -200,7 +189,7 @@ TEST(ImuPropagator, CalibrationIsConstantAndItsCorrelationFollowsTheNavigationSt
   const ImuNoise noise{0.01, 0.1, 0.001, 0.01};
   const double dt = 0.005;
   const int steps = 20;
-  FilterState x0 = someState();
+  FilterState x0 = synth::someState();
   x0.lidar = SensorCalibration{so3::Exp(Vec3(0.1, -0.2, 1.5)), Vec3(0.1, 0.0, 0.2), 0.003};
   x0.camera = SensorCalibration{so3::Exp(Vec3(-1.5, 0.1, 0.0)), Vec3(0.05, -0.02, 0.0), -0.01};
   std::mt19937 rng(5);
@@ -260,7 +249,7 @@ TEST(ImuPropagator, ScaleAndMisalignmentSpreadMatchesDrawnGyrosOverOneWindow) {
   const double dt = 0.005;
   const int steps = 20;  // one window
   const Vec3 gyro(0.2, -0.3, 1.1);
-  FilterState x0 = someState();
+  FilterState x0 = synth::someState();
   x0.gyro_bias.setZero();
   ImuPropagator prop(noise);
   ImuSample s0;

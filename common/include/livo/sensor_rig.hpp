@@ -33,6 +33,8 @@ struct ImuRig {
   double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
   double gyro_scale_std = 0.0;          // relative 1-sigma of the gyro's scale factors (datasheet tolerance)
   double gyro_misalignment_std = 0.0;   // rad, 1-sigma of its axis misalignment / cross-axis sensitivity
+  double accel_scale_std = 0.0;         // the accelerometer's, likewise
+  double accel_misalignment_std = 0.0;  // rad
   double gravity = 9.81;                // m/s^2, world z up
 };
 

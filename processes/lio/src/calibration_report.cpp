@@ -76,6 +76,23 @@ std::string describe(const CalibrationEstimate& e, bool with_camera) {
   return os.str();
 }
 
+std::string describeImuIntrinsics(const ImuIntrinsics& k, const ImuIntrinsics::Covariance& P) {
+  std::ostringstream os;
+  os << std::setprecision(3) << "IMU axes:";
+  auto put = [&](const char* what, int offset, int n, double unit, const char* unit_name) {
+    os << " " << what << " (";
+    for (int i = 0; i < n; ++i) os << (i ? ", " : "") << k.value[offset + i] * unit;
+    os << ") +/- (";
+    for (int i = 0; i < n; ++i) os << (i ? ", " : "") << std::sqrt(std::max(0.0, P(offset + i, offset + i))) * unit;
+    os << ") " << unit_name;
+  };
+  put("gyro scale", ImuIntrinsics::kGyroScale, 3, 100.0, "%,");
+  put("off-diagonal", ImuIntrinsics::kGyroCross, 6, 1e3, "mrad;");
+  put("accel scale", ImuIntrinsics::kAccelScale, 3, 100.0, "%,");
+  put("off-diagonal", ImuIntrinsics::kAccelCross, 6, 1e3, "mrad");
+  return os.str();
+}
+
 std::string calibrationCsvHeader() {
   std::string h = "t_s";
   for (const char* s : {"lidar", "camera"}) {

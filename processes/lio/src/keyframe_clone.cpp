@@ -45,23 +45,38 @@ Mat6 heldCalibrationCovariance(const Pose3& T_rel, const HeldCalibration& held) 
   return cov;
 }
 
-CloneCrossCovariance carriedThroughUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
-                                          const CloneCrossCovariance& C) {
+ConditionedBeside conditionedOnUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
+                                      const Eigen::MatrixXd& C, const StateVector& dx) {
   std::vector<int> idx;
   for (int i = 0; i < FilterState::kDim; ++i)
     if (P_prior(i, i) > 0.0) idx.push_back(i);
-  const int n = static_cast<int>(idx.size());
-  Eigen::MatrixXd Pr(n, n), Cr(n, 6);
+  const int n = static_cast<int>(idx.size()), m = static_cast<int>(C.cols());
+  Eigen::MatrixXd Pr(n, n), Cr(n, m), Qr(n, n);
+  Eigen::VectorXd dr(n);
   for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) Pr(r, c) = P_prior(idx[r], idx[c]);
+    for (int c = 0; c < n; ++c) {
+      Pr(r, c) = P_prior(idx[r], idx[c]);
+      Qr(r, c) = P_post(idx[r], idx[c]);
+    }
     Cr.row(r) = C.row(idx[r]);
+    dr(r) = dx(idx[r]);
   }
-  // P_post P_prior^-1 C: the solve over the estimated states, then P_post's columns over them
+  // the solve over the estimated states (held ones have zero rows in C and no step), then P_post's
+  // columns over them
   const Eigen::MatrixXd Y = Pr.ldlt().solve(Cr);
-  CloneCrossCovariance out = CloneCrossCovariance::Zero();
+  ConditionedBeside out;
+  out.cross = Eigen::MatrixXd::Zero(FilterState::kDim, m);
   for (int r = 0; r < FilterState::kDim; ++r)
-    for (int k = 0; k < n; ++k) out.row(r) += P_post(r, idx[k]) * Y.row(k);
+    for (int k = 0; k < n; ++k) out.cross.row(r) += P_post(r, idx[k]) * Y.row(k);
+  out.mean_step = Y.transpose() * dr;
+  const Eigen::MatrixXd change = -Cr.transpose() * Y + Y.transpose() * Qr * Y;
+  out.covariance_change = 0.5 * (change + change.transpose());
   return out;
+}
+
+CloneCrossCovariance carriedThroughUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
+                                          const CloneCrossCovariance& C) {
+  return conditionedOnUpdate(P_prior, P_post, C, StateVector::Zero()).cross;
 }
 
 }  // namespace livo::lio

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "livo/sensor_rig.hpp"
+#include "livo/text_format.hpp"
 
 namespace livo::lio {
 
@@ -37,6 +38,11 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   imu.read("accel_random_walk", l.imu_noise.accel_random_walk);
   imu.readOptional("gyro_scale_std", l.imu_noise.gyro_scale_std);
   imu.readOptional("gyro_misalignment_std", l.imu_noise.gyro_misalignment_std);
+  imu.readOptional("accel_scale_std", l.imu_noise.accel_scale_std);
+  imu.readOptional("accel_misalignment_std", l.imu_noise.accel_misalignment_std);
+  if (!(l.imu_noise.accel_scale_std >= 0.0)) throw ConfigError(imu.where("accel_scale_std") + ": must be >= 0");
+  if (!(l.imu_noise.accel_misalignment_std >= 0.0))
+    throw ConfigError(imu.where("accel_misalignment_std") + ": must be >= 0");
   if (!(l.imu_noise.gyro_scale_std >= 0.0)) throw ConfigError(imu.where("gyro_scale_std") + ": must be >= 0");
   if (!(l.imu_noise.gyro_misalignment_std >= 0.0))
     throw ConfigError(imu.where("gyro_misalignment_std") + ": must be >= 0");
@@ -119,6 +125,14 @@ void readLio(const Config& c, LioNodeOptions* o) {
   cal.readOptional("camera_rotation", l.calibration.camera_rotation);
   cal.readOptional("camera_translation", l.calibration.camera_translation);
   cal.readOptional("camera_time", l.calibration.camera_time);
+  std::string imu_axes;
+  if (cal.readOptional("imu_axes", imu_axes)) {
+    using A = CalibrationEstimation::ImuAxes;
+    if (imu_axes == "budget") l.calibration.imu_axes = A::kBudget;
+    else if (imu_axes == "consider") l.calibration.imu_axes = A::kConsider;
+    else if (imu_axes == "estimate") l.calibration.imu_axes = A::kEstimate;
+    else throw ConfigError(cal.where("imu_axes") + ": must be budget, consider or estimate (got '" + imu_axes + "')");
+  }
   c.readOptional("point_stride", l.point_stride);
   c.readOptional("scan_voxel_size", l.scan_voxel_size);
   c.readOptional("min_points", l.min_points);
@@ -269,8 +283,15 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << o.keyframe_channel << "\n"
      << "  imu noise: gyro " << l.imu_noise.gyro_noise_density << " / " << l.imu_noise.gyro_random_walk << ", accel "
      << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gyro scale "
-     << l.imu_noise.gyro_scale_std << " and misalignment " << l.imu_noise.gyro_misalignment_std << " rad per "
-     << l.imu_noise.systematic_error_window_s << " s sweep, gravity " << l.init.gravity
+     << l.imu_noise.gyro_scale_std << " and misalignment " << l.imu_noise.gyro_misalignment_std << " rad, accel "
+     << l.imu_noise.accel_scale_std << " and " << l.imu_noise.accel_misalignment_std
+     << " rad ("
+     << (l.calibration.imu_axes == CalibrationEstimation::ImuAxes::kEstimate   ? "estimated)"
+         : l.calibration.imu_axes == CalibrationEstimation::ImuAxes::kConsider ? "considered)"
+                                                                                 : "the gyro's budgeted per " +
+                                                                                       formatSignificant(l.imu_noise.systematic_error_window_s) +
+                                                                                       " s sweep)")
+     << ", gravity " << l.init.gravity
      << ", init window " << l.init.window_s << " s\n"
      << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["
      << l.min_range << ", " << l.max_range << "] m\n"

@@ -41,7 +41,16 @@ LioEstimator::LioEstimator(LioOptions options)
       map_(options.map),
       search_threads_(options.search_threads > 1 ? std::make_shared<WorkerThreads>(options.search_threads) : nullptr),
       keyframe_selector_(options.keyframe),
-      wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {}
+      wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {
+  if (opts_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
+    prop_.setIntrinsics({}, intrinsicsPrior(opts_.imu_noise), estimatesImuAxes());
+}
+
+Vec3 LioEstimator::nominalGyro(const FilterState& x) const {
+  // the reading a sensor with the nominal axes would have given: its rate minus the bias is the
+  // corrected rate
+  return prop_.angularVelocity(prop_.lastSample().gyro, x) + x.gyro_bias;
+}
 
 void LioEstimator::reset() {
   if (initialized_ && prop_.state().lidar.rot.allFinite() && prop_.state().camera.rot.allFinite() &&
@@ -52,7 +61,15 @@ void LioEstimator::reset() {
     has_kept_calibration_ = true;
   }
   frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
+  // the IMU's axes belong to the sensor too: kept when finite
+  const ImuIntrinsics intrinsics = prop_.intrinsics();
+  const ImuIntrinsics::Covariance intrinsics_cov = prop_.intrinsicsCovariance();
+  const bool keep_intrinsics = prop_.modelsIntrinsics() && intrinsics.value.allFinite() && intrinsics_cov.allFinite();
   prop_ = ImuPropagator(opts_.imu_noise);
+  if (keep_intrinsics)
+    prop_.setIntrinsics(intrinsics, intrinsics_cov, estimatesImuAxes());
+  else if (opts_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
+    prop_.setIntrinsics({}, intrinsicsPrior(opts_.imu_noise), estimatesImuAxes());
   map_.clear();
   keyframe_selector_.reset();
   initialized_ = false;
@@ -376,7 +393,6 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   }
   FilterState x = prop_.state();
   StateCovariance P = prop_.covariance();
-  const StateCovariance P_predicted = P;
 
   // 2. valid points, undistorted into the body frame at the end
   validPoints(scan, end_offset, note);
@@ -398,12 +414,11 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   // 5. LiDAR update or map seeding
   reseedAfterOutage(t_end, &x, &P, note);
   const SensorCalibration undistorted_with = x.lidar;
-  body_rate_ = prop_.lastSample().gyro - x.gyro_bias;
+  body_rate_ = prop_.angularVelocity(prop_.lastSample().gyro, x);
   res.status = lidarStage(reg, valid.size(), &x, &P, &res);
   toBodyAtSweepEnd(undistorted_with, x);
   noteRegistration(res.status, x, t_end);
-  prop_.setState(x, P);
-  if (clone_.valid) prop_.setCloneCross(carriedThroughUpdate(P_predicted, P, prop_.cloneCross()));
+  prop_.applyUpdate(x, P);
   res.utime = t_end;
   if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
 
@@ -418,7 +433,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   res.sweep_start_utime = t_first;
   res.state = x;
   res.covariance = P;
-  res.angular_velocity = prop_.lastSample().gyro - x.gyro_bias;
+  res.angular_velocity = prop_.angularVelocity(prop_.lastSample().gyro, x);
   res.world_points.resize(body.size());
   res.input_index.resize(body.size());
   for (size_t i = 0; i < body.size(); ++i) {
@@ -495,7 +510,7 @@ bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, StateCovari
                                       &travel->measured, &travel->measured_noise_gain);
   double speed = 0.0, scale_variance = 0.0;
   if (wheelSpeedAt(t_end, &speed, &scale_variance)) {
-    const WheelUpdateResult w = wheelVelocityUpdate(x, P, prop_.lastSample().gyro, speed, opts_.wheel, scale_variance);
+    const WheelUpdateResult w = wheelVelocityUpdate(x, P, nominalGyro(*x), speed, opts_.wheel, scale_variance);
     ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
     if (!w.applied)
       appendNote(note, "wheel speed rejected (chi2 " + formatSignificant(w.chi2) + "; filter minus wheels forward " +
@@ -630,8 +645,10 @@ HeldCalibration LioEstimator::heldCalibration(const FilterState& x) const {
   held.T_I_L = x.lidar.pose();
   held.lidar_rotation_std = opts_.calibration.lidar_rotation ? 0.0 : opts_.lidar_calibration_std.rotation;
   held.lidar_translation_std = opts_.calibration.lidar_translation ? 0.0 : opts_.lidar_calibration_std.translation;
-  held.gyro_scale_std = opts_.imu_noise.gyro_scale_std;
-  held.gyro_misalignment_std = opts_.imu_noise.gyro_misalignment_std;
+  if (!prop_.modelsIntrinsics()) {  // modelled, they are in the filter's covariance
+    held.gyro_scale_std = opts_.imu_noise.gyro_scale_std;
+    held.gyro_misalignment_std = opts_.imu_noise.gyro_misalignment_std;
+  }
   return held;
 }
 
@@ -651,7 +668,7 @@ Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<siz
   }
   // the next keyframe's increment starts here: Cov(δx, δpose) is P's pose columns
   clone_ = KeyframeClone{true, kf.id, kf.pose, kf.pose_covariance};
-  prop_.setCloneCross(P.leftCols<6>());
+  prop_.clonePose();
   const bool has_intensity = scan.intensity.size() == scan.points.size();
   for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
     kf.cloud.push_back(body[i]);
@@ -702,8 +719,7 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Sta
   T.linear() = x.rot * prior.rot.transpose();
   T.translation() = x.pos - T.linear() * prior.pos;
   prop_.transformSegments(T);
-  if (clone_.valid) prop_.setCloneCross(carriedThroughUpdate(prop_.covariance(), Ps, prop_.cloneCross()));
-  prop_.setState(x, Ps);
+  prop_.applyUpdate(x, Ps);
   return true;
 }
 
@@ -728,17 +744,16 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
     Tm.block<3, 3>(FilterState::kPos, FilterState::kPos) = Rc;
     Tm.block<3, 3>(FilterState::kVel, FilterState::kVel) = Rc;
     Tm.block<3, 3>(FilterState::kGravity, FilterState::kGravity) = Rc;
-    prop_.setState(x, Tm * prop_.covariance() * Tm.transpose());
+    // the clone moves with the frame: the relative pose and its covariance do not change
+    Mat6 Tc = Mat6::Identity();
+    Tc.bottomRightCorner<3, 3>() = Rc;
+    prop_.changeFrame(x, Tm, Tc);
     // the sweep in progress is undistorted along the recorded segments: they move with the frame
     prop_.transformSegments(T);
     keyframe_selector_.setReference(x.pose());
     if (clone_.valid) {
-      // the clone moves with the frame: the relative pose and its covariance do not change
-      Mat6 Tc = Mat6::Identity();
-      Tc.bottomRightCorner<3, 3>() = Rc;
       clone_.pose = T * clone_.pose;
       clone_.covariance = Tc * clone_.covariance * Tc.transpose();
-      prop_.setCloneCross(Tm * prop_.cloneCross() * Tc.transpose());
     }
   }
   if (opts_.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove) {

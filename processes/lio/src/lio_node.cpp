@@ -444,7 +444,10 @@ CalibrationEstimate LioNode::calibrationEstimate() const {
 
 std::string LioNode::calibrationSummary() const {
   if (!lio_.initialized()) return "";
-  return "calibration: " + describe(calibrationEstimate(), opts_.camera_handoff);
+  std::string text = "calibration: " + describe(calibrationEstimate(), opts_.camera_handoff);
+  if (lio_.modelsImuIntrinsics())
+    text += "; " + describeImuIntrinsics(lio_.imuIntrinsics(), lio_.imuIntrinsicsCovariance());
+  return text;
 }
 
 void LioNode::reportCalibration(int64_t utime) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "livo/imu_axes.hpp"
 #include "livo/sim/calibration_errors.hpp"
 
 namespace livo::sim {
@@ -28,12 +29,7 @@ bool ImuErrors::any() const {
 }
 
 Mat3 sensingAxes(const Vec3& scale_ppm, const Vec3& misalignment_mrad) {
-  const Vec3 m = misalignment_mrad * 1e-3;
-  Mat3 M = Mat3::Identity();
-  M(1, 0) = m[0];
-  M(2, 0) = m[1];
-  M(2, 1) = m[2];
-  return (Vec3::Ones() + scale_ppm * 1e-6).asDiagonal() * M;
+  return imuSensingAxes(scale_ppm * 1e-6, misalignment_mrad * 1e-3);
 }
 
 void applyImuErrors(const ImuErrors& e, double t, ImuReading* r) {

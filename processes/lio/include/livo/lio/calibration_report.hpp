@@ -6,6 +6,7 @@
 #include <string>
 
 #include "livo/filter_state.hpp"
+#include "livo/lio/imu_intrinsics.hpp"
 
 namespace livo::lio {
 
@@ -35,6 +36,10 @@ std::string describe(const CalibrationEstimate& e, bool with_camera);
 /// calibration.csv: a header and one row per report (t in s of sensor time).
 std::string calibrationCsvHeader();
 std::string calibrationCsvRow(double t, const CalibrationEstimate& e);
+
+/// "IMU axes: gyro scale (..) +/- (..) %, off-diagonal (..) +/- (..) mrad; accel ...": the
+/// sensing-axis errors as estimated (ImuIntrinsics), with their 1-sigmas.
+std::string describeImuIntrinsics(const ImuIntrinsics& k, const ImuIntrinsics::Covariance& P);
 
 /// calibration.yaml: the rig's extrinsics and time offsets as estimated, a config overlay.
 std::string calibrationOverlay(const FilterState& x, double lidar_time_offset_rig_s, double camera_time_offset_rig_s,

@@ -68,4 +68,19 @@ Mat6 heldCalibrationCovariance(const Pose3& T_rel, const HeldCalibration& held);
 CloneCrossCovariance carriedThroughUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
                                           const CloneCrossCovariance& C);
 
+/// The same for states y the update does not measure but estimates (the Kalman update of the
+/// filter augmented with y): with Y = P_prior^-1 C over the estimated states and dx = x_post ⊟ x_prior,
+///   C <- P_post Y,  y <- y + Y^T dx,  Cov(y) <- Cov(y) - C^T Y + Y^T P_post Y,
+/// and a state z beside them that is only considered (a cloned pose: its value is fixed) keeps
+/// its covariance while Cov(y, z) <- Cov(y, z) - C_y^T Y_z + Y_y^T P_post Y_z.
+/// `C` is Cov(δx, [y z]); the result's `covariance_change` is the change of Cov([y z]) (z's own
+/// block included, for the caller to leave out) and `mean_step` Y^T dx.
+struct ConditionedBeside {
+  Eigen::MatrixXd cross;              // the new Cov(δx, [y z])
+  Eigen::VectorXd mean_step;          // Y^T dx
+  Eigen::MatrixXd covariance_change;  // -C^T Y + Y^T P_post Y
+};
+ConditionedBeside conditionedOnUpdate(const StateCovariance& P_prior, const StateCovariance& P_post,
+                                      const Eigen::MatrixXd& C, const StateVector& dx);
+
 }  // namespace livo::lio

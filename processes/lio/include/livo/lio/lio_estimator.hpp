@@ -106,7 +106,12 @@ class LioEstimator {
   const FilterState& state() const { return prop_.state(); }
   const StateCovariance& covariance() const { return prop_.covariance(); }
   /// The bias-corrected angular rate at the filter's time (frame I).
-  Vec3 bodyRate() const { return prop_.lastSample().gyro - prop_.state().gyro_bias; }
+  Vec3 bodyRate() const { return prop_.angularVelocity(prop_.lastSample().gyro, prop_.state()); }
+  /// The IMU's sensing-axis errors as estimated (ImuIntrinsics), when they are.
+  bool modelsImuIntrinsics() const { return prop_.modelsIntrinsics(); }
+  bool estimatesImuAxes() const { return opts_.calibration.imu_axes == CalibrationEstimation::ImuAxes::kEstimate; }
+  const ImuIntrinsics& imuIntrinsics() const { return prop_.intrinsics(); }
+  const ImuIntrinsics::Covariance& imuIntrinsicsCovariance() const { return prop_.intrinsicsCovariance(); }
   const VoxelMap& map() const { return map_; }
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
   const LioOptions& options() const { return opts_; }
@@ -189,6 +194,9 @@ class LioEstimator {
   void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
   /// The calibration the filter holds at the rig's values, with the rig's stated uncertainty.
   HeldCalibration heldCalibration(const FilterState& x) const;
+  /// The gyro reading of the last sample as the nominal sensor would have given it (the wheel
+  /// update's input): the corrected rate plus the bias.
+  Vec3 nominalGyro(const FilterState& x) const;
   /// A new keyframe from the sweep (kept in the bounded keyframe store).
   Keyframe makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid, const std::vector<Vec3>& body,
                         const FilterState& x, const StateCovariance& P, int64_t t_end);

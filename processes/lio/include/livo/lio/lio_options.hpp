@@ -29,6 +29,13 @@ struct CalibrationEstimation {
   bool camera_rotation = true;
   bool camera_translation = false;
   bool camera_time = true;
+  // The IMU's scale and axis errors (ImuIntrinsics), where the rig states their 1-sigma
+  // (rig.imu.*_scale_std, *_misalignment_std): kBudget takes the gyro's as rate noise (ImuNoise)
+  // and as a held calibration of the keyframe increments, the accelerometer's not at all;
+  // kConsider carries them beside the filter at the nominal sensor's values (their correlation
+  // with the state tracked, Schmidt); kEstimate also corrects them (README, "The IMU's axes").
+  enum class ImuAxes { kBudget, kConsider, kEstimate };
+  ImuAxes imu_axes = ImuAxes::kBudget;
 };
 
 /// The prior 1-sigmas of the LiDAR's and the camera's calibration blocks for what `estimate` says.

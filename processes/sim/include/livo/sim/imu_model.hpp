@@ -42,7 +42,7 @@ struct ImuErrors {
   bool any() const;
 };
 
-/// K = (I + diag(scale_ppm * 1e-6)) * M(misalignment_mrad), see ImuErrors.
+/// K = (I + diag(scale_ppm * 1e-6)) * M(misalignment_mrad), see ImuErrors (livo::imuSensingAxes).
 Mat3 sensingAxes(const Vec3& scale_ppm, const Vec3& misalignment_mrad);
 
 /// Applies `errors` to an ideal reading taken t seconds after the start of the run.
