@@ -116,10 +116,7 @@ TEST(ImuIntrinsics, CarriedBesideTheFilterEqualsTheAugmentedFilter) {
   const ImuIntrinsics::Covariance Pk = intrinsicsPrior(0.01, 0.007, 0.01, 0.007);
   const Vec3 gyro(0.3, -0.4, 0.8), accel(0.3, 0.5, 9.9);
   ImuPropagator prop(noise);
-  ImuSample s0;
-  s0.utime = 0;
-  s0.gyro = gyro;
-  s0.accel = accel;
+  const ImuSample s0{0, gyro, accel};
   prop.setIntrinsics(someIntrinsics(), Pk, true);
   prop.reset(x0, P0, s0);
   MatA Pa = MatA::Zero();

@@ -109,7 +109,7 @@ void ImuPropagator::applyUpdate(const FilterState& x, const StateCovariance& P) 
     const ConditionedBeside r = conditionedOnUpdate(P_, P, C, x.boxminus(x_));
     intrinsics_cross_ = r.cross.leftCols<k>();
     clone_cross_ = r.cross.rightCols<6>();
-    if (update_intrinsics_) {  // considered, their value and covariance stay
+    if (update_intrinsics_) {  // estimated (considered, their value and covariance stay)
       intrinsics_.value += r.mean_step.head<k>();
       const ImuIntrinsics::Covariance Pk = intrinsics_cov_ + r.covariance_change.topLeftCorner<k, k>();
       intrinsics_cov_ = 0.5 * (Pk + Pk.transpose());

@@ -272,6 +272,15 @@ std::string describe(const CalibrationStd& s) {
   os << s.rotation * 180.0 / M_PI << " / " << s.translation << " / " << s.time * 1e3;
   return os.str();
 }
+// how the IMU's axis errors enter the filter (CalibrationEstimation::imu_axes)
+std::string imuAxesModel(const LioOptions& l) {
+  switch (l.calibration.imu_axes) {
+    case CalibrationEstimation::ImuAxes::kEstimate: return "estimated";
+    case CalibrationEstimation::ImuAxes::kConsider: return "considered";
+    case CalibrationEstimation::ImuAxes::kBudget: break;
+  }
+  return "the gyro's budgeted per " + formatSignificant(l.imu_noise.systematic_error_window_s) + " s sweep";
+}
 }  // namespace
 
 void printOptions(const LioNodeOptions& o, std::ostream& os) {
@@ -285,12 +294,7 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gyro scale "
      << l.imu_noise.gyro_scale_std << " and misalignment " << l.imu_noise.gyro_misalignment_std << " rad, accel "
      << l.imu_noise.accel_scale_std << " and " << l.imu_noise.accel_misalignment_std
-     << " rad ("
-     << (l.calibration.imu_axes == CalibrationEstimation::ImuAxes::kEstimate   ? "estimated)"
-         : l.calibration.imu_axes == CalibrationEstimation::ImuAxes::kConsider ? "considered)"
-                                                                                 : "the gyro's budgeted per " +
-                                                                                       formatSignificant(l.imu_noise.systematic_error_window_s) +
-                                                                                       " s sweep)")
+     << " rad (" << imuAxesModel(l) << ")"
      << ", gravity " << l.init.gravity
      << ", init window " << l.init.window_s << " s\n"
      << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["

@@ -94,7 +94,6 @@ class ImuPropagator {
   void setIntrinsics(const ImuIntrinsics& k, const ImuIntrinsics::Covariance& P, bool estimate);
   /// Whether the axes are modelled as states (estimated or considered).
   bool modelsIntrinsics() const { return model_intrinsics_; }
-  bool updatesIntrinsics() const { return update_intrinsics_; }
   const ImuIntrinsics& intrinsics() const { return intrinsics_; }
   const ImuIntrinsics::Covariance& intrinsicsCovariance() const { return intrinsics_cov_; }
   /// The bias- and axis-corrected body rate of a gyro reading under the state x.
