@@ -78,11 +78,13 @@ def main():
             raise SystemExit('error_budget.py: %s did not merge (%s)' % (v, ' '.join(cmd)))
         tags.append(tag)
     table = os.path.join(out, 'runs')
+    rows_file = os.path.join(table, 'rows.json')
+    if os.path.exists(rows_file):
+        os.remove(rows_file)  # a call that stops early must not leave an earlier call's rows to be read
     cmd = [sys.executable, os.path.join(ROOT, 'scripts', 'camera_table.py'), '--out', table, '--config-dir', configs,
            '--configs', ','.join(tags), '--seeds', a.seeds, '--duration', str(a.duration),
            '--logs', a.logs or os.path.join(out, 'logs')]
     subprocess.run(cmd, stdout=subprocess.DEVNULL)  # its own bars are not this table's: the rows decide
-    rows_file = os.path.join(table, 'rows.json')
     if not os.path.exists(rows_file):
         raise SystemExit('error_budget.py: camera_table.py wrote no rows (%s)' % table)
     rows = json.load(open(rows_file))
@@ -101,12 +103,12 @@ def main():
         lio = [1e3 * got[s]['lio'] for s in seeds]
         livo = [1e3 * got[s]['livo'] for s in seeds]
         rot = [got[s]['calibration']['rot_end_deg'] for s in seeds if 'calibration' in got[s]]
-        (ml, sl), (mv, sv_), (mr, sr) = mean_sd(lio), mean_sd(livo), mean_sd(rot)
+        (ml, sl), (mv, sdv), (mr, sr) = mean_sd(lio), mean_sd(livo), mean_sd(rot)
         if v == 'as_is':
             ref = (ml, mv)
         rel = ('%.2f' % (ml / ref[0]), '%.2f' % (mv / ref[1])) if ref else ('-', '-')
         lines.append('| %s | %.1f ± %.1f | %.1f ± %.1f | %s | %s | %.2f | %.2f ± %.2f |' % (
-            v, ml, sl, mv, sv_, rel[0], rel[1], mv / ml, mr, sr))
+            v, ml, sl, mv, sdv, rel[0], rel[1], mv / ml, mr, sr))
     lines.append('\nmean ± sample standard deviation over the seeds; "as is" is the config unchanged.')
     if failures:
         lines.append('\nvariants that did not run:')
