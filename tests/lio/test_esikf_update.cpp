@@ -565,7 +565,7 @@ TEST(EsikfUpdate, SingleScanRegistrationWithKnownOffsetConverges) {
   ScanToMapOptions mo;
   mo.point_noise_std = 0.03;
   mo.residual_range_factor = 1.0;  // a large initial offset: admit large residuals
-  ScanToMap s2m(setup.map, setup.body, mo);
+  ScanToMap s2m(setup.map, nullptr, setup.body, mo);
   EsikfOptions eo;
   eo.max_iterations = 15;
   FilterState post;
@@ -600,7 +600,7 @@ TEST(EsikfUpdate, TheRegistrationFloorBoundsWhatASweepSaysAboutThePose) {
     ScanToMapOptions mo;
     mo.registration_floor_rotation = floor_rot;
     mo.registration_floor_translation = floor_trans;
-    ScanToMap s2m(setup.map, body, mo);
+    ScanToMap s2m(setup.map, nullptr, body, mo);
     FilterState post;
     StateCovariance P;
     const EsikfResult r = iteratedUpdate(prior, looseCovariance(),
@@ -629,7 +629,7 @@ TEST(EsikfUpdate, CorridorIsFlaggedDegenerateAlongItsAxis) {
   const FilterState prior = offsetPrior(setup.truth, offset);
   ScanToMapOptions mo;
   mo.residual_range_factor = 1.0;
-  ScanToMap s2m(setup.map, setup.body, mo);
+  ScanToMap s2m(setup.map, nullptr, setup.body, mo);
   EsikfOptions eo;
   eo.max_iterations = 10;
   FilterState post;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 
 #include "livo/sensor_rig.hpp"
 #include "livo/text_format.hpp"
@@ -57,8 +58,10 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   lidar.readOptional("min_range", l.min_range);
   lidar.readOptional("max_range", l.max_range);
   double range_noise = 0.0;
-  if (lidar.readOptional("range_noise_std", range_noise) && range_noise > 0.0)
+  if (lidar.readOptional("range_noise_std", range_noise) && range_noise > 0.0) {
     l.matching = matchingForRangeNoise(range_noise, l.matching);  // lio.matching.* may still override
+    l.planes.range_noise_std = range_noise;
+  }
   lidar.read("T_I_L", l.extrinsics.T_I_L);
 
   const Config cam = rig.optionalSection("camera");
@@ -151,6 +154,18 @@ void readLio(const Config& c, LioNodeOptions* o) {
   map.readOptional("min_point_distance", l.map.min_point_distance);
   map.readOptional("seen_again_distance", l.map.seen_again_distance);
   map.readOptional("refresh_range_ratio", l.map.refresh_range_ratio);
+  const Config planes = map.optionalSection("planes");
+  planes.readOptional("enabled", l.planes.enabled);
+  planes.readOptional("cell_size", l.planes.cell_size);
+  planes.readOptional("max_points", l.planes.max_points);
+  planes.readOptional("min_points", l.planes.min_points);
+  planes.readOptional("point_stride", l.planes.point_stride);
+  planes.readOptional("max_std", l.planes.max_std);
+  planes.readOptional("max_normal_angle", l.planes.max_normal_angle);
+  planes.readOptional("refresh_range_ratio", l.planes.refresh_range_ratio);
+  planes.readOptional("max_variance_ratio", l.planes.max_variance_ratio);
+  planes.readOptional("model_std", l.planes.model_std);
+  planes.readOptional("max_range", l.planes.max_range);
   map.readOptional("radius", l.map_radius);
   map.readOptional("prune_distance", l.map_prune_distance);
   std::string on_correction = l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "move" : "rebuild";
@@ -237,6 +252,11 @@ void readLio(const Config& c, LioNodeOptions* o) {
   positive(l.map.voxel_size > 0 && l.map.max_points_per_voxel > 0, "map");
   if (!(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0))
     throw ConfigError(c.where("map") + ".refresh_range_ratio: must be in [0, 1)");
+  try {
+    VoxelPlanes check(l.planes);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(c.where("map") + ".planes: " + e.what());
+  }
   const SeenThroughOptions& st = l.seen_through;
   positive(st.beam_radius >= 0 && st.beam_divergence >= 0 && st.end_margin >= 0 && st.end_margin_fraction >= 0 &&
                st.min_range >= 0 && st.max_range > st.min_range && st.misses_to_remove >= 1 &&
@@ -305,7 +325,11 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << " m x " << l.map.max_points_per_voxel << " points, spacing " << l.map.min_point_distance << " m, radius "
      << l.map_radius << " m, "
      << (l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "moved" : "rebuilt from keyframes")
-     << " on a loop correction\n"
+     << " on a loop correction"
+     << (l.planes.enabled ? "; voxel planes of " + formatSignificant(l.planes.cell_size) + " m cells (range noise " +
+                                formatSignificant(l.planes.range_noise_std) + " m)"
+                          : std::string())
+     << "\n"
      << "  planes: k " << l.matching.plane.num_neighbors << ", thickness " << l.matching.plane.max_plane_thickness
      << " m; residual sigma " << l.matching.point_noise_std << " m, registration floor "
      << l.matching.registration_floor_rotation * 180.0 / M_PI << " deg / " << l.matching.registration_floor_translation

@@ -39,6 +39,7 @@ LioEstimator::LioEstimator(LioOptions options)
     : opts_(options),
       prop_(options.imu_noise),
       map_(options.map),
+      planes_(options.planes),
       search_threads_(options.search_threads > 1 ? std::make_shared<WorkerThreads>(options.search_threads) : nullptr),
       keyframe_selector_(options.keyframe),
       wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {
@@ -71,6 +72,7 @@ void LioEstimator::reset() {
   else if (opts_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
     prop_.setIntrinsics({}, intrinsicsPrior(opts_.imu_noise), estimatesImuAxes());
   map_.clear();
+  planes_.clear();
   keyframe_selector_.reset();
   initialized_ = false;
   init_window_.clear();
@@ -359,9 +361,16 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   return removed;
 }
 
+void LioEstimator::addToPlanes(const std::vector<Vec3>& body, const FilterState& x) {
+  std::vector<Vec3> world(body.size());
+  for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
+  planes_.add(world, x.rot * x.lidar.pos + x.pos);
+}
+
 void LioEstimator::pruneMap(const Vec3& position) {
   if ((position - last_prune_position_).norm() < opts_.map_prune_distance) return;
   map_.removeFarFrom(position, opts_.map_radius);
+  planes_.removeFarFrom(position, opts_.map_radius);
   last_prune_position_ = position;
 }
 
@@ -425,6 +434,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   // 6. map insertion and the local window
   if (res.status != ScanResult::Status::kPredicted) {
     res.map_points_seen_through = insertIntoMap(reg, x);
+    if (opts_.planes.enabled) addToPlanes(body, x);
     last_registered_body_ = reg;
     pruneMap(x.pos);
   }
@@ -532,6 +542,7 @@ void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, StateCovaria
   const double lost_s = static_cast<double>(t_end - last_registered_utime_) * 1e-6;
   if (lost_s <= opts_.reseed_after_s) return;
   map_.clear();
+  planes_.clear();
   // the IMU-only velocity of a long outage is worthless: keep it only after a short one
   if (lost_s > 3.0 * opts_.reseed_after_s) x->vel.setZero();
   const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
@@ -568,7 +579,7 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
 ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P,
                                                ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
+  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
   FilterState post;
   StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
@@ -585,7 +596,7 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, Fil
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
+    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
     FilterState post_still;
     StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(
@@ -758,11 +769,13 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
   }
   if (opts_.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove) {
     map_.transform(T);
+    planes_.clear();  // the cells do not follow a rotation of the grid: they fill again
     last_prune_position_ = T * last_prune_position_;
     return;
   }
   // rebuild the local map from the corrected keyframes around the new position
   map_.clear();
+  planes_.clear();
   const Vec3 lidar_position = initialized_ ? prop_.state().lidar.pos : opts_.extrinsics.T_I_L.translation();
   const Vec3 here = initialized_ ? prop_.state().pos : T.translation();
   for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {

@@ -30,9 +30,11 @@ namespace {
 constexpr size_t kMinSearchesPerThread = 256;
 }  // namespace
 
-ScanToMap::ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
+ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::vector<Vec3>& body_points,
+                     const ScanToMapOptions& options,
                      WorkerThreads* threads, const SensorCalibration& undistorted_with, const Vec3& body_rate)
     : map_(map),
+      planes_(planes),
       points_(body_points.size()),
       body_rate_(body_rate),
       opts_(options),
@@ -79,6 +81,11 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
       const uint32_t i = to_search_[j];
       Match& m = matches_[i];
       m.searched_at = world_[i];
+      if (const Plane* voxel_plane = planes_ ? planes_->planeAt(world_[i]) : nullptr) {
+        m.plane = *voxel_plane;
+        m.has_plane = true;
+        continue;
+      }
       m.has_plane = map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
                     fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity);
     }

@@ -220,10 +220,14 @@ class LioEstimator {
   /// map points were removed.
   size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
   void pruneMap(const Vec3& position);
+  /// Adds a registered sweep (body frame at x) to the voxel planes.
+  void addToPlanes(const std::vector<Vec3>& body, const FilterState& x);
+  const VoxelPlanes* planesForRegistration() const { return opts_.planes.enabled ? &planes_ : nullptr; }
 
   LioOptions opts_;
   ImuPropagator prop_;
   VoxelMap map_;
+  VoxelPlanes planes_;  // used by the registration when LioOptions::planes.enabled
   // the registration's neighbour searches beyond the calling thread (null: LioOptions::search_threads
   // is 1); shared by copies of the estimator, which take turns
   std::shared_ptr<WorkerThreads> search_threads_;

@@ -10,6 +10,7 @@
 #include "livo/sensor_samples.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "livo/lio/voxel_map.hpp"
+#include "livo/lio/voxel_planes.hpp"
 #include "livo/lio/wheel_scale.hpp"
 #include "livo/lio/wheel_update.hpp"
 
@@ -63,6 +64,7 @@ struct LioOptions {
 
   // map and registration
   VoxelMapOptions map;
+  VoxelPlanesOptions planes;           // planes that average the range noise (lio.map.planes)
   SeenThroughOptions seen_through;     // points later beams pass through leave the map
   double map_radius = 100.0;           // m, local window kept around the body
   double map_prune_distance = 10.0;    // m travelled between window prunings

@@ -16,6 +16,7 @@
 #include "livo/esikf_update.hpp"
 #include "livo/lio/point_to_plane.hpp"
 #include "livo/lio/voxel_map.hpp"
+#include "livo/lio/voxel_planes.hpp"
 #include "livo/worker_threads.hpp"
 
 namespace livo::lio {
@@ -57,7 +58,10 @@ class ScanToMap {
   /// undistorted through the LiDAR calibration `undistorted_with` and `body_rate` is the bias-corrected
   /// angular rate at the sweep end (frame I). With `threads`, the neighbour searches of an iterate
   /// are shared among them; the result is the same bit for bit.
-  ScanToMap(const VoxelMap& map, const std::vector<Vec3>& body_points, const ScanToMapOptions& options,
+  /// `planes` (may be null) answer first where they have a plane; the map's k nearest points
+  /// elsewhere.
+  ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::vector<Vec3>& body_points,
+            const ScanToMapOptions& options,
             WorkerThreads* threads = nullptr, const SensorCalibration& undistorted_with = {},
             const Vec3& body_rate = Vec3::Zero());
 
@@ -84,6 +88,7 @@ class ScanToMap {
     double r;
   };
   const VoxelMap& map_;
+  const VoxelPlanes* planes_;
   std::vector<Vec3> points_;          // the points in the LiDAR frame (q above)
   Vec3 body_rate_;
   ScanToMapOptions opts_;
