@@ -361,12 +361,6 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   return removed;
 }
 
-void LioEstimator::addToPlanes(const std::vector<Vec3>& body, const FilterState& x) {
-  std::vector<Vec3> world(body.size());
-  for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
-  planes_.add(world, x.rot * x.lidar.pos + x.pos);
-}
-
 void LioEstimator::pruneMap(const Vec3& position) {
   if ((position - last_prune_position_).norm() < opts_.map_prune_distance) return;
   map_.removeFarFrom(position, opts_.map_radius);
@@ -431,10 +425,17 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   res.utime = t_end;
   if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
 
-  // 6. map insertion and the local window
+  // 6. the sweep in the world (an output, and what the voxel planes take), map insertion and the
+  // local window
+  res.world_points.resize(body.size());
+  res.input_index.resize(body.size());
+  for (size_t i = 0; i < body.size(); ++i) {
+    res.input_index[i] = static_cast<uint32_t>(valid[i]);
+    res.world_points[i] = x.rot * body[i] + x.pos;
+  }
   if (res.status != ScanResult::Status::kPredicted) {
     res.map_points_seen_through = insertIntoMap(reg, x);
-    if (opts_.planes.enabled) addToPlanes(body, x);
+    if (opts_.planes.enabled) planes_.add(res.world_points, x.rot * x.lidar.pos + x.pos);
     last_registered_body_ = reg;
     pruneMap(x.pos);
   }
@@ -444,12 +445,6 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   res.state = x;
   res.covariance = P;
   res.angular_velocity = prop_.angularVelocity(prop_.lastSample().gyro, x);
-  res.world_points.resize(body.size());
-  res.input_index.resize(body.size());
-  for (size_t i = 0; i < body.size(); ++i) {
-    res.input_index[i] = static_cast<uint32_t>(valid[i]);
-    res.world_points[i] = x.rot * body[i] + x.pos;
-  }
   if (res.status != ScanResult::Status::kPredicted && keyframe_selector_.check(x.pose())) {
     res.is_keyframe = true;
     res.keyframe = makeKeyframe(scan, valid, body, x, P, t_end);

@@ -220,8 +220,6 @@ class LioEstimator {
   /// map points were removed.
   size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
   void pruneMap(const Vec3& position);
-  /// Adds a registered sweep (body frame at x) to the voxel planes.
-  void addToPlanes(const std::vector<Vec3>& body, const FilterState& x);
   const VoxelPlanes* planesForRegistration() const { return opts_.planes.enabled ? &planes_ : nullptr; }
 
   LioOptions opts_;
