@@ -86,6 +86,15 @@ ImuInitResult initializeImu(const std::vector<ImuSample>& window, const ImuInitO
   // a right (body) perturbation: δr_body = R0^T δr_world.
   Mat18 P = d.asDiagonal();
   P.block<3, 3>(S::kRot, S::kRot) = R0.transpose() * P.block<3, 3>(S::kRot, S::kRot) * R0;
+  if (use_static) {
+    // At rest the specific force is gravity, whose magnitude the rig states: what the mean exceeds
+    // it by is the accelerometer's error along up (body frame). Across up the error is a tilt.
+    const double n = static_cast<double>(window.size());
+    const double up_var = up_body.dot(m.var_accel.cwiseProduct(up_body)) / n + var(opts.static_up_bias_floor);
+    r.state.accel_bias = (m.mean_accel.norm() - opts.gravity) * up_body;
+    P.block<3, 3>(S::kAccelBias, S::kAccelBias) =
+        var(opts.accel_bias_std) * Mat3::Identity() + (up_var - var(opts.accel_bias_std)) * up_body * up_body.transpose();
+  }
   r.covariance = P;
   r.last = window.back();
   r.static_start = use_static;

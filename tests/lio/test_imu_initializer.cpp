@@ -44,6 +44,41 @@ TEST(ImuInitializer, StaticStartRecoversGravityAndGyroBias) {
   EXPECT_LT(r.covariance(FilterState::kVel, FilterState::kVel), 1e-3);
 }
 
+TEST(ImuInitializer, StaticStartTakesTheAccelerometerErrorAlongUpFromGravitysMagnitude) {
+  // At rest the specific force is gravity: a mean that exceeds the rig's 9.81 by 0.11 m/s^2 (a 1 %
+  // scale error, room_hard's accelerometer) is that much error along up, which the filter would
+  // otherwise learn only from the LiDAR's height, and integrate as a vertical acceleration until it
+  // does (0.2 m in 2 s). Across up the error looks like a tilt and stays with its prior.
+  auto traj = synth::roomTrajectory(2.0);  // still, tilted (roll 0.02, pitch -0.03)
+  synth::ImuErrorModel err;
+  err.noise = ImuNoise{1.7e-4, 2.9e-3, 0, 0};
+  err.accel_bias = Vec3(0.03, -0.02, 0.11);
+  const auto w = window(traj, 0.0, 0.5, err, 5);
+  const ImuInitOptions opts;
+  const ImuInitResult r = initializeImu(w, opts);
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.static_start);
+  const Vec3 up = r.state.rot.transpose() * Vec3::UnitZ();  // body frame
+  const Mat3 Pb = r.covariance.block<3, 3>(FilterState::kAccelBias, FilterState::kAccelBias);
+  const double sigma_up = std::sqrt(up.dot(Pb * up));
+  EXPECT_LT(sigma_up, 0.01);
+  EXPECT_GT(sigma_up, opts.static_up_bias_floor);
+  // the estimate along up within 3 sigma of the planted error's component
+  EXPECT_NEAR(r.state.accel_bias.dot(up), err.accel_bias.dot(up), 3.0 * sigma_up);
+  EXPECT_LT((r.state.accel_bias - r.state.accel_bias.dot(up) * up).norm(), 1e-12);  // nothing across up
+  const Vec3 across = up.unitOrthogonal();
+  EXPECT_NEAR(across.dot(Pb * across), opts.accel_bias_std * opts.accel_bias_std, 1e-12);
+  EXPECT_NEAR((Pb * up).dot(across), 0.0, 1e-12);
+  EXPECT_EQ(Eigen::LLT<Mat18>(r.covariance).info(), Eigen::Success);
+  // the state's specific force at rest is gravity's magnitude again: reading - bias = g up
+  const Vec3 mean = [&] {
+    Vec3 a = Vec3::Zero();
+    for (const auto& s : w) a += s.accel / static_cast<double>(w.size());
+    return a;
+  }();
+  EXPECT_NEAR((mean - r.state.accel_bias).norm(), opts.gravity, 1e-9);
+}
+
 TEST(ImuInitializer, MovingStartNeedsNoStillWindow) {
   auto traj = synth::roomTrajectory(0.0);
   synth::ImuErrorModel err;

@@ -1,6 +1,9 @@
 // IMU initialisation: the first state and covariance of the filter from a window of IMU samples.
 //  - static start: the body is still; gravity direction from the mean specific force, gyro bias
-//    from the mean rate, small initial covariance;
+//    from the mean rate, the accelerometer's bias along "up" from the mean specific force's
+//    magnitude against the rig's gravity (at rest it must equal it: the excess is the sensor's
+//    error along that axis, a scale error or a bias, which no later measurement separates from
+//    a vertical acceleration until the LiDAR sees the height), small initial covariance;
 //  - moving start: no still window is needed; gravity magnitude from the rig, direction from the
 //    averaged specific force, zero biases and velocity with a larger covariance.
 // The world frame W is gravity-aligned (z up) with the body origin at the start and zero yaw.
@@ -24,7 +27,8 @@ struct ImuInitOptions {
   // initial standard deviations, static start
   double static_rot_std = 0.01;       // rad, roll and pitch
   double static_vel_std = 0.01;       // m/s
-  double accel_bias_std = 0.05;       // m/s^2 (both modes)
+  double accel_bias_std = 0.05;       // m/s^2 (both modes; static: across "up" only)
+  double static_up_bias_floor = 2e-3; // m/s^2, added to the mean's standard error along "up"
   double gravity_std = 1e-3;          // m/s^2 per axis
   // initial standard deviations, moving start
   double moving_rot_std = 0.1;        // rad, roll and pitch
