@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A user's corridor run (config/sim/corridor.yaml, 15 s) through the LIO: most sweeps are flagged
+# A user's corridor run (config/sim/corridor.yaml with a 50 m LiDAR, 15 s) through the LIO: most sweeps are flagged
 # degenerate, and report.md says where: its "Where the estimate was weak" section counts the
 # degenerate sweeps as ODOMETRY has them, lists their stretches in seconds since the start (the
 # longest first) and says the position was least certain along the direction of travel; the
@@ -10,9 +10,10 @@ dir=$(mktemp -d /tmp/livo-weak-spots.XXXXXX)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 export LIVO_BUILD_DIR="$(dirname "$bin")"
-"$bin/livo-sim" --config "$root/config/sim/corridor.yaml" --out "$dir/corridor.lcmlog" --duration 15 --seed 2 --quiet \
+"$root/tests/pipeline/axis_degenerate_corridor.sh" "$root" "$dir/corridor.yaml" || fail "no corridor config"
+"$bin/livo-sim" --config "$dir/corridor.yaml" --out "$dir/corridor.lcmlog" --duration 15 --seed 2 --quiet \
   || fail "livo-sim failed"
-"$root/scripts/run_pipeline.sh" --log "$dir/corridor.lcmlog" --config "$root/config/sim/corridor.yaml" \
+"$root/scripts/run_pipeline.sh" --log "$dir/corridor.lcmlog" --config "$dir/corridor.yaml" \
   --processes lio --out "$dir/run" >/dev/null 2>"$dir/run.err" || { cat "$dir/run.err"; fail "the run failed"; }
 /usr/bin/python3 -B - "$root" "$dir/run" <<'PY' || exit 1
 import json, re, sys

@@ -26,9 +26,10 @@ struct PlaneFit {
 bool fitPlane(const Vec3* points, int n, PlaneFit* out);
 
 /// Least-squares plane through n >= 3 points. Returns false if the points are (nearly) collinear
-/// — the scatter's second eigenvalue below min_planarity times the largest — or one lies farther
-/// than max_thickness. No default: the callers' options say how planar (the LIO's
-/// `matching.plane.min_planarity`).
+/// — the scatter's second eigenvalue below min_planarity times the largest, for the whole set or
+/// for the set with any one point left out (a line plus one point beside it spans a plane the
+/// one point chose) — or one lies farther than max_thickness. No default: the callers' options
+/// say how planar (the LIO's `matching.plane.min_planarity`).
 bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity);
 
 }  // namespace livo

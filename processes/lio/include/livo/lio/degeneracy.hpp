@@ -8,10 +8,15 @@
 // axis has a translation eigenvalue near 0 (only range noise tilts the normals), a single plane
 // leaves two translations and the rotation about its normal unconstrained.
 //
-// Solution remapping in information form: every row of H is projected off the degenerate
-// directions (H' = H Q, Q = I - sum e e^T with e the degenerate [rotation; translation] unit
-// vectors), so the update takes nothing along them from the LiDAR, noise included, and the prior
-// (IMU, wheels) carries the state there. Removing the eigenvector of the full 6x6 G is not
+// Solution remapping in information form: the degenerate directions (unit [rotation; translation]
+// vectors e from each block's eigen-analysis) are marginalised out of the rows' information, so
+// the update takes nothing along them from the LiDAR, noise included, and of the other directions
+// only what holds wherever the pose lies along them; the prior (IMU, wheels) carries the state
+// there. Projecting the rows off them instead (H' = H Q, Q = I - sum e e^T) keeps what a row
+// measures jointly with the axis as if the position along it were known: in a featureless
+// corridor (tests/lio, CorridorFlagsDegeneracyWithoutDiverging) the two or three rows a sweep has
+// along it then tilt the attitude, the tilt leaks gravity into the acceleration along the axis,
+// and a bias-free IMU ended 0.19 of the distance off where it now ends 0.04. Removing the eigenvector of the full 6x6 G is not
 // enough: noisy normals couple the corridor's axis to a small rotation, and through the large
 // rotational information of far points that leaves the axis centimetre-level "information".
 #pragma once
@@ -35,7 +40,13 @@ struct DegeneracyReport {
 /// geometry: G above; threshold on its block eigenvalues.
 DegeneracyReport analyzeDegeneracy(const Mat6& geometry, double threshold);
 
-/// Projects S = H^T R^-1 H and g = H^T R^-1 z off the degenerate directions: S' = Q S Q, g' = Q g.
+/// Removes from S = H^T R^-1 H and g = H^T R^-1 z what the rows say along the degenerate
+/// directions by marginalising them out (the Schur complement): the rest keeps only the
+/// information that holds wherever the pose lies along those directions. Projecting them out
+/// (Q S Q) would keep, say, the rotation a row measures only jointly with the corridor's axis,
+/// as if the position along it were known; the few rows that see something along the axis (a
+/// corner's plane, a normal tilted by noise) would then pull the attitude instead, and the tilt
+/// leaks gravity into the acceleration along the axis.
 void removeDegenerateInformation(const DegeneracyReport& report, Mat6* S, Vec6* g);
 
 }  // namespace livo::lio

@@ -30,7 +30,7 @@ struct ScanToMapOptions {
                                         // 1 / (1 + (r/c)^2)); it damps residuals on planes
                                         // fitted across two surfaces (corners); 0: off
   double degeneracy_lever_arm = 1.0;    // m, L of the degeneracy test (degeneracy.hpp)
-  double degeneracy_threshold = 0.01;   // eigenvalue of G below which a direction is degenerate
+  double degeneracy_threshold = 0.003;  // eigenvalue of G below which a direction is degenerate
   bool remove_degenerate = true;        // drop the information of degenerate directions
   // The accuracy floor of one sweep's registration (1 sigma; rotation in rad, translation in m): the
   // map's own error (planes fitted to points that earlier, imperfect poses placed), shared by every
