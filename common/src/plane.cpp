@@ -64,7 +64,8 @@ bool fitPlane(const Vec3* pts, int n, PlaneFit* out) {
   return fitScatter(pts, n, out, &es);
 }
 
-bool fitPlane(const Vec3* pts, int n, double max_thickness, Plane* out, double min_planarity) {
+bool fitPlane(const Vec3* pts, int n, double max_thickness, Plane* out, double min_planarity,
+              bool* planar_without_any_one) {
   PlaneFit f;
   Eigen::SelfAdjointEigenSolver<Mat3> es;
   if (!fitScatter(pts, n, &f, &es)) return false;
@@ -72,7 +73,7 @@ bool fitPlane(const Vec3* pts, int n, double max_thickness, Plane* out, double m
   if (!(f.spread[1] > min_planarity * f.spread[2]) || !(f.spread[2] > 0.0)) return false;
   for (int i = 0; i < n; ++i)
     if (std::abs(f.plane.distance(pts[i])) > max_thickness) return false;
-  if (!planarWithoutAnyOne(pts, n, f, es, min_planarity)) return false;
+  if (planar_without_any_one) *planar_without_any_one = planarWithoutAnyOne(pts, n, f, es, min_planarity);
   *out = f.plane;
   return true;
 }

@@ -50,7 +50,7 @@ TEST(PointToPlane, RejectsCollinearAndTooFewPoints) {
   EXPECT_FALSE(fitPlane(line.data(), 2, 0.1, &p, kCollinearOnly));
 }
 
-TEST(PointToPlane, RejectsALinePlusOnePoint) {
+TEST(PointToPlane, TellsALinePlusOnePointFromAPlane) {
   // four floor points along one LiDAR ring and a wall point 40 cm above them: together they span a
   // plane (the whole-set planarity passes, every point lies on it), but it is the wall point's
   // choice; with any one of the four left out the rest still span it, without the wall point not
@@ -58,14 +58,19 @@ TEST(PointToPlane, RejectsALinePlusOnePoint) {
   for (int i = 0; i < 4; ++i) pts.emplace_back(0.15 * i, 1.3, -1.2);
   pts.emplace_back(0.2, 1.5, -0.8);
   Plane p;
-  EXPECT_FALSE(fitPlane(pts.data(), 5, 0.03, &p, 0.02));
+  bool planar_without_any_one = true;
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.03, &p, 0.02, &planar_without_any_one));
+  EXPECT_FALSE(planar_without_any_one);
   // the same five with the fourth floor point off the line are a plane with or without any one
   pts[3] = Vec3(0.3, 1.0, -1.2);
   pts[4] = Vec3(0.2, 1.45, -1.2);
-  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.03, &p, 0.02));
+  ASSERT_TRUE(fitPlane(pts.data(), 5, 0.03, &p, 0.02, &planar_without_any_one));
+  EXPECT_TRUE(planar_without_any_one);
   EXPECT_NEAR(std::abs(p.normal.z()), 1.0, 1e-9);
   // three points have nothing to leave out
-  EXPECT_TRUE(fitPlane(pts.data() + 2, 3, 0.03, &p, 0.02));
+  planar_without_any_one = false;
+  EXPECT_TRUE(fitPlane(pts.data() + 2, 3, 0.03, &p, 0.02, &planar_without_any_one));
+  EXPECT_TRUE(planar_without_any_one);
 }
 
 namespace {

@@ -26,10 +26,14 @@ struct PlaneFit {
 bool fitPlane(const Vec3* points, int n, PlaneFit* out);
 
 /// Least-squares plane through n >= 3 points. Returns false if the points are (nearly) collinear
-/// — the scatter's second eigenvalue below min_planarity times the largest, for the whole set or
-/// for the set with any one point left out (a line plus one point beside it spans a plane the
-/// one point chose) — or one lies farther than max_thickness. No default: the callers' options
-/// say how planar (the LIO's `matching.plane.min_planarity`).
-bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity);
+/// — the scatter's second eigenvalue below min_planarity times the largest — or one lies farther
+/// than max_thickness. No default: the callers' options say how planar (the LIO's
+/// `matching.plane.min_planarity`). If planar_without_any_one is given, it says whether the set
+/// stays that planar with any one point left out: a line plus one point beside it (four floor
+/// points along one LiDAR ring and a wall point) spans a plane that one point chose. Such a plane
+/// may still be right (four points of one ring on a wall and one of the next), so it is not
+/// rejected here; the LIO does not count it as evidence that its direction is observed.
+bool fitPlane(const Vec3* points, int n, double max_thickness, Plane* out, double min_planarity,
+              bool* planar_without_any_one = nullptr);
 
 }  // namespace livo

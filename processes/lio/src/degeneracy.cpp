@@ -40,6 +40,11 @@ void removeDegenerateInformation(const DegeneracyReport& report, Mat6* S, Vec6* 
   // an orthonormal basis of the pose's tangent space: the degenerate directions first (m of them),
   // then the rest, each block's directions from its own eigenvectors
   const int m = report.degenerate_rotations + report.degenerate_translations;
+  if (m == 6) {
+    S->setZero();
+    g->setZero();
+    return;
+  }
   Mat6 U = Mat6::Zero();
   int col = 0;
   for (int i = 0; i < report.degenerate_rotations; ++i) U.block<3, 1>(0, col++) = report.rotation_directions.col(i);

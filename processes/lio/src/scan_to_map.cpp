@@ -83,11 +83,12 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
       m.searched_at = world_[i];
       if (const Plane* voxel_plane = planes_ ? planes_->planeAt(world_[i]) : nullptr) {
         m.plane = *voxel_plane;
-        m.has_plane = true;
+        m.has_plane = m.observes_normal = true;
         continue;
       }
       m.has_plane = map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
-                    fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity);
+                    fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity,
+                             &m.observes_normal);
     }
   };
   if (threads_)
@@ -101,7 +102,8 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
     if (!m.has_plane) continue;
     const double r = m.plane.distance(world_[i]);
     if (!(std::abs(r) <= gate_[i])) continue;
-    rows_.push_back(Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x, sweep_end, body_rate_), r});
+    rows_.push_back(
+        Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x, sweep_end, body_rate_), r, m.observes_normal});
   }
   const int count = static_cast<int>(rows_.size());
   last_count_ = count;
@@ -119,25 +121,38 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
     const double c = std::max(opts_.robust_scale, 3.0 * 1.4826 * *mid);
     c2 = c * c;
   }
-  Mat13 S = Mat13::Zero();
+  // The degeneracy test counts only the rows whose planes stay planes with any one neighbour left
+  // out: a line of floor points plus the wall point beside it spans a plane that point chose, and
+  // in a corridor such planes are the only rows along the axis, hiding its degeneracy.
   Mat6 G = Mat6::Zero();
-  Vec13 g = Vec13::Zero();
+  int observing = 0;
   for (const Row& row : rows_) {
-    const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
-    S.noalias() += rw * row.h.transpose() * row.h;
-    g.noalias() += rw * row.h.transpose() * row.r;
+    if (!row.observes_normal) continue;
     Row6 hs = row.h.head<6>();
     hs.head<3>() *= inv_lever;
     G.noalias() += hs.transpose() * hs;
+    ++observing;
+  }
+  info->geometry = G / static_cast<double>(std::max(observing, 1));
+  degeneracy_ = analyzeDegeneracy(info->geometry, opts_.degeneracy_threshold);
+  // Where the other rows fix the whole pose, such a plane is mostly right (four points of one
+  // ring on a wall and one of the next look the same) and a wrong one is outvoted; where they do
+  // not, it would be the only say in a direction, and a wrong one tilts the attitude there.
+  const bool degenerate = opts_.remove_degenerate && degeneracy_.degenerate;
+  Mat13 S = Mat13::Zero();
+  Vec13 g = Vec13::Zero();
+  for (const Row& row : rows_) {
+    if (degenerate && !row.observes_normal) continue;
+    const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
+    S.noalias() += rw * row.h.transpose() * row.h;
+    g.noalias() += rw * row.h.transpose() * row.r;
   }
   S *= w;
   g *= w;
-  info->geometry = G / static_cast<double>(count);
   info->calibration_block = FilterState::kLidar;
   min_information_eigenvalue_ =
       Eigen::SelfAdjointEigenSolver<Mat6>(Mat6(S.topLeftCorner<6, 6>()), Eigen::EigenvaluesOnly).eigenvalues()[0];
-  degeneracy_ = analyzeDegeneracy(info->geometry, opts_.degeneracy_threshold);
-  if (opts_.remove_degenerate && degeneracy_.degenerate) {
+  if (degenerate) {
     // the pose off its degenerate directions; the calibration, which the same rows would measure
     // along them (the extrinsic translation's column is the position's), not at all
     Mat6 Sp = S.topLeftCorner<6, 6>();

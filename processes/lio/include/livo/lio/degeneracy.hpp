@@ -1,7 +1,10 @@
 // Degeneracy of a scan-to-map registration from the eigen-analysis of its information matrix.
 //
 // The test runs on a unit-free version of H^T H averaged over the m residuals, with the rotation
-// columns divided by a reference lever arm L:  G = D H^T H D / m,  D = diag(I3 / L, I3).
+// columns divided by a reference lever arm L:  G = D H^T H D / m,  D = diag(I3 / L, I3). The LIO
+// builds it from the rows whose planes stay planes with any one neighbour left out (plane.hpp): a
+// line of floor points plus one wall point spans a plane that only that point chose, and in a
+// corridor such planes would be the axis's only "evidence".
 // Its translation block is the scatter of the plane normals (eigenvalues in [0, 1], summing to
 // 1); its rotation block is the points' mean squared lever arm about each axis over L^2.
 // A direction of either block with an eigenvalue below the threshold is degenerate: a corridor's

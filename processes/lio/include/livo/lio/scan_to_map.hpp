@@ -82,10 +82,12 @@ class ScanToMap {
     Plane plane;
     Vec3 searched_at = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
     bool has_plane = false;
+    bool observes_normal = false;  // the plane stays one with any of its neighbours left out
   };
   struct Row {
     Eigen::Matrix<double, 1, kMeasuredDim> h;
     double r;
+    bool observes_normal;  // counts in the degeneracy test; only these are used in a degenerate sweep
   };
   const VoxelMap& map_;
   const VoxelPlanes* planes_;
