@@ -722,6 +722,19 @@ TEST(EsikfUpdate, DegenerateDirectionsAreMarginalisedOutOfTheSweepsInformation) 
   // information about the rotation than the rows hold when x is free
   const Mat6 projected = Q * S * Q;
   EXPECT_GT((B.transpose() * projected * B - expected).norm(), 5e-3 * expected.norm());
+  // every direction degenerate: nothing is left; none: the information is untouched
+  const DegeneracyReport all = analyzeDegeneracy(G, 1e9);
+  ASSERT_EQ(all.degenerate_rotations + all.degenerate_translations, 6);
+  Mat6 S_all = S;
+  Vec6 g_all = g;
+  removeDegenerateInformation(all, &S_all, &g_all);
+  EXPECT_TRUE(S_all.isZero(0.0) && g_all.isZero(0.0));
+  const DegeneracyReport none = analyzeDegeneracy(G, 0.0);
+  ASSERT_FALSE(none.degenerate);
+  Mat6 S_none = S;
+  Vec6 g_none = g;
+  removeDegenerateInformation(none, &S_none, &g_none);
+  EXPECT_TRUE(S_none == S && g_none == g);
 }
 
 TEST(EsikfUpdate, PoseMeasurementFloorAddsItsCovarianceAndKeepsTheMeasuredPose) {

@@ -247,31 +247,63 @@ TEST(VioImage, AffineWarpBetweenViews) {
   const Pose3 T_ref = Pose3::Identity();
   const Vec3 p(0.4, -0.3, 4.0);
   Eigen::Matrix2d A;
-  ASSERT_TRUE(affineWarp(cam, T_ref, T_ref, p, &A));
+  ASSERT_TRUE(affineWarp(cam, T_ref, T_ref, p, Vec3::Zero(), &A));
   EXPECT_TRUE(A.isApprox(Eigen::Matrix2d::Identity(), 1e-9));
   // moving halfway towards the point doubles its image size: reference offsets are half
   Pose3 T_cur = Pose3::Identity();
   T_cur.translation() = 0.5 * p;
-  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, &A));
+  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, Vec3::Zero(), &A));
   EXPECT_NEAR(A.determinant(), 0.25, 0.03);  // 0.5 per axis, modulated by the distortion
   // rolling the camera about its axis by 10 deg rotates the offsets by 10 deg
   Pose3 T_roll = Pose3::Identity();
   T_roll.linear() = so3::Exp(Vec3(0.0, 0.0, 10.0 * M_PI / 180.0));
   const Vec3 q(0.0, 0.0, 3.0);  // on the axis: no distortion effect
-  ASSERT_TRUE(affineWarp(cam, T_roll, T_ref, q, &A));
+  ASSERT_TRUE(affineWarp(cam, T_roll, T_ref, q, Vec3::Zero(), &A));
   EXPECT_NEAR(std::atan2(A(1, 0), A(0, 0)) * 180.0 / M_PI, 10.0, 1e-6);
   EXPECT_NEAR(A.determinant(), 1.0, 1e-9);
   // the warp predicts where a nearby surface point appears: a point on the fronto-parallel plane
   // 2 cm to the side of p, seen from both cameras
   T_cur.translation() = Vec3(0.3, 0.1, 0.5);
   T_cur.linear() = so3::Exp(Vec3(0.02, -0.05, 0.03));
-  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, &A));
+  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, Vec3::Zero(), &A));
   const Vec3 n = p.normalized(), t1 = n.unitOrthogonal();
   const Vec3 p2 = p + 0.02 * t1;
   Eigen::Vector2d c0, c1, r0, r1;
   ASSERT_TRUE(cam.project(T_cur.inverse() * p, &c0) && cam.project(T_cur.inverse() * p2, &c1));
   ASSERT_TRUE(cam.project(p, &r0) && cam.project(p2, &r1));
   EXPECT_LT((A * (c1 - c0) - (r1 - r0)).norm(), 0.01 * (r1 - r0).norm());
+}
+
+TEST(VioImage, AffineWarpFollowsTheSurfaceNormal) {
+  // a floor 1.5 m below the cameras seen obliquely from views 20 deg apart about the vertical and
+  // at 0.7 of the distance: the warp with the floor's normal maps offsets on the floor between the
+  // views; the fronto-parallel one is off by the change of foreshortening
+  const CameraProjection cam(camera());
+  const Vec3 n(0.0, -1.0, 0.0);  // camera frame: y down, the floor at y = 1.5 faces up
+  const Vec3 p(0.2, 1.5, 3.0);
+  const Pose3 T_ref = Pose3::Identity();
+  Pose3 T_cur = Pose3::Identity();
+  T_cur.linear() = so3::Exp(Vec3(0.0, 20.0 * M_PI / 180.0, 0.0));
+  T_cur.translation() = p - 0.7 * (T_cur.linear() * p);
+  Eigen::Matrix2d A_n, A_fp;
+  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, n, &A_n));
+  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, Vec3::Zero(), &A_fp));
+  double worst_n = 0.0, worst_fp = 0.0;
+  for (const Vec3& d : {Vec3(0.02, 0.0, 0.0), Vec3(0.0, 0.0, 0.02), Vec3(0.014, 0.0, -0.014)}) {
+    const Vec3 q = p + d;  // on the floor
+    Eigen::Vector2d c0, c1, r0, r1;
+    ASSERT_TRUE(cam.project(T_cur.inverse() * p, &c0) && cam.project(T_cur.inverse() * q, &c1));
+    ASSERT_TRUE(cam.project(p, &r0) && cam.project(q, &r1));
+    const double scale = (r1 - r0).norm();
+    worst_n = std::max(worst_n, (A_n * (c1 - c0) - (r1 - r0)).norm() / scale);
+    worst_fp = std::max(worst_fp, (A_fp * (c1 - c0) - (r1 - r0)).norm() / scale);
+  }
+  EXPECT_LT(worst_n, 0.01);  // first order in the 2 cm offset (0.3 % for a pinhole)
+  EXPECT_GT(worst_fp, 0.3);  // the fronto-parallel plane is not the floor (57 % for a pinhole)
+  // seen edge-on from the reference (|cos| below kMinNormalIncidence): fronto-parallel
+  Eigen::Matrix2d A_edge;
+  ASSERT_TRUE(affineWarp(cam, T_cur, T_ref, p, p.normalized().unitOrthogonal(), &A_edge));
+  EXPECT_TRUE(A_edge.isApprox(A_fp, 1e-12));
 }
 
 TEST(VioSelection, DepthEdgeTellsSlantedPlanesFromSteps) {

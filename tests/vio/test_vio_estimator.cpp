@@ -316,6 +316,36 @@ TEST(VioEstimator, VoxelPointsSnapFlatVoxelsOntoTheirPlane) {
   EXPECT_NEAR(raw[0].z(), 0.21, 1e-6);
 }
 
+TEST(VioEstimator, VoxelPointsGiveTheNormalsOfPlanarVoxelsOnly) {
+  // a wall voxel with 3 cm range noise: its normal; a corner, one ring's arc (a line with the
+  // noise across it) and a voxel of three points: none
+  MapOptions o;
+  o.normal_max_rms = 0.05;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.03);
+  std::uniform_real_distribution<double> u(0.01, 0.29);
+  std::vector<float> x, y, z;
+  auto add = [&](double a, double b, double c) { x.push_back(a), y.push_back(b), z.push_back(c); };
+  for (int i = 0; i < 40; ++i) add(u(rng), u(rng), std::clamp(0.15 + noise(rng), 0.001, 0.299));
+  for (int i = 0; i < 20; ++i) add(1.2 + u(rng), u(rng), 0.05), add(1.25, u(rng), u(rng));
+  for (int i = 0; i < 20; ++i) add(2.1 + u(rng), 0.15, std::clamp(0.15 + noise(rng), 0.001, 0.299));
+  add(3.1, 0.1, 0.1), add(3.2, 0.1, 0.2), add(3.15, 0.2, 0.15);
+  std::vector<Vec3> normals;
+  const std::vector<Vec3> points = voxelPoints(x.data(), y.data(), z.data(), x.size(), o, &normals);
+  ASSERT_EQ(points.size(), 4u);
+  ASSERT_EQ(normals.size(), 4u);
+  EXPECT_NEAR(normals[0].norm(), 1.0, 1e-9);
+  EXPECT_GT(std::abs(normals[0].z()), std::cos(10.0 * M_PI / 180.0));  // 40 points, 3 cm noise: a few deg
+  EXPECT_EQ(normals[1], Vec3::Zero());
+  EXPECT_EQ(normals[2], Vec3::Zero());
+  EXPECT_EQ(normals[3], Vec3::Zero());
+  EXPECT_TRUE(points[0].isApprox(Vec3(x[0], y[0], z[0]), 1e-6));  // normals do not move the points
+  o.normal_max_rms = 0.0;  // off: no normals
+  voxelPoints(x.data(), y.data(), z.data(), x.size(), o, &normals);
+  ASSERT_EQ(normals.size(), 4u);
+  EXPECT_EQ(normals[0], Vec3::Zero());
+}
+
 TEST(VioEstimator, CovarianceCountsOnlyTheInformationBeyondThePrior) {
   // the same image and prior through both covariance rules: the state steps alike, but with a
   // prior tighter than the image along some directions `beyond_prior` leaves those directions as

@@ -17,14 +17,16 @@ bool extractStoredPatches(const ImagePyramid& pyramid, const Eigen::Vector2d& u0
 }
 
 bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pose3& T_W_Cref, const Vec3& p_W,
-                Eigen::Matrix2d* A) {
+                const Vec3& normal_W, Eigen::Matrix2d* A) {
   Eigen::Vector2d px;
   Eigen::Matrix<double, 2, 3> Jc, Jr;
   const Mat3 R_CW_cur = T_W_Ccur.linear().transpose(), R_CW_ref = T_W_Cref.linear().transpose();
   if (!camera.projectWithJacobian(R_CW_cur * (p_W - T_W_Ccur.translation()), &px, &Jc)) return false;
   if (!camera.projectWithJacobian(R_CW_ref * (p_W - T_W_Cref.translation()), &px, &Jr)) return false;
-  // tangent basis of the plane through p_W perpendicular to the reference ray
-  const Vec3 n = (p_W - T_W_Cref.translation()).normalized();
+  // tangent basis of the plane through p_W: the surface's where it is known and faces the
+  // reference camera, else perpendicular to the reference ray
+  const Vec3 ray = (p_W - T_W_Cref.translation()).normalized();
+  const Vec3 n = std::abs(normal_W.dot(ray)) >= kMinNormalIncidence ? normal_W : ray;
   const Vec3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
   Eigen::Matrix<double, 3, 2> T;
   T << t1, t2;

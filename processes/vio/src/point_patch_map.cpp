@@ -11,12 +11,13 @@ uint64_t PointPatchMap::keyOf(const Vec3& p) const { return voxelKeyOf(p, inv_vo
 
 int PointPatchMap::find(const Vec3& p) const { return index_.find(keyOf(p)); }
 
-int PointPatchMap::add(const Vec3& p, int64_t utime, PatchObservation observation) {
+int PointPatchMap::add(const Vec3& p, int64_t utime, PatchObservation observation, const Vec3& normal) {
   const int index = static_cast<int>(points_.size());
   if (index_.insert(keyOf(p), index) != index) return -1;  // the voxel's point is another
   MapPoint m;
   m.id = next_id_++;
   m.position = p;
+  m.normal = normal;
   m.last_seen = utime;
   m.observations.push_back(std::move(observation));
   points_.push_back(std::move(m));
@@ -77,6 +78,7 @@ void PointPatchMap::transform(const Pose3& T) {
   J.bottomRightCorner<3, 3>() = T.linear().cast<float>();
   for (auto& m : points_) {
     m.position = T * m.position;
+    m.normal = T.linear() * m.normal;
     for (auto& o : m.observations) {
       o.view.T_W_I = T * o.view.T_W_I;
       o.view.vel_W = T.linear() * o.view.vel_W;

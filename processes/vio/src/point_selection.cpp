@@ -142,7 +142,7 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
       // the reference view through the calibration in the state (reference_view.hpp)
       const ReferenceView& view = m.observations[static_cast<size_t>(ref)].view;
       ok = projectIntoReference(camera, view, calibration, m.position, &u_ref) &&
-           affineWarp(camera, T_W_C, view.T_W_I * calibration.pose(), m.position, &A);
+           affineWarp(camera, T_W_C, view.T_W_I * calibration.pose(), m.position, m.normal, &A);
       shift = u_ref - view.pixel;
     }
     // the warped 8x8 patch (with a pixel's room for the update to move it) must stay inside the

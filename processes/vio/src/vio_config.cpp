@@ -34,6 +34,8 @@ void readVio(const Config& c, VioNodeOptions* n) {
   map.readOptional("recent_scans", o.map.recent_scans);
   map.readOptional("plane_snap_max_rms", o.map.plane_snap_max_rms);
   map.readOptional("plane_snap_min_points", o.map.plane_snap_min_points);
+  map.readOptional("normal_max_rms", o.map.normal_max_rms);
+  map.readOptional("normal_min_points", o.map.normal_min_points);
 
   const Config sel = c.optionalSection("selection");
   sel.readOptional("grid_cell_px", o.selection.grid_cell_px);
@@ -143,7 +145,8 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << " s)\n"
      << "  map: voxel " << o.map.voxel_size << " m, radius " << o.map.radius << " m, max " << o.map.max_points
      << " points x " << o.map.max_observations << " patches, " << o.map.recent_scans << " recent scans, plane snap "
-     << o.map.plane_snap_max_rms << " m RMS from " << o.map.plane_snap_min_points << " points\n"
+     << o.map.plane_snap_max_rms << " m RMS from " << o.map.plane_snap_min_points << " points, normals "
+     << o.map.normal_max_rms << " m RMS from " << o.map.normal_min_points << " points\n"
      << "  selection: grid " << o.selection.grid_cell_px << " px, depth " << o.selection.min_depth << ".."
      << o.selection.max_depth << " m, occlusion cell " << o.selection.depth_cell_px << " px, max view angle "
      << o.selection.max_view_angle_deg << " deg\n"

@@ -13,7 +13,8 @@ namespace {
 constexpr int kMaxCandidatesPerCell = 8;  // gradient evaluations per new-point cell
 }  // namespace
 
-std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& o) {
+std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& o,
+                              std::vector<Vec3>* normals) {
   // group the finite points by voxel (CSR: first point of each voxel in arrival order)
   const double inv = 1.0 / o.voxel_size;
   std::unordered_map<uint64_t, uint32_t> voxel_of;
@@ -31,21 +32,31 @@ std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, si
     group[i] = it->second;
     ++count[it->second];
   }
-  if (o.plane_snap_max_rms <= 0.0) return first;
+  const bool snap = o.plane_snap_max_rms > 0.0, with_normals = normals != nullptr && o.normal_max_rms > 0.0;
+  if (normals != nullptr) normals->assign(first.size(), Vec3::Zero());
+  if (!snap && !with_normals) return first;
   std::vector<uint32_t> start(first.size() + 1, 0);
   for (size_t g = 0; g < first.size(); ++g) start[g + 1] = start[g] + count[g];
   std::vector<Vec3> members(start.back());
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
   for (size_t i = 0; i < n; ++i)
     if (group[i] != UINT32_MAX) members[fill[group[i]]++] = Vec3(x[i], y[i], z[i]);
-  // a flat voxel: its first point onto the plane of all its points (the range noise normal to the
-  // surface averages out; a position along the surface is as good as any for a patch)
-  const double max_ms = o.plane_snap_max_rms * o.plane_snap_max_rms;
+  // A flat voxel (its points within max_rms of their plane, spread twice as wide as thick): for the
+  // snap its first point onto the plane (the range noise normal to the surface averages out; a
+  // position along the surface is as good as any for a patch), for the normal also spread across
+  // in both directions (kMinNormalSpread of the voxel: one ring's arc is a line, whatever its
+  // scatter says)
+  constexpr double kMinNormalSpread = 0.15;
+  const double snap_ms = o.plane_snap_max_rms * o.plane_snap_max_rms, normal_ms = o.normal_max_rms * o.normal_max_rms;
+  const double min_spread = kMinNormalSpread * kMinNormalSpread * o.voxel_size * o.voxel_size;
   PlaneFit fit;
   for (size_t g = 0; g < first.size(); ++g) {
     const int m = static_cast<int>(count[g]);
-    if (m < o.plane_snap_min_points || !fitPlane(members.data() + start[g], m, &fit)) continue;
-    if (fit.spread[0] <= max_ms && fit.spread[1] >= 4.0 * fit.spread[0]) first[g] = fit.plane.project(first[g]);
+    const bool try_snap = snap && m >= o.plane_snap_min_points, try_normal = with_normals && m >= o.normal_min_points;
+    if (!(try_snap || try_normal) || !fitPlane(members.data() + start[g], m, &fit)) continue;
+    if (fit.spread[1] < 4.0 * fit.spread[0]) continue;
+    if (try_normal && fit.spread[0] <= normal_ms && fit.spread[1] >= min_spread) (*normals)[g] = fit.plane.normal;
+    if (try_snap && fit.spread[0] <= snap_ms) first[g] = fit.plane.project(first[g]);
   }
   return first;
 }
@@ -67,7 +78,7 @@ void VioEstimator::reset() {
 void VioEstimator::addScan(int64_t utime, const float* x, const float* y, const float* z, size_t n) {
   Scan s;
   s.utime = utime;
-  s.points = voxelPoints(x, y, z, n, options_.map);
+  s.points = voxelPoints(x, y, z, n, options_.map, &s.normals);
   // newest last; equal stamps keep arrival order
   auto it = std::upper_bound(scans_.begin(), scans_.end(), utime, [](int64_t t, const Scan& e) { return t < e.utime; });
   scans_.insert(it, std::move(s));
@@ -92,8 +103,10 @@ size_t VioEstimator::recentScanPoints() const {
 
 void VioEstimator::applyCorrection(const Pose3& T) {
   map_.transform(T);
-  for (auto& s : scans_)
+  for (auto& s : scans_) {
     for (auto& p : s.points) p = T * p;
+    for (auto& nrm : s.normals) nrm = T.linear() * nrm;
+  }
 }
 
 void VioEstimator::fillDepth(const Pose3& T_W_C) {
@@ -241,14 +254,15 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
   struct Best {
     float gradient = -1.0f;
     int evaluated = 0;
-    Vec3 p = Vec3::Zero();
+    Vec3 p = Vec3::Zero(), normal = Vec3::Zero();
     Eigen::Vector2d px = Eigen::Vector2d::Zero();
     double dt = 0.0;  // row time
   };
   std::vector<Best> best(occupied.size());
   const int gl = std::min(1, pyramid_.levels() - 1);
   for (auto s = scans_.rbegin(); s != scans_.rend(); ++s) {
-    for (const Vec3& p : s->points) {
+    for (size_t k = 0; k < s->points.size(); ++k) {
+      const Vec3& p = s->points[k];
       const Vec3 p_C = T_C_W * p;
       if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !seen(p)) continue;
       px = sp.pixel;
@@ -266,6 +280,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
       if (g > b.gradient) {
         b.gradient = g;
         b.p = p;
+        b.normal = s->normals[k];
         b.px = px;
         b.dt = sp.dt;
       }
@@ -279,7 +294,7 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
     }
     PatchObservation obs;
     if (!makeObservation(b.px, image, viewAt(b.dt), pose_cov_W, &obs)) continue;
-    if (map_.add(b.p, image.utime, std::move(obs)) >= 0) ++r->new_points;
+    if (map_.add(b.p, image.utime, std::move(obs), b.normal) >= 0) ++r->new_points;
   }
 }
 

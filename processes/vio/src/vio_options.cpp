@@ -15,6 +15,8 @@ void validate(const VioOptions& o) {
   require(o.map.recent_scans >= 1, "map.recent_scans must be >= 1");
   require(o.map.plane_snap_max_rms >= 0.0, "map.plane_snap_max_rms must be >= 0");
   require(o.map.plane_snap_min_points >= 3, "map.plane_snap_min_points must be >= 3");
+  require(o.map.normal_max_rms >= 0.0, "map.normal_max_rms must be >= 0");
+  require(o.map.normal_min_points >= 3, "map.normal_min_points must be >= 3");
   require(o.selection.grid_cell_px >= 8, "selection.grid_cell_px must be >= 8");
   require(o.selection.min_depth > 0.0 && o.selection.max_depth > o.selection.min_depth,
           "selection: need 0 < min_depth < max_depth");

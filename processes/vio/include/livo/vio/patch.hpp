@@ -3,12 +3,13 @@
 // current view and re-centred where the state's camera calibration projects the point into the
 // reference image), and the affine warp between two views of a map point.
 //
-// Warp model: the fronto-parallel approximation. The surface around the point is taken as the
-// plane through it perpendicular to the reference camera's ray, and the warp is that plane's
-// homography linearised at the point (both projections with their distortion), i.e. the 2x2
-// map from current pixel offsets to reference pixel offsets. No surface normal is needed; for
-// the view changes at which the map refreshes patches the error is a small fraction of a pixel
-// over an 8x8 patch.
+// Warp model: the surface around the point is the plane through it with the LiDAR's normal where
+// the map knows one (FAST-LIVO2's), else perpendicular to the reference camera's ray (the
+// fronto-parallel approximation); the warp is that plane's homography linearised at the point
+// (both projections with their distortion), i.e. the 2x2 map from current pixel offsets to
+// reference pixel offsets. On a surface seen obliquely the fronto-parallel warp is off by the
+// change of foreshortening between the views (a floor seen 60 deg off its normal, views 10 deg
+// apart: 30 % of the patch's extent).
 #pragma once
 
 #include <cstdint>
@@ -35,10 +36,15 @@ inline double patchBorder(int levels) { return (0.5 * kStored + 1.0) * static_ca
 /// level-0 pixel u0; false if one does not fit in its level.
 bool extractStoredPatches(const ImagePyramid& pyramid, const Eigen::Vector2d& u0, int levels, uint8_t* out);
 
-/// The 2x2 warp A with (reference pixel offset) = A (current pixel offset) for the map point p_W,
-/// fronto-parallel to the reference ray; false if p_W does not project into both cameras.
+/// Below this |cos| between the surface normal and the reference ray the plane is seen nearly
+/// edge-on (beyond 80 deg) and the warp falls back to fronto-parallel.
+constexpr double kMinNormalIncidence = 0.17;
+
+/// The 2x2 warp A with (reference pixel offset) = A (current pixel offset) for the map point p_W on
+/// the plane with normal `normal_W` (zero or nearly edge-on to the reference ray: fronto-parallel
+/// to that ray); false if p_W does not project into both cameras.
 bool affineWarp(const CameraProjection& camera, const Pose3& T_W_Ccur, const Pose3& T_W_Cref, const Vec3& p_W,
-                Eigen::Matrix2d* A);
+                const Vec3& normal_W, Eigen::Matrix2d* A);
 
 /// The reference patch warped into the current view: out[j*kPatch + i] is the stored patch
 /// (one level) at `shift` + A (i - 3.5, j - 3.5) from its centre (shift: where the reference image

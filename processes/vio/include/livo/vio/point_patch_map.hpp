@@ -33,6 +33,7 @@ struct PatchObservation {
 struct MapPoint {
   int64_t id = 0;                  // unique, increasing: a deterministic tie-breaker
   Vec3 position = Vec3::Zero();    // W
+  Vec3 normal = Vec3::Zero();      // W, unit: the surface's, from the LiDAR; zero if not known
   int64_t last_seen = 0;           // utime of the last image it was tracked in (or created)
   std::vector<PatchObservation> observations;
 };
@@ -43,8 +44,9 @@ class PointPatchMap {
 
   /// Index of the point in p's voxel, or -1.
   int find(const Vec3& p) const;
-  /// Adds a point in p's (free) voxel with its first observation; returns its index, -1 if taken.
-  int add(const Vec3& p, int64_t utime, PatchObservation observation);
+  /// Adds a point in p's (free) voxel with its first observation and its surface normal (zero if
+  /// not known); returns its index, -1 if taken.
+  int add(const Vec3& p, int64_t utime, PatchObservation observation, const Vec3& normal = Vec3::Zero());
   /// Appends an observation, dropping the oldest beyond max_observations.
   void addObservation(int index, PatchObservation observation);
 

@@ -35,8 +35,10 @@ namespace livo::vio {
 
 /// One point per map voxel of a registered scan (world frame; non-finite points skipped): the
 /// voxel's first point, moved onto the plane of the voxel's points when they are flat
-/// (MapOptions::plane_snap_*).
-std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& options);
+/// (MapOptions::plane_snap_*). With `normals`: per returned point the unit normal of that plane
+/// where the voxel's points form one (MapOptions::normal_*), zero elsewhere.
+std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, size_t n, const MapOptions& options,
+                              std::vector<Vec3>* normals = nullptr);
 
 struct ImageResult {
   bool valid = false;                // an update to adopt
@@ -85,6 +87,7 @@ class VioEstimator {
   struct Scan {
     int64_t utime = 0;
     std::vector<Vec3> points;
+    std::vector<Vec3> normals;  // per point, zero where its voxel is not a plane
   };
   void fillDepth(const Pose3& T_W_C);
   /// `x`: the posterior at the image stamp.

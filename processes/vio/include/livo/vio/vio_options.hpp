@@ -18,6 +18,11 @@ struct MapOptions {
                                      // scan's points in that voxel when they lie this close to it
                                      // (RMS) and spread twice as wide as thick; 0: raw points
   int plane_snap_min_points = 6;     // fewer points in the voxel: the raw point is kept
+  double normal_max_rms = 0.0;       // m: a map point takes the normal of its voxel's scan points
+                                     // when at least normal_min_points lie this close to their plane
+                                     // (RMS) and spread over it (voxelPoints); the patch warp then
+                                     // follows that plane; 0: no normals, the fronto-parallel warp
+  int normal_min_points = 6;
 };
 
 /// Which map points take part in an update.
