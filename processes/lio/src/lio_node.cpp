@@ -92,9 +92,9 @@ void LioNode::resetAll(const std::string& why) {
 
 void LioNode::announceReset(const std::string& why) {
   ++resets_;
+  saveNumbering();  // before anything of the new epoch is published (as for keyframes)
   node_.warn("odometry reset to epoch " + std::to_string(lio_.frame().epoch) + ": " + why + ": re-initialising");
   node_.publishHealthNow();  // the reason reaches resets.json / report.md even if a warning follows
-  saveNumbering();
 }
 
 void LioNode::onImu(const imu_t& m) {
@@ -419,8 +419,10 @@ void LioNode::process(const PendingScan& p) {
   if (opts_.publish_registered_scan)
     node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, lio_.frame()));
   if (r.is_keyframe) {
-    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
+    // the numbering on disk first: a process killed between the two then skips an id on restart
+    // instead of repeating the one it published (livo-loop refuses a repeated id)
     saveNumbering();
+    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
   }
 }
 
