@@ -1,4 +1,4 @@
-// livo-sim --config config/sim/NAME.yaml --out LOG [--duration S] [--seed N] [--threads N]
+// livo-sim --config config/sim/NAME.yaml --out LOG [--duration S] [--seed N] [--threads N] [--no-images]
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
       .option("--threads", "N", "worker threads (default: sim.threads; the log does not depend on it)")
       .option("--truth", "FILE", "also write the run's truth as JSON: the calibration errors drawn and the rig as "
                                  "rendered (for evaluation scripts; no estimator reads it)")
+      .flag("--no-images", "leave out the camera's (and depth) images: a log for LiDAR-only runs in a fraction of "
+                           "the time, every other channel as it is with them")
       .flag("--quiet", "no progress output");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config") || !cli.has("--out")) {
@@ -38,6 +40,7 @@ int main(int argc, char** argv) {
       if (t < 1 || t > 256) throw std::invalid_argument("--threads: must be in 1..256");
       overrides.threads = static_cast<int>(t);
     }
+    overrides.no_images = cli.has("--no-images");
     const bool quiet = cli.has("--quiet");
     livo::sim::SimulationSetup setup = livo::sim::loadSimulation(cli.get("--config"), overrides);
     if (!quiet) livo::sim::printSimulation(setup, std::cerr);

@@ -124,6 +124,44 @@ TEST(Simulation, SameSeedGivesAByteIdenticalLogWhateverTheThreads) {
   EXPECT_FALSE(a == d);  // other noise (and other LiDAR dropouts)
 }
 
+// livo-sim --no-images: the camera's and depth images left out, every other channel byte for byte
+// as with them (each sensor draws its noise from a stream of its own), on a config with auto
+// exposure and drawn calibration errors and on one with an RGB-D camera and wheels.
+TEST(Simulation, NoImagesLeavesEveryOtherChannelAsItIs) {
+  const auto channelBytes = [](const std::string& path) {
+    std::map<std::string, std::string> bytes;
+    lcm::LogFile log(path, "r");
+    while (const lcm::LogEvent* ev = log.readNextEvent())
+      bytes[ev->channel] += std::to_string(ev->timestamp) + ":" +
+                            std::string(static_cast<const char*>(ev->data), static_cast<size_t>(ev->datalen));
+    return bytes;
+  };
+  for (const std::string config : {"room_hard", "tree_campus"}) {
+    SCOPED_TRACE(config);
+    SimOverrides o;
+    o.duration_s = 0.6;
+    o.seed = 5;
+    const SimulationSetup with = loadSimulation(configPath(config), o);
+    o.no_images = true;
+    const SimulationSetup without = loadSimulation(configPath(config), o);
+    const std::string a = livo_test::tempPath("sim_") + config + "_images.lcmlog";
+    const std::string b = livo_test::tempPath("sim_") + config + "_no_images.lcmlog";
+    {
+      LogWriter wa(a, with.rig.channels), wb(b, without.rig.channels);
+      Simulator(with).run(wa);
+      Simulator(without).run(wb);
+    }
+    std::map<std::string, std::string> all = channelBytes(a);
+    const std::map<std::string, std::string> rest = channelBytes(b);
+    ASSERT_EQ(all.count(with.rig.channels.camera), 1u);
+    EXPECT_EQ(all.count(with.rig.channels.depth), config == "tree_campus" ? 1u : 0u);
+    all.erase(with.rig.channels.camera);
+    all.erase(with.rig.channels.depth);
+    EXPECT_GE(all.size(), 3u);  // IMU, LiDAR, ground truth (and wheels)
+    EXPECT_TRUE(all == rest);
+  }
+}
+
 // rig.camera.time_offset_s: images carry the camera's clock (IMU time - offset), are rendered at
 // the IMU time and logged there, so the log stays in time order.
 TEST(Simulation, CameraTimeOffsetStampsImagesOnTheCameraClock) {

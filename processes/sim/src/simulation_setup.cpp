@@ -363,6 +363,7 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
 
   if (overrides.seed) s.options.seed = *overrides.seed;
   if (overrides.threads) s.options.threads = *overrides.threads;
+  if (overrides.no_images) s.options.images = false;
   if (overrides.duration_s) {
     if (!(*overrides.duration_s > 0.0)) throw ConfigError("--duration: must be > 0");
     s.options.duration_s = *overrides.duration_s;

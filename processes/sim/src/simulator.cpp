@@ -101,7 +101,7 @@ class SimulationRun {
       scanner_ = std::make_unique<LidarScanner>(*mounted_.lidar, o_.lidar, o_.lidar_effects);
       sweep_us_ = static_cast<int64_t>(std::llround(scanner_->pattern().sweepDuration() * 1e6));
     }
-    if (rig_.camera) {
+    if (rig_.camera && o_.images) {
       stats_.messages[rig_.channels.camera] = 0;
       if (rig_.camera->depth) stats_.messages[rig_.channels.depth] = 0;
       renderer_ = std::make_unique<CameraRenderer>(*mounted_.camera, o_.camera);

@@ -34,6 +34,8 @@ struct SimOptions {
   double ground_truth_rate_hz = 100.0;
   uint64_t seed = 1;
   int threads = 2;                    // worker threads; the output does not depend on it
+  bool images = true;                 // false: no camera or depth images (livo-sim --no-images); every
+                                      // other channel is as it is with them (each sensor draws its own noise)
   Vec3 initial_gyro_bias = Vec3::Zero();   // rad/s
   Vec3 initial_accel_bias = Vec3::Zero();  // m/s^2
   LidarPatternOptions lidar;
@@ -53,6 +55,7 @@ struct SimOverrides {
   std::optional<double> duration_s;
   std::optional<uint64_t> seed;
   std::optional<int> threads;
+  bool no_images = false;  // leave the camera's and depth images out
 };
 
 struct SimulationSetup {
