@@ -83,6 +83,8 @@ void writeImu(YamlText& y, const StarterRigInputs& in) {
   else
     y.line(4, "rate_hz", "200", "REPLACE: the IMU's rate, Hz (placeholder: 200; not measured)");
   if (noise) {
+    y.raw("    # " + noise->source + "'s white noise is the sensor's at rest: where motors shake the IMU (a drone's");
+    y.raw("    # rotors, an engine), state what it reads with them running (processes/lio/README.md, \"The IMU's noise on a drone\")");
     y.line(4, "gyro_noise_density", num(noise->gyro_noise_density), noise->source + ": rad/s/sqrt(Hz)");
     y.line(4, "gyro_random_walk", num(noise->gyro_random_walk), noise->source + ": rad/s^2/sqrt(Hz)");
     y.line(4, "accel_noise_density", num(noise->accel_noise_density), noise->source + ": m/s^2/sqrt(Hz)");
