@@ -9,10 +9,11 @@
 # - room_hard: against all of the covariance (the held calibration included), mean NEES at most 12
 #   (1.4x too sure in standard deviation). A band of one run cannot hold there: the calibration error
 #   is drawn once per run, so a run's mean moves with its draw (3.4-7.5 on seeds 802-806, mean 5.6;
-#   this seed 7.5 then, 5.85 at bb9c29b). The bound catches what the held calibration fixed (29-209 before it).
+#   this seed 7.5 then, 5.85 at bb9c29b). The bound catches what the held calibration fixed (29-209
+#   before it).
 # The logs are made without images (livo-sim --no-images: the LIO alone gives the same outputs, in a
-# third of the simulation time). campus_loop_hard is not run here (the costliest simulation): tests/loop/drift_bar_test.sh checks
-# campus_loop_long_hard's increments the same one-sided way.
+# quarter of the simulation time). campus_loop_hard is not run here (the costliest simulation):
+# tests/loop/drift_bar_test.sh checks campus_loop_long_hard's increments the same one-sided way.
 #   tests/loop/keyframe_nees_test.sh SOURCE_DIR BIN_DIR
 set -uo pipefail
 root="$1"; bin="$2"

@@ -463,6 +463,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
     os << "  lidar: columns " << (o.lidar.columns ? std::to_string(o.lidar.columns) : std::string("model default"))
        << ", start azimuth " << o.lidar.start_azimuth_deg << " deg\n";
   if (s.rig.lidar) printLidarEffects(o.lidar_effects, os);
+  if (s.rig.camera && !o.images) os << "  camera: images left out (--no-images); the other channels as with them\n";
   if (s.rig.camera)
     os << "  camera: exposure " << o.camera.exposure_time * 1e3 << " ms +-" << o.camera.exposure_variation * 100
        << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples
