@@ -535,8 +535,10 @@ struct CalibrationRun {
   double dtSigma() const { return std::sqrt(covariance(3, 3)); }
 };
 
-CalibrationRun calibrationRun(const Pose3& T_I_L_true, double dt_true, const Pose3& T_I_L_rig) {
+CalibrationRun calibrationRun(const Pose3& T_I_L_true, double dt_true, const Pose3& T_I_L_rig,
+                              const synth::Trajectory& trajectory = synth::roomTrajectory(1.0)) {
   synth::SequenceSpec spec;
+  spec.traj = trajectory;
   spec.duration = 20.0;
   spec.imu_error = synth::realisticImu();
   spec.lidar.range_noise_std = 0.01;
@@ -609,6 +611,24 @@ TEST(LioEstimator, RecoversAPlantedLidarTimeShiftAndExtrinsicRotation) {
   EXPECT_LT(std::abs(r.dt_error), 0.2 * planted_dt);
   EXPECT_LT(r.rotSigma().maxCoeff(), 0.2 * planted_rot.norm());
   EXPECT_LT(r.dtSigma(), 0.2 * planted_dt);
+}
+
+// The same walk rocked as a car's suspension rocks it (0.3-0.4 deg of roll and pitch at 4.5 Hz, 1.3
+// deg/s...8 deg/s of rate that turns over within a sweep): the body's rate at a sweep's end says little
+// about its rate at the sweep's middle, so moving the whole undistorted sweep by the end's rate
+// times the time shift is the wrong model of a shift. The sweep is undistorted along the IMU's motion
+// at each point's stamp plus the shift in use instead (point_to_plane.hpp). Measured: with the
+// end's rate alone the filter recovered 1.5 of the 4 ms planted (error -2.5 ms, 50 of its sigmas of
+// 0.05 ms); now 0.05 ms off.
+TEST(LioEstimator, RecoversAPlantedLidarTimeShiftWhileTheBodyRocks) {
+  synth::Trajectory rocking = synth::roomTrajectory(1.0);
+  rocking.rot_terms.push_back({Vec3(0.005, 0.007, 0.0), 2.0 * M_PI * 4.5});
+  const double planted_dt = 0.004;
+  const CalibrationRun r = calibrationRun(kCalibrationRig, planted_dt, kCalibrationRig, rocking);
+  EXPECT_GE(r.tracked, r.outputs - 1);
+  EXPECT_LT(r.ate, 0.02);
+  EXPECT_LT(std::abs(r.dt_error), 3.0 * r.dtSigma());
+  EXPECT_LT(std::abs(r.dt_error), 0.2 * planted_dt);
 }
 
 // Given the true calibration and the same prior, the filter keeps it: the estimate stays within its

@@ -95,16 +95,19 @@ struct JacobianCheck {
 // The 13 columns of the Jacobian and the central differences of the residual under x ⊞ d, with d on
 // the pose [0, 6) and on the LiDAR's calibration block; the sweep end is recomputed for every
 // perturbed state (the time shift and the rotation move it).
-JacobianCheck checkJacobian(const PointToPlaneResidual& r, const FilterState& x, const Vec3& body_rate) {
+JacobianCheck checkJacobian(const PointToPlaneResidual& r, const FilterState& x, const Vec3& body_rate,
+                            double undistorted_dt = 0.0) {
   JacobianCheck c;
-  c.analytic = r.jacobian(x, sweepEndPose(x, body_rate), body_rate);
+  c.analytic = r.jacobian(x, sweepEndPose(x, body_rate, undistorted_dt), body_rate);
   const double h = 1e-6;
   for (int k = 0; k < kMeasuredDim; ++k) {
     const int state = k < 6 ? k : FilterState::kLidar + (k - 6);
     StateVector d = StateVector::Zero();
     d[state] = h;
     const FilterState xp = x.boxplus(d), xm = x.boxplus(-d);
-    c.numeric[k] = (r.value(xp, sweepEndPose(xp, body_rate)) - r.value(xm, sweepEndPose(xm, body_rate))) / (2 * h);
+    c.numeric[k] = (r.value(xp, sweepEndPose(xp, body_rate, undistorted_dt)) -
+                    r.value(xm, sweepEndPose(xm, body_rate, undistorted_dt))) /
+                   (2 * h);
   }
   return c;
 }
@@ -135,6 +138,20 @@ TEST(PointToPlane, JacobianMatchesNumericDifferentiationWithoutTimeShift) {
     for (int k = 0; k < kMeasuredDim; ++k)
       EXPECT_NEAR(c.analytic[k], c.numeric[k], 1e-6 * std::max(1.0, std::abs(c.numeric[k]))) << "column " << k;
     // the time shift's column is not trivial here: the point's motion along the plane normal
+    EXPECT_GT(std::abs(c.numeric[12]), 0.1);
+  }
+}
+
+// A sweep undistorted with the time shift the state holds (the filter's shift has settled): the
+// sweep's end is the state's pose, and all 13 columns are exact, the time shift's included.
+TEST(PointToPlane, JacobianIsExactWhereTheSweepWasUndistortedWithTheStatesTimeShift) {
+  const double dt = 0.003;
+  const FilterState x = residualState(dt);
+  const Vec3 body_rate(0.3, -0.5, 1.2);
+  for (const PointToPlaneResidual& r : someResiduals()) {
+    const JacobianCheck c = checkJacobian(r, x, body_rate, dt);
+    for (int k = 0; k < kMeasuredDim; ++k)
+      EXPECT_NEAR(c.analytic[k], c.numeric[k], 1e-6 * std::max(1.0, std::abs(c.numeric[k]))) << "column " << k;
     EXPECT_GT(std::abs(c.numeric[12]), 0.1);
   }
 }

@@ -87,7 +87,7 @@ std::vector<Vec3> undistort(const LidarScan& scan, const SweepMotion& m, bool to
   std::vector<size_t> all(scan.points.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = i;
   std::vector<Vec3> out;
-  und.undistort(scan, scan.utime, all, &out);
+  und.undistort(scan, scan.utime, 0.0, all, &out);
   return out;
 }
 

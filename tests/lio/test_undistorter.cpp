@@ -46,7 +46,7 @@ TEST(Undistorter, SweepWithKnownMotion) {
   std::vector<size_t> all(scan.points.size());
   for (size_t k = 0; k < all.size(); ++k) all[k] = k;
   std::vector<Vec3> body;
-  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), all, &body);
+  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), 0.0, all, &body);
 
   const Pose3 T_end_inv = traj.pose(t1).inverse();
   double max_err = 0.0, max_raw = 0.0;
@@ -61,12 +61,18 @@ TEST(Undistorter, SweepWithKnownMotion) {
   EXPECT_GT(max_raw, 0.1);
   EXPECT_LT(max_err, 1e-3);
 
+  // A LiDAR clock 4 ms behind (the sweep stamped 4 ms before it was taken) with that time shift
+  // given moves every point as the true stamps do: each point along the motion from its own instant.
+  std::vector<Vec3> body_shifted;
+  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6) - 4000, 0.004, all, &body_shifted);
+  for (size_t k = 0; k < all.size(); ++k) ASSERT_LT((body_shifted[k] - body[k]).norm(), 1e-9) << k;
+
   // A whole sweep (which reuses the previous point's IMU segment) moves each point as a single
   // point is moved, in any point order.
   std::vector<size_t> shuffled = all;
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   std::vector<Vec3> body_shuffled;
-  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), shuffled, &body_shuffled);
+  und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), 0.0, shuffled, &body_shuffled);
   for (size_t k = 0; k < shuffled.size(); k += 7) {
     const size_t j = shuffled[k];
     const Vec3 single = und.toEnd(scan.points[j], scan.utime + static_cast<int64_t>(time_offset * 1e6), scan.time_offset[j]);

@@ -475,7 +475,8 @@ void LioEstimator::undistortToSweepEnd(const LidarScan& scan, const FilterState&
   const Pose3 T_I_L = at_end.lidar.pose();
   if (!prop_.segments().empty()) {
     const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, T_I_L);
-    und.undistort(scan, t_first, valid_, &body_);
+    // each point at its stamp plus the LiDAR's time shift in use (the rate changes within a sweep)
+    und.undistort(scan, t_first, at_end.lidar.dt, valid_, &body_);
   } else {
     body_.clear();
     for (size_t j : valid_) body_.push_back(T_I_L * scan.points[j]);
@@ -485,11 +486,13 @@ void LioEstimator::undistortToSweepEnd(const LidarScan& scan, const FilterState&
 
 void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x) {
   // body_ and reg_ hold the points through the calibration of the undistortion, as if taken at the
-  // filter's time; the sweep was seen through x's extrinsic at the state's time plus the time shift
-  // (ScanToMap): A = T_W_I^-1 T_W_I(end) T_I_L(x) T_I_L(undistortion)^-1
-  const bool same = x.lidar.dt == 0.0 && x.lidar.rot == undistorted_with.rot && x.lidar.pos == undistorted_with.pos;
+  // filter's time; the sweep was seen through x's extrinsic at the state's time plus what the time
+  // shift moved beyond the undistortion's (ScanToMap): A = T_W_I^-1 T_W_I(end) T_I_L(x) T_I_L(undistortion)^-1
+  const bool same = x.lidar.dt == undistorted_with.dt && x.lidar.rot == undistorted_with.rot &&
+                    x.lidar.pos == undistorted_with.pos;
   if (same) return;
-  const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate_) * x.lidar.pose() * undistorted_with.pose().inverse();
+  const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate_, undistorted_with.dt) * x.lidar.pose() *
+                  undistorted_with.pose().inverse();
   for (Vec3& p : body_) p = A * p;
   for (Vec3& p : reg_) p = A * p;
 }

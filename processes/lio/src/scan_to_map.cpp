@@ -37,6 +37,7 @@ ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::
       planes_(planes),
       points_(body_points.size()),
       body_rate_(body_rate),
+      undistorted_dt_(undistorted_with.dt),
       opts_(options),
       threads_(threads),
       matches_(body_points.size()),
@@ -63,7 +64,7 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
   const double w = 1.0 / (opts_.point_noise_std * opts_.point_noise_std);
   const double inv_lever = 1.0 / opts_.degeneracy_lever_arm;
   // the body pose at the sweep's true end and the LiDAR's mounting at the iterate
-  const Pose3 sweep_end = sweepEndPose(x, body_rate_);
+  const Pose3 sweep_end = sweepEndPose(x, body_rate_, undistorted_dt_);
   const Mat3 R_WL = sweep_end.linear() * x.lidar.rot;
   const Vec3 t_WL = sweep_end * x.lidar.pos;
   // 1. the points' images, and which of them moved enough to search their neighbours anew

@@ -59,10 +59,10 @@ size_t Undistorter::segmentAt(double t) const {
 
 Vec3 Undistorter::toEndRelative(const Vec3& p_L, double t) const { return moveToEnd(p_L, t, segmentAt(t)); }
 
-void Undistorter::undistort(const LidarScan& scan, int64_t first_utime_imu, const std::vector<size_t>& indices,
-                            std::vector<Vec3>* out) const {
+void Undistorter::undistort(const LidarScan& scan, int64_t first_utime_imu, double time_shift,
+                            const std::vector<size_t>& indices, std::vector<Vec3>* out) const {
   out->resize(indices.size());
-  const double base = static_cast<double>(first_utime_imu - end_utime_) * 1e-6;
+  const double base = static_cast<double>(first_utime_imu - end_utime_) * 1e-6 + time_shift;
   // A sweep's points come (mostly) in time order: the previous point's segment is checked before
   // a binary search (the same segment as segmentAt's).
   size_t seg = 0;

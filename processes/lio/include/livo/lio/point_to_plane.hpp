@@ -1,8 +1,13 @@
 // Point-to-plane residuals (paper eq. 9) with the LiDAR's calibration in the state: a point q of the
 // undistorted sweep in the LiDAR frame, its world image w seen from the body pose of the sweep's
-// true end (the state's time plus the LiDAR's time shift dt: R Exp(ω dt), p + v dt) through the
-// state's extrinsic, and a plane n^T x + d = 0 fitted to its nearest map neighbours:
-//   w = R Exp(ω dt) (R_IL q + t_IL) + p + v dt,   r = n^T w + d.
+// true end through the state's extrinsic, and a plane n^T x + d = 0 fitted to its nearest map
+// neighbours. The sweep was undistorted with the LiDAR's time shift of the prior, dt0: each point
+// moved along the IMU's motion from its stamp plus dt0 into the body frame at the state's time;
+// what the state's dt says beyond that moves the whole sweep with the body's motion at its end:
+//   w = R Exp(ω (dt - dt0)) (R_IL q + t_IL) + p + v (dt - dt0),   r = n^T w + d.
+// (Moving the whole sweep by the end's rate alone, dt0 = 0, is a model of a time shift that holds
+// only while the body's rate is the same over the sweep: a car's suspension rocks it at 1-5 Hz,
+// half a period in a 100 ms sweep, and the shift then estimated was half the true one.)
 #pragma once
 
 #include "livo/esikf_update.hpp"
@@ -23,9 +28,10 @@ struct PlaneFitOptions {
                                       // nearly collinear neighbours of one far ring
 };
 
-/// The body pose of the sweep's true end, R Exp(ω dt) and p + v dt (ω: the body rate, frame I).
-inline Pose3 sweepEndPose(const FilterState& x, const Vec3& body_rate) {
-  const double dt = x.lidar.dt;
+/// The body pose of the sweep's true end, R Exp(ω (dt - dt0)) and p + v (dt - dt0) (ω: the body
+/// rate, frame I; dt0: the time shift the sweep was undistorted with).
+inline Pose3 sweepEndPose(const FilterState& x, const Vec3& body_rate, double undistorted_dt) {
+  const double dt = x.lidar.dt - undistorted_dt;
   return se3::fromRotationTranslation(dt != 0.0 ? Mat3(x.rot * so3::Exp(body_rate * dt)) : x.rot, x.pos + x.vel * dt);
 }
 
@@ -33,7 +39,7 @@ struct PointToPlaneResidual {
   Vec3 q_lidar;  // point in the LiDAR frame at the sweep end
   Plane plane;   // world frame
 
-  /// r at state x; `end` = sweepEndPose(x, body_rate).
+  /// r at state x; `end` = sweepEndPose(x, body_rate, dt0).
   double value(const FilterState& x, const Pose3& end) const {
     return plane.distance(end * (x.lidar.rot * q_lidar + x.lidar.pos));
   }

@@ -55,8 +55,8 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
 class ScanToMap {
  public:
   /// `map` must outlive this object and stay unchanged while it is used; `body_points` were
-  /// undistorted through the LiDAR calibration `undistorted_with` and `body_rate` is the bias-corrected
-  /// angular rate at the sweep end (frame I). With `threads`, the neighbour searches of an iterate
+  /// undistorted through the LiDAR calibration `undistorted_with` (its extrinsic and time shift) and
+  /// `body_rate` is the bias-corrected angular rate at the sweep end (frame I). With `threads`, the neighbour searches of an iterate
   /// are shared among them; the result is the same bit for bit.
   /// `planes` (may be null) answer first where they have a plane; the map's k nearest points
   /// elsewhere.
@@ -93,6 +93,7 @@ class ScanToMap {
   const VoxelPlanes* planes_;
   std::vector<Vec3> points_;          // the points in the LiDAR frame (q above)
   Vec3 body_rate_;
+  double undistorted_dt_;             // the time shift the points were undistorted with
   ScanToMapOptions opts_;
   WorkerThreads* threads_;
   std::vector<Match> matches_;

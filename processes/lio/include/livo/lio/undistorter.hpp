@@ -25,9 +25,11 @@ class Undistorter {
   /// Same with the time relative to the end (t <= 0 inside the sweep).
   Vec3 toEndRelative(const Vec3& p_L, double t_rel_end) const;
 
-  /// Undistorts a whole scan; `first_utime_imu` is scan.utime in the IMU clock.
-  void undistort(const LidarScan& scan, int64_t first_utime_imu, const std::vector<size_t>& indices,
-                 std::vector<Vec3>* out_body) const;
+  /// Undistorts a whole scan; `first_utime_imu` is scan.utime in the IMU clock, and every point was
+  /// taken `time_shift` seconds after its stamp (the LiDAR's estimated time shift): it is moved
+  /// along the motion from that instant to the end.
+  void undistort(const LidarScan& scan, int64_t first_utime_imu, double time_shift,
+                 const std::vector<size_t>& indices, std::vector<Vec3>* out_body) const;
 
  private:
   struct Seg {
