@@ -20,10 +20,19 @@ import argparse, json, sys
 import numpy as np
 
 
+def refuse_non_finite(path, a):
+    """A NaN or infinite value would make every lag's RMS NaN: name its first row instead."""
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        raise SystemExit('imu_gt_lag.py: %s: %d rows with a non-finite value, the first at data row %d'
+                         % (path, int(bad.sum()), int(np.argmax(bad)) + 1))
+
+
 def read_imu(path):
     a = np.loadtxt(path, delimiter=',', comments='#', ndmin=2)
     if a.shape[1] < 4:
         raise SystemExit('imu_gt_lag.py: %s: expected "ns, w_x, w_y, w_z, ..." rows' % path)
+    refuse_non_finite(path, a[:, :4])
     return a[:, 0] * 1e-9, a[:, 1:4]
 
 
@@ -31,6 +40,7 @@ def read_tum(path):
     a = np.loadtxt(path, comments='#', ndmin=2)
     if a.shape[1] != 8:
         raise SystemExit('imu_gt_lag.py: %s: expected TUM rows "t x y z qx qy qz qw"' % path)
+    refuse_non_finite(path, a)
     return a[:, 0], a[:, 4:8]
 
 

@@ -2,7 +2,7 @@
 # scripts/imu_gt_lag.py on EuRoC V1_01 (real ADIS16448 gyro, Vicon-based ground truth): the ground
 # truth shifted by +3 ms and by -2 ms is found 3 ms and 2 ms the other way (within 0.1 ms of the
 # unshifted answer), the unshifted recording is aligned to within 1 ms, the residual at 5 ms off is
-# well above the least, and a file that is not TUM is refused with a message.
+# well above the least, and a file that is not TUM or has a NaN row is refused with a message.
 set -uo pipefail
 root="$1"; data="$2"
 dir=$(mktemp -d /tmp/livo-imu-gt-lag.XXXXXX)
@@ -28,4 +28,7 @@ PY
 printf '1 2 3\n4 5 6\n' > "$dir/bad.tum"
 if /usr/bin/python3 "$root/scripts/imu_gt_lag.py" --imu "$imu" --gt "$dir/bad.tum" > "$dir/bad.txt" 2>&1; then fail "a 3-column ground truth was accepted"; fi
 grep -q "expected TUM rows" "$dir/bad.txt" || fail "no clear error for a bad file: $(cat "$dir/bad.txt")"
+awk '!/^#/ && ++n == 100 { $5 = "nan" } !/^#/ { print }' "$gt" > "$dir/nan.tum"
+if /usr/bin/python3 "$root/scripts/imu_gt_lag.py" --imu "$imu" --gt "$dir/nan.tum" > "$dir/nan.txt" 2>&1; then fail "a NaN quaternion was accepted"; fi
+grep -q "non-finite value, the first at data row 100" "$dir/nan.txt" || fail "no clear error for a NaN row: $(cat "$dir/nan.txt")"
 echo "imu_gt_lag_test: passed"
