@@ -402,6 +402,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
   const std::vector<size_t>& valid = valid_;
   res.num_points = static_cast<int>(valid.size());
   undistortToSweepEnd(scan, x, t_first, t_end);
+  const SensorCalibration undistorted_with = x.lidar;  // the wheel update below may move it
   const std::vector<Vec3>& body = body_;
 
   // 3. registration subset: stride, then voxel downsampling
@@ -416,9 +417,8 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
 
   // 5. LiDAR update or map seeding
   reseedAfterOutage(t_end, &x, &P, note);
-  const SensorCalibration undistorted_with = x.lidar;
   body_rate_ = prop_.angularVelocity(prop_.lastSample().gyro, x);
-  res.status = lidarStage(reg, valid.size(), &x, &P, &res);
+  res.status = lidarStage(reg, valid.size(), undistorted_with, &x, &P, &res);
   toBodyAtSweepEnd(undistorted_with, x);
   noteRegistration(res.status, x, t_end);
   prop_.applyUpdate(x, P);
@@ -550,8 +550,9 @@ void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, StateCovaria
   appendNote(note, "no registration for " + formatSignificant(lost_s) + " s: map re-seeded at the predicted pose");
 }
 
-ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, StateCovariance* P,
-                                            ScanResult* res) {
+ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid,
+                                            const SensorCalibration& undistorted_with, FilterState* x,
+                                            StateCovariance* P, ScanResult* res) {
   std::string* note = &res->message;
   ScanResult::Status status;
   if (map_.empty()) {
@@ -565,7 +566,7 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
     status = ScanResult::Status::kPredicted;
     appendNote(note, "too few valid points (" + std::to_string(num_valid) + "): prediction only");
   } else {
-    status = registerSweep(reg, x, P, res);
+    status = registerSweep(reg, undistorted_with, x, P, res);
   }
   gap_bridged_ = false;
   gap_undo_rot_.setIdentity();
@@ -574,10 +575,11 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
   return status;
 }
 
-ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P,
-                                               ScanResult* res) {
+ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg,
+                                               const SensorCalibration& undistorted_with, FilterState* x,
+                                               StateCovariance* P, ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
+  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate_);
   FilterState post;
   StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
@@ -594,7 +596,7 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, Fil
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), x->lidar, body_rate_);
+    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate_);
     FilterState post_still;
     StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(

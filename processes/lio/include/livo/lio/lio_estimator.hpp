@@ -185,11 +185,13 @@ class LioEstimator {
   bool wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel, std::string* note);
   /// After reseed_after_s without a registration: drops the map (seeded anew at the prediction).
   void reseedAfterOutage(int64_t t_end, FilterState* x, StateCovariance* P, std::string* note);
-  /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis.
-  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, FilterState* x, StateCovariance* P,
-                                ScanResult* res);
+  /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis. `reg` was
+  /// undistorted through `undistorted_with` (the LiDAR's calibration before any update of this sweep).
+  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, const SensorCalibration& undistorted_with,
+                                FilterState* x, StateCovariance* P, ScanResult* res);
   /// The iterated point-to-plane update (and the no-time-passed hypothesis after a bridged gap).
-  ScanResult::Status registerSweep(const std::vector<Vec3>& reg, FilterState* x, StateCovariance* P, ScanResult* res);
+  ScanResult::Status registerSweep(const std::vector<Vec3>& reg, const SensorCalibration& undistorted_with,
+                                   FilterState* x, StateCovariance* P, ScanResult* res);
   /// Remembers the last registration (re-seeding, velocity after IMU gaps).
   void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
   /// The calibration the filter holds at the rig's values, with the rig's stated uncertainty.
