@@ -2,9 +2,17 @@
 """Checks a run's loops.json against the log's GROUND_TRUTH (pure Python, no LCM bindings).
 
     tests/loop/check_loops.py --log SIM.lcmlog --loops RUN/loops.json [--max-trans 0.5] [--max-rot-deg 2]
+                              [--odometry TUM]
 
 A loop is false if its T_to_from disagrees with the ground-truth relative body pose of the two
 keyframes (interpolated at their stamps) by more than the bounds. Exit status 1 if any is false.
+--odometry (an odometry.tum, e.g. of the LIO alone on the same log) adds a line per loop: the loop's
+error against the truth as the right perturbation its `information` is for ([rotation in deg;
+translation in m in the newer keyframe's frame], T_true = T_loop (R Exp(phi), t + R tau)), the NEES
+of that error with the loop's information (chi-square with 6 degrees of freedom if it is honest),
+and the odometry's error of the same relative pose taken the same way: where the two errors are
+alike the odometry and the loop share the error (a held calibration's, say) and the loop cannot
+mend it; where they differ, the smaller says which of the two a correction should believe.
 """
 import argparse, bisect, json, math, struct, sys
 
@@ -111,13 +119,50 @@ def revisit_drift(traj, gt, times, radius=10.0, min_path=100.0):
     return math.dist(est, true)
 
 
+def qmat(q):
+    w, x, y, z = q
+    return [[1 - 2*(y*y + z*z), 2*(x*y - w*z), 2*(x*z + w*y)],
+            [2*(x*y + w*z), 1 - 2*(x*x + z*z), 2*(y*z - w*x)],
+            [2*(x*z - w*y), 2*(y*z + w*x), 1 - 2*(x*x + y*y)]]
+
+
+def log_q(q):
+    """The rotation vector (rad) of a unit quaternion w, x, y, z."""
+    w, v = q[0], q[1:]
+    if w < 0:
+        w, v = -w, tuple(-x for x in v)
+    n = math.sqrt(sum(x*x for x in v))
+    if n < 1e-12:
+        return (2*v[0], 2*v[1], 2*v[2])
+    a = 2*math.atan2(n, w)
+    return tuple(a*x/n for x in v)
+
+
+def right_error(q_est, t_est, q_true, t_true):
+    """xi = [phi; tau] with T_true = (R_est Exp(phi), t_est + R_est tau)."""
+    phi = log_q(qmul(qconj(q_est), q_true))
+    tau = qrot(qconj(q_est), tuple(t_true[i] - t_est[i] for i in range(3)))
+    return list(phi) + list(tau)
+
+
+def relative(tr, times, t_to, t_from):
+    """T_to_from = T_W_to^-1 T_W_from of a trajectory at two stamps: (q, t)."""
+    pf, qf, _ = interp(tr, times, t_from)
+    pt, qt, _ = interp(tr, times, t_to)
+    return qmul(qconj(qt), qf), qrot(qconj(qt), tuple(pf[i] - pt[i] for i in range(3)))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--log", required=True)
     ap.add_argument("--loops", required=True)
     ap.add_argument("--max-trans", type=float, default=0.5)
     ap.add_argument("--max-rot-deg", type=float, default=2.0)
+    ap.add_argument("--odometry", help="odometry.tum: its error of each loop's relative pose, beside the loop's")
     a = ap.parse_args()
+    odo = read_tum(a.odometry) if a.odometry else None
+    odo_times = [o[0] for o in odo] if odo else None
+    nees = []
     gt = read_ground_truth(a.log)
     times = [g[0] for g in gt]
     loops = json.load(open(a.loops))
@@ -139,6 +184,20 @@ def main():
         print("%5d -> %5d  t %.1f -> %.1f  gt |t| %.2f m  err %.3f m %.3f deg  inl %d fit %.3f ov %.2f %s" % (
             l["from_id"], l["to_id"], l["from_time"], l["to_time"], math.sqrt(sum(x*x for x in ttf)), tr, rot,
             l["coarse_inliers"], l["fitness"], l["overlap"], "FALSE" if bad else "ok"))
+        if odo:
+            xi = right_error(qe, te, qtf, ttf)
+            info = l["information"]
+            n = sum(xi[i] * info[6*i + j] * xi[j] for i in range(6) for j in range(6))
+            nees.append(n)
+            qo, to = relative(odo, odo_times, l["to_time"], l["from_time"])
+            xo = right_error(qo, to, qtf, ttf)
+            fmt = lambda x: "rot [%s] deg  trans [%s] m" % (" ".join("%6.3f" % math.degrees(v) for v in x[:3]),
+                                                            " ".join("%7.4f" % v for v in x[3:]))
+            print("        loop %s  NEES %.1f%s\n        odom %s" % (
+                fmt(xi), n, "  (corrected)" if l.get("corrected") else "", fmt(xo)))
+    if nees:
+        print("loops' NEES against the truth: mean %.1f, median %.1f (6 for an honest information)" % (
+            sum(nees) / len(nees), sorted(nees)[len(nees) // 2]))
     print("false loops: %d of %d" % (false, len(loops["loops"])))
     return 1 if false else 0
 
