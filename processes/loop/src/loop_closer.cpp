@@ -377,10 +377,13 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
 
 std::optional<Mat6> LoopCloser::accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) const {
   // the odometry's covariance of the increment, if it came with one from the previous keyframe
+  // (without its held-calibration part unless compose_held_calibration)
+  const Mat6 increment = options_.compose_held_calibration
+                             ? input.relative_covariance
+                             : Mat6(input.relative_covariance - input.relative_covariance_held_calibration);
   std::optional<Mat6> given;
-  if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id &&
-      isCovariance(input.relative_covariance))
-    given = options_.odometry_covariance_scale * input.relative_covariance;
+  if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id && isCovariance(increment))
+    given = options_.odometry_covariance_scale * increment;
   const Mat6 cov = given ? *given : driftCovariance(step.translation().norm(), driftModel());
   const Mat6 Ad = se3::adjoint(kf->odometry);
   const Mat6 W = newest_.cumulative_covariance + Ad * cov * Ad.transpose();

@@ -58,6 +58,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   if (!(c.gravity_prior_sigma >= 0)) throw ConfigError(s.where("gravity_prior_sigma") + ": must be >= 0 (0: off)");
   s.readOptional("odometry_covariance_from_filter", c.odometry_covariance_from_filter);
   s.readOptional("odometry_covariance_scale", c.odometry_covariance_scale);
+  s.readOptional("compose_held_calibration", c.compose_held_calibration);
   if (!(c.odometry_covariance_scale > 0)) throw ConfigError(s.where("odometry_covariance_scale") + ": must be > 0");
   s.readOptional("merge_distance", c.merge_distance);
   s.checkAllUsed();
@@ -100,7 +101,7 @@ void printOptions(const LoopNodeOptions& o, std::ostream& os) {
      << "; odometry edges weighted by "
      << (c.odometry_covariance_from_filter ? "the odometry's increment covariances (the drift model where none)"
                                            : "the drift model")
-     << "\n";
+     << (c.compose_held_calibration ? "" : " without their held-calibration part") << "\n";
 }
 
 }  // namespace livo::loop

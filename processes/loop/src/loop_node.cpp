@@ -51,6 +51,7 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   in.covariance = matrixFrom<6>(m.pose_covariance);
   in.relative_to_id = m.relative_to_id;
   in.relative_covariance = matrixFrom<6>(m.relative_covariance);
+  in.relative_covariance_held_calibration = matrixFrom<6>(m.relative_covariance_held_calibration);
   in.cloud.reserve(c.x.size());
   size_t non_finite = 0;
   for (size_t i = 0; i < c.x.size(); ++i) {

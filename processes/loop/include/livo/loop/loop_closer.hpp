@@ -52,6 +52,13 @@ struct LoopCloserOptions {
   bool odometry_covariance_from_filter = true;
   /// The increments' covariances are used times this (1: as the odometry states them).
   double odometry_covariance_scale = 1.0;
+  /// Whether the increments' held-calibration part (keyframe_t.relative_covariance_held_calibration)
+  /// is composed with the rest. It is one error for the whole run, not one per increment: the
+  /// LiDAR mount's telescopes over a chain ((Ad(T_ab^-1) - I) Ad(X) c for the whole span) and is
+  /// the same in a loop's registration, so summing it increment by increment as independent
+  /// noise grows without bound what stays bounded (README, "The odometry edges"). false (the
+  /// default): the filter's part alone.
+  bool compose_held_calibration = false;
   // The drift model: odometry edge noise added to the relative covariance of the keyframes'
   // absolute ones (which, from a filter with a map, barely grow and say little about the
   // increment): a floor plus a part proportional to the distance travelled, the usual drift model
@@ -132,6 +139,9 @@ struct KeyframeInput {
   /// keyframe of the epoch and positive definite; otherwise the drift model stands in.
   int64_t relative_to_id = -1;
   Mat6 relative_covariance = Mat6::Zero();
+  /// The part of relative_covariance the odometry's held calibration adds (keyframe_t; zero where
+  /// nothing is held).
+  Mat6 relative_covariance_held_calibration = Mat6::Zero();
   Points cloud;                      // body frame I
 };
 
