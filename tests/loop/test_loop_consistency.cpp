@@ -312,7 +312,9 @@ TEST(LoopConsistency, TheHeldCalibrationIsNotComposedAsNoisePerIncrement) {
   const Points scene = makeScene(41, 0.15);
   const DriftingLaps laps(2 * DriftingLaps::kPerLap + 6);
   // the filter's part and the held part of every increment (standard deviations per axis: rad, m)
-  const auto run = [&](const std::vector<Pose3>& odometry, Vec2 filter, Vec2 held, bool compose, double offset) {
+  // (corrupt_held: the held part as sent is not finite, the whole as above)
+  const auto run = [&](const std::vector<Pose3>& odometry, Vec2 filter, Vec2 held, bool compose, double offset,
+                       bool corrupt_held = false) {
     LoopCloserOptions o;
     o.merge_distance = 0.0;
     o.compose_held_calibration = compose;
@@ -333,6 +335,7 @@ TEST(LoopConsistency, TheHeldCalibrationIsNotComposedAsNoisePerIncrement) {
       in.relative_covariance = in.relative_covariance_held_calibration;
       in.relative_covariance.diagonal() +=
           (Vec6() << Vec3::Constant(filter(0) * filter(0)), Vec3::Constant(filter(1) * filter(1))).finished();
+      if (corrupt_held) in.relative_covariance_held_calibration(0, 0) = std::nan("");
       closer->addKeyframe(in);
     }
     return closer;
@@ -356,6 +359,17 @@ TEST(LoopConsistency, TheHeldCalibrationIsNotComposedAsNoisePerIncrement) {
   EXPECT_GE(corrections(*composed), 1u);  // the control: composed, the held part lets the loops pull
   EXPECT_EQ(corrections(*filter_part), 0u);
   EXPECT_LT(worstAgainst(*filter_part, laps.truth), 0.02);
+  EXPECT_EQ(filter_part->unusableHeldParts(), 0);
+
+  // a held part that is not finite: the whole covariance is composed (as if compose_held_calibration),
+  // not the drift model, and the closer counts the increments
+  const auto corrupt = run(laps.truth, sure, held, false, 0.04, true);
+  EXPECT_EQ(corrupt->unusableHeldParts(), static_cast<int64_t>(laps.truth.size()) - 1);
+  ASSERT_EQ(pairs(*corrupt), pairs(*composed));
+  EXPECT_EQ(corrections(*corrupt), corrections(*composed));
+  for (size_t k = 0; k < corrupt->loops().size(); ++k)
+    EXPECT_EQ(corrupt->loops()[k].odometry_covariance, composed->loops()[k].odometry_covariance);
+  composed->forEachPose([&](int64_t id, const Pose3& T) { EXPECT_EQ(corrupt->pose(id).matrix(), T.matrix()); });
 
   // the drifting odometry (3e-4 rad and 7 mm off per increment) saying so in its filter's part,
   // with the loops as registered

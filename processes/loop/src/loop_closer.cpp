@@ -375,15 +375,18 @@ std::optional<Correction> LoopCloser::addLoopEdge(const PoseEdge* edge, int64_t 
   return c;
 }
 
-std::optional<Mat6> LoopCloser::accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) const {
+std::optional<Mat6> LoopCloser::accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) {
   // the odometry's covariance of the increment, if it came with one from the previous keyframe
-  // (without its held-calibration part unless compose_held_calibration)
-  const Mat6 increment = options_.compose_held_calibration
-                             ? input.relative_covariance
-                             : Mat6(input.relative_covariance - input.relative_covariance_held_calibration);
+  // (without its held-calibration part unless compose_held_calibration; whole if that part leaves
+  // no covariance, rather than none and the drift model)
+  const Mat6 filter_part = input.relative_covariance - input.relative_covariance_held_calibration;
+  const bool whole = options_.compose_held_calibration || !isCovariance(filter_part);
+  const Mat6& increment = whole ? input.relative_covariance : filter_part;
   std::optional<Mat6> given;
-  if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id && isCovariance(increment))
+  if (options_.odometry_covariance_from_filter && input.relative_to_id == newest_.id && isCovariance(increment)) {
     given = options_.odometry_covariance_scale * increment;
+    unusable_held_parts_ += whole && !options_.compose_held_calibration;
+  }
   const Mat6 cov = given ? *given : driftCovariance(step.translation().norm(), driftModel());
   const Mat6 Ad = se3::adjoint(kf->odometry);
   const Mat6 W = newest_.cumulative_covariance + Ad * cov * Ad.transpose();

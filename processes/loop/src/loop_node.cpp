@@ -63,7 +63,12 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
     node_.warn("keyframe " + std::to_string(m.id) + ": dropped " + std::to_string(non_finite) + " non-finite points");
   if (in.cloud.empty())
     node_.warn("keyframe " + std::to_string(m.id) + " has no points: kept in the graph, not used for loops");
+  const int64_t unusable_held_parts = closer_.unusableHeldParts();
   const AddResult r = closer_.addKeyframe(in);
+  if (unusable_held_parts == 0 && closer_.unusableHeldParts() > 0)
+    node_.warn("keyframe " + std::to_string(m.id) +
+               ": the held-calibration part of the increment's covariance is not finite or larger than the whole; "
+               "the whole is composed for such increments (said once; counted in the summary)");
   for (const LoopRegistrationResult& a : r.attempts) {
     if (a.fine.iterations == 0) continue;  // stopped at the coarse stage
     std::ostringstream s;
@@ -119,9 +124,14 @@ std::string LoopNode::summary() const {
   const ReasonCounts& rejected = closer_.rejectedRegistrations();
   std::string registered = std::to_string(closer_.registrations()) + " candidates registered";
   if (!rejected.empty()) registered += " (" + rejected.summary(std::to_string(rejected.total()) + " rejected") + ")";
-  return registered + ", " + std::to_string(closer_.loops().size()) + " loops, " + std::to_string(closer_.corrections()) +
-         " corrections, " + std::to_string(refused) + " refused as inconsistent (" + std::to_string(by_odometry) +
-         " with the odometry, " + std::to_string(refused - by_odometry) + " with an earlier loop)";
+  std::string out = registered + ", " + std::to_string(closer_.loops().size()) + " loops, " +
+                    std::to_string(closer_.corrections()) + " corrections, " + std::to_string(refused) +
+                    " refused as inconsistent (" + std::to_string(by_odometry) + " with the odometry, " +
+                    std::to_string(refused - by_odometry) + " with an earlier loop)";
+  if (closer_.unusableHeldParts() > 0)
+    out += ", " + std::to_string(closer_.unusableHeldParts()) +
+           " increments composed with their held-calibration part (it was unusable)";
+  return out;
 }
 
 void LoopNode::writeOutputs() {

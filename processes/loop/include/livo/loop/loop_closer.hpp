@@ -57,7 +57,8 @@ struct LoopCloserOptions {
   /// LiDAR mount's telescopes over a chain ((Ad(T_ab^-1) - I) Ad(X) c for the whole span) and is
   /// the same in a loop's registration, so summing it increment by increment as independent
   /// noise grows without bound what stays bounded (README, "The odometry edges"). false (the
-  /// default): the filter's part alone.
+  /// default): the filter's part alone, or the whole covariance for an increment whose held part
+  /// leaves none (not finite, or larger than the whole; counted in unusableHeldParts()).
   bool compose_held_calibration = false;
   // The drift model: odometry edge noise added to the relative covariance of the keyframes'
   // absolute ones (which, from a filter with a map, barely grow and say little about the
@@ -237,6 +238,9 @@ class LoopCloser {
   /// registration rejected, by the test that did (LoopRegistrationResult::rejected_by).
   int64_t registrations() const { return registrations_; }
   const ReasonCounts& rejectedRegistrations() const { return rejected_registrations_; }
+  /// Increments whose held-calibration part could not be taken out of their covariance (it left
+  /// no covariance): composed whole instead (compose_held_calibration false).
+  int64_t unusableHeldParts() const { return unusable_held_parts_; }
   /// Accepted loops that were optimised and published as a correction.
   size_t corrections() const { return static_cast<size_t>(next_correction_id_ - 1); }
   int64_t utime(int64_t id) const { return placement(id).utime; }
@@ -352,7 +356,7 @@ class LoopCloser {
   /// The increment `step` from the newest keyframe to kf: kf's cumulative covariance from the
   /// newest one's, and the increment's covariance if the input gave a usable one (else nullopt;
   /// the drift model stands in for the cumulative sum).
-  std::optional<Mat6> accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf) const;
+  std::optional<Mat6> accumulateIncrement(const KeyframeInput& input, const Pose3& step, Keyframe* kf);
   /// The odometry's covariance of T_a^-1 T_b (right perturbation) for two keyframes of an epoch,
   /// if every increment between them came with one (odometry_covariance_from_filter).
   std::optional<Mat6> odometryBetween(const Keyframe& a, const Keyframe& b) const;
@@ -393,6 +397,7 @@ class LoopCloser {
   std::vector<LoopAnchor> anchors_;    // parallel to loops_
   std::vector<RefusedLoop> refused_;
   int64_t registrations_ = 0;
+  int64_t unusable_held_parts_ = 0;
   ReasonCounts rejected_registrations_;
   int64_t keyframes_since_loop_ = 1000000;
   CorrectionTable published_;  // the corrections this closer published (T_Ck_O), per epoch
