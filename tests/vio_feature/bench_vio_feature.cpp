@@ -5,9 +5,9 @@
 // core), with the true rotation as the hint (range(0) = 1) or without (0); the counters give the
 // median, p90 and max per image and the tracks carried over per image.
 //
-// BM_VisualSubsystemPerImage: the whole visual subsystem per image, front end and back end, as
-// VioFeatureNode::process runs them (the gyro's rotation hint, FeatureTracker::track, the depth
-// image's depths when there is one, FrameFeatures, SlidingWindowEstimator::addFrame), with the
+// BM_VisualSubsystemPerImage: the whole visual subsystem per image, front end and back end:
+// VioFeatureEstimator::addImage as the node runs it (the gyro's rotation hint, FeatureTracker::track,
+// the depth image's depths when there is one, FrameFeatures, SlidingWindowEstimator::addFrame), with the
 // trajectory's exact IMU at 200 Hz (gyro = angular velocity, accel = R^T (a + g)) fed to the
 // estimator up to each image first; no LiDAR, no wheels. Images are rendered at 20 Hz (640x480)
 // from a sim config: t = 0.05..5 s warm up (the start at rest initialises the estimator, the walk
@@ -31,10 +31,12 @@
 #include <vector>
 
 #include "livo/config.hpp"
+#include "livo/time.hpp"
 #include "livo/vio_feature/feature_depth.hpp"
 #include "livo/vio_feature/feature_tracker.hpp"
 #include "livo/vio_feature/sliding_window_estimator.hpp"
 #include "livo/vio_feature/vio_feature_config.hpp"
+#include "livo/vio_feature/vio_feature_estimator.hpp"
 #include "rendered_sequence.hpp"
 
 using namespace livo;
@@ -128,10 +130,10 @@ const Subsystem& subsystem(int which) {
   out->config = configs[which];
   out->sequence = std::make_unique<livo_test::RenderedSequence>(out->config);
   out->options = vio_feature::readVioFeatureNodeOptions(Config::load(std::string(LIVO_SOURCE_DIR) + "/" + out->config));
-  out->options.use_lidar_depth = false;  // no LIO here
-  out->options.window.use_wheel = false; // IMU and camera only
+  out->options.core.use_lidar_depth = false;  // no LIO here
+  out->options.core.window.use_wheel = false; // IMU and camera only
   const bool depth = which == 2;
-  out->options.use_depth_image = depth;
+  out->options.core.use_depth_image = depth;
   int imu_k = 0;
   const int n = static_cast<int>(std::lround(kWarmUpEnd / kImageDt)) + kTimedImages;
   for (int k = 1; k <= n; ++k) {
@@ -153,48 +155,18 @@ const Subsystem& subsystem(int which) {
   return *cache[which];
 }
 
-/// VioFeatureNode::process without the node: one image through the front end and the back end.
-class VisualSubsystem {
- public:
-  explicit VisualSubsystem(const vio_feature::VioFeatureNodeOptions& o)
-      : opts_(o), estimator_(o.window), tracker_(CameraProjection(o.camera), o.tracker),
-        offset_us_(std::llround(o.window.camera_time_offset_s * 1e6)) {}
-
-  void addImu(const std::vector<ImuSample>& samples) {
-    for (const ImuSample& s : samples) estimator_.addImu(s);
-  }
-  /// `utime`: the image's time on the IMU clock (its stamp is that less the rig's camera time
-  /// offset); `depth` may be null.
-  FrameResult process(int64_t utime, const cv::Mat& grey, const cv::Mat* depth) {
-    const int64_t t = utime;
-    const int64_t stamp = utime - offset_us_;
-    Mat3 R_I;
-    const bool hint = last_t_ != INT64_MIN && estimator_.gyroRotation(last_t_, t, &R_I);
-    const Mat3 R_IC = opts_.window.T_I_C.linear();
-    const Mat3 R_cur_prev = R_IC.transpose() * R_I.transpose() * R_IC;
-    last_t_ = t;
-    TrackedFrame tracked = tracker_.track(stamp, grey, hint ? &R_cur_prev : nullptr);
-    if (depth) depthFromImage(*depth, opts_.depth_image, &tracked.features);
-    FrameFeatures frame;
-    frame.utime = stamp;
-    frame.keyframe = tracked.keyframe;
-    frame.features.reserve(tracked.features.size());
-    for (const FeatureObservation& f : tracked.features) frame.features.push_back({f.id, f.xy, f.depth});
-    const bool was_initialized = estimator_.initialized();
-    FrameResult r = estimator_.addFrame(frame);
-    if (was_initialized && !estimator_.initialized()) tracker_.reset(), ++restarts_;
-    return r;
-  }
-  int restarts() const { return restarts_; }
-
- private:
-  vio_feature::VioFeatureNodeOptions opts_;
-  SlidingWindowEstimator estimator_;
-  FeatureTracker tracker_;
-  int64_t offset_us_ = 0;
-  int64_t last_t_ = INT64_MIN;
-  int restarts_ = 0;
-};
+/// One image through the front end and the back end (VioFeatureNode::process without the node).
+/// `utime`: the image's time on the IMU clock (its stamp is that less the rig's camera time offset);
+/// `depth` may be null.
+FrameResult processImage(vio_feature::VioFeatureEstimator* vs, const std::vector<ImuSample>& imu, int64_t utime,
+                         const cv::Mat& grey, const cv::Mat* depth) {
+  for (const ImuSample& s : imu) vs->addImu(s);
+  vio_feature::ImageInput in;
+  in.utime = utime - toUtime(vs->options().window.camera_time_offset_s);
+  in.grey = grey;
+  in.depth = depth;
+  return vs->addImage(in).frame;
+}
 
 double wallSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -204,12 +176,12 @@ void BM_VisualSubsystemPerImage(benchmark::State& state) {
   const Subsystem& sub = subsystem(static_cast<int>(state.range(0)));
   const livo_test::RenderedSequence& seq = *sub.sequence;
   const bool depth = !sub.depths.empty();
-  VisualSubsystem vs(sub.options);
+  vio_feature::VioFeatureEstimator vs(sub.options.core);
   const size_t warm = sub.times.size() - kTimedImages;
   int tracked_in_warm_up = 0;
   for (size_t k = 0; k < warm; ++k) {
-    vs.addImu(sub.imu[k]);
-    const FrameResult r = vs.process(seq.utime(sub.times[k]), sub.images[k], depth ? &sub.depths[k] : nullptr);
+    const FrameResult r =
+        processImage(&vs, sub.imu[k], seq.utime(sub.times[k]), sub.images[k], depth ? &sub.depths[k] : nullptr);
     tracked_in_warm_up += r.status == FrameResult::Status::kTracked;
   }
   if (tracked_in_warm_up < 20) {
@@ -222,8 +194,8 @@ void BM_VisualSubsystemPerImage(benchmark::State& state) {
   size_t k = warm;
   for (auto _ : state) {
     const double c0 = cpuSeconds(), w0 = wallSeconds();
-    vs.addImu(sub.imu[k]);
-    const FrameResult r = vs.process(seq.utime(sub.times[k]), sub.images[k], depth ? &sub.depths[k] : nullptr);
+    const FrameResult r =
+        processImage(&vs, sub.imu[k], seq.utime(sub.times[k]), sub.images[k], depth ? &sub.depths[k] : nullptr);
     const double dc = cpuSeconds() - c0, dw = wallSeconds() - w0;
     state.SetIterationTime(dc);
     cpu_ms.push_back(dc * 1e3);
@@ -243,7 +215,7 @@ void BM_VisualSubsystemPerImage(benchmark::State& state) {
   state.counters["in_graph"] = in_graph / n;
   state.counters["with_depth"] = with_depth / n;
   state.counters["not_tracked"] = not_tracked;
-  state.counters["restarts"] = vs.restarts();
+  state.counters["restarts"] = vs.epoch();
   state.SetLabel(sub.config);
 }
 BENCHMARK(BM_VisualSubsystemPerImage)->Arg(0)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)

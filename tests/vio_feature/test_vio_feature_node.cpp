@@ -83,7 +83,7 @@ Outputs runNode(std::vector<Message> messages, const VioFeatureNodeOptions& opti
 VioFeatureNodeOptions roomOptions() {
   VioFeatureNodeOptions o =
       readVioFeatureNodeOptions(Config::load(std::string(LIVO_SOURCE_DIR) + "/config/sim/room.yaml"));
-  o.use_lidar_depth = false;  // no LIO here
+  o.core.use_lidar_depth = false;  // no LIO here
   return o;
 }
 
@@ -157,10 +157,10 @@ TEST(VioFeatureNode, RefusesBadImagesAndMalformedMessagesAndGoesOn) {
 TEST(VioFeatureNode, ReadsTheRigAndAStrictSection) {
   const std::string base = std::string(LIVO_SOURCE_DIR) + "/config/sim/bridge_deck.yaml";
   const VioFeatureNodeOptions o = readVioFeatureNodeOptions(Config::load(base));
-  EXPECT_TRUE(o.window.use_wheel);
-  EXPECT_TRUE(o.use_lidar_depth);
-  EXPECT_TRUE(o.use_depth_image);
-  EXPECT_GT(o.window.focal, 100.0);
+  EXPECT_TRUE(o.core.window.use_wheel);
+  EXPECT_TRUE(o.core.use_lidar_depth);
+  EXPECT_TRUE(o.core.use_depth_image);
+  EXPECT_GT(o.core.window.focal, 100.0);
   Config c = Config::load(base);
   EXPECT_THROW(readVioFeatureNodeOptions(Config::fromString(R"(
 rig:

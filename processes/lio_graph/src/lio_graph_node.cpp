@@ -3,39 +3,12 @@
 #include <chrono>
 #include <sstream>
 
-#include "livo/keyframe_t.hpp"
+#include "livo/lio_graph/lio_graph_messages.hpp"
 #include "livo/loop_correction_message.hpp"
-#include "livo/messages.hpp"
-#include "livo/odometry_t.hpp"
-#include "livo/output_messages.hpp"
-#include "livo/registered_scan_t.hpp"
 #include "livo/sensor_messages.hpp"
 #include "livo/time.hpp"
 
 namespace livo::lio_graph {
-
-namespace {
-
-odometry_t toOdometry(const GraphScanResult& r, const OdometryFrame& frame) {
-  odometry_t o;
-  o.utime = r.utime;
-  o.parent_frame = "W";
-  o.child_frame = "I";
-  poseTo(r.pose, o.position, o.orientation);
-  vec3To(r.velocity, o.velocity);
-  vec3To(r.angular_velocity, o.angular_velocity);
-  matrixTo<6>(r.pose_covariance, o.pose_covariance);
-  matrixTo<3>(Mat3(Mat3::Identity() * 1e-2), o.velocity_covariance);
-  // a predicted sweep used none: its matching, if any, was not taken
-  o.num_residuals = r.status == GraphScanResult::Status::kPredicted ? 0 : r.edge_residuals + r.surface_residuals;
-  o.degenerate = r.degenerate ? 1 : 0;
-  o.min_information_eigenvalue = 0.0;
-  o.epoch = frame.epoch;
-  o.correction_id = frame.correction_id;
-  return o;
-}
-
-}  // namespace
 
 LioGraphNode::LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNodeOptions options)
     : node_(lcm, std::move(node_options)), opts_(std::move(options)), estimator_(opts_.core) {
@@ -53,12 +26,8 @@ LioGraphNode::LioGraphNode(lcm::LCM& lcm, NodeOptions node_options, LioGraphNode
 }
 
 void LioGraphNode::onVisualState(const visual_state_t& m) {
-  VisualSample s;
-  s.utime = m.utime;
-  s.pose = poseFrom(m.position, m.orientation);
-  s.epoch = m.epoch;
   std::string why;
-  if (!estimator_.addVisualState(s, &why)) {
+  if (!estimator_.addVisualState(toVisualSample(m), &why)) {
     node_.reject(opts_.visual_state_channel, why);
     return;
   }
@@ -162,14 +131,10 @@ void LioGraphNode::process(const PendingSweep& p) {
   visual_ += r.visual_motion;
   visual_factors_ += r.visual_factor;
   if (!r.message.empty()) node_.info(r.message);
-  const OutputFrame frame{estimator_.frame().epoch, estimator_.frame().correction_id};
-  node_.publish(opts_.odometry_channel, toOdometry(r, estimator_.frame()));
-  node_.publish(opts_.registered_scan_channel,
-                registeredScanMessage(r.utime, r.sweep_start_utime, r.pose, r.world_points, r.input_index, p.msg, frame));
-  if (r.is_keyframe)
-    node_.publish(opts_.keyframe_channel,
-                  keyframeMessage(r.keyframe.id, r.keyframe.utime, r.keyframe.pose, r.keyframe.pose_covariance,
-                                  KeyframeIncrement{}, r.keyframe.cloud, r.keyframe.intensity, p.msg.num_rings, frame));
+  const OdometryFrame& frame = estimator_.frame();
+  node_.publish(opts_.odometry_channel, toOdometry(r, frame));
+  node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, frame));
+  if (r.is_keyframe) node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, frame));
 }
 
 std::string LioGraphNode::summary() const {

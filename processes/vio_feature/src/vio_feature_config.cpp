@@ -6,10 +6,11 @@ namespace livo::vio_feature {
 
 VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   VioFeatureNodeOptions n;
-  SlidingWindowOptions& w = n.window;
+  VioFeatureOptions& core = n.core;
+  SlidingWindowOptions& w = core.window;
   const SensorRig rig = readSensorRig(root.section("rig"));
   if (!rig.camera) throw ConfigError(root.where("rig") + ": livo-vio-feature needs a rig.camera");
-  n.camera = *rig.camera;
+  core.camera = *rig.camera;
   n.imu_channel = rig.channels.imu;
   n.camera_channel = rig.channels.camera;
   n.depth_channel = rig.channels.depth;
@@ -24,8 +25,8 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
     w.wheel_rig = *rig.wheel;
     w.wheel_noise = WheelPreintegrationNoise::fromRig(*rig.wheel);
   }
-  n.use_depth_image = rig.camera->depth;
-  n.use_lidar_depth = rig.lidar.has_value();
+  core.use_depth_image = rig.camera->depth;
+  core.use_lidar_depth = rig.lidar.has_value();
 
   const Config c = root.optionalSection("vio_feature");
   if (!c.isNull()) {
@@ -36,17 +37,17 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
     ch.readOptional("odometry", n.odometry_channel);
     bool flag = false;
     if (c.readOptional("wheel", flag)) w.use_wheel = flag && rig.wheel.has_value();
-    if (c.readOptional("depth_image", flag)) n.use_depth_image = flag && rig.camera->depth;
-    if (c.readOptional("lidar_depth", flag)) n.use_lidar_depth = flag && rig.lidar.has_value();
+    if (c.readOptional("depth_image", flag)) core.use_depth_image = flag && rig.camera->depth;
+    if (c.readOptional("lidar_depth", flag)) core.use_lidar_depth = flag && rig.lidar.has_value();
     c.readOptional("wheel_max_wait_s", n.wheel_max_wait_s);
     c.readOptional("depth_max_wait_s", n.depth_max_wait_s);
     c.readOptional("lidar_max_wait_s", n.lidar_max_wait_s);
-    c.readOptional("lidar_depth_window_s", n.lidar_depth_window_s);
-    c.readOptional("lidar_lag_s", n.lidar_lag_s);
-    c.readOptional("tracked_features", n.tracker.max_features);
-    c.readOptional("min_distance_px", n.tracker.min_distance_px);
-    c.readOptional("ransac_threshold_px", n.tracker.ransac_threshold_px);
-    c.readOptional("keyframe_parallax_px", n.tracker.keyframe_parallax_px);
+    c.readOptional("lidar_depth_window_s", core.lidar_depth_window_s);
+    c.readOptional("lidar_lag_s", core.lidar_lag_s);
+    c.readOptional("tracked_features", core.tracker.max_features);
+    c.readOptional("min_distance_px", core.tracker.min_distance_px);
+    c.readOptional("ransac_threshold_px", core.tracker.ransac_threshold_px);
+    c.readOptional("keyframe_parallax_px", core.tracker.keyframe_parallax_px);
     c.readOptional("window_frames", w.window_frames);
     c.readOptional("graph_features", w.max_features);
     c.readOptional("pixel_sigma", w.pixel_sigma);
@@ -61,10 +62,10 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
   if (w.window_frames < 4) fail("window_frames", "must be >= 4");
   if (w.max_features < 1) fail("graph_features", "must be >= 1");
-  if (n.tracker.max_features < 1) fail("tracked_features", "must be >= 1");
-  if (!(n.tracker.min_distance_px > 0.0)) fail("min_distance_px", "must be > 0");
-  if (!(n.tracker.ransac_threshold_px > 0.0)) fail("ransac_threshold_px", "must be > 0");
-  if (!(n.tracker.keyframe_parallax_px > 0.0)) fail("keyframe_parallax_px", "must be > 0");
+  if (core.tracker.max_features < 1) fail("tracked_features", "must be >= 1");
+  if (!(core.tracker.min_distance_px > 0.0)) fail("min_distance_px", "must be > 0");
+  if (!(core.tracker.ransac_threshold_px > 0.0)) fail("ransac_threshold_px", "must be > 0");
+  if (!(core.tracker.keyframe_parallax_px > 0.0)) fail("keyframe_parallax_px", "must be > 0");
   if (!(w.pixel_sigma > 0.0 && w.reprojection_cauchy > 0.0)) fail("pixel_sigma", "pixel_sigma and reprojection_cauchy must be > 0");
   if (!(w.depth_sigma_base > 0.0 && w.depth_sigma_relative >= 0.0))
     fail("depth_sigma_base", "depth_sigma_base must be > 0 and depth_sigma_relative >= 0");
@@ -73,29 +74,31 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   if (!(w.outlier_px > 0.0)) fail("outlier_px", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0 && n.depth_max_wait_s >= 0.0 && n.lidar_max_wait_s >= 0.0))
     fail("lidar_max_wait_s", "the waits must be >= 0");
-  if (!(n.lidar_depth_window_s >= 0.0)) fail("lidar_depth_window_s", "must be >= 0");
-  if (!(n.lidar_lag_s >= 0.0)) fail("lidar_lag_s", "must be >= 0");
+  if (!(core.lidar_depth_window_s >= 0.0)) fail("lidar_depth_window_s", "must be >= 0");
+  if (!(core.lidar_lag_s >= 0.0)) fail("lidar_lag_s", "must be >= 0");
   if (!(w.focal > 0.0)) throw ConfigError(root.where("rig") + ": the camera's fx and fy must be > 0");
   return n;
 }
 
 void printOptions(const VioFeatureNodeOptions& n, std::ostream& os) {
-  const SlidingWindowOptions& w = n.window;
+  const VioFeatureOptions& core = n.core;
+  const SlidingWindowOptions& w = core.window;
   os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.camera_channel
-     << (n.use_depth_image ? ", " + n.depth_channel : std::string())
+     << (core.use_depth_image ? ", " + n.depth_channel : std::string())
      << (w.use_wheel ? ", " + n.wheel_channel : std::string())
-     << (n.use_lidar_depth ? ", " + n.registered_scan_channel : std::string()) << "; outputs " << n.visual_state_channel
+     << (core.use_lidar_depth ? ", " + n.registered_scan_channel : std::string()) << "; outputs " << n.visual_state_channel
      << ", " << n.odometry_channel << "\n"
-     << "  camera " << n.camera.width << "x" << n.camera.height << " (" << distortionModelName(n.camera.distortion_model)
-     << "); KLT " << n.tracker.max_features << " corners " << n.tracker.min_distance_px << " px apart, keyframes at "
-     << n.tracker.keyframe_parallax_px << " px parallax\n"
+     << "  camera " << core.camera.width << "x" << core.camera.height << " ("
+     << distortionModelName(core.camera.distortion_model) << "); KLT " << core.tracker.max_features << " corners "
+     << core.tracker.min_distance_px << " px apart, keyframes at " << core.tracker.keyframe_parallax_px
+     << " px parallax\n"
      << "  window " << w.window_frames << " states, " << w.max_features << " features, " << w.solver_iterations
      << " solver iterations; factors: reprojection (sigma " << w.pixel_sigma << " px), IMU preintegration, bias walk"
      << (w.use_wheel ? ", wheel preintegration" : "") << "; depth from "
-     << (n.use_depth_image && n.use_lidar_depth ? "the depth image and the LiDAR"
-         : n.use_depth_image                    ? "the depth image"
-         : n.use_lidar_depth                    ? "the LiDAR"
-                                                : "triangulation only")
+     << (core.use_depth_image && core.use_lidar_depth ? "the depth image and the LiDAR"
+         : core.use_depth_image                          ? "the depth image"
+         : core.use_lidar_depth                          ? "the LiDAR"
+                                                         : "triangulation only")
      << "\n";
 }
 

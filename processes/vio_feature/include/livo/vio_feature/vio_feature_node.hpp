@@ -1,6 +1,8 @@
 // The livo-vio-feature node: IMU, CAMERA (and DEPTH, WHEEL, REGISTERED_SCAN) in; VISUAL_STATE
 // (visual_state_t, the coupling with livo-lio-graph) and VISUAL_ODOMETRY (the same as odometry_t,
-// for the evaluation and the tools) out, around a FeatureTracker and a SlidingWindowEstimator.
+// for the evaluation and the tools) out, around a VioFeatureEstimator (the core without LCM). The
+// node checks and converts the messages (vio_feature_messages.hpp), buffers them and decides when
+// an image is processed.
 //
 // Determinism: images wait in a queue and are processed once the IMU has passed their time and,
 // for what the rig has, a wheel reading has, their depth image has arrived and a REGISTERED_SCAN
@@ -13,7 +15,6 @@
 #include <deque>
 #include <map>
 #include <string>
-#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/core.hpp>
@@ -23,10 +24,8 @@
 #include "livo/node.hpp"
 #include "livo/reason_counts.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "livo/vio_feature/feature_depth.hpp"
-#include "livo/vio_feature/feature_tracker.hpp"
-#include "livo/vio_feature/sliding_window_estimator.hpp"
 #include "livo/vio_feature/vio_feature_config.hpp"
+#include "livo/vio_feature/vio_feature_estimator.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
 namespace livo::vio_feature {
@@ -35,9 +34,9 @@ class VioFeatureNode {
  public:
   VioFeatureNode(lcm::LCM& lcm, NodeOptions node_options, VioFeatureNodeOptions options);
   Node& node() { return node_; }
-  const SlidingWindowEstimator& estimator() const { return estimator_; }
+  const VioFeatureEstimator& estimator() const { return estimator_; }
   /// Restarts so far (= the current epoch).
-  int32_t epoch() const { return epoch_; }
+  int32_t epoch() const { return estimator_.epoch(); }
 
   struct Counts {
     int64_t images = 0;        // processed
@@ -47,7 +46,7 @@ class VioFeatureNode {
     int64_t with_depth_image = 0;  // processed with their depth image
     int64_t with_lidar = 0;    // processed with LiDAR points
   };
-  const Counts& counts() const { return counts_; }
+  Counts counts() const;
   std::string summary() const;
   /// Why images gave no state, and how often (bad, out of order, dropped, before initialisation,
   /// rejected by the window).
@@ -62,10 +61,6 @@ class VioFeatureNode {
     int64_t t = 0;      // IMU clock
     cv::Mat grey;
   };
-  struct StoredScan {
-    int64_t t = 0;               // end of sweep (IMU clock)
-    std::vector<Vec3> points_I;  // body frame at t, in front of the camera
-  };
   void onImu(const imu_t& m);
   void onWheel(const wheel_odometry_t& m);
   void onImage(const image_t& m);
@@ -74,26 +69,19 @@ class VioFeatureNode {
   bool ready(const PendingImage& p) const;
   void processReady();
   void process(const PendingImage& p);
-  /// Depth from the stored scans moved into the camera at t (the window's poses); how many features got one.
-  int lidarDepth(int64_t t, std::vector<FeatureObservation>* features);
-  void publish(const FrameResult& r);
 
   Node node_;
   VioFeatureNodeOptions opts_;
-  SlidingWindowEstimator estimator_;
-  FeatureTracker tracker_;
-  LidarDepthMap lidar_map_;
-  int64_t offset_us_ = 0;
+  VioFeatureEstimator estimator_;
   std::deque<PendingImage> pending_;
   std::map<int64_t, cv::Mat> depth_images_;  // by camera utime
-  std::deque<StoredScan> scans_;
+  std::deque<BodyScan> scans_;
   int64_t imu_watermark_ = INT64_MIN;
   int64_t wheel_watermark_ = INT64_MIN;
   int64_t scan_watermark_ = INT64_MIN;
-  int64_t last_image_t_ = INT64_MIN;
-  int32_t epoch_ = 0;
   std::string init_note_;  // the last reason the estimator gave for not initialising yet
-  Counts counts_;
+  int64_t bad_images_ = 0;  // Counts::bad_images
+  int64_t dropped_ = 0;     // Counts::dropped
   ReasonCounts refused_;  // why images gave no state
 };
 

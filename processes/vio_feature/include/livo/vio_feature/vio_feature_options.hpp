@@ -1,9 +1,14 @@
-// Options of livo-vio-feature's back end (the `vio_feature:` config section and the rig).
+// Options of livo-vio-feature's core (the `vio_feature:` config section and the rig):
+// VioFeatureOptions for VioFeatureEstimator (front end, depth sources, back end), of which
+// SlidingWindowOptions is the back end's part.
 #pragma once
 
 #include "livo/imu_initializer.hpp"
 #include "livo/imu_preintegration.hpp"
+#include "livo/sensor_rig.hpp"
 #include "livo/so3.hpp"
+#include "livo/vio_feature/feature_depth.hpp"
+#include "livo/vio_feature/feature_tracker.hpp"
 #include "livo/wheel_preintegration.hpp"
 
 namespace livo::vio_feature {
@@ -43,6 +48,22 @@ struct SlidingWindowOptions {
   double outlier_px = 8.0;              // after an optimisation, a feature this far off in any frame is dropped
   int solver_iterations = 8;
   double max_imu_gap_s = 0.5;           // s without IMU between frames: the estimator restarts
+};
+
+/// VioFeatureEstimator's options: everything but the node's channels and waits.
+struct VioFeatureOptions {
+  CameraRig camera;               // rig.camera
+  bool use_depth_image = false;   // rig.camera.depth and vio_feature.depth_image not false
+  bool use_lidar_depth = false;   // rig.lidar present and vio_feature.lidar_depth not false
+  // An image uses the scans that ended at least this long before it (and the node waits for one
+  // that ended later): livo-lio-graph, coupled, holds a sweep until a visual state past its end
+  // exists, so an image must not wait for the sweep around it. More than a sweep's period.
+  double lidar_lag_s = 0.15;
+  double lidar_depth_window_s = 1.0;  // registered scans this recent lend their points
+  FeatureTrackerOptions tracker;
+  DepthImageOptions depth_image;
+  LidarDepthOptions lidar_depth;
+  SlidingWindowOptions window;
 };
 
 }  // namespace livo::vio_feature
