@@ -112,16 +112,6 @@ struct Subsystem {
   std::vector<std::vector<ImuSample>> imu;  // before each image: the samples up to its time
 };
 
-/// The trajectory's exact IMU (200 Hz on the trajectory's clock), as the node tests make it.
-ImuSample exactImu(const livo_test::RenderedSequence& seq, double t) {
-  const sim::BodyState s = seq.trajectory().at(t);
-  ImuSample m;
-  m.utime = seq.utime(t);
-  m.gyro = s.angular_velocity;
-  m.accel = s.T_W_I.linear().transpose() * (s.acceleration + Vec3(0.0, 0.0, 9.81));
-  return m;
-}
-
 const Subsystem& subsystem(int which) {
   static std::array<std::unique_ptr<Subsystem>, 3> cache;
   if (cache[which]) return *cache[which];
@@ -148,7 +138,8 @@ const Subsystem& subsystem(int which) {
     }
     out->images.push_back(grey);
     std::vector<ImuSample> imu;  // up to the first sample at or past the image (the node's watermark)
-    while (imu.empty() || imu.back().utime < out->sequence->utime(t)) imu.push_back(exactImu(*out->sequence, 0.005 * imu_k++));
+    while (imu.empty() || imu.back().utime < out->sequence->utime(t))
+      imu.push_back(livo_test::exactImu(*out->sequence, 0.005 * imu_k++));
     out->imu.push_back(std::move(imu));
   }
   cache[which] = std::move(out);

@@ -16,6 +16,7 @@
 
 #include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/depth_effects.hpp"
+#include "livo/sensor_samples.hpp"
 #include "livo/sim/simulation_setup.hpp"
 
 namespace livo_test {
@@ -114,5 +115,16 @@ class RenderedSequence {
   std::unique_ptr<livo::sim::BodyTrajectory> trajectory_;
   std::unique_ptr<livo::sim::CameraRenderer> renderer_;
 };
+
+/// The trajectory's exact IMU sample at trajectory time t (gyro = angular velocity, accel =
+/// R^T (a + g)), stamped on the sequence's clock.
+inline livo::ImuSample exactImu(const RenderedSequence& seq, double t) {
+  const livo::sim::BodyState s = seq.trajectory().at(t);
+  livo::ImuSample m;
+  m.utime = seq.utime(t);
+  m.gyro = s.angular_velocity;
+  m.accel = s.T_W_I.linear().transpose() * (s.acceleration + livo::Vec3(0.0, 0.0, 9.81));
+  return m;
+}
 
 }  // namespace livo_test

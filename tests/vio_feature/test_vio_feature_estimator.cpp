@@ -28,16 +28,6 @@ VioFeatureOptions roomOptions() {
   return o;
 }
 
-/// The trajectory's exact IMU at trajectory time t (gyro = angular velocity, accel = R^T (a + g)).
-ImuSample exactImu(const livo_test::RenderedSequence& seq, double t) {
-  const sim::BodyState s = seq.trajectory().at(t);
-  ImuSample m;
-  m.utime = seq.utime(t);
-  m.gyro = s.angular_velocity;
-  m.accel = s.T_W_I.linear().transpose() * (s.acceleration + Vec3(0.0, 0.0, 9.81));
-  return m;
-}
-
 /// Feeds the IMU from sample *k on (200 Hz) until it has passed trajectory time t, skipping the
 /// samples inside (gap_from, gap_to).
 void feedImuUpTo(const livo_test::RenderedSequence& seq, double t, int* k, VioFeatureEstimator* e,
@@ -46,7 +36,7 @@ void feedImuUpTo(const livo_test::RenderedSequence& seq, double t, int* k, VioFe
     const double ti = 0.005 * *k;
     ++*k;
     if (ti > gap_from && ti < gap_to) continue;
-    EXPECT_TRUE(e->addImu(exactImu(seq, ti)));
+    EXPECT_TRUE(e->addImu(livo_test::exactImu(seq, ti)));
     if (seq.utime(ti) >= e->imuTime(seq.utime(t))) return;
   }
 }
