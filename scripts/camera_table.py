@@ -122,12 +122,14 @@ def lidar_offset(truth):
 
 
 def evaluate_at_lidar(build, run_dir, gt, truth):
-    """ATE rmse of the run's odometry.tum at the LiDAR (lidar_offset), or None if it did not run."""
+    """ATE rmse of the run's odometry.tum at the LiDAR (lidar_offset), or None if it did not run (then
+    run_dir/evaluate_lidar.txt says why)."""
     out = os.path.join(run_dir, 'evaluation_odometry_lidar.json')
     o = ','.join('%.9g' % x for x in lidar_offset(truth))
     cmd = [os.path.join(build, 'bin', 'livo-evaluate'), '--est', os.path.join(run_dir, 'odometry.tum'), '--gt', gt,
            '--align', 'se3', '--gt-offset', o, '--json', out, '--quiet']
-    if subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+    # livo-evaluate's messages go to the run's folder, beside its other logs
+    if not sv.run(cmd, os.path.join(run_dir, 'evaluate_lidar.txt')):
         return None
     return json.load(open(out))['ate']['rmse']
 
