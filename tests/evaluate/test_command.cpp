@@ -234,3 +234,49 @@ TEST(EvaluateCommand, PlotMarksWeakStretchesAndLoops) {
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.err.find(dir + "/bad.json: not a weak_spots.json"), std::string::npos) << bad.err;
 }
+
+// --align 4dof, and the ground-vehicle metrics whatever the alignment: named in the JSON, the
+// terminal summary and the Markdown report.
+TEST(EvaluateCommand, FourDofAlignmentAndGroundVehicleMetrics) {
+  const std::string dir = livo_test::tempDir();
+  const Trajectory gt = fixtures::wigglyTrajectory(300);
+  Trajectory est = gt;
+  for (size_t i = 0; i < est.size(); ++i)
+    est[i].pose.translation().z() += 0.3 * static_cast<double>(i) / 299.0;  // climbing 0.3 m too much
+  writeTum(dir + "/gt.tum", gt);
+  writeTum(dir + "/est.tum", est);
+  const CommandResult r = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--align", "4dof",
+                               "--json", dir + "/4dof.json", "--report", dir + "/4dof.md"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string vertical =
+      "Vertical drift (z error, heights anchored at the first pose): +0.3000 m at the end";
+  const std::vector<std::string> lines = {"4dof (yaw about z and translation), yaw ",
+                                          "ATE after a 4-DoF alignment (yaw about z and translation): rmse ",
+                                          vertical + ", +0.",
+                                          "Roll / pitch error (gravity direction in the body, rmse): roll "};
+  for (const std::string& line : lines)
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  const auto j = nlohmann::json::parse(readFile(dir + "/4dof.json"));
+  EXPECT_EQ(j["alignment"]["mode"], "4dof");
+  EXPECT_EQ(j["ate_4dof"].get<double>(), j["ate"]["rmse"].get<double>());
+  EXPECT_NEAR(j["vertical"]["end_m"].get<double>(), 0.3, 1e-6);  // TUM files keep about 9 digits
+  EXPECT_NEAR(j["vertical"]["max_abs_m"].get<double>(), 0.3, 1e-6);
+  EXPECT_NEAR(j["vertical"]["per_100m"].get<double>(),
+              0.3 / (j["vertical"]["path_length_m"].get<double>() / 100.0), 1e-12);
+  EXPECT_EQ(j["vertical"]["path_length_m"], j["end_point"]["path_length_m"]);
+  for (const char* key : {"roll_rmse_deg", "pitch_rmse_deg", "tilt_rmse_deg", "tilt_max_deg"})
+    EXPECT_LT(j["attitude"][key].get<double>(), 1e-5) << key;
+  const std::string md = readFile(dir + "/4dof.md");
+  EXPECT_NE(md.find("| alignment | 4dof (yaw about z and translation), yaw "), std::string::npos) << md;
+  EXPECT_NE(md.find("ATE after 4dof alignment"), std::string::npos) << md;
+  EXPECT_NE(md.find("\n\n" + vertical), std::string::npos) << md;
+
+  // With the default SE(3) alignment the JSON carries the 4-DoF ATE beside it.
+  const CommandResult se3_run =
+      run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--json", dir + "/se3.json", "--quiet"});
+  ASSERT_EQ(se3_run.code, 0) << se3_run.err;
+  const auto se3 = nlohmann::json::parse(readFile(dir + "/se3.json"));
+  EXPECT_EQ(se3["alignment"]["mode"], "se3");
+  EXPECT_EQ(se3["ate_4dof"], j["ate_4dof"]);
+  EXPECT_LE(se3["ate"]["rmse"].get<double>(), j["ate_4dof"].get<double>());  // SE(3) has more freedom
+}

@@ -44,7 +44,8 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
                   "(LOG or LOG:CHANNEL; livo.pose_t or livo.odometry_t messages). Numbers as evo's evo_ape/evo_rpe.");
   cli.option("--est", "E", "estimated trajectory: file, LCM log (channel ODOMETRY) or LOG:CHANNEL")
       .option("--gt", "G", "ground truth: file, LCM log (channel GROUND_TRUTH) or LOG:CHANNEL")
-      .option("--align", "MODE", "Umeyama alignment of the estimate: se3, sim3 or none", "se3")
+      .option("--align", "MODE", "alignment of the estimate: se3 or sim3 (Umeyama), 4dof (yaw about z and "
+                                 "translation) or none", "se3")
       .option("--max-dt", "S", "largest stamp gap of an associated pair, seconds", "0.01")
       .option("--gt-offset", "X,Y,Z", "point on the body (body frame, m) the ground truth tracks, e.g. a prism")
       .option("--rpe-delta", "N", "RPE over N frames", "1")

@@ -11,6 +11,7 @@ const char* alignmentName(Alignment a) {
   switch (a) {
     case Alignment::kSE3: return "se3";
     case Alignment::kSim3: return "sim3";
+    case Alignment::kFourDof: return "4dof";
     case Alignment::kNone: break;
   }
   return "none";
@@ -20,7 +21,9 @@ Alignment parseAlignment(const std::string& name) {
   if (name == "se3") return Alignment::kSE3;
   if (name == "sim3") return Alignment::kSim3;
   if (name == "none") return Alignment::kNone;
-  throw std::invalid_argument("--align: expected se3, sim3 or none, got '" + name + "'");
+  if (name == "4dof") return Alignment::kFourDof;
+  throw std::invalid_argument("--align: expected se3, sim3 or none, or 4dof (yaw about z and translation), "
+                              "got '" + name + "'");
 }
 
 void EvaluationOptions::validate() const {
@@ -65,6 +68,41 @@ std::string timeRange(const Trajectory& t) {
   os << std::fixed << std::setprecision(6) << t.size() << " poses, " << lo << " .. " << hi << " s";
   return os.str();
 }
+
+Similarity3 alignmentFor(Alignment mode, const std::vector<Vec3>& est_positions,
+                         const std::vector<Vec3>& gt_positions) {
+  switch (mode) {
+    case Alignment::kSE3: return umeyamaAlignment(est_positions, gt_positions, false);
+    case Alignment::kSim3: return umeyamaAlignment(est_positions, gt_positions, true);
+    case Alignment::kFourDof: return fourDofAlignment(est_positions, gt_positions);
+    case Alignment::kNone: break;
+  }
+  return Similarity3{};
+}
+
+/// Per pair |p_est - p_gt| after a 4-DoF alignment of the estimate; empty when its yaw is undefined.
+std::vector<double> fourDofPositionErrors(const std::vector<Vec3>& est_positions,
+                                          const std::vector<Vec3>& gt_positions) {
+  Similarity3 yaw_and_shift;
+  try {
+    yaw_and_shift = fourDofAlignment(est_positions, gt_positions);
+  } catch (const AlignmentError&) {
+    return {};
+  }
+  std::vector<double> errors;
+  for (size_t k = 0; k < est_positions.size(); ++k)
+    errors.push_back((yaw_and_shift.apply(est_positions[k]) - gt_positions[k]).norm());
+  return errors;
+}
+
+/// The metrics a ground-vehicle claim needs, on the estimate as read (offset applied, not aligned).
+void addGroundVehicleMetrics(Evaluation& ev, const std::vector<Pose3>& est_as_read,
+                             const std::vector<Vec3>& est_positions, const std::vector<Vec3>& gt_positions) {
+  ev.ate_4dof_m = fourDofPositionErrors(est_positions, gt_positions);
+  ev.ate_4dof = summarizeErrors(ev.ate_4dof_m);
+  ev.vertical = verticalDrift(ev.gt, est_as_read);
+  ev.attitude = attitudeError(ev.gt, est_as_read);
+}
 }  // namespace
 
 Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInput& gt_in, const EvaluationOptions& options) {
@@ -93,12 +131,14 @@ Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInp
 
   const size_t n = ev.pairs.size();
   std::vector<Vec3> est_positions(n), gt_positions(n);
+  std::vector<Pose3> est_as_read;  // per pair, offset applied
   for (size_t k = 0; k < n; ++k) {
     const StampedPose& e = est[ev.pairs.est[k]];
     const StampedPose& g = gt[ev.pairs.gt[k]];
     ev.est_stamps.push_back(e.stamp);
     ev.gt_stamps.push_back(g.stamp);
     ev.gt.push_back(g.pose);
+    est_as_read.push_back(e.pose);
     est_positions[k] = e.pose.translation();
     gt_positions[k] = g.pose.translation();
   }
@@ -106,7 +146,7 @@ Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInp
 
   if (options.alignment != Alignment::kNone) {
     try {
-      ev.alignment = umeyamaAlignment(est_positions, gt_positions, options.alignment == Alignment::kSim3);
+      ev.alignment = alignmentFor(options.alignment, est_positions, gt_positions);
     } catch (const AlignmentError& e) {
       throw EvaluationError(std::string(e.what()) + " (" + std::to_string(n) + " pairs; try --align none)");
     }
@@ -131,6 +171,7 @@ Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInp
   ev.end_point.translation_m = end_error.translation().norm();
   ev.end_point.rotation_deg = rotationAngle(end_error.linear()) * 180.0 / M_PI;
   for (size_t k = 1; k < n; ++k) ev.end_point.path_length_m += (gt_positions[k] - gt_positions[k - 1]).norm();
+  addGroundVehicleMetrics(ev, est_as_read, est_positions, gt_positions);
   return ev;
 }
 

@@ -20,6 +20,23 @@ json input(const TrajectoryInput& in) {
 }
 
 json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+json verticalDrift(const VerticalDrift& v) {
+  return json{{"end_m", v.end_m},
+              {"per_100m", v.hasPath() ? json(v.per100m()) : json(nullptr)},
+              {"max_abs_m", v.max_abs_m},
+              {"path_length_m", v.path_length_m}};
+}
+
+json attitude(const AttitudeError& a) {
+  if (a.tilt.count == 0)
+    return json{{"roll_rmse_deg", nullptr}, {"pitch_rmse_deg", nullptr}, {"tilt_rmse_deg", nullptr},
+                {"tilt_max_deg", nullptr}};
+  return json{{"roll_rmse_deg", a.roll.rmse},
+              {"pitch_rmse_deg", a.pitch.rmse},
+              {"tilt_rmse_deg", a.tilt.rmse},
+              {"tilt_max_deg", a.tilt.max}};
+}
 }  // namespace
 
 json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const TrajectoryInput& gt,
@@ -71,6 +88,9 @@ json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const Traj
                     {"rotation_deg", ev.end_point.rotation_deg},
                     {"path_length_m", ev.end_point.path_length_m},
                     {"percent", ev.end_point.percent()}};
+  j["ate_4dof"] = ev.ate_4dof.count ? json(ev.ate_4dof.rmse) : json(nullptr);
+  j["vertical"] = verticalDrift(ev.vertical);
+  j["attitude"] = attitude(ev.attitude);
   return j;
 }
 

@@ -62,6 +62,12 @@ std::string fixed(double v, int decimals) {
   return os.str();
 }
 
+std::string signedFixed(double v, int decimals) {
+  std::ostringstream os;
+  os << std::showpos << std::fixed << std::setprecision(decimals) << v;
+  return os.str();
+}
+
 Table errorTable(const Evaluation& ev) {
   Table t{{"error", "rmse", "mean", "median", "std", "min", "max", "count"}, {}};
   auto row = [&](const std::string& name, const ErrorStatistics& s) {
@@ -105,6 +111,9 @@ Table inputTable(const Evaluation& ev, const TrajectoryInput& est, const Traject
   t.rows.push_back({"pairs", pairing});
   std::string alignment = alignmentName(options.alignment);
   if (options.alignment == Alignment::kSim3) alignment += ", scale " + num(ev.alignment.scale, 8);
+  if (options.alignment == Alignment::kFourDof)
+    alignment += " (yaw about z and translation), yaw " + fixed(yawOf(ev.alignment.rotation) * 180.0 / M_PI, 4) +
+                 " deg";
   t.rows.push_back({"alignment", alignment});
   if (!options.gt_offset.isZero())
     t.rows.push_back({"gt offset (body, m)", num(options.gt_offset.x()) + ", " + num(options.gt_offset.y()) + ", " +
@@ -126,6 +135,35 @@ std::string endPointLine(const Evaluation& ev) {
   return os.str();
 }
 
+std::string fourDofAteLine(const Evaluation& ev) {
+  if (ev.ate_4dof.count == 0)
+    return "ATE after a 4-DoF alignment (yaw about z and translation): undefined (no horizontal spread)";
+  return "ATE after a 4-DoF alignment (yaw about z and translation): rmse " + num(ev.ate_4dof.rmse) + " m";
+}
+
+std::string verticalDriftLine(const Evaluation& ev) {
+  std::ostringstream os;
+  os << "Vertical drift (z error, heights anchored at the first pose): " << signedFixed(ev.vertical.end_m, 4)
+     << " m at the end";
+  if (ev.vertical.hasPath()) os << ", " << signedFixed(ev.vertical.per100m(), 4) << " m per 100 m";
+  os << " over " << fixed(ev.vertical.path_length_m, 1) << " m; largest |z error| "
+     << fixed(ev.vertical.max_abs_m, 4) << " m";
+  return os.str();
+}
+
+std::string attitudeLine(const Evaluation& ev) {
+  const AttitudeError& a = ev.attitude;
+  return "Roll / pitch error (gravity direction in the body, rmse): roll " + fixed(a.roll.rmse, 4) +
+         " deg, pitch " + fixed(a.pitch.rmse, 4) + " deg, tilt " + fixed(a.tilt.rmse, 4) + " deg (largest tilt " +
+         fixed(a.tilt.max, 4) + " deg)";
+}
+
+/// The lines of the metrics for a ground vehicle, each ending in a newline; `separator` between them.
+void groundVehicleLines(std::ostream& os, const Evaluation& ev, const std::string& separator) {
+  os << fourDofAteLine(ev) << "\n" << separator << verticalDriftLine(ev) << "\n" << separator
+     << attitudeLine(ev) << "\n";
+}
+
 }  // namespace
 
 void printSummary(std::ostream& os, const Evaluation& ev, const TrajectoryInput& est, const TrajectoryInput& gt,
@@ -134,6 +172,7 @@ void printSummary(std::ostream& os, const Evaluation& ev, const TrajectoryInput&
   os << "\n";
   errorTable(ev).text(os);
   os << "\n" << endPointLine(ev) << "\n";
+  groundVehicleLines(os, ev, "");
   if (ev.drift.segments == 0) {
     os << "KITTI drift: no segment (the ground-truth path, " << fixed(ev.drift.path_length_m, 1)
        << " m, is shorter than the shortest segment length)\n";
@@ -154,6 +193,8 @@ void writeMarkdownReport(const std::string& path, const Evaluation& ev, const Tr
       << (options.rpe.delta == 1 ? "" : "s") << ".\n\n";
   errorTable(ev).markdown(out);
   out << "\n" << endPointLine(ev) << "\n";
+  out << "\n";
+  groundVehicleLines(out, ev, "\n");
   out << "\n## KITTI drift\n\n";
   if (ev.drift.segments == 0) {
     out << "No segment: the ground-truth path (" << fixed(ev.drift.path_length_m, 1)

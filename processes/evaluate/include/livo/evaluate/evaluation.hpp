@@ -1,5 +1,6 @@
 // The whole evaluation of an estimated trajectory against ground truth: association, alignment,
-// absolute trajectory error with coverage, relative pose error and KITTI drift.
+// absolute trajectory error with coverage, relative pose error, KITTI drift, and for a ground
+// vehicle the ATE after a 4-DoF alignment, the vertical drift and the roll / pitch error.
 #pragma once
 
 #include <stdexcept>
@@ -7,11 +8,14 @@
 #include <vector>
 
 #include "livo/evaluate/association.hpp"
+#include "livo/evaluate/attitude_error.hpp"
 #include "livo/evaluate/error_statistics.hpp"
+#include "livo/evaluate/four_dof_alignment.hpp"
 #include "livo/evaluate/kitti_drift.hpp"
 #include "livo/evaluate/relative_pose_error.hpp"
 #include "livo/evaluate/trajectory_input.hpp"
 #include "livo/evaluate/umeyama.hpp"
+#include "livo/evaluate/vertical_drift.hpp"
 
 namespace livo::evaluate {
 
@@ -20,13 +24,14 @@ class EvaluationError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Alignment { kNone, kSE3, kSim3 };
+/// kFourDof: yaw about z and translation (fourDofAlignment), for worlds with z up.
+enum class Alignment { kNone, kSE3, kSim3, kFourDof };
 const char* alignmentName(Alignment a);
-/// "none", "se3" or "sim3"; throws std::invalid_argument otherwise.
+/// "none", "se3", "sim3" or "4dof"; throws std::invalid_argument otherwise.
 Alignment parseAlignment(const std::string& name);
 
 struct EvaluationOptions {
-  Alignment alignment = Alignment::kSE3;  // Umeyama on the associated positions (evo -a / -as)
+  Alignment alignment = Alignment::kSE3;  // Umeyama on the associated positions (evo -a / -as), or 4-DoF
   double max_dt = 0.01;                   // s, largest stamp gap of a pair (evo's default)
   Vec3 gt_offset = Vec3::Zero();          // body frame; moves each estimated pose to that point
   double coverage_gap = 0.0;              // s; 0: three times the median interval between pairs
@@ -76,6 +81,14 @@ struct Evaluation {
   ErrorStatistics rpe_rotation_deg;
   KittiDrift drift;
   EndPointDrift end_point;
+  // Whatever `alignment` is: the ATE after a 4-DoF alignment (count 0 when the yaw is undefined),
+  // and on the estimate as read (not aligned): the vertical drift, heights anchored at the first
+  // pair, and the roll / pitch / tilt error (a world yaw, all a 4-DoF alignment rotates, changes
+  // none of the three).
+  std::vector<double> ate_4dof_m;  // per pair, empty when the yaw is undefined
+  ErrorStatistics ate_4dof;
+  VerticalDrift vertical;
+  AttitudeError attitude;
 };
 
 /// Pairs by time stamp when both sides have stamps, else by index. Throws EvaluationError when no
