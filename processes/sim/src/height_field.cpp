@@ -6,7 +6,16 @@
 
 namespace livo::sim {
 
-HeightField::HeightField(const HeightFieldOptions& o) {
+HeightField::HeightField(const HeightFieldOptions& o)
+    : HeightField(o, [&o](double x, double y) {
+        double h = o.center.z();
+        int k = 0;
+        for (const auto& [amplitude, wavelength] : o.relief)
+          h += amplitude * gradientNoise(x / wavelength, y / wavelength, 1 << 20, o.seed + 31 * k++);
+        return h;
+      }) {}
+
+HeightField::HeightField(const HeightFieldOptions& o, const std::function<double(double, double)>& height) {
   if (!(o.resolution > 0.0) || !(o.size_x > 0.0) || !(o.size_y > 0.0))
     throw std::invalid_argument("height field: size and resolution must be > 0");
   cell_ = o.resolution;
@@ -17,12 +26,7 @@ HeightField::HeightField(const HeightFieldOptions& o) {
   heights_.resize(static_cast<size_t>(nx_ + 1) * (ny_ + 1));
   for (int j = 0; j <= ny_; ++j) {
     for (int i = 0; i <= nx_; ++i) {
-      const double x = x0_ + i * cell_, y = y0_ + j * cell_;
-      double h = o.center.z();
-      int k = 0;
-      for (const auto& [amplitude, wavelength] : o.relief)
-        h += amplitude * gradientNoise(x / wavelength, y / wavelength, 1 << 20, o.seed + 31 * k++);
-      heights_[static_cast<size_t>(j) * (nx_ + 1) + i] = h;
+      heights_[static_cast<size_t>(j) * (nx_ + 1) + i] = height(x0_ + i * cell_, y0_ + j * cell_);
     }
   }
   cell_range_.resize(static_cast<size_t>(nx_) * ny_);

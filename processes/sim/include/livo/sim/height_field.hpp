@@ -1,8 +1,9 @@
-// Height-field ground: z = base + relief(x, y) over a rectangle, sampled on a regular grid and
-// ray-cast cell by cell (2-D DDA with per-cell height bounds, two triangles per cell).
+// Height-field ground: z = base + relief(x, y) (or any height function) over a rectangle, sampled on a
+// regular grid and ray-cast cell by cell (2-D DDA with per-cell height bounds, two triangles per cell).
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct HeightFieldOptions {
 class HeightField {
  public:
   explicit HeightField(const HeightFieldOptions& options);
+  /// The grid of `grid` (center x, y, size, resolution; its relief and center z unused) sampled from
+  /// z = height(x, y) at the vertices.
+  HeightField(const HeightFieldOptions& grid, const std::function<double(double, double)>& height);
 
   /// Height of the triangulated surface at (x, y) (base height outside the rectangle).
   double heightAt(double x, double y) const;
