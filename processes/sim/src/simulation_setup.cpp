@@ -460,7 +460,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
   if (s.scene->terrain) {
     const Terrain& t = *s.scene->terrain;
     os << "  terrain: " << t.options().profiles.size() << " grade profiles, " << t.options().relief.size()
-       << " relief waves, grades up to " << t.maxGrade() * 100.0 << " %, curvature up to " << t.maxCurvature()
+       << " relief waves, grades at most " << t.maxGrade() * 100.0 << " %, curvature at most " << t.maxCurvature()
        << " /m\n";
   }
   os << "  trajectory: " << s.trajectory_description << "\n";

@@ -154,7 +154,7 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
     const Vec3 p_BI = T_I_rear_axle.inverse().translation();
     os << "; rear axle " << p_BI.x() << " m behind and " << p_BI.z() << " m below the body origin";
     if (ground)
-      os << "; on the scene's terrain (grades up to " << ground->maxGrade() * 100.0 << " %, wheelbase "
+      os << "; on the scene's terrain (grades at most " << ground->maxGrade() * 100.0 << " %, wheelbase "
          << wheelbase << " m, track " << track_width << " m)";
     out.trajectory = std::make_unique<CarTrajectory>(
         std::move(path),
