@@ -169,9 +169,13 @@ TEST(CarOnTerrain, RollsWithTheDeckCamber) {
     ASSERT_NEAR(pitchOf(R), 0.0, 1e-12) << "x = " << x;
   }
   for (double x = 60.0; x <= 87.0; x += 0.5) {
-    const Mat3 R = c.frame(timeAtX(x)).R;
-    ASSERT_NEAR(rollOf(R), std::atan(kCamber * std::cos(std::atan(kGrade))), 1e-12) << "x = " << x;
-    ASSERT_NEAR(pitchOf(R), std::atan(kGrade), 1e-12) << "x = " << x;
+    const CarFrame f = c.frame(timeAtX(x));
+    ASSERT_NEAR(rollOf(f.R), std::atan(kCamber * std::cos(std::atan(kGrade))), 1e-12) << "x = " << x;
+    ASSERT_NEAR(pitchOf(f.R), std::atan(kGrade), 1e-12) << "x = " << x;
+    // the rear axle rolls along the car's x axis on the inclined, cambered plane (no side slip)
+    const Vec3 v_B = f.R.transpose() * f.v;
+    ASSERT_LT(std::abs(v_B.y()) + std::abs(v_B.z()), 1e-9) << "x = " << x;
+    ASSERT_NEAR(v_B.x(), kSpeed / std::cos(std::atan(kGrade)), 1e-9) << "x = " << x;  // speed is horizontal
   }
 }
 
