@@ -1,12 +1,24 @@
 #include "livo/sim/height_field.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "livo/sim/noise.hpp"
 
 namespace livo::sim {
 
-HeightField::HeightField(const HeightFieldOptions& o) {
+HeightField::HeightField(const HeightFieldOptions& o)
+    : HeightField(o, [&o](double x, double y) {
+        double h = o.center.z();
+        int k = 0;
+        for (const auto& [amplitude, wavelength] : o.relief)
+          h += amplitude * gradientNoise(x / wavelength, y / wavelength, 1 << 20, o.seed + 31 * k++);
+        return h;
+      }) {}
+
+HeightField::HeightField(const HeightFieldOptions& o, const std::function<double(double, double)>& height) {
   if (!(o.resolution > 0.0) || !(o.size_x > 0.0) || !(o.size_y > 0.0))
     throw std::invalid_argument("height field: size and resolution must be > 0");
   cell_ = o.resolution;
@@ -17,12 +29,7 @@ HeightField::HeightField(const HeightFieldOptions& o) {
   heights_.resize(static_cast<size_t>(nx_ + 1) * (ny_ + 1));
   for (int j = 0; j <= ny_; ++j) {
     for (int i = 0; i <= nx_; ++i) {
-      const double x = x0_ + i * cell_, y = y0_ + j * cell_;
-      double h = o.center.z();
-      int k = 0;
-      for (const auto& [amplitude, wavelength] : o.relief)
-        h += amplitude * gradientNoise(x / wavelength, y / wavelength, 1 << 20, o.seed + 31 * k++);
-      heights_[static_cast<size_t>(j) * (nx_ + 1) + i] = h;
+      heights_[static_cast<size_t>(j) * (nx_ + 1) + i] = height(x0_ + i * cell_, y0_ + j * cell_);
     }
   }
   cell_range_.resize(static_cast<size_t>(nx_) * ny_);
@@ -31,6 +38,19 @@ HeightField::HeightField(const HeightFieldOptions& o) {
       const double a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i, j + 1), d = vertex(i + 1, j + 1);
       cell_range_[static_cast<size_t>(j) * nx_ + i] = {static_cast<float>(std::min({a, b, c, d})),
                                                        static_cast<float>(std::max({a, b, c, d}))};
+    }
+  }
+  // blocks of cells: a ray crosses a block whose heights it stays clear of without visiting its cells
+  nbx_ = (nx_ + kBlock - 1) / kBlock;
+  nby_ = (ny_ + kBlock - 1) / kBlock;
+  block_range_.assign(static_cast<size_t>(nbx_) * nby_, {std::numeric_limits<float>::max(),
+                                                         std::numeric_limits<float>::lowest()});
+  for (int j = 0; j < ny_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      auto& b = block_range_[static_cast<size_t>(j / kBlock) * nbx_ + i / kBlock];
+      const auto& c = cell_range_[static_cast<size_t>(j) * nx_ + i];
+      b.first = std::min(b.first, c.first);
+      b.second = std::max(b.second, c.second);
     }
   }
   double lo = heights_[0], hi = heights_[0];
@@ -88,6 +108,42 @@ bool HeightField::intersect(const PreparedRay& pr, double t_min, double t_max, d
   double t0 = t_min, t1 = t_max;
   if (!bounds_.clip(pr, &t0, &t1)) return false;
   const Ray& r = pr.ray;
+  // the same 2-D DDA over blocks; the cells of a block the ray may meet are walked
+  const double block = kBlock * cell_;
+  const Vec3 entry = r.origin + t0 * r.direction;
+  int i = std::clamp(static_cast<int>(std::floor((entry.x() - x0_) / block)), 0, nbx_ - 1);
+  int j = std::clamp(static_cast<int>(std::floor((entry.y() - y0_) / block)), 0, nby_ - 1);
+  const int step_i = r.direction.x() > 0.0 ? 1 : -1, step_j = r.direction.y() > 0.0 ? 1 : -1;
+  const double dx = std::abs(r.direction.x()) > 1e-15 ? block / std::abs(r.direction.x()) : kInfinity;
+  const double dy = std::abs(r.direction.y()) > 1e-15 ? block / std::abs(r.direction.y()) : kInfinity;
+  const double bx = x0_ + (i + (step_i > 0 ? 1 : 0)) * block, by = y0_ + (j + (step_j > 0 ? 1 : 0)) * block;
+  double next_x = dx < kInfinity ? (bx - r.origin.x()) / r.direction.x() : kInfinity;
+  double next_y = dy < kInfinity ? (by - r.origin.y()) / r.direction.y() : kInfinity;
+  double t_enter = t0;
+  while (true) {
+    const double t_exit = std::min({next_x, next_y, t1});
+    const double za = r.origin.z() + t_enter * r.direction.z(), zb = r.origin.z() + t_exit * r.direction.z();
+    const auto& range = block_range_[static_cast<size_t>(j) * nbx_ + i];
+    if (std::max(za, zb) >= range.first - 1e-6 && std::min(za, zb) <= range.second + 1e-6 &&
+        walkCells(r, t_enter, t_exit, t_min, t_max, t, face))
+      return true;
+    if (t_exit >= t1) return false;
+    if (next_x < next_y) {
+      i += step_i;
+      t_enter = next_x;
+      next_x += dx;
+    } else {
+      j += step_j;
+      t_enter = next_y;
+      next_y += dy;
+    }
+    if (i < 0 || j < 0 || i >= nbx_ || j >= nby_) return false;
+  }
+}
+
+bool HeightField::walkCells(const Ray& r, double t_start, double t_end, double t_min, double t_max, double* t,
+                            int* face) const {
+  const double t0 = t_start, t1 = t_end;
   const Vec3 entry = r.origin + t0 * r.direction;
   int i = std::clamp(static_cast<int>(std::floor((entry.x() - x0_) / cell_)), 0, nx_ - 1);
   int j = std::clamp(static_cast<int>(std::floor((entry.y() - y0_) / cell_)), 0, ny_ - 1);

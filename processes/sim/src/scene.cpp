@@ -22,7 +22,12 @@ int Scene::addShape(const std::string& name, const Shape& shape, const Material&
 }
 
 int Scene::addHeightField(const std::string& name, const HeightFieldOptions& options, const Material& material) {
-  height_fields_.push_back(std::make_unique<HeightField>(options));
+  return addHeightField(name, std::make_unique<HeightField>(options), material);
+}
+
+int Scene::addHeightField(const std::string& name, std::unique_ptr<HeightField> field,
+                          const Material& material) {
+  height_fields_.push_back(std::move(field));
   objects_.push_back({name, -1, static_cast<int>(height_fields_.size()) - 1, -1, material});
   built_ = false;
   return static_cast<int>(objects_.size()) - 1;

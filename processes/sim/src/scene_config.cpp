@@ -1,6 +1,8 @@
 #include "livo/sim/scene_config.hpp"
 
+#include <cmath>
 #include <map>
+#include <memory>
 #include <stdexcept>
 
 #include "livo/sim/random.hpp"
@@ -285,6 +287,90 @@ void readMover(Scene& scene, const Config& c, const std::string& name, const std
   }
 }
 
+Vec2 pair(const Config& c, const std::string& key, const std::string& what) {
+  const auto v = c.get<std::vector<double>>(key);
+  if (v.size() != 2) throw ConfigError(c.where(key) + ": expected " + what);
+  return Vec2(v[0], v[1]);
+}
+
+GradeProfile readGradeProfile(const Config& c) {
+  GradeProfile g;
+  c.readOptional("direction_deg", g.direction_deg);
+  if (c.has("origin")) g.origin = pair(c, "origin", "[x, y]");
+  c.read("stations", g.stations);
+  c.read("heights", g.heights);
+  c.readOptional("curve_length", g.curve_length);
+  c.checkAllUsed();
+  if (g.stations.size() < 2) throw ConfigError(c.where("stations") + ": needs at least 2 stations");
+  if (g.heights.size() != g.stations.size())
+    throw ConfigError(c.where("heights") + ": needs one height per station");
+  if (!(g.curve_length > 0.0)) throw ConfigError(c.where("curve_length") + ": must be > 0");
+  for (size_t i = 1; i < g.stations.size(); ++i)
+    if (!(g.stations[i] - g.stations[i - 1] >= g.curve_length))
+      throw ConfigError(c.where("stations") + ": stations " + std::to_string(g.stations[i - 1]) + " and " +
+                        std::to_string(g.stations[i]) + " are closer than curve_length (" +
+                        std::to_string(g.curve_length) + " m): their vertical curves would overlap");
+  return g;
+}
+
+ReliefWave readReliefWave(const Config& c) {
+  ReliefWave w;
+  c.read("amplitude", w.amplitude);
+  w.wavelength = positive(c, "wavelength");
+  c.readOptional("direction_deg", w.direction_deg);
+  c.readOptional("phase_deg", w.phase_deg);
+  c.checkAllUsed();
+  return w;
+}
+
+/// `terrain:` the graded ground a car drives on (base, profiles, relief) and its surface: a height
+/// field sampled from it on `resolution`, which must keep its triangles within 1 mm of h.
+void readTerrain(Scene& scene, const Config& c, const std::map<std::string, int>& textures) {
+  TerrainOptions o;
+  c.readOptional("base", o.base);
+  const Config profiles = c.optionalSection("profiles");
+  if (!profiles.isNull())
+    for (const std::string& name : profiles.keys())
+      o.profiles.push_back(readGradeProfile(profiles.section(name)));
+  const Config relief = c.optionalSection("relief");
+  if (!relief.isNull())
+    for (const std::string& name : relief.keys()) o.relief.push_back(readReliefWave(relief.section(name)));
+  const Config surface = c.section("surface");
+  const Material m = readMaterial(surface, textures);
+  if (m.kind != MaterialKind::kOpaque)
+    throw ConfigError(surface.where("material") + ": the terrain is opaque");
+  HeightFieldOptions grid;
+  grid.center.head<2>() = pair(surface, "center", "[x, y]");
+  const Vec2 size = pair(surface, "size", "[size_x, size_y] > 0");
+  if (!(size.x() > 0.0) || !(size.y() > 0.0))
+    throw ConfigError(surface.where("size") + ": expected [size_x, size_y] > 0");
+  grid.size_x = size.x(), grid.size_y = size.y();
+  grid.resolution = 0.25;
+  surface.readOptional("resolution", grid.resolution);
+  if (!(grid.resolution > 0.0)) throw ConfigError(surface.where("resolution") + ": must be > 0");
+  if (grid.size_x / grid.resolution * grid.size_y / grid.resolution > 2e7)
+    throw ConfigError(surface.where("resolution") + ": too fine for this size (more than 2e7 cells)");
+  surface.checkAllUsed();
+  c.checkAllUsed();
+  auto terrain = std::make_shared<const Terrain>(o);
+  // linear interpolation on a right triangle with legs r departs from h by at most M r^2 / 4
+  // (M: the largest curvature; the triangle's smallest enclosing circle has radius r / sqrt 2)
+  const double departure = terrain->maxCurvature() * grid.resolution * grid.resolution / 4.0;
+  if (departure > 1e-3)
+    throw ConfigError(surface.where("resolution") +
+                      ": the triangles would depart from the terrain by up to " +
+                      std::to_string(departure * 1e3) + " mm (curvature up to " +
+                      std::to_string(terrain->maxCurvature()) + " /m); take at most " +
+                      std::to_string(std::sqrt(4e-3 / terrain->maxCurvature())) + " m");
+  Material mi = m;
+  Random shift(hashString("terrain"), 0x7e47ULL);
+  mi.u_offset = shift.uniform() * scene.texture(m.texture).periodU();
+  mi.v_offset = shift.uniform() * scene.texture(m.texture).periodV();
+  const auto height = [t = terrain.get()](double x, double y) { return t->height(x, y); };
+  scene.addHeightField("terrain", std::make_unique<HeightField>(grid, height), mi);
+  scene.terrain = std::move(terrain);
+}
+
 }  // namespace
 
 std::unique_ptr<Scene> readScene(const Config& c) {
@@ -312,6 +398,7 @@ std::unique_ptr<Scene> readScene(const Config& c) {
   const Config objects = c.section("objects");
   if (objects.keys().empty()) throw ConfigError(c.where("objects") + ": the scene has no objects");
   for (const std::string& name : objects.keys()) readObject(*scene, objects.section(name), name, textures);
+  if (c.has("terrain")) readTerrain(*scene, c.section("terrain"), textures);
   if (c.has("movers")) {
     const Config movers = c.section("movers");
     for (const std::string& name : movers.keys()) readMover(*scene, movers.section(name), name, textures);

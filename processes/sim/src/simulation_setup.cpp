@@ -6,6 +6,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "livo/sim/car_trajectory.hpp"
 #include "livo/sim/lidar_pattern.hpp"
 #include "livo/sim/scene_config.hpp"
 #include "livo/sim/trajectory_config.hpp"
@@ -374,7 +375,9 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   // a car's rear axle is where the wheels truly are
   const SensorRig mounted = trueRig(s.rig, s.calibration_errors);
   const Pose3 T_I_rear_axle = mounted.wheel ? mounted.wheel->T_I_B : Pose3::Identity();
-  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir, T_I_rear_axle);
+  const double track_width = mounted.wheel ? mounted.wheel->track_width : CarTrajectoryOptions().track_width;
+  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir,
+                                               T_I_rear_axle, s.scene->terrain, track_width);
   s.trajectory = std::move(traj.trajectory);
   s.trajectory_description = traj.description;
   s.recorded = traj.recorded;
@@ -454,6 +457,12 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
      << s.scene->textureCount() << " textures";
   if (s.scene->moverCount() > 0) os << ", " << s.scene->moverCount() << " moving objects";
   os << "\n";
+  if (s.scene->terrain) {
+    const Terrain& t = *s.scene->terrain;
+    os << "  terrain: " << t.options().profiles.size() << " grade profiles, " << t.options().relief.size()
+       << " relief waves, grades at most " << t.maxGrade() * 100.0 << " %, curvature at most " << t.maxCurvature()
+       << " /m\n";
+  }
   os << "  trajectory: " << s.trajectory_description << "\n";
   if (s.replaysRecordedImu()) os << "  IMU: the recording's own samples, unchanged\n";
   else

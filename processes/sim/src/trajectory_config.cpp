@@ -85,7 +85,8 @@ TrajectoryConfig readRecorded(const Config& c, const std::string& base_dir) {
 }  // namespace
 
 TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
-                                      const Pose3& T_I_rear_axle) {
+                                      const Pose3& T_I_rear_axle, std::shared_ptr<const Terrain> ground,
+                                      double track_width) {
   const std::string type = c.get<std::string>("type");
   if (type == "recorded") {
     TrajectoryConfig out = readRecorded(c, base_dir);
@@ -106,6 +107,7 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
 
   std::unique_ptr<Path> path;
   std::ostringstream os;
+  double wheelbase = CarTrajectoryOptions().wheelbase;
   if (type == "handheld" || type == "car") {
     const bool car = type == "car";
     const std::vector<Vec3> waypoints = readWaypoints(c);
@@ -121,6 +123,10 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
     }
     o.attitude = AttitudeMode::kFollowHeading;
     o.shake = car ? carShake(shake) : handheldShake(shake);
+    if (car) {
+      wheelbase = positive(c, "wheelbase", wheelbase);
+      track_width = positive(c, "track_width", track_width);
+    }
   } else if (type == "uav") {
     const Vec3 center = c.get<Vec3>("center");
     const Vec3 amplitude = c.get<Vec3>("amplitude");
@@ -147,8 +153,13 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
   if (type == "car") {
     const Vec3 p_BI = T_I_rear_axle.inverse().translation();
     os << "; rear axle " << p_BI.x() << " m behind and " << p_BI.z() << " m below the body origin";
+    if (ground)
+      os << "; on the scene's terrain (grades at most " << ground->maxGrade() * 100.0 << " %, wheelbase "
+         << wheelbase << " m, track " << track_width << " m)";
     out.trajectory = std::make_unique<CarTrajectory>(
-        std::move(path), CarTrajectoryOptions{o.start_still_s, o.ramp_s, o.shake, T_I_rear_axle});
+        std::move(path),
+        CarTrajectoryOptions{o.start_still_s, o.ramp_s, o.shake, T_I_rear_axle, ground, wheelbase,
+                             track_width});
   } else {
     out.trajectory = std::make_unique<ProceduralTrajectory>(std::move(path), o);
   }

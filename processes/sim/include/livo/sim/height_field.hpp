@@ -1,8 +1,9 @@
-// Height-field ground: z = base + relief(x, y) over a rectangle, sampled on a regular grid and
-// ray-cast cell by cell (2-D DDA with per-cell height bounds, two triangles per cell).
+// Height-field ground: z = base + relief(x, y) (or any height function) over a rectangle, sampled on a
+// regular grid and ray-cast cell by cell (2-D DDA with per-cell height bounds, two triangles per cell).
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct HeightFieldOptions {
 class HeightField {
  public:
   explicit HeightField(const HeightFieldOptions& options);
+  /// The grid of `grid` (center x, y, size, resolution; its relief and center z unused) sampled from
+  /// z = height(x, y) at the vertices.
+  HeightField(const HeightFieldOptions& grid, const std::function<double(double, double)>& height);
 
   /// Height of the triangulated surface at (x, y) (base height outside the rectangle).
   double heightAt(double x, double y) const;
@@ -34,11 +38,17 @@ class HeightField {
   double vertex(int i, int j) const { return heights_[static_cast<size_t>(j) * (nx_ + 1) + i]; }
   Vec3 vertexPoint(int i, int j) const { return Vec3(x0_ + i * cell_, y0_ + j * cell_, vertex(i, j)); }
   bool intersectCell(int i, int j, const Ray& ray, double t_lo, double t_hi, double* t, int* tri) const;
+  /// The cell walk (2-D DDA) from the ray's point at t_start until t_end, the nearest hit first.
+  bool walkCells(const Ray& ray, double t_start, double t_end, double t_min, double t_max, double* t,
+                 int* face) const;
 
   int nx_ = 0, ny_ = 0;
   double x0_ = 0.0, y0_ = 0.0, cell_ = 1.0;
   std::vector<double> heights_;               // (nx+1) x (ny+1), absolute z
   std::vector<std::pair<float, float>> cell_range_;  // min/max z per cell
+  static constexpr int kBlock = 16;                   // cells per block side
+  int nbx_ = 0, nby_ = 0;
+  std::vector<std::pair<float, float>> block_range_;  // min/max z per block of kBlock x kBlock cells
   Aabb bounds_;
 };
 

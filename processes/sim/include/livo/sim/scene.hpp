@@ -15,6 +15,7 @@
 #include "livo/sim/height_field.hpp"
 #include "livo/sim/moving_object.hpp"
 #include "livo/sim/shapes.hpp"
+#include "livo/sim/terrain.hpp"
 #include "livo/sim/texture.hpp"
 
 namespace livo::sim {
@@ -64,6 +65,8 @@ class Scene {
   int addTexture(const TextureOptions& options);
   int addShape(const std::string& name, const Shape& shape, const Material& material);
   int addHeightField(const std::string& name, const HeightFieldOptions& options, const Material& material);
+  int addHeightField(const std::string& name, std::unique_ptr<HeightField> field,
+                     const Material& material);
   /// A moving object (opaque or glass); it is not in the BVH but tested at each cast's time.
   int addMover(const std::string& name, const MovingObject& mover, const Material& material);
   /// Builds the acceleration structure; call after the last add*() and before casting.
@@ -103,6 +106,9 @@ class Scene {
 
   Lighting lighting;
   Sky sky;
+  /// The graded ground a car drives on (null: none; the scene's `terrain:`); its surface is one of
+  /// the objects, a height field sampled from it.
+  std::shared_ptr<const Terrain> terrain;
 
  private:
   struct Object {

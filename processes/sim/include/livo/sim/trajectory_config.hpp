@@ -7,6 +7,7 @@
 
 #include "livo/asl_dataset.hpp"
 #include "livo/config.hpp"
+#include "livo/sim/terrain.hpp"
 #include "livo/sim/trajectory.hpp"
 
 namespace livo::sim {
@@ -22,8 +23,11 @@ struct TrajectoryConfig {
 
 /// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths;
 /// `T_I_rear_axle` is where a car's rear axle is, the TRUE wheel base frame (identity: at the body
-/// origin, for a rig without wheel encoder).
+/// origin, for a rig without wheel encoder). A car drives on `ground` when there is one (the scene's
+/// terrain), its wheels `track_width` apart unless the trajectory says otherwise.
 TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
-                                      const Pose3& T_I_rear_axle = Pose3::Identity());
+                                      const Pose3& T_I_rear_axle = Pose3::Identity(),
+                                      std::shared_ptr<const Terrain> ground = nullptr,
+                                      double track_width = 1.6);
 
 }  // namespace livo::sim
