@@ -2,10 +2,13 @@
 tables that compare processes or options on the simulator (planar_wheel_ablation.py,
 visual_coupling_table.py). Not a command of its own.
 
-For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log (or a kept one is
-reused), then scripts/run_pipeline.sh runs each variant on it, recording only what livo-evaluate
-reads, and the row gets per variant the ATE (RMSE after an SE(3) alignment), the end-point drift
-and the share of the run with odometry.
+For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log (or a kept one with the
+same key is reused), then scripts/run_pipeline.sh runs each variant on it, recording only what
+livo-evaluate reads, and the row gets per variant the metrics of livo-evaluate's JSON (METRICS: the
+ATE after an SE(3) and after a 4-DoF alignment, the vertical drift, the roll and pitch RMSE, the
+end-point drift) and the share of the run with odometry. Logs and runs are reused only when the key
+written beside them (what they were made from: config bytes, seed, duration, the executables'
+hashes) matches.
 """
 import hashlib, json, os, subprocess, sys
 
@@ -90,13 +93,6 @@ def build_dir():
     return os.environ.get('LIVO_BUILD_DIR', os.path.join(ROOT, 'build'))
 
 
-def require_tools(script, tools):
-    bin_dir = os.path.join(build_dir(), 'bin')
-    for tool in tools:
-        if not os.access(os.path.join(bin_dir, tool), os.X_OK):
-            raise SystemExit('%s: %s missing: run scripts/build.sh' % (script, os.path.join(bin_dir, tool)))
-
-
 def config_path(script, name):
     config = os.path.join(ROOT, 'config', 'sim', name + '.yaml')
     if not os.path.exists(config):
@@ -124,21 +120,49 @@ def run_variant(v, log, config, run_dir, base, bin_dir, env):
     return evaluation(run_dir) if ok else None
 
 
-def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, check_row=None, durations=None,
-          resume=False):
-    """Runs every variant on every config x seed. Returns (rows, failures): a row is
-    {'config', 'seed', 'length', variant name: (ATE m, end-point drift m, coverage)}; check_row(row,
-    failures) adds the failures of a finished row. durations maps a config to its own duration.
-    Logs go to logs/NAME_sSEED_DURs.lcmlog when `logs` is given (reused when there, kept), else
-    beside the runs (removed unless keep_logs). resume: a run whose directory already holds its
-    evaluation is not run again (the log is then not needed)."""
+# what a run's row holds per variant, from livo-evaluate's JSON
+METRICS = (
+    ('ate', 'ATE m', lambda e: e['ate']['rmse']),
+    ('ate_4dof', 'ATE 4-DoF m', lambda e: e.get('ate_4dof')),
+    ('z_end', 'z error at the end m', lambda e: e.get('vertical', {}).get('end_m')),
+    ('z_per_100m', 'z error per 100 m', lambda e: e.get('vertical', {}).get('per_100m')),
+    ('roll', 'roll RMSE deg', lambda e: e.get('attitude', {}).get('roll_rmse_deg')),
+    ('pitch', 'pitch RMSE deg', lambda e: e.get('attitude', {}).get('pitch_rmse_deg')),
+    ('end', 'end-point drift m', lambda e: e['end_point']['translation_m']),
+)
+PIPELINE_TOOLS = ('livo-sim', 'livo-playback', 'livo-record', 'livo-evaluate', 'livo-config', 'livo-loginfo',
+                  'livo-report')
+
+
+def metrics_of(e):
+    return {name: get(e) for name, _, get in METRICS} | {'coverage': e['ate']['coverage']}
+
+
+def sweep(script, configs, seeds, duration, variants, out, executables, logs=None, keep_logs=False,
+          durations=None, resume=False):
+    """Runs every variant on every config x seed. Returns (rows, failures): a row is {'config', 'seed',
+    'duration', 'length', variant name: metrics_of(its evaluation)}; a variant that did not run or
+    wrote no trajectory is a failure and has no entry, one with odometry over less than 90 % of the
+    log a failure with its entry. durations maps
+    a config to its own duration. `executables` (build/bin names) are what the variants run besides
+    the pipeline's tools; exits naming a missing one.
+
+    Logs go to logs/NAME_sSEED_DURs.lcmlog when `logs` is given (kept), else beside the runs (removed
+    unless keep_logs); a log is reused only when its key (the config's bytes, seed, duration and
+    livo-sim's hash, written beside it) matches. resume: a run is reused only when the key written
+    beside its evaluation (config bytes, the variant's processes, swaps and overlay, seed, duration,
+    the log's key, the executables' and run_pipeline.sh's hashes) matches; else it runs again."""
     build = build_dir()
     bin_dir = os.path.join(build, 'bin')
+    tools = sorted(set(PIPELINE_TOOLS) | set(executables))
+    sim, sim_hash, run_hash = keyed_executables(script, build, tools,
+                                                [os.path.join(ROOT, 'scripts', 'run_pipeline.sh')])
     env = dict(os.environ, LIVO_BUILD_DIR=build)
     os.makedirs(out, exist_ok=True)
     rows, failures = [], []
     for name in configs:
-        config = config_path('sim_variants.py', name)
+        config = config_path(script, name)
+        config_bytes = open(config, 'rb').read()
         dur = (durations or {}).get(name, duration)
         for seed in seeds:
             tag = '%s_s%s' % (name, seed)
@@ -147,53 +171,111 @@ def sweep(configs, seeds, duration, variants, out, logs=None, keep_logs=False, c
             if logs:
                 os.makedirs(logs, exist_ok=True)
             log = os.path.join(logs, '%s_%gs.lcmlog' % (tag, dur)) if logs else base + '.lcmlog'
+            log_key = key_of(config_bytes, seed, dur, sim_hash)
+            run_keys = {v.name: key_of(config_bytes, v.processes, sorted(v.swaps.items()), v.overlay, v.record,
+                                       seed, dur, log_key, run_hash) for v in variants}
+            done = {v.name: resume and cached(os.path.join(base, v.name, 'evaluation_odometry.json'),
+                                              run_keys[v.name]) for v in variants}
             made_log = False
-            done = resume and all(evaluation(os.path.join(base, v.name)) for v in variants)
-            if not done and not os.path.exists(log):
+            if not all(done.values()) and not cached(log, log_key):
                 print('%s: simulating %g s' % (tag, dur), file=sys.stderr, flush=True)
                 part = '%s.%d.part' % (log, os.getpid())  # a concurrent run simulating the same log keeps its own
-                if not run([os.path.join(bin_dir, 'livo-sim'), '--config', config, '--out', part, '--seed', seed,
-                            '--duration', str(dur), '--quiet'], base + '.sim.txt'):
+                if not run([sim, '--config', config, '--out', part, '--seed', seed, '--duration', str(dur),
+                            '--quiet'], base + '.sim.txt'):
                     failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                     continue
                 os.replace(part, log)
+                mark(log, log_key)
                 made_log = True
             row = {'config': name, 'seed': seed, 'duration': dur}
             for v in variants:
                 run_dir = os.path.join(base, v.name)
-                e = evaluation(run_dir) if resume else None
-                if e is None:
+                done_file = os.path.join(run_dir, 'evaluation_odometry.json')
+                if done[v.name]:
+                    e = evaluation(run_dir)
+                else:
                     print('%s: %s' % (tag, v.name), file=sys.stderr, flush=True)
+                    if os.path.exists(done_file + '.key'):
+                        os.remove(done_file + '.key')
                     e = run_variant(v, log, config, run_dir, base, bin_dir, env)
+                    if e is not None:
+                        mark(done_file, run_keys[v.name])
                 if e is None:
-                    failures.append('%s: the %s run failed (%s/%s.txt)' % (tag, v.name, base, v.name))
+                    failures.append('%s: the %s run failed or wrote no trajectory (%s/%s.txt)' % (tag, v.name, base, v.name))
                     continue
-                row[v.name] = (e['ate']['rmse'], e['end_point']['translation_m'], e['ate']['coverage'])
-                row['length'] = e['end_point']['path_length_m']
                 if e['ate']['coverage'] < 0.9:
                     failures.append('%s: %s has odometry over only %.0f %% of the run' % (tag, v.name, 100 * e['ate']['coverage']))
+                row[v.name] = metrics_of(e)
+                row['length'] = e['end_point']['path_length_m']
             rows.append(row)
-            if check_row:
-                check_row(row, failures)
             if made_log and not keep_logs and not logs:
                 os.remove(log)
+                os.remove(log + '.key')
     return rows, failures
 
 
-def markdown(rows, shown, bold=lambda row, variant: False):
-    """The table: per row config, seed, seconds, distance and 'ATE / end-point drift' per variant."""
-    lines = ['| config | seed | s | distance m | ' + ' | '.join(shown) + ' |',
-             '| --- | --- | --- | --- | ' + ' | '.join('---' for _ in shown) + ' |']
+def missing_variants(bar, needed, chosen, failures):
+    """A bar whose variants were not all chosen is a failure (not checked is not met); False then."""
+    left_out = [v for v in needed if v not in chosen]
+    if left_out:
+        failures.append('%s: not checked, variant(s) %s not run' % (bar, ','.join(left_out)))
+    return not left_out
+
+
+def per_config(rows, variants, metric, magnitude=False):
+    """{config: {variant: [value per run]}} of one metric over the rows that have it."""
+    table = {}
     for r in rows:
-        cells = []
+        for v in variants:
+            if v in r and r[v].get(metric) is not None:
+                x = r[v][metric]
+                table.setdefault(r['config'], {}).setdefault(v, []).append(abs(x) if magnitude else x)
+    return table
+
+
+def mean_sd(xs):
+    """Mean and sample standard deviation (0 for one value)."""
+    m = sum(xs) / len(xs)
+    sd = (sum((x - m) ** 2 for x in xs) / (len(xs) - 1)) ** 0.5 if len(xs) > 1 else 0.0
+    return m, sd
+
+
+def fmt(x, digits=4):
+    return '-' if x is None else '%.*f' % (digits, x)
+
+
+def markdown(rows, shown, bold=lambda row, variant: False):
+    """Per run and variant every metric (METRICS); bold: the variants `bold` picks."""
+    lines = ['| config | seed | s | distance m | variant | ' + ' | '.join(h for _, h, _ in METRICS) + ' |',
+             '| --- | --- | --- | --- | --- | ' + ' | '.join('---' for _ in METRICS) + ' |']
+    for r in rows:
         for v in shown:
             if v not in r:
-                cells.append('-')
-                continue
-            cell = '%.4f / %.3f' % r[v][:2]
-            cells.append('**%s**' % cell if bold(r, v) else cell)
-        lines.append('| %s | %s | %g | %s | %s |' % (r['config'], r['seed'], r['duration'],
-                                                     '%.0f' % r['length'] if 'length' in r else '-', ' | '.join(cells)))
+                cells = ['(did not run)'] + ['-'] * (len(METRICS) - 1)
+            else:
+                cells = [fmt(r[v][m], 3 if m in ('roll', 'pitch', 'end', 'z_end', 'z_per_100m') else 4)
+                         for m, _, _ in METRICS]
+            name = '**%s**' % v if v in r and bold(r, v) else v
+            lines.append('| %s | %s | %g | %s | %s | %s |' % (r['config'], r['seed'], r['duration'],
+                                                            '%.0f' % r['length'] if 'length' in r else '-', name,
+                                                            ' | '.join(cells)))
+    return lines
+
+
+def summary(rows, shown):
+    """Per config and variant the mean ± standard deviation over its runs of every metric (the
+    vertical errors as magnitudes: a drift up and one down do not cancel)."""
+    lines = ['| config | variant | runs | ' + ' | '.join(h for _, h, _ in METRICS) + ' |',
+             '| --- | --- | --- | ' + ' | '.join('---' for _ in METRICS) + ' |']
+    tables = {m: per_config(rows, shown, m, magnitude=m in ('z_end', 'z_per_100m')) for m, _, _ in METRICS}
+    for config in dict.fromkeys(r['config'] for r in rows):
+        for v in shown:
+            cells, n = [], 0
+            for m, _, _ in METRICS:
+                xs = tables[m].get(config, {}).get(v, [])
+                n = max(n, len(xs))
+                cells.append('%s ± %s' % (fmt(mean_sd(xs)[0]), fmt(mean_sd(xs)[1])) if xs else '-')
+            lines.append('| %s | %s | %d | %s |' % (config, v, n, ' | '.join(cells)))
     return lines
 
 

@@ -128,8 +128,12 @@ rc=$?
 /usr/bin/python3 - "$dir/coupling/table.md" <<'PY' || { cat "$dir/coupling.txt"; exit 1; }
 import re, sys
 rows = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | 1 |')]
-assert len(rows) == 1, rows
-cells = [c.strip().strip('*') for c in rows[0].strip().strip('|').split('|')][4:]
-assert len(cells) == 3 and all(re.fullmatch(r'\d+\.\d{4} / \d+\.\d{3}', c) for c in cells), cells
-print('coupling table row:', rows[0].strip())
+assert len(rows) == 3, rows  # a line per variant
+for row in rows:
+    cells = [c.strip().strip('*') for c in row.strip().strip('|').split('|')][5:]
+    # ATE, 4-DoF ATE, z at the end, z per 100 m, roll, pitch, end-point drift
+    assert len(cells) == 7 and all(re.fullmatch(r'-?\d+\.\d{3,4}', c) for c in cells), cells
+summary = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | ') and ' ± ' in l]
+assert len(summary) == 3, summary  # mean ± sd per variant
+print('coupling table:', *[r.strip() for r in rows], sep='\n')
 PY
