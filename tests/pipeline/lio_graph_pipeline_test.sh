@@ -84,15 +84,6 @@ echo stale >"$dir/ablation/bridge_deck_s1/lio/evaluation_odometry.json.key"
   --duration 4 --variants graph,graph-bare,lio --resume >"$dir/ablation3.txt" 2>&1
 grep -q '^bridge_deck_s1: lio$' "$dir/ablation3.txt" && ! grep -Eq '^bridge_deck_s1: graph(-bare)?$' "$dir/ablation3.txt" ||
   { cat "$dir/ablation3.txt"; fail "--resume did not run again exactly the run whose key changed"; }
-/usr/bin/python3 - "$dir/ablation/table.md" <<'PY' || { cat "$dir/ablation.txt"; exit 1; }
-import re, sys
-rows = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | 1 |')]
-assert len(rows) == 3, rows  # a line per variant
-for row in rows:
-    cells = [c.strip().strip('*') for c in row.strip().strip('|').split('|')][5:]
-    # ATE, 4-DoF ATE, z at the end, z per 100 m, roll, pitch, end-point drift
-    assert len(cells) == 7 and all(re.fullmatch(r'-?\d+\.\d{3,4}', c) for c in cells), cells
-summary = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | ') and ' ± ' in l]
-assert len(summary) == 3, summary  # mean ± sd per variant
-print('ablation table:', *[r.strip() for r in rows], sep='\n')
-PY
+echo "ablation table:"
+/usr/bin/python3 "$root/tests/pipeline/check_variant_table.py" "$dir/ablation/table.md" bridge_deck 1 3 ||
+  { cat "$dir/ablation.txt"; fail "the ablation table is not what it should be"; }

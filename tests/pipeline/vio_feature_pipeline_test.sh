@@ -125,15 +125,6 @@ PY
   --duration 4 >"$dir/coupling.txt" 2>&1
 rc=$?
 [ $rc -le 1 ] || { cat "$dir/coupling.txt"; fail "visual_coupling_table.py failed ($rc)"; }
-/usr/bin/python3 - "$dir/coupling/table.md" <<'PY' || { cat "$dir/coupling.txt"; exit 1; }
-import re, sys
-rows = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | 1 |')]
-assert len(rows) == 3, rows  # a line per variant
-for row in rows:
-    cells = [c.strip().strip('*') for c in row.strip().strip('|').split('|')][5:]
-    # ATE, 4-DoF ATE, z at the end, z per 100 m, roll, pitch, end-point drift
-    assert len(cells) == 7 and all(re.fullmatch(r'-?\d+\.\d{3,4}', c) for c in cells), cells
-summary = [l for l in open(sys.argv[1]) if l.startswith('| bridge_deck | ') and ' ± ' in l]
-assert len(summary) == 3, summary  # mean ± sd per variant
-print('coupling table:', *[r.strip() for r in rows], sep='\n')
-PY
+echo "coupling table:"
+/usr/bin/python3 "$root/tests/pipeline/check_variant_table.py" "$dir/coupling/table.md" bridge_deck 1 3 ||
+  { cat "$dir/coupling.txt"; fail "the coupling table is not what it should be"; }

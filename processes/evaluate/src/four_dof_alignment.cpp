@@ -17,19 +17,8 @@ namespace livo::evaluate {
 // largest, equal to hypot(a, b), at psi = atan2(b, a); undefined when a = b = 0.
 // The z offset is the difference of the mean heights (the z row of t).
 Similarity3 fourDofAlignment(const std::vector<Vec3>& source, const std::vector<Vec3>& target) {
-  if (source.size() != target.size())
-    throw AlignmentError("alignment needs as many source as target points (" + std::to_string(source.size()) +
-                         " vs " + std::to_string(target.size()) + ")");
-  if (source.empty()) throw AlignmentError("alignment needs at least one pair of points");
-  const double n = static_cast<double>(source.size());
-
-  Vec3 mean_x = Vec3::Zero(), mean_y = Vec3::Zero();
-  for (size_t i = 0; i < source.size(); ++i) {
-    mean_x += source[i];
-    mean_y += target[i];
-  }
-  mean_x /= n;
-  mean_y /= n;
+  const PairedCentroids centroids = pairedCentroids(source, target);
+  const Vec3 &mean_x = centroids.source, &mean_y = centroids.target;
 
   double a = 0.0, b = 0.0, spread_x = 0.0, spread_y = 0.0;
   for (size_t i = 0; i < source.size(); ++i) {

@@ -20,20 +20,25 @@ Eigen::Matrix4d Similarity3::matrix() const {
   return m;
 }
 
-Similarity3 umeyamaAlignment(const std::vector<Vec3>& source, const std::vector<Vec3>& target, bool with_scale) {
+PairedCentroids pairedCentroids(const std::vector<Vec3>& source, const std::vector<Vec3>& target) {
   if (source.size() != target.size())
     throw AlignmentError("alignment needs as many source as target points (" + std::to_string(source.size()) +
                          " vs " + std::to_string(target.size()) + ")");
   if (source.empty()) throw AlignmentError("alignment needs at least one pair of points");
-  const double n = static_cast<double>(source.size());
-
-  Vec3 mean_x = Vec3::Zero(), mean_y = Vec3::Zero();
+  PairedCentroids c;
   for (size_t i = 0; i < source.size(); ++i) {
-    mean_x += source[i];
-    mean_y += target[i];
+    c.source += source[i];
+    c.target += target[i];
   }
-  mean_x /= n;
-  mean_y /= n;
+  c.source /= static_cast<double>(source.size());
+  c.target /= static_cast<double>(source.size());
+  return c;
+}
+
+Similarity3 umeyamaAlignment(const std::vector<Vec3>& source, const std::vector<Vec3>& target, bool with_scale) {
+  const double n = static_cast<double>(source.size());
+  const PairedCentroids centroids = pairedCentroids(source, target);
+  const Vec3 &mean_x = centroids.source, &mean_y = centroids.target;
 
   double sigma_x = 0.0;  // variance of the source, eq. 36
   Mat3 cov = Mat3::Zero();  // cross-covariance, eq. 38

@@ -89,6 +89,38 @@ bool intersectTriangle(const Ray& r, const Vec3& a, const Vec3& b, const Vec3& c
   *t = tt;
   return true;
 }
+
+/// The 2-D DDA: the cells of a grid of square cells of side `size` from (x0, y0), nx x ny of them,
+/// that the ray crosses from the cell of its point at t0 until t1, in order. visit(i, j, t_enter,
+/// t_exit) returns true to stop the walk (a hit), which then returns true.
+template <class Visit>
+bool walkGrid(const Ray& r, double t0, double t1, double x0, double y0, double size, int nx, int ny, Visit&& visit) {
+  const Vec3 entry = r.origin + t0 * r.direction;
+  int i = std::clamp(static_cast<int>(std::floor((entry.x() - x0) / size)), 0, nx - 1);
+  int j = std::clamp(static_cast<int>(std::floor((entry.y() - y0) / size)), 0, ny - 1);
+  const int step_i = r.direction.x() > 0.0 ? 1 : -1, step_j = r.direction.y() > 0.0 ? 1 : -1;
+  const double dx = std::abs(r.direction.x()) > 1e-15 ? size / std::abs(r.direction.x()) : kInfinity;
+  const double dy = std::abs(r.direction.y()) > 1e-15 ? size / std::abs(r.direction.y()) : kInfinity;
+  const double bx = x0 + (i + (step_i > 0 ? 1 : 0)) * size, by = y0 + (j + (step_j > 0 ? 1 : 0)) * size;
+  double next_x = dx < kInfinity ? (bx - r.origin.x()) / r.direction.x() : kInfinity;
+  double next_y = dy < kInfinity ? (by - r.origin.y()) / r.direction.y() : kInfinity;
+  double t_enter = t0;
+  while (true) {
+    const double t_exit = std::min({next_x, next_y, t1});
+    if (visit(i, j, t_enter, t_exit)) return true;
+    if (t_exit >= t1) return false;
+    if (next_x < next_y) {
+      i += step_i;
+      t_enter = next_x;
+      next_x += dx;
+    } else {
+      j += step_j;
+      t_enter = next_y;
+      next_y += dy;
+    }
+    if (i < 0 || j < 0 || i >= nx || j >= ny) return false;
+  }
+}
 }  // namespace
 
 bool HeightField::intersectCell(int i, int j, const Ray& ray, double t_lo, double t_hi, double* t, int* tri) const {
@@ -108,76 +140,28 @@ bool HeightField::intersect(const PreparedRay& pr, double t_min, double t_max, d
   double t0 = t_min, t1 = t_max;
   if (!bounds_.clip(pr, &t0, &t1)) return false;
   const Ray& r = pr.ray;
-  // the same 2-D DDA over blocks; the cells of a block the ray may meet are walked
-  const double block = kBlock * cell_;
-  const Vec3 entry = r.origin + t0 * r.direction;
-  int i = std::clamp(static_cast<int>(std::floor((entry.x() - x0_) / block)), 0, nbx_ - 1);
-  int j = std::clamp(static_cast<int>(std::floor((entry.y() - y0_) / block)), 0, nby_ - 1);
-  const int step_i = r.direction.x() > 0.0 ? 1 : -1, step_j = r.direction.y() > 0.0 ? 1 : -1;
-  const double dx = std::abs(r.direction.x()) > 1e-15 ? block / std::abs(r.direction.x()) : kInfinity;
-  const double dy = std::abs(r.direction.y()) > 1e-15 ? block / std::abs(r.direction.y()) : kInfinity;
-  const double bx = x0_ + (i + (step_i > 0 ? 1 : 0)) * block, by = y0_ + (j + (step_j > 0 ? 1 : 0)) * block;
-  double next_x = dx < kInfinity ? (bx - r.origin.x()) / r.direction.x() : kInfinity;
-  double next_y = dy < kInfinity ? (by - r.origin.y()) / r.direction.y() : kInfinity;
-  double t_enter = t0;
-  while (true) {
-    const double t_exit = std::min({next_x, next_y, t1});
+  // the DDA over blocks; the cells of a block whose heights the ray reaches are walked
+  return walkGrid(r, t0, t1, x0_, y0_, kBlock * cell_, nbx_, nby_, [&](int i, int j, double t_enter, double t_exit) {
     const double za = r.origin.z() + t_enter * r.direction.z(), zb = r.origin.z() + t_exit * r.direction.z();
     const auto& range = block_range_[static_cast<size_t>(j) * nbx_ + i];
-    if (std::max(za, zb) >= range.first - 1e-6 && std::min(za, zb) <= range.second + 1e-6 &&
-        walkCells(r, t_enter, t_exit, t_min, t_max, t, face))
-      return true;
-    if (t_exit >= t1) return false;
-    if (next_x < next_y) {
-      i += step_i;
-      t_enter = next_x;
-      next_x += dx;
-    } else {
-      j += step_j;
-      t_enter = next_y;
-      next_y += dy;
-    }
-    if (i < 0 || j < 0 || i >= nbx_ || j >= nby_) return false;
-  }
+    return std::max(za, zb) >= range.first - 1e-6 && std::min(za, zb) <= range.second + 1e-6 &&
+           walkCells(r, t_enter, t_exit, t_min, t_max, t, face);
+  });
 }
 
 bool HeightField::walkCells(const Ray& r, double t_start, double t_end, double t_min, double t_max, double* t,
                             int* face) const {
-  const double t0 = t_start, t1 = t_end;
-  const Vec3 entry = r.origin + t0 * r.direction;
-  int i = std::clamp(static_cast<int>(std::floor((entry.x() - x0_) / cell_)), 0, nx_ - 1);
-  int j = std::clamp(static_cast<int>(std::floor((entry.y() - y0_) / cell_)), 0, ny_ - 1);
-  const int step_i = r.direction.x() > 0.0 ? 1 : -1, step_j = r.direction.y() > 0.0 ? 1 : -1;
-  const double dx = std::abs(r.direction.x()) > 1e-15 ? cell_ / std::abs(r.direction.x()) : kInfinity;
-  const double dy = std::abs(r.direction.y()) > 1e-15 ? cell_ / std::abs(r.direction.y()) : kInfinity;
-  const double bx = x0_ + (i + (step_i > 0 ? 1 : 0)) * cell_, by = y0_ + (j + (step_j > 0 ? 1 : 0)) * cell_;
-  double next_x = dx < kInfinity ? (bx - r.origin.x()) / r.direction.x() : kInfinity;
-  double next_y = dy < kInfinity ? (by - r.origin.y()) / r.direction.y() : kInfinity;
-  double t_enter = t0;
-  const double slack = 1e-9 * (1.0 + std::abs(t1));
-  while (true) {
-    const double t_exit = std::min({next_x, next_y, t1});
+  const double slack = 1e-9 * (1.0 + std::abs(t_end));
+  return walkGrid(r, t_start, t_end, x0_, y0_, cell_, nx_, ny_, [&](int i, int j, double t_enter, double t_exit) {
     const double za = r.origin.z() + t_enter * r.direction.z(), zb = r.origin.z() + t_exit * r.direction.z();
     const auto& range = cell_range_[static_cast<size_t>(j) * nx_ + i];
-    if (std::max(za, zb) >= range.first - 1e-9 && std::min(za, zb) <= range.second + 1e-9) {
-      int tri;
-      if (intersectCell(i, j, r, std::max(t_min, t_enter - slack), std::min(t_max, t_exit + slack), t, &tri)) {
-        *face = (j * nx_ + i) * 2 + tri;
-        return true;
-      }
-    }
-    if (t_exit >= t1) return false;
-    if (next_x < next_y) {
-      i += step_i;
-      t_enter = next_x;
-      next_x += dx;
-    } else {
-      j += step_j;
-      t_enter = next_y;
-      next_y += dy;
-    }
-    if (i < 0 || j < 0 || i >= nx_ || j >= ny_) return false;
-  }
+    if (std::max(za, zb) < range.first - 1e-9 || std::min(za, zb) > range.second + 1e-9) return false;
+    int tri;
+    if (!intersectCell(i, j, r, std::max(t_min, t_enter - slack), std::min(t_max, t_exit + slack), t, &tri))
+      return false;
+    *face = (j * nx_ + i) * 2 + tri;
+    return true;
+  });
 }
 
 SurfacePoint HeightField::surface(const Ray& ray, double t, int face) const {

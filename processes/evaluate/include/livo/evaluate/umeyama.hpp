@@ -27,6 +27,13 @@ struct Similarity3 {
   Eigen::Matrix4d matrix() const;
 };
 
+/// The centroids of two point sets paired index by index, the first step of every least-squares
+/// alignment here. Throws AlignmentError if the sets differ in size or are empty.
+struct PairedCentroids {
+  Vec3 source = Vec3::Zero(), target = Vec3::Zero();
+};
+PairedCentroids pairedCentroids(const std::vector<Vec3>& source, const std::vector<Vec3>& target);
+
 /// The similarity mapping `source` onto `target` in the least-squares sense (point k onto point k);
 /// scale is fixed to 1 unless `with_scale`. Throws AlignmentError if the sets differ in size, are
 /// empty, or their cross-covariance has rank below 2 (all points on one line).
