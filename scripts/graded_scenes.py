@@ -304,7 +304,8 @@ def long_slope():
     w.comment("a farm shed beside the top of the climb and one at the foot (far off the road)")
     w.box("buildings", "shed_low", -70.0, 30.0, 14.0, 9.0, 5.0, tex("panels", 0.5), pitch=False, margin=0.05)
     w.box("buildings", "shed_high", 360.0, -34.0, 18.0, 10.0, 6.0, tex("brick", 0.4), pitch=False, margin=0.05)
-    tail = ""
+    tail = ("  # under the verges: a level plane below every piece, so that no seam between two pieces shows the sky\n"
+            "  under_verges: {type: plane, center: [150, 0, -0.12], texture: grass, reflectivity: 0.3}\n")
     header = """# One long straight climb (issue 44, "Terrain": a long slope where a LiDAR with a narrow vertical
 # field sees little ground ahead). A two-lane road along x, 10 m of asphalt (crowned lanes of 4 m and
 # 1 m shoulders) between 15 cm kerbs, grass verges, sparse roadside structure: a fence 9 m north,
@@ -474,7 +475,10 @@ textures:
   # curvature up to 0.042 /m (the crown's rounding): 0.25 m cells keep the triangles within 0.7 mm
   surface: {center: [0, 0], size: [900, 10], resolution: 0.25, texture: asphalt, reflectivity: 0.2}
 """
-    write(os.path.join(ROOT, "config/sim/scenes/bridge_deck_graded.yaml"), header, terrain, head, w)
+    tail = ("  # under the land at both ends: a level plane below every piece, so that no seam between two pieces\n"
+            "  # shows the sky (the water stays visible beside the deck)\n"
+            "  under_land: {type: plane, center: [-550, 0, -3.82], size: [500, 1200], texture: grass, reflectivity: 0.3, repeat: {count: 2, step: [1100, 0, 0]}}\n")
+    write(os.path.join(ROOT, "config/sim/scenes/bridge_deck_graded.yaml"), header, terrain, head, w, tail)
 
 
 # ---------------------------------------------------------------------------------------------
