@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "livo/sim/car_trajectory.hpp"
 #include "livo/sim/scene_config.hpp"
@@ -130,6 +131,25 @@ TEST(Terrain, GradientAndHessianAreTheHeightsDerivatives) {
   EXPECT_NEAR(r->maxCurvature(), kGrade / 20.0, 1e-15);
   EXPECT_THROW(Terrain({0.0, {GradeProfile{0.0, Vec2::Zero(), {0.0, 10.0}, {0.0, 1.0}, 20.0}}, {}}),
                std::invalid_argument);
+}
+
+/// The error names what is wrong: stations out of order are not "too close", NaN is refused.
+TEST(Terrain, RefusesStationsOutOfOrderAndNonFiniteNumbers) {
+  const auto message = [](const TerrainOptions& o) {
+    try {
+      Terrain t(o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message({0.0, {GradeProfile{0.0, Vec2::Zero(), {100.0, 0.0}, {0.0, 1.0}, 20.0}}, {}}).find("must increase"),
+            std::string::npos);
+  EXPECT_NE(message({0.0, {GradeProfile{0.0, Vec2::Zero(), {0.0, 100.0}, {0.0, NAN}, 20.0}}, {}}).find("non-finite"),
+            std::string::npos);
+  EXPECT_NE(message({0.0, {}, {ReliefWave{NAN, 100.0, 0.0, 0.0}}}).find("finite"), std::string::npos);
+  EXPECT_NE(message({NAN, {}, {}}).find("base"), std::string::npos);
+  EXPECT_EQ(message({0.0, {ramp()}, {ReliefWave{0.1, 50.0, 30.0, 10.0}}}), "accepted");
 }
 
 TEST(CarOnTerrain, PitchesWithAFivePercentRampAndClimbsIt) {

@@ -17,6 +17,7 @@ Vec2 unitDirection(double deg) {
 }  // namespace
 
 Terrain::Terrain(const TerrainOptions& options) : options_(options) {
+  if (!std::isfinite(options.base)) throw std::invalid_argument("terrain: base must be finite");
   for (size_t k = 0; k < options.profiles.size(); ++k) {
     const GradeProfile& g = options.profiles[k];
     const std::string name = "terrain profile " + std::to_string(k) + ": ";
@@ -24,6 +25,16 @@ Terrain::Terrain(const TerrainOptions& options) : options_(options) {
     if (n < 2) throw std::invalid_argument(name + "needs at least 2 stations");
     if (g.heights.size() != n) throw std::invalid_argument(name + "needs one height per station");
     if (!(g.curve_length > 0.0)) throw std::invalid_argument(name + "curve_length must be > 0");
+    if (!g.origin.allFinite() || !std::isfinite(g.direction_deg))
+      throw std::invalid_argument(name + "origin and direction_deg must be finite");
+    for (size_t i = 0; i < n; ++i)
+      if (!std::isfinite(g.stations[i]) || !std::isfinite(g.heights[i]))
+        throw std::invalid_argument(name + "station " + std::to_string(i) + " has a non-finite position or height");
+    for (size_t i = 1; i < n; ++i)
+      if (!(g.stations[i] > g.stations[i - 1]))
+        throw std::invalid_argument(name + "stations must increase (station " + std::to_string(i) + " at " +
+                                    std::to_string(g.stations[i]) + " m follows " +
+                                    std::to_string(g.stations[i - 1]) + " m)");
     Profile p;
     p.direction = unitDirection(g.direction_deg);
     p.origin = g.origin;
@@ -48,11 +59,19 @@ Terrain::Terrain(const TerrainOptions& options) : options_(options) {
   }
   for (size_t k = 0; k < options.relief.size(); ++k) {
     const ReliefWave& w = options.relief[k];
-    if (!(w.wavelength > 0.0))
-      throw std::invalid_argument("terrain relief wave " + std::to_string(k) + ": wavelength must be > 0");
-    const double kw = 2.0 * M_PI / w.wavelength;
-    max_grade_ += std::abs(w.amplitude) * kw;
-    max_curvature_ += std::abs(w.amplitude) * kw * kw;
+    const std::string name = "terrain relief wave " + std::to_string(k) + ": ";
+    if (!(w.wavelength > 0.0) || !std::isfinite(w.wavelength))
+      throw std::invalid_argument(name + "wavelength must be finite and > 0");
+    if (!std::isfinite(w.amplitude) || !std::isfinite(w.direction_deg) || !std::isfinite(w.phase_deg))
+      throw std::invalid_argument(name + "amplitude, direction_deg and phase_deg must be finite");
+    Wave v;
+    v.direction = unitDirection(w.direction_deg);
+    v.wavenumber = 2.0 * M_PI / w.wavelength;
+    v.phase = w.phase_deg * M_PI / 180.0;
+    v.amplitude = w.amplitude;
+    max_grade_ += std::abs(w.amplitude) * v.wavenumber;
+    max_curvature_ += std::abs(w.amplitude) * v.wavenumber * v.wavenumber;
+    waves_.push_back(v);
   }
 }
 
@@ -90,10 +109,10 @@ GroundJet Terrain::at(double x, double y) const {
     g.gradient += f[1] * p.direction;
     g.hessian += f[2] * p.direction * p.direction.transpose();
   }
-  for (const ReliefWave& w : options_.relief) {
-    const Vec2 d = unitDirection(w.direction_deg);
-    const double kw = 2.0 * M_PI / w.wavelength;
-    const double arg = kw * d.dot(q) + w.phase_deg * M_PI / 180.0;
+  for (const Wave& w : waves_) {
+    const Vec2& d = w.direction;
+    const double kw = w.wavenumber;
+    const double arg = kw * d.dot(q) + w.phase;
     const double sn = std::sin(arg), cs = std::cos(arg);
     g.height += w.amplitude * sn;
     g.gradient += w.amplitude * kw * cs * d;

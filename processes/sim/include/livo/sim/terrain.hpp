@@ -46,7 +46,7 @@ struct GroundJet {
 class Terrain {
  public:
   /// Throws std::invalid_argument for stations that do not increase, overlapping vertical curves,
-  /// sizes that disagree or non-positive lengths.
+  /// sizes that disagree, non-positive lengths or non-finite numbers.
   explicit Terrain(const TerrainOptions& options);
 
   GroundJet at(double x, double y) const;
@@ -65,11 +65,17 @@ class Terrain {
     std::vector<double> grades;  // grades[i] runs into station i; grades[0] = grades[n] = 0
     double curve_length = 0.0;
   };
+  struct Wave {
+    Vec2 direction;                            // unit
+    double wavenumber = 0.0, phase = 0.0;      // rad/m, rad
+    double amplitude = 0.0;                    // m
+  };
   /// Height, slope and second derivative of a profile at station s.
   static void profileAt(const Profile& p, double s, double out[3]);
 
   TerrainOptions options_;
   std::vector<Profile> profiles_;
+  std::vector<Wave> waves_;
   double max_grade_ = 0.0, max_curvature_ = 0.0;
 };
 
