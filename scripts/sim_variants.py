@@ -89,6 +89,31 @@ def has_camera(config):
     return False
 
 
+def config_duration(config):
+    """A config file's sim.duration_s (seconds), None if it has none."""
+    in_sim = False
+    for line in open(config):
+        if line.startswith('sim:'):
+            in_sim = True
+        elif line[:1].isalpha():
+            in_sim = False
+        elif in_sim and line.startswith('  duration_s:'):
+            return float(line.split(':', 1)[1].split('#', 1)[0])
+    return None
+
+
+def parse_durations(script, text):
+    """--duration-of's NAME=SECONDS,... as a dict."""
+    durations = {}
+    for item in filter(None, text.split(',')):
+        name, _, seconds = item.partition('=')
+        try:
+            durations[name] = float(seconds)
+        except ValueError:
+            raise SystemExit('%s: --duration-of wants NAME=SECONDS, not %r' % (script, item))
+    return durations
+
+
 def build_dir():
     return os.environ.get('LIVO_BUILD_DIR', os.path.join(ROOT, 'build'))
 
@@ -130,8 +155,8 @@ METRICS = (
     ('pitch', 'pitch RMSE deg', lambda e: e.get('attitude', {}).get('pitch_rmse_deg')),
     ('end', 'end-point drift m', lambda e: e['end_point']['translation_m']),
 )
-PIPELINE_TOOLS = ('livo-sim', 'livo-playback', 'livo-record', 'livo-evaluate', 'livo-config', 'livo-loginfo',
-                  'livo-report')
+# what a variant's run executes besides its own processes (livo-sim is keyed through the log's key)
+PIPELINE_TOOLS = ('livo-playback', 'livo-record', 'livo-evaluate', 'livo-config', 'livo-loginfo', 'livo-report')
 
 
 def metrics_of(e):
@@ -139,15 +164,17 @@ def metrics_of(e):
 
 
 def sweep(script, configs, seeds, duration, variants, out, executables, logs=None, keep_logs=False,
-          durations=None, resume=False):
+          durations=None, resume=False, images=True):
     """Runs every variant on every config x seed. Returns (rows, failures): a row is {'config', 'seed',
     'duration', 'length', variant name: metrics_of(its evaluation)}; a variant that did not run or
     wrote no trajectory is a failure and has no entry, one with odometry over less than 90 % of the
     log a failure with its entry. durations maps
-    a config to its own duration. `executables` (build/bin names) are what the variants run besides
+    a config to its own duration; a config without one runs for `duration`, or when that is None for
+    its own sim.duration_s. images=False simulates without the camera's images (livo-sim --no-images:
+    a fraction of the time) when no variant reads them. `executables` (build/bin names) are what the variants run besides
     the pipeline's tools; exits naming a missing one.
 
-    Logs go to logs/NAME_sSEED_DURs.lcmlog when `logs` is given (kept), else beside the runs (removed
+    Logs go to logs/NAME_sSEED_DURs[_noimages].lcmlog when `logs` is given (kept), else beside the runs (removed
     unless keep_logs); a log is reused only when its key (the config's bytes, seed, duration and
     livo-sim's hash, written beside it) matches. resume: a run is reused only when the key written
     beside its evaluation (config bytes, the variant's processes, swaps and overlay, seed, duration,
@@ -164,14 +191,19 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
         config = config_path(script, name)
         config_bytes = open(config, 'rb').read()
         dur = (durations or {}).get(name, duration)
+        if dur is None:
+            dur = config_duration(config)
+            if dur is None:
+                raise SystemExit('%s: %s has no sim.duration_s: give --duration' % (script, config))
         for seed in seeds:
             tag = '%s_s%s' % (name, seed)
             base = os.path.join(out, tag)
             os.makedirs(base, exist_ok=True)
             if logs:
                 os.makedirs(logs, exist_ok=True)
-            log = os.path.join(logs, '%s_%gs.lcmlog' % (tag, dur)) if logs else base + '.lcmlog'
-            log_key = key_of(config_bytes, seed, dur, sim_hash)
+            suffix = '' if images else '_noimages'
+            log = os.path.join(logs, '%s_%gs%s.lcmlog' % (tag, dur, suffix)) if logs else base + '.lcmlog'
+            log_key = key_of(config_bytes, seed, dur, sim_hash, *([] if images else ['no-images']))
             run_keys = {v.name: key_of(config_bytes, v.processes, sorted(v.swaps.items()), v.overlay, v.record,
                                        seed, dur, log_key, run_hash) for v in variants}
             done = {v.name: resume and cached(os.path.join(base, v.name, 'evaluation_odometry.json'),
@@ -181,7 +213,7 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
                 print('%s: simulating %g s' % (tag, dur), file=sys.stderr, flush=True)
                 part = '%s.%d.part' % (log, os.getpid())  # a concurrent run simulating the same log keeps its own
                 if not run([sim, '--config', config, '--out', part, '--seed', seed, '--duration', str(dur),
-                            '--quiet'], base + '.sim.txt'):
+                            '--quiet'] + ([] if images else ['--no-images']), base + '.sim.txt'):
                     failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                     continue
                 os.replace(part, log)
