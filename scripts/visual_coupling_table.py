@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The second paper's two subsystems alone and coupled on the simulator, one command.
 
-    scripts/visual_coupling_table.py --out DIR [--configs NAME,...] [--seeds 2,3,4,5,6] [--duration 60]
+    scripts/visual_coupling_table.py --out DIR [--configs NAME,...] [--seeds 2,3,4,5,6] [--duration S]
                                      [--duration-of NAME=S,...] [--logs DIR] [--keep-logs]
                                      [--variants graph,vio,coupled,coupled-factor] [--resume]
 
@@ -16,8 +16,9 @@ seed, livo-sim writes the log, then scripts/run_pipeline.sh runs (sim_variants.p
                   (lio_graph.visual_factor: true; not run unless asked for)
 and DIR/table.md gets, per run and variant, the ATE (SE(3) and 4-DoF aligned), the vertical drift, the
 roll and pitch RMSE and the end-point drift, per config their mean ± standard deviation over the seeds,
-and issue 44's bar on means: on bridge_deck and tree_campus the coupled pair's mean ATE at most the
-LiDAR subsystem's alone (graph), and elsewhere no worse than the better of the two alone. A bar whose
+and issue 44's bar on means: on bridge_deck and tree_campus (and their graded variants) the coupled
+pair's mean ATE at most the LiDAR subsystem's alone (graph), and elsewhere no worse than the better of
+the two alone. Every run lasts its config's sim.duration_s unless --duration or --duration-of says. A bar whose
 variants were not all run is missed, not skipped. Seed 1 was used for tuning; the defaults are five
 seeds that were not. --resume reuses a run only when its key (config, seed, duration, the log's key and
 the executables' hashes, written beside it) matches. Exit status 1 if a bar is missed or a run failed.
@@ -37,7 +38,7 @@ VARIANTS = [
                overlay='lio_graph: {visual_state: true, visual_factor: true}\n'),
 ]
 DEFAULT_VARIANTS = 'graph,vio,coupled'
-GROUND_VEHICLES = ('bridge_deck', 'tree_campus')  # where the coupled pair must beat both
+GROUND_VEHICLES = ('bridge_deck', 'tree_campus')  # where (and on their graded variants) the LiDAR subsystem is the bar
 
 
 def default_configs():
@@ -50,7 +51,7 @@ def check_bars(rows, chosen, failures):
     ate = sv.per_config(rows, ('graph', 'vio', 'coupled'), 'ate')
     for config in dict.fromkeys(r['config'] for r in rows):
         means = {v: sv.mean_sd(xs)[0] for v, xs in ate.get(config, {}).items()}
-        if config in GROUND_VEHICLES:
+        if config.startswith(GROUND_VEHICLES):
             bar = '%s: the coupled pair\'s mean ATE at most the LiDAR subsystem\'s alone' % config
             needed = ('graph', 'coupled')
         else:
@@ -72,7 +73,8 @@ def main():
     ap.add_argument('--out', required=True)
     ap.add_argument('--configs', default=','.join(default_configs()))
     ap.add_argument('--seeds', default='2,3,4,5,6', help='seeds not used for tuning (seed 1 was)')
-    ap.add_argument('--duration', type=float, default=60.0)
+    ap.add_argument('--duration', type=float, default=None,
+                    help="seconds of every run (default: each config's own sim.duration_s)")
     ap.add_argument('--duration-of', default='', help='NAME=S,...: a duration of its own for a config')
     ap.add_argument('--keep-logs', action='store_true')
     ap.add_argument('--resume', action='store_true',
@@ -84,13 +86,7 @@ def main():
     unknown = [v for v in chosen if v not in [x.name for x in VARIANTS]]
     if unknown:
         raise SystemExit('visual_coupling_table.py: unknown variant(s) %s' % ','.join(unknown))
-    durations = {}
-    for item in filter(None, a.duration_of.split(',')):
-        name, _, seconds = item.partition('=')
-        try:
-            durations[name] = float(seconds)
-        except ValueError:
-            raise SystemExit('visual_coupling_table.py: --duration-of wants NAME=SECONDS, not %r' % item)
+    durations = sv.parse_durations('visual_coupling_table.py', a.duration_of)
     configs = a.configs.split(',')
     for name in configs:
         sv.config_path('visual_coupling_table.py', name)
