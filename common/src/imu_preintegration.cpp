@@ -25,6 +25,8 @@ ImuPreintegrationNoise ImuPreintegrationNoise::fromRig(const ImuRig& rig) {
   n.accel_noise_density = rig.accel_noise_density;
   n.gyro_random_walk = rig.gyro_random_walk;
   n.accel_random_walk = rig.accel_random_walk;
+  n.gyro_scale_std = rig.gyro_scale_std;
+  n.gyro_misalignment_std = rig.gyro_misalignment_std;
   return n;
 }
 
@@ -76,8 +78,11 @@ void ImuPreintegration::integrate(const Vec3& gyro, const Vec3& accel, double dt
   B.block<3, 3>(6, 0) = 0.5 * dt * dv_dng;
   B.block<3, 3>(6, 3) = 0.5 * dt * dv_dna;
   Eigen::Matrix<double, 6, 1> q;
-  q << Vec3::Constant(noise_.gyro_noise_density * noise_.gyro_noise_density / dt),
-      Vec3::Constant(noise_.accel_noise_density * noise_.accel_noise_density / dt);
+  Vec3 gyro_density2 = Vec3::Constant(noise_.gyro_noise_density * noise_.gyro_noise_density);
+  if (noise_.gyro_scale_std > 0.0 || noise_.gyro_misalignment_std > 0.0)
+    gyro_density2 += gyroSystematicDensity2(w, noise_.gyro_scale_std, noise_.gyro_misalignment_std,
+                                            noise_.systematic_error_window_s);
+  q << gyro_density2 / dt, Vec3::Constant(noise_.accel_noise_density * noise_.accel_noise_density / dt);
   covariance_ = A * covariance_ * A.transpose() + B * q.asDiagonal() * B.transpose();
   covariance_ = (0.5 * (covariance_ + covariance_.transpose())).eval();  // (aliasing)
 

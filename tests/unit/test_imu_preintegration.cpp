@@ -412,6 +412,39 @@ TEST(ImuPreintegration, NoiseFromRig) {
   EXPECT_NEAR(pre.covariance()(0, 0), 0.75, 1e-15);
 }
 
+// The gyro's scale and misalignment in the noise budget: a steady turn about z at w for T seconds
+// adds s² w² window to the density² about z (the turn's axis, where the rotation error stays put)
+// and m² w² window about x and y (the cross-axis terms); at rest or with zero 1-sigmas the
+// covariance is exactly the white-noise one. The same helper as livo-lio's propagation.
+TEST(ImuPreintegration, GyroScaleAndMisalignmentInTheBudget) {
+  ImuRig rig;
+  rig.gyro_scale_std = 0.01;
+  rig.gyro_misalignment_std = 0.005;
+  ImuPreintegrationNoise n = ImuPreintegrationNoise::fromRig(rig);
+  EXPECT_EQ(n.gyro_scale_std, 0.01);
+  EXPECT_EQ(n.gyro_misalignment_std, 0.005);
+  n.systematic_error_window_s = 0.1;
+  const double w = 1.0, dt = 0.005, sigma2 = n.gyro_noise_density * n.gyro_noise_density;
+  ImuPreintegration turn(Vec3::Zero(), Vec3::Zero(), n), rest(Vec3::Zero(), Vec3::Zero(), n);
+  ImuPreintegrationNoise white = n;
+  white.gyro_scale_std = white.gyro_misalignment_std = 0.0;
+  ImuPreintegration turn_white(Vec3::Zero(), Vec3::Zero(), white), rest_white(Vec3::Zero(), Vec3::Zero(), white);
+  for (int k = 0; k < 200; ++k) {
+    turn.integrate(Vec3(0.0, 0.0, w), Vec3::Zero(), dt);
+    turn_white.integrate(Vec3(0.0, 0.0, w), Vec3::Zero(), dt);
+    rest.integrate(Vec3::Zero(), Vec3::Zero(), dt);
+    rest_white.integrate(Vec3::Zero(), Vec3::Zero(), dt);
+  }
+  const Mat9 c = turn.covariance();
+  EXPECT_NEAR(c(2, 2), (sigma2 + 0.01 * 0.01 * w * w * 0.1) * 1.0, 1e-12);
+  EXPECT_NEAR(c(0, 0) + c(1, 1), 2.0 * (sigma2 + 0.005 * 0.005 * w * w * 0.1) * 1.0, 1e-4 * c(0, 0));
+  EXPECT_TRUE(rest.covariance() == rest_white.covariance());
+  EXPECT_GT(c(2, 2), 100.0 * turn_white.covariance()(2, 2));
+  EXPECT_TRUE(gyroSystematicDensity2(Vec3(0.3, -0.2, 1.0), 0.0, 0.0, 0.1).isZero(0.0));
+  EXPECT_NEAR(gyroSystematicDensity2(Vec3(0.3, -0.2, 1.0), 0.01, 0.005, 0.1).x(),
+              (1e-4 * 0.09 + 2.5e-5 * (0.04 + 1.0)) * 0.1, 1e-18);
+}
+
 // The templated maps against so3.hpp, across the series threshold and for w < 0.
 TEST(ImuPreintegrationQuaternionMaps, MatchSo3) {
   for (const Vec3& r : {Vec3(0, 0, 0), Vec3(1e-9, -2e-9, 3e-9), Vec3(7e-7, 0, 0), Vec3(1.2e-6, 0, 0),

@@ -90,13 +90,35 @@ Eigen::Matrix<T, 3, 1> quaternionLog(const Eigen::Quaternion<T>& q) {
 /// finite, very stiff weight in the directions that have no noise instead of failing.
 Eigen::MatrixXd upperSqrtInformation(const Eigen::MatrixXd& covariance);
 
+/// The gyro's scale-factor and axis-misalignment errors as a rate noise (density², per axis) at the
+/// bias-corrected rate w: M w with M's diagonal of scale_std (relative) and its off-diagonal of
+/// misalignment_std (rad) has var((M w)_i) = s² w_i² + m² (|w|² - w_i²); unlike white noise it keeps
+/// its sign through a turn, so over the `window_s` between two corrections of the attitude it adds up
+/// to M w T, which a white rate noise of density² = var(M w) T matches at T = window_s. livo-lio's
+/// propagation and the shared preintegration budget it the same way (0 std: nothing).
+inline Vec3 gyroSystematicDensity2(const Vec3& w, double scale_std, double misalignment_std, double window_s) {
+  const Vec3 w2 = w.cwiseAbs2();
+  const double s2 = scale_std * scale_std, m2 = misalignment_std * misalignment_std;
+  return (s2 * w2 + m2 * (Vec3::Constant(w2.sum()) - w2)) * window_s;
+}
+
 /// Continuous-time noise of the IMU as the preintegration uses it.
 struct ImuPreintegrationNoise {
   double gyro_noise_density = 1.7e-4;   // rad/s/sqrt(Hz)
   double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
   double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
   double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
+  // The gyro's scale and misalignment (rig.imu.gyro_scale_std, gyro_misalignment_std) in the noise
+  // budget (gyroSystematicDensity2): a turn's increments are trusted less than a straight drive's,
+  // by the turn. systematic_error_window_s is the spacing of the states the factors join (the
+  // LiDAR sweep period for livo-lio-graph, the keyframe spacing for livo-vio-feature). The
+  // accelerometer's scale and misalignment are not budgeted: against gravity they act as a bias
+  // (estimated), and the motion's own specific force is small beside it on a ground vehicle.
+  double gyro_scale_std = 0.0;             // relative
+  double gyro_misalignment_std = 0.0;      // rad
+  double systematic_error_window_s = 0.1;  // s
 
+  /// The rig's densities and gyro errors; systematic_error_window_s is left to the caller.
   static ImuPreintegrationNoise fromRig(const ImuRig& rig);
 };
 
@@ -107,7 +129,7 @@ class ImuPreintegration {
 
   /// Adds one interval of dt seconds over which the body rate is `gyro` (rad/s) and the specific
   /// force `accel` (m/s²), as measured (biases included). Its discrete noise has the covariance
-  /// density² / dt per axis. dt == 0 adds nothing; a negative or non-finite dt throws
+  /// density² / dt per axis, the gyro's density² raised by gyroSystematicDensity2 at the rate. dt == 0 adds nothing; a negative or non-finite dt throws
   /// std::invalid_argument.
   void integrate(const Vec3& gyro, const Vec3& accel, double dt);
 

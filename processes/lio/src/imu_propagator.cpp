@@ -1,5 +1,7 @@
 #include "livo/lio/imu_propagator.hpp"
 
+#include "livo/imu_preintegration.hpp"
+
 namespace livo::lio {
 
 namespace {
@@ -59,10 +61,8 @@ void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& ac
 Mat12 discreteNoiseCovariance(const ImuNoise& n, double dt, const Vec3& omega) {
   Mat12 Q = Mat12::Zero();
   const double inv = 1.0 / dt;
-  // var((M w)_i) = s^2 w_i^2 + m^2 (|w|^2 - w_i^2) for M = I + scale + misalignment with independent entries
-  const Vec3 w2 = omega.cwiseAbs2();
-  const double s2 = n.gyro_scale_std * n.gyro_scale_std, m2 = n.gyro_misalignment_std * n.gyro_misalignment_std;
-  const Vec3 systematic = (s2 * w2 + m2 * (Vec3::Constant(w2.sum()) - w2)) * n.systematic_error_window_s;
+  const Vec3 systematic =
+      gyroSystematicDensity2(omega, n.gyro_scale_std, n.gyro_misalignment_std, n.systematic_error_window_s);
   Q.diagonal().segment<3>(0) = (Vec3::Constant(n.gyro_noise_density * n.gyro_noise_density) + systematic) * inv;
   Q.diagonal().segment<3>(3).setConstant(n.accel_noise_density * n.accel_noise_density * inv);
   Q.diagonal().segment<3>(6).setConstant(n.gyro_random_walk * n.gyro_random_walk * inv);

@@ -17,6 +17,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   o.gravity = rig.imu.gravity;
   if (!rig.lidar) throw ConfigError(root.where("rig") + ": livo-lio-graph needs a rig.lidar");
   o.extrinsics.T_I_L = rig.lidar->T_I_L;
+  o.imu_noise.systematic_error_window_s = 1.0 / rig.lidar->rate_hz;  // the states are the sweeps
   o.min_range = std::max(rig.lidar->min_range, o.features.min_range);
   o.max_range = rig.lidar->max_range;
   if (rig.wheel) {
