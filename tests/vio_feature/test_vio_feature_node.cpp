@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 
 #include "bus_messages.hpp"
 #include "livo/image_t.hpp"
@@ -180,5 +182,33 @@ vio_feature: {window_frames: 2}
 rig:
   imu: {rate_hz: 200}
 )")),
+               ConfigError);
+}
+
+TEST(VioFeatureNode, ReadsTheTyreScalesSigma) {
+  // bridge_deck.yaml (a rig with wheels, no vio_feature: section) with one appended
+  std::ifstream in(std::string(LIVO_SOURCE_DIR) + "/config/sim/bridge_deck.yaml");
+  const std::string rig((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(rig.empty());
+  const VioFeatureNodeOptions defaults = readVioFeatureNodeOptions(Config::fromString(rig));
+  EXPECT_TRUE(defaults.core.window.use_wheel);
+  EXPECT_EQ(defaults.core.window.wheel_scale_std, 0.02);  // it has a depth image
+  // without a depth source the tyres stay nominal unless asked for
+  EXPECT_EQ(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false}\n"))
+                .core.window.wheel_scale_std,
+            0.0);
+  EXPECT_EQ(readVioFeatureNodeOptions(
+                Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false, wheel_scale_std: 0.03}\n"))
+                .core.window.wheel_scale_std,
+            0.03);
+  EXPECT_EQ(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {wheel_scale_std: 0}\n"))
+                .core.window.wheel_scale_std,
+            0.0);
+  EXPECT_EQ(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {wheel_scale_std: 0.05}\n"))
+                .core.window.wheel_scale_std,
+            0.05);
+  EXPECT_THROW(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {wheel_scale_std: -0.01}\n")),
+               ConfigError);
+  EXPECT_THROW(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {wheel_scale_std: 0.5}\n")),
                ConfigError);
 }

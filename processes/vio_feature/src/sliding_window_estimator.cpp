@@ -118,6 +118,7 @@ bool SlidingWindowEstimator::addWheel(const WheelSample& s, std::string* why) {
 }
 
 void SlidingWindowEstimator::reset() {
+  // wheel_scale_ stays: the tyres have not changed, and the next window's prior starts from it
   features_.clear();
   rejected_.clear();
   recent_.clear();
@@ -143,6 +144,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
     addObservations(*window_.back(), in);
     res.status = FrameResult::Status::kInitialized;
     res.state = stateOf(*window_.back());
+    res.wheel_scale = wheelScale();
     return res;
   }
 
@@ -171,6 +173,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   res.status = FrameResult::Status::kTracked;
   res.state = stateOf(cur);
   res.state.pose_covariance = newestPoseCovariance(graph);
+  res.wheel_scale = wheelScale();
 
   // The previous newest state stays if it is a keyframe (the oldest then leaves), else it goes.
   if (static_cast<int>(window_.size()) > opts_.window_frames) {
@@ -253,12 +256,14 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
     res->note = "waiting for the wheels over the initialisation window";
     return false;
   }
-  // The body-frame velocity from the wheels: the wheel frame B moves forward at the mean speed;
+  // The body-frame velocity from the wheels: the wheel frame B moves forward at the mean speed
+  // (through the tyre scales as estimated so far: [1, 1] unless an earlier epoch learnt them);
   // v_I = R_IB v_B - w x t_IB.
   const Mat3 R_IB = opts_.wheel_rig.T_I_B.linear();
   const Vec3 t_IB = opts_.wheel_rig.T_I_B.translation();
   auto bodyVelocity = [&](const WheelSample& w, const Vec3& gyro) {
-    return Vec3(R_IB * Vec3(0.5 * (w.left_speed + w.right_speed), 0.0, 0.0) - gyro.cross(t_IB));
+    const double forward = 0.5 * (wheel_scale_[0] * w.left_speed + wheel_scale_[1] * w.right_speed);
+    return Vec3(R_IB * Vec3(forward, 0.0, 0.0) - gyro.cross(t_IB));
   };
   // Integrated over the window with R_k the body's rotation at k in the frame at t0 (from the gyro):
   //   sum R_k f_k dt = [R v]_{t0}^{t} - T g_0   (d(R v)/dt = R (dv/dt + w x v) = R (f + g_k)),
@@ -285,8 +290,13 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   const Vec3 up_t = -(R.transpose() * g0).normalized();
   const Mat3 R_W_I = Quat::FromTwoVectors(up_t, Vec3::UnitZ()).toRotationMatrix();
   const Vec3 v_W = R_W_I * v1;
-  startWindow(t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(), opts_.moving_init_rot_std,
-              3.0 * opts_.wheel_noise.speed_std + 0.05, opts_.init.moving_gyro_bias_std);
+  // With the scales estimated, the velocity's prior carries their uncertainty too: through the
+  // first wheel factors a velocity prior at the nominal radii is a prior on the scales (at 10 m/s
+  // with the rig's 2 cm/s, sigma 0.11 m/s is 1.1 % of the speed: tighter than wheel_scale_std).
+  double vel_std = 3.0 * opts_.wheel_noise.speed_std + 0.05;
+  if (estimatesWheelScale()) vel_std = std::hypot(vel_std, opts_.wheel_scale_std * v_W.norm());
+  startWindow(t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(), opts_.moving_init_rot_std, vel_std,
+              opts_.init.moving_gyro_bias_std);
   res->static_start = false;
   res->note = "initialised in motion from the wheels";
   return true;
@@ -313,6 +323,11 @@ void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v
   f->prior_blocks.push_back({f->bg});
   f->priors.emplace_back(makeVectorPriorFactor(ba, Vec3::Constant(opts_.init.accel_bias_std)));
   f->prior_blocks.push_back({f->ba});
+  // the tyre scales, once per window (epoch): around what an earlier epoch learnt, [1, 1] at first
+  if (estimatesWheelScale()) {
+    f->priors.emplace_back(makeWheelScalePrior(wheelScale(), opts_.wheel_scale_std));
+    f->prior_blocks.push_back({wheel_scale_});
+  }
   window_.push_back(std::move(f));
   recent_.clear();
 }
@@ -363,7 +378,7 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
       else wp.integrate(w[k].left_speed, w[k].right_speed, w[k + 1].left_speed, w[k + 1].right_speed, dt);
     }
     if (ok && wp.duration() > 0.0) {
-      to.wheel.reset(makeWheelFactor(wp));
+      to.wheel.reset(estimatesWheelScale() ? makeScaledWheelFactor(wp) : makeWheelFactor(wp));
       to.wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
     } else {
       to.wheel_samples.clear();
@@ -452,7 +467,7 @@ void SlidingWindowEstimator::forEachFactor(const std::vector<Feature*>& features
     Frame& e = *window_[k - 1];
     if (f.imu) add(f.imu.get(), nullptr, {e.q, e.p, e.v, e.bg, e.ba, f.q, f.p, f.v});
     if (f.bias_walk) add(f.bias_walk.get(), nullptr, {e.bg, e.ba, f.bg, f.ba});
-    if (f.wheel) add(f.wheel.get(), f.wheel_loss.get(), {e.q, e.p, f.q, f.p});
+    if (f.wheel) add(f.wheel.get(), f.wheel_loss.get(), wheelBlocks(e, f));
   }
   for (Feature* ft : features) {
     Frame& a = *ft->anchor();
@@ -512,7 +527,8 @@ void SlidingWindowEstimator::marginalizeOldest() {
   for (size_t i = 0; i < a.priors.size(); ++i) m.addFactor(a.priors[i].get(), a.prior_blocks[i]);
   if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
   if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
-  if (b.wheel) m.addFactor(b.wheel.get(), {a.q, a.p, b.q, b.p}, b.wheel_loss.get());
+  if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
+  // the scales are not dropped: what these factors said about them stays in the prior
   std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   // The features anchored here leave with it: what they said about the states that stay goes into
   // the prior (those in the last optimisation); a later observation of the same track starts anew.
@@ -657,6 +673,11 @@ bool SlidingWindowEstimator::gyroRotation(int64_t t0, int64_t t1, Mat3* R) const
     *R = *R * so3::Exp((0.5 * (samples[k].gyro + samples[k + 1].gyro) - bg) *
                        toSeconds(samples[k + 1].utime - samples[k].utime));
   return true;
+}
+
+std::vector<double*> SlidingWindowEstimator::wheelBlocks(Frame& a, Frame& b) const {
+  if (estimatesWheelScale()) return {a.q, a.p, b.q, b.p, wheel_scale_};
+  return {a.q, a.p, b.q, b.p};
 }
 
 VisualState SlidingWindowEstimator::stateOf(const Frame& f) const {

@@ -2,6 +2,8 @@
 
 #include <ostream>
 
+#include "livo/text_format.hpp"
+
 namespace livo::vio_feature {
 
 VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
@@ -19,6 +21,7 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   w.camera_time_offset_s = rig.camera->time_offset_s;
   w.focal = 0.5 * (rig.camera->fx + rig.camera->fy);
   w.imu_noise = ImuPreintegrationNoise::fromRig(rig.imu);
+  w.imu_noise.systematic_error_window_s = 1.0 / rig.camera->rate_hz;  // the states are the frames
   w.gravity = rig.imu.gravity;
   if (rig.wheel) {
     w.use_wheel = true;
@@ -28,6 +31,7 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   core.use_depth_image = rig.camera->depth;
   core.use_lidar_depth = rig.lidar.has_value();
 
+  bool scale_given = false;
   const Config c = root.optionalSection("vio_feature");
   if (!c.isNull()) {
     c.readOptional("name", n.name);
@@ -56,6 +60,7 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
     c.readOptional("depth_sigma_relative", w.depth_sigma_relative);
     c.readOptional("solver_iterations", w.solver_iterations);
     c.readOptional("wheel_cauchy", w.wheel_cauchy);
+    scale_given = c.readOptional("wheel_scale_std", w.wheel_scale_std);
     c.readOptional("outlier_px", w.outlier_px);
     c.checkAllUsed();
   }
@@ -71,6 +76,9 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
     fail("depth_sigma_base", "depth_sigma_base must be > 0 and depth_sigma_relative >= 0");
   if (w.solver_iterations < 1) fail("solver_iterations", "must be >= 1");
   if (!(w.wheel_cauchy > 0.0)) fail("wheel_cauchy", "must be > 0");
+  if (!scale_given)  // the tyres estimated only where measured depths make their scale observable
+    w.wheel_scale_std = core.use_depth_image || core.use_lidar_depth ? kDepthWheelScaleStd : 0.0;
+  if (!(w.wheel_scale_std >= 0.0 && w.wheel_scale_std <= 0.2)) fail("wheel_scale_std", "must be in [0, 0.2]");
   if (!(w.outlier_px > 0.0)) fail("outlier_px", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0 && n.depth_max_wait_s >= 0.0 && n.lidar_max_wait_s >= 0.0))
     fail("lidar_max_wait_s", "the waits must be >= 0");
@@ -94,7 +102,11 @@ void printOptions(const VioFeatureNodeOptions& n, std::ostream& os) {
      << " px parallax\n"
      << "  window " << w.window_frames << " states, " << w.max_features << " features, " << w.solver_iterations
      << " solver iterations; factors: reprojection (sigma " << w.pixel_sigma << " px), IMU preintegration, bias walk"
-     << (w.use_wheel ? ", wheel preintegration" : "") << "; depth from "
+     << (w.use_wheel ? ", wheel preintegration" : "")
+     << (w.use_wheel && w.wheel_scale_std > 0.0
+             ? " (tyre scales estimated, prior sigma " + formatSignificant(w.wheel_scale_std) + ")"
+             : std::string())
+     << "; depth from "
      << (core.use_depth_image && core.use_lidar_depth ? "the depth image and the LiDAR"
          : core.use_depth_image                          ? "the depth image"
          : core.use_lidar_depth                          ? "the LiDAR"

@@ -189,6 +189,9 @@ std::string VioFeatureNode::summary() const {
   if (c.bad_images) s << ", " << c.bad_images << " refused";
   if (c.dropped) s << ", " << c.dropped << " dropped waiting for the IMU";
   if (estimator_.epoch()) s << "; " << estimator_.epoch() << " restarts";
+  if (estimator_.window().estimatesWheelScale())
+    s << "; tyre scales " << estimator_.window().wheelScale().x() << " (left), " << estimator_.window().wheelScale().y()
+      << " (right)";
   return s.str();
 }
 

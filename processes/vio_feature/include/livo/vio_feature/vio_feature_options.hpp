@@ -13,6 +13,9 @@
 
 namespace livo::vio_feature {
 
+/// The tyre scales' prior sigma where the window has measured depths (livo-lio-graph's).
+constexpr double kDepthWheelScaleStd = 0.02;
+
 struct SlidingWindowOptions {
   Pose3 T_I_C = Pose3::Identity();      // rig.camera: p_I = T_I_C p_C
   double camera_time_offset_s = 0.0;    // rig.camera: image utime + offset = the IMU clock
@@ -29,6 +32,12 @@ struct SlidingWindowOptions {
   WheelPreintegrationNoise wheel_noise;
   double wheel_cauchy = 3.0;            // Cauchy loss on the whitened wheel residual (slip)
   double max_wheel_gap_s = 0.2;         // a longer gap between readings: no wheel factor there
+  // The tyres' radii over the nominal ([s_l, s_r], wheel_preintegration.hpp) as a parameter of the
+  // window with this prior sigma around 1 (livo-lio-graph's wheel_scale_std); 0 keeps them at the
+  // nominal. Only measured depths make the common scale observable: the node's config sets
+  // kDepthWheelScaleStd when a depth source is on and leaves 0 otherwise (monocular, the estimate
+  // wanders where the nominal radii are right: README, the window's wheel factor).
+  double wheel_scale_std = 0.0;
   // A moving start with the wheel: the body velocity from the wheels, gravity from the specific
   // force over this window minus the acceleration the wheels and the gyro say the body had.
   double moving_init_window_s = 0.5;
