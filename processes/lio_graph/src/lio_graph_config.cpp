@@ -63,6 +63,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     c.readOptional("surface_voxel", o.features.surface_voxel);
     c.readOptional("degenerate_eigenvalue", o.matching.degenerate_eigenvalue);
     c.readOptional("planar_factors", o.planar_factors);
+    c.readOptional("planar_ground_only", o.planar_ground_only);
     c.readOptional("plane_sigma_angle_deg", o.plane_sigma_angle_deg);
     c.readOptional("plane_sigma_distance", o.plane_sigma_distance);
     c.readOptional("plane_match_angle_deg", o.plane_match_angle_deg);
@@ -112,7 +113,9 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
      << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
      << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
-     << (o.planar_factors ? ", adaptive planar factors" : "")
+     << (o.planar_factors ? (o.planar_ground_only ? ", adaptive planar factors (the ground)"
+                                                  : ", adaptive planar factors (every plane)")
+                          : "")
      << (o.use_visual_motion ? "; deskew and guess from the visual subsystem's motion" : "")
      << (o.use_visual_motion && o.visual_factor ? ", and its motion as a relative-pose factor" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg

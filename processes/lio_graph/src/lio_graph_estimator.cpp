@@ -511,6 +511,7 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
   const double cos_match = std::cos(opts_.plane_match_angle_deg * M_PI / 180.0);
   std::vector<const PlaneLandmark*> used;
   for (const ExtractedPlane& e : extractPlanes(cloud, po)) {
+    if (opts_.planar_ground_only && !e.ground) continue;
     // the observation in the world, the sensor on its positive side
     Plane w;
     w.normal = R * e.plane.normal;

@@ -37,6 +37,12 @@ struct LioGraphOptions {
   // Adaptive planar factors (the paper's contribution): planes extracted from every sweep
   // (plane_extraction.hpp) become landmarks of the window, each observation a factor.
   bool planar_factors = true;
+  // Only the ground (a level plane below the sensor, plane_extraction.hpp) becomes a landmark. With
+  // every plane, patches of curved surfaces (tree crowns overhead, tilted 10-20 deg) joined
+  // landmarks they did not fit (residuals up to 70 sigma) and, where the LiDAR says nothing along
+  // the road, pulled that direction and the tyre scales away: long_slope diverged on every seed
+  // (README, "Measured").
+  bool planar_ground_only = true;
   PlaneExtractionOptions planes;
   double plane_cloud_voxel = 0.2;       // m: the sweep is downsampled to this before extraction
   double plane_sigma_angle_deg = 1.0;   // an observed plane's normal
