@@ -76,30 +76,28 @@ def evaluation(run_dir, name='odometry'):
     return json.load(open(path)) if os.path.exists(path) else None
 
 
+def section_line(config, section, prefix):
+    """The first line of a config file's top-level `section:` that starts with `prefix`, or None."""
+    inside = False
+    for line in open(config):
+        if line.startswith(section + ':'):
+            inside = True
+        elif line[:1].isalpha():
+            inside = False
+        elif inside and line.startswith(prefix):
+            return line
+    return None
+
+
 def has_camera(config):
     """Whether a config file's rig: section has a camera: block."""
-    in_rig = False
-    for line in open(config):
-        if line.startswith('rig:'):
-            in_rig = True
-        elif line[:1].isalpha():
-            in_rig = False
-        elif in_rig and line.startswith('  camera:'):
-            return True
-    return False
+    return section_line(config, 'rig', '  camera:') is not None
 
 
 def config_duration(config):
     """A config file's sim.duration_s (seconds), None if it has none."""
-    in_sim = False
-    for line in open(config):
-        if line.startswith('sim:'):
-            in_sim = True
-        elif line[:1].isalpha():
-            in_sim = False
-        elif in_sim and line.startswith('  duration_s:'):
-            return float(line.split(':', 1)[1].split('#', 1)[0])
-    return None
+    line = section_line(config, 'sim', '  duration_s:')
+    return float(line.split(':', 1)[1].split('#', 1)[0]) if line else None
 
 
 def parse_durations(script, text):

@@ -358,11 +358,11 @@ class CarMotion {
 
 }  // namespace
 
-TEST(SlidingWindowEstimator, StartsInMotionFromTheWheels) {
-  // A car already driving at 1.5 m/s when the estimator first hears it: no rest to initialise
-  // from, so the wheels give the velocity and, with the gyro, the gravity direction.
-  const CarMotion car(26.0);
-  const synth::ImuErrorModel err = synth::realisticImu();
+namespace {
+
+/// The car's rig: a forward camera (450 px focal, 1 px sigma), 50 Hz wheels on a 0.5 m track with
+/// 1 cm/s noise.
+SlidingWindowOptions carOptions() {
   SlidingWindowOptions o;
   o.T_I_C = forwardCamera();
   o.focal = 450.0;
@@ -372,6 +372,17 @@ TEST(SlidingWindowEstimator, StartsInMotionFromTheWheels) {
   o.wheel_rig.track_width = 0.5;
   o.wheel_rig.speed_noise_std = 0.01;
   o.wheel_noise = WheelPreintegrationNoise::fromRig(o.wheel_rig);
+  return o;
+}
+
+}  // namespace
+
+TEST(SlidingWindowEstimator, StartsInMotionFromTheWheels) {
+  // A car already driving at 1.5 m/s when the estimator first hears it: no rest to initialise
+  // from, so the wheels give the velocity and, with the gyro, the gravity direction.
+  const CarMotion car(26.0);
+  const synth::ImuErrorModel err = synth::realisticImu();
+  SlidingWindowOptions o = carOptions();
   SlidingWindowEstimator est(o);
   SyntheticTracks tracks([&](double t) { return car.pose(t); }, o.T_I_C, 1.0, 0.0, 0.0, 3, Vec3(-30.0, -30.0, -1.0),
                          Vec3(50.0, 50.0, 4.0), 25000);
@@ -439,15 +450,7 @@ CarRun driveCar(double wheel_scale_std, double s_left, double s_right, double un
                 double gap_at = 0.0) {
   const CarMotion car(until + 2.0);
   const synth::ImuErrorModel err = synth::realisticImu();
-  SlidingWindowOptions o;
-  o.T_I_C = forwardCamera();
-  o.focal = 450.0;
-  o.pixel_sigma = 1.0;
-  o.use_wheel = true;
-  o.wheel_rig.rate_hz = 50.0;
-  o.wheel_rig.track_width = 0.5;
-  o.wheel_rig.speed_noise_std = 0.01;
-  o.wheel_noise = WheelPreintegrationNoise::fromRig(o.wheel_rig);
+  SlidingWindowOptions o = carOptions();
   o.wheel_scale_std = wheel_scale_std;
   SlidingWindowEstimator est(o);
   SyntheticTracks tracks([&](double t) { return car.pose(t); }, o.T_I_C, 1.0, depth_fraction, 0.01, 3,
