@@ -129,8 +129,8 @@ class ImuPreintegration {
 
   /// Adds one interval of dt seconds over which the body rate is `gyro` (rad/s) and the specific
   /// force `accel` (m/s²), as measured (biases included). Its discrete noise has the covariance
-  /// density² / dt per axis, the gyro's density² raised by gyroSystematicDensity2 at the rate. dt == 0 adds nothing; a negative or non-finite dt throws
-  /// std::invalid_argument.
+  /// density² / dt per axis, the gyro's density² raised by gyroSystematicDensity2 at the rate.
+  /// dt == 0 adds nothing; a negative or non-finite dt throws std::invalid_argument.
   void integrate(const Vec3& gyro, const Vec3& accel, double dt);
 
   /// Starts over (no interval) linearised at new biases.
