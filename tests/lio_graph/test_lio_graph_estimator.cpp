@@ -8,11 +8,13 @@
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <set>
 
 #include <Eigen/SVD>
 
 #include "livo/lio_graph/lio_graph_estimator.hpp"
 #include "livo/time.hpp"
+#include "livo/voxel_key.hpp"
 #include "synthetic_world.hpp"
 
 using namespace livo;
@@ -341,9 +343,11 @@ std::vector<Pose3> posesBackFromCorrection(const Pose3& T) {
   spec.lidar.range_noise_std = 0.01;
   const synth::SyntheticSequence seq(spec);
   LioGraphOptions o = optionsFor(spec);
-  // the only world-frame voxel grids: a correction that maps them onto themselves changes no map
+  // the only world-frame voxel grids (the map's points and the local map's keyframe cells): a
+  // correction that maps them onto themselves changes no map
   o.map_edge_voxel = 0.2;
   o.map_surface_voxel = 0.4;
+  o.local_map_spacing = 0.4;
   LioGraphEstimator est(o);
   const int half = seq.numScans() / 2;
   std::vector<Pose3> poses;
@@ -415,4 +419,52 @@ TEST(LioGraphEstimator, LoopCorrectionIsExactlyRigid) {
     for (size_t i = 0; i < identity.size(); ++i) worst = std::max(worst, (turned[i].matrix() - identity[i].matrix()).norm());
     EXPECT_LT(worst, 1e-9) << "turn " << turn.transpose();
   }
+}
+
+TEST(LioGraphEstimator, TheLocalMapKeepsTheFirstKeyframeOfEachPlaceAndTheNewest) {
+  // The room walk goes round more than once: a place is matched against the keyframe that mapped it
+  // first (LIO-SAM's surrounding keyframes), and the store grows with the places, not the distance.
+  synth::SequenceSpec spec;
+  spec.duration = 20.0;
+  spec.imu_error = synth::realisticImu();
+  spec.lidar.range_noise_std = 0.01;
+  const synth::SyntheticSequence seq(spec);
+  LioGraphOptions o = optionsFor(spec, false);
+  o.keyframe.min_distance = 0.3;  // many keyframes per cell
+  LioGraphEstimator est(o);
+  size_t next_imu = 0;
+  int keyframes = 0;
+  std::vector<Vec3> est_p, gt_p;
+  for (int k = 0; k < seq.numScans(); ++k) {
+    const int64_t t_end = seq.scanEndUtime(k);
+    while (next_imu < seq.imu().size() && seq.imu()[next_imu].utime <= t_end + 10000) est.addImu(seq.imu()[next_imu++]);
+    const GraphScanResult res = est.addScan(seq.scan(k));
+    keyframes += res.is_keyframe;
+    if (res.hasOutput()) {
+      est_p.push_back(res.pose.translation());
+      gt_p.push_back(seq.truth(res.utime).translation());
+    }
+  }
+  const size_t stored = est.storedKeyframes();
+  const size_t newest = static_cast<size_t>(o.local_map_keyframes);
+  ASSERT_GT(stored, newest);
+  EXPECT_LT(stored, static_cast<size_t>(keyframes)) << "nothing was dropped";
+  EXPECT_EQ(est.storedKeyframe(0).id, 0) << "the first keyframe is the oldest of its cell: it stays";
+  // the older ones one per cell, the first there (ids ascending); the newest all kept, consecutive
+  std::set<VoxelKey> cells;
+  for (size_t i = 0; i < stored; ++i) {
+    const GraphKeyframe& kf = est.storedKeyframe(i);
+    if (i > 0) {
+      EXPECT_GT(kf.id, est.storedKeyframe(i - 1).id);
+    }
+    if (i + newest >= stored) {
+      EXPECT_EQ(kf.id, keyframes - static_cast<int64_t>(stored - i)) << "stored keyframe " << i;
+      continue;
+    }
+    EXPECT_TRUE(cells.insert(voxelKeyOf(kf.pose.translation(), 1.0 / o.local_map_spacing)).second)
+        << "two older keyframes in one cell (stored keyframe " << i << ")";
+    EXPECT_TRUE(kf.cloud.empty()) << "a stored keyframe keeps its features only";
+  }
+  std::cout << keyframes << " keyframes, " << stored << " stored, " << cells.size() << " cells\n";
+  EXPECT_LT(synth::alignedRmse(est_p, gt_p), 0.05);
 }

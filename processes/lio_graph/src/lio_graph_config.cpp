@@ -3,6 +3,7 @@
 #include <ostream>
 
 #include "livo/sensor_rig.hpp"
+#include "livo/text_format.hpp"
 
 namespace livo::lio_graph {
 
@@ -54,6 +55,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     c.readOptional("keyframe_angle_deg", o.keyframe.min_angle_deg);
     c.readOptional("local_map_keyframes", o.local_map_keyframes);
     c.readOptional("local_map_radius", o.local_map_radius);
+    c.readOptional("local_map_spacing", o.local_map_spacing);
     c.readOptional("map_edge_voxel", o.map_edge_voxel);
     c.readOptional("map_surface_voxel", o.map_surface_voxel);
     c.readOptional("lidar_point_sigma", o.lidar_point_sigma);
@@ -80,6 +82,7 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.keyframe.min_angle_deg > 0.0)) fail("keyframe_angle_deg", "must be > 0");
   if (o.local_map_keyframes < 1) fail("local_map_keyframes", "must be >= 1");
   if (!(o.local_map_radius > 0.0)) fail("local_map_radius", "must be > 0");
+  if (!(o.local_map_spacing >= 0.0)) fail("local_map_spacing", "must be >= 0 (0: the newest keyframes only)");
   if (!(o.map_edge_voxel > 0.0 && o.map_surface_voxel > 0.0 && o.features.surface_voxel > 0.0))
     fail("map_surface_voxel", "voxel sizes must be > 0");
   if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
@@ -119,7 +122,9 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << (o.use_visual_motion ? "; deskew and guess from the visual subsystem's motion" : "")
      << (o.use_visual_motion && o.visual_factor ? ", and its motion as a relative-pose factor" : "") << "\n"
      << "  keyframes every " << o.keyframe.min_distance << " m / " << o.keyframe.min_angle_deg
-     << " deg; local map: " << o.local_map_keyframes << " keyframes within " << o.local_map_radius << " m\n";
+     << " deg; local map: the newest " << o.local_map_keyframes << " keyframes"
+     << (o.local_map_spacing > 0.0 ? " and the oldest per " + formatSignificant(o.local_map_spacing) + " m cell" : "")
+     << " within " << o.local_map_radius << " m\n";
 }
 
 }  // namespace livo::lio_graph

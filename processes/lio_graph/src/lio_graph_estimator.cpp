@@ -490,11 +490,13 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
     s.edges = std::move(features.edges);
     s.surfaces = std::move(features.surfaces);
     s.node = newest;
-    keyframes_.push_back(std::move(s));
-    while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
-    rebuildLocalMap(keyframes_.back().kf.pose.translation());
     res.is_keyframe = true;
-    res.keyframe = keyframes_.back().kf;
+    res.keyframe = s.kf;
+    s.kf.cloud = {};  // the map needs the features only
+    s.kf.intensity = {};
+    keyframes_.push_back(std::move(s));
+    pruneStoredKeyframes();
+    rebuildLocalMap(keyframes_.back().kf.pose.translation());
   }
   return res;
 }
@@ -628,16 +630,49 @@ void LioGraphEstimator::updateKeyframePoses() {
     if (k.node) k.kf.pose = k.node->pose();
 }
 
+std::vector<size_t> LioGraphEstimator::firstKeyframePerCell(const std::vector<size_t>& candidates) const {
+  if (!(opts_.local_map_spacing > 0.0)) return {};
+  std::vector<Vec3> positions;
+  for (size_t i : candidates) positions.push_back(keyframes_[i].kf.pose.translation());
+  std::vector<size_t> first;
+  for (size_t j : firstPointPerVoxel(positions, opts_.local_map_spacing)) first.push_back(candidates[j]);
+  return first;
+}
+
+std::vector<const LioGraphEstimator::StoredKeyframe*> LioGraphEstimator::localMapKeyframes(const Vec3& here) const {
+  const size_t first_newest =
+      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(opts_.local_map_keyframes));
+  const double r2 = opts_.local_map_radius * opts_.local_map_radius;
+  std::vector<size_t> older, newest;
+  for (size_t i = 0; i < keyframes_.size(); ++i)
+    if ((keyframes_[i].kf.pose.translation() - here).squaredNorm() <= r2) (i < first_newest ? older : newest).push_back(i);
+  std::vector<const StoredKeyframe*> chosen;  // oldest first
+  for (size_t i : firstKeyframePerCell(older)) chosen.push_back(&keyframes_[i]);
+  for (size_t i : newest) chosen.push_back(&keyframes_[i]);
+  return chosen;
+}
+
+void LioGraphEstimator::pruneStoredKeyframes() {
+  // keep what localMapKeyframes() can still choose: the newest, and the oldest of each cell
+  const size_t first_newest =
+      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(opts_.local_map_keyframes));
+  std::vector<size_t> older(first_newest);
+  for (size_t i = 0; i < first_newest; ++i) older[i] = i;
+  std::vector<size_t> keep = firstKeyframePerCell(older);
+  for (size_t i = first_newest; i < keyframes_.size(); ++i) keep.push_back(i);
+  std::deque<StoredKeyframe> kept;
+  for (size_t i : keep) kept.push_back(std::move(keyframes_[i]));
+  keyframes_ = std::move(kept);
+  while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+}
+
 void LioGraphEstimator::rebuildLocalMap(const Vec3& here) {
-  std::vector<const StoredKeyframe*> chosen;  // the newest local_map_keyframes within the radius
-  for (auto it = keyframes_.rbegin(); it != keyframes_.rend() && static_cast<int>(chosen.size()) < opts_.local_map_keyframes; ++it)
-    if ((it->kf.pose.translation() - here).norm() <= opts_.local_map_radius) chosen.push_back(&*it);
   // Oldest first, so a voxel keeps an older keyframe's point: the newest sweep's rings, which the
   // next sweep's rings resemble wherever the body moves, would pull the match towards standing still.
   std::vector<Vec3> edges, surfaces;
-  for (auto it = chosen.rbegin(); it != chosen.rend(); ++it) {
-    for (const Vec3& e : (*it)->edges) edges.push_back((*it)->kf.pose * e);
-    for (const Vec3& s : (*it)->surfaces) surfaces.push_back((*it)->kf.pose * s);
+  for (const StoredKeyframe* k : localMapKeyframes(here)) {
+    for (const Vec3& e : k->edges) edges.push_back(k->kf.pose * e);
+    for (const Vec3& s : k->surfaces) surfaces.push_back(k->kf.pose * s);
   }
   std::vector<Vec3> e_ds, s_ds;
   for (size_t i : firstPointPerVoxel(edges, opts_.map_edge_voxel)) e_ds.push_back(edges[i]);

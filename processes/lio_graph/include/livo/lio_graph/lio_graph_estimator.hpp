@@ -137,7 +137,15 @@ class LioGraphEstimator {
   void optimize();
   void marginalizeOldest();
   void updateKeyframePoses();
-  /// The local map from the newest keyframes within local_map_radius of `here`.
+  struct StoredKeyframe;
+  /// Of the stored keyframes `candidates` (indices, oldest first), the oldest in each
+  /// local_map_spacing cell (none when the spacing is 0).
+  std::vector<size_t> firstKeyframePerCell(const std::vector<size_t>& candidates) const;
+  /// The local map's keyframes around `here`, oldest first (lio_graph_options.hpp).
+  std::vector<const StoredKeyframe*> localMapKeyframes(const Vec3& here) const;
+  /// Drops the stored keyframes localMapKeyframes() can no longer choose.
+  void pruneStoredKeyframes();
+  /// The local map from localMapKeyframes(here).
   void rebuildLocalMap(const Vec3& here);
   /// What a loop correction does to a block of the marginal prior (a window state's or landmark's).
   WorldMotion motionOf(const double* block) const;

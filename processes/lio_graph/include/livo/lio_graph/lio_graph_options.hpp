@@ -70,8 +70,12 @@ struct LioGraphOptions {
   int window_states = 10;               // sweeps in the fixed-lag smoother
   int solver_iterations = 10;
   KeyframeOptions keyframe;             // a new keyframe (local map, KEYFRAME) after 1 m or 10 deg
-  int local_map_keyframes = 30;         // the newest keyframes within local_map_radius form the map
+  // The local map (LIO-SAM's surrounding keyframes): the newest local_map_keyframes, and of every
+  // stored keyframe within local_map_radius the oldest in each local_map_spacing cell, so a place
+  // seen before is matched against what was mapped there first, not only against the last metres.
+  int local_map_keyframes = 10;
   double local_map_radius = 50.0;       // m
+  double local_map_spacing = 2.0;       // m
   double map_edge_voxel = 0.2;          // m
   double map_surface_voxel = 0.4;       // m
   // The scan-matching result as a pose measurement: information = scale * J^T J / sigma^2. The
@@ -80,7 +84,10 @@ struct LioGraphOptions {
   double lidar_point_sigma = 0.05;      // m
   double lidar_information_scale = 0.05;
   double max_imu_gap_s = 0.5;           // s without IMU: the state is re-initialised
-  size_t max_stored_keyframes = 200;    // keyframes kept for the local map (older ones dropped)
+  // Keyframes kept for the local map: the newest local_map_keyframes and the oldest per
+  // local_map_spacing cell (so the store grows with the area covered, not the distance); beyond
+  // this many the oldest go.
+  size_t max_stored_keyframes = 2000;
 };
 
 }  // namespace livo::lio_graph
