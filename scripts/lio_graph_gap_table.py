@@ -61,25 +61,10 @@ def check_bars(rows, chosen, ratio, failures):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--out', required=True)
-    ap.add_argument('--configs', default='room,campus_loop,bridge_deck')
-    ap.add_argument('--seeds', default='2,3,4,5,6', help='seeds not used for tuning (seed 1 was)')
-    ap.add_argument('--duration', type=float, default=None,
-                    help="seconds of every run (default: each config's own sim.duration_s)")
-    ap.add_argument('--duration-of', default='', help='NAME=S,...: a duration of its own for a config')
-    ap.add_argument('--keep-logs', action='store_true')
-    ap.add_argument('--resume', action='store_true',
-                    help='reuse the runs already evaluated in --out whose key (config, seed, binaries) matches')
-    ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs_noimages.lcmlog): kept, reused when their key matches')
-    ap.add_argument('--variants', default='graph-loop,lio-loop')
+    sv.add_arguments(ap, 'room,campus_loop,bridge_deck', 'graph-loop,lio-loop', images=False)
     ap.add_argument('--ratio', type=float, default=1.5, help="the bar: graph-loop's mean ATE over lio-loop's")
     a = ap.parse_args()
-    chosen = a.variants.split(',')
-    unknown = [v for v in chosen if v not in [x.name for x in VARIANTS]]
-    if unknown:
-        raise SystemExit('lio_graph_gap_table.py: unknown variant(s) %s' % ','.join(unknown))
-    for name in a.configs.split(','):
-        sv.config_path('lio_graph_gap_table.py', name)
+    chosen = sv.chosen_variants('lio_graph_gap_table.py', a, VARIANTS)
     variants = [v for v in VARIANTS if v.name in chosen]
     rows, failures = sv.sweep('lio_graph_gap_table.py', a.configs.split(','), a.seeds.split(','), a.duration,
                               variants, a.out, ('livo-lio', 'livo-lio-graph', 'livo-loop'), a.logs, a.keep_logs,

@@ -244,6 +244,35 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
     return rows, failures
 
 
+def add_arguments(ap, configs, variants, images=True):
+    """The command line every table script shares: --out, --configs (default `configs`), --seeds,
+    --duration, --duration-of, --keep-logs, --resume, --logs, --variants (default `variants`)."""
+    ap.add_argument('--out', required=True)
+    ap.add_argument('--configs', default=configs)
+    ap.add_argument('--seeds', default='2,3,4,5,6', help='seeds not used for tuning (seed 1 was)')
+    ap.add_argument('--duration', type=float, default=None,
+                    help="seconds of every run (default: each config's own sim.duration_s)")
+    ap.add_argument('--duration-of', default='', help='NAME=S,...: a duration of its own for a config')
+    ap.add_argument('--keep-logs', action='store_true')
+    ap.add_argument('--resume', action='store_true',
+                    help='reuse the runs already evaluated in --out whose key (config, seed, binaries) matches')
+    ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs%s.lcmlog): kept, reused when their '
+                                   'key matches' % ('' if images else '_noimages'))
+    ap.add_argument('--variants', default=variants)
+
+
+def chosen_variants(script, a, variants):
+    """The variant names --variants chose (exits naming an unknown one), after checking every
+    --configs name has its config."""
+    chosen = a.variants.split(',')
+    unknown = [v for v in chosen if v not in [x.name for x in variants]]
+    if unknown:
+        raise SystemExit('%s: unknown variant(s) %s' % (script, ','.join(unknown)))
+    for name in a.configs.split(','):
+        config_path(script, name)
+    return chosen
+
+
 def missing_variants(bar, needed, chosen, failures):
     """A bar whose variants were not all chosen is a failure (not checked is not met); False then."""
     left_out = [v for v in needed if v not in chosen]

@@ -70,26 +70,11 @@ def check_bars(rows, chosen, failures):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--out', required=True)
-    ap.add_argument('--configs', default=','.join(default_configs()))
-    ap.add_argument('--seeds', default='2,3,4,5,6', help='seeds not used for tuning (seed 1 was)')
-    ap.add_argument('--duration', type=float, default=None,
-                    help="seconds of every run (default: each config's own sim.duration_s)")
-    ap.add_argument('--duration-of', default='', help='NAME=S,...: a duration of its own for a config')
-    ap.add_argument('--keep-logs', action='store_true')
-    ap.add_argument('--resume', action='store_true',
-                    help='reuse the runs already evaluated in --out whose key (config, seed, binaries) matches')
-    ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs.lcmlog): kept, reused when their key matches')
-    ap.add_argument('--variants', default=DEFAULT_VARIANTS)
+    sv.add_arguments(ap, ','.join(default_configs()), DEFAULT_VARIANTS)
     a = ap.parse_args()
-    chosen = a.variants.split(',')
-    unknown = [v for v in chosen if v not in [x.name for x in VARIANTS]]
-    if unknown:
-        raise SystemExit('visual_coupling_table.py: unknown variant(s) %s' % ','.join(unknown))
+    chosen = sv.chosen_variants('visual_coupling_table.py', a, VARIANTS)
     durations = sv.parse_durations('visual_coupling_table.py', a.duration_of)
     configs = a.configs.split(',')
-    for name in configs:
-        sv.config_path('visual_coupling_table.py', name)
     variants = [v for v in VARIANTS if v.name in chosen]
     rows, failures = sv.sweep('visual_coupling_table.py', configs, a.seeds.split(','), a.duration, variants, a.out,
                               ('livo-lio-graph', 'livo-vio-feature'), a.logs, a.keep_logs, durations, a.resume)

@@ -32,6 +32,15 @@ struct RunLog {
   size_t max_landmarks = 0;
 };
 
+/// The ray-cast room walked for `duration` s with a realistic IMU and a 1 cm range noise.
+synth::SequenceSpec roomWalk(double duration) {
+  synth::SequenceSpec spec;
+  spec.duration = duration;
+  spec.imu_error = synth::realisticImu();
+  spec.lidar.range_noise_std = 0.01;
+  return spec;
+}
+
 LioGraphOptions optionsFor(const synth::SequenceSpec& spec, bool planar = true) {
   LioGraphOptions o;
   o.planar_factors = planar;
@@ -101,10 +110,7 @@ RunLog run(const synth::SequenceSpec& spec, bool planar = true, LioGraphOptions*
 }  // namespace
 
 TEST(LioGraphEstimator, TracksTheRoomWalkWithARealisticImu) {
-  synth::SequenceSpec spec;
-  spec.duration = 12.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(12.0);
   // every plane (the default takes the ground only, which the VLP-16 hardly sees as a plane in a
   // room walked at 1 m: the walls and the ceiling are the room's planes)
   LioGraphOptions every_plane = optionsFor(spec);
@@ -136,10 +142,7 @@ TEST(LioGraphEstimator, TakesTheVisualMotionAsARelativePoseFactor) {
   // 1 cm/sqrt(s) and jittering 3 mm) deskews the sweeps, guesses the match and joins the graph
   // as relative-pose factors whose scale is a parameter: the graph learns the scale from the LiDAR
   // and the IMU, and the estimate stays as good as without the visual motion.
-  synth::SequenceSpec spec;
-  spec.duration = 12.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(12.0);
   LioGraphOptions o = optionsFor(spec);
   o.use_visual_motion = true;
   o.visual_factor = true;
@@ -185,10 +188,7 @@ TEST(LioGraphEstimator, LearnsTheTyreScalesFromTheWheels) {
   // and 2 % small on the right (a reading is the true speed over the scale) with 1 cm/s noise. The
   // walk slides sideways and bobs, which a car does not: the planar-motion sigmas are opened so the
   // wheels speak for the forward speed and the yaw rate only.
-  synth::SequenceSpec spec;
-  spec.duration = 12.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(12.0);
   const synth::SyntheticSequence seq(spec);
   const double s_left = 1.03, s_right = 0.98;
   LioGraphOptions o = optionsFor(spec);
@@ -260,10 +260,7 @@ double rmse(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 /// The room walk with the loop correction T applied half way through, as the node applies one
 /// (between two sweeps): before it the estimate is G * truth (G the gauge), after it T * G * truth.
 void checkCorrectedWalk(const Pose3& T) {
-  synth::SequenceSpec spec;
-  spec.duration = 12.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(12.0);
   const synth::SyntheticSequence seq(spec);
   LioGraphEstimator est(optionsFor(spec));
   const int half = seq.numScans() / 2;
@@ -355,10 +352,7 @@ void checkCorrectedWalk(const Pose3& T) {
 /// The room walk's output poses with the loop correction T applied half way through (no keyframe
 /// listed: all move by T), the later ones moved back by T^-1.
 std::vector<Pose3> posesBackFromCorrection(const Pose3& T) {
-  synth::SequenceSpec spec;
-  spec.duration = 12.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(12.0);
   const synth::SyntheticSequence seq(spec);
   LioGraphOptions o = optionsFor(spec);
   // the only world-frame voxel grids (the map's points and the local map's keyframe cells): a
@@ -442,10 +436,7 @@ TEST(LioGraphEstimator, LoopCorrectionIsExactlyRigid) {
 TEST(LioGraphEstimator, TheLocalMapKeepsTheFirstKeyframeOfEachPlaceAndTheNewest) {
   // The room walk goes round more than once: a place is matched against the keyframe that mapped it
   // first (LIO-SAM's surrounding keyframes), and the store grows with the places, not the distance.
-  synth::SequenceSpec spec;
-  spec.duration = 20.0;
-  spec.imu_error = synth::realisticImu();
-  spec.lidar.range_noise_std = 0.01;
+  const synth::SequenceSpec spec = roomWalk(20.0);
   const synth::SyntheticSequence seq(spec);
   LioGraphOptions o = optionsFor(spec, false);
   o.keyframe.min_distance = 0.3;  // many keyframes per cell
