@@ -56,6 +56,11 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     c.readOptional("local_map_keyframes", o.local_map_keyframes);
     c.readOptional("local_map_radius", o.local_map_radius);
     c.readOptional("local_map_spacing", o.local_map_spacing);
+    int max_stored = static_cast<int>(o.max_stored_keyframes);
+    if (c.readOptional("max_stored_keyframes", max_stored)) {
+      if (max_stored < 1) throw ConfigError(c.where("max_stored_keyframes") + ": must be >= 1");
+      o.max_stored_keyframes = static_cast<size_t>(max_stored);
+    }
     c.readOptional("map_edge_voxel", o.map_edge_voxel);
     c.readOptional("map_surface_voxel", o.map_surface_voxel);
     c.readOptional("lidar_point_sigma", o.lidar_point_sigma);

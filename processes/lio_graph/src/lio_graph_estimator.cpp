@@ -663,7 +663,18 @@ void LioGraphEstimator::pruneStoredKeyframes() {
   std::deque<StoredKeyframe> kept;
   for (size_t i : keep) kept.push_back(std::move(keyframes_[i]));
   keyframes_ = std::move(kept);
-  while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+  // beyond the bound, the older keyframe farthest from the newest (first of equals) goes
+  const size_t bound = std::max(opts_.max_stored_keyframes, static_cast<size_t>(opts_.local_map_keyframes));
+  while (keyframes_.size() > bound) {
+    const Vec3 here = keyframes_.back().kf.pose.translation();
+    size_t farthest = 0;
+    double far2 = -1.0;
+    for (size_t i = 0; i + static_cast<size_t>(opts_.local_map_keyframes) < keyframes_.size(); ++i) {
+      const double d2 = (keyframes_[i].kf.pose.translation() - here).squaredNorm();
+      if (d2 > far2) far2 = d2, farthest = i;
+    }
+    keyframes_.erase(keyframes_.begin() + static_cast<std::ptrdiff_t>(farthest));
+  }
 }
 
 void LioGraphEstimator::rebuildLocalMap(const Vec3& here) {

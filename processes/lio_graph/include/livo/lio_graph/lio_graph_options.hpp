@@ -86,8 +86,9 @@ struct LioGraphOptions {
   double max_imu_gap_s = 0.5;           // s without IMU: the state is re-initialised
   // Keyframes kept for the local map: the newest local_map_keyframes and the oldest per
   // local_map_spacing cell (so the store grows with the area covered, not the distance); beyond
-  // this many the oldest go.
-  size_t max_stored_keyframes = 2000;
+  // this many the one farthest from the newest goes (a 64-beam sweep's features are about 0.25 MB:
+  // 500 bound the store near 125 MB; 1 km of new road fills it).
+  size_t max_stored_keyframes = 500;
 };
 
 }  // namespace livo::lio_graph
