@@ -24,7 +24,7 @@
 #                           [--swap P=EXE] [--processes P,...] [--record CH,CH,...]
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
-#                           [--stop-grace S] [--overlay FILE,...] [--max-lag N] [--serial]
+#                           [--stop-grace S] [--overlay FILE,...] [--max-lag N] [--serial] [--ground-map]
 # Processes default to those of lio, vio, vio_feature, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
@@ -40,6 +40,8 @@
 # fall up to N messages (16; and 16 MB, livo-playback --max-lag-mb) behind the rest, so they run
 # beside lio, vio and loop on the second core (livo-playback --lag); 0: they keep in step. --serial: every process handles every message
 # before the next goes out (no lag, no quiet promises): slower, and the outputs are the same.
+# --ground-map: records REGISTERED_SCAN whatever --record says, and evaluation_odometry.json gets the
+# ground-map thickness of those scans against GROUND_TRUTH (livo-evaluate --ground-map).
 set -euo pipefail
 # One brace group: bash reads all of it before running any of it, so editing this file during a
 # long run (a 30 min soak) cannot break that run.
@@ -48,10 +50,10 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,42p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,44p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0 ground_map=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -73,6 +75,7 @@ while [ $# -gt 0 ]; do
     --overlay) overlays+="${overlays:+,}$2"; shift 2 ;;
     --max-lag) max_lag="$2"; shift 2 ;;
     --serial) serial=1; shift ;;
+    --ground-map) ground_map=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
             exe="${2#*=}"
             # a path relative to where the script was called from (the processes run inside --out)
@@ -88,6 +91,7 @@ done
 [[ "$max_restarts" =~ ^[0-9]+$ ]] || die "--max-restarts takes a whole number"
 [[ "$stop_grace" =~ ^[0-9]+$ ]] || die "--stop-grace takes whole seconds"
 [[ "$max_lag" =~ ^[0-9]+$ ]] || die "--max-lag takes a whole number"
+[ "$ground_map" = 0 ] || [[ ",$record," == *",REGISTERED_SCAN,"* ]] || record+=",REGISTERED_SCAN"
 [ -f "$log" ] || die "no such log: $log"
 [ -f "$config" ] || die "no such config: $config"
 log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
@@ -164,8 +168,19 @@ if [ "$inside" = 0 ]; then
     "$bin/livo-loginfo" "$out/outputs.lcmlog" 2>/dev/null | grep -q '^GROUND_TRUTH ' && gt="$out/outputs.lcmlog:GROUND_TRUTH"
     marks=()
     [ -s "$out/weak_spots.json" ] && marks=(--marks "$out/weak_spots.json")
+    # the ground map of the odometry's own scans (the loop-corrected trajectory did not register them)
+    ground=()
+    if [ "$ground_map" = 1 ]; then
+      if "$bin/livo-loginfo" "$out/outputs.lcmlog" 2>/dev/null | grep -q '^REGISTERED_SCAN '; then
+        ground=(--ground-map "$out/outputs.lcmlog:REGISTERED_SCAN")
+      else
+        warnings+=("no REGISTERED_SCAN was recorded: no ground-map thickness")
+      fi
+    fi
     for kind in odometry trajectory; do
-      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$gt" --align se3 ${marks[@]+"${marks[@]}"} \
+      extra=()
+      [ "$kind" = odometry ] && extra=(${ground[@]+"${ground[@]}"})
+      if "$bin/livo-evaluate" --est "$out/$kind.tum" --gt "$gt" --align se3 ${marks[@]+"${marks[@]}"} ${extra[@]+"${extra[@]}"} \
           --json "$out/evaluation_$kind.json" --plot "$out/$kind.svg" >"$out/logs/evaluate_$kind.txt" 2>&1; then
         evaluations+="${evaluations:+;}$kind=$out/evaluation_$kind.json"
         figures+="${figures:+;}$kind against ground truth=$kind.svg"

@@ -6,7 +6,8 @@ For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log (or a 
 same key is reused), then scripts/run_pipeline.sh runs each variant on it, recording only what
 livo-evaluate reads, and the row gets per variant the metrics of livo-evaluate's JSON (METRICS: the
 ATE after an SE(3) and after a 4-DoF alignment, the vertical drift, the roll and pitch RMSE, the
-end-point drift) and the share of the run with odometry. Logs and runs are reused only when the key
+end-point drift, and for a variant with ground_map the ground-map thickness of its registered scans)
+and the share of the run with odometry. Logs and runs are reused only when the key
 written beside them (what they were made from: config bytes, seed, duration, the executables'
 hashes) matches.
 """
@@ -18,10 +19,12 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 class Variant:
     """A pipeline run: the processes started, executables swapped in (process -> binary name in
     build/bin), an overlay merged over the config, the channels recorded besides ODOMETRY,
-    GROUND_TRUTH and HEALTH."""
+    GROUND_TRUTH and HEALTH, and whether to measure the ground-map thickness (run_pipeline.sh
+    --ground-map: REGISTERED_SCAN recorded too, the bulk of the recording while it lasts)."""
 
-    def __init__(self, name, processes='lio', swaps=None, overlay=None, record=()):
+    def __init__(self, name, processes='lio', swaps=None, overlay=None, record=(), ground_map=False):
         self.name, self.processes, self.swaps, self.overlay, self.record = name, processes, swaps or {}, overlay, record
+        self.ground_map = ground_map
 
 
 # --- results reused only for the same inputs: a key over everything a result depends on ---
@@ -129,6 +132,8 @@ def run_variant(v, log, config, run_dir, base, bin_dir, env):
     cmd = [os.path.join(ROOT, 'scripts', 'run_pipeline.sh'), '--log', log, '--config', config,
            '--out', run_dir, '--processes', v.processes,
            '--record', ','.join(('ODOMETRY', 'GROUND_TRUTH', 'HEALTH') + tuple(v.record))]
+    if v.ground_map:
+        cmd += ['--ground-map']
     for process, exe in sorted(v.swaps.items()):
         cmd += ['--swap', '%s=%s' % (process, os.path.join(bin_dir, exe))]
     if v.overlay:
@@ -152,7 +157,11 @@ METRICS = (
     ('roll', 'roll RMSE deg', lambda e: e.get('attitude', {}).get('roll_rmse_deg')),
     ('pitch', 'pitch RMSE deg', lambda e: e.get('attitude', {}).get('pitch_rmse_deg')),
     ('end', 'end-point drift m', lambda e: e['end_point']['translation_m']),
+    # None unless the variant asked for it (Variant.ground_map)
+    ('ground_thickness', 'ground-map thickness m', lambda e: (e.get('ground_map') or {}).get('thickness_rms_m')),
 )
+# measured only when a variant asks (None otherwise): a table leaves them out when no run has them
+OPTIONAL_METRICS = ('ground_thickness',)
 # what a variant's run executes besides its own processes (livo-sim is keyed through the log's key)
 PIPELINE_TOOLS = ('livo-playback', 'livo-record', 'livo-evaluate', 'livo-config', 'livo-loginfo', 'livo-report')
 
@@ -175,8 +184,9 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
     Logs go to logs/NAME_sSEED_DURs[_noimages].lcmlog when `logs` is given (kept), else beside the runs (removed
     unless keep_logs); a log is reused only when its key (the config's bytes, seed, duration and
     livo-sim's hash, written beside it) matches. resume: a run is reused only when the key written
-    beside its evaluation (config bytes, the variant's processes, swaps and overlay, seed, duration,
-    the log's key, the executables' and run_pipeline.sh's hashes) matches; else it runs again."""
+    beside its evaluation (config bytes, the variant's processes, swaps, overlay, recorded channels and
+    ground map, seed, duration, the log's key, the executables' and run_pipeline.sh's hashes)
+    matches; else it runs again."""
     build = build_dir()
     bin_dir = os.path.join(build, 'bin')
     tools = sorted(set(PIPELINE_TOOLS) | set(executables))
@@ -203,7 +213,8 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
             log = os.path.join(logs, '%s_%gs%s.lcmlog' % (tag, dur, suffix)) if logs else base + '.lcmlog'
             log_key = key_of(config_bytes, seed, dur, sim_hash, *([] if images else ['no-images']))
             run_keys = {v.name: key_of(config_bytes, v.processes, sorted(v.swaps.items()), v.overlay, v.record,
-                                       seed, dur, log_key, run_hash) for v in variants}
+                                       seed, dur, log_key, run_hash, *(['ground-map'] if v.ground_map else []))
+                        for v in variants}
             done = {v.name: resume and cached(os.path.join(base, v.name, 'evaluation_odometry.json'),
                                               run_keys[v.name]) for v in variants}
             made_log = False
@@ -303,17 +314,24 @@ def fmt(x, digits=4):
     return '-' if x is None else '%.*f' % (digits, x)
 
 
+def table_metrics(rows, shown):
+    """METRICS but the optional ones no run of the shown variants measured."""
+    return [(m, h, get) for m, h, get in METRICS
+            if m not in OPTIONAL_METRICS or any(r[v].get(m) is not None for r in rows for v in shown if v in r)]
+
+
 def markdown(rows, shown, bold=lambda row, variant: False):
-    """Per run and variant every metric (METRICS); bold: the variants `bold` picks."""
-    lines = ['| config | seed | s | distance m | variant | ' + ' | '.join(h for _, h, _ in METRICS) + ' |',
-             '| --- | --- | --- | --- | --- | ' + ' | '.join('---' for _ in METRICS) + ' |']
+    """Per run and variant every metric (table_metrics); bold: the variants `bold` picks."""
+    metrics = table_metrics(rows, shown)
+    lines = ['| config | seed | s | distance m | variant | ' + ' | '.join(h for _, h, _ in metrics) + ' |',
+             '| --- | --- | --- | --- | --- | ' + ' | '.join('---' for _ in metrics) + ' |']
     for r in rows:
         for v in shown:
             if v not in r:
-                cells = ['(did not run)'] + ['-'] * (len(METRICS) - 1)
+                cells = ['(did not run)'] + ['-'] * (len(metrics) - 1)
             else:
                 cells = [fmt(r[v][m], 3 if m in ('roll', 'pitch', 'end', 'z_end', 'z_per_100m') else 4)
-                         for m, _, _ in METRICS]
+                         for m, _, _ in metrics]
             name = '**%s**' % v if v in r and bold(r, v) else v
             lines.append('| %s | %s | %g | %s | %s | %s |' % (r['config'], r['seed'], r['duration'],
                                                             '%.0f' % r['length'] if 'length' in r else '-', name,
@@ -324,13 +342,14 @@ def markdown(rows, shown, bold=lambda row, variant: False):
 def summary(rows, shown):
     """Per config and variant the mean ± standard deviation over its runs of every metric (the
     vertical errors as magnitudes: a drift up and one down do not cancel)."""
-    lines = ['| config | variant | runs | ' + ' | '.join(h for _, h, _ in METRICS) + ' |',
-             '| --- | --- | --- | ' + ' | '.join('---' for _ in METRICS) + ' |']
-    tables = {m: per_config(rows, shown, m, magnitude=m in ('z_end', 'z_per_100m')) for m, _, _ in METRICS}
+    metrics = table_metrics(rows, shown)
+    lines = ['| config | variant | runs | ' + ' | '.join(h for _, h, _ in metrics) + ' |',
+             '| --- | --- | --- | ' + ' | '.join('---' for _ in metrics) + ' |']
+    tables = {m: per_config(rows, shown, m, magnitude=m in ('z_end', 'z_per_100m')) for m, _, _ in metrics}
     for config in dict.fromkeys(r['config'] for r in rows):
         for v in shown:
             cells, n = [], 0
-            for m, _, _ in METRICS:
+            for m, _, _ in metrics:
                 xs = tables[m].get(config, {}).get(v, [])
                 n = max(n, len(xs))
                 cells.append('%s ± %s' % (fmt(mean_sd(xs)[0]), fmt(mean_sd(xs)[1])) if xs else '-')

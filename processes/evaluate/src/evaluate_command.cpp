@@ -10,6 +10,7 @@
 #include "livo/evaluate/evaluation.hpp"
 #include "livo/evaluate/json_report.hpp"
 #include "livo/command_line.hpp"
+#include "livo/evaluate/scan_log.hpp"
 #include "livo/evaluate/summary_tables.hpp"
 #include "livo/evaluate/svg_plot.hpp"
 
@@ -28,6 +29,23 @@ std::vector<double> parseNumberList(const std::string& option, const std::string
     values.push_back(v);
   }
   return values;
+}
+
+/// The ground-map thickness of the registered scans --ground-map names, against the ground truth.
+GroundMapThickness groundMapOf(const CommandLine& cli, const TrajectoryInput& gt, const EvaluationOptions& evaluation) {
+  if (!gt.has_stamps)
+    throw std::invalid_argument("--ground-map needs a ground truth with time stamps (" + gt.path +
+                                " is a KITTI pose file)");
+  GroundMapOptions options;
+  options.cell_m = cli.getDouble("--ground-cell");
+  options.band_m = cli.getDouble("--ground-band");
+  options.max_dt = cli.getDouble("--ground-max-dt");
+  options.gt_offset = evaluation.gt_offset;
+  options.validate();
+  const ScanLogInput scans = scanLogInput(cli.get("--ground-map"), "REGISTERED_SCAN");
+  GroundMapThickness g = groundMapThickness(registeredScanSource(scans), gt.poses, options);
+  g.source = scans.spec == scans.path ? scans.path + ":" + scans.channel : scans.spec;
+  return g;
 }
 
 std::string baseName(const std::string& path) {
@@ -53,6 +71,12 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
       .option("--drift-lengths", "L1,L2,...", "KITTI drift segment lengths, m", "100,200,300,400,500,600,700,800")
       .option("--drift-step", "N", "KITTI drift: a segment starts every N poses", "10")
       .option("--coverage-gap", "S", "longest interval between pairs that counts as covered, s (default: 3x median)")
+      .option("--ground-map", "LOG[:CHANNEL]", "also the ground-map thickness of the registered scans "
+                                               "(livo.registered_scan_t, channel REGISTERED_SCAN) against --gt")
+      .option("--ground-cell", "M", "ground map: side of the square cells, m", "0.5")
+      .option("--ground-band", "M", "ground map: the ground layer, m above a cell's 5th percentile height", "0.2")
+      .option("--ground-max-dt", "S", "ground map: a scan's ground truth is interpolated between poses at most S "
+                                      "before and after it", "0.05")
       .option("--json", "F", "write the figures as JSON")
       .option("--plot", "F", "write a figure (SVG): top view coloured by error, errors over time")
       .option("--marks", "F", "mark on the figure the degenerate and predicted stretches and the loop closures of a "
@@ -81,7 +105,8 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
     options.validate();
     const TrajectoryInput est = readTrajectoryInput(cli.get("--est"), "ODOMETRY");
     const TrajectoryInput gt = readTrajectoryInput(cli.get("--gt"), "GROUND_TRUTH");
-    const Evaluation ev = evaluateTrajectory(est, gt, options);
+    Evaluation ev = evaluateTrajectory(est, gt, options);
+    if (cli.has("--ground-map")) ev.ground_map = groundMapOf(cli, gt, options);
 
     if (!cli.has("--quiet")) printSummary(out, ev, est, gt, options);
     const std::string title =

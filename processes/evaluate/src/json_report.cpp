@@ -37,6 +37,23 @@ json attitude(const AttitudeError& a) {
               {"tilt_rmse_deg", a.tilt.rmse},
               {"tilt_max_deg", a.tilt.max}};
 }
+json groundMap(const GroundMapThickness& g) {
+  const auto measured = [&](double v) { return g.cells ? json(v) : json(nullptr); };
+  return json{{"source", g.source},
+              {"cell_m", g.cell_m},
+              {"band_m", g.band_m},
+              {"thickness_rms_m", measured(g.thickness.rmse)},
+              {"thickness_median_m", measured(g.thickness.median)},
+              {"truth_rms_m", measured(g.truth.rmse)},
+              {"truth_median_m", measured(g.truth.median)},
+              {"cells", g.cells},
+              {"points", g.points},
+              {"points_binned", g.points_binned},
+              {"points_skipped", g.points_skipped},
+              {"scans", g.scans},
+              {"scans_skipped", g.scans_skipped},
+              {"scans_empty", g.scans_empty}};
+}
 }  // namespace
 
 json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const TrajectoryInput& gt,
@@ -91,6 +108,7 @@ json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const Traj
   j["ate_4dof"] = ev.ate_4dof.count ? json(ev.ate_4dof.rmse) : json(nullptr);
   j["vertical"] = verticalDrift(ev.vertical);
   j["attitude"] = attitude(ev.attitude);
+  j["ground_map"] = ev.ground_map ? groundMap(*ev.ground_map) : json(nullptr);
   return j;
 }
 

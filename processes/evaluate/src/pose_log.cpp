@@ -26,8 +26,10 @@ Message decodeOrThrow(const lcm::LogEvent& ev, const std::string& where) {
     throw PoseLogError(where + ": does not decode as livo." + Message::getTypeName());
   return m;
 }
+}  // namespace
 
-StampedPose stampedPose(int64_t utime, const double position[3], const double orientation[4], const std::string& where) {
+StampedPose stampedPoseOf(int64_t utime, const double position[3], const double orientation[4],
+                          const std::string& where) {
   if (!allFinite(position, 3) || !allFinite(orientation, 4))
     throw PoseLogError(where + ": pose is not finite");
   const double qn = std::sqrt(orientation[0] * orientation[0] + orientation[1] * orientation[1] +
@@ -36,7 +38,6 @@ StampedPose stampedPose(int64_t utime, const double position[3], const double or
     throw PoseLogError(where + ": orientation quaternion has norm " + std::to_string(qn) + ", not 1");
   return StampedPose{toSeconds(utime), poseFrom(position, orientation)};
 }
-}  // namespace
 
 bool isLcmLog(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -66,10 +67,10 @@ PoseLog readPoseLog(const std::string& path, const std::string& channel) {
     StampedPose s;
     if (type_name == "livo.pose_t") {
       const auto m = decodeOrThrow<pose_t>(*ev, where);
-      s = stampedPose(m.utime, m.position, m.orientation, where);
+      s = stampedPoseOf(m.utime, m.position, m.orientation, where);
     } else {
       const auto m = decodeOrThrow<odometry_t>(*ev, where);
-      s = stampedPose(m.utime, m.position, m.orientation, where);
+      s = stampedPoseOf(m.utime, m.position, m.orientation, where);
     }
     out.poses.push_back(s);
   }

@@ -158,10 +158,27 @@ std::string attitudeLine(const Evaluation& ev) {
          fixed(a.tilt.max, 4) + " deg)";
 }
 
+std::string groundMapLine(const GroundMapThickness& g) {
+  std::ostringstream os;
+  os << "Ground-map thickness (" << g.source << ", " << num(g.cell_m) << " m cells, the lowest " << num(g.band_m)
+     << " m of each): ";
+  if (g.cells == 0)
+    os << "no cell with 10 ground points from 2 scans";
+  else
+    os << "rms " << fixed(g.thickness.rmse, 4) << " m, median " << fixed(g.thickness.median, 4)
+       << " m; truth floor rms " << fixed(g.truth.rmse, 4) << " m, median " << fixed(g.truth.median, 4) << " m; "
+       << g.cells << " cells, " << g.points << " ground points";
+  os << "; " << g.scans << " scans";
+  if (g.scans_skipped > 0) os << ", " << g.scans_skipped << " skipped (" << g.scans_empty << " empty, the rest without ground truth)";
+  if (g.points_skipped > 0) os << ", " << g.points_skipped << " points skipped (not finite, or beyond the cell grid)";
+  return os.str();
+}
+
 /// The lines of the metrics for a ground vehicle, each ending in a newline; `separator` between them.
 void groundVehicleLines(std::ostream& os, const Evaluation& ev, const std::string& separator) {
   os << fourDofAteLine(ev) << "\n" << separator << verticalDriftLine(ev) << "\n" << separator
      << attitudeLine(ev) << "\n";
+  if (ev.ground_map) os << separator << groundMapLine(*ev.ground_map) << "\n";
 }
 
 }  // namespace

@@ -23,21 +23,24 @@ const char* formatName(TrajectoryFormat f) {
 }
 }  // namespace
 
+LogSpec splitLogSpec(const std::string& spec) {
+  if (isRegularFile(spec)) return LogSpec{spec, ""};
+  const size_t colon = spec.rfind(':');
+  if (colon == std::string::npos || colon == 0 || !isRegularFile(spec.substr(0, colon)))
+    throw InputError(spec + ": no such file");
+  LogSpec named{spec.substr(0, colon), spec.substr(colon + 1)};
+  if (named.channel.empty()) throw InputError(spec + ": empty channel name after ':'");
+  if (!isLcmLog(named.path))
+    throw InputError(spec + ": a channel was named, but " + named.path + " is not an LCM log");
+  return named;
+}
+
 TrajectoryInput readTrajectoryInput(const std::string& spec, const std::string& default_channel) {
   TrajectoryInput in;
   in.spec = spec;
-  in.path = spec;
-  std::string channel;
-  if (!isRegularFile(spec)) {
-    const size_t colon = spec.rfind(':');
-    if (colon == std::string::npos || colon == 0 || !isRegularFile(spec.substr(0, colon)))
-      throw InputError(spec + ": no such file");
-    in.path = spec.substr(0, colon);
-    channel = spec.substr(colon + 1);
-    if (channel.empty()) throw InputError(spec + ": empty channel name after ':'");
-    if (!isLcmLog(in.path))
-      throw InputError(spec + ": a channel was named, but " + in.path + " is not an LCM log");
-  }
+  const LogSpec named = splitLogSpec(spec);
+  in.path = named.path;
+  std::string channel = named.channel;
 
   if (isLcmLog(in.path)) {
     if (channel.empty()) channel = default_channel;

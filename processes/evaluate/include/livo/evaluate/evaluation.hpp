@@ -1,8 +1,10 @@
 // The whole evaluation of an estimated trajectory against ground truth: association, alignment,
 // absolute trajectory error with coverage, relative pose error, KITTI drift, and for a ground
-// vehicle the ATE after a 4-DoF alignment, the vertical drift and the roll / pitch error.
+// vehicle the ATE after a 4-DoF alignment, the vertical drift and the roll / pitch error (and, from
+// the registered scans, the ground-map thickness: ground_map.hpp).
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "livo/evaluate/attitude_error.hpp"
 #include "livo/evaluate/error_statistics.hpp"
 #include "livo/evaluate/four_dof_alignment.hpp"
+#include "livo/evaluate/ground_map.hpp"
 #include "livo/evaluate/kitti_drift.hpp"
 #include "livo/evaluate/relative_pose_error.hpp"
 #include "livo/evaluate/trajectory_input.hpp"
@@ -89,6 +92,8 @@ struct Evaluation {
   ErrorStatistics ate_4dof;
   VerticalDrift vertical;
   AttitudeError attitude;
+  // From the registered scans when asked for (livo-evaluate --ground-map), not by evaluateTrajectory.
+  std::optional<GroundMapThickness> ground_map;
 };
 
 /// Pairs by time stamp when both sides have stamps, else by index. Throws EvaluationError when no

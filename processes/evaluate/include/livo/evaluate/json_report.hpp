@@ -1,6 +1,6 @@
 // The evaluation as JSON: ate.{rmse,mean,median,max,coverage} in metres, rpe.* in metres and
-// degrees, drift.* in % and deg/m, ate_4dof, vertical.* and attitude.* (m, deg), plus the inputs,
-// pairing and alignment used.
+// degrees, drift.* in % and deg/m, ate_4dof, vertical.* and attitude.* (m, deg), ground_map.* (m;
+// null when not asked for), plus the inputs, pairing and alignment used.
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
 // Poses recorded in an LCM log: livo.pose_t (e.g. GROUND_TRUTH) or livo.odometry_t (e.g. ODOMETRY).
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,11 @@ struct PoseLog {
   Trajectory poses;       // sorted by stamp (utime in seconds); equal stamps keep log order
   std::string type_name;  // "livo.pose_t" or "livo.odometry_t"
 };
+
+/// A message's pose at its stamp (utime in seconds). Throws PoseLogError starting with `where` for a
+/// non-finite pose or a quaternion whose norm is not about 1 (a corrupted or unset one).
+StampedPose stampedPoseOf(int64_t utime, const double position[3], const double orientation[4],
+                          const std::string& where);
 
 /// True if the file starts with an LCM log event's sync word.
 bool isLcmLog(const std::string& path);

@@ -22,6 +22,17 @@ struct TrajectoryInput {
   bool has_stamps = true;  // false for KITTI poses: stamps are line indices, pairing is by index
 };
 
+/// An input named as "FILE" or "LOG:CHANNEL".
+struct LogSpec {
+  std::string path;
+  std::string channel;  // empty when not named (the caller's default, for an LCM log)
+};
+
+/// `spec` as a path and a channel: an existing file is the path as it is; else "PATH:CHANNEL" names
+/// an LCM log and a channel. Throws InputError for no such file, an empty channel name, or a
+/// channel named on a file that is not an LCM log.
+LogSpec splitLogSpec(const std::string& spec);
+
 /// Reads `spec`: an existing file is read whole (an LCM log on `default_channel`); otherwise
 /// "PATH:CHANNEL" names an LCM log and a channel. KITTI pose rows are kept exactly as written
 /// (their rotations are off SO(3) by ~1e-7, and evo evaluates them so). Throws (InputError, TrajectoryError or
