@@ -97,14 +97,33 @@ TEST(ScanMatching, RecoversAKnownDisplacementInARoom) {
     const ScanFeatures f = featuresAt(scene, p, yaw, 0.01);
     // the prediction off by 0.3 m and 3 degrees
     const Pose3 initial = truth * se3::fromRotationTranslation(so3::Exp(Vec3(0.01, -0.02, 0.05)), Vec3(0.2, -0.15, 0.1));
-    const ScanMatchResult r = matchScan(map, f, initial, ScanMatchingOptions{});
-    ASSERT_TRUE(r.valid);
-    EXPECT_FALSE(r.degenerate);
-    EXPECT_TRUE(r.converged);
-    const Vec6 err = se3::Log(truth.inverse() * r.T_W_I);
-    EXPECT_LT(err.head<3>().norm(), 0.2 * M_PI / 180.0) << err.transpose();
-    EXPECT_LT(err.tail<3>().norm(), 0.02) << err.transpose();
-    EXPECT_GT(r.surface_residuals, 200);
+    // LIO-SAM's plane test (1 m, 0.2 m, no collinearity test): every ring arc of the one-sweep map
+    // stands for a plane, the floor's too; the error 0.05 deg and 8 mm
+    ScanMatchingOptions lio_sam;
+    lio_sam.max_neighbour_distance = 1.0;
+    lio_sam.max_plane_distance = 0.2;
+    lio_sam.min_planarity = 0.0;
+    const ScanMatchResult a = matchScan(map, f, initial, lio_sam);
+    ASSERT_TRUE(a.valid);
+    EXPECT_FALSE(a.degenerate);
+    EXPECT_TRUE(a.converged);
+    const Vec6 err_a = se3::Log(truth.inverse() * a.T_W_I);
+    EXPECT_LT(err_a.head<3>().norm(), 0.2 * M_PI / 180.0) << err_a.transpose();
+    EXPECT_LT(err_a.tail<3>().norm(), 0.02) << err_a.transpose();
+    // The default (livo-lio's test) refuses the collinear neighbour sets, and in a map of one sweep
+    // the floor is nothing else (arcs of single rings 0.9 m apart): about 40 % of the residuals go,
+    // the floor's with them, and the height rests on the rest (1.4-1.8 cm here, 0.21 deg). In the
+    // pipeline the local map holds several sweeps whose rings interleave, and there the default
+    // halved the held-out ATE (README, "Against livo-lio"); this pins what it costs a one-sweep map.
+    const ScanMatchResult b = matchScan(map, f, initial, ScanMatchingOptions{});
+    ASSERT_TRUE(b.valid);
+    EXPECT_FALSE(b.degenerate);
+    EXPECT_TRUE(b.converged);
+    const Vec6 err_b = se3::Log(truth.inverse() * b.T_W_I);
+    EXPECT_LT(err_b.head<3>().norm(), 0.25 * M_PI / 180.0) << err_b.transpose();
+    EXPECT_LT(err_b.tail<3>().norm(), 0.02) << err_b.transpose();
+    EXPECT_GT(b.surface_residuals, 200);
+    EXPECT_LT(b.surface_residuals, 0.7 * a.surface_residuals) << b.surface_residuals << " of " << a.surface_residuals;
   }
 }
 

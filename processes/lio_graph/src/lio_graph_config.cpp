@@ -69,6 +69,9 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     c.readOptional("surface_threshold", o.features.surface_threshold);
     c.readOptional("surface_voxel", o.features.surface_voxel);
     c.readOptional("degenerate_eigenvalue", o.matching.degenerate_eigenvalue);
+    c.readOptional("max_neighbour_distance", o.matching.max_neighbour_distance);
+    c.readOptional("max_plane_distance", o.matching.max_plane_distance);
+    c.readOptional("min_planarity", o.matching.min_planarity);
     c.readOptional("planar_factors", o.planar_factors);
     c.readOptional("planar_ground_only", o.planar_ground_only);
     c.readOptional("plane_sigma_angle_deg", o.plane_sigma_angle_deg);
@@ -88,6 +91,9 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (o.local_map_keyframes < 1) fail("local_map_keyframes", "must be >= 1");
   if (!(o.local_map_radius > 0.0)) fail("local_map_radius", "must be > 0");
   if (!(o.local_map_spacing >= 0.0)) fail("local_map_spacing", "must be >= 0 (0: the newest keyframes only)");
+  if (!(o.matching.max_neighbour_distance > 0.0)) fail("max_neighbour_distance", "must be > 0");
+  if (!(o.matching.max_plane_distance > 0.0)) fail("max_plane_distance", "must be > 0");
+  if (!(o.matching.min_planarity >= 0.0 && o.matching.min_planarity < 1.0)) fail("min_planarity", "must be in [0, 1)");
   if (!(o.map_edge_voxel > 0.0 && o.map_surface_voxel > 0.0 && o.features.surface_voxel > 0.0))
     fail("map_surface_voxel", "voxel sizes must be > 0");
   if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))

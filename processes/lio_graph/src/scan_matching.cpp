@@ -46,6 +46,18 @@ double residualWeight(double residual, const Vec3& body) {
   return s > 0.1 ? s : 0.0;
 }
 
+/// The plane of a surface point's map neighbours, if they make one (ScanMatchingOptions).
+bool planeOf(const std::vector<Vec3>& nb, const ScanMatchingOptions& o, Plane* plane) {
+  const int n = static_cast<int>(nb.size());
+  if (o.min_planarity > 0.0) return fitPlane(nb.data(), n, o.max_plane_distance, plane, o.min_planarity);
+  PlaneFit fit;
+  if (!fitPlane(nb.data(), n, &fit)) return false;
+  for (const Vec3& p : nb)
+    if (!(std::abs(fit.plane.distance(p)) <= o.max_plane_distance)) return false;
+  *plane = fit.plane;
+  return true;
+}
+
 void collectResiduals(const LocalMap& map, const ScanFeatures& f, const Pose3& T, const ScanMatchingOptions& o,
                       std::vector<Residual>* out, int* edges, int* surfaces) {
   out->clear();
@@ -76,15 +88,12 @@ void collectResiduals(const LocalMap& map, const ScanFeatures& f, const Pose3& T
     for (const Vec3& b : f.surfaces) {
       const Vec3 w = T * b;
       if (!neighbours(*map.surfaceTree(), map.surfaces(), w, o.neighbours, o.max_neighbour_distance, &nb)) continue;
-      PlaneFit fit;
-      if (!fitPlane(nb.data(), static_cast<int>(nb.size()), &fit)) continue;
-      bool flat = true;
-      for (const Vec3& p : nb) flat = flat && std::abs(fit.plane.distance(p)) <= o.max_plane_distance;
-      if (!flat) continue;
-      const double d = fit.plane.distance(w);
+      Plane plane;
+      if (!planeOf(nb, o, &plane)) continue;
+      const double d = plane.distance(w);
       const double s = residualWeight(d, b);
       if (s <= 0.0) continue;
-      out->push_back({fit.plane.normal, w - d * fit.plane.normal, b, s});
+      out->push_back({plane.normal, w - d * plane.normal, b, s});
       ++*surfaces;
     }
   }

@@ -22,7 +22,8 @@ struct FeatureOptions {
   double surface_threshold = 0.1;   // roughness below which a point is planar
   double occlusion_gap = 0.3;       // m: range jump between neighbours that marks an occlusion
   double parallel_ratio = 0.02;     // |range jump| / range to both neighbours: beam grazing a surface
-  double surface_voxel = 0.4;       // m: surface points downsampled (first point per voxel)
+  double surface_voxel = 0.2;       // m: surface points downsampled (first point per voxel; 0.4 with
+                                    // LIO-SAM's plane test: README, "Against livo-lio")
   double min_range = 1.0;           // m (the vehicle itself, rain, the mount)
 };
 
