@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "evaluate_command_runner.hpp"
 #include "livo/evaluate/evaluate_command.hpp"
 #include "livo/trajectory_io.hpp"
 #include "synthetic_trajectory.hpp"
@@ -20,19 +21,8 @@ namespace {
 
 const std::string kTrajectories = std::string(LIVO_SHARED_DATA) + "/trajectories/";
 
-struct CommandResult {
-  int code;
-  std::string out, err;
-};
-
-CommandResult run(std::vector<std::string> args) {
-  args.insert(args.begin(), "livo-evaluate");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  std::ostringstream out, err;
-  const int code = evaluate::runEvaluateCommand(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
-}
+using evaluate::test::CommandResult;
+CommandResult run(std::vector<std::string> args) { return evaluate::test::runEvaluate(std::move(args)); }
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);

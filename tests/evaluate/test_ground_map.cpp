@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lcm_log_writer.hpp"
+#include "evaluate_command_runner.hpp"
 #include "livo/evaluate/evaluate_command.hpp"
 #include "livo/evaluate/ground_map.hpp"
 #include "livo/messages.hpp"
@@ -248,19 +249,8 @@ TEST(GroundMap, RefusesBadOptions) {
 // ---- livo-evaluate --ground-map on an LCM log ----
 namespace {
 
-struct CommandResult {
-  int code;
-  std::string out, err;
-};
-
-CommandResult run(std::vector<std::string> args) {
-  args.insert(args.begin(), "livo-evaluate");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  std::ostringstream out, err;
-  const int code = runEvaluateCommand(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
-}
+using evaluate::test::CommandResult;
+CommandResult run(std::vector<std::string> args) { return evaluate::test::runEvaluate(std::move(args)); }
 
 registered_scan_t scanMessage(const Scan& s, const std::string& frame = "W") {
   registered_scan_t m{};
