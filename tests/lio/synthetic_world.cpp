@@ -1,6 +1,8 @@
 #include "synthetic_world.hpp"
 
+#include <Eigen/QR>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -119,6 +121,41 @@ double Scene::raycast(const Vec3& o, const Vec3& d) const {
     const double t = -(p.n.dot(o) + p.d) / den;
     if (t > 0.0) best = std::min(best, t);
   }
+  for (const auto& g : grounds) best = std::min(best, g.raycast(o, d));
+  return best;
+}
+
+double GradedGround::height(double at_x) const {
+  if (x.empty()) return 0.0;
+  if (at_x <= x.front()) return h.front();
+  if (at_x >= x.back()) return h.back();
+  const size_t i = static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at_x) - x.begin());  // x[i-1] <= at_x < x[i]
+  return h[i - 1] + (h[i] - h[i - 1]) * (at_x - x[i - 1]) / (x[i] - x[i - 1]);
+}
+
+double GradedGround::grade(double at_x) const {
+  if (x.size() < 2 || at_x < x.front() || at_x >= x.back()) return 0.0;
+  const size_t i = static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at_x) - x.begin());
+  return (h[i] - h[i - 1]) / (x[i] - x[i - 1]);
+}
+
+double GradedGround::raycast(const Vec3& o, const Vec3& d) const {
+  double best = std::numeric_limits<double>::infinity();
+  if (x.empty()) return best;
+  const double inf = std::numeric_limits<double>::infinity();
+  // piece j spans [x[j-1], x[j]] (x[-1] = -inf, x[n] = +inf): z = h(x_ref) + g (x - x_ref)
+  for (size_t j = 0; j <= x.size(); ++j) {
+    const double lo = j == 0 ? -inf : x[j - 1], hi = j == x.size() ? inf : x[j];
+    const double x_ref = j == 0 ? x.front() : x[j - 1];
+    const double h_ref = j == 0 ? h.front() : h[j - 1];
+    const double g = (j == 0 || j == x.size()) ? 0.0 : (h[j] - h[j - 1]) / (x[j] - x[j - 1]);
+    const double den = d.z() - g * d.x();
+    if (std::abs(den) < 1e-12) continue;
+    const double t = (h_ref + g * (o.x() - x_ref) - o.z()) / den;
+    if (!(t > 0.0) || t >= best) continue;
+    const double xh = o.x() + t * d.x();
+    if (xh >= lo - 1e-9 && xh <= hi + 1e-9) best = t;
+  }
   return best;
 }
 
@@ -141,6 +178,100 @@ Scene corridorScene() {
   return s;
 }
 
+GradedGround gradedRoad() {
+  GradedGround g;
+  g.x = {20.0, 50.0, 75.0};
+  g.h = {0.0, 1.5, 0.5};
+  return g;
+}
+
+Scene gradedRoadScene(const GradedGround& ground) {
+  Scene s;
+  s.grounds.push_back(ground);
+  auto standing = [&](double x, double y, double half_x, double half_y, double tall) {
+    const double foot = ground.height(x);  // the piece under its centre; 1 m buried covers a 5 % grade
+    s.solids.push_back({Vec3(x - half_x, y - half_y, foot - 1.0), Vec3(x + half_x, y + half_y, foot + tall)});
+  };
+  // poles about every 30 m, alternating sides, not evenly (a regular pattern aliases along the road)
+  const double pole_x[] = {-25.0, 4.0, 31.0, 63.0, 89.0, 118.0, 146.0};
+  for (int i = 0; i < 7; ++i) standing(pole_x[i], (i % 2 == 0 ? 1.0 : -1.0) * (6.0 + 0.4 * i), 0.15, 0.15, 5.0);
+  // low buildings, well off the road
+  standing(-12.0, -15.0, 4.0, 2.5, 3.0);
+  standing(40.0, 14.0, 5.0, 3.0, 3.5);
+  standing(102.0, -16.0, 6.0, 3.0, 3.0);
+  return s;
+}
+
+namespace {
+/// The ground's profile with each knot rounded into a parabolic vertical curve `curve` m long
+/// (centred on the knot): its height and slope.
+void roundedProfile(const GradedGround& g, double x, double curve, double* height, double* slope) {
+  *height = g.height(x);
+  *slope = g.grade(x);
+  for (size_t i = 0; i < g.x.size(); ++i) {
+    const double u = x - g.x[i] + 0.5 * curve;
+    if (u <= 0.0 || u >= curve) continue;
+    const double before = g.grade(g.x[i] - 1e-9), after = g.grade(g.x[i]);
+    const double change = after - before;
+    *height = g.h[i] + before * (x - g.x[i]) + change * u * u / (2.0 * curve);
+    *slope = before + change * u / curve;
+  }
+}
+
+/// Coefficients c_k of f(s) - f(0) ~ sum_k c_k (1 - cos(k pi s / span)), k = 1..K, least squares
+/// over samples of [0, span].
+std::vector<double> fitCosines(const std::vector<double>& s, const std::vector<double>& f, double span, int K) {
+  Eigen::MatrixXd M(static_cast<Eigen::Index>(s.size()), K);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(s.size()));
+  for (size_t j = 0; j < s.size(); ++j) {
+    for (int k = 0; k < K; ++k) M(static_cast<Eigen::Index>(j), k) = 1.0 - std::cos((k + 1) * M_PI * s[j] / span);
+    b(static_cast<Eigen::Index>(j)) = f[j] - f.front();
+  }
+  const Eigen::VectorXd c = M.colPivHouseholderQr().solve(b);
+  return std::vector<double>(c.data(), c.data() + K);
+}
+}  // namespace
+
+Trajectory gradedDrive(const GradedGround& ground, double t_still, double duration, double distance, double height,
+                       double curve_length) {
+  Trajectory tr;
+  tr.t_still = t_still;
+  const double drive = duration - t_still;
+  // along x: from rest, two thirds of the way to the half period's turning point at `duration`
+  const double w = M_PI / (1.5 * drive);
+  const double A = distance / (1.0 - std::cos(w * drive));
+  tr.pos_terms = {{Vec3(A, 0.0, 0.0), w}};
+  // height and pitch fitted over a span a little past the end (the IMU runs on), ending level
+  const double span = drive + 2.0;
+  const int K = 60;
+  std::vector<double> s, z, pitch;
+  for (int j = 0; j <= 4000; ++j) {
+    s.push_back(span * j / 4000.0);
+    const double x = A * (1.0 - std::cos(w * s.back()));
+    double hz, slope;
+    roundedProfile(ground, x, curve_length, &hz, &slope);
+    z.push_back(hz + height);
+    pitch.push_back(-std::atan(slope));  // nose up climbing: a negative turn about y
+  }
+  tr.p0 = Vec3(0.0, 0.0, z.front());
+  tr.phi0 = Vec3(0.0, pitch.front(), 0.0);
+  const std::vector<double> cz = fitCosines(s, z, span, K), cp = fitCosines(s, pitch, span, K);
+  for (int k = 0; k < K; ++k) {
+    tr.pos_terms.push_back({Vec3(0.0, 0.0, cz[static_cast<size_t>(k)]), (k + 1) * M_PI / span});
+    tr.rot_terms.push_back({Vec3(0.0, cp[static_cast<size_t>(k)], 0.0), (k + 1) * M_PI / span});
+  }
+  return tr;
+}
+
+double gradedDriveHeightError(const Trajectory& traj, const GradedGround& ground, double duration, double height) {
+  double worst = 0.0;
+  for (double t = 0.0; t <= duration; t += 0.01) {
+    const Vec3 p = traj.pose(t).translation();
+    worst = std::max(worst, std::abs(p.z() - ground.height(p.x()) - height));
+  }
+  return worst;
+}
+
 LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarModel& m, int64_t utime,
                         int64_t base_utime, const Pose3& T_I_L, std::mt19937* rng) {
   LidarScan scan;
@@ -161,7 +292,11 @@ LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarM
     for (int r = 0; r < m.rings; ++r) {
       const double el = (m.fov_down_deg + (m.fov_up_deg - m.fov_down_deg) * r / std::max(1, m.rings - 1)) * M_PI / 180.0;
       const Vec3 d_L(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-      const Vec3 d_W = T_W_L.linear() * d_L;
+      Vec3 d_W = T_W_L.linear() * d_L;
+      if (m.elevation_error_deg != 0.0) {
+        const double el_true = el + m.elevation_error_deg * M_PI / 180.0;
+        d_W = T_W_L.linear() * Vec3(std::cos(el_true) * std::cos(az), std::cos(el_true) * std::sin(az), std::sin(el_true));
+      }
       double range = scene.raycast(T_W_L.translation(), d_W);
       if (!std::isfinite(range) || range > m.max_range || range < m.min_range) continue;
       if (m.range_noise_std > 0.0) range += m.range_noise_std * noise(*rng);

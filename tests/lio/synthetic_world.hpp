@@ -44,10 +44,24 @@ struct InfinitePlane {
   double d;  // n.x + d = 0
 };
 
+/// A ground of planar pieces along x, the same at every y (a road's grade profile without camber):
+/// its height is linear between the knots (x[i], h[i]) (x ascending) and level beyond the first
+/// and the last. A height field: a ray from above it meets it first where the nearest of the
+/// pieces' planes, hit within the piece's own x interval, is met.
+struct GradedGround {
+  std::vector<double> x, h;
+  double height(double at_x) const;
+  /// The slope dh/dx of the piece at x (the right one at a knot).
+  double grade(double at_x) const;
+  /// Distance along the unit ray from o to the ground, or +inf (exact: a plane per piece).
+  double raycast(const Vec3& o, const Vec3& d) const;
+};
+
 struct Scene {
   std::vector<Box> shells;   // seen from inside (rooms)
   std::vector<Box> solids;   // seen from outside (pillars, furniture)
   std::vector<InfinitePlane> planes;
+  std::vector<GradedGround> grounds;
   /// Distance along the unit ray to the first hit, or +inf.
   double raycast(const Vec3& o, const Vec3& d) const;
 };
@@ -57,6 +71,27 @@ Scene roomScene();
 /// Two parallel walls (y = +-1.5) and a floor (z = -1.2), infinite along x.
 Scene corridorScene();
 
+/// A road along +x with grade changes (planar pieces, sharp knots): level until x = 20 m, 5 % up to
+/// x = 50 m (+1.5 m), a crest, 4 % down to x = 75 m (+0.5 m), then level again.
+GradedGround gradedRoad();
+/// The road and, far apart as outdoors, poles (0.3 m square, 5 m tall) about every 30 m on either
+/// side 6-8.4 m from the centre line and three low buildings 11-13 m out; everything stands on the
+/// ground (its foot 1 m below it). The LiDAR's height comes from the ground alone: the structure
+/// is vertical, its tops above the sensor.
+Scene gradedRoadScene(const GradedGround& ground = gradedRoad());
+/// A vehicle driving along +x over `ground` (heading along x), still for `t_still` s, then from rest
+/// x(s) = A (1 - cos(w s)), reaching `distance` m at `duration` at about 5 m/s (w: two thirds of the
+/// way to the half period's turning point); its height `height` m above the ground and its pitch
+/// the ground's grade (nose up climbing), each a sum of 60 cosines fitted (least squares over
+/// samples, deterministic) to the profile with every knot rounded into a parabolic vertical curve
+/// `curve_length` m long, so that pose, velocity, rates and specific force stay analytic and the
+/// IMU exact. Over a sharp knot the body floats up to grade change x curve_length / 8 off `height`
+/// (6.5 cm at gradedRoad()'s crest with 6 m curves): a suspension. gradedDriveHeightError() gives it.
+Trajectory gradedDrive(const GradedGround& ground, double t_still, double duration, double distance = 100.0,
+                       double height = 1.8, double curve_length = 6.0);
+/// The largest |z - ground(x) - height| of the drive over [0, duration] (m).
+double gradedDriveHeightError(const Trajectory& traj, const GradedGround& ground, double duration, double height);
+
 struct LidarModel {
   int rings = 16;
   double fov_down_deg = -15.0, fov_up_deg = 15.0;
@@ -64,6 +99,9 @@ struct LidarModel {
   double sweep_duration = 0.1; // s
   double min_range = 0.5, max_range = 100.0;
   double range_noise_std = 0.0;
+  // An intrinsic calibration error: every beam leaves this much above its nominal elevation, the
+  // points reported along the nominal (0: none). Far ground then lies lower than near ground.
+  double elevation_error_deg = 0.0;
   static LidarModel vlp16() { return {}; }
   static LidarModel hdl64() { return {64, -24.9, 2.0, 2048, 0.1, 0.5, 120.0, 0.0}; }
 };
