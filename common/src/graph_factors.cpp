@@ -100,6 +100,26 @@ struct WheelCost {
   }
 };
 
+/// The wheel factor through a mounting correction δ (the last block), with or without the scales.
+struct MountedWheelCost {
+  WheelPreintegration pre;
+  Mat6 sqrt_info;
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* mounting, T* r) const {
+    const T unit[2] = {T(1.0), T(1.0)};
+    return (*this)(q_i, p_i, q_j, p_j, unit, mounting, r);
+  }
+  template <class T>
+  bool operator()(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, const T* mounting,
+                  T* r) const {
+    T raw[6];
+    pre.residual(q_i, p_i, q_j, p_j, scale, mounting, raw);
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> out_map(r);
+    out_map = sqrt_info.cast<T>() * Eigen::Map<const Eigen::Matrix<T, 6, 1>>(raw);
+    return true;
+  }
+};
+
 }  // namespace
 
 ceres::Problem::Options nonOwningProblemOptions() {
@@ -161,6 +181,10 @@ ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma) {
   return new ceres::AutoDiffCostFunction<VectorPriorCost<2>, 2, 2>(new VectorPriorCost<2>{mean, Vec2::Constant(1.0 / sigma)});
 }
 
+ceres::CostFunction* makeWheelMountingPrior(const Vec3& mean, double sigma) {
+  return makeVectorPriorFactor(mean, Vec3::Constant(sigma));
+}
+
 ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration) {
   return new ceres::AutoDiffCostFunction<WheelCost, 6, 4, 3, 4, 3>(
       new WheelCost{preintegration, preintegration.sqrtInformation()});
@@ -169,6 +193,13 @@ ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration) 
 ceres::CostFunction* makeScaledWheelFactor(const WheelPreintegration& preintegration) {
   return new ceres::AutoDiffCostFunction<WheelCost, 6, 4, 3, 4, 3, 2>(
       new WheelCost{preintegration, preintegration.sqrtInformation()});
+}
+
+ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration, const WheelCalibrationBlocks& what) {
+  if (!what.mounting) return what.scales ? makeScaledWheelFactor(preintegration) : makeWheelFactor(preintegration);
+  auto* cost = new MountedWheelCost{preintegration, preintegration.sqrtInformation()};
+  if (what.scales) return new ceres::AutoDiffCostFunction<MountedWheelCost, 6, 4, 3, 4, 3, 2, 3>(cost);
+  return new ceres::AutoDiffCostFunction<MountedWheelCost, 6, 4, 3, 4, 3, 3>(cost);
 }
 
 }  // namespace livo

@@ -138,6 +138,12 @@ WheelRig readWheel(const Config& c) {
   c.read("track_width", w.track_width);
   c.read("speed_noise_std", w.speed_noise_std);
   c.read("T_I_B", w.T_I_B);
+  w.calibration_std = readCalibrationUncertainty(c);
+  // the graphs estimate the wheel frame's rotation only: a stated translation or time offset would
+  // be a belief nothing acts on
+  if (w.calibration_std.translation > 0.0 || w.calibration_std.time_offset_s > 0.0)
+    throw ConfigError(c.where("calibration_std") +
+                      ": of the wheel only rotation_deg is estimated (translation and time_offset_s must be 0)");
   requirePositive(c, "rate_hz", w.rate_hz);
   requirePositive(c, "track_width", w.track_width);
   requireNonNegative(c, "speed_noise_std", w.speed_noise_std);
@@ -208,6 +214,7 @@ void printSensorRig(const SensorRig& r, std::ostream& os) {
     os << "  wheel:  " << w.rate_hz << " Hz on " << r.channels.wheel << ", track " << w.track_width << " m, noise "
        << w.speed_noise_std << " m/s\n          T_I_B ";
     printPose(os, w.T_I_B);
+    if (w.calibration_std.rotation_deg > 0.0) os << ", rotation known to " << w.calibration_std.rotation_deg << " deg";
     os << "\n";
   }
   os << "  ground truth on " << r.channels.ground_truth << "\n";

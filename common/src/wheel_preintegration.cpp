@@ -2,7 +2,15 @@
 
 #include <stdexcept>
 
+#include "livo/text_format.hpp"
+
 namespace livo {
+
+std::string wheelMountingText(const Vec3& mounting) {
+  const Vec3 deg = mounting * (180.0 / M_PI);
+  return "wheel mounting off the rig's by roll " + formatSignificant(deg.x()) + ", pitch " +
+         formatSignificant(deg.y()) + ", yaw " + formatSignificant(deg.z()) + " deg";
+}
 
 WheelPreintegrationNoise WheelPreintegrationNoise::fromRig(const WheelRig& rig) {
   WheelPreintegrationNoise n;

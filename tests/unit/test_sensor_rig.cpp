@@ -1,5 +1,6 @@
 // The rig's camera keys: depth (an RGB-D camera's registered depth, its channel) and the
-// distortion model, read, printed and validated; the model read from an ASL sensor.yaml.
+// distortion model, read, printed and validated; the model read from an ASL sensor.yaml; the LiDAR
+// model; the wheel's calibration uncertainty (its mounting rotation only).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -130,4 +131,31 @@ TEST(SensorRig, LidarModelIsOneOfTheKnown) {
   EXPECT_EQ(readRig(withLidar("VLP-32C")).lidar->model, "VLP-32C");
   const std::string e = errorOf(withLidar("VLP-32"));
   EXPECT_NE(e.find("rig.lidar.model: unknown LiDAR model 'VLP-32'"), std::string::npos) << e;
+}
+
+// The wheel's calibration_std (read as the LiDAR's and the camera's): its rotation only, absent is
+// exact (nothing estimated, the rig printed as before); a translation or time offset is refused.
+TEST(SensorRig, WheelStatesItsMountingRotationUncertainty) {
+  auto withWheel = [](const std::string& extra) {
+    return rigYaml("") + "  wheel: {rate_hz: 50, track_width: 1.1, speed_noise_std: 0.03, " + extra +
+           "T_I_B: {translation: [-0.8, 0, -1.15], rpy_deg: [0, 0, 0]}}\n";
+  };
+  const SensorRig exact = readRig(withWheel(""));
+  ASSERT_TRUE(exact.wheel);
+  EXPECT_EQ(exact.wheel->calibration_std.rotation_deg, 0.0);
+  std::ostringstream exact_print;
+  printSensorRig(exact, exact_print);
+  EXPECT_EQ(exact_print.str().find("known to"), std::string::npos) << exact_print.str();
+
+  const SensorRig stated = readRig(withWheel("calibration_std: {rotation_deg: 0.5}, "));
+  EXPECT_DOUBLE_EQ(stated.wheel->calibration_std.rotation_deg, 0.5);
+  std::ostringstream stated_print;
+  printSensorRig(stated, stated_print);
+  EXPECT_NE(stated_print.str().find("rotation known to 0.5 deg"), std::string::npos) << stated_print.str();
+
+  const std::string t = errorOf(withWheel("calibration_std: {rotation_deg: 0.5, translation: 0.02}, "));
+  EXPECT_NE(t.find("rig.wheel.calibration_std"), std::string::npos) << t;
+  EXPECT_NE(t.find("only rotation_deg"), std::string::npos) << t;
+  EXPECT_NE(errorOf(withWheel("calibration_std: {time_offset_s: 0.005}, ")), "");
+  EXPECT_NE(errorOf(withWheel("calibration_std: {rotation_deg: 20}, ")), "");  // the shared range check
 }

@@ -1,7 +1,9 @@
 // Wheel-encoder preintegration: straight lines and a constant-speed circle against their closed
 // forms, the residual at the truth and under known perturbations with a non-trivial extrinsic,
 // the templated residual against the double one (and its Jet derivatives), and the covariance
-// against its closed form on a straight line and the exact effect of noisy readings on a circle.
+// against its closed form on a straight line and the exact effect of noisy readings on a circle;
+// the mounting correction: zero gives the residual without it exactly, the truth of a turned wheel
+// frame is found through it, and its Jet derivatives against central differences.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -306,6 +308,51 @@ TEST(WheelPreintegration, ScaleCorrectionIsSecondOrder) {
   EXPECT_NEAR(corrected_norm[0] / corrected_norm[1], 4.0, 0.4);
 }
 
+// A mounting correction of zero is the residual without one, to the last bit (the graphs' outputs
+// without a stated wheel calibration must not move), with and without the scales.
+TEST(WheelPreintegration, ZeroMountingIsTheResidualWithoutIt) {
+  const WheelRig rig = testRig();
+  const WheelPreintegration pre = slalom(rig, 1.0, 1.0);
+  const Pose3 Ti = kStart * rig.T_I_B.inverse();
+  const Pose3 Tj = Ti * se3::fromRotationTranslation(so3::Exp(Vec3(0.02, -0.03, 0.5)), Vec3(5.0, 0.4, -0.2));
+  const Quat qi(Ti.linear()), qj(Tj.linear());
+  const Vec3 pi = Ti.translation(), pj = Tj.translation();
+  const double unit[2] = {1.0, 1.0}, scale[2] = {1.012, 0.994}, zero[3] = {0.0, 0.0, 0.0};
+  Vec6 plain, with_unit, scaled, mounted_unit, mounted_scaled;
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), plain.data());
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), unit, with_unit.data());
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), scale, scaled.data());
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), unit, zero, mounted_unit.data());
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), scale, zero, mounted_scaled.data());
+  EXPECT_GT(plain.norm(), 0.1);
+  EXPECT_TRUE(mounted_unit == plain) << (mounted_unit - plain).transpose();
+  EXPECT_TRUE(mounted_unit == with_unit);
+  EXPECT_TRUE(mounted_scaled == scaled) << (mounted_scaled - scaled).transpose();
+}
+
+// The wheels of a rig whose wheel frame is truly R_IB Exp(δ) (turned 0.7 deg in pitch, 1 deg in
+// yaw, 0.3 deg in roll): the IMU poses of that truth leave a residual on the nominal frame that
+// grows with the distance (the speed seen sideways and upwards), and none through the correction δ.
+TEST(WheelPreintegration, MountingCorrectionFindsATurnedWheelFrame) {
+  const WheelRig rig = testRig();
+  const Vec3 delta = Vec3(0.3, 0.7, 1.0) * (M_PI / 180.0);
+  const Pose3 T_I_O = rig.T_I_B * se3::fromRotationTranslation(so3::Exp(delta), Vec3::Zero());
+  const double v = 2.0, duration = 2.0, unit[2] = {1.0, 1.0}, zero[3] = {0.0, 0.0, 0.0};
+  const WheelPreintegration pre = drive(rig, v, 0.0, duration);  // a straight line: exact at the truth
+  const Pose3 Ti = kStart * T_I_O.inverse(), Tj = kStart * arc(v, 0.0, duration) * T_I_O.inverse();
+  const Quat qi(Ti.linear()), qj(Tj.linear());
+  const Vec3 pi = Ti.translation(), pj = Tj.translation();
+  Vec6 nominal, corrected;
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), unit, zero, nominal.data());
+  pre.residual(qi.coeffs().data(), pi.data(), qj.coeffs().data(), pj.data(), unit, delta.data(), corrected.data());
+  EXPECT_LT(corrected.norm(), 1e-12) << corrected.transpose();
+  // nominal: the 4 m driven appear in the turned frame, about 4 m x (yaw, -pitch) to first order
+  const Vec3 seen = so3::Exp(delta) * Vec3(v * duration, 0.0, 0.0);
+  EXPECT_NEAR((nominal.tail<3>() - (seen - Vec3(v * duration, 0.0, 0.0))).norm(), 0.0, 1e-12) << nominal.transpose();
+  EXPECT_NEAR(nominal(4), v * duration * delta.z(), 1e-3);
+  EXPECT_NEAR(nominal(5), -v * duration * delta.y(), 1e-3);
+}
+
 TEST(WheelPreintegration, ZeroAndNegativeIntervals) {
   const WheelRig rig = testRig();
   WheelPreintegration pre = drive(rig, 1.0, 0.2, 0.5);
@@ -350,6 +397,49 @@ TEST(WheelPreintegrationJet, DerivativesMatchCentralDifferences) {
         EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7) << "w " << w << " residual " << k << " parameter " << i;
       }
     }
+  }
+}
+
+// The derivatives with respect to the mounting correction δ (and the poses and scales with it)
+// that Ceres' AutoDiff takes, against central differences of the residual, at δ = 0 (the start of
+// every run) and at a turned frame, on an arc and with scales off one.
+TEST(WheelPreintegrationJet, MountingDerivativesMatchCentralDifferences) {
+  constexpr int kParams = 19;  // q_i p_i q_j p_j s δ
+  using J = ceres::Jet<double, kParams>;
+  const WheelRig rig = testRig();
+  const WheelPreintegration pre = slalom(rig, 1.0, 1.0);
+  const Pose3 Ti = kStart * rig.T_I_B.inverse();
+  const Pose3 Tj = Ti * se3::fromRotationTranslation(so3::Exp(Vec3(0.02, -0.03, 0.5)), Vec3(5.0, 0.4, -0.2));
+  for (const Vec3& delta : {Vec3::Zero().eval(), Vec3(0.012, -0.009, 0.017)}) {
+    Eigen::Matrix<double, kParams, 1> x;
+    x << Quat(Ti.linear()).coeffs(), Ti.translation(), Quat(Tj.linear()).coeffs(), Tj.translation(), 1.01, 0.995,
+        delta;
+    auto residual = [&](const auto* p) {
+      using T = std::decay_t<decltype(*p)>;
+      Eigen::Matrix<T, 6, 1> r;
+      pre.residual(p, p + 4, p + 7, p + 11, p + 14, p + 16, r.data());
+      return r;
+    };
+    std::array<J, kParams> xj;
+    for (int i = 0; i < kParams; ++i) xj[i] = J(x[i], i);
+    const Eigen::Matrix<J, 6, 1> rj = residual(xj.data());
+    const double h = 1e-6;  // as above: truncation and rounding both below 1e-8 at |terms| ~ 10
+    for (int i = 0; i < kParams; ++i) {
+      Eigen::Matrix<double, kParams, 1> xp = x, xm = x;
+      xp[i] += h;
+      xm[i] -= h;
+      const Vec6 numeric = (residual(xp.data()) - residual(xm.data())) / (2 * h);
+      for (int k = 0; k < 6; ++k) {
+        ASSERT_TRUE(std::isfinite(rj[k].v[i]));
+        EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7) << "delta " << delta.transpose() << " residual " << k
+                                                  << " parameter " << i;
+      }
+    }
+    // the mounting moves the translation residual by about the distance driven (5 m) per radian
+    double mounting_gain = 0.0;
+    for (int i = 16; i < kParams; ++i)
+      for (int k = 3; k < 6; ++k) mounting_gain = std::max(mounting_gain, std::abs(rj[k].v[i]));
+    EXPECT_GT(mounting_gain, 4.0);
   }
 }
 #endif  // LIVO_HAVE_CERES_JET

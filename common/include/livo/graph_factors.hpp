@@ -49,6 +49,8 @@ ceres::CostFunction* makeScaledRelativePoseFactor(const Pose3& T_i_j, const Mat6
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma);
 /// The wheel scales' prior (2 residuals; block s).
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma);
+/// The wheel mounting correction's prior (3 residuals; block δ): isotropic, sigma in radians.
+ceres::CostFunction* makeWheelMountingPrior(const Vec3& mean, double sigma);
 /// A Gaussian prior on a scalar block (1 residual).
 ceres::CostFunction* makeScalarPriorFactor(double mean, double sigma);
 
@@ -57,5 +59,15 @@ ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration);
 /// The same with the wheel scales [s_l, s_r] as a block (wheel_preintegration.hpp; blocks q_i p_i
 /// q_j p_j s): the tyres' true radii over the nominal, estimated with the trajectory.
 ceres::CostFunction* makeScaledWheelFactor(const WheelPreintegration& preintegration);
+
+/// What a wheel factor estimates besides the poses (wheel_preintegration.hpp): the tyres' scales
+/// [s_l, s_r] and the mounting correction δ of the wheel frame (3 entries, radians).
+struct WheelCalibrationBlocks {
+  bool scales = false;
+  bool mounting = false;
+};
+/// The wheel preintegration between i and j with the blocks q_i p_i q_j p_j, then s if
+/// `what.scales`, then δ if `what.mounting` (without either: makeWheelFactor's).
+ceres::CostFunction* makeWheelFactor(const WheelPreintegration& preintegration, const WheelCalibrationBlocks& what);
 
 }  // namespace livo

@@ -40,7 +40,9 @@ struct ImuRig {
 
 /// How well a sensor's calibration is known (1-sigma per axis; 0: exact): the extrinsic's rotation
 /// and translation and the time offset. livo-lio estimates what is not exact, with this as the
-/// prior (design.md, "Calibration in the filter"). Key `calibration_std` of a lidar or camera.
+/// prior (design.md, "Calibration in the filter"). Key `calibration_std` of a lidar or camera; of
+/// the wheel, only its rotation (livo-lio-graph and livo-vio-feature estimate the wheel frame's
+/// mounting rotation, wheel_preintegration.hpp).
 struct CalibrationUncertainty {
   double rotation_deg = 0.0;
   double translation = 0.0;    // m
@@ -91,6 +93,7 @@ struct WheelRig {
   double track_width = 0.5;           // m
   double speed_noise_std = 0.02;      // m/s per wheel
   Pose3 T_I_B = Pose3::Identity();
+  CalibrationUncertainty calibration_std;  // of T_I_B's rotation only (0: exact, not estimated)
 };
 
 struct SensorRig {

@@ -2,10 +2,11 @@
 // factor, its eqs. 11-17, after Ground-Fusion): the rotation and translation of the wheel frame
 // O between two states, in O at the first, with their 6x6 covariance.
 //
-// O is the rig's base frame B (WheelRig::T_I_B, the pose of B in the IMU frame): x forward, z up,
-// origin between the wheels. From the wheel speeds the forward speed is v = (v_l + v_r) / 2 and
-// the yaw rate w = (v_r - v_l) / track_width; between two readings (midpoint integration, both
-// averaged over the interval's ends)
+// O is the rig's base frame B (WheelRig::T_I_B, the pose of B in the IMU frame; turned by the
+// mounting correction below where it is estimated): x forward, z up, origin between the wheels.
+// From the wheel speeds the forward speed is v = (v_l + v_r) / 2 and the yaw rate
+// w = (v_r - v_l) / track_width; between two readings (midpoint integration, both averaged over the
+// interval's ends)
 //   ΔR_{k+1} = ΔR_k Exp(z w dt),   Δp_{k+1} = Δp_k + ΔR_k Exp(½ z w dt) [v dt, 0, 0]^T,
 // exact on a straight line; on an arc each chord is v dt instead of v dt sinc(½ w dt) (relative
 // error (w dt)² / 24).
@@ -21,13 +22,32 @@
 // planar-motion prior cannot absorb. With true speeds s_l v_l and s_r v_r, the preintegrated motion
 // depends on s = [s_l, s_r] (1 at the nominal radius); like the IMU biases it is corrected to first
 // order, ΔR(s) = ΔR Exp(J_R (s - 1)), Δp(s) = Δp + J_p (s - 1), with J_R, J_p integrated alongside.
+//
+// Mounting. The rig's T_I_B is a calibration, good to a few tenths of a degree. The wheels drive
+// along the true O's x, so a yaw error of R_IB puts their forward speed sideways in the body (a
+// lateral velocity the IMU and the LiDAR contradict) and a pitch error puts it vertically (a height
+// drift of d sin(pitch) over a distance d, 0.9 m per 100 m at 0.5 deg). The residual therefore
+// takes O as B turned by Exp(δ), R_IO = R_IB Exp(δ) (δ = 0: the rig's nominal; the lever arm t_IB
+// stays), with δ a parameter block the graphs estimate under the rig's stated uncertainty
+// (WheelRig::calibration_std). All three axes, not only yaw and pitch: the prior holds the roll,
+// which the wheels hardly see (a rotation about the direction of motion; only in turns does it
+// tilt the yaw-rate axis, against the roll/pitch-rate sigma), so a 3-vector costs one direction
+// that the prior alone decides, and in exchange the block is the plain rotation vector of the
+// mounting error, with the same isotropic prior as the LiDAR's and the camera's extrinsics, and no
+// choice of which two axes a vehicle's "forward" makes observable.
 #pragma once
+
+#include <string>
 
 #include "livo/imu_preintegration.hpp"  // quaternionExp/Log for the templated residual, upperSqrtInformation
 #include "livo/sensor_rig.hpp"
 #include "livo/so3.hpp"
 
 namespace livo {
+
+/// A mounting correction δ (rad) for a log line: "wheel mounting off the rig's by roll R, pitch P,
+/// yaw Y deg" (δ's components about the wheel frame's x, y, z: roll, pitch and yaw at these angles).
+std::string wheelMountingText(const Vec3& mounting);
 
 struct WheelPreintegrationNoise {
   double speed_std = 0.02;            // m/s per wheel (WheelRig::speed_noise_std)
@@ -74,6 +94,11 @@ class WheelPreintegration {
   /// The same with the wheel scales s = [s_l, s_r] (the preintegration corrected to first order).
   template <class T>
   void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, T* r) const;
+  /// The same with the wheel frame turned by the mounting correction δ (3 entries, a rotation
+  /// vector): R_IO = R_IB Exp(δ) (above); δ = 0 gives the overload without it exactly.
+  template <class T>
+  void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, const T* mounting,
+                T* r) const;
 
  private:
   double track_width_;
@@ -88,6 +113,11 @@ class WheelPreintegration {
   Mat6 covariance_ = Mat6::Zero();
   Eigen::Matrix<double, 3, 2> dR_ds_ = Eigen::Matrix<double, 3, 2>::Zero();
   Eigen::Matrix<double, 3, 2> dp_ds_ = Eigen::Matrix<double, 3, 2>::Zero();
+
+  /// The residual with O's orientation in the body q_IO (the rig's q_IB, or it turned by δ).
+  template <class T>
+  void residualWithWheelFrame(const Eigen::Quaternion<T>& q_IO, const T* q_i, const T* p_i, const T* q_j,
+                              const T* p_j, const T* scale, T* r) const;
 };
 
 template <class T>
@@ -99,13 +129,26 @@ void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, con
 template <class T>
 void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale,
                                    T* r) const {
+  residualWithWheelFrame(Eigen::Quaternion<T>(q_IB_.cast<T>()), q_i, p_i, q_j, p_j, scale, r);
+}
+
+template <class T>
+void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale,
+                                   const T* mounting, T* r) const {
+  const Eigen::Matrix<T, 3, 1> delta(mounting[0], mounting[1], mounting[2]);
+  residualWithWheelFrame(Eigen::Quaternion<T>(q_IB_.cast<T>() * quaternionExp<T>(delta)), q_i, p_i, q_j, p_j, scale,
+                         r);
+}
+
+template <class T>
+void WheelPreintegration::residualWithWheelFrame(const Eigen::Quaternion<T>& q_IO, const T* q_i, const T* p_i,
+                                                 const T* q_j, const T* p_j, const T* scale, T* r) const {
   using Vec3T = Eigen::Matrix<T, 3, 1>;
   using QuatT = Eigen::Quaternion<T>;
   const Eigen::Map<const QuatT> Q_i(q_i), Q_j(q_j);
   const Eigen::Map<const Vec3T> P_i(p_i), P_j(p_j);
-  const QuatT q_IB = q_IB_.cast<T>();
   const Vec3T t_IB = t_IB_.cast<T>();
-  const QuatT Q_Oi = Q_i * q_IB, Q_Oj = Q_j * q_IB;
+  const QuatT Q_Oi = Q_i * q_IO, Q_Oj = Q_j * q_IO;
   const Vec3T P_Oi = P_i + Q_i * t_IB, P_Oj = P_j + Q_j * t_IB;
   const QuatT Q_Oi_inv = Q_Oi.conjugate();
   const Eigen::Matrix<T, 2, 1> ds(scale[0] - T(1.0), scale[1] - T(1.0));

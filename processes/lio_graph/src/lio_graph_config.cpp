@@ -127,6 +127,10 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
      << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
      << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
+     << (o.use_wheel && o.wheel_rig.calibration_std.rotation_deg > 0.0
+             ? " through the estimated mounting rotation (prior sigma " +
+                   formatSignificant(o.wheel_rig.calibration_std.rotation_deg) + " deg)"
+             : std::string())
      << (o.planar_factors ? (o.planar_ground_only ? ", adaptive planar factors (the ground)"
                                                   : ", adaptive planar factors (every plane)")
                           : "")

@@ -83,16 +83,18 @@ struct LioGraphEstimator::Node {
   Mat6 lidar_information = Mat6::Zero();  // ... and its information [dtheta (right), dp]
   /// A prior of the first state (the initialisation).
   struct Unary {
-    enum class Kind { kPose, kVelocity, kBias, kWheelScale, kVisualScale } kind;
+    enum class Kind { kPose, kVelocity, kBias, kWheelScale, kWheelMounting, kVisualScale } kind;
     std::vector<double*> blocks;
     Pose3 pose = Pose3::Identity();   // kPose: W_T_I and its information
     Mat6 information = Mat6::Zero();
-    Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();  // kVelocity (world frame), kBias; kWheelScale: head<2>, sigma(0); kVisualScale: (0)
+    // kVelocity (world frame), kBias, kWheelMounting (body frame); kWheelScale: head<2>, sigma(0); kVisualScale: (0)
+    Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();
     std::unique_ptr<ceres::CostFunction> cost;
     void remake() {
       switch (kind) {
         case Kind::kPose: cost.reset(makePoseFactor(pose, information)); break;
         case Kind::kWheelScale: cost.reset(makeWheelScalePrior(mean.head<2>(), sigma(0))); break;
+        case Kind::kWheelMounting: cost.reset(makeWheelMountingPrior(mean, sigma(0))); break;
         case Kind::kVisualScale: cost.reset(makeScalarPriorFactor(mean(0), sigma(0))); break;
         default: cost.reset(makeVectorPriorFactor(mean, sigma));
       }
@@ -245,6 +247,15 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.blocks = {wheel_scale_};
     u.mean.head<2>() = wheelScale();
     u.sigma.setConstant(opts_.wheel_scale_std);
+  }
+  // the wheel frame's mounting likewise, around what an earlier epoch learned, with the rig's sigma
+  if (estimatesWheelMounting()) {
+    n->priors.emplace_back();
+    Unary& u = n->priors.back();
+    u.kind = Unary::Kind::kWheelMounting;
+    u.blocks = {wheel_mounting_};
+    u.mean = wheelMounting();
+    u.sigma.setConstant(opts_.wheel_rig.calibration_std.rotation_deg * M_PI / 180.0);
   }
   // the visual motion's scale likewise
   if (estimatesVisualScale()) {
@@ -441,7 +452,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
                                           pre.duration()));
     if (opts_.use_wheel) {
       if (auto w = wheelBetween(prev.utime, t_end)) {
-        n->wheel.reset(estimatesWheelScale() ? makeScaledWheelFactor(*w) : makeWheelFactor(*w));
+        n->wheel.reset(makeWheelFactor(*w, {estimatesWheelScale(), estimatesWheelMounting()}));
         n->wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
       } else {
         appendNote(note, "no wheel readings over the sweep");
@@ -471,6 +482,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
   res.accel_bias = Vec3(newest->ba[0], newest->ba[1], newest->ba[2]);
   res.angular_velocity = newest->last_gyro - res.gyro_bias;
   res.wheel_scale = wheelScale();
+  res.wheel_mounting = wheelMounting();
   res.pose_covariance = newestPoseCovariance();
   res.world_points.reserve(body.size());
   for (const Vec3& b : body) res.world_points.push_back(res.pose * b);
@@ -619,8 +631,10 @@ std::vector<double*> LioGraphEstimator::visualBlocks(Node& a, Node& b) {
 }
 
 std::vector<double*> LioGraphEstimator::wheelBlocks(Node& a, Node& b) {
-  if (estimatesWheelScale()) return {a.q, a.p, b.q, b.p, wheel_scale_};
-  return {a.q, a.p, b.q, b.p};
+  std::vector<double*> blocks = {a.q, a.p, b.q, b.p};  // in makeWheelFactor's order
+  if (estimatesWheelScale()) blocks.push_back(wheel_scale_);
+  if (estimatesWheelMounting()) blocks.push_back(wheel_mounting_);
+  return blocks;
 }
 
 void LioGraphEstimator::updateKeyframePoses() {
@@ -698,7 +712,8 @@ WorldMotion LioGraphEstimator::motionOf(const double* block) const {
     if (block == n->v) return WorldMotion::kDirection;
     if (block == n->bg || block == n->ba) return WorldMotion::kNone;
   }
-  if (block == wheel_scale_ || block == visual_scale_) return WorldMotion::kNone;
+  // the wheel mounting is a body-frame rotation: a correction of the world leaves it
+  if (block == wheel_scale_ || block == wheel_mounting_ || block == visual_scale_) return WorldMotion::kNone;
   for (const auto& l : landmarks_)
     if (block == l->c) return WorldMotion::kDirection;
   throw std::logic_error("the marginal prior holds a block that is neither a window state's nor a landmark's");
@@ -803,6 +818,7 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
         if (b != n.q && b != n.p) drop.insert(b);
     for (auto& l : landmarks_) drop.insert(l->c);
     drop.insert(wheel_scale_);
+    drop.insert(wheel_mounting_);
     drop.insert(visual_scale_);
     const auto marginal = m.marginalize(drop, 1e-12);
     if (!marginal || marginal->J.cols() != 6) return Mat6::Identity();

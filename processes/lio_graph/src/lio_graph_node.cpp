@@ -146,6 +146,7 @@ std::string LioGraphNode::summary() const {
     s << ", " << visual_factors_ << " with its relative-pose factor (visual scale " << estimator_.visualScale() << ")";
   if (opts_.core.use_wheel && opts_.core.wheel_scale_std > 0.0)
     s << "; tyre scales " << estimator_.wheelScale().x() << " (left), " << estimator_.wheelScale().y() << " (right)";
+  if (estimator_.estimatesWheelMounting()) s << "; " << wheelMountingText(estimator_.wheelMounting());
   return s.str();
 }
 

@@ -118,7 +118,8 @@ bool SlidingWindowEstimator::addWheel(const WheelSample& s, std::string* why) {
 }
 
 void SlidingWindowEstimator::reset() {
-  // wheel_scale_ stays: the tyres have not changed, and the next window's prior starts from it
+  // wheel_scale_ and wheel_mounting_ stay: the vehicle has not changed, and the next window's priors
+  // start from them
   features_.clear();
   rejected_.clear();
   recent_.clear();
@@ -145,6 +146,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
     res.status = FrameResult::Status::kInitialized;
     res.state = stateOf(*window_.back());
     res.wheel_scale = wheelScale();
+    res.wheel_mounting = wheelMounting();
     return res;
   }
 
@@ -174,6 +176,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   res.state = stateOf(cur);
   res.state.pose_covariance = newestPoseCovariance(graph);
   res.wheel_scale = wheelScale();
+  res.wheel_mounting = wheelMounting();
 
   // The previous newest state stays if it is a keyframe (the oldest then leaves), else it goes.
   if (static_cast<int>(window_.size()) > opts_.window_frames) {
@@ -257,9 +260,9 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
     return false;
   }
   // The body-frame velocity from the wheels: the wheel frame B moves forward at the mean speed
-  // (through the tyre scales as estimated so far: [1, 1] unless an earlier epoch learnt them);
-  // v_I = R_IB v_B - w x t_IB.
-  const Mat3 R_IB = opts_.wheel_rig.T_I_B.linear();
+  // (through the tyre scales and the mounting as estimated so far: nominal unless an earlier epoch
+  // learnt them); v_I = R_IB v_B - w x t_IB.
+  const Mat3 R_IB = opts_.wheel_rig.T_I_B.linear() * so3::Exp(wheelMounting());
   const Vec3 t_IB = opts_.wheel_rig.T_I_B.translation();
   auto bodyVelocity = [&](const WheelSample& w, const Vec3& gyro) {
     const double forward = 0.5 * (wheel_scale_[0] * w.left_speed + wheel_scale_[1] * w.right_speed);
@@ -295,6 +298,8 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   // with the rig's 2 cm/s, sigma 0.11 m/s is 1.1 % of the speed: tighter than wheel_scale_std).
   double vel_std = 3.0 * opts_.wheel_noise.speed_std + 0.05;
   if (estimatesWheelScale()) vel_std = std::hypot(vel_std, opts_.wheel_scale_std * v_W.norm());
+  // likewise the mounting's: its rotation turns the velocity's direction
+  if (estimatesWheelMounting()) vel_std = std::hypot(vel_std, wheelMountingStd() * v_W.norm());
   startWindow(t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(), opts_.moving_init_rot_std, vel_std,
               opts_.init.moving_gyro_bias_std);
   res->static_start = false;
@@ -327,6 +332,11 @@ void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v
   if (estimatesWheelScale()) {
     f->priors.emplace_back(makeWheelScalePrior(wheelScale(), opts_.wheel_scale_std));
     f->prior_blocks.push_back({wheel_scale_});
+  }
+  // the wheel mounting likewise, with the rig's sigma
+  if (estimatesWheelMounting()) {
+    f->priors.emplace_back(makeWheelMountingPrior(wheelMounting(), wheelMountingStd()));
+    f->prior_blocks.push_back({wheel_mounting_});
   }
   window_.push_back(std::move(f));
   recent_.clear();
@@ -378,7 +388,7 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
       else wp.integrate(w[k].left_speed, w[k].right_speed, w[k + 1].left_speed, w[k + 1].right_speed, dt);
     }
     if (ok && wp.duration() > 0.0) {
-      to.wheel.reset(estimatesWheelScale() ? makeScaledWheelFactor(wp) : makeWheelFactor(wp));
+      to.wheel.reset(makeWheelFactor(wp, {estimatesWheelScale(), estimatesWheelMounting()}));
       to.wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
     } else {
       to.wheel_samples.clear();
@@ -528,7 +538,7 @@ void SlidingWindowEstimator::marginalizeOldest() {
   if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
   if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
   if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
-  // the scales are not dropped: what these factors said about them stays in the prior
+  // the scales and the mounting are not dropped: what these factors said about them stays in the prior
   std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   // The features anchored here leave with it: what they said about the states that stay goes into
   // the prior (those in the last optimisation); a later observation of the same track starts anew.
@@ -676,8 +686,14 @@ bool SlidingWindowEstimator::gyroRotation(int64_t t0, int64_t t1, Mat3* R) const
 }
 
 std::vector<double*> SlidingWindowEstimator::wheelBlocks(Frame& a, Frame& b) const {
-  if (estimatesWheelScale()) return {a.q, a.p, b.q, b.p, wheel_scale_};
-  return {a.q, a.p, b.q, b.p};
+  std::vector<double*> blocks = {a.q, a.p, b.q, b.p};  // in makeWheelFactor's order
+  if (estimatesWheelScale()) blocks.push_back(wheel_scale_);
+  if (estimatesWheelMounting()) blocks.push_back(wheel_mounting_);
+  return blocks;
+}
+
+double SlidingWindowEstimator::wheelMountingStd() const {
+  return opts_.wheel_rig.calibration_std.rotation_deg * M_PI / 180.0;
 }
 
 VisualState SlidingWindowEstimator::stateOf(const Frame& f) const {

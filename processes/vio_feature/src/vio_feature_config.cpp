@@ -106,6 +106,10 @@ void printOptions(const VioFeatureNodeOptions& n, std::ostream& os) {
      << (w.use_wheel && w.wheel_scale_std > 0.0
              ? " (tyre scales estimated, prior sigma " + formatSignificant(w.wheel_scale_std) + ")"
              : std::string())
+     << (w.use_wheel && w.wheel_rig.calibration_std.rotation_deg > 0.0
+             ? " through the estimated mounting rotation (prior sigma " +
+                   formatSignificant(w.wheel_rig.calibration_std.rotation_deg) + " deg)"
+             : std::string())
      << "; depth from "
      << (core.use_depth_image && core.use_lidar_depth ? "the depth image and the LiDAR"
          : core.use_depth_image                          ? "the depth image"

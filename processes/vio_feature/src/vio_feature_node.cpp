@@ -192,6 +192,7 @@ std::string VioFeatureNode::summary() const {
   if (estimator_.window().estimatesWheelScale())
     s << "; tyre scales " << estimator_.window().wheelScale().x() << " (left), " << estimator_.window().wheelScale().y()
       << " (right)";
+  if (estimator_.window().estimatesWheelMounting()) s << "; " << wheelMountingText(estimator_.window().wheelMounting());
   return s.str();
 }
 

@@ -7,7 +7,9 @@
 //   4. a new state (pose, velocity, biases) joins a fixed-lag window with an IMU preintegration
 //      factor, a bias random walk, the LiDAR pose factor (its information from the matching, so a
 //      degenerate direction is left to the other sensors), with wheels a wheel preintegration
-//      factor and, with the visual subsystem, its motion since the previous state as a relative
+//      factor (through the tyres' scales and, where the rig states its uncertainty, the wheel
+//      frame's mounting rotation: blocks of the graph for the whole run, never marginalised) and,
+//      with the visual subsystem, its motion since the previous state as a relative
 //      pose factor; the window is optimised and its oldest state marginalised into a linear prior,
 //      so the cost per sweep does not grow with the run;
 //   5. every keyframe_distance / keyframe_angle a keyframe: its features enter the local map.
@@ -50,6 +52,7 @@ struct GraphScanResult {
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
   Vec3 gyro_bias = Vec3::Zero(), accel_bias = Vec3::Zero();
   Vec2 wheel_scale = Vec2::Ones();          // [left, right] tyre radius over the nominal
+  Vec3 wheel_mounting = Vec3::Zero();       // the wheel frame's mounting correction δ (rad; wheelMounting())
   Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
   bool degenerate = false;
   bool visual_motion = false;   // the deskew and the guess took the visual subsystem's motion
@@ -94,6 +97,10 @@ class LioGraphEstimator {
   size_t planeLandmarks() const { return landmarks_.size(); }
   size_t storedKeyframes() const { return keyframes_.size(); }
   Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
+  /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
+  /// estimated when estimatesWheelMounting(), else zero (the rig's nominal).
+  Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
+  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.calibration_std.rotation_deg > 0.0; }
   /// What the visual subsystem's translations are multiplied by to be true (estimated).
   double visualScale() const { return visual_scale_[0]; }
   /// Stored keyframe i, oldest first (i < storedKeyframes()).
@@ -102,8 +109,9 @@ class LioGraphEstimator {
   const LocalMap& localMap() const { return map_; }
   /// Gravity in the world frame: (0, 0, -gravity) until a loop correction tilts the frame.
   const Vec3& gravity() const { return gravity_W_; }
-  /// Forgets everything (state, map, keyframes); the next sweeps initialise again in a new odometry
-  /// epoch (frame().epoch + 1, no correction).
+  /// Forgets everything (state, map, keyframes) but what belongs to the vehicle (the tyre scales,
+  /// the wheel mounting: the next epoch's priors are centred on them); the next sweeps initialise
+  /// again in a new odometry epoch (frame().epoch + 1, no correction).
   void reset();
 
   /// Loop correction (lcmtypes/loop_correction_t.lcm), adopted as livo-lio adopts it: everything
@@ -181,6 +189,7 @@ class LioGraphEstimator {
   int64_t next_keyframe_id_ = 0;
   int64_t last_sweep_end_ = -1;
   double wheel_scale_[2] = {1.0, 1.0};  // a block of the graph for as long as it runs (never marginalised)
+  double wheel_mounting_[3] = {0.0, 0.0, 0.0};  // likewise, the wheel frame's mounting correction δ
   double visual_scale_[1] = {1.0};      // the truth over the visual motion's scale, likewise
   OdometryFrame frame_;
   Vec3 gravity_W_;  // what the IMU factors, the prediction and the plane extraction's "up" use

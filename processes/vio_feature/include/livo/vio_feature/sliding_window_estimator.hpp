@@ -6,8 +6,10 @@
 //   - wheel preintegration factors (Cauchy loss) when the rig has a wheel encoder, corrected to
 //     first order in the tyres' scales [s_l, s_r] (true radius over the nominal), one parameter
 //     block for the whole run with a prior of sigma wheel_scale_std around 1 (as livo-lio-graph's),
-//   - the marginal prior of the states and features that left the window (and, the scale block
-//     never leaving, what they said about the scales)
+//     and, where the rig states its uncertainty (rig.wheel.calibration_std), through the wheel
+//     frame's mounting rotation, likewise a block for the whole run with that prior around the rig's,
+//   - the marginal prior of the states and features that left the window (and, the scale and
+//     mounting blocks never leaving, what they said about them)
 // (VINS-Mono's scheme, the wheel as in Ground-Fusion, from common/'s preintegration and factors).
 // When the window is full, a new keyframe pushes the oldest state out (marginalised: its factors
 // become the prior); a new frame that is not a keyframe replaces the previous newest, whose
@@ -71,6 +73,7 @@ struct FrameResult {
   int outliers = 0;           // dropped after this optimisation
   bool static_start = false;  // kInitialized: at rest, else in motion (wheels)
   Vec2 wheel_scale = Vec2::Ones();  // kInitialized, kTracked: [left, right] tyre radius over the nominal
+  Vec3 wheel_mounting = Vec3::Zero();  // kInitialized, kTracked: the wheel frame's mounting correction (rad)
 };
 
 const char* statusName(FrameResult::Status s);
@@ -99,12 +102,17 @@ class SlidingWindowEstimator {
   /// bias (none before initialisation); false where the IMU does not cover [t0, t1].
   bool gyroRotation(int64_t t0, int64_t t1, Mat3* R) const;
   /// Drops the window, the features and the prior (the buffers stay): the next frames initialise.
-  /// The tyre scales learnt so far stay: the next window's scale prior is centred on them.
+  /// The tyre scales and the wheel mounting learnt so far stay: the next window's priors are
+  /// centred on them.
   void reset();
   /// The tyres' scales [left, right] (true radius over the nominal): estimated when
   /// estimatesWheelScale(), else [1, 1].
   Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
   bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
+  /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
+  /// estimated when estimatesWheelMounting() (the rig states its rotation's uncertainty), else zero.
+  Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
+  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.calibration_std.rotation_deg > 0.0; }
   /// The newest IMU sample's time (0 before any).
   int64_t imuWatermark() const { return imu_.empty() ? 0 : imu_.back().utime; }
   int64_t wheelWatermark() const { return wheel_.empty() ? 0 : wheel_.back().utime; }
@@ -144,8 +152,11 @@ class SlidingWindowEstimator {
   void eraseFeature(uint64_t id);
   Mat6 newestPoseCovariance(const std::vector<Feature*>& features) const;
   VisualState stateOf(const Frame& f) const;
-  /// The parameter blocks of b's wheel factor (from a): the poses, and the scales if estimated.
+  /// The parameter blocks of b's wheel factor (from a): the poses, and the scales and the mounting
+  /// if estimated.
   std::vector<double*> wheelBlocks(Frame& a, Frame& b) const;
+  /// The mounting prior's sigma (rad): the rig's rotation uncertainty.
+  double wheelMountingStd() const;
 
   SlidingWindowOptions opts_;
   Vec3 gravity_W_;
@@ -161,6 +172,7 @@ class SlidingWindowEstimator {
   // [s_l, s_r]: a parameter block for as long as the estimator lives (never marginalised, kept
   // across reset()); mutable as the const walks over the factors hand Ceres its pointer.
   mutable double wheel_scale_[2] = {1.0, 1.0};
+  mutable double wheel_mounting_[3] = {0.0, 0.0, 0.0};  // δ, likewise
 };
 
 }  // namespace livo::vio_feature
