@@ -12,6 +12,14 @@ std::string wheelMountingText(const Vec3& mounting) {
          formatSignificant(deg.y()) + ", yaw " + formatSignificant(deg.z()) + " deg";
 }
 
+std::string wheelFactorText(const WheelRig& rig, double scale_std) {
+  std::string s = "wheel preintegration";
+  if (scale_std > 0.0) s += " (tyre scales estimated, prior sigma " + formatSignificant(scale_std) + ")";
+  if (rig.estimatesMounting())
+    s += " through the estimated mounting rotation (prior sigma " + formatSignificant(rig.calibration_std.rotation_deg) + " deg)";
+  return s;
+}
+
 WheelPreintegrationNoise WheelPreintegrationNoise::fromRig(const WheelRig& rig) {
   WheelPreintegrationNoise n;
   n.speed_std = rig.speed_noise_std;

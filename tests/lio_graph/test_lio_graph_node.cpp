@@ -220,3 +220,46 @@ TEST(LioGraphNode, ImuGapStartsANewEpochAndRefusesTheOldOnesCorrections) {
   EXPECT_GT(epoch0_corrected, 0);
   EXPECT_GT(epoch1, 0);
 }
+
+// The scan-to-map plane test's keys (livo-lio's test: neighbours within max_neighbour_distance, a
+// plane thinner than max_plane_distance, the collinearity ratio min_planarity) and the surface
+// features' voxel are read, and a value out of range is refused naming its own key.
+TEST(LioGraphConfig, ReadsThePlaneTestAndRefusesOutOfRangeValuesNamingTheKey) {
+  const std::string rig = kConfig;
+  const LioGraphNodeOptions defaults = readLioGraphNodeOptions(Config::fromString(rig));
+  EXPECT_DOUBLE_EQ(defaults.core.matching.max_neighbour_distance, 1.5);
+  EXPECT_DOUBLE_EQ(defaults.core.matching.max_plane_distance, 0.03);
+  EXPECT_DOUBLE_EQ(defaults.core.matching.min_planarity, 0.02);
+  EXPECT_DOUBLE_EQ(defaults.core.features.surface_voxel, 0.2);
+  const LioGraphNodeOptions lio_sam = readLioGraphNodeOptions(Config::fromString(
+      rig + "lio_graph: {max_neighbour_distance: 1.0, max_plane_distance: 0.2, min_planarity: 0, surface_voxel: 0.4}\n"));
+  EXPECT_DOUBLE_EQ(lio_sam.core.matching.max_neighbour_distance, 1.0);
+  EXPECT_DOUBLE_EQ(lio_sam.core.matching.max_plane_distance, 0.2);
+  EXPECT_DOUBLE_EQ(lio_sam.core.matching.min_planarity, 0.0);
+  EXPECT_DOUBLE_EQ(lio_sam.core.features.surface_voxel, 0.4);
+
+  const auto refusal = [&](const std::string& section) {
+    try {
+      readLioGraphNodeOptions(Config::fromString(rig + "lio_graph: {" + section + "}\n"));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"max_neighbour_distance: 0", "lio_graph.max_neighbour_distance"},
+      {"max_plane_distance: -0.01", "lio_graph.max_plane_distance"},
+      {"min_planarity: 1.0", "lio_graph.min_planarity"},
+      {"min_planarity: -0.1", "lio_graph.min_planarity"},
+      {"surface_voxel: 0", "lio_graph.surface_voxel"},
+      {"max_stored_keyframes: 0", "lio_graph.max_stored_keyframes"},
+      {"keyframe_distance: 0", "lio_graph.keyframe_distance"},
+      {"wheel_scale_std: 0.3", "lio_graph.wheel_scale_std"},
+      {"min_plane_distance: 0.1", "min_plane_distance"},  // an unknown key, named
+  };
+  for (const auto& [section, key] : bad) {
+    const std::string why = refusal(section);
+    EXPECT_NE(why, "accepted") << section;
+    EXPECT_NE(why.find(key), std::string::npos) << section << " -> " << why;
+  }
+}

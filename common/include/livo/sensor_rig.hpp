@@ -94,6 +94,11 @@ struct WheelRig {
   double speed_noise_std = 0.02;      // m/s per wheel
   Pose3 T_I_B = Pose3::Identity();
   CalibrationUncertainty calibration_std;  // of T_I_B's rotation only (0: exact, not estimated)
+
+  /// The graphs estimate the mounting rotation where the rig states its uncertainty
+  /// (wheel_preintegration.hpp, "Mounting"); its prior sigma per axis, rad.
+  bool estimatesMounting() const { return calibration_std.rotation_deg > 0.0; }
+  double mountingStdRad() const { return calibration_std.rotation_deg * (M_PI / 180.0); }
 };
 
 struct SensorRig {

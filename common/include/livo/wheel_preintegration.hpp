@@ -49,6 +49,11 @@ namespace livo {
 /// yaw Y deg" (δ's components about the wheel frame's x, y, z: roll, pitch and yaw at these angles).
 std::string wheelMountingText(const Vec3& mounting);
 
+/// The wheel factor in a graph's options line (--check-config): "wheel preintegration", then
+/// " (tyre scales estimated, prior sigma S)" where scale_std > 0 and " through the estimated
+/// mounting rotation (prior sigma R deg)" where the rig states its uncertainty.
+std::string wheelFactorText(const WheelRig& rig, double scale_std);
+
 struct WheelPreintegrationNoise {
   double speed_std = 0.02;            // m/s per wheel (WheelRig::speed_noise_std)
   // The planar-motion assumption; defaults for a car on a road, as the LIO's wheel update:

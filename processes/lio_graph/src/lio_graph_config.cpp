@@ -94,8 +94,9 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.matching.max_neighbour_distance > 0.0)) fail("max_neighbour_distance", "must be > 0");
   if (!(o.matching.max_plane_distance > 0.0)) fail("max_plane_distance", "must be > 0");
   if (!(o.matching.min_planarity >= 0.0 && o.matching.min_planarity < 1.0)) fail("min_planarity", "must be in [0, 1)");
-  if (!(o.map_edge_voxel > 0.0 && o.map_surface_voxel > 0.0 && o.features.surface_voxel > 0.0))
-    fail("map_surface_voxel", "voxel sizes must be > 0");
+  if (!(o.map_edge_voxel > 0.0)) fail("map_edge_voxel", "must be > 0");
+  if (!(o.map_surface_voxel > 0.0)) fail("map_surface_voxel", "must be > 0");
+  if (!(o.features.surface_voxel > 0.0)) fail("surface_voxel", "must be > 0");
   if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
     fail("lidar_information_scale", "lidar_point_sigma and lidar_information_scale must be > 0");
   if (!(o.wheel_cauchy > 0.0)) fail("wheel_cauchy", "must be > 0");
@@ -125,12 +126,7 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
      << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
-     << o.lidar_information_scale << ")" << (o.use_wheel ? ", wheel preintegration" : "")
-     << (o.use_wheel && o.wheel_scale_std > 0.0 ? " (tyre scales estimated)" : "")
-     << (o.use_wheel && o.wheel_rig.calibration_std.rotation_deg > 0.0
-             ? " through the estimated mounting rotation (prior sigma " +
-                   formatSignificant(o.wheel_rig.calibration_std.rotation_deg) + " deg)"
-             : std::string())
+     << o.lidar_information_scale << ")" << (o.use_wheel ? ", " + wheelFactorText(o.wheel_rig, o.wheel_scale_std) : std::string())
      << (o.planar_factors ? (o.planar_ground_only ? ", adaptive planar factors (the ground)"
                                                   : ", adaptive planar factors (every plane)")
                           : "")

@@ -255,7 +255,7 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.kind = Unary::Kind::kWheelMounting;
     u.blocks = {wheel_mounting_};
     u.mean = wheelMounting();
-    u.sigma.setConstant(opts_.wheel_rig.calibration_std.rotation_deg * M_PI / 180.0);
+    u.sigma.setConstant(opts_.wheel_rig.mountingStdRad());
   }
   // the visual motion's scale likewise
   if (estimatesVisualScale()) {

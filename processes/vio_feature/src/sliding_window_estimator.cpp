@@ -299,7 +299,7 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   double vel_std = 3.0 * opts_.wheel_noise.speed_std + 0.05;
   if (estimatesWheelScale()) vel_std = std::hypot(vel_std, opts_.wheel_scale_std * v_W.norm());
   // likewise the mounting's: its rotation turns the velocity's direction
-  if (estimatesWheelMounting()) vel_std = std::hypot(vel_std, wheelMountingStd() * v_W.norm());
+  if (estimatesWheelMounting()) vel_std = std::hypot(vel_std, opts_.wheel_rig.mountingStdRad() * v_W.norm());
   startWindow(t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(), opts_.moving_init_rot_std, vel_std,
               opts_.init.moving_gyro_bias_std);
   res->static_start = false;
@@ -335,7 +335,7 @@ void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v
   }
   // the wheel mounting likewise, with the rig's sigma
   if (estimatesWheelMounting()) {
-    f->priors.emplace_back(makeWheelMountingPrior(wheelMounting(), wheelMountingStd()));
+    f->priors.emplace_back(makeWheelMountingPrior(wheelMounting(), opts_.wheel_rig.mountingStdRad()));
     f->prior_blocks.push_back({wheel_mounting_});
   }
   window_.push_back(std::move(f));
@@ -690,10 +690,6 @@ std::vector<double*> SlidingWindowEstimator::wheelBlocks(Frame& a, Frame& b) con
   if (estimatesWheelScale()) blocks.push_back(wheel_scale_);
   if (estimatesWheelMounting()) blocks.push_back(wheel_mounting_);
   return blocks;
-}
-
-double SlidingWindowEstimator::wheelMountingStd() const {
-  return opts_.wheel_rig.calibration_std.rotation_deg * M_PI / 180.0;
 }
 
 VisualState SlidingWindowEstimator::stateOf(const Frame& f) const {

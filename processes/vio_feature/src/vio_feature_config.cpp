@@ -102,14 +102,7 @@ void printOptions(const VioFeatureNodeOptions& n, std::ostream& os) {
      << " px parallax\n"
      << "  window " << w.window_frames << " states, " << w.max_features << " features, " << w.solver_iterations
      << " solver iterations; factors: reprojection (sigma " << w.pixel_sigma << " px), IMU preintegration, bias walk"
-     << (w.use_wheel ? ", wheel preintegration" : "")
-     << (w.use_wheel && w.wheel_scale_std > 0.0
-             ? " (tyre scales estimated, prior sigma " + formatSignificant(w.wheel_scale_std) + ")"
-             : std::string())
-     << (w.use_wheel && w.wheel_rig.calibration_std.rotation_deg > 0.0
-             ? " through the estimated mounting rotation (prior sigma " +
-                   formatSignificant(w.wheel_rig.calibration_std.rotation_deg) + " deg)"
-             : std::string())
+     << (w.use_wheel ? ", " + wheelFactorText(w.wheel_rig, w.wheel_scale_std) : std::string())
      << "; depth from "
      << (core.use_depth_image && core.use_lidar_depth ? "the depth image and the LiDAR"
          : core.use_depth_image                          ? "the depth image"

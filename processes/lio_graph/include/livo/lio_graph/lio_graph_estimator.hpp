@@ -100,7 +100,7 @@ class LioGraphEstimator {
   /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
   /// estimated when estimatesWheelMounting(), else zero (the rig's nominal).
   Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
-  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.calibration_std.rotation_deg > 0.0; }
+  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.estimatesMounting(); }
   /// What the visual subsystem's translations are multiplied by to be true (estimated).
   double visualScale() const { return visual_scale_[0]; }
   /// Stored keyframe i, oldest first (i < storedKeyframes()).

@@ -112,7 +112,7 @@ class SlidingWindowEstimator {
   /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
   /// estimated when estimatesWheelMounting() (the rig states its rotation's uncertainty), else zero.
   Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
-  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.calibration_std.rotation_deg > 0.0; }
+  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.estimatesMounting(); }
   /// The newest IMU sample's time (0 before any).
   int64_t imuWatermark() const { return imu_.empty() ? 0 : imu_.back().utime; }
   int64_t wheelWatermark() const { return wheel_.empty() ? 0 : wheel_.back().utime; }
@@ -155,8 +155,6 @@ class SlidingWindowEstimator {
   /// The parameter blocks of b's wheel factor (from a): the poses, and the scales and the mounting
   /// if estimated.
   std::vector<double*> wheelBlocks(Frame& a, Frame& b) const;
-  /// The mounting prior's sigma (rad): the rig's rotation uncertainty.
-  double wheelMountingStd() const;
 
   SlidingWindowOptions opts_;
   Vec3 gravity_W_;
