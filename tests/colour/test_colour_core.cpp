@@ -14,8 +14,8 @@
 #include "livo/colour/colouring_pipeline.hpp"
 #include "livo/colour/depth_buffer.hpp"
 #include "livo/colour/exposure_gain.hpp"
-#include "livo/colour/map_files.hpp"
 #include "livo/colour/view_cone.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "scene_fixtures.hpp"
 #include "temp_path.hpp"
 

@@ -10,13 +10,13 @@
 
 #include "livo/colour/colour_node.hpp"
 #include "livo/colored_cloud_t.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "livo/colour/map_files.hpp"
 #include "scene_fixtures.hpp"
 #include "temp_path.hpp"
 
@@ -174,11 +174,11 @@ TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
   EXPECT_EQ(node.pipeline().stats().scans, 2);
 
   node.finish();
-  colour::ColouredPoints back;
+  ColouredPoints back;
   std::string error;
-  ASSERT_TRUE(colour::readPly(node.plyPath(), &back, &error)) << error;
+  ASSERT_TRUE(readPly(node.plyPath(), &back, &error)) << error;
   EXPECT_EQ(back.size(), node.pipeline().map().colouredCount());
-  ASSERT_TRUE(colour::readPcd(node.pcdPath(), &back, &error)) << error;
+  ASSERT_TRUE(readPcd(node.pcdPath(), &back, &error)) << error;
   EXPECT_EQ(back.size(), node.pipeline().map().colouredCount());
 }
 
@@ -386,11 +386,11 @@ TEST(ColourNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
   EXPECT_EQ(node.pipeline().map().colouredCount(), 0u);
   EXPECT_GT(node.pipeline().map().size(), 1000u);
   EXPECT_FALSE(mapHasPointNear(node.pipeline(), a + shift));
-  colour::ColouredPoints old;
+  ColouredPoints old;
   std::string error;
-  ASSERT_TRUE(colour::readPly(dir + "/colour_map_epoch0.ply", &old, &error)) << error;
+  ASSERT_TRUE(readPly(dir + "/colour_map_epoch0.ply", &old, &error)) << error;
   EXPECT_EQ(old.size(), coloured_epoch0);
-  ASSERT_TRUE(colour::readPcd(dir + "/colour_map_epoch0.pcd", &old, &error)) << error;
+  ASSERT_TRUE(readPcd(dir + "/colour_map_epoch0.pcd", &old, &error)) << error;
   EXPECT_EQ(old.size(), coloured_epoch0);
 
   // the old epoch afterwards: a scan and a correction, both without effect

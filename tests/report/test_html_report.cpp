@@ -16,8 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-colour::ColouredPoints planeOfPoints(int n_side, double step) {
-  colour::ColouredPoints p;
+ColouredPoints planeOfPoints(int n_side, double step) {
+  ColouredPoints p;
   for (int i = 0; i < n_side; ++i)
     for (int j = 0; j < n_side; ++j) {
       p.position.emplace_back(static_cast<float>(1000.0 + i * step), static_cast<float>(-500.0 + j * step), 2.0f);
@@ -45,7 +45,7 @@ std::string runFolder(const std::string& name) {
                                        "## Warnings\n\nNone.\n";
   std::ofstream(dir + "/figure.svg") << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" height=\"10\"/>\n";
   std::string error;
-  EXPECT_TRUE(colour::writePly(dir + "/colour_map.ply", planeOfPoints(100, 0.05), &error)) << error;
+  EXPECT_TRUE(writePly(dir + "/colour_map.ply", planeOfPoints(100, 0.05), &error)) << error;
   writeTum(dir + "/trajectory.tum", pathAlongX(1000.0, 1005.0, -498.0, 3.0));
   return dir;
 }
@@ -65,7 +65,7 @@ TEST(HtmlReport, Base64OfTheRfcVectors) {
 }
 
 TEST(HtmlReport, ViewerSceneThinsToTheCapTheSameEveryTime) {
-  const colour::ColouredPoints map = planeOfPoints(300, 0.01);  // 90,000 points, 1 cm apart
+  const ColouredPoints map = planeOfPoints(300, 0.01);  // 90,000 points, 1 cm apart
   const Trajectory path = pathAlongX(1000.0, 1003.0, -499.0, 3.5);
   ViewerOptions o;
   o.max_points = 10'000;

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "livo/colour/map_files.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/report/map_views.hpp"
 #include "livo/report/octomap_slice.hpp"
 #include "livo/report/picture_annotations.hpp"
@@ -29,7 +29,7 @@ const std::array<uint8_t, 3> kRed{220, 30, 30}, kGreen{30, 200, 40}, kBlue{20, 4
 cv::Vec3b bgr(const std::array<uint8_t, 3>& rgb) { return {rgb[2], rgb[1], rgb[0]}; }
 
 /// Points on a grid `step` apart (at cell centres) over [x0, x1) x [y0, y1) at height z.
-void addPlane(colour::ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
+void addPlane(ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
               const std::array<uint8_t, 3>& rgb) {
   for (double x = x0 + step / 2; x < x1; x += step)
     for (double y = y0 + step / 2; y < y1; y += step) {
@@ -63,7 +63,7 @@ std::string readBytes(const std::string& path) {
 }  // namespace
 
 TEST(MapPictures, TopViewPutsEachPlaneOnItsPixelsTheHigherInFront) {
-  colour::ColouredPoints pts;
+  ColouredPoints pts;
   addPlane(&pts, 0.5, 1.0, 0.5, 1.0, 0.0, 0.01, kRed);     // 50 x 50 px
   addPlane(&pts, 0.75, 1.25, 0.75, 1.25, 0.5, 0.01, kGreen);  // above it, overlapping a quarter
   TopViewFrame f;
@@ -91,7 +91,7 @@ TEST(MapPictures, TopViewPutsEachPlaneOnItsPixelsTheHigherInFront) {
 }
 
 TEST(MapPictures, PerspectiveViewDrawsTheNearerPlaneInFront) {
-  colour::ColouredPoints pts;
+  ColouredPoints pts;
   addPlane(&pts, -1.0, 1.0, -1.0, 1.0, 0.0, 0.02, kRed);
   addPlane(&pts, 0.0, 1.0, 0.0, 1.0, 5.0, 0.02, kGreen);  // halfway up to the camera
   PerspectiveView view;  // 10 m above the origin, looking straight down, image x along world x
@@ -174,11 +174,11 @@ TEST(MapPictures, TrajectoryHeightFollowsTheNearestPose) {
   EXPECT_TRUE(TrajectoryHeight().empty());
   EXPECT_EQ(TrajectoryHeight().at(1.0, 2.0), 0.0);
   // the ceiling cut relative to it
-  colour::ColouredPoints p;
+  ColouredPoints p;
   addPlane(&p, 0.0, 4.0, 0.0, 1.0, 1.8, 0.5, kRed);     // below 1 + 1 m: kept
   addPlane(&p, 0.0, 4.0, 0.0, 1.0, 2.5, 0.5, kBlue);    // the low part's ceiling: cut
   addPlane(&p, 10.0, 14.0, 0.0, 1.0, 2.5, 0.5, kGreen); // as high, over the high part: kept
-  const colour::ColouredPoints kept = pointsBelowCut(p, h, 1.0);
+  const ColouredPoints kept = pointsBelowCut(p, h, 1.0);
   EXPECT_EQ(kept.size(), 16u + 16u);
   for (const auto& c : kept.rgb) EXPECT_NE(c, kBlue);
 }
@@ -302,7 +302,7 @@ TEST(MapPictures, AnEmptyRunFolderGivesNotesNotErrors) {
 
 TEST(MapPictures, ASyntheticRunGetsEveryPictureByteIdenticalTwice) {
   // a 6 x 4 m room: red floor, green walls, blue ceiling at 2.5 m; the path at 1.2 m
-  colour::ColouredPoints room;
+  ColouredPoints room;
   addPlane(&room, 0.0, 6.0, 0.0, 4.0, 0.0, 0.05, kRed);
   addPlane(&room, 0.0, 6.0, 0.0, 4.0, 2.5, 0.05, kBlue);
   for (double z = 0.025; z < 2.5; z += 0.05) {
@@ -318,7 +318,7 @@ TEST(MapPictures, ASyntheticRunGetsEveryPictureByteIdenticalTwice) {
   for (const std::string& dir : dirs) {
     fs::create_directories(dir);
     std::string error;
-    ASSERT_TRUE(colour::writePly(dir + "/colour_map.ply", room, &error)) << error;
+    ASSERT_TRUE(writePly(dir + "/colour_map.ply", room, &error)) << error;
     ASSERT_TRUE(tree.writeBinary(dir + "/octomap.bt"));
     writeTum(dir + "/trajectory.tum", path);
     writeTum(dir + "/odometry.tum", path);

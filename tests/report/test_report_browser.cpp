@@ -52,7 +52,7 @@ std::string readText(const std::string& path) {
 }
 
 /// Points on a grid (cell centres) over [x0, x1) x [y0, y1) at height z, or a wall when z1 > z.
-void addPlane(colour::ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
+void addPlane(ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
               const std::array<uint8_t, 3>& rgb) {
   for (double x = x0 + step / 2; x < x1; x += step)
     for (double y = y0 + step / 2; y < y1; y += step) {
@@ -65,14 +65,14 @@ void addPlane(colour::ColouredPoints* p, double x0, double x1, double y0, double
 /// through it, its pictures and report.md, and report.html.
 std::string makeRun(const std::string& dir) {
   fs::create_directories(dir);
-  colour::ColouredPoints room;
+  ColouredPoints room;
   addPlane(&room, 0.0, 6.0, 0.0, 4.0, 0.0, 0.04, {220, 40, 40});
   for (double z = 0.02; z < 2.4; z += 0.04) {
     addPlane(&room, 0.0, 6.0, 3.96, 4.0, z, 0.04, {40, 200, 60});
     addPlane(&room, 5.96, 6.0, 0.0, 4.0, z, 0.04, {40, 200, 60});
   }
   std::string error;
-  EXPECT_TRUE(colour::writePly(dir + "/colour_map.ply", room, &error)) << error;
+  EXPECT_TRUE(writePly(dir + "/colour_map.ply", room, &error)) << error;
   Trajectory path;
   for (int i = 0; i <= 100; ++i) {
     Pose3 T = Pose3::Identity();

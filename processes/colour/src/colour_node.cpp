@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "livo/colored_cloud_t.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/correction_frames.hpp"
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
@@ -14,7 +15,6 @@
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "livo/colour/map_files.hpp"
 
 namespace livo::colour {
 

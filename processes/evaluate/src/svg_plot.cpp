@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "livo/evaluate/plot_scale.hpp"
+#include "livo/plot_scale.hpp"
 #include "livo/text_format.hpp"
 
 namespace livo::evaluate {

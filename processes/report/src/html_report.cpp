@@ -152,13 +152,13 @@ std::string thousands(size_t n) {
 
 // The 3D section, or a note of why there is none; fills the counts and errors of `report`.
 std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_three, HtmlReport* report) {
-  colour::ColouredPoints map;
+  ColouredPoints map;
   const std::string map_path = inDir(dir, o.colour_map);
   const std::string map_name = fs::path(o.colour_map).filename().string();
   std::string map_note;
   if (fs::exists(map_path)) {
     std::string error;
-    if (!colour::readPly(map_path, &map, &error)) {
+    if (!readPly(map_path, &map, &error)) {
       report->warnings.push_back("the RGB map is not in the 3D view: " + error);
       map_note = "The RGB map is not shown: " + escapeMarkup(error) + ".";
       map = {};

@@ -141,7 +141,7 @@ const char* const kViewerScript = R"JS(
 
 }  // namespace
 
-ViewerScene viewerScene(const colour::ColouredPoints& map, const Trajectory& trajectory,
+ViewerScene viewerScene(const ColouredPoints& map, const Trajectory& trajectory,
                         const std::vector<double>& reset_stamps, const ViewerOptions& options) {
   ViewerScene s;
   s.map_points = map.size();

@@ -199,9 +199,9 @@ cv::Mat cropToContent(const cv::Mat& image, const cv::Vec3b& background, int mar
   return image(cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)).clone();
 }
 
-colour::ColouredPoints pointsBelowCut(const colour::ColouredPoints& points, const TrajectoryHeight& height,
+ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height,
                                       double cut_above_m) {
-  colour::ColouredPoints out;
+  ColouredPoints out;
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points.position[i];
     if (!p.allFinite() || p.z() > height.at(p.x(), p.y()) + cut_above_m) continue;
@@ -211,7 +211,7 @@ colour::ColouredPoints pointsBelowCut(const colour::ColouredPoints& points, cons
   return out;
 }
 
-cv::Mat renderTopView(const colour::ColouredPoints& points, const TopViewFrame& frame, const SplatStyle& style,
+cv::Mat renderTopView(const ColouredPoints& points, const TopViewFrame& frame, const SplatStyle& style,
                       cv::Mat1f* top_z) {
   cv::Mat image(frame.height, frame.width, CV_8UC3, cv::Scalar(style.background[0], style.background[1], style.background[2]));
   cv::Mat1f depth(frame.height, frame.width, kInf);  // -z: the highest point is the nearest
@@ -242,7 +242,7 @@ cv::Mat renderTopView(const colour::ColouredPoints& points, const TopViewFrame& 
   return image;
 }
 
-cv::Mat renderPerspective(const colour::ColouredPoints& points, const PerspectiveView& view, const SplatStyle& style,
+cv::Mat renderPerspective(const ColouredPoints& points, const PerspectiveView& view, const SplatStyle& style,
                           cv::Mat1f* depth_out) {
   cv::Mat image(view.height, view.width, CV_8UC3, cv::Scalar(style.background[0], style.background[1], style.background[2]));
   cv::Mat1f depth(view.height, view.width, kInf);

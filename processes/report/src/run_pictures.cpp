@@ -8,7 +8,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "livo/colour/map_files.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/file_output.hpp"
 #include "livo/report/map_views.hpp"
 #include "livo/report/picture_annotations.hpp"
@@ -68,7 +68,7 @@ Trajectory readRunTrajectory(const std::string& path, std::vector<std::string>* 
 struct RunFiles {
   Trajectory final_estimate, odometry;
   std::vector<double> reset_stamps;
-  evaluate::PlotMarks marks;
+  PlotMarks marks;
   bool has_marks = false;
   Trajectory map_path;  // path() since the last reset: the maps are of that epoch
   const Trajectory& path() const { return final_estimate.empty() ? odometry : final_estimate; }
@@ -88,7 +88,7 @@ RunFiles readRunFiles(const std::string& dir, std::vector<std::string>* notes) {
   }
   if (fs::exists(inDir(dir, "weak_spots.json"))) {
     try {
-      r.marks = evaluate::readPlotMarks(inDir(dir, "weak_spots.json"));
+      r.marks = readPlotMarks(inDir(dir, "weak_spots.json"));
       r.has_marks = true;
     } catch (const std::exception& e) {
       notes->push_back(std::string("the weak spots are not marked: ") + e.what());
@@ -101,7 +101,7 @@ RunFiles readRunFiles(const std::string& dir, std::vector<std::string>* notes) {
 // The positions of at most ~kFramingSample points, evenly through the file: enough for the
 // framing's percentiles and axis, without a copy of a map of millions.
 constexpr size_t kFramingSample = 1'000'000;
-std::vector<Vec3> framingSample(const colour::ColouredPoints& points) {
+std::vector<Vec3> framingSample(const ColouredPoints& points) {
   const size_t stride = points.size() / kFramingSample + 1;
   std::vector<Vec3> out;
   out.reserve(points.size() / stride + 1);
@@ -157,13 +157,13 @@ void colourMapPictures(const std::string& dir, const RunFiles& run, const Trajec
                          "the run left it out).");
     return;
   }
-  colour::ColouredPoints all;
+  ColouredPoints all;
   std::string error;
-  if (!colour::readPly(path, &all, &error)) {
+  if (!readPly(path, &all, &error)) {
     set->notes.push_back("No RGB map pictures: " + error + ".");
     return;
   }
-  const colour::ColouredPoints points = height.empty() ? all : pointsBelowCut(all, height, o.cut_above_m);
+  const ColouredPoints points = height.empty() ? all : pointsBelowCut(all, height, o.cut_above_m);
   if (points.size() == 0) {
     set->notes.push_back("No RGB map pictures: " + name + " holds no point" + (all.size() ? " below the cut" : "") + ".");
     return;

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "livo/evaluate/plot_scale.hpp"
+#include "livo/plot_scale.hpp"
 #include "livo/report/map_views.hpp"
 #include "livo/text_format.hpp"
 
@@ -119,7 +119,7 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
 
   // axes: ticks and a light grid, equal scales
   const double x_lo = c.xmin, x_hi = c.xmin + plot_w / s, y_lo = c.ymax - plot_h / s, y_hi = c.ymax;
-  const auto xt = evaluate::niceTicks(x_lo, x_hi, 8), yt = evaluate::niceTicks(y_lo, y_hi, 6);
+  const auto xt = niceTicks(x_lo, x_hi, 8), yt = niceTicks(y_lo, y_hi, 6);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   os << "<rect x=\"" << fixed1(kLeft) << "\" y=\"" << fixed1(kTop) << "\" width=\"" << fixed1(plot_w) << "\" height=\"" << fixed1(plot_h)
      << "\" fill=\"none\" stroke=\"#888888\"/>\n";
@@ -128,14 +128,14 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
     os << "<line x1=\"" << fixed1(px) << "\" y1=\"" << fixed1(kTop) << "\" x2=\"" << fixed1(px) << "\" y2=\"" << fixed1(kTop + plot_h)
        << "\" stroke=\"#e6e6e6\"/>\n";
     os << "<text x=\"" << fixed1(px) << "\" y=\"" << fixed1(kTop + plot_h + 18) << "\" font-size=\"12\" text-anchor=\"middle\" "
-       << kFont << ">" << evaluate::tickLabel(x, xstep) << "</text>\n";
+       << kFont << ">" << tickLabel(x, xstep) << "</text>\n";
   }
   for (double y : yt) {
     const double py = c(Vec3(0, y, 0)).second;
     os << "<line x1=\"" << fixed1(kLeft) << "\" y1=\"" << fixed1(py) << "\" x2=\"" << fixed1(kLeft + plot_w) << "\" y2=\"" << fixed1(py)
        << "\" stroke=\"#e6e6e6\"/>\n";
     os << "<text x=\"" << fixed1(kLeft - 8) << "\" y=\"" << fixed1(py + 4) << "\" font-size=\"12\" text-anchor=\"end\" " << kFont
-       << ">" << evaluate::tickLabel(y, ystep) << "</text>\n";
+       << ">" << tickLabel(y, ystep) << "</text>\n";
   }
   os << "<text x=\"" << fixed1(kLeft + 0.5 * plot_w) << "\" y=\"" << fixed1(height - 12) << "\" font-size=\"13\" "
      << "text-anchor=\"middle\" " << kFont << ">x (m)</text>\n";
@@ -156,8 +156,8 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
   if (pieces.empty()) throw std::invalid_argument("trajectoryTopSvg: no finite pose in the estimate");
   const auto degenerate = runsInSpans(est, pieces, in.marks.degenerate);
   const auto predicted = runsInSpans(est, pieces, in.marks.predicted);
-  for (const auto& run : predicted) polyline(os, pixels(est, run), evaluate::kPredictedColour, 9, "stroke-opacity=\"0.45\"");
-  for (const auto& run : degenerate) polyline(os, pixels(est, run), evaluate::kDegenerateColour, 9, "stroke-opacity=\"0.45\"");
+  for (const auto& run : predicted) polyline(os, pixels(est, run), kPredictedColour, 9, "stroke-opacity=\"0.45\"");
+  for (const auto& run : degenerate) polyline(os, pixels(est, run), kDegenerateColour, 9, "stroke-opacity=\"0.45\"");
   if (draw_odometry)
     for (const auto& [a, b] : pathPieces(in.odometry, in.reset_stamps))
       polyline(os, pixels(in.odometry, range(a, b)), kOdometryColour, 1.2);
@@ -168,9 +168,9 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
     if (a < 0 || b < 0) continue;
     const auto pa = c(est[a].pose.translation()), pb = c(est[b].pose.translation());
     os << "<line x1=\"" << fixed1(pa.first) << "\" y1=\"" << fixed1(pa.second) << "\" x2=\"" << fixed1(pb.first) << "\" y2=\""
-       << fixed1(pb.second) << "\" stroke=\"" << evaluate::kLoopColour << "\" stroke-width=\"1.8\" stroke-dasharray=\"6,3\"/>\n";
+       << fixed1(pb.second) << "\" stroke=\"" << kLoopColour << "\" stroke-width=\"1.8\" stroke-dasharray=\"6,3\"/>\n";
     for (const auto& p : {pa, pb})
-      os << "<circle cx=\"" << fixed1(p.first) << "\" cy=\"" << fixed1(p.second) << "\" r=\"3.5\" fill=\"" << evaluate::kLoopColour
+      os << "<circle cx=\"" << fixed1(p.first) << "\" cy=\"" << fixed1(p.second) << "\" r=\"3.5\" fill=\"" << kLoopColour
          << "\"/>\n";
     ++loops_drawn;
   }
@@ -192,13 +192,13 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
   };
   items.push_back({stroke(kEstimateColour, 1.8, ""), has_final ? "trajectory (trajectory.tum)" : "odometry (odometry.tum)"});
   if (draw_odometry) items.push_back({stroke(kOdometryColour, 1.2, ""), "online odometry"});
-  if (!degenerate.empty()) items.push_back({stroke(evaluate::kDegenerateColour, 9, "stroke-opacity=\"0.45\""), "degenerate sweeps"});
+  if (!degenerate.empty()) items.push_back({stroke(kDegenerateColour, 9, "stroke-opacity=\"0.45\""), "degenerate sweeps"});
   if (!predicted.empty())
-    items.push_back({stroke(evaluate::kPredictedColour, 9, "stroke-opacity=\"0.45\""), "predicted, no LiDAR update"});
+    items.push_back({stroke(kPredictedColour, 9, "stroke-opacity=\"0.45\""), "predicted, no LiDAR update"});
   if (loops_drawn > 0)
-    items.push_back({stroke(evaluate::kLoopColour, 1.8, "stroke-dasharray=\"6,3\"") +
-                         "<circle cx=\"0\" cy=\"0\" r=\"3.5\" fill=\"" + evaluate::kLoopColour + "\"/><circle cx=\"26\" cy=\"0\" "
-                         "r=\"3.5\" fill=\"" + evaluate::kLoopColour + "\"/>",
+    items.push_back({stroke(kLoopColour, 1.8, "stroke-dasharray=\"6,3\"") +
+                         "<circle cx=\"0\" cy=\"0\" r=\"3.5\" fill=\"" + kLoopColour + "\"/><circle cx=\"26\" cy=\"0\" "
+                         "r=\"3.5\" fill=\"" + kLoopColour + "\"/>",
                      "loop closure"});
   items.push_back({"<circle cx=\"8\" cy=\"0\" r=\"5\" fill=\"#3cb43c\" stroke=\"#282828\"/><rect x=\"17\" y=\"-4.5\" "
                    "width=\"9\" height=\"9\" fill=\"#dc2828\" stroke=\"#282828\"/>",

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "livo/evaluate/evaluation.hpp"
-#include "livo/evaluate/plot_marks.hpp"
+#include "livo/plot_marks.hpp"
 
 namespace livo::evaluate {
 

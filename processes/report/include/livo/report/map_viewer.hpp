@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "livo/colour/map_files.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/trajectory_io.hpp"
 
 namespace livo::report {
@@ -39,7 +39,7 @@ struct ViewerScene {
 /// Keeps the first point of each voxel of the finest grid point_size_m x 1.25^k (k >= 0) that
 /// leaves at most max_points, or every point when there are no more than that (deterministic:
 /// the file's order decides), and the trajectory's positions at least 5 cm apart (at most 50,000).
-ViewerScene viewerScene(const colour::ColouredPoints& map, const Trajectory& trajectory,
+ViewerScene viewerScene(const ColouredPoints& map, const Trajectory& trajectory,
                         const std::vector<double>& reset_stamps, const ViewerOptions& options = {});
 
 /// The page's 3D section: the scene's data blocks, a canvas with its controls and the script

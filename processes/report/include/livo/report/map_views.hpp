@@ -9,7 +9,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "livo/colour/map_files.hpp"
+#include "livo/coloured_point_files.hpp"
 #include "livo/report/trajectory_height.hpp"
 #include "livo/trajectory_io.hpp"
 
@@ -86,16 +86,16 @@ struct SplatStyle {
 
 /// The points no higher than the trajectory's height there plus `cut_above_m` (the ceiling of a
 /// room, the canopy over a road would hide the map from above).
-colour::ColouredPoints pointsBelowCut(const colour::ColouredPoints& points, const TrajectoryHeight& height,
+ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height,
                                       double cut_above_m);
 
 /// The points from straight above: the highest point of a pixel wins it. `top_z` (if given) gets
 /// the z of each pixel's point (NaN where none).
-cv::Mat renderTopView(const colour::ColouredPoints& points, const TopViewFrame& frame, const SplatStyle& style,
+cv::Mat renderTopView(const ColouredPoints& points, const TopViewFrame& frame, const SplatStyle& style,
                       cv::Mat1f* top_z = nullptr);
 /// The points through the camera: the nearest wins. `depth` (if given) gets each pixel's depth
 /// (infinity where none).
-cv::Mat renderPerspective(const colour::ColouredPoints& points, const PerspectiveView& view, const SplatStyle& style,
+cv::Mat renderPerspective(const ColouredPoints& points, const PerspectiveView& view, const SplatStyle& style,
                           cv::Mat1f* depth = nullptr);
 
 /// The trajectory cut into pieces, [begin, end) index ranges of at least one pose: at a reset

@@ -1,10 +1,10 @@
-#include "livo/evaluate/plot_scale.hpp"
+#include "livo/plot_scale.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-namespace livo::evaluate {
+namespace livo {
 
 namespace {
 double niceStep(double span, int target) {
@@ -58,4 +58,4 @@ std::string errorColour(double t) {
   return buf;
 }
 
-}  // namespace livo::evaluate
+}  // namespace livo

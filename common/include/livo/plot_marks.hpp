@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-namespace livo::evaluate {
+namespace livo {
 
 struct PlotMarks {
   /// [from, to] stamps of the sweeps flagged degenerate (degenerate.spans[].from/to).
@@ -34,4 +34,4 @@ inline constexpr const char* kLoopColour = "#c51b7d";
 /// be read or lacks a key above.
 PlotMarks readPlotMarks(const std::string& path);
 
-}  // namespace livo::evaluate
+}  // namespace livo

@@ -1,4 +1,4 @@
-#include "livo/colour/map_files.hpp"
+#include "livo/coloured_point_files.hpp"
 
 #include <cstdio>
 #include <cstring>
@@ -8,7 +8,7 @@
 
 #include "livo/file_output.hpp"
 
-namespace livo::colour {
+namespace livo {
 
 namespace {
 
@@ -161,4 +161,4 @@ bool readPcd(const std::string& path, ColouredPoints* pts, std::string* error) {
   return true;
 }
 
-}  // namespace livo::colour
+}  // namespace livo

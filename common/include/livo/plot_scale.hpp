@@ -1,10 +1,11 @@
-// Pieces of a chart: linear data-to-pixel scales, round tick values and an error colour map.
+// Pieces of a chart: linear data-to-pixel scales, round tick values and an error colour map (the
+// figures of livo-evaluate and livo-report).
 #pragma once
 
 #include <string>
 #include <vector>
 
-namespace livo::evaluate {
+namespace livo {
 
 /// Maps [lo, hi] in data units onto [px_lo, px_hi] pixels (px_hi < px_lo flips, as for a y axis).
 struct LinearScale {
@@ -25,4 +26,4 @@ std::string tickLabel(double v, double step);
 /// Colour of a value in [0, 1]: blue (low) through pale yellow to red (high), as "#rrggbb".
 std::string errorColour(double t);
 
-}  // namespace livo::evaluate
+}  // namespace livo

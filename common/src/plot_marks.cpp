@@ -1,4 +1,4 @@
-#include "livo/evaluate/plot_marks.hpp"
+#include "livo/plot_marks.hpp"
 
 #include <fstream>
 #include <limits>
@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace livo::evaluate {
+namespace livo {
 
 namespace {
 
@@ -38,4 +38,4 @@ PlotMarks readPlotMarks(const std::string& path) {
   }
 }
 
-}  // namespace livo::evaluate
+}  // namespace livo

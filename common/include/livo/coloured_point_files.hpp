@@ -1,5 +1,6 @@
-// The coloured map as files: binary little-endian PLY (x y z float, red green blue uchar) and
-// binary PCD v0.7 (x y z rgb, rgb packed as PCL does), both readable back here for tests.
+// Coloured points as files: binary little-endian PLY (x y z float, red green blue uchar) and
+// binary PCD v0.7 (x y z rgb, rgb packed as PCL does), both readable back. livo-colour writes its
+// RGB map with them (colour_map.ply / .pcd), livo-report reads it for its pictures and report.html.
 #pragma once
 
 #include <array>
@@ -10,7 +11,7 @@
 
 #include <Eigen/Core>
 
-namespace livo::colour {
+namespace livo {
 
 struct ColouredPoints {
   std::vector<Eigen::Vector3f> position;
@@ -34,4 +35,4 @@ bool writePcd(const std::string& path, const ColouredPoints& points, std::string
 bool readPly(const std::string& path, ColouredPoints* points, std::string* error);
 bool readPcd(const std::string& path, ColouredPoints* points, std::string* error);
 
-}  // namespace livo::colour
+}  // namespace livo
