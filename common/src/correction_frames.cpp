@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "livo/loop_correction_t.hpp"
-#include "livo/map_inputs.hpp"
+#include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
 
 namespace livo {

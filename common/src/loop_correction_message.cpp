@@ -4,6 +4,7 @@
 
 #include "livo/correction_frames.hpp"
 #include "livo/map_inputs.hpp"
+#include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
 
 namespace livo {

@@ -1,7 +1,6 @@
 #include "livo/map_inputs.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
@@ -35,13 +34,6 @@ void moveRegisteredScan(const Pose3& T, registered_scan_t* m) {
     c.y[i] = static_cast<float>(p.y());
     c.z[i] = static_cast<float>(p.z());
   }
-}
-
-std::string poseProblem(const double position[3], const double q[4]) {
-  if (!allFinite(position, 3) || !allFinite(q, 4)) return "pose is not finite";
-  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-  if (!(norm >= 0.5 && norm <= 2.0)) return "orientation is not a unit quaternion";
-  return "";
 }
 
 std::string keyframeProblem(const keyframe_t& m) {

@@ -36,10 +36,6 @@ std::string viewRegisteredScan(const registered_scan_t& m, RegisteredScanView* v
 /// loop correction's frame brought into a map's (MapFrame).
 void moveRegisteredScan(const Pose3& T, registered_scan_t* m);
 
-/// Why a message pose cannot be used: non-finite numbers, or a quaternion (w, x, y, z) whose norm
-/// is not within [0.5, 2] (poseFrom() normalises it); "" if it can.
-std::string poseProblem(const double position[3], const double orientation_wxyz[4]);
-
 /// Why a KEYFRAME cannot be used for map rebuilds: a bad pose, cloud arrays that disagree with
 /// num_points, a cloud not in the body frame "I"; "" if it can.
 std::string keyframeProblem(const keyframe_t& m);

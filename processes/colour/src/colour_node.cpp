@@ -12,6 +12,7 @@
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/map_inputs.hpp"
+#include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
