@@ -6,6 +6,7 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
+#include "livo/node.hpp"
 #include "livo/registered_scan_t.hpp"
 
 namespace livo {
@@ -77,6 +78,46 @@ MapCorrection readMapCorrection(const loop_correction_t& m, MapFrame* frame) {
   if (c.problem.empty()) c.problem = correctionTransform(m, &T_Ck_O);
   if (c.problem.empty()) c.step = frame->addCorrection(m.correction_id, m.epoch, T_Ck_O);
   return c;
+}
+
+bool takeRegisteredScan(Node& node, const std::string& channel, const registered_scan_t& m,
+                        const MapFrame::Placed& placed,
+                        const std::function<bool(const RegisteredScanView&, std::string* why)>& add) {
+  registered_scan_t moved;
+  RegisteredScanView view;
+  std::string why = viewRegisteredScanInMap(m, placed, &moved, &view);
+  if (why.empty() && add(view, &why)) return true;
+  node.reject(channel, why);
+  return false;
+}
+
+bool takeKeyframePose(Node& node, const std::string& channel, const keyframe_t& m, bool cloud,
+                      const std::function<MapFrame::Placed()>& place, Pose3* T_map_I) {
+  if (const std::string why = cloud ? keyframeProblem(m) : poseProblem(m.position, m.orientation); !why.empty()) {
+    node.reject(channel, why);
+    return false;
+  }
+  const MapFrame::Placed placed = place();
+  if (placed.placement != MapFrame::Placement::kUse) {
+    node.reject(channel, placed.why);
+    return false;
+  }
+  *T_map_I = placed.to_map * poseFrom(m.position, m.orientation);
+  return true;
+}
+
+bool takeMapCorrection(Node& node, const std::string& channel, const loop_correction_t& m, MapFrame* frame,
+                       MapCorrection* correction) {
+  *correction = readMapCorrection(m, frame);
+  if (!correction->problem.empty()) {
+    node.reject(channel, correction->problem);
+    return false;
+  }
+  if (!correction->step.apply) {
+    node.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + correction->step.why);
+    return false;
+  }
+  return true;
 }
 
 }  // namespace livo

@@ -9,6 +9,7 @@
 #include "livo/map_inputs.hpp"
 #include "livo/message_checks.hpp"
 #include "livo/messages.hpp"
+#include "livo/node.hpp"
 #include "livo/registered_scan_t.hpp"
 
 using namespace livo;
@@ -103,4 +104,58 @@ TEST(MapInputs, CorrectedKeyframePoses) {
   EXPECT_EQ(correctedKeyframePoses(bad, &poses), "malformed corrected pose");
   EXPECT_EQ(correctedKeyframePoses(correction({}), &poses), "");
   EXPECT_TRUE(poses.empty());
+}
+
+// The map builders' shared intake (takeKeyframePose / takeMapCorrection): a refusal is counted on
+// the node's channel, a keyframe's placement (which may start a new epoch) is asked only for a
+// sound message, and a correction the map does not move to is no refusal.
+TEST(MapInputs, TakeKeyframePoseAndMapCorrectionRefuseOnTheNode) {
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  Node node(lcm, NodeOptions{"map_builder", "PROGRESS_MB", "HEALTH_MB", 0.0, false, true, {}});
+  node.subscribe<keyframe_t>("KEYFRAME", [](const keyframe_t&) {});
+  node.subscribe<loop_correction_t>("LOOP_CORRECTION", [](const loop_correction_t&) {});
+  const auto rejected = [&](const std::string& channel) {
+    for (const channel_stats_t& s : node.channelStats())
+      if (s.channel == channel) return s.rejected;
+    return int64_t{-1};
+  };
+
+  keyframe_t k{};
+  poseTo(pose(2.0, 0.3), k.position, k.orientation);
+  k.cloud.frame = "I";
+  int placements = 0;
+  MapFrame::Placed shifted;
+  shifted.placement = MapFrame::Placement::kUse;
+  shifted.to_map = pose(1.0, 0.0);
+  const auto place = [&] { ++placements; return shifted; };
+  Pose3 T;
+  ASSERT_TRUE(takeKeyframePose(node, "KEYFRAME", k, true, place, &T));
+  EXPECT_LT((T.matrix() - (pose(1.0, 0.0) * pose(2.0, 0.3)).matrix()).norm(), 1e-12);
+  EXPECT_EQ(placements, 1);
+
+  keyframe_t bad = k;
+  bad.position[1] = std::nan("");
+  EXPECT_FALSE(takeKeyframePose(node, "KEYFRAME", bad, false, place, &T));
+  EXPECT_EQ(placements, 1);  // not placed: a bad message must not start an epoch
+  EXPECT_EQ(rejected("KEYFRAME"), 1);
+
+  keyframe_t torn = k;  // the cloud's arrays disagree with num_points: only a builder of clouds refuses
+  torn.cloud.num_points = 3;
+  EXPECT_TRUE(takeKeyframePose(node, "KEYFRAME", torn, false, place, &T));
+  EXPECT_FALSE(takeKeyframePose(node, "KEYFRAME", torn, true, place, &T));
+  EXPECT_EQ(rejected("KEYFRAME"), 2);
+
+  shifted.placement = MapFrame::Placement::kOldEpoch;
+  shifted.why = "of another epoch";
+  EXPECT_FALSE(takeKeyframePose(node, "KEYFRAME", k, true, place, &T));
+  EXPECT_EQ(rejected("KEYFRAME"), 3);
+
+  MapFrame frame;
+  MapCorrection c;
+  loop_correction_t torn_correction = correction({{1, pose(0.0, 0.0)}});
+  torn_correction.num_keyframes = 2;
+  EXPECT_FALSE(takeMapCorrection(node, "LOOP_CORRECTION", torn_correction, &frame, &c));
+  EXPECT_FALSE(c.problem.empty());
+  EXPECT_EQ(rejected("LOOP_CORRECTION"), 1);
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -60,5 +61,28 @@ struct MapCorrection {
   MapFrame::CorrectionStep step;
 };
 MapCorrection readMapCorrection(const loop_correction_t& m, MapFrame* frame);
+
+class Node;
+
+// The three inputs as a map-building node takes them, a refusal said on its node (Node::reject on
+// `channel`) and the message then dropped, so that every map builder refuses alike.
+
+/// A REGISTERED_SCAN's view in the map's frame (viewRegisteredScanInMap()) given to `add`, which
+/// says why it refuses it (as the map cores' addScan); false if refused.
+bool takeRegisteredScan(Node& node, const std::string& channel, const registered_scan_t& m,
+                        const MapFrame::Placed& placed,
+                        const std::function<bool(const RegisteredScanView&, std::string* why)>& add);
+
+/// A KEYFRAME's pose in the map's frame (the placement's to_map times its pose); false if refused:
+/// a bad pose (poseProblem(), or with `cloud` keyframeProblem(): the cloud too), or a placement
+/// other than kUse. `place` (MapFrame::place() of the keyframe's epoch and correction, which may
+/// start a new epoch) is called only for a sound message.
+bool takeKeyframePose(Node& node, const std::string& channel, const keyframe_t& m, bool cloud,
+                      const std::function<MapFrame::Placed()>& place, Pose3* T_map_I);
+
+/// A LOOP_CORRECTION the map moves to (readMapCorrection()); false if refused or not applied (the
+/// latter said as a Node::info line with the step's reason).
+bool takeMapCorrection(Node& node, const std::string& channel, const loop_correction_t& m, MapFrame* frame,
+                       MapCorrection* correction);
 
 }  // namespace livo

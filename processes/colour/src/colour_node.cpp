@@ -36,18 +36,8 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
   node_.declareOutput(options_.colored_cloud_channel);
 
   node_.subscribe<registered_scan_t>(options_.registered_scan_channel, [this](const registered_scan_t& m) {
-    registered_scan_t moved;
-    RegisteredScanView v;
-    if (const std::string why = viewRegisteredScanInMap(m, placeInMap(m.epoch, m.correction_id), &moved, &v);
-        !why.empty()) {
-      node_.reject(options_.registered_scan_channel, why);
-      return;
-    }
-    std::string error;
-    if (!pipeline_.addScan(v, &error)) {
-      node_.reject(options_.registered_scan_channel, error);
-      return;
-    }
+    const auto add = [this](const RegisteredScanView& v, std::string* why) { return pipeline_.addScan(v, why); };
+    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add)) return;
     publishRecoloured(m.utime);
     if (first_scan_utime_ == INT64_MIN) first_scan_utime_ = m.utime;
     if (m.utime - last_status_utime_ >= kStatusPeriodUs) {
@@ -91,27 +81,15 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
     publishRecoloured(m.utime);
   });
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
-    if (const std::string why = poseProblem(m.position, m.orientation); !why.empty()) {  // the cloud is not used
-      node_.reject(options_.keyframe_channel, why);
-      return;
-    }
-    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
-    if (placed.placement != MapFrame::Placement::kUse) {
-      node_.reject(options_.keyframe_channel, placed.why);
-      return;
-    }
-    pipeline_.addKeyframe(m.id, m.utime, placed.to_map * poseFrom(m.position, m.orientation));
+    Pose3 T_map_I;
+    const bool cloud = false;  // the colour map keeps only the keyframe poses
+    if (takeKeyframePose(node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); },
+                         &T_map_I))
+      pipeline_.addKeyframe(m.id, m.utime, T_map_I);
   });
   node_.subscribe<loop_correction_t>(options_.loop_correction_channel, [this](const loop_correction_t& m) {
-    const MapCorrection c = readMapCorrection(m, &frame_);
-    if (!c.problem.empty()) {
-      node_.reject(options_.loop_correction_channel, c.problem);
-      return;
-    }
-    if (!c.step.apply) {
-      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + c.step.why);
-      return;
-    }
+    MapCorrection c;
+    if (!takeMapCorrection(node_, options_.loop_correction_channel, m, &frame_, &c)) return;
     const int moved = pipeline_.applyCorrection(c.corrected, c.step.unlisted);
     std::ostringstream s;
     s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved the map";

@@ -22,18 +22,8 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
       output_dir_(std::move(output_dir)) {
   if (options_.publish_period_s > 0) node_.declareOutput(options_.octomap_channel);
   node_.subscribe<registered_scan_t>(options_.registered_scan_channel, [this](const registered_scan_t& m) {
-    registered_scan_t moved;
-    RegisteredScanView v;
-    if (const std::string why = viewRegisteredScanInMap(m, placeInMap(m.epoch, m.correction_id), &moved, &v);
-        !why.empty()) {
-      node_.reject(options_.registered_scan_channel, why);
-      return;
-    }
-    std::string error;
-    if (!builder_.addScan(v, &error)) {
-      node_.reject(options_.registered_scan_channel, error);
-      return;
-    }
+    const auto add = [this](const RegisteredScanView& v, std::string* why) { return builder_.addScan(v, why); };
+    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add)) return;
     if (builder_.takeRebuildFinished()) {
       node_.info("staged rebuild done: the map is rebuilt from " + std::to_string(builder_.keyframes()) +
                  " keyframes" + (builder_.rebuilding() ? " (another started: keyframes moved while it ran)" : ""));
@@ -58,19 +48,13 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
     });
   }
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
-    if (const std::string why = keyframeProblem(m); !why.empty()) {
-      node_.reject(options_.keyframe_channel, why);
-      return;
-    }
-    const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
-    if (placed.placement != MapFrame::Placement::kUse) {
-      node_.reject(options_.keyframe_channel, placed.why);
-      return;
-    }
-    const point_cloud_t& c = m.cloud;
     Keyframe k;
+    const bool cloud = true;  // rebuilds cast the keyframe's cloud
+    if (!takeKeyframePose(node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); },
+                          &k.T_W_I))
+      return;
+    const point_cloud_t& c = m.cloud;
     k.utime = m.utime;
-    k.T_W_I = placed.to_map * poseFrom(m.position, m.orientation);
     for (int i = 0; i < c.num_points; ++i) {
       const Eigen::Vector3f p(c.x[i], c.y[i], c.z[i]);
       if (p.allFinite()) k.points.push_back(p);
@@ -78,15 +62,8 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
     if (!builder_.addKeyframe(m.id, std::move(k))) node_.reject(options_.keyframe_channel, "pose is not finite");
   });
   node_.subscribe<loop_correction_t>(options_.loop_correction_channel, [this](const loop_correction_t& m) {
-    const MapCorrection c = readMapCorrection(m, &frame_);
-    if (!c.problem.empty()) {
-      node_.reject(options_.loop_correction_channel, c.problem);
-      return;
-    }
-    if (!c.step.apply) {
-      node_.info("loop correction " + std::to_string(m.correction_id) + " not applied: " + c.step.why);
-      return;
-    }
+    MapCorrection c;
+    if (!takeMapCorrection(node_, options_.loop_correction_channel, m, &frame_, &c)) return;
     const int moved = builder_.applyCorrection(c.corrected, c.step.unlisted);
     std::ostringstream s;
     s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
