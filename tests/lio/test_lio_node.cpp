@@ -144,6 +144,28 @@ TEST(LioNode, ReadsTheRigSchemaAndStrictLioSection) {
   EXPECT_NEAR(w.lio.wheel.T_I_B.translation().z(), -0.3, 1e-12);
 }
 
+// A value out of range is refused naming its own key, not a neighbour checked in the same line.
+TEST(LioNode, RefusesOutOfRangeValuesNamingTheKey) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"  point_stride: 0\n", "lio.point_stride"},
+      {"  scan_voxel_size: 0\n", "lio.scan_voxel_size"},
+      {"  reseed_after_s: 0\n", "lio.reseed_after_s"},
+      {"  map: {max_points_per_voxel: 0}\n", "lio.map.max_points_per_voxel"},
+      {"  map: {seen_through: {ray_stride: 0}}\n", "lio.map.seen_through.ray_stride"},
+      {"  matching: {num_neighbors: 2}\n", "lio.matching.num_neighbors"},
+      {"  esikf: {max_iterations: 0}\n", "lio.esikf.max_iterations"},
+  };
+  for (const auto& [line, key] : bad) {
+    std::string why = "accepted";
+    try {
+      readLioNodeOptions(Config::fromString(std::string(kConfig) + line));
+    } catch (const ConfigError& e) {
+      why = e.what();
+    }
+    EXPECT_NE(why.find(key + ":"), std::string::npos) << line << " -> " << why;
+  }
+}
+
 TEST(LioNode, PublishesOdometryScansAndKeyframes) {
   LioNode::SweepCounts sweeps;
   RunSetup setup;

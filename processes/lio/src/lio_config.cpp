@@ -246,31 +246,39 @@ void readLio(const Config& c, LioNodeOptions* o) {
   inRange(s.gate_chi2 > 0.0, "gate_chi2", "must be positive");
   inRange(s.max_interval_s > 0.0 && s.max_interval_s <= 10.0, "max_interval_s", "must be in (0, 10] s");
 
-  auto positive = [&](bool ok, const char* key) {
-    if (!ok) throw ConfigError(c.where(key) + ": must be positive");
+  // every check names the key it is about (c.where: lio.KEY, with its section)
+  auto check = [&](bool ok, const std::string& key, const char* what) {
+    if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
-  positive(l.map.voxel_size > 0 && l.map.max_points_per_voxel > 0, "map");
-  if (!(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0))
-    throw ConfigError(c.where("map") + ".refresh_range_ratio: must be in [0, 1)");
+  check(l.map.voxel_size > 0, "map.voxel_size", "must be positive");
+  check(l.map.max_points_per_voxel > 0, "map.max_points_per_voxel", "must be positive");
+  check(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0, "map.refresh_range_ratio", "must be in [0, 1)");
   try {
-    VoxelPlanes check(l.planes);
+    VoxelPlanes check_planes(l.planes);
   } catch (const std::invalid_argument& e) {
     throw ConfigError(c.where("map") + ".planes: " + e.what());
   }
   const SeenThroughOptions& st = l.seen_through;
-  positive(st.beam_radius >= 0 && st.beam_divergence >= 0 && st.end_margin >= 0 && st.end_margin_fraction >= 0 &&
-               st.min_range >= 0 && st.max_range > st.min_range && st.misses_to_remove >= 1 &&
-               st.misses_to_remove <= 100 && st.ray_stride >= 1,
-           "map.seen_through");
-  positive(l.scan_voxel_size > 0 && l.point_stride > 0, "scan_voxel_size");
-  if (!(l.search_threads >= 1 && l.search_threads <= 64)) throw ConfigError(c.where("search_threads") + ": must be 1 to 64");
-  positive(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors");
-  positive(l.matching.point_noise_std > 0 && l.esikf.max_iterations > 0, "matching.point_noise_std");
-  positive(l.init.window_s > 0, "init.window_s");
-  positive(o->posterior_max_wait_s > 0, "posterior_max_wait_s");
-  positive(o->image_lidar_wait_s > 0, "image_lidar_wait_s");
-  positive(o->image_max_wait_s >= 0, "image_max_wait_s");
-  positive(l.max_imu_backlog_s > 0 && l.reseed_after_s > 0, "max_imu_backlog_s");
+  check(st.beam_radius >= 0, "map.seen_through.beam_radius", "must be >= 0");
+  check(st.beam_divergence >= 0, "map.seen_through.beam_divergence", "must be >= 0");
+  check(st.end_margin >= 0, "map.seen_through.end_margin", "must be >= 0");
+  check(st.end_margin_fraction >= 0, "map.seen_through.end_margin_fraction", "must be >= 0");
+  check(st.min_range >= 0, "map.seen_through.min_range", "must be >= 0");
+  check(st.max_range > st.min_range, "map.seen_through.max_range", "must be above map.seen_through.min_range");
+  check(st.misses_to_remove >= 1 && st.misses_to_remove <= 100, "map.seen_through.misses_to_remove", "must be 1 to 100");
+  check(st.ray_stride >= 1, "map.seen_through.ray_stride", "must be >= 1");
+  check(l.scan_voxel_size > 0, "scan_voxel_size", "must be positive");
+  check(l.point_stride > 0, "point_stride", "must be positive");
+  check(l.search_threads >= 1 && l.search_threads <= 64, "search_threads", "must be 1 to 64");
+  check(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors", "must be 3 to 32");
+  check(l.matching.point_noise_std > 0, "matching.point_noise_std", "must be positive");
+  check(l.esikf.max_iterations > 0, "esikf.max_iterations", "must be positive");
+  check(l.init.window_s > 0, "init.window_s", "must be positive");
+  check(o->posterior_max_wait_s > 0, "posterior_max_wait_s", "must be positive");
+  check(o->image_lidar_wait_s > 0, "image_lidar_wait_s", "must be positive");
+  check(o->image_max_wait_s >= 0, "image_max_wait_s", "must be >= 0");
+  check(l.max_imu_backlog_s > 0, "max_imu_backlog_s", "must be positive");
+  check(l.reseed_after_s > 0, "reseed_after_s", "must be positive");
 }
 }  // namespace
 
