@@ -255,6 +255,9 @@ TEST(LioGraphConfig, ReadsThePlaneTestAndRefusesOutOfRangeValuesNamingTheKey) {
       {"max_stored_keyframes: 0", "lio_graph.max_stored_keyframes"},
       {"keyframe_distance: 0", "lio_graph.keyframe_distance"},
       {"wheel_scale_std: 0.3", "lio_graph.wheel_scale_std"},
+      {"lidar_point_sigma: 0", "lio_graph.lidar_point_sigma"},
+      {"plane_threshold_per_metre: -1", "lio_graph.plane_threshold_per_metre"},
+      {"visual_sigma_rotation_deg: 0", "lio_graph.visual_sigma_rotation_deg"},
       {"min_plane_distance: 0.1", "min_plane_distance"},  // an unknown key, named
   };
   for (const auto& [section, key] : bad) {

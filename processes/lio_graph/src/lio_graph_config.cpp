@@ -97,22 +97,22 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.map_edge_voxel > 0.0)) fail("map_edge_voxel", "must be > 0");
   if (!(o.map_surface_voxel > 0.0)) fail("map_surface_voxel", "must be > 0");
   if (!(o.features.surface_voxel > 0.0)) fail("surface_voxel", "must be > 0");
-  if (!(o.lidar_point_sigma > 0.0 && o.lidar_information_scale > 0.0))
-    fail("lidar_information_scale", "lidar_point_sigma and lidar_information_scale must be > 0");
+  if (!(o.lidar_point_sigma > 0.0)) fail("lidar_point_sigma", "must be > 0");
+  if (!(o.lidar_information_scale > 0.0)) fail("lidar_information_scale", "must be > 0");
   if (!(o.wheel_cauchy > 0.0)) fail("wheel_cauchy", "must be > 0");
   if (!(o.wheel_scale_std >= 0.0 && o.wheel_scale_std <= 0.2)) fail("wheel_scale_std", "must be in [0, 0.2]");
-  if (!(o.plane_sigma_angle_deg > 0.0 && o.plane_sigma_distance > 0.0))
-    fail("plane_sigma_distance", "plane_sigma_angle_deg and plane_sigma_distance must be > 0");
-  if (!(o.plane_match_angle_deg > 0.0 && o.plane_match_distance > 0.0))
-    fail("plane_match_distance", "plane_match_angle_deg and plane_match_distance must be > 0");
-  if (!(o.planes.threshold_base > 0.0 && o.planes.threshold_per_metre >= 0.0))
-    fail("plane_threshold_base", "plane_threshold_base must be > 0 and plane_threshold_per_metre >= 0");
+  if (!(o.plane_sigma_angle_deg > 0.0)) fail("plane_sigma_angle_deg", "must be > 0");
+  if (!(o.plane_sigma_distance > 0.0)) fail("plane_sigma_distance", "must be > 0");
+  if (!(o.plane_match_angle_deg > 0.0)) fail("plane_match_angle_deg", "must be > 0");
+  if (!(o.plane_match_distance > 0.0)) fail("plane_match_distance", "must be > 0");
+  if (!(o.planes.threshold_base > 0.0)) fail("plane_threshold_base", "must be > 0");
+  if (!(o.planes.threshold_per_metre >= 0.0)) fail("plane_threshold_per_metre", "must be >= 0");
   if (!(o.planes.max_quality_ratio > 0.0)) fail("plane_max_quality_ratio", "must be > 0");
   if (!(n.wheel_max_wait_s >= 0.0)) fail("wheel_max_wait_s", "must be >= 0");
   if (!(n.visual_max_wait_s >= 0.0)) fail("visual_max_wait_s", "must be >= 0");
-  if (!(o.visual_sigma_rotation_deg > 0.0 && o.visual_sigma_translation > 0.0 && o.visual_sigma_translation_ratio >= 0.0))
-    fail("visual_sigma_translation",
-         "visual_sigma_rotation_deg and visual_sigma_translation must be > 0, visual_sigma_translation_ratio >= 0");
+  if (!(o.visual_sigma_rotation_deg > 0.0)) fail("visual_sigma_rotation_deg", "must be > 0");
+  if (!(o.visual_sigma_translation > 0.0)) fail("visual_sigma_translation", "must be > 0");
+  if (!(o.visual_sigma_translation_ratio >= 0.0)) fail("visual_sigma_translation_ratio", "must be >= 0");
   if (!(o.visual_cauchy > 0.0)) fail("visual_cauchy", "must be > 0");
   if (!(o.visual_scale_std >= 0.0 && o.visual_scale_std <= 0.2)) fail("visual_scale_std", "must be in [0, 0.2]");
   return n;

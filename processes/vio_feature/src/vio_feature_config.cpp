@@ -71,7 +71,8 @@ VioFeatureNodeOptions readVioFeatureNodeOptions(const Config& root) {
   if (!(core.tracker.min_distance_px > 0.0)) fail("min_distance_px", "must be > 0");
   if (!(core.tracker.ransac_threshold_px > 0.0)) fail("ransac_threshold_px", "must be > 0");
   if (!(core.tracker.keyframe_parallax_px > 0.0)) fail("keyframe_parallax_px", "must be > 0");
-  if (!(w.pixel_sigma > 0.0 && w.reprojection_cauchy > 0.0)) fail("pixel_sigma", "pixel_sigma and reprojection_cauchy must be > 0");
+  if (!(w.pixel_sigma > 0.0)) fail("pixel_sigma", "must be > 0");
+  if (!(w.reprojection_cauchy > 0.0)) fail("reprojection_cauchy", "must be > 0");
   if (!(w.depth_sigma_base > 0.0 && w.depth_sigma_relative >= 0.0))
     fail("depth_sigma_base", "depth_sigma_base must be > 0 and depth_sigma_relative >= 0");
   if (w.solver_iterations < 1) fail("solver_iterations", "must be >= 1");
