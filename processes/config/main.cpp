@@ -2,10 +2,9 @@
 // process would read it (livo::Config::load with overlays), written as one file; what
 // scripts/run_pipeline.sh --overlay runs the processes on.
 #include <iostream>
-#include <sstream>
 
 #include "livo/command_line.hpp"
-#include "livo/config.hpp"
+#include "livo/config/merged_config.hpp"
 #include "livo/file_output.hpp"
 
 int main(int argc, char** argv) {
@@ -22,23 +21,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    const std::string base = cli.get("BASE");
-    std::vector<std::string> overlays;
-    std::stringstream list(cli.has("--overlay") ? cli.get("--overlay") : std::string());
-    for (std::string f; std::getline(list, f, ',');)
-      if (!f.empty()) overlays.push_back(f);
-    const livo::Config merged = livo::Config::load(base, overlays);
-    merged.checkKeysIn(livo::kConfigSections);
-    std::string header = "# livo-config merge: " + base;
-    for (const std::string& o : overlays) header += " + " + o;
-    header += "\n";
-    const std::string text = livo::Config::mergedText(base, overlays);
+    const std::string text = livo::config::mergedConfig(
+        cli.get("BASE"), livo::config::overlayList(cli.has("--overlay") ? cli.get("--overlay") : std::string()));
     if (!cli.has("--out")) {
-      std::cout << header << text;
+      std::cout << text;
       return 0;
     }
     std::string error;
-    if (!livo::writeFileAtomically(cli.get("--out"), {header, text}, &error)) {
+    if (!livo::writeFileAtomically(cli.get("--out"), {text}, &error)) {
       std::cerr << "livo-config: " << error << "\n";
       return 1;
     }
