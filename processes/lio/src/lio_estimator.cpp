@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "livo/lio/scan_to_map.hpp"
+#include "livo/sweep_timing.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/lio/undistorter.hpp"
@@ -15,8 +16,6 @@
 namespace livo::lio {
 
 namespace {
-constexpr double kMaxSweepS = 1.0;  // offsets beyond this are garbage
-
 void appendNote(std::string* note, const std::string& what) {
   if (!note) return;
   if (!note->empty()) *note += "; ";
@@ -192,19 +191,8 @@ StateCovariance LioEstimator::initialCovariance(const ImuInitResult& r) const {
   return P;
 }
 
-double LioEstimator::scanEndOffset(const LidarScan& scan) const {
-  double end = (std::isfinite(scan.sweep_duration) && scan.sweep_duration > 0.0 && scan.sweep_duration <= kMaxSweepS)
-                   ? scan.sweep_duration
-                   : 0.0;
-  for (float t : scan.time_offset)
-    if (std::isfinite(t) && t >= 0.0f && t <= kMaxSweepS) end = std::max(end, static_cast<double>(t));
-  return end;
-}
-
-int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const { return scanEndUtime(scan, scanEndOffset(scan)); }
-
-int64_t LioEstimator::scanEndUtime(const LidarScan& scan, double end_offset) const {
-  return scan.utime + toUtime(opts_.extrinsics.time_offset_s + end_offset);
+int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const {
+  return sweepTiming(scan, opts_.extrinsics.time_offset_s).end_utime;
 }
 
 void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note) {
@@ -280,7 +268,7 @@ void LioEstimator::drainBacklog(int64_t newest) {
     imu_.pop_front();
     stepTo(s, &worst_gap, nullptr);
   }
-  prop_.dropSegmentsBefore(prop_.utime() - toUtime(kMaxSweepS));
+  prop_.dropSegmentsBefore(prop_.utime() - toUtime(kMaxSweepDurationS));
 }
 
 bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
@@ -376,9 +364,9 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     res.message = "waiting for the IMU initialisation";
     return res;
   }
-  const double end_offset = scanEndOffset(scan);
-  const int64_t t_end = scanEndUtime(scan, end_offset);
-  const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
+  const SweepTiming timing = sweepTiming(scan, opts_.extrinsics.time_offset_s);
+  const double end_offset = timing.end_offset_s;
+  const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
   if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
     // before the first output this is a sweep recorded during the IMU initialisation window
     res.status = map_.empty() ? ScanResult::Status::kInitializing : ScanResult::Status::kRejected;

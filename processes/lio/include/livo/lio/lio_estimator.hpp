@@ -90,7 +90,8 @@ class LioEstimator {
   /// Processes a sweep; IMU samples up to its end should have been added (see scanEndUtime).
   ScanResult addScan(const LidarScan& scan);
 
-  /// End of the sweep in the IMU clock (the watermark the IMU must pass before addScan).
+  /// End of the sweep in the IMU clock (the watermark the IMU must pass before addScan):
+  /// livo/sweep_timing.hpp's, through the rig's LiDAR time offset.
   int64_t scanEndUtime(const LidarScan& scan) const;
 
   bool initialized() const { return initialized_; }
@@ -160,9 +161,6 @@ class LioEstimator {
   void reset();
 
  private:
-  double scanEndOffset(const LidarScan& scan) const;
-  /// scanEndUtime with the sweep's scanEndOffset given (a pass over its points less).
-  int64_t scanEndUtime(const LidarScan& scan, double end_offset) const;
   // The stages of addScan, in order.
   // The per-sweep point buffers are members (valid_, body_, reg_), reused from sweep to sweep.
   /// Indices of the sweep's usable points (finite, inside the sweep [0, end_offset] and the range
