@@ -183,6 +183,22 @@ TEST(LioGraphEstimator, SameInputsSameOutputs) {
   for (size_t i = 0; i < a.poses.size(); ++i) EXPECT_TRUE(a.poses[i].matrix() == b.poses[i].matrix()) << i;
 }
 
+// The sweep's end is livo-lio's (livo/sweep_timing.hpp): a sweep_duration beyond 1 s is garbage,
+// and offsets that are negative, NaN or beyond 1 s do not move the end.
+TEST(LioGraphEstimator, EndsASweepWhereLivoLioDoes) {
+  LioGraphOptions options;
+  options.extrinsics.time_offset_s = 0.002;
+  const LioGraphEstimator estimator(options);
+  LidarScan scan;
+  scan.utime = 1'000'000;
+  scan.sweep_duration = 5.0;
+  scan.time_offset = {-0.5f, std::numeric_limits<float>::quiet_NaN(), 0.0625f, 2.0f};
+  scan.points.assign(scan.time_offset.size(), Vec3::Zero());
+  EXPECT_EQ(estimator.scanEndUtime(scan), 1'064'500);  // 1 s + 2 ms + 62.5 ms (before: 5 s believed)
+  scan.sweep_duration = 0.1;
+  EXPECT_EQ(estimator.scanEndUtime(scan), 1'102'000);
+}
+
 
 TEST(LioGraphEstimator, LearnsTheTyreScalesFromTheWheels) {
   // The room walk with a wheel encoder on the body (B = I): the body-frame forward speed and the

@@ -12,6 +12,7 @@
 #include "livo/lio_graph/plane_factor.hpp"
 #include "livo/plane.hpp"
 #include "livo/sample_interval.hpp"
+#include "livo/sweep_timing.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/voxel_downsample.hpp"
@@ -19,8 +20,6 @@
 namespace livo::lio_graph {
 
 namespace {
-
-constexpr double kMaxSweepS = 1.0;      // time offsets beyond this are garbage
 
 void appendNote(std::string* note, const std::string& what) {
   if (!note->empty()) *note += "; ";
@@ -182,10 +181,7 @@ void LioGraphEstimator::dropImuBefore(int64_t utime) {
 }
 
 int64_t LioGraphEstimator::scanEndUtime(const LidarScan& scan) const {
-  double end = std::isfinite(scan.sweep_duration) && scan.sweep_duration > 0.0 ? scan.sweep_duration : 0.0;
-  for (float t : scan.time_offset)
-    if (std::isfinite(t) && t <= kMaxSweepS) end = std::max(end, static_cast<double>(t));
-  return scan.utime + toUtime(opts_.extrinsics.time_offset_s) + toUtime(end);
+  return sweepTiming(scan, opts_.extrinsics.time_offset_s).end_utime;
 }
 
 bool LioGraphEstimator::addVisualState(const VisualSample& s, std::string* why) { return visual_.add(s, why); }
@@ -349,8 +345,8 @@ void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std
 GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
   GraphScanResult res;
   std::string* note = &res.message;
-  const int64_t t_end = scanEndUtime(scan);
-  const int64_t t_first = scan.utime + toUtime(opts_.extrinsics.time_offset_s);
+  const SweepTiming timing = sweepTiming(scan, opts_.extrinsics.time_offset_s);
+  const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
   res.utime = t_end;
   res.sweep_start_utime = t_first;
   if (t_end <= last_sweep_end_) {

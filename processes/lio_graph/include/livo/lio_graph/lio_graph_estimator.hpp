@@ -88,7 +88,8 @@ class LioGraphEstimator {
   bool addVisualState(const VisualSample& s, std::string* why = nullptr);
   /// The newest visual state's time (INT64_MIN before any).
   int64_t visualWatermark() const { return visual_.newest(); }
-  /// End of the sweep in the IMU clock: the IMU must have passed it before addScan.
+  /// End of the sweep in the IMU clock: the IMU must have passed it before addScan
+  /// (livo/sweep_timing.hpp's, through the rig's LiDAR time offset: the same as livo-lio's).
   int64_t scanEndUtime(const LidarScan& scan) const;
   GraphScanResult addScan(const LidarScan& scan);
 
