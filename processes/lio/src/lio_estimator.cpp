@@ -8,7 +8,6 @@
 #include <cmath>
 
 #include "livo/lio/scan_to_map.hpp"
-#include "livo/sweep_timing.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/lio/undistorter.hpp"
@@ -191,10 +190,6 @@ StateCovariance LioEstimator::initialCovariance(const ImuInitResult& r) const {
   return P;
 }
 
-int64_t LioEstimator::scanEndUtime(const LidarScan& scan) const {
-  return sweepTiming(scan, opts_.extrinsics.time_offset_s).end_utime;
-}
-
 void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note) {
   // Nothing is known about the motion over the gap: keep pose and biases, widen the pose by what
   // the body may have done meanwhile, forget the velocity, and restart at s.
@@ -356,7 +351,7 @@ void LioEstimator::pruneMap(const Vec3& position) {
   last_prune_position_ = position;
 }
 
-ScanResult LioEstimator::addScan(const LidarScan& scan) {
+ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timing) {
   ScanResult res;
   std::string* note = &res.message;
   if (!initialized_) {
@@ -364,7 +359,6 @@ ScanResult LioEstimator::addScan(const LidarScan& scan) {
     res.message = "waiting for the IMU initialisation";
     return res;
   }
-  const SweepTiming timing = sweepTiming(scan, opts_.extrinsics.time_offset_s);
   const double end_offset = timing.end_offset_s;
   const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
   if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {

@@ -156,7 +156,11 @@ void LioNode::onLidar(const point_cloud_t& m) {
     return;
   }
   p->msg = m;
-  const int64_t t_end = lio_.scanEndUtime(p->scan);
+  p->timing = lio_.sweepTiming(p->scan);
+  const int64_t t_end = p->timing.end_utime;
+  // Refused on arrival if the filter is already past its end. addScan asks again when its turn
+  // comes: the filter may have moved meanwhile (a duplicate queued beside it ends where the first
+  // left the filter), and before the map is seeded it refuses sweeps of the IMU start-up window.
   if (!lio_.acceptsSweepEnding(t_end)) {
     node_.reject(opts_.lidar_channel, "sweep ends before the filter time (late or duplicate)");
     return;
@@ -392,7 +396,7 @@ void LioNode::process(const PendingScan& p) {
   // The sweep is processed from whichever handler moved the IMU watermark past it: time it on its own.
   const auto t0 = std::chrono::steady_clock::now();
   const int32_t epoch_before = lio_.frame().epoch;
-  ScanResult r = lio_.addScan(p.scan);
+  ScanResult r = lio_.addScan(p.scan, p.timing);
   if (lio_.frame().epoch != epoch_before) announceReset(r.message.empty() ? "the filter re-initialised" : r.message);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   ++sweeps_;

@@ -12,7 +12,6 @@
 #include "livo/lio_graph/plane_factor.hpp"
 #include "livo/plane.hpp"
 #include "livo/sample_interval.hpp"
-#include "livo/sweep_timing.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 #include "livo/voxel_downsample.hpp"
@@ -180,10 +179,6 @@ void LioGraphEstimator::dropImuBefore(int64_t utime) {
   while (imu_.size() > 2 && imu_[1].utime <= utime) imu_.pop_front();
 }
 
-int64_t LioGraphEstimator::scanEndUtime(const LidarScan& scan) const {
-  return sweepTiming(scan, opts_.extrinsics.time_offset_s).end_utime;
-}
-
 bool LioGraphEstimator::addVisualState(const VisualSample& s, std::string* why) { return visual_.add(s, why); }
 
 bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
@@ -342,10 +337,9 @@ void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std
   }
 }
 
-GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan) {
+GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTiming& timing) {
   GraphScanResult res;
   std::string* note = &res.message;
-  const SweepTiming timing = sweepTiming(scan, opts_.extrinsics.time_offset_s);
   const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
   res.utime = t_end;
   res.sweep_start_utime = t_first;

@@ -74,8 +74,8 @@ void LioGraphNode::onLidar(const point_cloud_t& m) {
     return;
   }
   p.msg = m;
-  p.end_utime = estimator_.scanEndUtime(p.scan);
-  if (!pending_.empty() && p.end_utime <= pending_.back().end_utime) {
+  p.timing = estimator_.sweepTiming(p.scan);
+  if (!pending_.empty() && p.timing.end_utime <= pending_.back().timing.end_utime) {
     node_.reject(opts_.lidar_channel, "sweep does not end after the previous one");
     return;
   }
@@ -104,12 +104,12 @@ void LioGraphNode::onLoopCorrection(const loop_correction_t& m) {
 void LioGraphNode::processReady() {
   while (!pending_.empty()) {
     const PendingSweep& p = pending_.front();
-    if (imu_watermark_ < p.end_utime) return;
-    if (opts_.core.use_wheel && wheel_watermark_ < p.end_utime &&
-        imu_watermark_ < p.end_utime + toUtime(opts_.wheel_max_wait_s))
+    const int64_t t_end = p.timing.end_utime;
+    if (imu_watermark_ < t_end) return;
+    if (opts_.core.use_wheel && wheel_watermark_ < t_end && imu_watermark_ < t_end + toUtime(opts_.wheel_max_wait_s))
       return;
-    if (opts_.core.use_visual_motion && estimator_.visualWatermark() < p.end_utime &&
-        imu_watermark_ < p.end_utime + toUtime(opts_.visual_max_wait_s))
+    if (opts_.core.use_visual_motion && estimator_.visualWatermark() < t_end &&
+        imu_watermark_ < t_end + toUtime(opts_.visual_max_wait_s))
       return;
     process(p);
     pending_.pop_front();
@@ -118,7 +118,7 @@ void LioGraphNode::processReady() {
 
 void LioGraphNode::process(const PendingSweep& p) {
   const auto t0 = std::chrono::steady_clock::now();
-  const GraphScanResult r = estimator_.addScan(p.scan);
+  const GraphScanResult r = estimator_.addScan(p.scan, p.timing);
   node_.recordWork("sweep", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (!r.hasOutput()) {
     if (r.status == GraphScanResult::Status::kRejected) node_.reject(opts_.lidar_channel, r.message);

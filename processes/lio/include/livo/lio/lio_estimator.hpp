@@ -17,6 +17,7 @@
 #include "livo/lio/keyframe_clone.hpp"
 #include "livo/lio/lio_options.hpp"
 #include "livo/odometry_frame.hpp"
+#include "livo/sweep_timing.hpp"
 
 namespace livo::lio {
 
@@ -88,11 +89,18 @@ class LioEstimator {
   /// Adds a wheel reading (IMU clock); used only if options.wheel.enabled.
   bool addWheel(const WheelSample& s, std::string* why = nullptr);
   /// Processes a sweep; IMU samples up to its end should have been added (see scanEndUtime).
-  ScanResult addScan(const LidarScan& scan);
+  ScanResult addScan(const LidarScan& scan) { return addScan(scan, sweepTiming(scan)); }
+  /// The same with the sweep's timing as sweepTiming(scan) gave it (a node times a sweep once, on
+  /// arrival, and keeps it while the sweep waits for the IMU).
+  ScanResult addScan(const LidarScan& scan, const SweepTiming& timing);
 
-  /// End of the sweep in the IMU clock (the watermark the IMU must pass before addScan):
-  /// livo/sweep_timing.hpp's, through the rig's LiDAR time offset.
-  int64_t scanEndUtime(const LidarScan& scan) const;
+  /// The sweep's start and end in the IMU clock (livo/sweep_timing.hpp, through the rig's LiDAR
+  /// time offset); the end is the watermark the IMU must pass before addScan.
+  SweepTiming sweepTiming(const LidarScan& scan) const {
+    return livo::sweepTiming(scan, opts_.extrinsics.time_offset_s);
+  }
+  /// sweepTiming(scan).end_utime.
+  int64_t scanEndUtime(const LidarScan& scan) const { return sweepTiming(scan).end_utime; }
 
   bool initialized() const { return initialized_; }
   /// Initialised and the map seeded: the state is worth handing to the camera.

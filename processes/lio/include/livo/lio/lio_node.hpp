@@ -36,6 +36,7 @@
 #include "livo/lio/lio_messages.hpp"
 #include "livo/node.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "livo/sweep_timing.hpp"
 #include "livo/time.hpp"
 
 namespace livo::lio {
@@ -86,6 +87,7 @@ class LioNode {
   struct PendingScan {
     point_cloud_t msg;
     LidarScan scan;
+    SweepTiming timing;  // lio_.sweepTiming(scan), once on arrival
   };
   void onImu(const imu_t& m);
   /// A plausible sample on a confirmed clock: into the buffer (or a reset on a clock step back).

@@ -29,6 +29,7 @@
 #include "livo/lio_graph/visual_motion.hpp"
 #include "livo/marginalization.hpp"
 #include "livo/odometry_frame.hpp"
+#include "livo/sweep_timing.hpp"
 
 namespace livo::lio_graph {
 
@@ -88,10 +89,17 @@ class LioGraphEstimator {
   bool addVisualState(const VisualSample& s, std::string* why = nullptr);
   /// The newest visual state's time (INT64_MIN before any).
   int64_t visualWatermark() const { return visual_.newest(); }
-  /// End of the sweep in the IMU clock: the IMU must have passed it before addScan
-  /// (livo/sweep_timing.hpp's, through the rig's LiDAR time offset: the same as livo-lio's).
-  int64_t scanEndUtime(const LidarScan& scan) const;
-  GraphScanResult addScan(const LidarScan& scan);
+  /// The sweep's start and end in the IMU clock (livo/sweep_timing.hpp, through the rig's LiDAR
+  /// time offset: the same as livo-lio's); the IMU must have passed the end before addScan.
+  SweepTiming sweepTiming(const LidarScan& scan) const {
+    return livo::sweepTiming(scan, opts_.extrinsics.time_offset_s);
+  }
+  /// sweepTiming(scan).end_utime.
+  int64_t scanEndUtime(const LidarScan& scan) const { return sweepTiming(scan).end_utime; }
+  GraphScanResult addScan(const LidarScan& scan) { return addScan(scan, sweepTiming(scan)); }
+  /// The same with the sweep's timing as sweepTiming(scan) gave it (a node times a sweep once, on
+  /// arrival, and keeps it while the sweep waits for the IMU).
+  GraphScanResult addScan(const LidarScan& scan, const SweepTiming& timing);
 
   bool initialized() const { return !window_.empty(); }
   size_t windowSize() const { return window_.size(); }

@@ -21,6 +21,7 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "livo/sweep_timing.hpp"
 #include "livo/visual_state_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
 
@@ -41,7 +42,7 @@ class LioGraphNode {
   struct PendingSweep {
     point_cloud_t msg;
     LidarScan scan;
-    int64_t end_utime;
+    SweepTiming timing;  // estimator_.sweepTiming(scan), once on arrival
   };
   void onImu(const imu_t& m);
   void onWheel(const wheel_odometry_t& m);
