@@ -28,13 +28,13 @@
 #include <utility>
 #include <vector>
 
+#include "livo/evaluate/umeyama.hpp"
 #include "livo/latency_stats.hpp"
 #include "livo/lio/lio_estimator.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
-#include "livo/evaluate/umeyama.hpp"
 
 namespace livo_soak {
 
@@ -95,10 +95,10 @@ inline livo::point_cloud_t toPointCloud(const livo::sim::LidarSweep& m) {
 class SimLioDriver : public livo::sim::SensorDataSink {
  public:
   struct Options {
-    size_t expected_sweeps = 0;  // the trajectory record is reserved up front: it must not look like a leak
-    bool images = false;         // queue images for handOff() (the node's camera_handoff)
-    int64_t camera_offset_us = 0;// image utime + this = IMU time (rig.camera.time_offset_s)
-    double outage_begin_s = 0.0; // sweeps starting in [begin, end) (sim seconds) are not fed: a LiDAR outage
+    size_t expected_sweeps = 0;    // the trajectory record is reserved up front: it must not look like a leak
+    bool images = false;           // queue images for handOff() (the node's camera_handoff)
+    int64_t camera_offset_us = 0;  // image utime + this = IMU time (rig.camera.time_offset_s)
+    double outage_begin_s = 0.0;   // sweeps starting in [begin, end) (sim seconds) are not fed: a LiDAR outage
     double outage_end_s = 0.0;
   };
 

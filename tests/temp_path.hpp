@@ -2,9 +2,9 @@
 // parallel processes, so fixed names under /tmp would collide. Removed when the process ends.
 #pragma once
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 #include "livo/asl_dataset.hpp"
 
-#include <algorithm>
 #include <dirent.h>
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -27,7 +27,8 @@ std::vector<AslImuSample> readAslImuCsv(const std::string& path) {
     std::vector<std::string> fields;
     while (std::getline(ss, field, ',')) fields.push_back(field);
     if (fields.size() < 7)
-      throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 7 columns (t[ns], w xyz, a xyz), got " + std::to_string(fields.size()));
+      throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 7 columns (t[ns], w xyz, a xyz), got " +
+                            std::to_string(fields.size()));
     AslImuSample s;
     try {
       size_t used = 0;
@@ -89,9 +90,12 @@ AslSensorYaml readAslSensorYaml(const std::string& path) {
     if (y["distortion_coefficients"]) s.distortion = y["distortion_coefficients"].as<std::vector<double>>();
     if (y["distortion_model"]) {
       const std::string model = y["distortion_model"].as<std::string>();
-      if (model == "radial-tangential" || model == "radtan") s.distortion_model = DistortionModel::kRadtan;
-      else if (model == "equidistant") s.distortion_model = DistortionModel::kEquidistant;
-      else throw TrajectoryError(path + ": distortion_model '" + model + "' is neither radial-tangential nor equidistant");
+      if (model == "radial-tangential" || model == "radtan")
+        s.distortion_model = DistortionModel::kRadtan;
+      else if (model == "equidistant")
+        s.distortion_model = DistortionModel::kEquidistant;
+      else
+        throw TrajectoryError(path + ": distortion_model '" + model + "' is neither radial-tangential nor equidistant");
     }
     if (y["resolution"]) {
       const auto r = y["resolution"].as<std::vector<int>>();
@@ -109,7 +113,8 @@ AslSensorYaml readAslSensorYaml(const std::string& path) {
 
 CameraRig aslCameraRig(const AslSensorYaml& s, const std::string& path) {
   if (s.intrinsics.size() != 4 || s.width <= 0 || s.height <= 0 || s.distortion.size() != 4)
-    throw TrajectoryError(path + ": not a pinhole camera's sensor.yaml (needs intrinsics [fu, fv, cu, cv], resolution "
+    throw TrajectoryError(path +
+                          ": not a pinhole camera's sensor.yaml (needs intrinsics [fu, fv, cu, cv], resolution "
                           "and four distortion_coefficients)");
   CameraRig c;
   c.width = s.width;

@@ -32,17 +32,24 @@ bool toFormat(const cv::Mat& src, bool bgr, bool owned, PixelFormat format, cv::
   const bool grey_out = format == PixelFormat::kGrey || (format == PixelFormat::kGreyOrRgb && c == 1);
   int code = -1;  // -1: the pixels are already as wanted
   if (grey_out) {
-    if (c == 3) code = bgr ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY;
-    else if (c == 4) code = bgr ? cv::COLOR_BGRA2GRAY : cv::COLOR_RGBA2GRAY;
+    if (c == 3)
+      code = bgr ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY;
+    else if (c == 4)
+      code = bgr ? cv::COLOR_BGRA2GRAY : cv::COLOR_RGBA2GRAY;
   } else {
-    if (c == 1) code = cv::COLOR_GRAY2RGB;
-    else if (c == 3 && bgr) code = cv::COLOR_BGR2RGB;
-    else if (c == 4) code = bgr ? cv::COLOR_BGRA2RGB : cv::COLOR_RGBA2RGB;
+    if (c == 1)
+      code = cv::COLOR_GRAY2RGB;
+    else if (c == 3 && bgr)
+      code = cv::COLOR_BGR2RGB;
+    else if (c == 4)
+      code = bgr ? cv::COLOR_BGRA2RGB : cv::COLOR_RGBA2RGB;
   }
   // into a new Mat: converting into *out would write into pixels it may share with another Mat
   cv::Mat converted;
-  if (code < 0) converted = owned ? src : src.clone();
-  else cv::cvtColor(src, converted, code);
+  if (code < 0)
+    converted = owned ? src : src.clone();
+  else
+    cv::cvtColor(src, converted, code);
   *out = converted;
   return true;
 }
@@ -112,15 +119,15 @@ bool imdecodeChecked(const RawImage& raw, int flags, cv::Mat* img, std::string* 
   return true;
 }
 
-bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat format, cv::Mat* out,
-                      std::string* why) {
+bool decodeCompressed(const RawImage& raw, int width, int height, PixelFormat format, cv::Mat* out, std::string* why) {
   // a JPEG wanted in grey is decoded to its luma directly (no chroma work); the rest as stored
   const bool jpeg_luma = format == PixelFormat::kGrey && raw.encoding == static_cast<int>(ImageEncoding::kJpeg);
   cv::Mat img;
   if (!imdecodeChecked(raw, jpeg_luma ? cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION : cv::IMREAD_UNCHANGED,
                        &img, why))
     return false;
-  if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257.0);
+  if (img.depth() == CV_16U)
+    img.convertTo(img, CV_8U, 1.0 / 257.0);
   else if (img.depth() != CV_8U) {
     *why = std::string(encodingName(raw.encoding)) + " image has pixels of neither 8 nor 16 bits";
     return false;
@@ -141,8 +148,8 @@ bool rawView(const RawImage& raw, int width, int height, int type, cv::Mat* view
   }
   const size_t row = static_cast<size_t>(width) * CV_ELEM_SIZE(type);
   if (raw.row_stride != 0 && (raw.row_stride < 0 || static_cast<size_t>(raw.row_stride) < row)) {
-    *why = "image row_stride " + std::to_string(raw.row_stride) + " is shorter than a row of " +
-           std::to_string(width) + " pixels (" + std::to_string(row) + " bytes)";
+    *why = "image row_stride " + std::to_string(raw.row_stride) + " is shorter than a row of " + std::to_string(width) +
+           " pixels (" + std::to_string(row) + " bytes)";
     return false;
   }
   const size_t stride = raw.row_stride > 0 ? static_cast<size_t>(raw.row_stride) : row;
@@ -187,8 +194,10 @@ bool decodeImage(const RawImage& raw, int width, int height, PixelFormat format,
   if (enc == ImageEncoding::kJpeg || enc == ImageEncoding::kPng)
     return decodeCompressed(raw, width, height, format, out, why);
   int channels = 0;
-  if (enc == ImageEncoding::kGray8) channels = 1;
-  else if (enc == ImageEncoding::kRgb8 || enc == ImageEncoding::kBgr8) channels = 3;
+  if (enc == ImageEncoding::kGray8)
+    channels = 1;
+  else if (enc == ImageEncoding::kRgb8 || enc == ImageEncoding::kBgr8)
+    channels = 3;
   else if (enc == ImageEncoding::kDepth16 || enc == ImageEncoding::kDepth32f) {
     *why = "image " + encodingText(raw.encoding) + " is a depth image, not a picture";
     return false;

@@ -10,8 +10,7 @@ namespace {
 /// theta_d(theta) = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8) and its derivative.
 double equidistantThetaD(const std::array<double, 4>& k, double theta, double* dtheta_d = nullptr) {
   const double t2 = theta * theta;
-  if (dtheta_d)
-    *dtheta_d = 1.0 + t2 * (3.0 * k[0] + t2 * (5.0 * k[1] + t2 * (7.0 * k[2] + t2 * 9.0 * k[3])));
+  if (dtheta_d) *dtheta_d = 1.0 + t2 * (3.0 * k[0] + t2 * (5.0 * k[1] + t2 * (7.0 * k[2] + t2 * 9.0 * k[3])));
   return theta * (1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3]))));
 }
 
@@ -23,12 +22,13 @@ CameraProjection::CameraProjection(const CameraRig& rig) : rig_(rig) {
   // The valid field: the undistorted image corners, with a margin (radtan: a fixed-point inversion,
   // which stays where the polynomial is monotonic; equidistant: undistort's 1-D Newton on theta).
   double r2 = 0.0;
-  const double corners[4][2] = {{0, 0}, {double(rig.width - 1), 0}, {0, double(rig.height - 1)},
-                                {double(rig.width - 1), double(rig.height - 1)}};
+  const double corners[4][2] = {
+      {0, 0}, {double(rig.width - 1), 0}, {0, double(rig.height - 1)}, {double(rig.width - 1), double(rig.height - 1)}};
   for (const auto& c : corners) {
     const Eigen::Vector2d d((c[0] - rig.cx) / rig.fx, (c[1] - rig.cy) / rig.fy);
     Eigen::Vector2d u = d;
-    if (rig.distortion_model == DistortionModel::kEquidistant) u = undistort(d);
+    if (rig.distortion_model == DistortionModel::kEquidistant)
+      u = undistort(d);
     else
       for (int it = 0; it < 50; ++it) u += d - distort(u);
     r2 = std::max(r2, u.squaredNorm());
@@ -46,7 +46,8 @@ Eigen::Vector2d CameraProjection::distort(const Eigen::Vector2d& xy) const {
   const double k1 = k[0], k2 = k[1], p1 = k[2], p2 = k[3];
   const double x = xy.x(), y = xy.y(), r2 = x * x + y * y;
   const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
-  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x), y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
 }
 
 bool CameraProjection::project(const Eigen::Vector3d& p_C, Eigen::Vector2d* pixel, double border) const {

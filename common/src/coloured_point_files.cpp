@@ -77,8 +77,8 @@ bool writePly(const std::string& path, const PointStream& pts, std::string* erro
 bool writePcd(const std::string& path, const PointStream& pts, std::string* error) {
   std::ostringstream h;
   h << "# .PCD v0.7 - livo-colour map, world frame W\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\n"
-    << "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " << pts.count << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS "
-    << pts.count << "\nDATA binary\n";
+    << "TYPE F F F F\nCOUNT 1 1 1 1\nWIDTH " << pts.count << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << pts.count
+    << "\nDATA binary\n";
   return writePoints(path, h.str(), pts, true, error);
 }
 

@@ -9,8 +9,9 @@
 
 namespace livo {
 
-const std::vector<std::string> kConfigSections = {
-    "rig", "sim", "bus", "playback", "lio", "lio_graph", "vio", "vio_feature", "loop", "colour", "octomap", "pipeline", "evaluate"};
+const std::vector<std::string> kConfigSections = {"rig",       "sim",      "bus",         "playback", "lio",
+                                                  "lio_graph", "vio",      "vio_feature", "loop",     "colour",
+                                                  "octomap",   "pipeline", "evaluate"};
 
 namespace {
 
@@ -243,7 +244,8 @@ Eigen::Quaterniond quaternionFrom(const Config& cfg, const std::vector<double>& 
   Eigen::Quaterniond out(q[0], q[1], q[2], q[3]);
   const double n = out.norm();
   if (std::abs(n - 1.0) > 1e-3)
-    throw ConfigError(cfg.where(key) + ": quaternion [w, x, y, z] must have unit norm (norm " + std::to_string(n) + ")");
+    throw ConfigError(cfg.where(key) + ": quaternion [w, x, y, z] must have unit norm (norm " + std::to_string(n) +
+                      ")");
   return out.normalized();
 }
 
@@ -283,14 +285,16 @@ template <>
 std::vector<int> Config::convert<std::vector<int>>(const YAML::Node& n, const std::string& key) const {
   if (!n.IsSequence()) throw ConfigError(where(key) + ": expected a list of integers, got " + describe(n));
   std::vector<int> v;
-  for (size_t i = 0; i < n.size(); ++i) v.push_back(scalarAs<int>(*this, n[i], key + "[" + std::to_string(i) + "]", "an integer"));
+  for (size_t i = 0; i < n.size(); ++i)
+    v.push_back(scalarAs<int>(*this, n[i], key + "[" + std::to_string(i) + "]", "an integer"));
   return v;
 }
 template <>
 std::vector<std::string> Config::convert<std::vector<std::string>>(const YAML::Node& n, const std::string& key) const {
   if (!n.IsSequence()) throw ConfigError(where(key) + ": expected a list of strings, got " + describe(n));
   std::vector<std::string> v;
-  for (size_t i = 0; i < n.size(); ++i) v.push_back(scalarAs<std::string>(*this, n[i], key + "[" + std::to_string(i) + "]", "a string"));
+  for (size_t i = 0; i < n.size(); ++i)
+    v.push_back(scalarAs<std::string>(*this, n[i], key + "[" + std::to_string(i) + "]", "a string"));
   return v;
 }
 template <>
@@ -325,7 +329,8 @@ Eigen::Isometry3d Config::convert<Eigen::Isometry3d>(const YAML::Node& n, const 
     T.translation() = M.topRightCorner<3, 1>();
     return T;
   }
-  if (!n.IsMap()) throw ConfigError(where(key) + ": expected {translation, rotation|rpy_deg} or 16 numbers, got " + describe(n));
+  if (!n.IsMap())
+    throw ConfigError(where(key) + ": expected {translation, rotation|rpy_deg} or 16 numbers, got " + describe(n));
   const Config sub(n, state_, keyPath(key));
   T.translation() = sub.get<Eigen::Vector3d>("translation");
   const bool has_q = sub.has("rotation"), has_rpy = sub.has("rpy_deg");
@@ -334,20 +339,21 @@ Eigen::Isometry3d Config::convert<Eigen::Isometry3d>(const YAML::Node& n, const 
     T.linear() = sub.get<Eigen::Quaterniond>("rotation").toRotationMatrix();
   } else {
     const Eigen::Vector3d rpy = sub.get<Eigen::Vector3d>("rpy_deg") * M_PI / 180.0;
-    T.linear() = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-                  Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-                     .toRotationMatrix();
+    T.linear() =
+        (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
   }
   sub.checkAllUsed();
   return T;
 }
 
-#define LIVO_CONFIG_FETCH(T)                                                 \
+#define LIVO_CONFIG_FETCH(T)                                                \
   bool Config::fetch(const std::string& key, bool required, T& out) const { \
-    const YAML::Node n = child(key, required);                               \
-    if (!n) return false;                                                    \
-    out = convert<T>(n, key);                                                \
-    return true;                                                             \
+    const YAML::Node n = child(key, required);                              \
+    if (!n) return false;                                                   \
+    out = convert<T>(n, key);                                               \
+    return true;                                                            \
   }
 LIVO_CONFIG_VALUE_TYPES(LIVO_CONFIG_FETCH)
 #undef LIVO_CONFIG_FETCH

@@ -198,7 +198,7 @@ ConsistencyTest consistencyTest(const Vec13& e, const Mat13& S, const Vec13& g, 
   const Eigen::MatrixXd L = llt.matrixL();
   Eigen::VectorXd er(n), gr(n);
   for (int r = 0; r < n; ++r) er[r] = e[idx[r]], gr[r] = g[idx[r]];
-  const Eigen::MatrixXd W = L.transpose() * restrict(S, idx, n) * L;
+  const Eigen::MatrixXd W = L.transpose()* restrict(S, idx, n) * L;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (W + W.transpose()));
   // ν_w = L⁻¹ e - W⁺ Lᵀ g over the tested directions
   const Eigen::VectorXd e_w = L.triangularView<Eigen::Lower>().solve(er);

@@ -45,9 +45,9 @@ bool fromFilterState(const filter_state_t& m, FilterState* x, StateCovariance* P
   constexpr int n = FilterState::kDim;
   if (!allFinite(m.orientation, 4) || !allFinite(m.position, 3) || !allFinite(m.velocity, 3) ||
       !allFinite(m.gyro_bias, 3) || !allFinite(m.accel_bias, 3) || !allFinite(m.gravity, 3) ||
-      !allFinite(m.angular_velocity, 3) || !allFinite(m.lidar_orientation, 4) || !allFinite(m.lidar_position, 3) || !std::isfinite(m.lidar_time_shift) ||
-      !allFinite(m.camera_orientation, 4) || !allFinite(m.camera_position, 3) || !std::isfinite(m.camera_time_shift) ||
-      !allFinite(m.covariance, n * n))
+      !allFinite(m.angular_velocity, 3) || !allFinite(m.lidar_orientation, 4) || !allFinite(m.lidar_position, 3) ||
+      !std::isfinite(m.lidar_time_shift) || !allFinite(m.camera_orientation, 4) || !allFinite(m.camera_position, 3) ||
+      !std::isfinite(m.camera_time_shift) || !allFinite(m.covariance, n * n))
     return false;
   if (!unitQuaternion(m.orientation) || !unitQuaternion(m.lidar_orientation) || !unitQuaternion(m.camera_orientation))
     return false;

@@ -178,7 +178,8 @@ ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma) 
 }
 
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma) {
-  return new ceres::AutoDiffCostFunction<VectorPriorCost<2>, 2, 2>(new VectorPriorCost<2>{mean, Vec2::Constant(1.0 / sigma)});
+  return new ceres::AutoDiffCostFunction<VectorPriorCost<2>, 2, 2>(
+      new VectorPriorCost<2>{mean, Vec2::Constant(1.0 / sigma)});
 }
 
 ceres::CostFunction* makeWheelMountingPrior(const Vec3& mean, double sigma) {

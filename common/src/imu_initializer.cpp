@@ -92,8 +92,8 @@ ImuInitResult initializeImu(const std::vector<ImuSample>& window, const ImuInitO
     const double n = static_cast<double>(window.size());
     const double up_var = up_body.dot(m.var_accel.cwiseProduct(up_body)) / n + var(opts.static_up_bias_floor);
     r.state.accel_bias = (m.mean_accel.norm() - opts.gravity) * up_body;
-    P.block<3, 3>(S::kAccelBias, S::kAccelBias) =
-        var(opts.accel_bias_std) * Mat3::Identity() + (up_var - var(opts.accel_bias_std)) * up_body * up_body.transpose();
+    P.block<3, 3>(S::kAccelBias, S::kAccelBias) = var(opts.accel_bias_std) * Mat3::Identity() +
+                                                  (up_var - var(opts.accel_bias_std)) * up_body * up_body.transpose();
   }
   r.covariance = P;
   r.last = window.back();

@@ -30,8 +30,7 @@ ImuPreintegrationNoise ImuPreintegrationNoise::fromRig(const ImuRig& rig) {
   return n;
 }
 
-ImuPreintegration::ImuPreintegration(const Vec3& gyro_bias, const Vec3& accel_bias,
-                                     const ImuPreintegrationNoise& noise)
+ImuPreintegration::ImuPreintegration(const Vec3& gyro_bias, const Vec3& accel_bias, const ImuPreintegrationNoise& noise)
     : noise_(noise) {
   reset(gyro_bias, accel_bias);
 }
@@ -54,12 +53,12 @@ void ImuPreintegration::integrate(const Vec3& gyro, const Vec3& accel, double dt
   const Vec3 w = gyro - bg_;
   const Vec3 a = accel - ba_;
   const Vec3 theta = w * dt;
-  const Mat3 step_R = so3::Exp(theta);         // Exp(w dt)
-  const Mat3 half_R = so3::Exp(0.5 * theta);   // Exp(½ w dt)
+  const Mat3 step_R = so3::Exp(theta);        // Exp(w dt)
+  const Mat3 half_R = so3::Exp(0.5 * theta);  // Exp(½ w dt)
   const Mat3 Jr = so3::rightJacobian(theta);
   const Mat3 Jr_half = so3::rightJacobian(0.5 * theta);
-  const Mat3 mid_R = delta_R_ * half_R;        // ΔR_m, the rotation at the interval's middle
-  const Vec3 dv = mid_R * a * dt;              // velocity increment in frame i
+  const Mat3 mid_R = delta_R_ * half_R;  // ΔR_m, the rotation at the interval's middle
+  const Vec3 dv = mid_R * a * dt;        // velocity increment in frame i
 
   // Linearisation: x_{k+1} = A x_k + B n with x = [δφ, δv, δp] and n = [gyro, accel] noise.
   // ∂(ΔR_m a)/∂δφ = -ΔR_k hat(Exp(½ w dt) a); ∂(ΔR_m a)/∂n_g = -ΔR_m hat(a) Jr(½ w dt) ½ dt.
@@ -128,9 +127,8 @@ void ImuPreintegration::predict(const Mat3& R_i, const Vec3& p_i, const Vec3& v_
   *p_j = p_i + v_i * dt + 0.5 * gravity_W * dt * dt + R_i * correctedDeltaP(bg, ba);
 }
 
-Vec9 ImuPreintegration::residual(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Mat3& R_j,
-                                 const Vec3& p_j, const Vec3& v_j, const Vec3& bg, const Vec3& ba,
-                                 const Vec3& gravity_W) const {
+Vec9 ImuPreintegration::residual(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Mat3& R_j, const Vec3& p_j,
+                                 const Vec3& v_j, const Vec3& bg, const Vec3& ba, const Vec3& gravity_W) const {
   const double dt = duration_;
   Vec9 r;
   r.head<3>() = so3::Log(Mat3(correctedDeltaR(bg).transpose() * R_i.transpose() * R_j));

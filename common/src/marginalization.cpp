@@ -43,7 +43,7 @@ bool MarginalPriorFactor::Evaluate(double const* const* parameters, double* resi
     const int local = m.quaternion[b] ? 3 : m.sizes[b];
     if (jacobians[b]) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Jb(jacobians[b], rows,
-                                                                                          m.sizes[b]);
+                                                                                            m.sizes[b]);
       if (m.quaternion[b]) {
         Eigen::Matrix<double, 3, 4, Eigen::RowMajor> D;
         minusAmbientJacobian(m.x0[b].data(), parameters[b], D.data());
@@ -69,8 +69,7 @@ MarginalPrior movedPrior(const MarginalPrior& prior, const std::vector<WorldMoti
     const int local = prior.quaternion[b] ? 3 : prior.sizes[b];
     const bool three = !prior.quaternion[b] && prior.sizes[b] == 3;
     switch (motion[b]) {
-      case WorldMotion::kNone:
-        break;
+      case WorldMotion::kNone: break;
       case WorldMotion::kRotation: {
         if (!prior.quaternion[b]) throw std::invalid_argument("movedPrior: a rotation on a Euclidean block");
         const Eigen::Map<const Eigen::Quaterniond> q0(prior.x0[b].data());
@@ -170,8 +169,8 @@ bool Marginalizer::marginalInformation(const std::vector<const double*>& keep, E
   std::map<const double*, int> ambient;
   std::vector<double*> order = blockOrder(drop, &ambient);
   // the kept blocks last, in the order asked for
-  order.resize(static_cast<size_t>(
-      std::count_if(order.begin(), order.end(), [&](double* b) { return drop.count(b) > 0; })));
+  order.resize(
+      static_cast<size_t>(std::count_if(order.begin(), order.end(), [&](double* b) { return drop.count(b) > 0; })));
   int k = 0;
   for (const double* b : keep) {
     if (!ambient.count(b)) return false;  // touched by no factor: no information
@@ -216,9 +215,8 @@ std::shared_ptr<MarginalPrior> Marginalizer::marginalize(const std::set<const do
   const Eigen::MatrixXd Hmm = 0.5 * (H.topLeftCorner(m, m) + H.topLeftCorner(m, m).transpose());
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> em(Hmm);
   const double mmax = em.eigenvalues().size() ? std::max(em.eigenvalues().maxCoeff(), 0.0) : 0.0;
-  const Eigen::VectorXd inv = (em.eigenvalues().array() > eps * mmax)
-                                  .select(em.eigenvalues().array().inverse(), 0.0)
-                                  .matrix();
+  const Eigen::VectorXd inv =
+      (em.eigenvalues().array() > eps * mmax).select(em.eigenvalues().array().inverse(), 0.0).matrix();
   const Eigen::MatrixXd Hmm_inv = em.eigenvectors() * inv.asDiagonal() * em.eigenvectors().transpose();
   const Eigen::MatrixXd Hrm = H.bottomLeftCorner(k, m);
   Eigen::MatrixXd Hp = H.bottomRightCorner(k, k) - Hrm * Hmm_inv * Hrm.transpose();

@@ -62,9 +62,9 @@ uint64_t readBigEndian64(const uint8_t* b) {
 
 const std::vector<MessageType>& messageTypes() {
   static const std::vector<MessageType> types =
-      listTypes<imu_t, point_cloud_t, image_t, wheel_odometry_t, pose_t, odometry_t, filter_state_t,
-                registered_scan_t, keyframe_t, loop_correction_t, colored_cloud_t, octomap_t, progress_t,
-                channel_stats_t, health_t, visual_state_t>();
+      listTypes<imu_t, point_cloud_t, image_t, wheel_odometry_t, pose_t, odometry_t, filter_state_t, registered_scan_t,
+                keyframe_t, loop_correction_t, colored_cloud_t, octomap_t, progress_t, channel_stats_t, health_t,
+                visual_state_t>();
   return types;
 }
 

@@ -7,16 +7,15 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
-#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
+#include <poll.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
-#include <cstring>
-#include <cerrno>
-#include <poll.h>
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -26,8 +25,8 @@
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/pose_t.hpp"
-#include "livo/wheel_odometry_t.hpp"
 #include "livo/progress_t.hpp"
+#include "livo/wheel_odometry_t.hpp"
 
 namespace livo {
 
@@ -154,8 +153,8 @@ bool isSensorMessage(const void* data, size_t size) {
   const auto* b = static_cast<const uint8_t*>(data);
   uint64_t fingerprint = 0;
   for (int i = 0; i < 8; ++i) fingerprint = (fingerprint << 8) | b[i];
-  for (int64_t sensor : {imu_t::getHash(), point_cloud_t::getHash(), image_t::getHash(), wheel_odometry_t::getHash(),
-                         pose_t::getHash()})
+  for (int64_t sensor :
+       {imu_t::getHash(), point_cloud_t::getHash(), image_t::getHash(), wheel_odometry_t::getHash(), pose_t::getHash()})
     if (fingerprint == static_cast<uint64_t>(sensor)) return true;
   return false;
 }
@@ -252,7 +251,8 @@ void Node::publishProgress(bool finished) {
   p.instance = instance_;
   p.idle = !finished && receiveQueueEmpty() ? 1 : 0;
   p.idle_checked_us =
-      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+          .count();
   for (const auto& s : subs_) {
     p.input_channel.push_back(s.channel);
     p.handled.push_back(s.handled);
@@ -378,8 +378,9 @@ void Node::printSummary(std::ostream& os) const {
   os << "[" << options_.name << "] processing time per message (peak RSS " << std::fixed << std::setprecision(1)
      << peakRssMb() << " MB, CPU " << std::setprecision(2) << cpuSeconds() << " s):\n";
   os << "  " << std::left << std::setw(22) << "channel" << std::right << std::setw(9) << "messages" << std::setw(11)
-     << "median ms" << std::setw(9) << "p90 ms" << std::setw(9) << "max ms" << std::setw(9) << "decode!" << std::setw(10)
-     << "rejected" << "\n";
+     << "median ms" << std::setw(9) << "p90 ms" << std::setw(9) << "max ms" << std::setw(9) << "decode!"
+     << std::setw(10) << "rejected"
+     << "\n";
   for (const auto& c : channelStats()) {
     os << "  " << std::left << std::setw(22) << c.channel << std::right << std::setw(9) << c.messages
        << std::setprecision(3) << std::setw(11) << c.median_ms << std::setw(9) << c.p90_ms << std::setw(9) << c.max_ms

@@ -8,9 +8,8 @@
 namespace livo {
 
 registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime, const Pose3& pose,
-                                        const std::vector<Vec3>& world_points,
-                                        const std::vector<uint32_t>& input_index, const point_cloud_t& in,
-                                        const OutputFrame& frame) {
+                                        const std::vector<Vec3>& world_points, const std::vector<uint32_t>& input_index,
+                                        const point_cloud_t& in, const OutputFrame& frame) {
   registered_scan_t m;
   m.utime = utime;
   m.epoch = frame.epoch;

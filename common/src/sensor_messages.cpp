@@ -32,8 +32,10 @@ bool fromMessage(const point_cloud_t& m, LidarScan* scan, std::string* why) {
   scan->points.resize(n);
   scan->time_offset.assign(m.time_offset.begin(), m.time_offset.end());
   scan->intensity.assign(m.intensity.begin(), m.intensity.end());
-  if (m.ring.size() == n) scan->ring.assign(m.ring.begin(), m.ring.end());
-  else scan->ring.clear();
+  if (m.ring.size() == n)
+    scan->ring.assign(m.ring.begin(), m.ring.end());
+  else
+    scan->ring.clear();
   for (size_t i = 0; i < n; ++i) scan->points[i] = Vec3(m.x[i], m.y[i], m.z[i]);
   return true;
 }

@@ -7,9 +7,8 @@
 
 namespace livo {
 
-const std::vector<std::string> kLidarModels = {"VLP-16",  "OS1-16",  "OS1-64",  "HDL-64E",      "livox-avia",
-                                                "VLP-32C", "OS0-128", "OS1-128", "OS2-128", "livox-mid360",
-                                                "hesai-xt32"};
+const std::vector<std::string> kLidarModels = {"VLP-16",  "OS1-16",  "OS1-64",  "HDL-64E",      "livox-avia", "VLP-32C",
+                                               "OS0-128", "OS1-128", "OS2-128", "livox-mid360", "hesai-xt32"};
 
 const char* distortionModelName(DistortionModel m) {
   return m == DistortionModel::kEquidistant ? "equidistant" : "radtan";
@@ -57,8 +56,10 @@ CalibrationUncertainty readCalibrationUncertainty(const Config& sensor) {
   c.readOptional("translation", u.translation);
   c.readOptional("time_offset_s", u.time_offset_s);
   c.checkAllUsed();
-  if (!(u.rotation_deg >= 0.0 && u.rotation_deg <= 10.0)) throw ConfigError(c.where("rotation_deg") + ": must be in [0, 10] deg");
-  if (!(u.translation >= 0.0 && u.translation <= 1.0)) throw ConfigError(c.where("translation") + ": must be in [0, 1] m");
+  if (!(u.rotation_deg >= 0.0 && u.rotation_deg <= 10.0))
+    throw ConfigError(c.where("rotation_deg") + ": must be in [0, 10] deg");
+  if (!(u.translation >= 0.0 && u.translation <= 1.0))
+    throw ConfigError(c.where("translation") + ": must be in [0, 1] m");
   if (!(u.time_offset_s >= 0.0 && u.time_offset_s <= 0.1))
     throw ConfigError(c.where("time_offset_s") + ": must be in [0, 0.1] s");
   return u;
@@ -103,9 +104,12 @@ CameraRig readCamera(const Config& c) {
   c.read("cy", cam.cy);
   std::string model = distortionModelName(cam.distortion_model);
   c.readOptional("distortion_model", model);
-  if (model == distortionModelName(DistortionModel::kRadtan)) cam.distortion_model = DistortionModel::kRadtan;
-  else if (model == distortionModelName(DistortionModel::kEquidistant)) cam.distortion_model = DistortionModel::kEquidistant;
-  else throw ConfigError(c.where("distortion_model") + ": '" + model + "' is not radtan or equidistant");
+  if (model == distortionModelName(DistortionModel::kRadtan))
+    cam.distortion_model = DistortionModel::kRadtan;
+  else if (model == distortionModelName(DistortionModel::kEquidistant))
+    cam.distortion_model = DistortionModel::kEquidistant;
+  else
+    throw ConfigError(c.where("distortion_model") + ": '" + model + "' is not radtan or equidistant");
   std::vector<double> d;
   if (c.readOptional("distortion", d)) {
     if (d.size() != 4)
@@ -200,9 +204,9 @@ void printSensorRig(const SensorRig& r, std::ostream& os) {
   if (r.camera) {
     const auto& c = *r.camera;
     os << "  camera: " << c.width << "x" << c.height << (c.color ? " RGB8" : " GRAY8") << " at " << c.rate_hz
-       << " Hz on " << r.channels.camera << ", f " << c.fx << "/" << c.fy << ", c " << c.cx << "/" << c.cy
-       << ", " << distortionModelName(c.distortion_model) << " distortion [" << c.distortion[0] << ", "
-       << c.distortion[1] << ", " << c.distortion[2] << ", " << c.distortion[3] << "]";
+       << " Hz on " << r.channels.camera << ", f " << c.fx << "/" << c.fy << ", c " << c.cx << "/" << c.cy << ", "
+       << distortionModelName(c.distortion_model) << " distortion [" << c.distortion[0] << ", " << c.distortion[1]
+       << ", " << c.distortion[2] << ", " << c.distortion[3] << "]";
     if (c.depth) os << "\n          depth images registered to it on " << r.channels.depth;
     os << "\n          T_I_C ";
     printPose(os, c.T_I_C);

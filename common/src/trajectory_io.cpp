@@ -35,7 +35,8 @@ Pose3 poseFromTranslationQuat(double x, double y, double z, double qw, double qx
   Quat q(qw, qx, qy, qz);
   const double n = q.norm();
   if (!(n > 0.5 && n < 1.5) || !std::isfinite(x + y + z))
-    throw TrajectoryError(path + ":" + std::to_string(line_no) + ": invalid pose (quaternion norm " + std::to_string(n) + ")");
+    throw TrajectoryError(path + ":" + std::to_string(line_no) + ": invalid pose (quaternion norm " +
+                          std::to_string(n) + ")");
   Pose3 T = Pose3::Identity();
   T.linear() = q.normalized().toRotationMatrix();
   T.translation() = Vec3(x, y, z);
@@ -67,7 +68,9 @@ Trajectory readTum(const std::string& path) {
   Trajectory t;
   readNumericRows(path, [&](int ln, const std::vector<double>& v) {
     if (v.size() != 8) requireColumns(v, 8, path, ln, "t x y z qx qy qz qw");
-    if (v.size() > 8) throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 8 numbers (TUM), got " + std::to_string(v.size()));
+    if (v.size() > 8)
+      throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 8 numbers (TUM), got " +
+                            std::to_string(v.size()));
     t.push_back({v[0], poseFromTranslationQuat(v[1], v[2], v[3], v[7], v[4], v[5], v[6], path, ln)});
   });
   return t;
@@ -90,7 +93,9 @@ void writeTum(const std::string& path, const Trajectory& trajectory) {
 Trajectory readKittiPoses(const std::string& path, const std::string& times_path) {
   Trajectory t;
   readNumericRows(path, [&](int ln, const std::vector<double>& v) {
-    if (v.size() != 12) throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 12 numbers (KITTI 3x4 pose), got " + std::to_string(v.size()));
+    if (v.size() != 12)
+      throw TrajectoryError(path + ":" + std::to_string(ln) + ": expected 12 numbers (KITTI 3x4 pose), got " +
+                            std::to_string(v.size()));
     // Kept as written: KITTI rotations carry ~7 digits and are off SO(3) by ~1e-7; evaluation
     // tools (evo, the devkit) use them as they are, and so do we.
     Pose3 T = Pose3::Identity();
@@ -105,7 +110,8 @@ Trajectory readKittiPoses(const std::string& path, const std::string& times_path
       stamps.push_back(v[0]);
     });
     if (stamps.size() != t.size())
-      throw TrajectoryError(times_path + ": " + std::to_string(stamps.size()) + " times for " + std::to_string(t.size()) + " poses in " + path);
+      throw TrajectoryError(times_path + ": " + std::to_string(stamps.size()) + " times for " +
+                            std::to_string(t.size()) + " poses in " + path);
     for (size_t i = 0; i < t.size(); ++i) t[i].stamp = stamps[i];
   }
   return t;
@@ -133,8 +139,8 @@ TrajectoryFormat detectTrajectoryFormat(const std::string& path) {
     if (line.find(',') != std::string::npos) return TrajectoryFormat::kEurocCsv;
     if (v.size() == 12) return TrajectoryFormat::kKitti;
     if (v.size() == 8) return TrajectoryFormat::kTum;
-    throw TrajectoryError(path + ":" + std::to_string(line_no) + ": cannot tell the format from " + std::to_string(v.size()) +
-                          " numbers (TUM has 8, KITTI 12, EuRoC csv is comma separated)");
+    throw TrajectoryError(path + ":" + std::to_string(line_no) + ": cannot tell the format from " +
+                          std::to_string(v.size()) + " numbers (TUM has 8, KITTI 12, EuRoC csv is comma separated)");
   }
   throw TrajectoryError(path + ": no poses");
 }

@@ -36,11 +36,13 @@ std::vector<size_t> firstPointPerVoxelOf(const std::vector<Vec3>& points, size_t
 
 std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, const std::vector<size_t>& subset,
                                        double voxel_size) {
-  return firstPointPerVoxelOf(points, subset.size(), [&](size_t i) { return subset[i]; }, voxel_size);
+  return firstPointPerVoxelOf(
+      points, subset.size(), [&](size_t i) { return subset[i]; }, voxel_size);
 }
 
 std::vector<size_t> firstPointPerVoxel(const std::vector<Vec3>& points, double voxel_size) {
-  return firstPointPerVoxelOf(points, points.size(), [](size_t i) { return i; }, voxel_size);
+  return firstPointPerVoxelOf(
+      points, points.size(), [](size_t i) { return i; }, voxel_size);
 }
 
 }  // namespace livo

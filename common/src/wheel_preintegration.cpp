@@ -16,7 +16,8 @@ std::string wheelFactorText(const WheelRig& rig, double scale_std) {
   std::string s = "wheel preintegration";
   if (scale_std > 0.0) s += " (tyre scales estimated, prior sigma " + formatSignificant(scale_std) + ")";
   if (rig.estimatesMounting())
-    s += " through the estimated mounting rotation (prior sigma " + formatSignificant(rig.calibration_std.rotation_deg) + " deg)";
+    s += " through the estimated mounting rotation (prior sigma " +
+         formatSignificant(rig.calibration_std.rotation_deg) + " deg)";
   return s;
 }
 
@@ -70,8 +71,9 @@ void WheelPreintegration::integrate(double v_left0, double v_right0, double v_le
   dtheta_ds.row(2) << -v_left / track_width_ * dt, v_right / track_width_ * dt;
   Eigen::Matrix<double, 3, 2> du_ds = Eigen::Matrix<double, 3, 2>::Zero();
   du_ds.row(0) << 0.5 * v_left * dt, 0.5 * v_right * dt;
-  dp_ds_ += -mid_R * so3::hat(step_p) * (half_R.transpose() * dR_ds_ + 0.5 * so3::rightJacobian(0.5 * theta) * dtheta_ds) +
-            mid_R * du_ds;
+  dp_ds_ +=
+      -mid_R * so3::hat(step_p) * (half_R.transpose() * dR_ds_ + 0.5 * so3::rightJacobian(0.5 * theta) * dtheta_ds) +
+      mid_R * du_ds;
   dR_ds_ = step_R.transpose() * dR_ds_ + so3::rightJacobian(theta) * dtheta_ds;
 
   delta_p_ += mid_R * step_p;

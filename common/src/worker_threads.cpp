@@ -21,7 +21,8 @@ WorkerThreads::~WorkerThreads() {
 
 void WorkerThreads::forEachShare(size_t n, const std::function<void(size_t, size_t)>& fn, size_t min_share) {
   const size_t max_shares = n / std::max<size_t>(1, min_share);
-  const int shares = static_cast<int>(std::min<size_t>(static_cast<size_t>(threads()), std::max<size_t>(1, max_shares)));
+  const int shares =
+      static_cast<int>(std::min<size_t>(static_cast<size_t>(threads()), std::max<size_t>(1, max_shares)));
   if (shares == 1) {
     fn(0, n);
     return;

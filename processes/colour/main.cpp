@@ -6,8 +6,9 @@
 #include "livo/config_check.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-colour",
-                        "Colours registered scans from the camera images; publishes COLORED_CLOUD and writes the map as PLY/PCD.");
+  livo::CommandLine cli(
+      "livo-colour",
+      "Colours registered scans from the camera images; publishes COLORED_CLOUD and writes the map as PLY/PCD.");
   cli.option("--config", "FILE", "project config (rig: with a camera, optional colour:)")
       .option("--name", "NAME", "node name on the bus", "colour")
       .option("--output-dir", "DIR", "where the map files go", ".")

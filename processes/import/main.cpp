@@ -2,11 +2,11 @@
 // project's LCM log (exit 0; 1 an input not read to its end; 2 usage or a bad --rig; 3 the log does not fit --rig).
 #include <iostream>
 
+#include "livo/command_line.hpp"
+#include "livo/config.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
-#include "livo/command_line.hpp"
 #include "livo/import/rosbag_presets.hpp"
-#include "livo/config.hpp"
 
 namespace {
 
@@ -26,11 +26,13 @@ livo::import::KittiPointFields pointFields(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-import",
-                        "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
-                        "DEPTH, GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
-  cli.positional("FORMAT", "rosbag (ROS 1 bag), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
-                           "ouster (pcap + metadata JSON)");
+  livo::CommandLine cli(
+      "livo-import",
+      "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
+      "DEPTH, GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
+  cli.positional("FORMAT",
+                 "rosbag (ROS 1 bag), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
+                 "ouster (pcap + metadata JSON)");
   cli.positional("INPUT", "the bag, folder or pcap file");
   cli.option("--out", "LOG", "output LCM log (required unless --list-topics)")
       .option("--preset", "NAME", "rosbag topic map and conventions: ntu_viral, m2dgr (--list-presets)")
@@ -38,14 +40,17 @@ int main(int argc, char** argv) {
       .option("--lidar", "TOPIC", "rosbag: LiDAR topic (sensor_msgs/PointCloud2)")
       .option("--camera", "TOPIC", "rosbag: camera topic (sensor_msgs/Image or CompressedImage)")
       .option("--camera-right", "TOPIC", "rosbag: second camera topic")
-      .option("--depth", "TOPIC", "rosbag: depth image topic registered to the camera (sensor_msgs/Image 16UC1 mm or 32FC1 m)")
-      .option("--camera-info", "TOPIC",
-              "rosbag: the camera's sensor_msgs/CameraInfo (default: the only one, or the one in the camera's namespace); "
-              "read for --rig-out, --rig and the sidecar")
+      .option("--depth", "TOPIC",
+              "rosbag: depth image topic registered to the camera (sensor_msgs/Image 16UC1 mm or 32FC1 m)")
+      .option(
+          "--camera-info", "TOPIC",
+          "rosbag: the camera's sensor_msgs/CameraInfo (default: the only one, or the one in the camera's namespace); "
+          "read for --rig-out, --rig and the sidecar")
       .option("--ground-truth", "TOPIC|FILE",
               "rosbag: ground-truth topic (Odometry, PoseStamped, PoseWithCovarianceStamped, TransformStamped, "
               "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
-      .flag("--no-auto-topics", "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
+      .flag("--no-auto-topics",
+            "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
       .flag("--list-topics", "rosbag: print the bag's topics, types and counts, then exit")
       .flag("--list-presets", "print the presets, then exit")
       .option("--rig-out", "FILE",
@@ -66,7 +71,9 @@ int main(int argc, char** argv) {
       .option("--lidar-rings", "N", "rosbag: beams of the LiDAR (default: from the cloud)")
       .option("--lidar-time-field", "NAME", "rosbag: per-point time field (default: time, t, offset_time, timestamp)")
       .option("--lidar-time-unit", "s|ms|us|ns", "rosbag: unit of the time field (default: ns if integer, s if float)")
-      .flag("--no-azimuth-times", "rosbag: a spinning LiDAR's cloud without a time field keeps every point at the sweep start (default: times from the azimuth)")
+      .flag("--no-azimuth-times",
+            "rosbag: a spinning LiDAR's cloud without a time field keeps every point at the sweep start (default: "
+            "times from the azimuth)")
       .option("--imu-accel-unit", "auto|m/s2|g", "rosbag: acceleration unit", "auto")
       .option("--imu-gyro-unit", "rad/s|deg/s", "rosbag: angular rate unit", "rad/s")
       .flag("--use-bag-time", "rosbag: stamp messages with the bag's receive time instead of header.stamp")
@@ -82,7 +89,8 @@ int main(int argc, char** argv) {
   if (!cli.parse(argc, argv)) return cli.exitCode();
 
   if (cli.has("--list-presets")) {
-    for (const livo::import::RosbagPreset& p : livo::import::rosbagPresets()) std::cout << p.name << ": " << p.description << "\n";
+    for (const livo::import::RosbagPreset& p : livo::import::rosbagPresets())
+      std::cout << p.name << ": " << p.description << "\n";
     return 0;
   }
   livo::import::ImportJob job;

@@ -7,8 +7,9 @@
 #include "livo/lio/lio_node.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-lio", "ESIKF LiDAR-inertial odometry: IMU + LIDAR (+ WHEEL) in, ODOMETRY, "
-                                    "REGISTERED_SCAN and KEYFRAME out.");
+  livo::CommandLine cli("livo-lio",
+                        "ESIKF LiDAR-inertial odometry: IMU + LIDAR (+ WHEEL) in, ODOMETRY, "
+                        "REGISTERED_SCAN and KEYFRAME out.");
   cli.option("--config", "FILE", "project config with rig: and (optional) lio: sections")
       .option("--name", "NAME", "node name on the bus (overrides lio.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")
@@ -43,9 +44,10 @@ int main(int argc, char** argv) {
     if (!quiet && opts.lio.wheel.enabled) std::cerr << "[" << opts.name << "] " << node.wheelSummary() << "\n";
     if (!quiet && opts.camera_handoff) {
       const auto& h = node.handoffCounts();
-      std::cerr << "[" << opts.name << "] camera hand-off: " << h.priors << " priors, " << h.adopted << " posteriors adopted, "
-                << h.kept_prior << " kept the prior, " << h.missing << " unanswered (went on LiDAR-only), " << h.no_vio
-                << " images with no VIO running, " << h.images_skipped << " images before tracking or late\n";
+      std::cerr << "[" << opts.name << "] camera hand-off: " << h.priors << " priors, " << h.adopted
+                << " posteriors adopted, " << h.kept_prior << " kept the prior, " << h.missing
+                << " unanswered (went on LiDAR-only), " << h.no_vio << " images with no VIO running, "
+                << h.images_skipped << " images before tracking or late\n";
     }
     return rc;
   } catch (const std::exception& e) {

@@ -6,9 +6,10 @@
 #include "livo/lio_graph/lio_graph_node.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-lio-graph",
-                        "LIO-SAM-style LiDAR-inertial(-wheel) odometry on a fixed-lag factor graph: IMU + LIDAR (+ WHEEL) "
-                        "and LOOP_CORRECTION in, ODOMETRY, REGISTERED_SCAN and KEYFRAME out (a stand-in for livo-lio).");
+  livo::CommandLine cli(
+      "livo-lio-graph",
+      "LIO-SAM-style LiDAR-inertial(-wheel) odometry on a fixed-lag factor graph: IMU + LIDAR (+ WHEEL) "
+      "and LOOP_CORRECTION in, ODOMETRY, REGISTERED_SCAN and KEYFRAME out (a stand-in for livo-lio).");
   cli.option("--config", "FILE", "project config with rig: and (optional) lio_graph: sections")
       .option("--name", "NAME", "node name on the bus (overrides lio_graph.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")

@@ -3,16 +3,17 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
-#include "livo/config_check.hpp"
 #include "livo/config.hpp"
-#include "livo/node.hpp"
+#include "livo/config_check.hpp"
 #include "livo/loop/loop_node.hpp"
+#include "livo/node.hpp"
 
 int main(int argc, char** argv) {
   livo::CommandLine cli("livo-loop", "Loop closure: Quatro + Nano-GICP registration and pose-graph correction.");
   cli.option("--config", "FILE", "project config (reads the optional loop: section)")
       .option("--name", "N", "node name on the bus", "loop")
-      .option("--output-dir", "DIR", "write keyframes.tum, loops.json and global_map.ply here (overrides loop.output_dir)")
+      .option("--output-dir", "DIR",
+              "write keyframes.tum, loops.json and global_map.ply here (overrides loop.output_dir)")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
       .flag("--quiet", "no option summary at start, no summary at shutdown");
   livo::declareConfigCheck(cli);

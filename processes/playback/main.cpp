@@ -20,11 +20,13 @@ std::vector<std::string> splitList(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-playback", "Replays an LCM log onto the bus: real time, faster, or in lockstep with the pipeline.");
+  livo::CommandLine cli("livo-playback",
+                        "Replays an LCM log onto the bus: real time, faster, or in lockstep with the pipeline.");
   cli.positional("LOG", "LCM log to replay")
       .option("--speed", "X", "real-time factor; 0 = as fast as possible (ignored with --lockstep)", "1.0")
       .flag("--lockstep", "publish each message only after every consumer reported it handled the previous one")
-      .option("--consumers", "A,B,...", "node names to wait for (their --name): at the start, and with --lockstep after every message")
+      .option("--consumers", "A,B,...",
+              "node names to wait for (their --name): at the start, and with --lockstep after every message")
       .option("--channels", "REGEX", "replay only channels matching this regular expression", ".*")
       .option("--start", "S", "skip the first S seconds of the log", "0")
       .option("--duration", "S", "replay only S seconds (0: to the end)", "0")
@@ -33,21 +35,24 @@ int main(int argc, char** argv) {
               "nan:CH:FRAC jump:CH:AT_S:JUMP_S cut:CH:FROM_S:TO_S")
       .option("--seed", "N", "seed of the fault injector", "1")
       .option("--out", "LOG", "write the (faulted) stream to this log instead of publishing")
-      .option("--clock-file", "FILE",
-              "keep the log seconds replayed so far in FILE (rewritten every 20 ms; for supervisors that act at log times)")
+      .option(
+          "--clock-file", "FILE",
+          "keep the log seconds replayed so far in FILE (rewritten every 20 ms; for supervisors that act at log times)")
       .option("--progress-channel", "CH", "channel of the nodes' PROGRESS messages", "PROGRESS")
       .option("--stall-timeout", "S",
-              "lockstep: give up when a consumer is behind on a channel and its count has not moved for S seconds", "30")
+              "lockstep: give up when a consumer is behind on a channel and its count has not moved for S seconds",
+              "30")
       .option("--loss-grace", "S",
               "lockstep: an idle consumer still lacking a message published S seconds ago lost it on the bus "
-              "(reported, then not waited for)", "3")
-      .flag("--serial", "lockstep: wait for every consumer after every message, ignoring their quiet promises and --lag "
-                        "(the reference the default must equal)")
+              "(reported, then not waited for)",
+              "3")
+      .flag("--serial",
+            "lockstep: wait for every consumer after every message, ignoring their quiet promises and --lag "
+            "(the reference the default must equal)")
       .option("--lag", "A,B,...",
               "lockstep: consumers that may fall behind the rest (their outputs feed only recorders; checked)")
       .option("--max-lag", "N", "lockstep: how many messages a --lag consumer may be behind", "16")
-      .option("--max-lag-mb", "MB",
-              "lockstep: and how many megabytes (at each channel's mean message size)", "16")
+      .option("--max-lag-mb", "MB", "lockstep: and how many megabytes (at each channel's mean message size)", "16")
       .flag("--respawn", "lockstep: consumers may exit and be restarted by a supervisor; not waited for while away")
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
@@ -93,9 +98,10 @@ int main(int argc, char** argv) {
       std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
                 << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())
                 << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string())
-                << (r.not_waited > 0 ? "; " + std::to_string(r.not_waited) +
-                                           " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
-                                     : std::string())
+                << (r.not_waited > 0
+                        ? "; " + std::to_string(r.not_waited) +
+                              " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
+                        : std::string())
                 << std::endl;
     if (!o.quiet) std::cerr << "[playback] CPU " << livo::cpuSeconds() << " s (user + system)" << std::endl;
     if (!o.quiet && !r.waits.empty()) {

@@ -6,8 +6,9 @@
 #include "livo/record/recorder.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-record",
-                        "Records the named channels into an LCM log, reporting PROGRESS so lockstep playback waits for it.");
+  livo::CommandLine cli(
+      "livo-record",
+      "Records the named channels into an LCM log, reporting PROGRESS so lockstep playback waits for it.");
   cli.option("--out", "LOG", "log to write")
       .option("--channels", "A,B,...", "channels to record (names, not patterns)")
       .option("--name", "NAME", "node name on the bus", "record")

@@ -13,13 +13,13 @@
 
 #include "livo/command_line.hpp"
 #include "livo/file_output.hpp"
-#include "livo/text_format.hpp"
 #include "livo/report/html_report.hpp"
 #include "livo/report/memory_profile.hpp"
 #include "livo/report/pipeline_outputs.hpp"
 #include "livo/report/run_pictures.hpp"
 #include "livo/report/run_report.hpp"
 #include "livo/report/weak_spots.hpp"
+#include "livo/text_format.hpp"
 
 namespace {
 
@@ -39,8 +39,9 @@ void writeText(const std::string& path, const std::string& text) {
 }
 
 int extract(int argc, char** argv) {
-  livo::CommandLine cli("livo-report extract", "Writes odometry.tum, trajectory.tum, timing.json, resets.json and "
-                                               "weak_spots.json from a run's outputs log.");
+  livo::CommandLine cli("livo-report extract",
+                        "Writes odometry.tum, trajectory.tum, timing.json, resets.json and "
+                        "weak_spots.json from a run's outputs log.");
   cli.positional("OUTPUTS", "LCM log recorded during the run (lcm-logger)")
       .option("--dir", "DIR", "where to write the files", ".")
       .option("--odometry-channel", "CH", "online estimate", "ODOMETRY")
@@ -94,7 +95,8 @@ int markdown(int argc, char** argv) {
       .option("--figure", "CAPTION=FILE;...", "figures (paths relative to DIR)")
       .option("--warning", "TEXT;...", "warnings to list")
       .option("--injected", "TEXT;...", "faults injected by playback, one entry per channel")
-      .option("--sensor-use", "TEXT;...", "what the estimators did with each sensor, one entry per line of their summaries")
+      .option("--sensor-use", "TEXT;...",
+              "what the estimators did with each sensor, one entry per line of their summaries")
       .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   const std::string dir = cli.get("--dir");
@@ -133,12 +135,15 @@ int markdown(int argc, char** argv) {
     in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
-  if (std::ifstream c(dir + "/calibration.csv"); c) in.calibration = livo::report::readCalibrationCsv(dir + "/calibration.csv");
-  if (std::ifstream p(dir + "/pictures.json"); p) in.pictures = livo::report::picturesFromJson(nlohmann::json::parse(p));
+  if (std::ifstream c(dir + "/calibration.csv"); c)
+    in.calibration = livo::report::readCalibrationCsv(dir + "/calibration.csv");
+  if (std::ifstream p(dir + "/pictures.json"); p)
+    in.pictures = livo::report::picturesFromJson(nlohmann::json::parse(p));
   if (std::ifstream w(dir + "/weak_spots.json"); w)
     in.weak_spots = livo::report::weakSpotsFromJson(nlohmann::json::parse(w));
   else
-    in.warnings.push_back("weak_spots.json is missing (livo-report extract writes it): no \"Where the estimate was weak\"");
+    in.warnings.push_back(
+        "weak_spots.json is missing (livo-report extract writes it): no \"Where the estimate was weak\"");
   for (const auto& [node, p] : in.timing.items()) {
     for (const auto& [channel, c] : p["channels"].items()) {
       if (c.value("decode_failures", 0) > 0)
@@ -167,8 +172,10 @@ int pictures(int argc, char** argv) {
   cli.option("--dir", "DIR", "the run's output folder", ".")
       .option("--colour-map", "FILE", "the RGB map (binary PLY), relative to DIR", d.colour_map)
       .option("--octomap", "FILE", "the OctoMap (.bt), relative to DIR", d.octomap)
-      .option("--cut-above", "M", "RGB map pictures: leave out points higher above the trajectory", livo::formatSignificant(d.cut_above_m))
-      .option("--slice-below", "M", "OctoMap slice: from this far below the trajectory", livo::formatSignificant(d.band.below_m))
+      .option("--cut-above", "M", "RGB map pictures: leave out points higher above the trajectory",
+              livo::formatSignificant(d.cut_above_m))
+      .option("--slice-below", "M", "OctoMap slice: from this far below the trajectory",
+              livo::formatSignificant(d.band.below_m))
       .option("--slice-above", "M", "OctoMap slice: to this far above it", livo::formatSignificant(d.band.above_m))
       .option("--point-size", "M", "the RGB map's point spacing", livo::formatSignificant(d.point_size_m))
       .option("--size", "PX", "the pictures' longer side", std::to_string(d.long_side_px));
@@ -181,7 +188,8 @@ int pictures(int argc, char** argv) {
   o.band.above_m = cli.getDouble("--slice-above");
   o.point_size_m = cli.getDouble("--point-size");
   o.long_side_px = static_cast<int>(cli.getInt("--size"));
-  if (o.long_side_px < 100 || o.long_side_px > 10000) throw std::invalid_argument("--size: between 100 and 10000 pixels");
+  if (o.long_side_px < 100 || o.long_side_px > 10000)
+    throw std::invalid_argument("--size: between 100 and 10000 pixels");
   if (!(o.point_size_m > 0) || !(o.band.below_m + o.band.above_m > 0))
     throw std::invalid_argument("--point-size and the slice's band must be positive");
   const std::string dir = cli.get("--dir");
@@ -243,14 +251,17 @@ int html(int argc, char** argv) {
 }
 
 int memory(int argc, char** argv) {
-  livo::CommandLine cli("livo-report memory", "Prints each process's peak RSS at sensor times, from the HEALTH messages of a run's outputs log.");
+  livo::CommandLine cli(
+      "livo-report memory",
+      "Prints each process's peak RSS at sensor times, from the HEALTH messages of a run's outputs log.");
   cli.positional("OUTPUTS", "LCM log recorded during the run")
       .option("--at", "S,S,...", "seconds of sensor time since the first HEALTH", "300,900,1800")
       .option("--health-channel", "CH", "node health", "HEALTH");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   std::vector<double> at;
   for (const std::string& s : splitList(cli.get("--at"))) at.push_back(std::stod(s));
-  const livo::report::MemoryProfile p = livo::report::readMemoryProfile(cli.get("OUTPUTS"), cli.get("--health-channel"));
+  const livo::report::MemoryProfile p =
+      livo::report::readMemoryProfile(cli.get("OUTPUTS"), cli.get("--health-channel"));
   if (p.samples.empty()) {
     std::cerr << "livo-report: no HEALTH messages with a sensor time in " << cli.get("OUTPUTS") << "\n";
     return 1;

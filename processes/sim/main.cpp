@@ -10,17 +10,19 @@
 #include "livo/sim/simulator.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-sim",
-                        "Simulates IMU, LiDAR, camera, wheel encoder and ground truth in a scene and writes an LCM log.");
+  livo::CommandLine cli(
+      "livo-sim", "Simulates IMU, LiDAR, camera, wheel encoder and ground truth in a scene and writes an LCM log.");
   cli.option("--config", "FILE", "sim config (rig: and sim: sections), e.g. config/sim/room.yaml")
       .option("--out", "LOG", "LCM log file to write")
       .option("--duration", "S", "seconds to simulate (default: sim.duration_s)")
       .option("--seed", "N", "random seed (default: sim.seed)")
       .option("--threads", "N", "worker threads (default: sim.threads; the log does not depend on it)")
-      .option("--truth", "FILE", "also write the run's truth as JSON: the calibration errors drawn and the rig as "
-                                 "rendered (for evaluation scripts; no estimator reads it)")
-      .flag("--no-images", "leave out the camera's (and depth) images: a log for LiDAR-only runs in a fraction of "
-                           "the time, every other channel as it is with them")
+      .option("--truth", "FILE",
+              "also write the run's truth as JSON: the calibration errors drawn and the rig as "
+              "rendered (for evaluation scripts; no estimator reads it)")
+      .flag("--no-images",
+            "leave out the camera's (and depth) images: a log for LiDAR-only runs in a fraction of "
+            "the time, every other channel as it is with them")
       .flag("--quiet", "no progress output");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--config") || !cli.has("--out")) {
@@ -63,7 +65,8 @@ int main(int argc, char** argv) {
               << stats.sim_seconds << " s simulated in " << stats.wall_seconds << " s wall ("
               << stats.sim_seconds / std::max(stats.wall_seconds, 1e-9) << "x real time), "
               << writer.bytesWritten() / 1e6 << " MB\n";
-    for (const auto& [channel, count] : stats.messages) std::cerr << "  " << std::left << std::setw(14) << channel << count << " messages\n";
+    for (const auto& [channel, count] : stats.messages)
+      std::cerr << "  " << std::left << std::setw(14) << channel << count << " messages\n";
     if (setup.rig.lidar) std::cerr << "  LiDAR points: " << stats.lidar_points << "\n";
     if (setup.rig.wheel && setup.options.wheel_slip.enabled())
       std::cerr << "  wheel slip episodes: " << stats.wheel_slip_episodes << "\n";

@@ -6,8 +6,9 @@
 #include "livo/vio/vio_node.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-vio", "Sparse direct photometric update: CAMERA, STATE_PRIOR, REGISTERED_SCAN (and "
-                                    "LOOP_CORRECTION) in, STATE_POSTERIOR out.");
+  livo::CommandLine cli("livo-vio",
+                        "Sparse direct photometric update: CAMERA, STATE_PRIOR, REGISTERED_SCAN (and "
+                        "LOOP_CORRECTION) in, STATE_POSTERIOR out.");
   cli.option("--config", "FILE", "project config with rig: (with a camera) and (optional) vio: sections")
       .option("--name", "NAME", "node name on the bus (overrides vio.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")

@@ -7,9 +7,10 @@
 #include "livo/vio_feature/vio_feature_node.hpp"
 
 int main(int argc, char** argv) {
-  livo::CommandLine cli("livo-vio-feature",
-                        "Feature-based visual-inertial(-wheel) odometry on a sliding window: IMU + CAMERA (+ DEPTH, WHEEL, "
-                        "REGISTERED_SCAN for depth) in, VISUAL_STATE and VISUAL_ODOMETRY out.");
+  livo::CommandLine cli(
+      "livo-vio-feature",
+      "Feature-based visual-inertial(-wheel) odometry on a sliding window: IMU + CAMERA (+ DEPTH, WHEEL, "
+      "REGISTERED_SCAN for depth) in, VISUAL_STATE and VISUAL_ODOMETRY out.");
   cli.option("--config", "FILE", "project config with rig: and (optional) vio_feature: sections")
       .option("--name", "NAME", "node name on the bus (overrides vio_feature.name)")
       .option("--lcm-url", "URL", "LCM provider (default: LCM_DEFAULT_URL or LCM's default)")

@@ -10,8 +10,8 @@
 #include <memory>
 #include <string>
 
-#include "livo/colour/colouring_pipeline.hpp"
 #include "../octomap/sim_recording.hpp"
+#include "livo/colour/colouring_pipeline.hpp"
 
 namespace {
 

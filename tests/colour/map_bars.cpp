@@ -14,7 +14,8 @@
 //    hits land in either). Precision: occupied voxels that are surface voxels. Recall: of the
 //    surface voxels that were observed (within one voxel of a noise-free beam hit, and holding a
 //    hit or known in the map), those occupied; a surface lying on a face between two voxels
-//    counts once, found if either is occupied. The older figures against "voxels holding a noise-free hit" are printed too;
+//    counts once, found if either is occupied. The older figures against "voxels holding a noise-free hit" are printed
+//    too;
 //  - CPU time per scan and per image of each core.
 #include <chrono>
 #include <cmath>
@@ -44,7 +45,9 @@ uint64_t voxelKey(const Eigen::Vector3d& p, double res) {
                   static_cast<int64_t>(std::floor(p.z() / res)));
 }
 Eigen::Vector3d voxelCentre(uint64_t key, double res) {
-  auto v = [res](uint64_t u) { return (static_cast<double>(static_cast<int64_t>(u & 0x1FFFFF) - (1 << 20)) + 0.5) * res; };
+  auto v = [res](uint64_t u) {
+    return (static_cast<double>(static_cast<int64_t>(u & 0x1FFFFF) - (1 << 20)) + 0.5) * res;
+  };
   return {v(key >> 42), v(key >> 21), v(key)};
 }
 uint64_t bitsOf(const Eigen::Vector3f& p) {
@@ -156,7 +159,8 @@ class BarSink : public sim::SensorDataSink {
     std::unordered_set<uint64_t> candidates;
     for (uint64_t k : truth_voxels_) {
       const Eigen::Vector3d c = voxelCentre(k, res_);
-      const int64_t i = std::llround(c.x() / res_ - 0.5), j = std::llround(c.y() / res_ - 0.5), l = std::llround(c.z() / res_ - 0.5);
+      const int64_t i = std::llround(c.x() / res_ - 0.5), j = std::llround(c.y() / res_ - 0.5),
+                    l = std::llround(c.z() / res_ - 0.5);
       for (int di = -1; di <= 1; ++di)
         for (int dj = -1; dj <= 1; ++dj)
           for (int dl = -1; dl <= 1; ++dl) candidates.insert(indexKey(i + di, j + dj, l + dl));
@@ -184,20 +188,23 @@ class BarSink : public sim::SensorDataSink {
           Eigen::Vector3d nc = c;
           nc[a] += sgn * res_;
           const uint64_t n = voxelKey(nc, res_);
-          count(std::min(k, n) * 0x9E3779B97F4A7C15ull ^ std::max(k, n), occupied_keys.count(k) || occupied_keys.count(n));
+          count(std::min(k, n) * 0x9E3779B97F4A7C15ull ^ std::max(k, n),
+                occupied_keys.count(k) || occupied_keys.count(n));
         }
     }
     const auto& st = colour_.stats();
     std::printf("scans %lld, images %lld (without pose %lld), map points %zu, coloured %zu (with truth %zu)\n",
                 (long long)scans_, (long long)st.images, (long long)st.images_without_pose, colour_.map().size(),
                 colour_.map().colouredCount(), n);
-    std::printf("colour: mean error %.2f/255 (bar < 10), occluder-coloured points %.3f %% (bar < 1 %%), "
-                "samples accepted %lld, occluded %lld, outliers %lld, gain estimates %lld\n",
-                n ? err / n : 0.0, n ? 100.0 * occluded / n : 0.0, (long long)st.accepted, (long long)st.occluded,
-                (long long)st.outliers, (long long)st.gain_estimates);
-    std::printf("octomap: occupied voxels %zu, observed surface voxels %zu, precision %.4f, recall %.4f (bars >= 0.9)\n",
-                occupied.size(), surface_observed, occupied.empty() ? 0.0 : double(tp_surface) / occupied.size(),
-                surface_observed ? double(surface_found) / surface_observed : 0.0);
+    std::printf(
+        "colour: mean error %.2f/255 (bar < 10), occluder-coloured points %.3f %% (bar < 1 %%), "
+        "samples accepted %lld, occluded %lld, outliers %lld, gain estimates %lld\n",
+        n ? err / n : 0.0, n ? 100.0 * occluded / n : 0.0, (long long)st.accepted, (long long)st.occluded,
+        (long long)st.outliers, (long long)st.gain_estimates);
+    std::printf(
+        "octomap: occupied voxels %zu, observed surface voxels %zu, precision %.4f, recall %.4f (bars >= 0.9)\n",
+        occupied.size(), surface_observed, occupied.empty() ? 0.0 : double(tp_surface) / occupied.size(),
+        surface_observed ? double(surface_found) / surface_observed : 0.0);
     std::printf("octomap (old truth: voxels holding a noise-free hit, %zu): precision %.4f, recall %.4f\n",
                 truth_voxels_.size(), occupied.empty() ? 0.0 : double(tp) / occupied.size(),
                 truth_voxels_.empty() ? 0.0 : double(found) / truth_voxels_.size());
@@ -258,11 +265,13 @@ class BarSink : public sim::SensorDataSink {
     if (!hit.valid()) return Eigen::Vector3f::Constant(-1000.f);
     const sim::SurfacePoint sp = setup_.scene->surface(ray, hit);
     const sim::Scene& scene = *setup_.scene;
-    const double light = scene.lighting.ambient + scene.lighting.diffuse * std::max(0.0, -sp.normal.dot(scene.lighting.direction));
+    const double light =
+        scene.lighting.ambient + scene.lighting.diffuse * std::max(0.0, -sp.normal.dot(scene.lighting.direction));
     const double footprint = hit.t / setup_.rig.camera->fx;
     const sim::Texture& tex = scene.texture(scene.material(hit.object).texture);
     const double gain = 255.0 * setup_.options.camera.brightness * light;
-    if (!setup_.rig.camera->color) return Eigen::Vector3f::Constant(float(gain * tex.sampleLuminance(sp.u, sp.v, footprint)));
+    if (!setup_.rig.camera->color)
+      return Eigen::Vector3f::Constant(float(gain * tex.sampleLuminance(sp.u, sp.v, footprint)));
     return tex.sample(sp.u, sp.v, footprint) * float(gain);
   }
 
@@ -272,7 +281,7 @@ class BarSink : public sim::SensorDataSink {
   double res_;
   struct Truth {
     bool set = false, known = false;  // known: the point came from a beam of a scan
-    uint64_t bits = 0;  // of the position it was computed for
+    uint64_t bits = 0;                // of the position it was computed for
     Eigen::Vector3f colour;
   };
   std::vector<Truth> truth_;  // per map point id

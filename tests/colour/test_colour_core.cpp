@@ -25,8 +25,9 @@ using livo_test::WallAndBox;
 
 namespace {
 
-RegisteredScanView viewOf(int64_t utime, const std::vector<float>& x, const std::vector<float>& y, const std::vector<float>& z,
-                const std::vector<float>& dt, const Pose3& T = Pose3::Identity()) {
+RegisteredScanView viewOf(int64_t utime, const std::vector<float>& x, const std::vector<float>& y,
+                          const std::vector<float>& z, const std::vector<float>& dt,
+                          const Pose3& T = Pose3::Identity()) {
   RegisteredScanView v;
   v.utime = utime;
   v.cloud_utime = utime - 100000;
@@ -49,7 +50,8 @@ TEST(CameraProjection, AgreesWithOpenCvProjectPointsWithDistortion) {
   std::vector<cv::Point3d> object;
   for (int i = 0; i < 500; ++i) object.emplace_back(0.7 * u(rng), 0.5 * u(rng), 1.0 + std::abs(2.0 * u(rng)));
   const cv::Mat K = (cv::Mat_<double>(3, 3) << rig.fx, 0, rig.cx, 0, rig.fy, rig.cy, 0, 0, 1);
-  const cv::Mat D = (cv::Mat_<double>(1, 4) << rig.distortion[0], rig.distortion[1], rig.distortion[2], rig.distortion[3]);
+  const cv::Mat D =
+      (cv::Mat_<double>(1, 4) << rig.distortion[0], rig.distortion[1], rig.distortion[2], rig.distortion[3]);
   std::vector<cv::Point2d> expected;
   cv::projectPoints(object, cv::Mat::zeros(3, 1, CV_64F), cv::Mat::zeros(3, 1, CV_64F), K, D, expected);
   int inside = 0;
@@ -153,8 +155,8 @@ TEST(ColouringPipeline, PointsFarFromTheImageTimeTakeNoColour) {
   WallAndBox::points(0.05, 0.1, &x, &y, &z);
   std::vector<float> dt(x.size(), 0.0f);
   std::string error;
-  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));  // measured at 0.9 s
-  ASSERT_TRUE(pipe.addScan(viewOf(1400000, x, y, z, dt), &error));  // and again at 1.3 s
+  ASSERT_TRUE(pipe.addScan(viewOf(1000000, x, y, z, dt), &error));       // measured at 0.9 s
+  ASSERT_TRUE(pipe.addScan(viewOf(1400000, x, y, z, dt), &error));       // and again at 1.3 s
   ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 1150000), &error));  // >= 0.15 s from both
   pipe.flush();
   EXPECT_EQ(pipe.stats().images, 1);
@@ -218,7 +220,9 @@ TEST(ColouringPipeline, ExposureNormalisationKeepsColoursAcrossBrightnessChanges
     // the image brightens by 30 % (auto-exposure); stamps say so only when known_exposure
     const double gains[4] = {1.0, 1.0, 1.3, 1.3};
     for (int k = 0; k < 4; ++k)
-      ASSERT_TRUE(pipe.addImage(WallAndBox::render(rig, 900000 + 50000 * k, gains[k], known_exposure ? float(0.005 * gains[k]) : 0.0f), &error));
+      ASSERT_TRUE(pipe.addImage(
+          WallAndBox::render(rig, 900000 + 50000 * k, gains[k], known_exposure ? float(0.005 * gains[k]) : 0.0f),
+          &error));
     pipe.flush();
     EXPECT_EQ(pipe.stats().images, 4);
     if (!known_exposure) {
@@ -227,7 +231,8 @@ TEST(ColouringPipeline, ExposureNormalisationKeepsColoursAcrossBrightnessChanges
     double err = 0;
     int n = 0;
     for (const MapPoint& p : pipe.map().points()) {
-      if (!p.coloured() || p.position.z() < 3 || WallAndBox::inBox(p.position.x() * 0.4, p.position.y() * 0.4)) continue;
+      if (!p.coloured() || p.position.z() < 3 || WallAndBox::inBox(p.position.x() * 0.4, p.position.y() * 0.4))
+        continue;
       if (WallAndBox::wallGrey(p.position.x(), p.position.y()) * 1.3 > 250) continue;
       err += std::abs(p.colour[0] - WallAndBox::wallGrey(p.position.x(), p.position.y()));
       ++n;
@@ -287,7 +292,7 @@ TEST(ColouringPipeline, PointsBeyondTheCamerasReachAreNotMapped) {
 TEST(ColouringPipeline, PointsNoImageCanColourLeaveTheMap) {
   const CameraRig rig = livo_test::testCamera(false);
   ColourOptions o;
-  o.estimate_gain = false;  // window 0.3 s: scans are kept 2 * 0.3 + 1 s past their last point
+  o.estimate_gain = false;     // window 0.3 s: scans are kept 2 * 0.3 + 1 s past their last point
   o.map_only_in_view = false;  // the point behind the camera must enter the map first
   ColouringPipeline pipe(o, rig);
   std::string error;
@@ -347,8 +352,8 @@ TEST(ColouringPipeline, PointsOutsideTheWidenedViewConeAreNotMapped) {
   auto at = [](double angle, double r) {  // in the camera's x-z plane, `angle` from its axis (+z)
     return Eigen::Vector3f(float(r * std::sin(angle)), 0.f, float(r * std::cos(angle)));
   };
-  std::vector<Eigen::Vector3f> pts{at(deg(0), 5), at(deg(55), 5), at(deg(65), 5), at(deg(90), 5),
-                                   at(deg(180), 5), at(deg(120), 0.15)};
+  std::vector<Eigen::Vector3f> pts{at(deg(0), 5),  at(deg(55), 5),  at(deg(65), 5),
+                                   at(deg(90), 5), at(deg(180), 5), at(deg(120), 0.15)};
   auto scanOf = [&](int64_t utime, const Pose3& T, std::vector<float>* x, std::vector<float>* y, std::vector<float>* z,
                     std::vector<float>* dt) {
     x->clear(), y->clear(), z->clear(), dt->clear();
@@ -503,7 +508,8 @@ std::vector<MapPoint> allPoints(const ColourMap& map) {
   std::vector<MapPoint> out;
   map.forEachPoint([&](const MapPoint& p) { out.push_back(p); });
   std::sort(out.begin(), out.end(), [](const MapPoint& a, const MapPoint& b) {
-    return std::lexicographical_compare(a.position.data(), a.position.data() + 3, b.position.data(), b.position.data() + 3);
+    return std::lexicographical_compare(a.position.data(), a.position.data() + 3, b.position.data(),
+                                        b.position.data() + 3);
   });
   return out;
 }
@@ -550,8 +556,10 @@ TEST(ColourMapTiles, SpilledTilesComeBackWithTheSamePointsAndColours) {
     bool created = false;
     const uint32_t id = map.addPoint(p.position, 99, &created);
     EXPECT_EQ(created, !p.coloured());
-    if (p.coloured()) ASSERT_TRUE(samePoint(map.point(id), p));
-    else EXPECT_EQ(map.point(id).anchor, 99);
+    if (p.coloured())
+      ASSERT_TRUE(samePoint(map.point(id), p));
+    else
+      EXPECT_EQ(map.point(id).anchor, 99);
   }
   EXPECT_EQ(map.spilledTiles(), 0u);
   EXPECT_EQ(map.spilledBytes(), 0u);  // every record was given back
@@ -573,7 +581,8 @@ TEST(ColourMapTiles, BeyondTheResidentBudgetTheLeastRecentlyUsedTilesGoToDisk) {
   for (int tile = 0; tile < 3; ++tile) {
     map.setTime((tile + 1) * 1000000);
     for (int i = 0; i < 1000; ++i) {
-      const uint32_t id = map.addPoint(Eigen::Vector3f(2.0f * tile + 0.05f * (i % 40) + 0.01f, 0.05f * (i / 40) + 0.01f, 0.5f), tile);
+      const uint32_t id =
+          map.addPoint(Eigen::Vector3f(2.0f * tile + 0.05f * (i % 40) + 0.01f, 0.05f * (i / 40) + 0.01f, 0.5f), tile);
       map.accumulate(id, Eigen::Vector3f(10.0f * tile, 20.0f, 30.0f), acc);
       if (tile == 0) tile_a.push_back(map.point(id));
     }
@@ -585,7 +594,8 @@ TEST(ColourMapTiles, BeyondTheResidentBudgetTheLeastRecentlyUsedTilesGoToDisk) {
   EXPECT_EQ(map.residentTiles(), 2u);
   // over budget again, but the other two were used within min_idle_s: they stay
   map.setTime(3200000);
-  for (int i = 0; i < 1000; ++i) map.addPoint(Eigen::Vector3f(6.01f + 0.05f * (i % 40), 0.05f * (i / 40) + 0.01f, 0.5f), 3);
+  for (int i = 0; i < 1000; ++i)
+    map.addPoint(Eigen::Vector3f(6.01f + 0.05f * (i % 40), 0.05f * (i / 40) + 0.01f, 0.5f), 3);
   EXPECT_TRUE(map.evictIdle(3300000).empty());
   EXPECT_EQ(map.residentPoints(), 3000u);
   // the first tile comes back exactly as it went
@@ -625,7 +635,9 @@ TEST(ColourMapTiles, ACorrectionLeavesTilesOnDisk) {
   AccumulationOptions acc;
   // tile x in [0, 2): anchor 0, goes to disk; tile x in [2, 4): anchor 1, stays
   map.setTime(1000000);
-  for (int i = 0; i < 20; ++i) map.accumulate(map.addPoint(Eigen::Vector3f(0.1f * i + 0.025f, 0.025f, 0.025f), 0), Eigen::Vector3f(0.f, 0.f, 100.f), acc);
+  for (int i = 0; i < 20; ++i)
+    map.accumulate(map.addPoint(Eigen::Vector3f(0.1f * i + 0.025f, 0.025f, 0.025f), 0),
+                   Eigen::Vector3f(0.f, 0.f, 100.f), acc);
   map.setTime(3000000);
   std::vector<uint32_t> ids;
   for (int i = 0; i < 20; ++i) {
@@ -712,8 +724,8 @@ TEST(ViewCone, TheShortcutsDecideAsTheExactTest) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), frac(0.0, 1.0);
   int mismatches = 0, inside = 0, outside = 0, at_bound_inside = 0, at_bound_outside = 0;
-  const double half_angles[] = {0.0, 1e-7, 0.005, 0.3, 0.785, 1.05, 1.5, M_PI_2, 1.6, 2.5, 3.0, M_PI - 0.02,
-                                M_PI - 0.005, M_PI - 1e-9, M_PI, 4.0};
+  const double half_angles[] = {0.0, 1e-7, 0.005, 0.3,         0.785,        1.05,        1.5,  M_PI_2,
+                                1.6, 2.5,  3.0,   M_PI - 0.02, M_PI - 0.005, M_PI - 1e-9, M_PI, 4.0};
   const double travels[] = {0.0, 1e-6, 0.2, 0.8, 3.0, 40.0};
   for (const double half_angle : half_angles) {
     for (const double travel : travels) {
@@ -726,7 +738,8 @@ TEST(ViewCone, TheShortcutsDecideAsTheExactTest) {
       // a frame around the axis: points at a chosen angle and range
       const Eigen::Vector3d side = cone.axis.unitOrthogonal();
       auto at = [&](double angle, double r, double roll) {
-        const Eigen::Vector3d dir = Eigen::AngleAxisd(roll, cone.axis) * (std::cos(angle) * cone.axis + std::sin(angle) * side);
+        const Eigen::Vector3d dir =
+            Eigen::AngleAxisd(roll, cone.axis) * (std::cos(angle) * cone.axis + std::sin(angle) * side);
         return Eigen::Vector3d(cone.centre + r * dir);
       };
       auto check = [&](const Eigen::Vector3d& p) {
@@ -773,7 +786,8 @@ TEST(DepthBuffer, SplattingTheNearestPerCellLeavesTheBufferOfEverySplat) {
     const Eigen::Vector2d px(u(rng), v(rng));
     points.emplace_back(px, depth(rng));
     // crowd cells: more points in the same cell, nearer, farther and at the same depth
-    for (const double dz : {-0.05, 0.0, 0.0, 0.3}) points.emplace_back(px + Eigen::Vector2d(0.4, -0.3), std::max(0.2, points.back().second + dz));
+    for (const double dz : {-0.05, 0.0, 0.0, 0.3})
+      points.emplace_back(px + Eigen::Vector2d(0.4, -0.3), std::max(0.2, points.back().second + dz));
   }
   for (int image = 0; image < 2; ++image) {  // twice: the buffer's working set is reset between images
     every.clear();
@@ -799,7 +813,7 @@ TEST(ColourMap, AddPointsMatchesOneAddPointEach) {
     std::vector<Eigen::Vector3f> pts;
     for (int i = 0; i < 4000; ++i) {
       pts.emplace_back(u(rng) + 10.f * float(scan % 3), u(rng), 0.3f * u(rng));  // a region comes back every third
-      if (i % 5 == 0) pts.push_back(pts.back());  // the same voxel again
+      if (i % 5 == 0) pts.push_back(pts.back());                                 // the same voxel again
     }
     const int64_t utime = 1000000 + scan * 800000;
     one.setTime(utime);

@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "livo/colour/colour_node.hpp"
 #include "livo/colored_cloud_t.hpp"
+#include "livo/colour/colour_node.hpp"
 #include "livo/coloured_point_files.hpp"
 #include "livo/image_t.hpp"
 #include "livo/keyframe_t.hpp"
@@ -420,16 +420,19 @@ TEST(ColourNode, RefusesARigWithoutCamera) {
 
 // livo-colour reads the rig before it opens LCM (so --check-config refuses a rig without camera too).
 TEST(ColourConfig, RigMustHaveACamera) {
-  const std::string imu = "rig:\n  imu: {rate_hz: 200, gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
-                          "accel_random_walk: 0}\n";
+  const std::string imu =
+      "rig:\n  imu: {rate_hz: 200, gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
+      "accel_random_walk: 0}\n";
   try {
     colour::readColourRig(Config::fromString(imu, "nocam.yaml"));
     ADD_FAILURE() << "a rig without camera is refused";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("nocam.yaml: rig.camera: livo-colour needs a camera"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nocam.yaml: rig.camera: livo-colour needs a camera"), std::string::npos)
+        << e.what();
   }
-  const std::string camera = "  camera: {width: 640, height: 480, fx: 400, fy: 400, cx: 319.5, cy: 239.5, rate_hz: 20, "
-                             "T_I_C: {translation: [0, 0, 0], rpy_deg: [-90, 0, -90]}}\n";
+  const std::string camera =
+      "  camera: {width: 640, height: 480, fx: 400, fy: 400, cx: 319.5, cy: 239.5, rate_hz: 20, "
+      "T_I_C: {translation: [0, 0, 0], rpy_deg: [-90, 0, -90]}}\n";
   EXPECT_EQ(colour::readColourRig(Config::fromString(imu + camera)).camera->width, 640);
 }
 
@@ -441,9 +444,7 @@ TEST(ColourConfig, ReadsKeysStrictly) {
   EXPECT_EQ(o.map_name, "room");
   EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {voxel_sise: 0.1}")), ConfigError);
   EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {voxel_size: -1}")), ConfigError);
-  EXPECT_EQ(colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 8}"))
-                .core.max_pending_images,
-            8);
-  EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 0}")),
-               ConfigError);
+  EXPECT_EQ(
+      colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 8}")).core.max_pending_images, 8);
+  EXPECT_THROW(colour::readColourNodeOptions(Config::fromString("colour: {max_pending_images: 0}")), ConfigError);
 }

@@ -20,12 +20,12 @@ Trajectory stamped(const std::vector<double>& stamps) {
 
 TEST(NearestStamp, TakesTheFirstOfEquallyNearStampsLikeArgmin) {
   const NearestStamp n({3.0, 1.0, 2.0, 1.0, 0.5});
-  EXPECT_EQ(n.nearest(1.0), 1u);   // stamps 1 and 3 are 1.0: the first
+  EXPECT_EQ(n.nearest(1.0), 1u);  // stamps 1 and 3 are 1.0: the first
   EXPECT_EQ(n.nearest(1.2), 1u);
   EXPECT_EQ(n.nearest(0.75), 1u);  // 0.5 (index 4) and 1.0 (index 1) equally near: index 1 first
   EXPECT_EQ(n.nearest(-5.0), 4u);
   EXPECT_EQ(n.nearest(9.0), 0u);
-  EXPECT_EQ(n.nearest(2.5), 0u);   // 2 (index 2) and 3 (index 0): index 0 first
+  EXPECT_EQ(n.nearest(2.5), 0u);  // 2 (index 2) and 3 (index 0): index 0 first
 }
 
 TEST(NearestStamp, MatchesBruteForceArgminOnUnsortedStamps) {

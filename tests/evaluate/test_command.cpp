@@ -42,8 +42,8 @@ size_t count(const std::string& text, const std::string& what) {
 TEST(EvaluateCommand, WritesTableJsonSvgAndReport) {
   const std::string dir = livo_test::tempDir();
   const CommandResult r = run({"--est", kTrajectories + "freiburg1_xyz-rgbdslam.txt", "--gt",
-                     kTrajectories + "freiburg1_xyz-groundtruth.txt", "--align", "sim3", "--json", dir + "/fr1.json",
-                     "--plot", dir + "/fr1.svg", "--report", dir + "/fr1.md"});
+                               kTrajectories + "freiburg1_xyz-groundtruth.txt", "--align", "sim3", "--json",
+                               dir + "/fr1.json", "--plot", dir + "/fr1.svg", "--report", dir + "/fr1.md"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("ATE translation (m)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("0.0133894"), std::string::npos) << r.out;  // evo_ape tum ... -as: rmse 0.013389...
@@ -94,8 +94,8 @@ TEST(EvaluateCommand, EurocCsvGroundTruthGivesTheTumNumbers) {
     for (const auto& s : gt) {
       const Quat q(s.pose.linear());
       const Vec3 p = s.pose.translation();
-      out << std::llround(s.stamp * 1e9) << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << ","
-          << q.x() << "," << q.y() << "," << q.z() << "\n";
+      out << std::llround(s.stamp * 1e9) << "," << p.x() << "," << p.y() << "," << p.z() << "," << q.w() << "," << q.x()
+          << "," << q.y() << "," << q.z() << "\n";
     }
   }
   const std::string dir = livo_test::tempDir();
@@ -157,7 +157,8 @@ TEST(EvaluateCommand, FailsClearlyOnBadInput) {
   }
   r = run({"--est", dir + "/short_kitti.txt", "--gt", kTrajectories + "KITTI_00_gt.txt"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("cannot pair poses by index: the estimate has 2 poses, the ground truth 4541"), std::string::npos)
+  EXPECT_NE(r.err.find("cannot pair poses by index: the estimate has 2 poses, the ground truth 4541"),
+            std::string::npos)
       << r.err;
   {
     std::ofstream k(dir + "/bad_kitti.txt");
@@ -197,7 +198,8 @@ TEST(EvaluateCommand, PlotMarksWeakStretchesAndLoops) {
                  "loops": [{"time": 1025.0, "from_time": 1025.0, "to_time": 1001.0},
                            {"time": 1026.0, "from_time": 1026.0, "to_time": null}]})";
   }
-  const CommandResult plain = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/plain.svg", "--quiet"});
+  const CommandResult plain =
+      run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/plain.svg", "--quiet"});
   ASSERT_EQ(plain.code, 0) << plain.err;
   const CommandResult marked = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--plot", dir + "/marked.svg",
                                     "--marks", dir + "/weak_spots.json", "--quiet"});
@@ -215,7 +217,8 @@ TEST(EvaluateCommand, PlotMarksWeakStretchesAndLoops) {
   EXPECT_EQ(count(b, "stroke=\"#c51b7d\""), 1u + 1u + 3u * 2u);
   EXPECT_EQ(count(b, "nan"), 0u);
 
-  const CommandResult no_plot = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--marks", dir + "/weak_spots.json"});
+  const CommandResult no_plot =
+      run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--marks", dir + "/weak_spots.json"});
   EXPECT_EQ(no_plot.code, 1);
   EXPECT_NE(no_plot.err.find("--marks draws on the figure"), std::string::npos) << no_plot.err;
   { std::ofstream(dir + "/bad.json") << R"({"degenerate": {}})"; }
@@ -235,24 +238,21 @@ TEST(EvaluateCommand, FourDofAlignmentAndGroundVehicleMetrics) {
     est[i].pose.translation().z() += 0.3 * static_cast<double>(i) / 299.0;  // climbing 0.3 m too much
   writeTum(dir + "/gt.tum", gt);
   writeTum(dir + "/est.tum", est);
-  const CommandResult r = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--align", "4dof",
-                               "--json", dir + "/4dof.json", "--report", dir + "/4dof.md"});
+  const CommandResult r = run({"--est", dir + "/est.tum", "--gt", dir + "/gt.tum", "--align", "4dof", "--json",
+                               dir + "/4dof.json", "--report", dir + "/4dof.md"});
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string vertical =
-      "Vertical drift (z error, heights anchored at the first pose): +0.3000 m at the end";
-  const std::vector<std::string> lines = {"4dof (yaw about z and translation), yaw ",
-                                          "ATE after a 4-DoF alignment (yaw about z and translation): rmse ",
-                                          vertical + ", +0.",
-                                          "Roll / pitch error (gravity direction in the body, rmse): roll "};
-  for (const std::string& line : lines)
-    EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
+  const std::string vertical = "Vertical drift (z error, heights anchored at the first pose): +0.3000 m at the end";
+  const std::vector<std::string> lines = {
+      "4dof (yaw about z and translation), yaw ", "ATE after a 4-DoF alignment (yaw about z and translation): rmse ",
+      vertical + ", +0.", "Roll / pitch error (gravity direction in the body, rmse): roll "};
+  for (const std::string& line : lines) EXPECT_NE(r.out.find(line), std::string::npos) << line << "\n" << r.out;
   const auto j = nlohmann::json::parse(readFile(dir + "/4dof.json"));
   EXPECT_EQ(j["alignment"]["mode"], "4dof");
   EXPECT_EQ(j["ate_4dof"].get<double>(), j["ate"]["rmse"].get<double>());
   EXPECT_NEAR(j["vertical"]["end_m"].get<double>(), 0.3, 1e-6);  // TUM files keep about 9 digits
   EXPECT_NEAR(j["vertical"]["max_abs_m"].get<double>(), 0.3, 1e-6);
-  EXPECT_NEAR(j["vertical"]["per_100m"].get<double>(),
-              0.3 / (j["vertical"]["path_length_m"].get<double>() / 100.0), 1e-12);
+  EXPECT_NEAR(j["vertical"]["per_100m"].get<double>(), 0.3 / (j["vertical"]["path_length_m"].get<double>() / 100.0),
+              1e-12);
   EXPECT_EQ(j["vertical"]["path_length_m"], j["end_point"]["path_length_m"]);
   for (const char* key : {"roll_rmse_deg", "pitch_rmse_deg", "tilt_rmse_deg", "tilt_max_deg"})
     EXPECT_LT(j["attitude"][key].get<double>(), 1e-5) << key;

@@ -11,8 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lcm_log_writer.hpp"
 #include "evaluate_command_runner.hpp"
+#include "lcm_log_writer.hpp"
 #include "livo/evaluate/evaluate_command.hpp"
 #include "livo/evaluate/ground_map.hpp"
 #include "livo/messages.hpp"
@@ -26,10 +26,10 @@ using namespace livo::evaluate;
 
 namespace {
 
-constexpr double kGrade = 0.05;        // ground height z = 0.05 x
-constexpr double kWallX = 5.25;        // a wall across the ground, 2 m high
-constexpr int kScans = 10;             // 0.1 s apart from t = 100 s
-constexpr double kDriftPerScan = 0.01; // the planted vertical drift: 1 cm more every scan
+constexpr double kGrade = 0.05;         // ground height z = 0.05 x
+constexpr double kWallX = 5.25;         // a wall across the ground, 2 m high
+constexpr int kScans = 10;              // 0.1 s apart from t = 100 s
+constexpr double kDriftPerScan = 0.01;  // the planted vertical drift: 1 cm more every scan
 
 double groundHeight(double x) { return kGrade * x; }
 
@@ -182,7 +182,8 @@ TEST(GroundMap, PlantedVerticalDriftThickensTheGroundByItsSpread) {
   std::vector<double> wall_cell;
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 5; ++j) wall_cell.push_back(groundHeight(5.05 + 0.1 * i));
-  for (int j = 0; j < 5; ++j) wall_cell.push_back(groundHeight(kWallX) + 0.05), wall_cell.push_back(groundHeight(kWallX) + 0.15);
+  for (int j = 0; j < 5; ++j)
+    wall_cell.push_back(groundHeight(kWallX) + 0.05), wall_cell.push_back(groundHeight(kWallX) + 0.15);
   EXPECT_NEAR(g.truth.max, populationStd(wall_cell), 1e-6);  // about 5 cm, not the 2 m wall's half-metre spread
 }
 
@@ -301,8 +302,8 @@ std::string readFile(const std::string& path) {
 TEST(GroundMapCommand, ReportsTheThicknessInJsonSummaryAndReport) {
   const std::string log = writeLog("ground.lcmlog");
   const std::string json = livo_test::tempPath("ground.json"), md = livo_test::tempPath("ground.md");
-  const CommandResult r = run({"--est", log + ":GROUND_TRUTH", "--gt", log, "--align", "none", "--ground-map", log, "--json", json,
-                               "--report", md});
+  const CommandResult r = run({"--est", log + ":GROUND_TRUTH", "--gt", log, "--align", "none", "--ground-map", log,
+                               "--json", json, "--report", md});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(readFile(json))["ground_map"];
   EXPECT_EQ(j["cells"], 96);
@@ -315,7 +316,8 @@ TEST(GroundMapCommand, ReportsTheThicknessInJsonSummaryAndReport) {
   EXPECT_TRUE(j["truth_rms_m"].is_number());
   EXPECT_EQ(j["source"], log + ":REGISTERED_SCAN");
   EXPECT_EQ(j["cell_m"], 0.5);
-  EXPECT_NE(r.out.find("Ground-map thickness (" + log + ":REGISTERED_SCAN, 0.5 m cells, the lowest 0.2 m of each): "
+  EXPECT_NE(r.out.find("Ground-map thickness (" + log +
+                       ":REGISTERED_SCAN, 0.5 m cells, the lowest 0.2 m of each): "
                        "rms "),
             std::string::npos)
       << r.out;

@@ -121,9 +121,8 @@ TEST(FourDofAlignment, DoesNotRemoveAPlantedRoll) {
 
   // On a 3-D path SE(3) takes the tilt out entirely; the 4-DoF ATE keeps it.
   const Trajectory wiggly = fixtures::wigglyTrajectory(600);
-  const Evaluation se3 =
-      evaluateTrajectory(timed(fixtures::transformed(wiggly, worldRotation(Vec3(tilt, 0, 0)))), timed(wiggly),
-                         EvaluationOptions{});
+  const Evaluation se3 = evaluateTrajectory(timed(fixtures::transformed(wiggly, worldRotation(Vec3(tilt, 0, 0)))),
+                                            timed(wiggly), EvaluationOptions{});
   EXPECT_LT(se3.ate.max, 1e-9);
   EXPECT_GT(se3.ate_4dof.rmse, 0.1);
 }
@@ -308,7 +307,7 @@ TEST(GroundVehicleMetrics, JsonCarriesTheNewKeys) {
   EXPECT_NEAR(j["attitude"]["tilt_rmse_deg"].get<double>(), 0.3, 1e-9);
   EXPECT_NEAR(j["attitude"]["tilt_max_deg"].get<double>(), 0.3, 1e-9);
   // The keys that were there before keep their place.
-  for (const char* key : {"ate", "rpe", "drift", "end_point", "alignment", "association", "estimate",
-                          "ground_truth", "gt_offset"})
+  for (const char* key :
+       {"ate", "rpe", "drift", "end_point", "alignment", "association", "estimate", "ground_truth", "gt_offset"})
     EXPECT_TRUE(j.contains(key)) << key;
 }

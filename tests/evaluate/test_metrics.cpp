@@ -49,8 +49,8 @@ TEST(RotationAngle, ExactOnRotationsAndAsScipyOffSO3) {
   // Slightly non-orthonormal matrices (as KITTI files hold): SciPy 1.10.1's
   // norm(Rotation.from_matrix(M).as_rotvec()), both quaternion branches.
   Mat3 a, b;
-  a << 0.9999978750009297, -0.000500699562062615, -0.0019997482501098347, 0.0004989995629376149,
-      0.9999994750002734, -0.00100049912478148, 0.0020000482498910848, 0.0009994991252189798, 0.9999975000010939;
+  a << 0.9999978750009297, -0.000500699562062615, -0.0019997482501098347, 0.0004989995629376149, 0.9999994750002734,
+      -0.00100049912478148, 0.0020000482498910848, 0.0009994991252189798, 0.9999975000010939;
   b << 0.9428322904281532, 0.2853937810927889, -0.1721000177374649, 0.24512627573394719, -0.9437157254427833,
       -0.2220672684955547, -0.22579002488258718, 0.16718558330658195, -0.9597227961229002;
   EXPECT_NEAR(rotationAngle(a), 0.0022911677743079777, 1e-15);
@@ -188,7 +188,7 @@ TEST(KittiDrift, ScaleErrorIsThePercentAndYawRateTheDegreesPerMetre) {
 
 TEST(Coverage, GapsLongerThanTheThresholdAreNotCovered) {
   std::vector<double> stamps;
-  for (int i = 0; i <= 300; ++i) stamps.push_back(0.1 * i);  // 0 .. 30 s
+  for (int i = 0; i <= 300; ++i) stamps.push_back(0.1 * i);     // 0 .. 30 s
   for (int i = 600; i <= 1000; ++i) stamps.push_back(0.1 * i);  // 60 .. 100 s
   const Coverage c = groundTruthCoverage(stamps, 0.0, 100.0, 0.0);
   EXPECT_NEAR(c.gap, 0.3, 1e-12);

@@ -4,13 +4,13 @@
 #include <cmath>
 #include <functional>
 
-#include "livo/evaluate/evaluation.hpp"
 #include "lcm_log_writer.hpp"
+#include "livo/evaluate/evaluation.hpp"
+#include "livo/evaluate/pose_log.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/pose_t.hpp"
-#include "livo/evaluate/pose_log.hpp"
 #include "synthetic_trajectory.hpp"
 #include "temp_path.hpp"
 
@@ -108,7 +108,8 @@ TEST(PoseLog, ErrorsNameTheFileTheEventAndTheChannels) {
   const std::string log = makeLog(gt, Pose3::Identity());
 
   std::string m = errorOf([&] { readTrajectoryInput(log + ":IMU", "ODOMETRY"); });
-  EXPECT_NE(m.find(log + ": event 2 on IMU: is livo.imu_t, expected livo.pose_t or livo.odometry_t"), std::string::npos) << m;
+  EXPECT_NE(m.find(log + ": event 2 on IMU: is livo.imu_t, expected livo.pose_t or livo.odometry_t"), std::string::npos)
+      << m;
 
   m = errorOf([&] { readTrajectoryInput(log + ":NOPE", "ODOMETRY"); });
   EXPECT_NE(m.find("no messages on channel NOPE"), std::string::npos) << m;
@@ -164,5 +165,6 @@ TEST(PoseLog, ErrorsNameTheFileTheEventAndTheChannels) {
   writeBad([](lcm::LogFile& f) { fixtures::writeMessage(f, "ODOMETRY", 3, poseMessage(2000000, Pose3::Identity())); });
   m = errorOf([&] { readPoseLog(bad, "ODOMETRY"); });
   EXPECT_NE(m.find("event 3 on ODOMETRY: is livo.pose_t but earlier messages on the channel are livo.odometry_t"),
-            std::string::npos) << m;
+            std::string::npos)
+      << m;
 }

@@ -1,9 +1,9 @@
 // The shared EuRoC V1_01 sample (ASL folder + groundtruth.tum) against its own files.
 #include <gtest/gtest.h>
 
+#include "livo/image_t.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
-#include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/pose_t.hpp"
 #include "log_reading.hpp"

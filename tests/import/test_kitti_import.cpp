@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include "livo/image_t.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
 #include "livo/import/kitti_velodyne.hpp"
-#include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/point_cloud_t.hpp"
@@ -89,8 +89,8 @@ TEST(KittiImport, SharedSweepsWithoutTimestamps) {
 
 std::string oxtsLine(double lat, double lon, double yaw, double ax) {
   std::ostringstream os;
-  os << std::setprecision(17) << lat << " " << lon << " 110.5 0.01 -0.02 " << yaw
-     << " 1 2 3 4 5 " << ax << " -0.1 9.8 0 0 0 0.011 0.022 0.033 0 0 0 0.5 0.1 4 10 5 5 6\n";
+  os << std::setprecision(17) << lat << " " << lon << " 110.5 0.01 -0.02 " << yaw << " 1 2 3 4 5 " << ax
+     << " -0.1 9.8 0 0 0 0.011 0.022 0.033 0 0 0 0.5 0.1 4 10 5 5 6\n";
   return os.str();
 }
 

@@ -11,12 +11,12 @@
 
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
+#include "livo/import/ouster_metadata.hpp"
+#include "livo/import/pcap_reader.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/trajectory_io.hpp"
 #include "log_reading.hpp"
-#include "livo/import/ouster_metadata.hpp"
-#include "livo/import/pcap_reader.hpp"
 
 namespace livo::import {
 namespace {
@@ -163,8 +163,8 @@ TEST(OusterImport, GeometryAgreesWithTheCapturesPoseFile) {
   ASSERT_EQ(clouds.size(), 3u);
   std::vector<double> ranges;
   for (int j = 0; j < clouds[0].num_points; ++j)
-    ranges.push_back(std::sqrt(clouds[0].x[j] * clouds[0].x[j] + clouds[0].y[j] * clouds[0].y[j] +
-                               clouds[0].z[j] * clouds[0].z[j]));
+    ranges.push_back(
+        std::sqrt(clouds[0].x[j] * clouds[0].x[j] + clouds[0].y[j] * clouds[0].y[j] + clouds[0].z[j] * clouds[0].z[j]));
   std::sort(ranges.begin(), ranges.end());
   EXPECT_GT(ranges.front(), 0.1);
   EXPECT_LT(ranges[ranges.size() * 99 / 100], 120.0) << "OS1 rated range (rare multipath returns lie beyond)";

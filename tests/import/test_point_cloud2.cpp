@@ -16,7 +16,7 @@ constexpr uint8_t kUint16 = 4, kFloat32 = 7;  // sensor_msgs/PointField datatype
 // A 16-ring sweep of 360 columns, the first column at azimuth `start` rad, turning clockwise
 // (azimuth falling) or not; points in firing order (column by column) or ring by ring (organised).
 struct Sweep {
-  std::vector<uint8_t> bytes;  // x y z (float32), ring (uint16), 2 bytes padding: 16 per point
+  std::vector<uint8_t> bytes;    // x y z (float32), ring (uint16), 2 bytes padding: 16 per point
   std::vector<double> fraction;  // of the sweep, per point
   RosPointCloud2 msg;
 };
@@ -56,7 +56,8 @@ Sweep makeSweep(double start, bool clockwise, bool ring_major, double stagger_de
 TEST(PointCloud2Conversion, CloudsWithoutPointTimesGetThemFromTheAzimuth) {
   for (const bool clockwise : {true, false})
     for (const bool ring_major : {false, true}) {
-      SCOPED_TRACE(std::string(clockwise ? "clockwise" : "counter-clockwise") + (ring_major ? ", ring-major" : ", firing order"));
+      SCOPED_TRACE(std::string(clockwise ? "clockwise" : "counter-clockwise") +
+                   (ring_major ? ", ring-major" : ", firing order"));
       const Sweep s = makeSweep(2.5, clockwise, ring_major);
       PointCloudConversionOptions o;
       o.sweep_duration = 0.1;

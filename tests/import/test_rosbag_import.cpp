@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "livo/image_t.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/import_job.hpp"
-#include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/pose_t.hpp"
@@ -64,7 +64,8 @@ TEST_P(RosbagLayouts, EveryTypeAndPointCloudLayoutMatchesTheBag) {
   const std::string bag = kBags + "/layouts_" + compression + ".bag";
   const json exp = expectedFor(bag);
   const std::string dir = test::freshTempDir("rosbag_" + compression);
-  for (const std::string lidar : {"/velodyne_points", "/velodyne_end", "/ouster/points", "/hesai/pandar", "/livox/lidar"}) {
+  for (const std::string lidar :
+       {"/velodyne_points", "/velodyne_end", "/ouster/points", "/hesai/pandar", "/livox/lidar"}) {
     SCOPED_TRACE(compression + " " + lidar);
     ImportJob job = bagJob(bag, dir + "/out.lcmlog");
     job.rosbag.imu_topic = "/imu";
@@ -219,8 +220,10 @@ TEST(RosbagImport, SeveralDepthTopicsAreNotGuessedAndEachCanBeNamed) {
         float v;
         std::memcpy(&v, &depth[k].data[4 * i], 4);
         const json& e = exp["depth"][k]["metres"][i];
-        if (e.is_null()) EXPECT_TRUE(std::isnan(v)) << "pixel " << i;
-        else EXPECT_FLOAT_EQ(v, e.get<float>()) << "frame " << k << " pixel " << i;
+        if (e.is_null())
+          EXPECT_TRUE(std::isnan(v)) << "pixel " << i;
+        else
+          EXPECT_FLOAT_EQ(v, e.get<float>()) << "frame " << k << " pixel " << i;
       }
     }
   }
@@ -322,7 +325,8 @@ TEST(RosbagImport, TruncatedBagKeepsWhatCameBeforeTheCut) {
     EXPECT_NE(e.find(cut + ": record at offset "), std::string::npos) << e;
     EXPECT_NE(e.find("truncated"), std::string::npos) << e;
     EXPECT_GT(r.channel_counts.at("IMU"), 0) << "messages before the cut are kept";
-    EXPECT_EQ(test::readLog(job.out).size(), static_cast<size_t>(r.channel_counts.at("IMU") + r.channel_counts.at("LIDAR")));
+    EXPECT_EQ(test::readLog(job.out).size(),
+              static_cast<size_t>(r.channel_counts.at("IMU") + r.channel_counts.at("LIDAR")));
   }
 }
 

@@ -1,9 +1,9 @@
 // The writer's output is in time order with stable ties, in memory and through spilled runs.
 #include <gtest/gtest.h>
 
+#include "livo/import/sorted_log_writer.hpp"
 #include "livo/imu_t.hpp"
 #include "log_reading.hpp"
-#include "livo/import/sorted_log_writer.hpp"
 
 namespace livo::import {
 namespace {

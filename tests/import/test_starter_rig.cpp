@@ -128,7 +128,8 @@ TEST(StarterRig, APresetGivesItsDatasetsExtrinsicsAndCalibratedRig) {
 }
 
 SensorRig templateRig() {
-  return readSensorRig(Config::load(std::string(LIVO_SOURCE_DIR) + "/config/rigs/template_velodyne_vlp16.yaml").section("rig"));
+  return readSensorRig(
+      Config::load(std::string(LIVO_SOURCE_DIR) + "/config/rigs/template_velodyne_vlp16.yaml").section("rig"));
 }
 
 TEST(RigCheck, ImageSizeIsAnErrorNamingBothSizes) {
@@ -183,7 +184,9 @@ TEST(RigCheck, RatesAndRingsAreWarnings) {
   EXPECT_TRUE(r.rigFits());
   std::string all;
   for (const RigFinding& f : r.rig_findings) all += f.message + "\n";
-  EXPECT_NE(all.find("IMU rate: the rig (mine.yaml: rig.imu.rate_hz) says 400 Hz, the log's stamps 200 Hz"), std::string::npos) << all;
+  EXPECT_NE(all.find("IMU rate: the rig (mine.yaml: rig.imu.rate_hz) says 400 Hz, the log's stamps 200 Hz"),
+            std::string::npos)
+      << all;
   EXPECT_NE(all.find("VLP-32C (32 rings), the log's sweeps have 16"), std::string::npos) << all;
 }
 
@@ -222,7 +225,8 @@ TEST(LidarModels, GuessedFromRingsAndTimeLayout) {
   EXPECT_EQ(guessLidarModel(64, false, ouster, "").facts->model, "OS1-64");
   EXPECT_EQ(guessLidarModel(128, false, ouster, "").facts->model, "OS1-128");
   EXPECT_EQ(guessLidarModel(128, false, ouster, "OS0-128").facts->model, "OS0-128");
-  EXPECT_EQ(guessLidarModel(6, true, "x y z intensity line offset_time(uint32 ns, relative)", "").facts->model, "livox-avia");
+  EXPECT_EQ(guessLidarModel(6, true, "x y z intensity line offset_time(uint32 ns, relative)", "").facts->model,
+            "livox-avia");
   EXPECT_EQ(guessLidarModel(4, true, "", "").facts->model, "livox-mid360");
   const LidarModelGuess odd = guessLidarModel(40, false, velodyne, "");
   EXPECT_FALSE(odd.exact);
@@ -233,9 +237,9 @@ TEST(LidarModels, GuessedFromRingsAndTimeLayout) {
 TEST(RigSurvey, RateIsTheMedianInterval) {
   std::vector<int64_t> stamps;
   for (int i = 0; i < 100; ++i) stamps.push_back(1000000 + i * 5000);
-  stamps.push_back(stamps.back());          // a duplicate
+  stamps.push_back(stamps.back());           // a duplicate
   stamps.push_back(stamps.back() + 500000);  // a gap
-  std::swap(stamps[3], stamps[60]);         // out of order
+  std::swap(stamps[3], stamps[60]);          // out of order
   const MeasuredRate r = measureRate(stamps);
   EXPECT_EQ(r.messages, 102);
   EXPECT_DOUBLE_EQ(r.hz, 200.0);

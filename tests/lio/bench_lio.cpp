@@ -87,12 +87,23 @@ void BM_LioScan(benchmark::State& state) {
     ++k;
   }
   reportPercentiles(state, ms);
-  state.counters["points_per_sweep"] = static_cast<double>(points) / static_cast<double>(std::max<size_t>(1, ms.size()));
+  state.counters["points_per_sweep"] =
+      static_cast<double>(points) / static_cast<double>(std::max<size_t>(1, ms.size()));
   state.counters["map_points"] = static_cast<double>(lio.map().numPoints());
 }
 // {beams, timed sweeps, map upkeep (seen-through carving and range refresh) on}
-BENCHMARK(BM_LioScan)->Args({16, 60, 1})->Args({16, 60, 0})->Iterations(60)->UseManualTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_LioScan)->Args({64, 30, 1})->Args({64, 30, 0})->Iterations(30)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LioScan)
+    ->Args({16, 60, 1})
+    ->Args({16, 60, 0})
+    ->Iterations(60)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LioScan)
+    ->Args({64, 30, 1})
+    ->Args({64, 30, 0})
+    ->Iterations(30)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
 
 // ---- map structures ----
 struct MapData {
@@ -106,7 +117,8 @@ const MapData& largeMapData() {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> jitter(-0.05, 0.05), u(-30.0, 30.0);
     for (double x = -100.0; x < 100.0; x += 0.4)
-      for (double y = -100.0; y < 100.0; y += 0.4) d.map_points.emplace_back(x + jitter(rng), y + jitter(rng), 0.01 * jitter(rng));
+      for (double y = -100.0; y < 100.0; y += 0.4)
+        d.map_points.emplace_back(x + jitter(rng), y + jitter(rng), 0.01 * jitter(rng));
     for (int i = 0; i < 2300; ++i) d.sweep.emplace_back(u(rng), u(rng), 0.02 * jitter(rng));
     return d;
   }();
@@ -143,7 +155,9 @@ struct Cloud {
   size_t kdtree_get_point_count() const { return std::min(count, pts->size()); }
   double kdtree_get_pt(size_t i, size_t dim) const { return (*pts)[i][static_cast<int>(dim)]; }
   template <class B>
-  bool kdtree_get_bbox(B&) const { return false; }
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
 };
 using StaticTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3>;
 using DynamicTree = nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3>;

@@ -137,14 +137,15 @@ int main(int argc, char** argv) {
     // the figures of the bar: the sample at (or first after) `early` seconds and the last one
     const Sample* at_early = livo_soak::sampleAtOrAfter(samples, early);
     const Sample& last = samples.back();
-    std::printf("\nsimulated %.0f s in %.0f s wall; %lld sweeps with output (%lld tracked, %lld predicted, %lld "
-                "rejected, %lld initialising); %lld re-initialisations; %lld IMU samples refused\n",
-                stats.sim_seconds, stats.wall_seconds, static_cast<long long>(feeder.sweeps()),
-                static_cast<long long>(feeder.count(ScanResult::Status::kTracked)),
-                static_cast<long long>(feeder.count(ScanResult::Status::kPredicted)),
-                static_cast<long long>(feeder.count(ScanResult::Status::kRejected)),
-                static_cast<long long>(feeder.count(ScanResult::Status::kInitializing)),
-                static_cast<long long>(feeder.resets()), static_cast<long long>(feeder.refusedImu()));
+    std::printf(
+        "\nsimulated %.0f s in %.0f s wall; %lld sweeps with output (%lld tracked, %lld predicted, %lld "
+        "rejected, %lld initialising); %lld re-initialisations; %lld IMU samples refused\n",
+        stats.sim_seconds, stats.wall_seconds, static_cast<long long>(feeder.sweeps()),
+        static_cast<long long>(feeder.count(ScanResult::Status::kTracked)),
+        static_cast<long long>(feeder.count(ScanResult::Status::kPredicted)),
+        static_cast<long long>(feeder.count(ScanResult::Status::kRejected)),
+        static_cast<long long>(feeder.count(ScanResult::Status::kInitializing)),
+        static_cast<long long>(feeder.resets()), static_cast<long long>(feeder.refusedImu()));
     std::printf("per sweep: median %.2f ms, p90 %.2f ms, max %.2f ms\n", feeder.totalStats().medianMs(),
                 feeder.totalStats().p90Ms(), feeder.totalStats().maxMs());
     if (at_early && at_early != &last) {
@@ -153,9 +154,11 @@ int main(int argc, char** argv) {
       std::printf("the run is shorter than --early (%.0f s): no ratio\n", early);
     }
     if (feeder.estimated().size() >= 3) {
-      std::printf("ATE (SE(3)-aligned position RMSE over %zu sweeps): %.3f m; final position error (first pose aligned): %.3f m\n",
-                  feeder.estimated().size(), livo_soak::ateRmse(feeder.estimated(), feeder.groundTruth()),
-                  feeder.lastPositionError());
+      std::printf(
+          "ATE (SE(3)-aligned position RMSE over %zu sweeps): %.3f m; final position error (first pose aligned): %.3f "
+          "m\n",
+          feeder.estimated().size(), livo_soak::ateRmse(feeder.estimated(), feeder.groundTruth()),
+          feeder.lastPositionError());
     }
   } catch (const std::exception& e) {
     std::cerr << "livo_lio_soak: " << e.what() << "\n";

@@ -129,7 +129,8 @@ double GradedGround::height(double at_x) const {
   if (x.empty()) return 0.0;
   if (at_x <= x.front()) return h.front();
   if (at_x >= x.back()) return h.back();
-  const size_t i = static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at_x) - x.begin());  // x[i-1] <= at_x < x[i]
+  const size_t i =
+      static_cast<size_t>(std::upper_bound(x.begin(), x.end(), at_x) - x.begin());  // x[i-1] <= at_x < x[i]
   return h[i - 1] + (h[i] - h[i - 1]) * (at_x - x[i - 1]) / (x[i] - x[i - 1]);
 }
 
@@ -172,9 +173,9 @@ Scene roomScene() {
 
 Scene corridorScene() {
   Scene s;
-  s.planes.push_back({Vec3(0.0, 1.0, 0.0), 1.5});    // y = -1.5
-  s.planes.push_back({Vec3(0.0, -1.0, 0.0), 1.5});   // y = 1.5
-  s.planes.push_back({Vec3(0.0, 0.0, 1.0), 1.2});    // z = -1.2
+  s.planes.push_back({Vec3(0.0, 1.0, 0.0), 1.5});   // y = -1.5
+  s.planes.push_back({Vec3(0.0, -1.0, 0.0), 1.5});  // y = 1.5
+  s.planes.push_back({Vec3(0.0, 0.0, 1.0), 1.2});   // z = -1.2
   return s;
 }
 
@@ -290,12 +291,14 @@ LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarM
     const Pose3 T_W_L = traj.pose(t0 + dt) * T_I_L;
     const double az = 2.0 * M_PI * c / m.columns;
     for (int r = 0; r < m.rings; ++r) {
-      const double el = (m.fov_down_deg + (m.fov_up_deg - m.fov_down_deg) * r / std::max(1, m.rings - 1)) * M_PI / 180.0;
+      const double el =
+          (m.fov_down_deg + (m.fov_up_deg - m.fov_down_deg) * r / std::max(1, m.rings - 1)) * M_PI / 180.0;
       const Vec3 d_L(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
       Vec3 d_W = T_W_L.linear() * d_L;
       if (m.elevation_error_deg != 0.0) {
         const double el_true = el + m.elevation_error_deg * M_PI / 180.0;
-        d_W = T_W_L.linear() * Vec3(std::cos(el_true) * std::cos(az), std::cos(el_true) * std::sin(az), std::sin(el_true));
+        d_W = T_W_L.linear() *
+              Vec3(std::cos(el_true) * std::cos(az), std::cos(el_true) * std::sin(az), std::sin(el_true));
       }
       double range = scene.raycast(T_W_L.translation(), d_W);
       if (!std::isfinite(range) || range > m.max_range || range < m.min_range) continue;

@@ -58,8 +58,8 @@ struct GradedGround {
 };
 
 struct Scene {
-  std::vector<Box> shells;   // seen from inside (rooms)
-  std::vector<Box> solids;   // seen from outside (pillars, furniture)
+  std::vector<Box> shells;  // seen from inside (rooms)
+  std::vector<Box> solids;  // seen from outside (pillars, furniture)
   std::vector<InfinitePlane> planes;
   std::vector<GradedGround> grounds;
   /// Distance along the unit ray to the first hit, or +inf.
@@ -95,8 +95,8 @@ double gradedDriveHeightError(const Trajectory& traj, const GradedGround& ground
 struct LidarModel {
   int rings = 16;
   double fov_down_deg = -15.0, fov_up_deg = 15.0;
-  int columns = 1800;          // firings per revolution
-  double sweep_duration = 0.1; // s
+  int columns = 1800;           // firings per revolution
+  double sweep_duration = 0.1;  // s
   double min_range = 0.5, max_range = 100.0;
   double range_noise_std = 0.0;
   // An intrinsic calibration error: every beam leaves this much above its nominal elevation, the
@@ -112,7 +112,7 @@ LidarScan simulateSweep(const Scene& scene, const Trajectory& traj, const LidarM
                         int64_t base_utime, const Pose3& T_I_L, std::mt19937* rng);
 
 struct ImuErrorModel {
-  ImuNoise noise;             // densities; all zero: exact samples
+  ImuNoise noise;  // densities; all zero: exact samples
   Vec3 gyro_bias = Vec3::Zero();
   Vec3 accel_bias = Vec3::Zero();
   static ImuErrorModel exact() {
@@ -124,8 +124,8 @@ struct ImuErrorModel {
 
 /// IMU samples at rate_hz over [t0, t1] (trajectory time), stamped base_utime + t 1e6, with
 /// white noise (density / sqrt(dt)) and constant biases.
-std::vector<ImuSample> simulateImu(const Trajectory& traj, double t0, double t1, double rate_hz,
-                                   int64_t base_utime, const ImuErrorModel& err, std::mt19937* rng);
+std::vector<ImuSample> simulateImu(const Trajectory& traj, double t0, double t1, double rate_hz, int64_t base_utime,
+                                   const ImuErrorModel& err, std::mt19937* rng);
 
 /// A state away from every special case (turned on all axes, moving, biased, gravity tilted), for
 /// Jacobian tests.
@@ -174,7 +174,9 @@ class SyntheticSequence {
   LidarScan scan(int k) const;
   /// End of sweep k in the IMU clock.
   int64_t scanEndUtime(int k) const;
-  Pose3 truth(int64_t imu_utime) const { return spec_.traj.pose(static_cast<double>(imu_utime - spec_.base_utime) * 1e-6); }
+  Pose3 truth(int64_t imu_utime) const {
+    return spec_.traj.pose(static_cast<double>(imu_utime - spec_.base_utime) * 1e-6);
+  }
 
  private:
   SequenceSpec spec_;

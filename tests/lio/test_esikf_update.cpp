@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "livo/lio/degeneracy.hpp"
 #include "livo/esikf_update.hpp"
+#include "livo/lio/degeneracy.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "reference_algebra.hpp"
 #include "synthetic_world.hpp"
@@ -115,8 +115,7 @@ LinearisedMeasurement randomMeasurement(unsigned seed, int m, const StateVector&
 }  // namespace
 
 TEST(EsikfUpdate, InformationFormEqualsTextbookGain) {
-  const LinearisedMeasurement lm =
-      randomMeasurement(7, 9, StateVector::Ones(), Vec3(0.2, 0.1, -0.4), Vec3(1, 2, 3));
+  const LinearisedMeasurement lm = randomMeasurement(7, 9, StateVector::Ones(), Vec3(0.2, 0.1, -0.4), Vec3(1, 2, 3));
   // textbook: K of eq. (17), the step and covariance of eqs. (17) and (18)
   const Eigen::MatrixXd K = lm.gain();
   const StateCovariance Jinv = inverseOf(FilterState::boxminusJacobian(lm.x, lm.prior));
@@ -140,8 +139,7 @@ TEST(EsikfUpdate, InformationFormWithACalibrationBlockEqualsTextbookGain) {
       ASSERT_GT((FilterState::boxminusJacobian(lm.x, lm.prior).block<3, 3>(b, b) - Mat3::Identity()).norm(), 1e-3);
     const Eigen::MatrixXd K = lm.gain();
     const StateCovariance Jinv = inverseOf(FilterState::boxminusJacobian(lm.x, lm.prior));
-    const StateVector delta_ref =
-        -K * lm.z - (StateCovariance::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+    const StateVector delta_ref = -K * lm.z - (StateCovariance::Identity() - K * lm.H) * Jinv * lm.x.boxminus(lm.prior);
     const StateCovariance Ppost_ref = (StateCovariance::Identity() - K * lm.H) * lm.P;
     StateVector delta;
     StateCovariance Ppost;
@@ -218,8 +216,7 @@ TEST(EsikfUpdate, ConsiderStepEqualsTheSchmidtKalmanFilter) {
   const LinearisedMeasurement lm = randomMeasurement(9, 8, keep, Vec3(-0.1, 0.3, 0.2), Vec3(-1, 0.5, 2));
   const Eigen::MatrixXd Ks = keep.asDiagonal() * lm.gain();
   const StateCovariance Jinv = inverseOf(FilterState::boxminusJacobian(lm.x, lm.prior));
-  const StateVector delta_ref =
-      -Ks * lm.z - (StateCovariance::Identity() - Ks * lm.H) * Jinv * lm.x.boxminus(lm.prior);
+  const StateVector delta_ref = -Ks * lm.z - (StateCovariance::Identity() - Ks * lm.H) * Jinv * lm.x.boxminus(lm.prior);
   const StateCovariance I_KH = StateCovariance::Identity() - Ks * lm.H;
   const StateCovariance Ppost_ref = I_KH * lm.P * I_KH.transpose() + Ks * lm.R * Ks.transpose();
   StateVector delta;
@@ -435,7 +432,7 @@ TEST(EsikfUpdate, ConsistencyTestLeavesOutDirectionsTheMeasurementBarelySees) {
   EXPECT_NEAR(wider.mean_nis, 12.0, 0.3);
   // a planted error along the weakest untested direction does not count at min_information 0.01
   // (the measurement says almost nothing there), but does once that direction is tested
-  const Vec13 weak = L * V.col(3);  // λ = 0.0099
+  const Vec13 weak = L * V.col(3);                                      // λ = 0.0099
   const Vec13 offset = 50.0 * weak * std::sqrt(1.0 + 1.0 / lambda[3]);  // 50 sigma of P + S^-1 along it
   const Vec13 g = H.transpose() * (H * (-offset));
   const ConsistencyTest strict = consistencyTest(Vec13::Zero(), Mat13(H.transpose() * H), g, P, 0.99, 0.01);
@@ -509,8 +506,7 @@ struct RegistrationSetup {
   Pose3 truth;
 };
 
-RegistrationSetup makeRegistration(const synth::Scene& scene, const synth::Trajectory& traj, double t,
-                                   double noise) {
+RegistrationSetup makeRegistration(const synth::Scene& scene, const synth::Trajectory& traj, double t, double noise) {
   RegistrationSetup s;
   std::mt19937 rng(11);
   auto model = synth::LidarModel::vlp16();
@@ -550,8 +546,8 @@ StateCovariance looseCovariance() {
   StateCovariance P = StateCovariance::Zero();
   P.topLeftCorner<FilterState::kNavDim, FilterState::kNavDim>().setIdentity();
   P *= 1e-2;
-  P.topLeftCorner<3, 3>() *= 1.0;           // 0.1 rad
-  P.block<3, 3>(3, 3) = Mat3::Identity();   // 1 m
+  P.topLeftCorner<3, 3>() *= 1.0;          // 0.1 rad
+  P.block<3, 3>(3, 3) = Mat3::Identity();  // 1 m
   return P;
 }
 }  // namespace
@@ -569,11 +565,10 @@ TEST(EsikfUpdate, SingleScanRegistrationWithKnownOffsetConverges) {
   eo.max_iterations = 15;
   FilterState post;
   StateCovariance Ppost;
-  const EsikfResult r = iteratedUpdate(prior, looseCovariance(),
-                                       [&](const FilterState& x, int it, MeasurementInformation* info) {
-                                         return s2m.evaluate(x, it, info);
-                                       },
-                                       eo, &post, &Ppost);
+  const EsikfResult r = iteratedUpdate(
+      prior, looseCovariance(),
+      [&](const FilterState& x, int it, MeasurementInformation* info) { return s2m.evaluate(x, it, info); }, eo, &post,
+      &Ppost);
   ASSERT_TRUE(r.valid);
   EXPECT_TRUE(r.converged);
   const Vec6 err = se3::boxminus(post.pose(), setup.truth);
@@ -604,11 +599,10 @@ TEST(EsikfUpdate, TheRegistrationFloorBoundsWhatASweepSaysAboutThePose) {
     ScanToMap s2m(setup.map, nullptr, body, mo);
     FilterState post;
     StateCovariance P;
-    const EsikfResult r = iteratedUpdate(prior, looseCovariance(),
-                                         [&](const FilterState& x, int it, MeasurementInformation* info) {
-                                           return s2m.evaluate(x, it, info);
-                                         },
-                                         EsikfOptions{}, &post, &P);
+    const EsikfResult r = iteratedUpdate(
+        prior, looseCovariance(),
+        [&](const FilterState& x, int it, MeasurementInformation* info) { return s2m.evaluate(x, it, info); },
+        EsikfOptions{}, &post, &P);
     EXPECT_TRUE(r.valid);
     return Mat6(P.topLeftCorner<6, 6>());
   };
@@ -617,8 +611,8 @@ TEST(EsikfUpdate, TheRegistrationFloorBoundsWhatASweepSaysAboutThePose) {
   const Mat6 all_f = posterior(setup.body, kRot, kTrans), some_f = posterior(half, kRot, kTrans);
   for (int i = 0; i < 6; ++i) {
     const double floor2 = i < 3 ? kRot * kRot : kTrans * kTrans;
-    EXPECT_NEAR(some(i, i) / all(i, i), 2.0, 0.4) << i;          // independent errors: twice the points, half the variance
-    EXPECT_GT(all_f(i, i), 0.9 * floor2) << i;                                 // never surer than the floor
+    EXPECT_NEAR(some(i, i) / all(i, i), 2.0, 0.4) << i;  // independent errors: twice the points, half the variance
+    EXPECT_GT(all_f(i, i), 0.9 * floor2) << i;           // never surer than the floor
     EXPECT_NEAR(all_f(i, i), floor2 + all(i, i), 0.02 * all_f(i, i)) << i;     // the floor plus the points
     EXPECT_NEAR(some_f(i, i), floor2 + some(i, i), 0.02 * some_f(i, i)) << i;  // ... with half of them
     EXPECT_LT(some_f(i, i) / all_f(i, i), 1.15) << i;  // more points, hardly a change (at most 1.10)
@@ -637,11 +631,9 @@ TEST(EsikfUpdate, CorridorIsFlaggedDegenerateAlongItsAxis) {
   FilterState post;
   StateCovariance Ppost;
   const StateCovariance P0 = looseCovariance();
-  const EsikfResult r = iteratedUpdate(prior, P0,
-                                       [&](const FilterState& x, int it, MeasurementInformation* info) {
-                                         return s2m.evaluate(x, it, info);
-                                       },
-                                       eo, &post, &Ppost);
+  const EsikfResult r = iteratedUpdate(
+      prior, P0, [&](const FilterState& x, int it, MeasurementInformation* info) { return s2m.evaluate(x, it, info); },
+      eo, &post, &Ppost);
   ASSERT_TRUE(r.valid);
   const DegeneracyReport dr = analyzeDegeneracy(r.info.geometry, 0.01);
   EXPECT_TRUE(dr.degenerate) << dr.translation_eigenvalues.transpose();
@@ -673,8 +665,8 @@ TEST(EsikfUpdate, DegenerateDirectionsAreMarginalisedOutOfTheSweepsInformation) 
   Eigen::Matrix<double, 40, 6> H;
   for (int r = 0; r < 40; ++r) {
     const bool along_axis = r < 3;  // three rows at one corner 3 m ahead with a normal along x
-    const Vec3 normal = along_axis ? Vec3(1.0, 0.1 * n(rng), 0.1 * n(rng)).normalized()
-                                   : Vec3(0.0, n(rng), n(rng)).normalized();
+    const Vec3 normal =
+        along_axis ? Vec3(1.0, 0.1 * n(rng), 0.1 * n(rng)).normalized() : Vec3(0.0, n(rng), n(rng)).normalized();
     const Vec3 lever = along_axis ? Vec3(3.0 + 0.3 * n(rng), 1.4 + 0.05 * n(rng), -1.1 + 0.05 * n(rng))
                                   : Vec3(5.0 * n(rng), 5.0 * n(rng), 2.0 * n(rng));
     H.row(r) << (lever.cross(normal)).transpose(), normal.transpose();

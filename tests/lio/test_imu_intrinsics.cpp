@@ -51,7 +51,8 @@ TEST(ImuIntrinsics, ReadingJacobianMatchesNumericDifferentiation) {
     a.value[ImuIntrinsics::kGyroScale + i] += h;
     b.value[ImuIntrinsics::kGyroScale + i] -= h;
     const Vec3 num = (a.gyroAxes().inverse() * u - b.gyroAxes().inverse() * u) / (2 * h);
-    EXPECT_LT((J.col(i) - num).norm(), 1e-7) << "column " << i << ": " << J.col(i).transpose() << " vs " << num.transpose();
+    EXPECT_LT((J.col(i) - num).norm(), 1e-7)
+        << "column " << i << ": " << J.col(i).transpose() << " vs " << num.transpose();
   }
   // the simulator's sensing axes are the lower-triangular case of the filter's K
   const Vec3 scale(0.01, -0.02, 0.005), mis(0.003, -0.004, 0.006);
@@ -85,13 +86,15 @@ TEST(ImuIntrinsics, PropagationJacobiansMatchNumericDifferentiation) {
     Vec12 e = z;
     e[i] = h;
     Fw_num.col(i) = (errorMap(x, k, Vec18::Zero(), e, zk, gyro, accel, dt) -
-                     errorMap(x, k, Vec18::Zero(), -e, zk, gyro, accel, dt)) / (2 * h);
+                     errorMap(x, k, Vec18::Zero(), -e, zk, gyro, accel, dt)) /
+                    (2 * h);
   }
   for (int i = 0; i < ImuIntrinsics::kDim; ++i) {
     VecK e = zk;
     e[i] = h;
-    Fm_num.col(i) = (errorMap(x, k, Vec18::Zero(), z, e, gyro, accel, dt) -
-                     errorMap(x, k, Vec18::Zero(), z, -e, gyro, accel, dt)) / (2 * h);
+    Fm_num.col(i) =
+        (errorMap(x, k, Vec18::Zero(), z, e, gyro, accel, dt) - errorMap(x, k, Vec18::Zero(), z, -e, gyro, accel, dt)) /
+        (2 * h);
   }
   EXPECT_LT((Fx - Fx_num).cwiseAbs().maxCoeff(), 1e-8) << Fx - Fx_num;
   EXPECT_LT((Fw - Fw_num).cwiseAbs().maxCoeff(), 1e-8) << Fw - Fw_num;
@@ -195,8 +198,7 @@ TEST(ImuIntrinsics, APlantedErrorIsRecoveredFromPoseMeasurements) {
   noise.gyro_misalignment_std = 0.007;
   noise.accel_scale_std = 0.01;
   noise.accel_misalignment_std = 0.007;
-  std::vector<ImuSample> imu =
-      synth::simulateImu(traj, 0.0, duration, rate, 0, synth::ImuErrorModel::exact(), &rng);
+  std::vector<ImuSample> imu = synth::simulateImu(traj, 0.0, duration, rate, 0, synth::ImuErrorModel::exact(), &rng);
   const ImuIntrinsics truth = someIntrinsics();
   const double sg = noise.gyro_noise_density * std::sqrt(rate), sa = noise.accel_noise_density * std::sqrt(rate);
   for (ImuSample& s : imu) {
@@ -210,8 +212,8 @@ TEST(ImuIntrinsics, APlantedErrorIsRecoveredFromPoseMeasurements) {
   ImuPropagator prop(noise);
   prop.setIntrinsics({}, intrinsicsPrior(noise), true);
   StateCovariance P0 = StateCovariance::Zero();
-  P0.diagonal().head<18>() << Vec3::Constant(1e-6), Vec3::Constant(1e-6), Vec3::Constant(1e-4),
-      Vec3::Constant(1e-6), Vec3::Constant(1e-4), Vec3::Constant(1e-6);
+  P0.diagonal().head<18>() << Vec3::Constant(1e-6), Vec3::Constant(1e-6), Vec3::Constant(1e-4), Vec3::Constant(1e-6),
+      Vec3::Constant(1e-4), Vec3::Constant(1e-6);
   prop.reset(traj.state(0.0), P0, imu.front());
   const double sr = 1e-3, sp = 2e-3;  // a registered sweep: about 0.06 deg and 2 mm
   size_t i = 1;
@@ -232,7 +234,8 @@ TEST(ImuIntrinsics, APlantedErrorIsRecoveredFromPoseMeasurements) {
   }
   const VecK err = prop.intrinsics().value - truth.value;
   const VecK sigma = prop.intrinsicsCovariance().diagonal().cwiseSqrt();
-  for (int j = 0; j < ImuIntrinsics::kDim; ++j) EXPECT_LT(std::abs(err[j]), 3.0 * sigma[j]) << "state " << j << ": " << err.transpose();
+  for (int j = 0; j < ImuIntrinsics::kDim; ++j)
+    EXPECT_LT(std::abs(err[j]), 3.0 * sigma[j]) << "state " << j << ": " << err.transpose();
   // the gyro's scales, excited by the turns, to a third of their prior or better
   for (int j = 0; j < 3; ++j) EXPECT_LT(sigma[ImuIntrinsics::kGyroScale + j], 0.01 / 3.0) << sigma.transpose();
 }

@@ -45,8 +45,8 @@ TEST(ImuPropagator, JacobiansMatchNumericDifferentiation) {
     for (int i = 0; i < 12; ++i) {
       Eigen::Matrix<double, 12, 1> w = w0;
       w[i] = h;
-      Fw_num.col(i) = (errorMap(x, Vec18::Zero(), w, gyro, accel, dt) - errorMap(x, Vec18::Zero(), -w, gyro, accel, dt)) /
-                      (2 * h);
+      Fw_num.col(i) =
+          (errorMap(x, Vec18::Zero(), w, gyro, accel, dt) - errorMap(x, Vec18::Zero(), -w, gyro, accel, dt)) / (2 * h);
     }
     EXPECT_LT((Fx - Fx_num).cwiseAbs().maxCoeff(), 1e-8) << "dt " << dt << "\n" << Fx - Fx_num;
     EXPECT_LT((Fw - Fw_num).cwiseAbs().maxCoeff(), 1e-8) << "dt " << dt << "\n" << Fw - Fw_num;

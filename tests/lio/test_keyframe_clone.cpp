@@ -64,8 +64,8 @@ TEST(KeyframeClone, RelativePoseCovarianceMatchesNumericJacobians) {
   }
   const Eigen::MatrixXd S = randomCovariance(12, rng, 1e-3);  // [a; b]
   const Eigen::MatrixXd expected = J * S * J.transpose();
-  const Mat6 got = relativePoseCovariance(Ta, Tb, S.topLeftCorner(6, 6), S.bottomRightCorner(6, 6),
-                                          S.bottomLeftCorner(6, 6));
+  const Mat6 got =
+      relativePoseCovariance(Ta, Tb, S.topLeftCorner(6, 6), S.bottomRightCorner(6, 6), S.bottomLeftCorner(6, 6));
   EXPECT_LT((got - expected).norm(), 1e-8 * expected.norm()) << got << "\n\n" << expected;
 }
 
@@ -100,8 +100,7 @@ TEST(KeyframeClone, CrossCovarianceThroughUpdatesEqualsTheAugmentedFilter) {
     for (int r = 0; r < kMeasuredDim; ++r)
       for (int c = 0; c < kMeasuredDim; ++c) Info(m.stateIndex(r), m.stateIndex(c)) = m.HtRinvH(r, c);
     Eigen::MatrixXd Kh = Aug * Info;  // Aug_post = (I + Aug Info)^-1 Aug
-    const Eigen::MatrixXd Aug_post =
-        (Eigen::MatrixXd::Identity(n + 6, n + 6) + Kh).partialPivLu().solve(Aug);
+    const Eigen::MatrixXd Aug_post = (Eigen::MatrixXd::Identity(n + 6, n + 6) + Kh).partialPivLu().solve(Aug);
     C = carriedThroughUpdate(P, P_post, C);
     P = P_post;
     Aug = 0.5 * (Aug_post + Aug_post.transpose());

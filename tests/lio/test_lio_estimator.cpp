@@ -234,7 +234,7 @@ TEST(LioEstimator, RecoversFromBadInput) {
   const SyntheticSequence seq(spec);
   LioEstimator lio(optionsFor(spec));
   size_t imu_index = 0;
-  const int64_t gap_start = seq.scanEndUtime(60), gap_end = gap_start + 300'000;      // 0.3 s: bridged
+  const int64_t gap_start = seq.scanEndUtime(60), gap_end = gap_start + 300'000;       // 0.3 s: bridged
   const int64_t hole_start = seq.scanEndUtime(80), hole_end = hole_start + 1'500'000;  // 1.5 s: reset
   const RunLog log = run(
       lio, seq, 0, seq.numScans(), &imu_index,
@@ -314,7 +314,8 @@ TEST(LioEstimator, LidarOutageKeepsBuffersBoundedAndReseedsTheMap) {
   ASSERT_FALSE(after.results.empty());
   EXPECT_EQ(after.results.front().status, ScanResult::Status::kMapInitialized);
   EXPECT_NE(after.results.front().message.find("re-seeded"), std::string::npos) << after.results.front().message;
-  for (size_t i = 1; i < after.results.size(); ++i) EXPECT_EQ(after.results[i].status, ScanResult::Status::kTracked) << i;
+  for (size_t i = 1; i < after.results.size(); ++i)
+    EXPECT_EQ(after.results[i].status, ScanResult::Status::kTracked) << i;
   // after the outage the trajectory is right again up to the frame the re-seed started from
   EXPECT_LT(synth::alignedRmse(after.est, after.gt), 0.03);
 }
@@ -483,8 +484,9 @@ TEST(LioEstimator, LoopCorrectionInTheMiddleOfASweepMovesItsSegments) {
     worst = std::max(worst, (T.inverse() * a.world_points[i] - b.world_points[i]).norm());
   const Pose3 back = T.inverse() * a.state.pose();
   const double dp = (back.translation() - b.state.pos).norm();
-  std::printf("[lio-correction] mid-sweep correction of 0.58 m and 1.7 deg: pose %.2g m, points up to %.2g m from the twin's\n",
-              dp, worst);
+  std::printf(
+      "[lio-correction] mid-sweep correction of 0.58 m and 1.7 deg: pose %.2g m, points up to %.2g m from the twin's\n",
+      dp, worst);
   EXPECT_LT(dp, 2e-3);
   EXPECT_LT(worst, 0.01);
 }
@@ -521,8 +523,8 @@ namespace {
 // `T_I_L_rig` and no time shift, and estimates the extrinsic rotation and the time shift with a
 // prior of 1 deg and 10 ms (the translation held at the rig's, which is the truth here).
 struct CalibrationRun {
-  Vec3 rot_error = Vec3::Zero();  // Log(R_true^T R_est), rad
-  double dt_error = 0.0;          // s
+  Vec3 rot_error = Vec3::Zero();                         // Log(R_true^T R_est), rad
+  double dt_error = 0.0;                                 // s
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();  // of [rotation; time shift]
   double ate = 0.0;
   int tracked = 0, outputs = 0;
@@ -571,11 +573,12 @@ CalibrationRun calibrationRun(const Pose3& T_I_L_true, double dt_true, const Pos
   EXPECT_EQ(x.lidar.pos, T_I_L_rig.translation());
   constexpr int pos = FilterState::kLidar + FilterState::kCalPos;
   EXPECT_EQ((P.block<3, 3>(pos, pos).cwiseAbs().maxCoeff()), 0.0);
-  std::printf("LiDAR calibration: rotation error %.4f %.4f %.4f deg (sigma %.4f %.4f %.4f), time shift error %.3f ms "
-              "(sigma %.3f), Mahalanobis^2 %.2f, ATE %.4f m\n",
-              r.rot_error.x() * 180 / M_PI, r.rot_error.y() * 180 / M_PI, r.rot_error.z() * 180 / M_PI,
-              r.rotSigma().x() * 180 / M_PI, r.rotSigma().y() * 180 / M_PI, r.rotSigma().z() * 180 / M_PI,
-              r.dt_error * 1e3, r.dtSigma() * 1e3, r.mahalanobis2(), r.ate);
+  std::printf(
+      "LiDAR calibration: rotation error %.4f %.4f %.4f deg (sigma %.4f %.4f %.4f), time shift error %.3f ms "
+      "(sigma %.3f), Mahalanobis^2 %.2f, ATE %.4f m\n",
+      r.rot_error.x() * 180 / M_PI, r.rot_error.y() * 180 / M_PI, r.rot_error.z() * 180 / M_PI,
+      r.rotSigma().x() * 180 / M_PI, r.rotSigma().y() * 180 / M_PI, r.rotSigma().z() * 180 / M_PI, r.dt_error * 1e3,
+      r.dtSigma() * 1e3, r.mahalanobis2(), r.ate);
   return r;
 }
 
@@ -597,8 +600,8 @@ TEST(LioEstimator, RecoversAPlantedLidarTimeShiftAndExtrinsicRotation) {
   const Vec3 planted_rot = 0.5 * M_PI / 180.0 * Vec3(0.8, -0.6, 0.0);
   const double planted_dt = 0.004;
   // the rig says R_true Exp(-planted): the truth is the rig's ⊞ planted
-  const Pose3 rig =
-      se3::fromRotationTranslation(Mat3(kCalibrationRig.linear() * so3::Exp(-planted_rot)), kCalibrationRig.translation());
+  const Pose3 rig = se3::fromRotationTranslation(Mat3(kCalibrationRig.linear() * so3::Exp(-planted_rot)),
+                                                 kCalibrationRig.translation());
   const CalibrationRun r = calibrationRun(kCalibrationRig, planted_dt, rig);
   EXPECT_GE(r.tracked, r.outputs - 1);
   EXPECT_LT(r.ate, 0.02);

@@ -13,8 +13,8 @@
 #include "bus_messages.hpp"
 #include "livo/filter_state_message.hpp"
 #include "livo/image_t.hpp"
-#include "livo/loop_correction_t.hpp"
 #include "livo/lio/lio_node.hpp"
+#include "livo/loop_correction_t.hpp"
 #include "livo/message_registry.hpp"
 #include "livo/messages.hpp"
 #include "livo/progress_t.hpp"
@@ -46,8 +46,8 @@ struct Outputs {
   std::vector<keyframe_t> keyframes;
 };
 
-using livo_test::Message;
 using livo_test::encode;
+using livo_test::Message;
 
 struct RunSetup {
   std::string config = kConfig;
@@ -119,7 +119,8 @@ std::vector<Message> syntheticRun() {
   const synth::SyntheticSequence seq = syntheticSequence();
   std::vector<Message> msgs;
   for (const auto& s : seq.imu()) msgs.push_back(encode(s.utime, "IMU", synth::imuMessage(s)));
-  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
+  for (int k = 0; k < seq.numScans(); ++k)
+    msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
   livo_test::sortByArrival(&msgs);
   return msgs;
 }
@@ -137,8 +138,9 @@ TEST(LioNode, ReadsTheRigSchemaAndStrictLioSection) {
   EXPECT_THROW(readLioNodeOptions(Config::fromString(bad)), ConfigError);
   // a wheel section under rig enables the wheel update
   std::string wheel = std::string(kConfig);
-  wheel.insert(wheel.find("  camera:"), "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.02, "
-                                        "T_I_B: {translation: [0, 0, -0.3], rpy_deg: [0, 0, 0]}}\n");
+  wheel.insert(wheel.find("  camera:"),
+               "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.02, "
+               "T_I_B: {translation: [0, 0, -0.3], rpy_deg: [0, 0, 0]}}\n");
   const LioNodeOptions w = readLioNodeOptions(Config::fromString(wheel));
   EXPECT_TRUE(w.lio.wheel.enabled);
   EXPECT_NEAR(w.lio.wheel.T_I_B.translation().z(), -0.3, 1e-12);
@@ -452,7 +454,9 @@ TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
     EXPECT_EQ(out.odometry[i].utime, lidar_only.odometry[i].utime);
     const Pose3 truth = T_lio_truth * seq.truth(out.odometry[i].utime);
     if (out.odometry[i].utime > priors.front().utime) {
-      EXPECT_LT((poseOf(out.odometry[i].position, out.odometry[i].orientation).translation() - truth.translation()).norm(), 0.01)
+      EXPECT_LT(
+          (poseOf(out.odometry[i].position, out.odometry[i].orientation).translation() - truth.translation()).norm(),
+          0.01)
           << "sweep " << i;
     }
   }
@@ -664,9 +668,9 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
     }
     /// Drops the promises that do not cover this message; true if one still does.
     bool keepCovering(const std::string& channel, int64_t utime) {
-      active.erase(std::remove_if(active.begin(), active.end(),
-                                  [&](const progress_t& p) { return !covers(p, channel, utime); }),
-                   active.end());
+      active.erase(
+          std::remove_if(active.begin(), active.end(), [&](const progress_t& p) { return !covers(p, channel, utime); }),
+          active.end());
       return !active.empty();
     }
   };
@@ -685,8 +689,9 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
     RunSetup setup;
     if (handoff) setup.config = handoffConfig();
     if (wheels) {
-      setup.config.insert(setup.config.find("  camera:"), "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.05, "
-                                                          "T_I_B: {translation: [0, 0, 0], rpy_deg: [0, 0, 0]}}\n");
+      setup.config.insert(setup.config.find("  camera:"),
+                          "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.05, "
+                          "T_I_B: {translation: [0, 0, 0], rpy_deg: [0, 0, 0]}}\n");
     }
     LioNode::HandoffCounts counts;
     setup.handoff = &counts;
@@ -801,20 +806,21 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
     if (variant >= 6) {  // sweeps that arrive before the IMU passes the previous one's end
       EXPECT_GT(covered["LIDAR"], seen["LIDAR"] * 9 / 10) << covered["LIDAR"] << " of " << seen["LIDAR"];
     }
-    std::printf("%s: %lld of %lld IMU samples, %lld of %lld images, %lld of %lld sweeps, %lld of %lld wheel readings "
-                "inside the quiet promises\n",
-                variant == 0   ? "LiDAR-only"
-                : variant == 1 ? "camera hand-off"
-                : variant == 2 ? "swapped and duplicated IMU"
-                : variant == 3 ? "wheels"
-                : variant == 4 ? "hand-off, jittery camera"
-                : variant == 5 ? "hand-off, images 30 ms late"
-                : variant == 6 ? "hand-off, sweeps at their start"
-                               : "hand-off, wheels, sweeps at their start",
-                static_cast<long long>(covered["IMU"]), static_cast<long long>(seen["IMU"]),
-                static_cast<long long>(covered["CAMERA"]), static_cast<long long>(seen["CAMERA"]),
-                static_cast<long long>(covered["LIDAR"]), static_cast<long long>(seen["LIDAR"]),
-                static_cast<long long>(covered["WHEEL"]), static_cast<long long>(seen["WHEEL"]));
+    std::printf(
+        "%s: %lld of %lld IMU samples, %lld of %lld images, %lld of %lld sweeps, %lld of %lld wheel readings "
+        "inside the quiet promises\n",
+        variant == 0   ? "LiDAR-only"
+        : variant == 1 ? "camera hand-off"
+        : variant == 2 ? "swapped and duplicated IMU"
+        : variant == 3 ? "wheels"
+        : variant == 4 ? "hand-off, jittery camera"
+        : variant == 5 ? "hand-off, images 30 ms late"
+        : variant == 6 ? "hand-off, sweeps at their start"
+                       : "hand-off, wheels, sweeps at their start",
+        static_cast<long long>(covered["IMU"]), static_cast<long long>(seen["IMU"]),
+        static_cast<long long>(covered["CAMERA"]), static_cast<long long>(seen["CAMERA"]),
+        static_cast<long long>(covered["LIDAR"]), static_cast<long long>(seen["LIDAR"]),
+        static_cast<long long>(covered["WHEEL"]), static_cast<long long>(seen["WHEEL"]));
   }
 }
 
@@ -897,38 +903,39 @@ TEST(LioNode, AnAnswerArrivingAmongTheQuietSamplesChangesNothing) {
   // and at their start (as livo-sim writes them); and with lio giving up on an answer 30 ms past
   // the image, before the next event (the promises then end there)
   for (const int variant : {0, 1, 2}) {
-  const bool at_start = variant >= 1;
-  config = handoffConfig() + (variant == 2 ? "  posterior_max_wait_s: 0.03\n" : "");
-  in = withImages(syntheticRun(), &first_image, &last_image);
-  if (at_start) {
-    for (Message& m : in)
-      if (m.channel == "LIDAR") m.order_key -= 100'000;
-    livo_test::sortByArrival(&in);
-  }
-  const Run at_once = run([](int64_t) { return 0; });
-  const Run latest = run([](int64_t) { return 1000; });  // until playback would have to wait for vio
-  const Run mixed = run([](int64_t id) { return static_cast<int>(id % 4); });
-  ASSERT_GE(at_once.counts.adopted, 40);
-  // the samples between the image time (and its 20 ms reorder window) and the next event go while
-  // vio works: at least 2 an image (sweeps at their end: none for the first of each pair)
-  EXPECT_GT(latest.sent_while_held, (variant == 1 ? 4 : 1) * at_once.counts.adopted) << latest.sent_while_held;
-  EXPECT_GT(mixed.sent_while_held, at_once.counts.adopted / 2) << mixed.sent_while_held;
-  for (const Run* r : {&latest, &mixed}) {
-    EXPECT_EQ(r->counts.adopted, at_once.counts.adopted);
-    EXPECT_EQ(r->counts.missing, 0);
-    EXPECT_EQ(r->out.odometry_bytes, at_once.out.odometry_bytes);
-    ASSERT_EQ(r->out.scans.size(), at_once.out.scans.size());
-    for (size_t i = 0; i < r->out.scans.size(); ++i) {
-      EXPECT_EQ(r->out.scans[i].cloud.x, at_once.out.scans[i].cloud.x) << "scan " << i;
-      EXPECT_EQ(r->out.scans[i].cloud.y, at_once.out.scans[i].cloud.y) << "scan " << i;
-      EXPECT_EQ(r->out.scans[i].cloud.z, at_once.out.scans[i].cloud.z) << "scan " << i;
+    const bool at_start = variant >= 1;
+    config = handoffConfig() + (variant == 2 ? "  posterior_max_wait_s: 0.03\n" : "");
+    in = withImages(syntheticRun(), &first_image, &last_image);
+    if (at_start) {
+      for (Message& m : in)
+        if (m.channel == "LIDAR") m.order_key -= 100'000;
+      livo_test::sortByArrival(&in);
     }
-    EXPECT_EQ(r->out.keyframes.size(), at_once.out.keyframes.size());
-  }
-  std::printf("sweeps arriving at their %s%s: messages lio took while an answer was in flight: %lld (held to the "
-              "last), %lld (mixed), %lld images\n", at_start ? "start" : "end",
-              variant == 2 ? ", posterior_max_wait_s 0.03" : "",
-              static_cast<long long>(latest.sent_while_held), static_cast<long long>(mixed.sent_while_held),
-              static_cast<long long>(at_once.counts.adopted));
+    const Run at_once = run([](int64_t) { return 0; });
+    const Run latest = run([](int64_t) { return 1000; });  // until playback would have to wait for vio
+    const Run mixed = run([](int64_t id) { return static_cast<int>(id % 4); });
+    ASSERT_GE(at_once.counts.adopted, 40);
+    // the samples between the image time (and its 20 ms reorder window) and the next event go while
+    // vio works: at least 2 an image (sweeps at their end: none for the first of each pair)
+    EXPECT_GT(latest.sent_while_held, (variant == 1 ? 4 : 1) * at_once.counts.adopted) << latest.sent_while_held;
+    EXPECT_GT(mixed.sent_while_held, at_once.counts.adopted / 2) << mixed.sent_while_held;
+    for (const Run* r : {&latest, &mixed}) {
+      EXPECT_EQ(r->counts.adopted, at_once.counts.adopted);
+      EXPECT_EQ(r->counts.missing, 0);
+      EXPECT_EQ(r->out.odometry_bytes, at_once.out.odometry_bytes);
+      ASSERT_EQ(r->out.scans.size(), at_once.out.scans.size());
+      for (size_t i = 0; i < r->out.scans.size(); ++i) {
+        EXPECT_EQ(r->out.scans[i].cloud.x, at_once.out.scans[i].cloud.x) << "scan " << i;
+        EXPECT_EQ(r->out.scans[i].cloud.y, at_once.out.scans[i].cloud.y) << "scan " << i;
+        EXPECT_EQ(r->out.scans[i].cloud.z, at_once.out.scans[i].cloud.z) << "scan " << i;
+      }
+      EXPECT_EQ(r->out.keyframes.size(), at_once.out.keyframes.size());
+    }
+    std::printf(
+        "sweeps arriving at their %s%s: messages lio took while an answer was in flight: %lld (held to the "
+        "last), %lld (mixed), %lld images\n",
+        at_start ? "start" : "end", variant == 2 ? ", posterior_max_wait_s 0.03" : "",
+        static_cast<long long>(latest.sent_while_held), static_cast<long long>(mixed.sent_while_held),
+        static_cast<long long>(at_once.counts.adopted));
   }
 }

@@ -218,6 +218,6 @@ TEST(PointToPlane, MatchingOptionsScaleWithTheRangeNoise) {
     return static_cast<double>(accepted) / kTrials;
   };
   const double a_tuned = acceptance(tuned), a_scaled = acceptance(at3cm);
-  EXPECT_LT(a_tuned, 0.70);  // measured 0.615: 4 of 10 true planes lost
+  EXPECT_LT(a_tuned, 0.70);   // measured 0.615: 4 of 10 true planes lost
   EXPECT_GT(a_scaled, 0.85);  // measured 0.898
 }

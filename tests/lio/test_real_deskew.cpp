@@ -43,8 +43,8 @@ std::vector<Vec3> toPoints(const std::vector<float>& xyz) {
 }
 
 struct RealSweep {
-  LidarScan raw;                // LiDAR frame, times from the sweep start
-  std::vector<Vec3> deskewed;   // theirs, point i of raw is point i here
+  LidarScan raw;               // LiDAR frame, times from the sweep start
+  std::vector<Vec3> deskewed;  // theirs, point i of raw is point i here
 };
 
 /// Sweep k (raw_0k, deskewed_0k, times_0k: float32 x y z per point, float32 seconds per point).
@@ -237,16 +237,17 @@ SweepFit fitSweep(int k, int steps, bool also_to_end) {
     f.max_rate = std::max(f.max_rate, w.norm());
     mean_rate += w / static_cast<double>(m.imu.size() - 1);
   }
-  std::printf("[newer-deskew] sweep %d, %d step(s): raw vs theirs median %.1f mm p95 %.1f mm | ours to the start "
-              "median %.2f mm p95 %.2f mm\n",
-              k, steps, f.raw.median * 1e3, f.raw.p95 * 1e3, f.start.median * 1e3, f.start.p95 * 1e3);
+  std::printf(
+      "[newer-deskew] sweep %d, %d step(s): raw vs theirs median %.1f mm p95 %.1f mm | ours to the start "
+      "median %.2f mm p95 %.2f mm\n",
+      k, steps, f.raw.median * 1e3, f.raw.p95 * 1e3, f.start.median * 1e3, f.start.p95 * 1e3);
   if (also_to_end)
     std::printf("[newer-deskew]   to the end median %.1f mm p95 %.1f mm\n", f.end.median * 1e3, f.end.p95 * 1e3);
-  std::printf("[newer-deskew]   mean rate %+.3f %+.3f %+.3f rad/s (step max %.3f), v %+.3f %+.3f %+.3f m/s, "
-              "acc %+.2f %+.2f %+.2f m/s^2\n",
-              mean_rate.x(), mean_rate.y(), mean_rate.z(), f.max_rate,
-              m.velocity.x(), m.velocity.y(), m.velocity.z(), m.imu[0].accel.x(), m.imu[0].accel.y(),
-              m.imu[0].accel.z());
+  std::printf(
+      "[newer-deskew]   mean rate %+.3f %+.3f %+.3f rad/s (step max %.3f), v %+.3f %+.3f %+.3f m/s, "
+      "acc %+.2f %+.2f %+.2f m/s^2\n",
+      mean_rate.x(), mean_rate.y(), mean_rate.z(), f.max_rate, m.velocity.x(), m.velocity.y(), m.velocity.z(),
+      m.imu[0].accel.x(), m.imu[0].accel.y(), m.imu[0].accel.z());
   return f;
 }
 

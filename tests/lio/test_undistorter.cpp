@@ -28,7 +28,7 @@ TEST(Undistorter, SweepWithKnownMotion) {
   std::mt19937 rng(1);
   // sweep stamped in the LiDAR clock; the trajectory (IMU clock) time is t_lidar + offset
   LidarScan scan = synth::simulateSweep(scene, traj, synth::LidarModel::vlp16(),
-                                          base + static_cast<int64_t>((t_start + time_offset) * 1e6), base, T_I_L, &rng);
+                                        base + static_cast<int64_t>((t_start + time_offset) * 1e6), base, T_I_L, &rng);
   scan.utime -= static_cast<int64_t>(time_offset * 1e6);
   ASSERT_GT(scan.points.size(), 20000u);
 
@@ -75,7 +75,8 @@ TEST(Undistorter, SweepWithKnownMotion) {
   und.undistort(scan, scan.utime + static_cast<int64_t>(time_offset * 1e6), 0.0, shuffled, &body_shuffled);
   for (size_t k = 0; k < shuffled.size(); k += 7) {
     const size_t j = shuffled[k];
-    const Vec3 single = und.toEnd(scan.points[j], scan.utime + static_cast<int64_t>(time_offset * 1e6), scan.time_offset[j]);
+    const Vec3 single =
+        und.toEnd(scan.points[j], scan.utime + static_cast<int64_t>(time_offset * 1e6), scan.time_offset[j]);
     ASSERT_EQ(body_shuffled[k], single) << k;
     ASSERT_EQ(body[j], single) << j;
   }

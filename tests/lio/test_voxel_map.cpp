@@ -20,10 +20,10 @@ std::vector<Vec3> mapLikePoints(size_t n, unsigned seed) {
   std::vector<Vec3> pts;
   for (size_t i = 0; i < n; ++i) {
     switch (i % 4) {
-      case 0: pts.emplace_back(u(rng), u(rng), small(rng)); break;          // floor
-      case 1: pts.emplace_back(10.0 + small(rng), u(rng), 0.2 * u(rng)); break;  // wall
+      case 0: pts.emplace_back(u(rng), u(rng), small(rng)); break;                // floor
+      case 1: pts.emplace_back(10.0 + small(rng), u(rng), 0.2 * u(rng)); break;   // wall
       case 2: pts.emplace_back(u(rng), u(rng) * 0.1 + 3.0, 0.2 * u(rng)); break;  // slab
-      default: pts.emplace_back(u(rng), u(rng), u(rng)); break;             // clutter
+      default: pts.emplace_back(u(rng), u(rng), u(rng)); break;                   // clutter
     }
   }
   return pts;
@@ -158,7 +158,7 @@ TEST(VoxelMap, DownsamplingRule) {
   EXPECT_TRUE(map.insert(Vec3(0.5, 0.1, 0.1)));
   EXPECT_TRUE(map.insert(Vec3(0.9, 0.9, 0.9)));
   EXPECT_FALSE(map.insert(Vec3(0.1, 0.9, 0.9)));  // voxel full
-  EXPECT_TRUE(map.insert(Vec3(1.05, 0.1, 0.1)));   // next voxel, though close to (0.9, ...)
+  EXPECT_TRUE(map.insert(Vec3(1.05, 0.1, 0.1)));  // next voxel, though close to (0.9, ...)
   EXPECT_FALSE(map.insert(Vec3(std::nan(""), 0, 0)));
   EXPECT_EQ(map.numPoints(), 4u);
   EXPECT_EQ(map.numVoxels(), 2u);
@@ -257,7 +257,9 @@ std::vector<Vec3> sweepFrom(const Vec3& o, bool with_box) {
   return pts;
 }
 
-bool onTheBox(const Vec3& p) { return p.x() > 3.95 && p.x() < 6.05 && std::abs(p.y()) < 1.05 && p.z() < 1.55 && p.z() > 0.05; }
+bool onTheBox(const Vec3& p) {
+  return p.x() > 3.95 && p.x() < 6.05 && std::abs(p.y()) < 1.05 && p.z() < 1.55 && p.z() > 0.05;
+}
 }  // namespace
 
 // The box is mapped, then leaves: in the second that follows, beams through where it stood remove

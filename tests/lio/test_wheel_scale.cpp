@@ -19,7 +19,7 @@ using namespace livo::lio;
 namespace {
 const Pose3 kTIB = se3::fromRotationTranslation(so3::Exp(Vec3(0.0, 0.0, 0.05)), Vec3(-1.2, 0.1, -1.5));
 constexpr double kTrack = 1.6;
-constexpr double kSpeedNoise = 0.02;  // m/s per reading
+constexpr double kSpeedNoise = 0.02;      // m/s per reading
 constexpr double kPositionNoise = 0.003;  // m per axis, per pose
 constexpr double kYawNoise = 1e-4;        // rad per pose
 
@@ -35,8 +35,8 @@ double spinRate(double) { return 0.5; }
 
 struct SyntheticRun {
   std::vector<int64_t> sweep_utime;
-  std::vector<Pose3> poses;         // noisy W_T_I at each sweep end
-  std::deque<WheelSample> wheels;   // 50 Hz readings with scale and noise
+  std::vector<Pose3> poses;        // noisy W_T_I at each sweep end
+  std::deque<WheelSample> wheels;  // 50 Hz readings with scale and noise
 };
 
 SyntheticRun simulate(const Motion& m, double duration_s, Vec2 scale, uint32_t seed) {
@@ -54,8 +54,9 @@ SyntheticRun simulate(const Motion& m, double duration_s, Vec2 scale, uint32_t s
                             scale.y() * (v + 0.5 * kTrack * w) + kSpeedNoise * n01(rng)});
     }
     if (u % 100'000 == 0) {  // registered sweep
-      const Pose3 T_W_B = se3::fromRotationTranslation(so3::Exp(Vec3(0, 0, yaw + kYawNoise * n01(rng))),
-                                                       Vec3(x, y, 0.0) + kPositionNoise * Vec3(n01(rng), n01(rng), n01(rng)));
+      const Pose3 T_W_B =
+          se3::fromRotationTranslation(so3::Exp(Vec3(0, 0, yaw + kYawNoise * n01(rng))),
+                                       Vec3(x, y, 0.0) + kPositionNoise * Vec3(n01(rng), n01(rng), n01(rng)));
       run.sweep_utime.push_back(u);
       run.poses.push_back(T_W_B * T_B_I);
     }
@@ -93,7 +94,8 @@ TEST(WheelScale, TravelFollowsTheArc) {
   // its own radius times the angle
   const double r = 10.0, angle = 0.2;
   const Pose3 T_W_Ba = Pose3::Identity();
-  const Pose3 T_W_Bb = se3::fromRotationTranslation(so3::Exp(Vec3(0, 0, angle)), Vec3(r * std::sin(angle), r * (1 - std::cos(angle)), 0));
+  const Pose3 T_W_Bb = se3::fromRotationTranslation(so3::Exp(Vec3(0, 0, angle)),
+                                                    Vec3(r * std::sin(angle), r * (1 - std::cos(angle)), 0));
   const Pose3 T_B_I = kTIB.inverse();
   double forward = 0.0;
   const Vec2 d = predictedWheelTravel(T_W_Ba * T_B_I, T_W_Bb * T_B_I, kTIB, kTrack, &forward);
@@ -130,7 +132,8 @@ TEST(WheelScale, ConvergesToTheTrueScalesWithinItsThreeSigma) {
     EXPECT_LE(est.counts().outliers, 2) << "seed " << seed;
     for (int side = 0; side < 2; ++side) {
       EXPECT_LT(est.stds()[side], 0.001) << "seed " << seed;  // learned, not just the prior
-      EXPECT_LT(std::abs(est.scales()[side] - truth[side]), 3.0 * est.stds()[side]) << "seed " << seed << " side " << side;
+      EXPECT_LT(std::abs(est.scales()[side] - truth[side]), 3.0 * est.stds()[side])
+          << "seed " << seed << " side " << side;
     }
   }
 }

@@ -27,7 +27,8 @@ TEST(WheelUpdate, JacobianMatchesNumericDifferentiation) {
   for (int i = 0; i < FilterState::kDim; ++i) {
     StateVector d = StateVector::Zero();
     d[i] = h;
-    const Vec3 num = (wheelFrameVelocity(x.boxplus(d), gyro, kTIB) - wheelFrameVelocity(x.boxplus(-d), gyro, kTIB)) / (2 * h);
+    const Vec3 num =
+        (wheelFrameVelocity(x.boxplus(d), gyro, kTIB) - wheelFrameVelocity(x.boxplus(-d), gyro, kTIB)) / (2 * h);
     EXPECT_LT((H.col(i) - num).norm(), 1e-8) << "state " << i;
   }
 }

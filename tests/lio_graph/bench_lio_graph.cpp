@@ -40,7 +40,8 @@ void BM_LioGraphScan(benchmark::State& state) {
   LioGraphEstimator est(opts);
   size_t imu_index = 0;
   auto feedImu = [&](int64_t t_end) {
-    while (imu_index < seq.imu().size() && seq.imu()[imu_index].utime <= t_end + 10000) est.addImu(seq.imu()[imu_index++]);
+    while (imu_index < seq.imu().size() && seq.imu()[imu_index].utime <= t_end + 10000)
+      est.addImu(seq.imu()[imu_index++]);
   };
   int k = 0;
   // untimed: initialisation and a full window
@@ -74,7 +75,12 @@ void BM_LioGraphScan(benchmark::State& state) {
   }
 }
 // {planar factors on, timed sweeps}
-BENCHMARK(BM_LioGraphScan)->Args({1, 60})->Args({0, 60})->Iterations(60)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LioGraphScan)
+    ->Args({1, 60})
+    ->Args({0, 60})
+    ->Iterations(60)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

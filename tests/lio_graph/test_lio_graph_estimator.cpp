@@ -1,9 +1,9 @@
 // The whole estimator on ray-cast sequences with exact ground truth (tests/lio's synthetic world):
 // the room walk with realistic IMU noise and biases, tracked to centimetres; outputs finite and
-// deterministic; the window bounded; tyres off their nominal radius learned from the wheels; a loop correction half way through (the estimate then
-// follows the corrected truth; with a correction that keeps the map's voxel grids, exactly the
-// uncorrected run moved rigidly); a reset starting a new odometry epoch; the graded drive's world
-// exact (the planar factors against a planted vertical drift on it: processes/lio_graph/README.md).
+// deterministic; the window bounded; tyres off their nominal radius learned from the wheels; a loop correction half way
+// through (the estimate then follows the corrected truth; with a correction that keeps the map's voxel grids, exactly
+// the uncorrected run moved rigidly); a reset starting a new odometry epoch; the graded drive's world exact (the planar
+// factors against a planted vertical drift on it: processes/lio_graph/README.md).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -81,7 +81,8 @@ struct VisualFeed {
 };
 
 RunLog run(const synth::SequenceSpec& spec, bool planar = true, LioGraphOptions* options = nullptr,
-           VisualFeed* visual = nullptr, std::vector<GraphScanResult>* results = nullptr, double* visual_scale = nullptr) {
+           VisualFeed* visual = nullptr, std::vector<GraphScanResult>* results = nullptr,
+           double* visual_scale = nullptr) {
   const synth::SyntheticSequence seq(spec);
   LioGraphEstimator est(options ? *options : optionsFor(spec, planar));
   RunLog r;
@@ -131,9 +132,9 @@ TEST(LioGraphEstimator, TracksTheRoomWalkWithARealisticImu) {
   const double ate_flat = synth::alignedRmse(flat.est, flat.gt);
   const RunLog ground = run(spec);
   const double ate_ground = synth::alignedRmse(ground.est, ground.gt);
-  std::cout << "room walk ATE: every plane " << ate << " m, the ground only " << ate_ground << " m ("
-            << ground.planes << " observations), without " << ate_flat << " m; " << r.planes
-            << " plane observations in " << r.outputs << " sweeps, at most " << r.max_landmarks << " landmarks\n";
+  std::cout << "room walk ATE: every plane " << ate << " m, the ground only " << ate_ground << " m (" << ground.planes
+            << " observations), without " << ate_flat << " m; " << r.planes << " plane observations in " << r.outputs
+            << " sweeps, at most " << r.max_landmarks << " landmarks\n";
   EXPECT_LT(ate_flat, 0.05);
   EXPECT_LT(ate_ground, 0.05);
 }
@@ -198,7 +199,6 @@ TEST(LioGraphEstimator, EndsASweepWhereLivoLioDoes) {
   scan.sweep_duration = 0.1;
   EXPECT_EQ(estimator.scanEndUtime(scan), 1'102'000);
 }
-
 
 TEST(LioGraphEstimator, LearnsTheTyreScalesFromTheWheels) {
   // The room walk with a wheel encoder on the body (B = I): the body-frame forward speed and the
@@ -400,8 +400,8 @@ TEST(LioGraphEstimator, LoopCorrectionYawAndTranslation) {
 
 TEST(LioGraphEstimator, LoopCorrectionWithRoll) {
   // a pose graph may tilt the frame a little: the world gravity tilts with it
-  checkCorrectedWalk(se3::fromRotationTranslation(
-      so3::Exp(Vec3(1.0 * M_PI / 180.0, 0.0, -3.0 * M_PI / 180.0)), Vec3(-0.4, 0.3, 0.05)));
+  checkCorrectedWalk(se3::fromRotationTranslation(so3::Exp(Vec3(1.0 * M_PI / 180.0, 0.0, -3.0 * M_PI / 180.0)),
+                                                  Vec3(-0.4, 0.3, 0.05)));
 }
 
 TEST(LioGraphEstimator, ResetStartsANewEpoch) {
@@ -446,7 +446,8 @@ TEST(LioGraphEstimator, LoopCorrectionIsExactlyRigid) {
         posesBackFromCorrection(se3::fromRotationTranslation(so3::Exp(turn), Vec3(0.8, -1.2, 0.4)));
     ASSERT_EQ(turned.size(), identity.size());
     double worst = 0.0;
-    for (size_t i = 0; i < identity.size(); ++i) worst = std::max(worst, (turned[i].matrix() - identity[i].matrix()).norm());
+    for (size_t i = 0; i < identity.size(); ++i)
+      worst = std::max(worst, (turned[i].matrix() - identity[i].matrix()).norm());
     EXPECT_LT(worst, 1e-9) << "turn " << turn.transpose();
   }
 }
@@ -533,8 +534,8 @@ TEST(GradedDrive, GroundRaycastAndImuAreExact) {
   for (double t = 1.05; t < duration + 0.2; t += 0.173) {
     const double h = 1e-4, h2 = 1e-3;
     const Vec3 v = (tr.pose(t + h).translation() - tr.pose(t - h).translation()) / (2.0 * h);
-    const Vec3 a = (tr.pose(t + h2).translation() - 2.0 * tr.pose(t).translation() + tr.pose(t - h2).translation()) /
-                   (h2 * h2);
+    const Vec3 a =
+        (tr.pose(t + h2).translation() - 2.0 * tr.pose(t).translation() + tr.pose(t - h2).translation()) / (h2 * h2);
     const Vec3 w = so3::Log(Mat3(tr.pose(t - h).linear().transpose() * tr.pose(t + h).linear())) / (2.0 * h);
     EXPECT_LT((v - tr.velocity(t)).norm(), 1e-6) << t;
     EXPECT_LT((a - tr.acceleration(t)).norm(), 1e-4) << t;

@@ -33,8 +33,8 @@ rig:
 
 constexpr int64_t kBase = 1'000'000'000;  // the synthetic sequence's first stamp
 
-using livo_test::Message;
 using livo_test::encode;
+using livo_test::Message;
 
 struct Outputs {
   std::vector<odometry_t> odometry;
@@ -83,11 +83,13 @@ std::vector<Message> syntheticRun(double duration, double gap_from = -1.0, doubl
     if (t > gap_from && t < gap_to) continue;
     msgs.push_back(encode(s.utime, "IMU", synth::imuMessage(s)));
   }
-  for (int k = 0; k < seq.numScans(); ++k) msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
+  for (int k = 0; k < seq.numScans(); ++k)
+    msgs.push_back(encode(seq.scanEndUtime(k), "LIDAR", synth::cloudMessage(seq.scan(k))));
   return msgs;
 }
 
-loop_correction_t correction(int64_t id, int64_t previous_id, int32_t epoch, const Pose3& T_Ck_Cj, const Pose3& T_Ck_O) {
+loop_correction_t correction(int64_t id, int64_t previous_id, int32_t epoch, const Pose3& T_Ck_Cj,
+                             const Pose3& T_Ck_O) {
   loop_correction_t lc{};
   lc.utime = kBase;
   lc.correction_id = id;
@@ -152,8 +154,8 @@ TEST(LioGraphNode, AdoptsLoopCorrectionsOfItsEpochInOrder) {
   const Pose3 T3 = se3::fromRotationTranslation(so3::Exp(Vec3(0.005, 0.0, -0.04)), Vec3(-0.2, 0.4, 0.02));
   const int64_t first = kBase + 1'400'000, third = kBase + 2'200'000;
   std::vector<Message> msgs = plain;
-  msgs.push_back(encode(first, "LOOP_CORRECTION", correction(1, 0, 1, T1, T1)));      // another epoch
-  msgs.push_back(encode(first + 1, "LOOP_CORRECTION", correction(1, 0, 0, T1, T1)));  // adopted
+  msgs.push_back(encode(first, "LOOP_CORRECTION", correction(1, 0, 1, T1, T1)));            // another epoch
+  msgs.push_back(encode(first + 1, "LOOP_CORRECTION", correction(1, 0, 0, T1, T1)));        // adopted
   msgs.push_back(encode(first + 300'000, "LOOP_CORRECTION", correction(1, 0, 0, T1, T1)));  // repeated
   msgs.push_back(encode(first + 300'001, "LOOP_CORRECTION", correction(2, 2, 0, T1, T1)));  // malformed
   // the transform from correction 2 (never received) is useless here: T_C3_O * T_C1_O^-1 is taken
@@ -232,7 +234,8 @@ TEST(LioGraphConfig, ReadsThePlaneTestAndRefusesOutOfRangeValuesNamingTheKey) {
   EXPECT_DOUBLE_EQ(defaults.core.matching.min_planarity, 0.02);
   EXPECT_DOUBLE_EQ(defaults.core.features.surface_voxel, 0.2);
   const LioGraphNodeOptions lio_sam = readLioGraphNodeOptions(Config::fromString(
-      rig + "lio_graph: {max_neighbour_distance: 1.0, max_plane_distance: 0.2, min_planarity: 0, surface_voxel: 0.4}\n"));
+      rig +
+      "lio_graph: {max_neighbour_distance: 1.0, max_plane_distance: 0.2, min_planarity: 0, surface_voxel: 0.4}\n"));
   EXPECT_DOUBLE_EQ(lio_sam.core.matching.max_neighbour_distance, 1.0);
   EXPECT_DOUBLE_EQ(lio_sam.core.matching.max_plane_distance, 0.2);
   EXPECT_DOUBLE_EQ(lio_sam.core.matching.min_planarity, 0.0);

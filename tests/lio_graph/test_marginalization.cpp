@@ -136,12 +136,14 @@ TEST(Marginalization, QuaternionChainMatchesTheFullProblemAtTheOptimum) {
   Eigen::Quaterniond q[3] = {rq(), rq(), rq()};
   Vec3 p[3] = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
   Mat6 info0 = Mat6::Identity() * 400.0, info2 = Mat6::Identity() * 4.0;
-  ceres::CostFunction* prior0 = makePoseFactor(se3::fromRotationTranslation(so3::Exp(Vec3(0.1, 0.2, -0.3)), Vec3::Zero()), info0);
-  ceres::CostFunction* prior2 = makePoseFactor(se3::fromRotationTranslation(so3::Exp(Vec3(0.5, -0.1, 0.4)), Vec3::Zero()), info2);
-  ceres::CostFunction* r01 = new ceres::AutoDiffCostFunction<RelativeRotation, 3, 4, 4>(
-      new RelativeRotation{rq().inverse(), 10.0});
-  ceres::CostFunction* r12 = new ceres::AutoDiffCostFunction<RelativeRotation, 3, 4, 4>(
-      new RelativeRotation{rq().inverse(), 10.0});
+  ceres::CostFunction* prior0 =
+      makePoseFactor(se3::fromRotationTranslation(so3::Exp(Vec3(0.1, 0.2, -0.3)), Vec3::Zero()), info0);
+  ceres::CostFunction* prior2 =
+      makePoseFactor(se3::fromRotationTranslation(so3::Exp(Vec3(0.5, -0.1, 0.4)), Vec3::Zero()), info2);
+  ceres::CostFunction* r01 =
+      new ceres::AutoDiffCostFunction<RelativeRotation, 3, 4, 4>(new RelativeRotation{rq().inverse(), 10.0});
+  ceres::CostFunction* r12 =
+      new ceres::AutoDiffCostFunction<RelativeRotation, 3, 4, 4>(new RelativeRotation{rq().inverse(), 10.0});
   ceres::Problem::Options keep;
   keep.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   keep.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -297,10 +299,14 @@ struct SmallWindow {
   std::vector<WorldMotion> motions(const MarginalPrior& prior) {
     std::vector<WorldMotion> m;
     for (const double* blk : prior.blocks) {
-      if (blk == b.q.coeffs().data()) m.push_back(WorldMotion::kRotation);
-      else if (blk == b.p.data()) m.push_back(WorldMotion::kPoint);
-      else if (blk == b.v.data() || blk == c.data()) m.push_back(WorldMotion::kDirection);
-      else m.push_back(WorldMotion::kNone);
+      if (blk == b.q.coeffs().data())
+        m.push_back(WorldMotion::kRotation);
+      else if (blk == b.p.data())
+        m.push_back(WorldMotion::kPoint);
+      else if (blk == b.v.data() || blk == c.data())
+        m.push_back(WorldMotion::kDirection);
+      else
+        m.push_back(WorldMotion::kNone);
     }
     return m;
   }

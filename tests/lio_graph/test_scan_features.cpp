@@ -64,8 +64,8 @@ TEST(ScanFeatures, EdgesLieOnTheScenesVerticalEdges) {
   int on_surface = 0;
   for (const Vec3& s : f.surfaces) {
     const bool floor = std::abs(s.z() + 1.5) < 0.05;
-    const bool face = (std::abs(s.x() - lo.x()) < 0.05 || std::abs(s.y() - lo.y()) < 0.05 ||
-                       std::abs(s.y() - hi.y()) < 0.05);
+    const bool face =
+        (std::abs(s.x() - lo.x()) < 0.05 || std::abs(s.y() - lo.y()) < 0.05 || std::abs(s.y() - hi.y()) < 0.05);
     on_surface += floor || face;
   }
   EXPECT_GT(on_surface, 0.95 * f.surfaces.size());
@@ -73,8 +73,8 @@ TEST(ScanFeatures, EdgesLieOnTheScenesVerticalEdges) {
 
 TEST(ScanFeatures, WithoutRingsEveryPointIsASurfaceCandidate) {
   std::mt19937 rng(1);
-  const LidarScan s = synth::simulateSweep(synth::roomScene(), still(Vec3(0, 0, 1.5), 0.0),
-                                           synth::LidarModel::vlp16(), 0, 0, Pose3::Identity(), &rng);
+  const LidarScan s = synth::simulateSweep(synth::roomScene(), still(Vec3(0, 0, 1.5), 0.0), synth::LidarModel::vlp16(),
+                                           0, 0, Pose3::Identity(), &rng);
   RingCloud c = ringCloudOf(s);
   c.ring.clear();
   FeatureOptions o;
@@ -92,11 +92,13 @@ TEST(ScanMatching, RecoversAKnownDisplacementInARoom) {
   addToMap(featuresAt(scene, A.translation(), 0.0), A, &edges, &surfaces);
   LocalMap map;
   map.rebuild(edges, surfaces);
-  for (const auto& [p, yaw] : std::vector<std::pair<Vec3, double>>{{Vec3(-2.2, 0.4, 1.5), 0.15}, {Vec3(-3.5, -0.6, 1.5), -0.3}}) {
+  for (const auto& [p, yaw] :
+       std::vector<std::pair<Vec3, double>>{{Vec3(-2.2, 0.4, 1.5), 0.15}, {Vec3(-3.5, -0.6, 1.5), -0.3}}) {
     const Pose3 truth = poseOf(p, yaw);
     const ScanFeatures f = featuresAt(scene, p, yaw, 0.01);
     // the prediction off by 0.3 m and 3 degrees
-    const Pose3 initial = truth * se3::fromRotationTranslation(so3::Exp(Vec3(0.01, -0.02, 0.05)), Vec3(0.2, -0.15, 0.1));
+    const Pose3 initial =
+        truth * se3::fromRotationTranslation(so3::Exp(Vec3(0.01, -0.02, 0.05)), Vec3(0.2, -0.15, 0.1));
     // LIO-SAM's plane test (1 m, 0.2 m, no collinearity test): every ring arc of the one-sweep map
     // stands for a plane, the floor's too; the error 0.05 deg and 8 mm
     ScanMatchingOptions lio_sam;

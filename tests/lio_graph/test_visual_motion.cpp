@@ -29,8 +29,7 @@ Pose3 bodyAt(double t, const Pose3& G) {
 TEST(VisualMotion, RelativeMotionIsInterpolatedAndFrameFree) {
   const Pose3 G = se3::fromRotationTranslation(so3::Exp(Vec3(0.1, -0.2, 1.0)), Vec3(5.0, -3.0, 2.0));
   VisualMotion vm;
-  for (int k = 0; k <= 40; ++k)
-    ASSERT_TRUE(vm.add(VisualSample{1'000'000 + k * 50'000, bodyAt(0.05 * k, G), 0}));
+  for (int k = 0; k <= 40; ++k) ASSERT_TRUE(vm.add(VisualSample{1'000'000 + k * 50'000, bodyAt(0.05 * k, G), 0}));
   // between samples (25 ms in): linear interpolation of a 2 m/s arc over 50 ms is good to 0.3 mm
   Pose3 rel;
   ASSERT_TRUE(vm.relative(1'000'000 + 225'000, 1'000'000 + 1'325'000, &rel));
@@ -86,7 +85,8 @@ TEST(GraphFactors, RelativePoseFactorMeasuresTheMotionInTheFirstBodyFrame) {
   // R_i^T d] whitened by the information (any square root of it: compare the squared norms)
   const Vec3 dtheta(0.003, -0.002, 0.004), d(0.02, -0.01, 0.03);
   const Pose3 Tj2 = se3::fromRotationTranslation(Tj.linear() * so3::Exp(dtheta), Tj.translation() + d);
-  for (const auto& [rot, shift] : {std::pair{dtheta, Vec3::Zero().eval()}, std::pair{Vec3::Zero().eval(), d}, std::pair{dtheta, d}}) {
+  for (const auto& [rot, shift] :
+       {std::pair{dtheta, Vec3::Zero().eval()}, std::pair{Vec3::Zero().eval(), d}, std::pair{dtheta, d}}) {
     const Pose3 T = se3::fromRotationTranslation(Tj.linear() * so3::Exp(rot), Tj.translation() + shift);
     Vec6 e;
     e << rot, Ti.linear().transpose() * shift;

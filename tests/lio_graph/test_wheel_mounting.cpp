@@ -58,8 +58,7 @@ synth::SequenceSpec drivenRoom(const Vec3& planted, double duration) {
 /// The wheel speeds at t from the trajectory through the wheel frame T_I_O (as livo-sim's
 /// idealWheelReading): the velocity of O's origin in O, the body rate about O's z; v_O is that
 /// velocity.
-WheelSample wheelReading(const synth::SequenceSpec& spec, const Pose3& T_I_O, double t, double track_width,
-                         Vec3* v_O) {
+WheelSample wheelReading(const synth::SequenceSpec& spec, const Pose3& T_I_O, double t, double track_width, Vec3* v_O) {
   const Pose3 T_W_I = spec.traj.pose(t);
   const Vec3 w_I = spec.traj.omegaBody(t);
   const Vec3 v_I = T_W_I.linear().transpose() * spec.traj.velocity(t) + w_I.cross(T_I_O.translation());
@@ -69,12 +68,12 @@ WheelSample wheelReading(const synth::SequenceSpec& spec, const Pose3& T_I_O, do
 }
 
 struct DriveLog {
-  Vec3 mounting = Vec3::Zero();   // learned (rad)
+  Vec3 mounting = Vec3::Zero();  // learned (rad)
   Vec2 wheel_scale = Vec2::Ones();
-  double ate = 0.0;               // m, aligned
-  double height_end = 0.0;        // m: the height error at the end, the first output anchored on the truth
-  double distance = 0.0;          // m driven
-  double max_side_speed = 0.0;    // m/s: the truth's lateral and vertical speed in O (0: a car)
+  double ate = 0.0;             // m, aligned
+  double height_end = 0.0;      // m: the height error at the end, the first output anchored on the truth
+  double distance = 0.0;        // m driven
+  double max_side_speed = 0.0;  // m/s: the truth's lateral and vertical speed in O (0: a car)
   int outputs = 0;
 };
 

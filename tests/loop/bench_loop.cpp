@@ -11,7 +11,8 @@
 //   Fine/Gicp               Nano-GICP from the coarse result (clouds, covariances, trees cached) <= 15 ms
 //   PoseGraph/Incremental   the node's solve after a loop at 2,000 keyframes                <= 30 ms
 //   PoseGraph/Batch         for reference: all loops of 2,000 keyframes at once, cold
-// Run (one core): taskset -c 0 build-dir/bin/livo_loop_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Run (one core): taskset -c 0 build-dir/bin/livo_loop_bench --benchmark_repetitions=5
+// --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -22,8 +23,8 @@
 
 #include "livo/loop/loop_closer.hpp"
 #include "livo/loop/loop_registration.hpp"
-#include "real_scans.hpp"
 #include "livo/loop/voxel_grid.hpp"
+#include "real_scans.hpp"
 
 namespace livo::loop {
 namespace {
@@ -252,7 +253,11 @@ void BM_PoseGraphIncremental(benchmark::State& state) {
   state.counters["loops"] = loops;
   state.counters["solver_iterations"] = iterations;
 }
-BENCHMARK(BM_PoseGraphIncremental)->Name("PoseGraph/Incremental")->Arg(2000)->Iterations(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PoseGraphIncremental)
+    ->Name("PoseGraph/Incremental")
+    ->Arg(2000)
+    ->Iterations(5)
+    ->Unit(benchmark::kMillisecond);
 
 // For reference, the cold case: all loops of the 2,000 keyframes at once, from the odometry.
 void BM_PoseGraphBatch(benchmark::State& state) {

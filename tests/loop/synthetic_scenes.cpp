@@ -46,7 +46,8 @@ Points makeScene(uint32_t seed, double spacing) {
     const Vec3 c(-26 + 52 * u(rng), -26 + 52 * u(rng), 0.0);
     sampleBox(c, Vec3(1.5 + 6 * u(rng), 1.5 + 5 * u(rng), 1.0 + 4 * u(rng)), M_PI * u(rng), spacing * 2, pts);
   }
-  for (int i = 0; i < 20; ++i) samplePole(Vec3(-28 + 56 * u(rng), -28 + 56 * u(rng), 0), 0.15 + 0.2 * u(rng), 2 + 4 * u(rng), spacing * 2, pts);
+  for (int i = 0; i < 20; ++i)
+    samplePole(Vec3(-28 + 56 * u(rng), -28 + 56 * u(rng), 0), 0.15 + 0.2 * u(rng), 2 + 4 * u(rng), spacing * 2, pts);
   for (int i = 0; i < 5; ++i) {  // free-standing walls at odd angles
     const double a = M_PI * u(rng);
     const Vec3 o(-25 + 50 * u(rng), -25 + 50 * u(rng), 0);

@@ -249,9 +249,12 @@ TEST(Fpfh, AnyNonZeroEqualsComputingTheFeatures) {
     for (int i = 0; i < n; ++i) {
       points.push_back(collinear ? axis * (side * u(rng)) : Vec3(u(rng), u(rng), u(rng)) * side);
       const int k = kind(rng);
-      if (k == 0) normals.push_back(Vec3::Zero());
-      else if (collinear || k == 1) normals.push_back(k % 2 ? axis : Vec3(-axis));  // on a line: degenerate pairs
-      else normals.push_back(Vec3(u(rng), u(rng), u(rng)).normalized());
+      if (k == 0)
+        normals.push_back(Vec3::Zero());
+      else if (collinear || k == 1)
+        normals.push_back(k % 2 ? axis : Vec3(-axis));  // on a line: degenerate pairs
+      else
+        normals.push_back(Vec3(u(rng), u(rng), u(rng)).normalized());
     }
     const PointTree tree(points);
     std::vector<int> at;

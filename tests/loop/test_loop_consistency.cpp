@@ -1,7 +1,7 @@
 // The consistency check before a loop enters the graph: false loops planted into a drifting run
 // (registration results between places 7-13 m apart claimed as the same place, or off by 1.5 m
-// and 5 deg; near candidates off by 0.5 m and 1 deg) are refused, the true loops still enter, and the trajectory is what it is without
-// the planted loops; with the check off the same plants enter and bend the trajectory.
+// and 5 deg; near candidates off by 0.5 m and 1 deg) are refused, the true loops still enter, and the trajectory is
+// what it is without the planted loops; with the check off the same plants enter and bend the trajectory.
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -12,8 +12,8 @@
 
 #include "livo/loop/loop_closer.hpp"
 #include "livo/loop/loop_consistency.hpp"
-#include "synthetic_scenes.hpp"
 #include "livo/loop/voxel_grid.hpp"
+#include "synthetic_scenes.hpp"
 
 namespace livo::loop {
 namespace {
@@ -55,7 +55,7 @@ struct LapRun {
   std::unique_ptr<LoopCloser> closer;
   std::shared_ptr<std::set<std::pair<int64_t, int64_t>>> planted =
       std::make_shared<std::set<std::pair<int64_t, int64_t>>>();  // (from, to), filled by the hook
-  double worst = 0.0;                              // m, final keyframe poses against the truth
+  double worst = 0.0;                                             // m, final keyframe poses against the truth
 };
 
 // What the registration says of the candidates 7-13 m away (which it registers correctly here)
@@ -68,7 +68,8 @@ LapRun runLaps(const DriftingLaps& laps, const Points& scene, bool check, Far fa
   o.merge_distance = 0.0;  // every keyframe a node: every pass is a loop candidate
   o.consistency_check = check;
   if (far != Far::kAsIs)
-    o.registration_hook = [&laps, &realistic, far, planted = run.planted, plants = 0](int64_t from, int64_t to, LoopRegistrationResult& r) mutable {
+    o.registration_hook = [&laps, &realistic, far, planted = run.planted, plants = 0](
+                              int64_t from, int64_t to, LoopRegistrationResult& r) mutable {
       const Pose3 T = laps.truth[to].inverse() * laps.truth[from];  // G = I: no roll or pitch
       const double d = T.translation().norm();
       const bool far_pair = d >= 7.0 && d <= 13.0;
@@ -86,12 +87,14 @@ LapRun runLaps(const DriftingLaps& laps, const Points& scene, bool check, Far fa
       r.T_target_source = T;
       if (near_pair) {  // a near miss the odometry alone would allow: 0.5 m and 1 deg
         r.T_target_source.translation() += Vec3(0.0, 0.5, 0.0);
-        r.T_target_source.linear() = r.T_target_source.linear() * Eigen::AngleAxisd(0.0175, Vec3::UnitZ()).toRotationMatrix();
+        r.T_target_source.linear() =
+            r.T_target_source.linear() * Eigen::AngleAxisd(0.0175, Vec3::UnitZ()).toRotationMatrix();
       } else if (plants++ % 2 == 0) {
         r.T_target_source.translation().setZero();  // "the same place": off by d
       } else {
         r.T_target_source.translation() += Vec3(0.0, 1.5, 0.0);  // a subtler one: 1.5 m and 5 deg
-        r.T_target_source.linear() = r.T_target_source.linear() * Eigen::AngleAxisd(0.087, Vec3::UnitZ()).toRotationMatrix();
+        r.T_target_source.linear() =
+            r.T_target_source.linear() * Eigen::AngleAxisd(0.087, Vec3::UnitZ()).toRotationMatrix();
       }
       planted->insert({from, to});
     };
@@ -115,8 +118,10 @@ TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
   const Points scene = makeScene(41, 0.15);
   const DriftingLaps laps(2 * DriftingLaps::kPerLap + 6);
   // the information a real registration of two keyframes 2.4 m apart claims
-  const GicpCloud a = GicpCloud::build(centroidPerVoxel(viewFrom(scene, laps.truth[0].translation(), M_PI / 2, 20.0, 0.02, 1), 0.4));
-  const GicpCloud b = GicpCloud::build(centroidPerVoxel(viewFrom(scene, laps.truth[1].translation(), M_PI / 2 + M_PI / 18, 20.0, 0.02, 2), 0.4));
+  const GicpCloud a =
+      GicpCloud::build(centroidPerVoxel(viewFrom(scene, laps.truth[0].translation(), M_PI / 2, 20.0, 0.02, 1), 0.4));
+  const GicpCloud b = GicpCloud::build(
+      centroidPerVoxel(viewFrom(scene, laps.truth[1].translation(), M_PI / 2 + M_PI / 18, 20.0, 0.02, 2), 0.4));
   const GicpResult realistic = gicpRegister(b, a, laps.truth[0].inverse() * laps.truth[1], {});
   ASSERT_TRUE(realistic.converged);
 
@@ -128,11 +133,12 @@ TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
   const double drift = translationError(laps.odometry.back(), laps.truth.back());
   std::printf("[loop-consistency] all candidates as registered: %zu loops, none refused, worst %.3f m\n",
               as_is.closer->loops().size(), as_is.worst);
-  std::printf("[loop-consistency] odometry drift %.2f m; without the far candidates: %zu loops, worst %.3f m; %zu planted: %zu refused, "
-              "%zu loops, worst %.3f m; unchecked with the plants: %zu loops, worst %.3f m\n",
-              drift, clean.closer->loops().size(), clean.worst, planted.planted->size(),
-              planted.closer->refusedLoops().size(), planted.closer->loops().size(), planted.worst,
-              planted_unchecked.closer->loops().size(), planted_unchecked.worst);
+  std::printf(
+      "[loop-consistency] odometry drift %.2f m; without the far candidates: %zu loops, worst %.3f m; %zu planted: %zu "
+      "refused, "
+      "%zu loops, worst %.3f m; unchecked with the plants: %zu loops, worst %.3f m\n",
+      drift, clean.closer->loops().size(), clean.worst, planted.planted->size(), planted.closer->refusedLoops().size(),
+      planted.closer->loops().size(), planted.worst, planted_unchecked.closer->loops().size(), planted_unchecked.worst);
   for (const RefusedLoop& f : planted.closer->refusedLoops())
     std::printf("[loop-consistency]   refused %ld -> %ld: %s\n", long(f.from_id), long(f.to_id), f.reason.c_str());
 
@@ -142,7 +148,7 @@ TEST(LoopConsistency, PlantedFalseLoopsAreRefusedAndTrueOnesStillEnter) {
   EXPECT_EQ(pairs(*as_is.closer), pairs(*as_is_unchecked.closer));
   ASSERT_GE(clean.closer->loops().size(), 4u);
   EXPECT_TRUE(clean.closer->refusedLoops().empty());
-  EXPECT_GT(drift, 0.3);  // there was something to correct ...
+  EXPECT_GT(drift, 0.3);                // there was something to correct ...
   EXPECT_LT(clean.worst, 0.5 * drift);  // ... and the loops did
 
   // every planted loop is refused, nothing else is, and the true loops enter as without plants
@@ -202,7 +208,8 @@ std::unique_ptr<LoopCloser> runWithGivenCovariance(const std::vector<Pose3>& tru
 
 double worstAgainst(const LoopCloser& closer, const std::vector<Pose3>& reference) {
   double worst = 0.0;
-  closer.forEachPose([&](int64_t id, const Pose3& pose) { worst = std::max(worst, translationError(pose, reference[id])); });
+  closer.forEachPose(
+      [&](int64_t id, const Pose3& pose) { worst = std::max(worst, translationError(pose, reference[id])); });
   return worst;
 }
 
@@ -227,8 +234,9 @@ TEST(LoopConsistency, TheOdometrysCovarianceDecidesWhetherALoopCorrects) {
   }
   // the drift model alone would have corrected it with these loops (their residuals pass 2 cm / 0.1 deg)
   const auto drift_model = runWithGivenCovariance(laps.truth, laps.truth, scene, {}, false);
-  std::printf("[loop-covariance] exact odometry: %zu loops, %zu corrections with its covariance, %zu with the drift model\n",
-              exact->loops().size(), corrections(*exact), corrections(*drift_model));
+  std::printf(
+      "[loop-covariance] exact odometry: %zu loops, %zu corrections with its covariance, %zu with the drift model\n",
+      exact->loops().size(), corrections(*exact), corrections(*drift_model));
 
   // the drifting odometry (0.34 m; 3e-4 rad and 7 mm off per increment) saying so: the loops
   // disagree with it beyond what that adds up to (a random walk: 2.5e-3 rad over a lap against the
@@ -270,21 +278,24 @@ TEST(LoopConsistency, ACorrectionIsPublishedOnlyWhereTheOptimumMovesTheKeyframe)
     };
   };
   const GivenCovariance sure{1.75e-4, 2e-3};
-  const auto with_optimum = runWithGivenCovariance(laps.truth, laps.truth, scene, sure, true, unsure_offset_loops(true));
-  const auto residual_only = runWithGivenCovariance(laps.truth, laps.truth, scene, sure, true, unsure_offset_loops(false));
+  const auto with_optimum =
+      runWithGivenCovariance(laps.truth, laps.truth, scene, sure, true, unsure_offset_loops(true));
+  const auto residual_only =
+      runWithGivenCovariance(laps.truth, laps.truth, scene, sure, true, unsure_offset_loops(false));
   ASSERT_GE(with_optimum->loops().size(), 8u);
   double largest_shift = 0.0, smallest_residual = 1.0;
   for (const AcceptedLoop& l : with_optimum->loops()) {
     largest_shift = std::max(largest_shift, l.optimum_shift_translation);
     smallest_residual = std::min(smallest_residual, l.residual_translation);
   }
-  std::printf("[loop-optimum] exact odometry, loops 4 cm off: %zu loops (residuals from %.3f m), %zu corrections and "
-              "worst %.4f m with the optimum deciding (largest shift %.4f m); %zu corrections and worst %.4f m on the "
-              "residual alone\n",
-              with_optimum->loops().size(), smallest_residual, corrections(*with_optimum),
-              worstAgainst(*with_optimum, laps.truth), largest_shift, corrections(*residual_only),
-              worstAgainst(*residual_only, laps.truth));
-  EXPECT_GE(smallest_residual, 0.02);       // every loop passes the residual gate
+  std::printf(
+      "[loop-optimum] exact odometry, loops 4 cm off: %zu loops (residuals from %.3f m), %zu corrections and "
+      "worst %.4f m with the optimum deciding (largest shift %.4f m); %zu corrections and worst %.4f m on the "
+      "residual alone\n",
+      with_optimum->loops().size(), smallest_residual, corrections(*with_optimum),
+      worstAgainst(*with_optimum, laps.truth), largest_shift, corrections(*residual_only),
+      worstAgainst(*residual_only, laps.truth));
+  EXPECT_GE(smallest_residual, 0.02);          // every loop passes the residual gate
   EXPECT_GE(corrections(*residual_only), 3u);  // the control: on the residual alone they correct
   EXPECT_EQ(corrections(*with_optimum), 0u);
   EXPECT_LT(largest_shift, 0.02);
@@ -351,10 +362,11 @@ TEST(LoopConsistency, TheHeldCalibrationIsNotComposedAsNoisePerIncrement) {
               1e-12 * nothing_held->loops()[k].odometry_covariance.norm());
   const double composed_sigma = std::sqrt(composed->loops().front().odometry_covariance(3, 3));
   const double filter_sigma = std::sqrt(filter_part->loops().front().odometry_covariance(3, 3));
-  std::printf("[loop-held] exact odometry, loops 4 cm off (10 cm stated): held part composed: odometry sigma %.3f m over "
-              "the first loop, %zu corrections, worst %.4f m; the filter's part: %.3f m, %zu corrections, worst %.4f m\n",
-              composed_sigma, corrections(*composed), worstAgainst(*composed, laps.truth), filter_sigma,
-              corrections(*filter_part), worstAgainst(*filter_part, laps.truth));
+  std::printf(
+      "[loop-held] exact odometry, loops 4 cm off (10 cm stated): held part composed: odometry sigma %.3f m over "
+      "the first loop, %zu corrections, worst %.4f m; the filter's part: %.3f m, %zu corrections, worst %.4f m\n",
+      composed_sigma, corrections(*composed), worstAgainst(*composed, laps.truth), filter_sigma,
+      corrections(*filter_part), worstAgainst(*filter_part, laps.truth));
   EXPECT_GT(composed_sigma, 3 * filter_sigma);
   EXPECT_GE(corrections(*composed), 1u);  // the control: composed, the held part lets the loops pull
   EXPECT_EQ(corrections(*filter_part), 0u);
@@ -390,7 +402,7 @@ TEST(LoopConsistency, TheHeldCalibrationIsNotComposedAsNoisePerIncrement) {
 struct TiltedRun {
   std::unique_ptr<LoopCloser> closer;
   std::vector<Correction> corrections;
-  double worst_tilt_deg = 0.0;        // keyframe poses: their up axis against the odometry's
+  double worst_tilt_deg = 0.0;             // keyframe poses: their up axis against the odometry's
   double worst_correction_tilt_deg = 0.0;  // T_Ck_O's rotation of the world's up axis
 };
 
@@ -423,12 +435,13 @@ TEST(LoopConsistency, CorrectionsKeepTheOdometrysRollAndPitch) {
   const TiltedRun levelled = runWithTiltedLoops(laps, scene, LoopCloserOptions{}.gravity_prior_sigma);
   const TiltedRun control = runWithTiltedLoops(laps, scene, 0.0);
   const double drift = translationError(laps.odometry.back(), laps.truth.back());
-  std::printf("[loop-tilt] loops tilted 0.3 deg: %zu loops, %zu corrections; worst tilt of a corrected pose %.2g deg, "
-              "of a correction %.2g deg; worst error %.3f m against the odometry's %.3f m. Without the levelling: "
-              "%zu corrections, worst tilt %.3f deg (pose) and %.3f deg (correction)\n",
-              levelled.closer->loops().size(), levelled.corrections.size(), levelled.worst_tilt_deg,
-              levelled.worst_correction_tilt_deg, worstAgainst(*levelled.closer, laps.truth), drift,
-              control.corrections.size(), control.worst_tilt_deg, control.worst_correction_tilt_deg);
+  std::printf(
+      "[loop-tilt] loops tilted 0.3 deg: %zu loops, %zu corrections; worst tilt of a corrected pose %.2g deg, "
+      "of a correction %.2g deg; worst error %.3f m against the odometry's %.3f m. Without the levelling: "
+      "%zu corrections, worst tilt %.3f deg (pose) and %.3f deg (correction)\n",
+      levelled.closer->loops().size(), levelled.corrections.size(), levelled.worst_tilt_deg,
+      levelled.worst_correction_tilt_deg, worstAgainst(*levelled.closer, laps.truth), drift, control.corrections.size(),
+      control.worst_tilt_deg, control.worst_correction_tilt_deg);
   // the scene shows the failure: without the levelling the loops' tilt reaches the corrections
   ASSERT_GE(control.corrections.size(), 3u);
   EXPECT_GT(control.worst_correction_tilt_deg, 0.1);

@@ -5,13 +5,13 @@
 #include <cstdio>
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "livo/loop/gicp.hpp"
 #include "livo/loop/loop_information.hpp"
-#include "synthetic_scenes.hpp"
 #include "livo/loop/voxel_grid.hpp"
+#include "synthetic_scenes.hpp"
 
 namespace livo::loop {
 namespace {
@@ -104,9 +104,10 @@ TEST(LoopInformation, CorridorAxisKeepsOnlyTheCapsInformation) {
   const double along = std::sqrt(cov(3, 3));
   const double across = std::max(std::sqrt(cov(4, 4)), std::sqrt(cov(5, 5)));
   const double naive_along = std::sqrt(r.plane_residual_variance / r.information(3, 3));
-  std::printf("[loop-information] corridor: sd along the axis %.3f m (cap %.1f m), across %.4f m; the scaled GICP "
-              "Hessian would claim %.4f m along it\n",
-              along, o.max_translation_sigma, across, naive_along);
+  std::printf(
+      "[loop-information] corridor: sd along the axis %.3f m (cap %.1f m), across %.4f m; the scaled GICP "
+      "Hessian would claim %.4f m along it\n",
+      along, o.max_translation_sigma, across, naive_along);
   EXPECT_GT(along, 0.9 * o.max_translation_sigma);
   EXPECT_LT(across, 2 * o.min_translation_sigma);
   EXPECT_LT(naive_along, 0.01);  // what not to trust

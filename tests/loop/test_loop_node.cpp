@@ -11,10 +11,10 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "livo/loop_correction_t.hpp"
-#include "livo/messages.hpp"
 #include "livo/loop/loop_node.hpp"
 #include "livo/loop/pose_graph.hpp"
+#include "livo/loop_correction_t.hpp"
+#include "livo/messages.hpp"
 #include "synthetic_scenes.hpp"
 #include "temp_path.hpp"
 
@@ -114,7 +114,8 @@ void runDriftedLoop(Adoption adoption) {
         adopted_id = m.correction_id;
       }
     const Pose3& T = truth[i];
-    const Points cloud = viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    const Points cloud =
+        viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
     published.push_back(adopted * odo[i]);
     keyframe_t k = makeKeyframe(i, published.back(), cloud);
     k.correction_id = adopted_id;
@@ -145,8 +146,7 @@ void runDriftedLoop(Adoption adoption) {
   }
   if (adoption == Adoption::kTwoKeyframesLate) {  // keyframes in the previous frame came after a correction
     bool stale_after_correction = false;
-    for (size_t c = 0; c < heard.size(); ++c)
-      stale_after_correction |= heard[c].first + 1 < total;
+    for (size_t c = 0; c < heard.size(); ++c) stale_after_correction |= heard[c].first + 1 < total;
     EXPECT_TRUE(stale_after_correction);
   }
   // The graph's odometry edges are the raw odometry increments whatever frame the poses came in.
@@ -175,10 +175,11 @@ void runDriftedLoop(Adoption adoption) {
   // odometry_to_corrected maps the raw pose of the keyframe that closed the loop onto its optimised one
   const Pose3 T_Ck_O = poseFrom(last->odometry_to_corrected_position, last->odometry_to_corrected_orientation);
   EXPECT_LT(translationError(T_Ck_O * odo[last->loop_from_id], node.closer().pose(last->loop_from_id)), 1e-9);
-  std::printf("[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
-              "%d corrections\n",
-              drift, worst, worst_final, translationError(newest, truth[last->keyframe_id[n - 1]]),
-              rotationErrorDeg(newest, truth[last->keyframe_id[n - 1]]), corrections);
+  std::printf(
+      "[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
+      "%d corrections\n",
+      drift, worst, worst_final, translationError(newest, truth[last->keyframe_id[n - 1]]),
+      rotationErrorDeg(newest, truth[last->keyframe_id[n - 1]]), corrections);
 
   node.writeOutputs();
   EXPECT_TRUE(std::filesystem::exists(lo.output_dir + "/loops.json"));
@@ -211,7 +212,7 @@ TEST(LoopNode, OdometryResetStartsANewGraphSegment) {
   lo.output_dir = livo_test::tempPath("loop-epochs");
   LoopNode node(lcm, no, lo);
   const int total = 30, reset_at = 20;
-  std::vector<Pose3> raw;  // as published: each epoch in its own raw frame
+  std::vector<Pose3> raw;            // as published: each epoch in its own raw frame
   Pose3 origin = Pose3::Identity();  // of the current epoch
   for (int i = 0; i < total; ++i) {
     const double a = 2 * M_PI * i / 36;
@@ -338,9 +339,8 @@ TEST(LoopCloser, FeaturesAreDerivedOnlyWhereAnOlderNodeIsNear) {
   EXPECT_GE(closer.loops().size(), 1u);
   // every candidate registered is counted: accepted (a loop, or refused by the consistency check)
   // or rejected by the registration's own tests
-  EXPECT_EQ(closer.registrations(),
-            static_cast<int64_t>(closer.loops().size() + closer.refusedLoops().size()) +
-                closer.rejectedRegistrations().total());
+  EXPECT_EQ(closer.registrations(), static_cast<int64_t>(closer.loops().size() + closer.refusedLoops().size()) +
+                                        closer.rejectedRegistrations().total());
 }
 
 // Exact odometry around a loop and past the start: the loops are verified and kept in the graph,

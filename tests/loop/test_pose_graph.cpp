@@ -1,8 +1,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "livo/loop/pose_graph.hpp"
 #include "synthetic_scenes.hpp"
@@ -185,12 +185,13 @@ TEST(PoseGraph, WarmStartedSolvesOnTheLoopScheduleEqualTheFullSolve) {
     worst_r = std::max(worst_r, rotationErrorDeg(incremental.pose(i), full.pose(i)));
     worst_truth = std::max(worst_truth, translationError(full.pose(i), laps.truth[i]));
   }
-  std::printf("[pose-graph] %d warm solves, %.1f iterations each; full solve %d iterations; incremental vs full: "
-              "%.2e m, %.2e deg; odometry drift %.2f m, worst solved %.3f m\n",
-              solves, double(iterations) / solves, fs.iterations, worst_t, worst_r, odometry_drift, worst_truth);
+  std::printf(
+      "[pose-graph] %d warm solves, %.1f iterations each; full solve %d iterations; incremental vs full: "
+      "%.2e m, %.2e deg; odometry drift %.2f m, worst solved %.3f m\n",
+      solves, double(iterations) / solves, fs.iterations, worst_t, worst_r, odometry_drift, worst_truth);
   EXPECT_LT(worst_t, 1e-4);
   EXPECT_LT(worst_r, 1e-4);
-  EXPECT_GT(odometry_drift, 1.0);        // the loops had something to correct ...
+  EXPECT_GT(odometry_drift, 1.0);                // the loops had something to correct ...
   EXPECT_LT(worst_truth, 0.1 * odometry_drift);  // ... and did
   EXPECT_LE(double(iterations) / solves, 5.0);   // warm starts: a few steps per loop
 }
@@ -235,7 +236,7 @@ TEST(PoseGraph, GravityPriorsKeepRollAndPitch) {
       if (with_prior) g.addGravityPrior(i, odo[i].linear().transpose() * Vec3::UnitZ(), 1e-4);
     }
     Mat6 odo_info = Mat6::Identity();
-    odo_info.topLeftCorner<3, 3>() *= 1e6;   // 1 mrad
+    odo_info.topLeftCorner<3, 3>() *= 1e6;      // 1 mrad
     odo_info.bottomRightCorner<3, 3>() *= 1e4;  // 1 cm
     for (int i = 1; i < 40; ++i) g.addEdge({i - 1, i, odo[i - 1].inverse() * odo[i], odo_info, false});
     g.addEdge({39, 0, loop, Mat6::Identity() * 1e4, true});
@@ -244,8 +245,10 @@ TEST(PoseGraph, GravityPriorsKeepRollAndPitch) {
     end_error[with_prior] = translationError(g.pose(39), truth[39]);
   }
   const double drift = translationError(odo[39], truth[39]);
-  std::printf("[pose-graph] tilt from the odometry's attitude: %.3f deg without priors, %.4f deg with; end %.3f / %.3f m "
-              "(odometry %.3f m)\n", worst_tilt[0] * 180 / M_PI, worst_tilt[1] * 180 / M_PI, end_error[0], end_error[1], drift);
+  std::printf(
+      "[pose-graph] tilt from the odometry's attitude: %.3f deg without priors, %.4f deg with; end %.3f / %.3f m "
+      "(odometry %.3f m)\n",
+      worst_tilt[0] * 180 / M_PI, worst_tilt[1] * 180 / M_PI, end_error[0], end_error[1], drift);
   EXPECT_GT(worst_tilt[0], 0.2 * 0.0175);  // 0.28 deg: the odometry edges take part of the 1 deg
   EXPECT_LT(worst_tilt[1], 0.05 * 0.0175);
   EXPECT_LT(end_error[1], 0.5 * drift);

@@ -5,8 +5,8 @@
 #include "livo/loop/coarse_features.hpp"
 #include "livo/loop/feature_matching.hpp"
 #include "livo/loop/quatro.hpp"
-#include "synthetic_scenes.hpp"
 #include "livo/loop/voxel_grid.hpp"
+#include "synthetic_scenes.hpp"
 
 namespace livo::loop {
 namespace {
@@ -84,7 +84,8 @@ TEST(Quatro, FpfhPipelineRegistersOverlappingViews) {
     const Pose3 W_T_t = yawPose(0.3, Vec3(0, 0, 1.8));
     const Pose3 W_T_s = yawPose(0.3 + yaw, Vec3(3.0, -2.0, 1.8));
     const CoarseFeatures target = computeCoarseFeatures(viewFrom(scene, W_T_t.translation(), 0.3, 25, 0.02, 1), {});
-    const CoarseFeatures source = computeCoarseFeatures(viewFrom(scene, W_T_s.translation(), 0.3 + yaw, 25, 0.02, 2), {});
+    const CoarseFeatures source =
+        computeCoarseFeatures(viewFrom(scene, W_T_s.translation(), 0.3 + yaw, 25, 0.02, 2), {});
     const Correspondences m = matchDescriptors(source.descriptors, target.descriptors);
     QuatroOptions o;
     o.noise_bound = 0.3;

@@ -8,9 +8,9 @@
 
 #include "livo/loop/loop_closer.hpp"
 #include "livo/loop/loop_registration.hpp"
+#include "livo/loop/voxel_grid.hpp"
 #include "real_scans.hpp"
 #include "synthetic_scenes.hpp"
-#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 namespace {
@@ -25,7 +25,8 @@ struct Prepared {
 // With the options livo-loop runs with (the fine voxel size unless given).
 Prepared prepare(const Points& raw, double fine_voxel = LoopCloserOptions{}.fine_voxel_size) {
   const LoopCloserOptions o;
-  return {computeCoarseFeatures(raw, o.coarse), GicpCloud::build(centroidPerVoxel(raw, fine_voxel), o.covariance_neighbors)};
+  return {computeCoarseFeatures(raw, o.coarse),
+          GicpCloud::build(centroidPerVoxel(raw, fine_voxel), o.covariance_neighbors)};
 }
 
 LoopRegistrationResult registerPair(const Prepared& source, const Prepared& target) {
@@ -33,11 +34,13 @@ LoopRegistrationResult registerPair(const Prepared& source, const Prepared& targ
 }
 
 void report(const std::string& what, const LoopRegistrationResult& r, const Pose3& truth) {
-  std::printf("[real-scan] %-22s coarse %.3f deg %.3f m | fine %.3f deg %.3f m | inliers %d fitness %.4f overlap %.2f ratio %.3f %s\n",
-              what.c_str(), rotationErrorDeg(r.coarse.T_target_source, truth),
-              translationError(r.coarse.T_target_source, truth), rotationErrorDeg(r.T_target_source, truth),
-              translationError(r.T_target_source, truth), r.coarse.num_inliers, r.fine.fitness, r.fine.overlap,
-              r.fine.translation_eigenvalue_ratio, r.accepted ? "accepted" : r.reason.c_str());
+  std::printf(
+      "[real-scan] %-22s coarse %.3f deg %.3f m | fine %.3f deg %.3f m | inliers %d fitness %.4f overlap %.2f ratio "
+      "%.3f %s\n",
+      what.c_str(), rotationErrorDeg(r.coarse.T_target_source, truth),
+      translationError(r.coarse.T_target_source, truth), rotationErrorDeg(r.T_target_source, truth),
+      translationError(r.T_target_source, truth), r.coarse.num_inliers, r.fine.fitness, r.fine.overlap,
+      r.fine.translation_eigenvalue_ratio, r.accepted ? "accepted" : r.reason.c_str());
 }
 
 TEST(RealScans, KittiSevenKeyframesRegisterToGraphPoses) {
@@ -73,9 +76,9 @@ TEST(RealScans, KittiSevenKeyframesRegisterToGraphPoses) {
 TEST(RealScans, KittiZeroFramePairMatchesGroundTruth) {
   // KITTI odometry sequence 00 calib.txt, Tr (velodyne -> camera 0), 3x4 row-major.
   Eigen::Matrix4d tr;
-  tr << 4.276802385584e-04, -9.999672484946e-01, -8.084491683471e-03, -1.198459927713e-02,
-      -7.210626507497e-03, 8.081198471645e-03, -9.999413164504e-01, -5.403984729748e-02,
-      9.999738645903e-01, 4.859485810390e-04, -7.206933692422e-03, -2.921968648686e-01, 0, 0, 0, 1;
+  tr << 4.276802385584e-04, -9.999672484946e-01, -8.084491683471e-03, -1.198459927713e-02, -7.210626507497e-03,
+      8.081198471645e-03, -9.999413164504e-01, -5.403984729748e-02, 9.999738645903e-01, 4.859485810390e-04,
+      -7.206933692422e-03, -2.921968648686e-01, 0, 0, 0, 1;
   Eigen::Matrix4d c1;
   c1 << 9.999978e-01, 5.272628e-04, -2.066935e-03, -4.690294e-02, -5.296506e-04, 9.999992e-01, -1.154865e-03,
       -2.839928e-02, 2.066324e-03, 1.155958e-03, 9.999971e-01, 8.586941e-01, 0, 0, 0, 1;

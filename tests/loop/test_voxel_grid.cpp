@@ -10,7 +10,8 @@ namespace {
 
 TEST(VoxelGrid, CentroidPerVoxelAndNonFiniteDropped) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  Points in{{0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {1.2, 0.0, 0.0}, {nan, 0, 0}, {0, std::numeric_limits<double>::infinity(), 0}};
+  Points in{
+      {0.1, 0.1, 0.1}, {0.3, 0.3, 0.3}, {1.2, 0.0, 0.0}, {nan, 0, 0}, {0, std::numeric_limits<double>::infinity(), 0}};
   const Points out = centroidPerVoxel(in, 1.0);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_TRUE(out[0].isApprox(Vec3(0.2, 0.2, 0.2)));
@@ -33,7 +34,8 @@ TEST(VoxelGrid, EmptyInput) { EXPECT_TRUE(centroidPerVoxel({}, 0.5).empty()); }
 // same order, bit for bit, as centroidPerVoxel of every point at once (negative coordinates too).
 TEST(VoxelGrid, StreamedCentroidsEqualTheDownsamplingOfAllPoints) {
   Points a;
-  for (int i = 0; i < 5000; ++i) a.push_back(Vec3(std::sin(i * 1.3) * 7, std::cos(i * 0.7) * 7, std::sin(i * 0.11) * 2));
+  for (int i = 0; i < 5000; ++i)
+    a.push_back(Vec3(std::sin(i * 1.3) * 7, std::cos(i * 0.7) * 7, std::sin(i * 0.11) * 2));
   a.push_back(Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0));
   for (double voxel : {0.2, 0.5, 0.0}) {
     VoxelCentroids streamed(voxel);

@@ -13,7 +13,7 @@
 namespace livo_bench {
 
 struct WorldSweep {
-  int64_t cloud_utime = 0, utime = 0;  // start, end
+  int64_t cloud_utime = 0, utime = 0;           // start, end
   livo::Pose3 T_W_I = livo::Pose3::Identity();  // at the end
   std::vector<float> x, y, z, time_offset;
 };

@@ -9,16 +9,16 @@
 #include <memory>
 #include <random>
 #include <set>
-#include <tuple>
 #include <sstream>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
+#include "livo/octomap/morton_index.hpp"
 #include "livo/octomap/octomap_builder.hpp"
 #include "livo/octomap/octomap_config.hpp"
-#include "livo/octomap/morton_index.hpp"
 #include "livo/octomap/ray_keys.hpp"
 #include "temp_path.hpp"
 
@@ -74,15 +74,15 @@ TEST(OccupancyMap, ClassifiesFreeOccupiedAndUnknownInABoxRoom) {
   OccupancyMap map(options(false));
   const Eigen::Vector3d origin(-0.5, 0.3, 1.2);
   for (int k = 0; k < 3; ++k) EXPECT_GT(map.insertRays(boxRoomHits(origin), origin), 40000u);
-  EXPECT_EQ(map.classify(Eigen::Vector3d(-2.05, 0.0, 1.0)), 1);   // west wall
-  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 2.05, 1.0)), 1);    // north wall
+  EXPECT_EQ(map.classify(Eigen::Vector3d(-2.05, 0.0, 1.0)), 1);    // west wall
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 2.05, 1.0)), 1);     // north wall
   EXPECT_EQ(map.classify(Eigen::Vector3d(-1.85, 0.35, 0.05)), 1);  // floor (within the 45° down-looking beams)
-  EXPECT_EQ(map.classify(Eigen::Vector3d(0.85, 0.0, 0.6)), 1);    // crate face towards the sensor
-  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 0.0, 1.2)), 0);     // open room
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.85, 0.0, 0.6)), 1);     // crate face towards the sensor
+  EXPECT_EQ(map.classify(Eigen::Vector3d(0.0, 0.0, 1.2)), 0);      // open room
   EXPECT_EQ(map.classify(Eigen::Vector3d(-1.0, -1.0, 2.0)), 0);
-  EXPECT_EQ(map.classify(Eigen::Vector3d(1.6, 0.0, 0.5)), -1);    // in the crate's shadow
-  EXPECT_EQ(map.classify(Eigen::Vector3d(1.05, 0.0, 0.6)), -1);   // inside the crate
-  EXPECT_EQ(map.classify(Eigen::Vector3d(3.0, 0.0, 1.0)), -1);    // outside the room
+  EXPECT_EQ(map.classify(Eigen::Vector3d(1.6, 0.0, 0.5)), -1);   // in the crate's shadow
+  EXPECT_EQ(map.classify(Eigen::Vector3d(1.05, 0.0, 0.6)), -1);  // inside the crate
+  EXPECT_EQ(map.classify(Eigen::Vector3d(3.0, 0.0, 1.0)), -1);   // outside the room
   // occupied voxels lie on the surfaces, not in the room's free middle
   const auto occupied = map.occupiedVoxels();
   EXPECT_GT(occupied.size(), 1000u);
@@ -112,7 +112,8 @@ TEST(OccupancyMap, BtAndOtFilesLoadBackWithOctomapsReaders) {
       std::vector<Eigen::Vector3f> p{{-2.05f, 0.05f, 1.05f}};
       EXPECT_EQ(map.setColours(p, {{{200, 10, 30}}}), 1u);
     }
-    const std::string bt = livo_test::tempPath(colour ? "c.bt" : "p.bt"), ot = livo_test::tempPath(colour ? "c.ot" : "p.ot");
+    const std::string bt = livo_test::tempPath(colour ? "c.bt" : "p.bt"),
+                      ot = livo_test::tempPath(colour ? "c.ot" : "p.ot");
     ASSERT_TRUE(map.writeBinary(bt));
     ASSERT_TRUE(map.writeFull(ot));
     const size_t occupied = map.occupiedVoxels().size();
@@ -174,7 +175,8 @@ namespace {
 std::vector<Eigen::Vector3f> wallAhead(const Eigen::Vector3f& origin, float direction = 1.f) {
   std::vector<Eigen::Vector3f> pts;
   for (int i = -5; i <= 5; ++i)
-    for (int j = 0; j <= 10; ++j) pts.push_back(origin + Eigen::Vector3f(direction * 3.05f, 0.1f * i + 0.05f, 0.1f * j + 0.05f));
+    for (int j = 0; j <= 10; ++j)
+      pts.push_back(origin + Eigen::Vector3f(direction * 3.05f, 0.1f * i + 0.05f, 0.1f * j + 0.05f));
   return pts;
 }
 struct ScanArrays {
@@ -231,7 +233,8 @@ TEST(OctomapBuilder, AStagedRebuildReplacesTheMapWhenEveryKeyframeIsCast) {
   for (int s = 0; s < 3; ++s) {
     const int64_t t = 2000000 + s * 100000;
     EXPECT_FALSE(builder.takeRebuildFinished());
-    ASSERT_TRUE(builder.addScan(arrays.view(t, wallAhead(now.translation().cast<float>(), -1.f), now), &error)) << error;
+    ASSERT_TRUE(builder.addScan(arrays.view(t, wallAhead(now.translation().cast<float>(), -1.f), now), &error))
+        << error;
     EXPECT_EQ(builder.rebuilding(), s < 2) << s;
   }
   EXPECT_TRUE(builder.takeRebuildFinished());
@@ -307,9 +310,9 @@ TEST(OctomapBuilder, RebuildCastsEachCorrectedKeyframeFromItsLidarOrigin) {
   corrected.translation() = Vec3(1.05, 0.0, 0.0);
   EXPECT_EQ(builder.applyCorrection({{0, corrected}, {1, odom}, {9, corrected}}), 1);  // 1 unchanged, 9 unknown
   EXPECT_EQ(builder.rebuilds(), 1);
-  EXPECT_EQ(builder.map().classify(new_wall), 1);    // keyframe 0's wall at its corrected pose
-  EXPECT_EQ(builder.map().classify(back_wall), 1);   // keyframe 1 at its (unchanged) pose
-  EXPECT_EQ(builder.map().classify(old_wall), -1);   // the old sweep and the old pose are gone
+  EXPECT_EQ(builder.map().classify(new_wall), 1);   // keyframe 0's wall at its corrected pose
+  EXPECT_EQ(builder.map().classify(back_wall), 1);  // keyframe 1 at its (unchanged) pose
+  EXPECT_EQ(builder.map().classify(old_wall), -1);  // the old sweep and the old pose are gone
   // free space from keyframe 0's LiDAR origin, (1.05, 0.5, 1.0) in the world, to its wall ...
   const Eigen::Vector3d lidar = (corrected * T_I_L).translation();
   EXPECT_NEAR((lidar - Eigen::Vector3d(1.05, 0.5, 1.0)).norm(), 0.0, 1e-9);
@@ -354,7 +357,8 @@ TEST(OctomapBuilder, RebuildsOnlyWhenPointsMoveBeyondTheTolerance) {
   EXPECT_EQ(builder.map().classify(Eigen::Vector3d(10.15, 0.05, 0.55)), 1);  // the wall at x + 0.06
   // 0.4 degrees move the wall's points (up to 10.06 m away) by about 7 cm
   EXPECT_EQ(builder.applyCorrection({{0, shifted(0.06, 0.4)}}), 1);
-  EXPECT_NEAR(builder.lastCorrectionShift(), 2.0 * std::sin(0.2 * M_PI / 180.0) * std::sqrt(10.05 * 10.05 + 2 * 0.55 * 0.55), 1e-6);
+  EXPECT_NEAR(builder.lastCorrectionShift(),
+              2.0 * std::sin(0.2 * M_PI / 180.0) * std::sqrt(10.05 * 10.05 + 2 * 0.55 * 0.55), 1e-6);
   EXPECT_EQ(builder.rebuilds(), 2);
   // with no tolerance any change rebuilds
   o.rebuild_tolerance = 0.0;
@@ -446,7 +450,7 @@ TEST(RayKeys, SameKeysAsOctomapsComputeRayKeys) {
         case 1: o = on_grid(0.f), e = on_grid(0.5f); break;
         case 2: o = on_grid(0.5f), e = on_grid(0.f); break;
         case 3: e = o + ::octomap::point3d(off(rng), 0.f, 0.f); break;  // axis-parallel
-        case 4: {  // diagonal
+        case 4: {                                                       // diagonal
           const float d = off(rng);
           e = o + ::octomap::point3d(d, d, (n % 2) ? d : -d);
           break;
@@ -486,7 +490,8 @@ struct StepChecker {  // a walkRayKeys walker
     const bool leaves = dir > 0 ? morton::atTop<A, kCheckBits>(i) : morton::atBottom<A, kCheckBits>(i);
     crossings += leaves;
     i = dir > 0 ? morton::up<A, kCheckBits>(i) : morton::down<A, kCheckBits>(i);
-    failures += !(k == want) || (dir != 1 && dir != -1) || i != idx(k) || leaves != ((prev[A] >> kCheckBits) != (k[A] >> kCheckBits));
+    failures += !(k == want) || (dir != 1 && dir != -1) || i != idx(k) ||
+                leaves != ((prev[A] >> kCheckBits) != (k[A] >> kCheckBits));
     prev = k;
     ++steps;
   }
@@ -593,15 +598,20 @@ TEST(OccupancyMap, SweepsMakeWhatOctomapsPerKeyUpdatesMake) {
 }
 
 TEST(OctomapConfig, FreeMarginAndRebuildToleranceAreReadAndChecked) {
-  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {free_margin: 0.3}")).core.free_margin, 0.3);
+  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {free_margin: 0.3}")).core.free_margin,
+                   0.3);
   EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {free_margin: -0.1}")), livo::ConfigError);
-  EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: 0}")).core.rebuild_tolerance, 0.0);
-  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: -0.01}")), livo::ConfigError);
-  const OctomapOptions tiles = readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 12.8, tile_idle_s: 2}")).core;
+  EXPECT_DOUBLE_EQ(
+      readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: 0}")).core.rebuild_tolerance, 0.0);
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {rebuild_tolerance: -0.01}")),
+               livo::ConfigError);
+  const OctomapOptions tiles =
+      readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 12.8, tile_idle_s: 2}")).core;
   EXPECT_DOUBLE_EQ(tiles.tile_size, 12.8);
   EXPECT_DOUBLE_EQ(tiles.tile_idle_s, 2.0);
   EXPECT_DOUBLE_EQ(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 0}")).core.tile_size, 0.0);
-  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 0.1}")), livo::ConfigError);  // one voxel
+  EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_size: 0.1}")),
+               livo::ConfigError);  // one voxel
   EXPECT_THROW(readOctomapNodeOptions(livo::Config::fromString("octomap: {tile_idle_s: -1}")), livo::ConfigError);
 }
 
@@ -702,7 +712,8 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
 
     auto sorted = [](std::vector<Eigen::Vector3d> v) {
       std::vector<std::tuple<long, long, long>> out;
-      for (const auto& p : v) out.emplace_back(std::lround(p.x() * 100), std::lround(p.y() * 100), std::lround(p.z() * 100));
+      for (const auto& p : v)
+        out.emplace_back(std::lround(p.x() * 100), std::lround(p.y() * 100), std::lround(p.z() * 100));
       std::sort(out.begin(), out.end());
       return out;
     };
@@ -719,7 +730,8 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
     const std::string single_ot = single.fullBytes(), tiled_ot = tiled.fullBytes();
     auto single_tree = readFull(single_ot), tiled_tree = readFull(tiled_ot);
     ASSERT_TRUE(single_tree && tiled_tree);
-    for (const auto& [bytes, tree] : {std::make_pair(&single_ot, single_tree.get()), std::make_pair(&tiled_ot, tiled_tree.get())}) {
+    for (const auto& [bytes, tree] :
+         {std::make_pair(&single_ot, single_tree.get()), std::make_pair(&tiled_ot, tiled_tree.get())}) {
       std::ostringstream again;
       tree->write(again);
       EXPECT_TRUE(again.str() == *bytes) << "colour " << colour << ": octomap does not write back what it read";

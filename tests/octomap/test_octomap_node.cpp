@@ -4,15 +4,15 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <octomap/OcTree.h>
+#include <lcm/lcm-cpp.hpp>
 
 #include "livo/keyframe_t.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/messages.hpp"
+#include "livo/octomap/octomap_node.hpp"
 #include "livo/octomap_t.hpp"
 #include "livo/registered_scan_t.hpp"
-#include "livo/octomap/octomap_node.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -47,7 +47,8 @@ NodeOptions quiet() {
 /// Every OCTOMAP message, appended to `out`.
 void collect(lcm::LCM& lcm, std::vector<octomap_t>* out) {
   lcm.subscribeFunction<octomap_t, std::vector<octomap_t>*>(
-      "OCTOMAP", [](const lcm::ReceiveBuffer*, const std::string&, const octomap_t* m, std::vector<octomap_t>* o) {
+      "OCTOMAP",
+      [](const lcm::ReceiveBuffer*, const std::string&, const octomap_t* m, std::vector<octomap_t>* o) {
         o->push_back(*m);
       },
       out);

@@ -11,6 +11,7 @@
 //           IMU i to stage1's socket and to stage2's lets stage1's answer overtake it. Counting
 //           by arrival, the two replays' STAGE2 once differed in CI on a loaded machine.
 //   DIE_AFTER N: after N messages, "crash" (_exit without a final PROGRESS) or "exit" (clean).
+#include <unistd.h>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
@@ -18,7 +19,6 @@
 #include <set>
 #include <string>
 #include <thread>
-#include <unistd.h>
 
 #include "livo/imu_t.hpp"
 #include "livo/node.hpp"

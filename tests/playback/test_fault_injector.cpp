@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
-#include "livo/playback/fault_injector.hpp"
 #include "livo/imu_t.hpp"
+#include "livo/playback/fault_injector.hpp"
 #include "test_log.hpp"
 
 using namespace livo;
@@ -154,7 +154,8 @@ TEST(FaultInjector, NanPointsOnlyInClouds) {
     point_cloud_t pc;
     ASSERT_EQ(pc.decode(e.data.data(), 0, static_cast<int>(e.data.size())), static_cast<int>(e.data.size()));
     int n = 0;
-    for (int i = 0; i < pc.num_points; ++i) n += !std::isfinite(pc.x[i]) || !std::isfinite(pc.y[i]) || !std::isfinite(pc.z[i]);
+    for (int i = 0; i < pc.num_points; ++i)
+      n += !std::isfinite(pc.x[i]) || !std::isfinite(pc.y[i]) || !std::isfinite(pc.z[i]);
     clouds_with_nan += n > 0;
     nan_points += n;
     points += pc.num_points;

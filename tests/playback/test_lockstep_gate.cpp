@@ -4,9 +4,9 @@
 
 #include "livo/playback/lockstep_gate.hpp"
 
+using livo::progress_t;
 using livo::playback::LockstepGate;
 using livo::playback::LockstepGateOptions;
-using livo::progress_t;
 
 namespace {
 progress_t progress(const std::string& node, int64_t seq, std::vector<std::pair<std::string, int64_t>> in,
@@ -161,7 +161,7 @@ TEST(LockstepGate, ToleratesRestartsWhenAsked) {
   g.onPublished("IMU", 1.0);
   g.onProgress(progress("lio", 1, {{"IMU", 1}}, {{"STATE_PRIOR", 1}}, false, false, 7), 1.1);
   g.onProgress(progress("vio", 1, {{"STATE_PRIOR", 0}}, {}, true, false, 8), 1.2);  // SIGTERM: final PROGRESS
-  EXPECT_TRUE(g.idle());  // vio is away
+  EXPECT_TRUE(g.idle());                                                            // vio is away
   g.onPublished("IMU", 2.0);
   g.onProgress(progress("lio", 2, {{"IMU", 2}}, {{"STATE_PRIOR", 2}}, false, false, 7), 2.1);
   EXPECT_TRUE(g.idle());
@@ -209,7 +209,7 @@ TEST(LockstepGate, HoldsTheReplayWhileAConsumerRestarts) {
   EXPECT_FALSE(g.awaitingRestart(1.0));
   g.onProgress(progress("vio", 1, {{"CAMERA", 0}}, {}, true, false, 1), 2.0);
   EXPECT_TRUE(g.idle());
-  EXPECT_TRUE(g.awaitingRestart(11.9));  // away since 2.0
+  EXPECT_TRUE(g.awaitingRestart(11.9));   // away since 2.0
   EXPECT_FALSE(g.awaitingRestart(12.1));  // given up waiting: the replay goes on without it
   g.onProgress(progress("vio", 0, {{"CAMERA", 0}}, {}, false, false, 2), 5.0);
   EXPECT_FALSE(g.awaitingRestart(5.0));
@@ -233,7 +233,7 @@ TEST(LockstepGate, AQuietPromiseLetsTheMessagesItCoversGoWithoutWaiting) {
   g.onPublished("IMU", 0.0, 100);
   g.onPublished("IMU", 0.0, 999);
   EXPECT_TRUE(g.caughtUp());
-  EXPECT_FALSE(g.idle());  // the end of the log still waits for everything
+  EXPECT_FALSE(g.idle());           // the end of the log still waits for everything
   g.onPublished("IMU", 0.0, 1000);  // at the promise's end: not covered
   EXPECT_FALSE(g.caughtUp());
   g.onProgress(withQuiet(progress("lio", 1, {{"IMU", 3}, {"LIDAR", 0}}, {{"ODOMETRY", 0}}), "IMU", 0, 1000));
@@ -319,7 +319,7 @@ TEST(LockstepGate, ALaggingConsumerFallsBehindByAtMostTheByteBound) {
   g.onPublished("CAMERA", 0.0, 4, 900'000);
   EXPECT_FALSE(g.caughtUp());  // 5.7 MB behind, 4 messages
   g.onProgress(progress("colour", 1, {{"REGISTERED_SCAN", 0}, {"CAMERA", 2}}, {{"COLORED_CLOUD", 0}}));
-  EXPECT_TRUE(g.caughtUp());   // 3.9 MB behind
+  EXPECT_TRUE(g.caughtUp());  // 3.9 MB behind
 }
 
 // octomap takes colour's clouds: colour lagging would hand them to octomap at positions that
@@ -397,15 +397,15 @@ TEST(LockstepGate, AnAnswerInFlightLetsOnlyQuietMessagesForOthersGo) {
   g.onProgress(progress("record", 0, {{"STATE_POSTERIOR", 0}, {"IMU", 0}}, {}));
   ASSERT_EQ(g.lagging(), std::vector<std::string>{"record"});
   g.onPublished("IMU", 0.0, 100);
-  g.onProgress(lioWaiting(1, 1, 0, 1));  // lio handed an image off: vio owes an answer
-  EXPECT_FALSE(g.caughtUp());             // (the rule that does not know the next message)
-  EXPECT_TRUE(g.mayPublish("IMU", 500));   // quiet for lio, not vio's
+  g.onProgress(lioWaiting(1, 1, 0, 1));     // lio handed an image off: vio owes an answer
+  EXPECT_FALSE(g.caughtUp());               // (the rule that does not know the next message)
+  EXPECT_TRUE(g.mayPublish("IMU", 500));    // quiet for lio, not vio's
   EXPECT_FALSE(g.mayPublish("IMU", 1000));  // lio would act on it: wait for the answer
   EXPECT_FALSE(g.mayPublish("IMU", LockstepGate::kNoUtime));
-  EXPECT_FALSE(g.mayPublish("CAMERA", 500));  // vio takes it
+  EXPECT_FALSE(g.mayPublish("CAMERA", 500));       // vio takes it
   EXPECT_TRUE(g.mayPublish("GROUND_TRUTH", 500));  // nobody in step takes it
   g.onPublished("IMU", 0.0, 500);
-  EXPECT_TRUE(g.mayPublish("IMU", 600));  // lio has not handled the last one: still quiet
+  EXPECT_TRUE(g.mayPublish("IMU", 600));                            // lio has not handled the last one: still quiet
   g.onProgress(lioWaiting(2, 2, 0, 1, /*posterior_quiet=*/false));  // it would act on the answer now
   EXPECT_FALSE(g.mayPublish("IMU", 600));
 

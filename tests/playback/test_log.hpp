@@ -1,8 +1,8 @@
 // A small synthetic log for the playback tests: IMU at 100 Hz and point clouds at 10 Hz.
 #pragma once
 
-#include <string>
 #include <unistd.h>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>

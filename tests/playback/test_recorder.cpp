@@ -5,10 +5,10 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include "bus_messages.hpp"
 #include "livo/health_t.hpp"
 #include "livo/node.hpp"
 #include "livo/odometry_t.hpp"
-#include "bus_messages.hpp"
 #include "livo/record/recorder.hpp"
 #include "temp_path.hpp"
 

@@ -40,9 +40,10 @@ Trajectory pathAlongX(double x0, double x1, double y, double z) {
 std::string runFolder(const std::string& name) {
   const std::string dir = livo_test::tempPath(name);
   fs::create_directories(dir);
-  std::ofstream(dir + "/report.md") << "# Pipeline run\n\n| | |\n| --- | --- |\n| log | `x.lcmlog` |\n\n## Accuracy\n\n"
-                                       "![a figure](figure.svg)\n\n![gone](missing.png)\n\n![remote](https://example.com/x.png)\n\n"
-                                       "## Warnings\n\nNone.\n";
+  std::ofstream(dir + "/report.md")
+      << "# Pipeline run\n\n| | |\n| --- | --- |\n| log | `x.lcmlog` |\n\n## Accuracy\n\n"
+         "![a figure](figure.svg)\n\n![gone](missing.png)\n\n![remote](https://example.com/x.png)\n\n"
+         "## Warnings\n\nNone.\n";
   std::ofstream(dir + "/figure.svg") << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" height=\"10\"/>\n";
   std::string error;
   EXPECT_TRUE(writePly(dir + "/colour_map.ply", planeOfPoints(100, 0.05), &error)) << error;
@@ -84,7 +85,8 @@ TEST(HtmlReport, ViewerSceneThinsToTheCapTheSameEveryTime) {
   EXPECT_EQ(a.origin.z(), 2.0);
   for (size_t k = 0; k < a.size(); k += 97) {
     const double x = a.positions[3 * k] + a.origin.x(), y = a.positions[3 * k + 1] + a.origin.y();
-    const int i = static_cast<int>(std::lround((x - 1000.0) / 0.01)), j = static_cast<int>(std::lround((y + 500.0) / 0.01));
+    const int i = static_cast<int>(std::lround((x - 1000.0) / 0.01)),
+              j = static_cast<int>(std::lround((y + 500.0) / 0.01));
     EXPECT_EQ(a.colours[3 * k], i % 256);
     EXPECT_EQ(a.colours[3 * k + 1], j % 256);
   }

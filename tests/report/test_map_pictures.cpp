@@ -64,7 +64,7 @@ std::string readBytes(const std::string& path) {
 
 TEST(MapPictures, TopViewPutsEachPlaneOnItsPixelsTheHigherInFront) {
   ColouredPoints pts;
-  addPlane(&pts, 0.5, 1.0, 0.5, 1.0, 0.0, 0.01, kRed);     // 50 x 50 px
+  addPlane(&pts, 0.5, 1.0, 0.5, 1.0, 0.0, 0.01, kRed);        // 50 x 50 px
   addPlane(&pts, 0.75, 1.25, 0.75, 1.25, 0.5, 0.01, kGreen);  // above it, overlapping a quarter
   TopViewFrame f;
   f.x_min = 0.0, f.y_max = 2.0, f.metres_per_pixel = 0.01, f.width = 200, f.height = 200;
@@ -84,7 +84,7 @@ TEST(MapPictures, TopViewPutsEachPlaneOnItsPixelsTheHigherInFront) {
   EXPECT_EQ(countColour(image, bgr(kRed)), 50u * 50u - 25u * 25u);
   EXPECT_EQ(countColour(image, bgr(kGreen)), 50u * 50u);
   // pixel (u, v) covers x in [u, u+1) cm and y down from 2 m: the red plane's corner pixel
-  EXPECT_EQ(image.at<cv::Vec3b>(149, 50), bgr(kRed));   // x 0.50-0.51, y 0.50-0.51
+  EXPECT_EQ(image.at<cv::Vec3b>(149, 50), bgr(kRed));  // x 0.50-0.51, y 0.50-0.51
   EXPECT_EQ(image.at<cv::Vec3b>(150, 50), cv::Vec3b(255, 255, 255));
   EXPECT_FLOAT_EQ(top_z(110, 100), 0.5f);
   EXPECT_TRUE(std::isnan(top_z(10, 10)));
@@ -123,7 +123,8 @@ TEST(MapPictures, ObliqueViewFramesTheBox) {
   EXPECT_LE(v.height, 1280);
   double umin = 1e9, umax = -1e9, vmin = 1e9, vmax = -1e9;
   for (int k = 0; k < 8; ++k) {
-    const Vec3 c((k & 1) ? box.max.x() : box.min.x(), (k & 2) ? box.max.y() : box.min.y(), (k & 4) ? box.max.z() : box.min.z());
+    const Vec3 c((k & 1) ? box.max.x() : box.min.x(), (k & 2) ? box.max.y() : box.min.y(),
+                 (k & 4) ? box.max.z() : box.min.z());
     cv::Point2d px;
     double z = 0;
     ASSERT_TRUE(v.project(c, &px, &z));
@@ -175,9 +176,9 @@ TEST(MapPictures, TrajectoryHeightFollowsTheNearestPose) {
   EXPECT_EQ(TrajectoryHeight().at(1.0, 2.0), 0.0);
   // the ceiling cut relative to it
   ColouredPoints p;
-  addPlane(&p, 0.0, 4.0, 0.0, 1.0, 1.8, 0.5, kRed);     // below 1 + 1 m: kept
-  addPlane(&p, 0.0, 4.0, 0.0, 1.0, 2.5, 0.5, kBlue);    // the low part's ceiling: cut
-  addPlane(&p, 10.0, 14.0, 0.0, 1.0, 2.5, 0.5, kGreen); // as high, over the high part: kept
+  addPlane(&p, 0.0, 4.0, 0.0, 1.0, 1.8, 0.5, kRed);      // below 1 + 1 m: kept
+  addPlane(&p, 0.0, 4.0, 0.0, 1.0, 2.5, 0.5, kBlue);     // the low part's ceiling: cut
+  addPlane(&p, 10.0, 14.0, 0.0, 1.0, 2.5, 0.5, kGreen);  // as high, over the high part: kept
   const ColouredPoints kept = pointsBelowCut(p, h, 1.0);
   EXPECT_EQ(kept.size(), 16u + 16u);
   for (const auto& c : kept.rgb) EXPECT_NE(c, kBlue);

@@ -34,9 +34,11 @@ TEST(MarkdownHtml, TablesWithAlignmentAndInlineCells) {
       "| loop |\n";
   EXPECT_EQ(markdownToHtml(md),
             "<table>\n<thead>\n"
-            "<tr><th>process</th><th style=\"text-align:right\">median ms</th><th style=\"text-align:center\">note</th></tr>\n"
+            "<tr><th>process</th><th style=\"text-align:right\">median ms</th><th "
+            "style=\"text-align:center\">note</th></tr>\n"
             "</thead>\n<tbody>\n"
-            "<tr><td>lio</td><td style=\"text-align:right\">4.25</td><td style=\"text-align:center\"><code>ODOMETRY</code></td></tr>\n"
+            "<tr><td>lio</td><td style=\"text-align:right\">4.25</td><td "
+            "style=\"text-align:center\"><code>ODOMETRY</code></td></tr>\n"
             "<tr><td>vio</td><td style=\"text-align:right\">7</td><td style=\"text-align:center\">a | b</td></tr>\n"
             "<tr><td>loop</td><td style=\"text-align:right\"></td><td style=\"text-align:center\"></td></tr>\n"
             "</tbody>\n</table>\n");
@@ -89,7 +91,9 @@ TEST(MarkdownHtml, LinksImagesAndAutolinks) {
   EXPECT_EQ(inlineMarkdownToHtml("![odometry against ground truth](odometry.svg)"),
             "<img src=\"odometry.svg\" alt=\"odometry against ground truth\">");
   MarkdownHtmlOptions o;
-  o.image_source = [](const std::string& src) { return src == "a.png" ? std::string("data:image/png;base64,QUJD") : ""; };
+  o.image_source = [](const std::string& src) {
+    return src == "a.png" ? std::string("data:image/png;base64,QUJD") : "";
+  };
   EXPECT_EQ(inlineMarkdownToHtml("![A](a.png) ![B](b.png)", o),
             "<img src=\"data:image/png;base64,QUJD\" alt=\"A\"> <span class=\"missing-image\">[B: b.png]</span>");
 }
@@ -97,7 +101,8 @@ TEST(MarkdownHtml, LinksImagesAndAutolinks) {
 TEST(MarkdownHtml, RawHtmlIsEscapedNeverPassedThrough) {
   EXPECT_EQ(markdownToHtml("<script>alert('x')</script> & \"q\"\n"),
             "<p>&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;q&quot;</p>\n");
-  EXPECT_EQ(markdownToHtml("> quoted *text*\n> more\n"), "<blockquote>\n<p>quoted <em>text</em>\nmore</p>\n</blockquote>\n");
+  EXPECT_EQ(markdownToHtml("> quoted *text*\n> more\n"),
+            "<blockquote>\n<p>quoted <em>text</em>\nmore</p>\n</blockquote>\n");
   EXPECT_EQ(livo::escapeMarkup("a<b>&\"'"), "a&lt;b&gt;&amp;&quot;&#39;");
 }
 
@@ -105,14 +110,17 @@ TEST(MarkdownHtml, AReportLikePage) {
   const std::string md =
       "# Pipeline run\n\n| | |\n| --- | --- |\n| log | `room.lcmlog` |\n\n## Accuracy\n\n"
       "No ground truth in the log: no accuracy figures.\n\n![odometry](odometry.svg)\n\n"
-      "## Where the estimate was weak\n\n**Degenerate sweeps** (`ODOMETRY.degenerate`): 12 of 300 (4.0 %) in 2 stretches:\n\n"
-      "| from s | to s | sweeps | least certain |\n| --- | --- | --- | --- |\n| 1.0 | 2.0 | 11 | along the direction of travel (body x) |\n\n"
+      "## Where the estimate was weak\n\n**Degenerate sweeps** (`ODOMETRY.degenerate`): 12 of 300 (4.0 %) in 2 "
+      "stretches:\n\n"
+      "| from s | to s | sweeps | least certain |\n| --- | --- | --- | --- |\n| 1.0 | 2.0 | 11 | along the direction "
+      "of travel (body x) |\n\n"
       "**Images the VIO did not use**:\n\n- vio: none of 600.\n\n## Warnings\n\nNone.\n";
   const std::string html = markdownToHtml(md);
-  for (const char* part : {"<h1 id=\"pipeline-run\">", "<td><code>room.lcmlog</code></td>", "<h2 id=\"accuracy\">",
-                           "<p><img src=\"odometry.svg\" alt=\"odometry\"></p>", "<h2 id=\"where-the-estimate-was-weak\">",
-                           "<p><strong>Degenerate sweeps</strong> (<code>ODOMETRY.degenerate</code>): 12 of 300",
-                           "<td>along the direction of travel (body x)</td>", "<li>vio: none of 600.</li>",
-                           "<h2 id=\"warnings\">Warnings</h2>\n<p>None.</p>"})
+  for (const char* part :
+       {"<h1 id=\"pipeline-run\">", "<td><code>room.lcmlog</code></td>", "<h2 id=\"accuracy\">",
+        "<p><img src=\"odometry.svg\" alt=\"odometry\"></p>", "<h2 id=\"where-the-estimate-was-weak\">",
+        "<p><strong>Degenerate sweeps</strong> (<code>ODOMETRY.degenerate</code>): 12 of 300",
+        "<td>along the direction of travel (body x)</td>", "<li>vio: none of 600.</li>",
+        "<h2 id=\"warnings\">Warnings</h2>\n<p>None.</p>"})
     EXPECT_NE(html.find(part), std::string::npos) << part << "\n" << html;
 }

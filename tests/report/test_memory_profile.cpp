@@ -16,7 +16,7 @@ TEST(MemoryProfile, PeakAtCheckpointsAndTheRunsEnd) {
   EXPECT_TRUE(std::isnan(p.peakAt("colour", 0.1)));  // nothing reported yet
   EXPECT_DOUBLE_EQ(p.peakAt("colour", 60.0), 20.0);
   EXPECT_DOUBLE_EQ(p.peakAt("colour", 149.9), 20.0);
-  EXPECT_DOUBLE_EQ(p.peakAt("colour", 300.0), 40.0);  // the checkpoint at the log's end counts
+  EXPECT_DOUBLE_EQ(p.peakAt("colour", 300.0), 40.0);   // the checkpoint at the log's end counts
   EXPECT_TRUE(std::isnan(p.peakAt("colour", 900.0)));  // beyond the run
   EXPECT_TRUE(std::isnan(p.peakAt("vio", 60.0)));      // no such node
   const std::string table = livo::report::memoryTable(p, {60.0, 300.0, 900.0});

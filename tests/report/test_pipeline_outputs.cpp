@@ -234,8 +234,7 @@ TEST(PipelineOutputs, ExplicitCorrectionIdsAndResets) {
   const PipelineOutputs out = readPipelineOutputs(path);
   const Trajectory t = loopCorrectedTrajectory(out);
   ASSERT_EQ(t.size(), 13u);
-  for (int i = 0; i < 12; ++i)
-    EXPECT_NEAR((t[i].pose.matrix() - (c * poseAt(i)).matrix()).norm(), 0.0, 1e-9) << i;
+  for (int i = 0; i < 12; ++i) EXPECT_NEAR((t[i].pose.matrix() - (c * poseAt(i)).matrix()).norm(), 0.0, 1e-9) << i;
   EXPECT_NEAR((t[12].pose.matrix() - poseAt(1).matrix()).norm(), 0.0, 1e-12);  // epoch 1: no loop
   ASSERT_EQ(out.resets.size(), 1u);
   EXPECT_EQ(out.resets[0].epoch, 1);

@@ -100,7 +100,8 @@ std::string makeRun(const std::string& dir) {
 TEST(ReportBrowser, ChromiumDrawsTheMapWithoutScriptErrors) {
   const std::string chromium = findChromium();
   if (chromium.empty())
-    GTEST_SKIP() << "chromium is not installed (scripts/install_deps.sh installs it): report.html was not opened in a browser";
+    GTEST_SKIP()
+        << "chromium is not installed (scripts/install_deps.sh installs it): report.html was not opened in a browser";
   ASSERT_TRUE(fs::exists("/usr/share/javascript/three/three.min.js"))
       << "three.js is missing: sudo apt-get install libjs-three (scripts/install_deps.sh installs it)";
   const std::string dir = livo_test::tempPath("browser_run");
@@ -111,7 +112,8 @@ TEST(ReportBrowser, ChromiumDrawsTheMapWithoutScriptErrors) {
   // On a private network namespace when we can make one (no route out), else the flags alone.
   const std::string bus = std::string(LIVO_SOURCE_DIR) + "/scripts/private_bus.sh";
   const bool isolated = run(shellQuote(bus) + " true >/dev/null 2>&1") == 0;
-  if (!isolated) std::cerr << "note: no private network namespace here; Chromium's networking is off by its flags only\n";
+  if (!isolated)
+    std::cerr << "note: no private network namespace here; Chromium's networking is off by its flags only\n";
   std::string base = "env HOME=" + shellQuote(home) + " XDG_CONFIG_HOME=" + shellQuote(home) +
                      " XDG_CACHE_HOME=" + shellQuote(home) + " " + (isolated ? shellQuote(bus) + " " : "") +
                      "timeout --kill-after=5 60 " + shellQuote(chromium) +
@@ -130,17 +132,21 @@ TEST(ReportBrowser, ChromiumDrawsTheMapWithoutScriptErrors) {
   const std::string url = " " + shellQuote("file://" + fs::absolute(page).string());
 
   // 1. The DOM once the page has run: no script error, the view drawn, where its canvas is.
-  ASSERT_EQ(run(base + " --dump-dom" + url + " >" + shellQuote(dir + "/dom.html") + " 2>" + shellQuote(dir + "/dom.log")), 0)
+  ASSERT_EQ(
+      run(base + " --dump-dom" + url + " >" + shellQuote(dir + "/dom.html") + " 2>" + shellQuote(dir + "/dom.log")), 0)
       << readText(dir + "/dom.log");
   const std::string dom = readText(dir + "/dom.html");
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(dom, m, std::regex(R"(<pre id="script-errors"[^>]*>([^<]*)</pre>)"))) << "no #script-errors";
+  ASSERT_TRUE(std::regex_search(dom, m, std::regex(R"(<pre id="script-errors"[^>]*>([^<]*)</pre>)")))
+      << "no #script-errors";
   EXPECT_EQ(m[1].str(), "") << "script errors in report.html";
   ASSERT_TRUE(std::regex_search(dom, m, std::regex(R"(<p id="viewer-status"[^>]*>)")));
   const std::string status_tag = m[0].str();
   EXPECT_NE(status_tag.find("data-state=\"drawn\""), std::string::npos)
-      << status_tag << "\n" << dom.substr(dom.find("id=\"viewer-status\""), 400);
-  ASSERT_TRUE(std::regex_search(status_tag, m, std::regex(R"re(data-canvas-rect="(\d+),(\d+),(\d+),(\d+)")re"))) << status_tag;
+      << status_tag << "\n"
+      << dom.substr(dom.find("id=\"viewer-status\""), 400);
+  ASSERT_TRUE(std::regex_search(status_tag, m, std::regex(R"re(data-canvas-rect="(\d+),(\d+),(\d+),(\d+)")re")))
+      << status_tag;
   const cv::Rect canvas(std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4]));
   ASSERT_GT(canvas.area(), 400 * 300);
   EXPECT_EQ(readText(dir + "/dom.log").find("Uncaught"), std::string::npos) << readText(dir + "/dom.log");

@@ -95,7 +95,8 @@ TEST(WeakSpots, MergesConsecutiveFlaggedSamplesIntoSpans) {
 }
 
 TEST(WeakSpots, LongestFirstByDurationThenSamplesThenTime) {
-  const std::vector<TimeSpan> s = longestFirst({{0.0, 0.2, 3}, {1.0, 1.5, 6}, {2.0, 2.0, 1}, {3.0, 3.2, 3}, {4.0, 4.2, 4}});
+  const std::vector<TimeSpan> s =
+      longestFirst({{0.0, 0.2, 3}, {1.0, 1.5, 6}, {2.0, 2.0, 1}, {3.0, 3.2, 3}, {4.0, 4.2, 4}});
   ASSERT_EQ(s.size(), 5u);
   EXPECT_DOUBLE_EQ(s[0].from, 1.0);
   EXPECT_DOUBLE_EQ(s[1].from, 4.0);  // 0.2 s and 4 samples
@@ -151,12 +152,16 @@ TEST(WeakSpots, SectionOnACorridorWithAVioAndALoop) {
   EXPECT_TRUE(contains(md, "33 of 100 (33.0 %) in 3 stretches")) << md;
   EXPECT_TRUE(contains(md, "along the direction of travel (body x) on 100 % of them")) << md;
   // longest first, in seconds since the first sweep
-  EXPECT_TRUE(contains(md, "| 2.0 | 4.9 | 30 | along the direction of travel (body x) |\n"
-                           "| 6.0 | 6.1 | 2 | along the direction of travel (body x) |\n"
-                           "| 9.0 | 9.0 | 1 |")) << md;
+  EXPECT_TRUE(contains(md,
+                       "| 2.0 | 4.9 | 30 | along the direction of travel (body x) |\n"
+                       "| 6.0 | 6.1 | 2 | along the direction of travel (body x) |\n"
+                       "| 9.0 | 9.0 | 1 |"))
+      << md;
   EXPECT_TRUE(contains(md, "3 of 100 sweeps (3.0 %): 7.0–7.2 s (3).")) << md;
-  EXPECT_TRUE(contains(md, "- vio: 4 of 40 images (10.0 %; priors kept): 2 × no image at the prior's time, "
-                           "2 × too few patches; when: 1.2–1.8 s (3), 7.5 s (1).")) << md;
+  EXPECT_TRUE(contains(md,
+                       "- vio: 4 of 40 images (10.0 %; priors kept): 2 × no image at the prior's time, "
+                       "2 × too few patches; when: 1.2–1.8 s (3), 7.5 s (1)."))
+      << md;
   EXPECT_TRUE(contains(md, "**Loop closures**: 1, at 9.5 s.")) << md;
   EXPECT_TRUE(contains(md, "| 9.5 | 17 (9.5 s) and 3 (1.0 s) | 0.420 m, 1.25 deg |")) << md;
 
@@ -171,8 +176,10 @@ TEST(WeakSpots, QuietRunIsShort) {
     q.num_residuals = 500;
   }
   const std::string md = weakSpotsMarkdown(findWeakSpots(o));
-  EXPECT_TRUE(contains(md, "**Degenerate sweeps** (`ODOMETRY.degenerate`: the LiDAR left some direction to the "
-                           "prediction): none of 100.\n")) << md;
+  EXPECT_TRUE(contains(md,
+                       "**Degenerate sweeps** (`ODOMETRY.degenerate`: the LiDAR left some direction to the "
+                       "prediction): none of 100.\n"))
+      << md;
   EXPECT_TRUE(contains(md, "update** (`ODOMETRY.num_residuals` 0 after an epoch's first sweep): none.\n")) << md;
   EXPECT_TRUE(contains(md, "**Images the VIO did not use**: no VIO ran.\n")) << md;
   EXPECT_TRUE(contains(md, "**Loop closures**: none.\n")) << md;
@@ -189,8 +196,8 @@ TEST(WeakSpots, ListsTheTenLongestStretchesAndCountsTheRest) {
   EXPECT_TRUE(contains(md, "| 3.0 | 3.4 | 5 |")) << md;  // 30-34, the longest, first
   const size_t rows = static_cast<size_t>(std::count(md.begin(), md.end(), '\n'));
   EXPECT_GT(rows, 10u);
-  const std::string rest = "and " + std::to_string(w.degenerate_stretches.size() - kListedStretches) +
-                           " shorter stretches (";
+  const std::string rest =
+      "and " + std::to_string(w.degenerate_stretches.size() - kListedStretches) + " shorter stretches (";
   EXPECT_TRUE(contains(md, rest)) << md;
   EXPECT_TRUE(contains(md, "at most 1 each).")) << md;
 }
@@ -208,8 +215,10 @@ TEST(WeakSpots, ListsTheTenLargestLoopCorrections) {
     o.loops.push_back(e);
   }
   const std::string md = weakSpotsMarkdown(findWeakSpots(o));
-  EXPECT_TRUE(contains(md, "**Loop closures**: 12, from 5.0 to 9.4 s; each moved the newest keyframe by 0.070 m "
-                           "(median), at most 0.120 m and 0.10 deg; the largest:")) << md;
+  EXPECT_TRUE(contains(md,
+                       "**Loop closures**: 12, from 5.0 to 9.4 s; each moved the newest keyframe by 0.070 m "
+                       "(median), at most 0.120 m and 0.10 deg; the largest:"))
+      << md;
   EXPECT_TRUE(contains(md, "| 9.4 | 31 and 11 | 0.120 m, 0.10 deg |\n| 9.0 | 30 and 10 | 0.110 m")) << md;
   EXPECT_TRUE(contains(md, "| 5.8 | 22 and 2 | 0.030 m, 0.10 deg |\n\nand 2 smaller ones.")) << md;
 }
@@ -239,8 +248,9 @@ TEST(WeakSpots, AFeatureVioCountsItsImagesFromHealth) {
   ASSERT_EQ(w.visual.size(), 1u);
   EXPECT_EQ(w.visual[0].refused, 8);
   EXPECT_EQ(w.visual[0].of, 200);
-  EXPECT_TRUE(contains(weakSpotsMarkdown(w), "- vio_feature: 8 of 200 images (4.0 %; images refused): 7 × before the "
-                                             "visual state was initialised, 1 × image not later than the previous one."));
+  EXPECT_TRUE(contains(weakSpotsMarkdown(w),
+                       "- vio_feature: 8 of 200 images (4.0 %; images refused): 7 × before the "
+                       "visual state was initialised, 1 × image not later than the previous one."));
 }
 
 namespace {

@@ -10,10 +10,10 @@
 #include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/imu_model.hpp"
 #include "livo/sim/lidar_scanner.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
 #include "livo/sim/wheel_model.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -87,7 +87,8 @@ double offRoomSurface(const Vec3& p) {
 
 /// Mean distance to the room's surface of a sweep's points put into the world with T_I_L and the
 /// body poses at stamp + time_offset + clock_offset.
-double meanOffSurface(const LidarSweep& sweep, const SimulationSetup& s, const Pose3& T_I_L, double clock_offset = 0.0) {
+double meanOffSurface(const LidarSweep& sweep, const SimulationSetup& s, const Pose3& T_I_L,
+                      double clock_offset = 0.0) {
   double sum = 0.0;
   for (size_t i = 0; i < sweep.size(); ++i) {
     const double t = s.trajectoryTime(sweep.utime) + clock_offset + sweep.time_offset[i];
@@ -135,18 +136,20 @@ TEST(CalibrationErrors, LidarTimeOffsetSweepsFromThePoseAtStampPlusOffset) {
   for (const LidarSweep& sweep : got.sweeps) {
     const double t = late.trajectoryTime(sweep.utime);
     const double sensor_time = (sweep.utime - late.start_utime) * 1e-6;
-    const LidarSweep shifted = scanner.scan(*late.scene, *late.trajectory, t + kOffset, sweep.utime, sensor_time, Random(9, 9));
+    const LidarSweep shifted =
+        scanner.scan(*late.scene, *late.trajectory, t + kOffset, sweep.utime, sensor_time, Random(9, 9));
     const LidarSweep on_time = scanner.scan(*late.scene, *late.trajectory, t, sweep.utime, sensor_time, Random(9, 9));
     expectSameSweeps({sweep}, {shifted}, 0.0);
     EXPECT_LT(meanOffSurface(sweep, late, late.rig.lidar->T_I_L, kOffset), 1e-6);  // on the walls at stamp + offset
-    EXPECT_GT(meanOffSurface(sweep, late, late.rig.lidar->T_I_L), 0.01);  // 12 ms at up to 1.5 m/s: off them
+    EXPECT_GT(meanOffSurface(sweep, late, late.rig.lidar->T_I_L), 0.01);           // 12 ms at up to 1.5 m/s: off them
     ASSERT_EQ(on_time.size(), sweep.size());
     EXPECT_NE(on_time.x, sweep.x);
   }
 }
 
 TEST(CalibrationErrors, CameraRendersFromTheTruePoseAndTime) {
-  const std::string errors = std::string("  calibration_errors: {camera: ") + kErrYaml + ", camera_time_offset_s: 0.0123}\n";
+  const std::string errors =
+      std::string("  calibration_errors: {camera: ") + kErrYaml + ", camera_time_offset_s: 0.0123}\n";
   const SimulationSetup wrong = load(movingRig(errors));
   const SimulationSetup plain = load(movingRig());
   const auto a = simulate(wrong), b = simulate(plain);
@@ -166,14 +169,16 @@ TEST(CalibrationErrors, CameraRendersFromTheTruePoseAndTime) {
 }
 
 TEST(CalibrationErrors, WheelReadsTheTrueBaseAtStampPlusOffset) {
-  const std::string errors = std::string("  calibration_errors: {wheel: ") + kErrYaml + ", wheel_time_offset_s: 0.0123}\n";
+  const std::string errors =
+      std::string("  calibration_errors: {wheel: ") + kErrYaml + ", wheel_time_offset_s: 0.0123}\n";
   const SimulationSetup wrong = load(movingRig(errors));
   const auto a = simulate(wrong);
   ASSERT_GE(a.wheel.size(), 17u);
   WheelRig mounted = *wrong.rig.wheel;
   mounted.T_I_B = mounted.T_I_B * errorTransform();
   for (const WheelReading& r : a.wheel) {
-    const WheelReading e = idealWheelReading(wrong.trajectory->at(wrong.trajectoryTime(r.utime) + kOffset), mounted, r.utime);
+    const WheelReading e =
+        idealWheelReading(wrong.trajectory->at(wrong.trajectoryTime(r.utime) + kOffset), mounted, r.utime);
     EXPECT_DOUBLE_EQ(r.left_speed, e.left_speed);
     EXPECT_DOUBLE_EQ(r.right_speed, e.right_speed);
   }
@@ -221,7 +226,8 @@ TEST(ImuErrors, TemperatureBiasFollowsTheRamp) {
 
 // The configured model reaches the published readings, before the (here zero) noise.
 TEST(ImuErrors, SimulatorPublishesTheErroneousReadings) {
-  const SimulationSetup s = load(movingRig(R"(  imu: {gyro_scale_ppm: [1000, -2000, 3000], gyro_misalignment_mrad: [1, 2, 3],
+  const SimulationSetup s =
+      load(movingRig(R"(  imu: {gyro_scale_ppm: [1000, -2000, 3000], gyro_misalignment_mrad: [1, 2, 3],
         accel_scale_ppm: [-500, 700, 1500], accel_misalignment_mrad: [-4, 5, -6], gyro_g_sensitivity: [1e-4, -2e-4, 3e-4],
         gyro_bias_per_c: [1e-4, 0, 0], accel_bias_per_c: [0, 0, 0.01], temperature: {start_c: 20, end_c: 40, ramp_s: 0.2}}
 )"));
@@ -246,21 +252,23 @@ TEST(ImuErrors, SimulatorPublishesTheErroneousReadings) {
 TEST(ImuErrors, ApplyToARecordingOnlyWhenItsImuIsSynthesised) {
   const std::string euroc = std::string(LIVO_SHARED_DATA) + "/euroc_v1_01";
   const std::string replayed = test::noiseFreeImuRig() + "sim:\n" + test::boxRoomScene() +
-                               "  trajectory: {type: recorded, ground_truth: " + euroc + "/groundtruth.tum, imu: " + euroc +
-                               "/mav0/imu0/data.csv}\n";
-  for (const std::string key : {"gyro_scale_ppm: [100, 0, 0]", "accel_misalignment_mrad: [1, 0, 0]", "initial_gyro_bias: [0.01, 0, 0]",
-                                "temperature: {start_c: 20}"}) {
+                               "  trajectory: {type: recorded, ground_truth: " + euroc +
+                               "/groundtruth.tum, imu: " + euroc + "/mav0/imu0/data.csv}\n";
+  for (const std::string key : {"gyro_scale_ppm: [100, 0, 0]", "accel_misalignment_mrad: [1, 0, 0]",
+                                "initial_gyro_bias: [0.01, 0, 0]", "temperature: {start_c: 20}"}) {
     SCOPED_TRACE(key);
-    EXPECT_NE(configError(replayed + "  imu: {" + key + "}\n").find("a recorded trajectory publishes its real IMU samples unchanged"),
+    EXPECT_NE(configError(replayed + "  imu: {" + key + "}\n")
+                  .find("a recorded trajectory publishes its real IMU samples unchanged"),
               std::string::npos);
   }
 
-  const std::string synthesised = test::noiseFreeImuRig() + "sim:\n  duration_s: 0.3\n" + test::boxRoomScene() +
-                                  "  trajectory: {type: recorded, ground_truth: " + std::string(LIVO_SHARED_DATA) +
-                                  "/trajectories/fr2_desk_groundtruth.txt, smoothing_s: 0.1, start_offset_s: 60}\n"
-                                  "  imu: {initial_gyro_bias: [0.01, -0.02, 0.03], initial_accel_bias: [0.1, 0.2, -0.3],\n"
-                                  "        gyro_scale_ppm: [1000, -2000, 3000], accel_misalignment_mrad: [-4, 5, -6],\n"
-                                  "        gyro_g_sensitivity: [1e-4, -2e-4, 3e-4]}\n";
+  const std::string synthesised =
+      test::noiseFreeImuRig() + "sim:\n  duration_s: 0.3\n" + test::boxRoomScene() +
+      "  trajectory: {type: recorded, ground_truth: " + std::string(LIVO_SHARED_DATA) +
+      "/trajectories/fr2_desk_groundtruth.txt, smoothing_s: 0.1, start_offset_s: 60}\n"
+      "  imu: {initial_gyro_bias: [0.01, -0.02, 0.03], initial_accel_bias: [0.1, 0.2, -0.3],\n"
+      "        gyro_scale_ppm: [1000, -2000, 3000], accel_misalignment_mrad: [-4, 5, -6],\n"
+      "        gyro_g_sensitivity: [1e-4, -2e-4, 3e-4]}\n";
   const SimulationSetup s = load(synthesised);
   ASSERT_FALSE(s.replaysRecordedImu());
   EXPECT_EQ(s.imu_errors.gyro_scale_ppm, Vec3(1000, -2000, 3000));
@@ -269,7 +277,8 @@ TEST(ImuErrors, ApplyToARecordingOnlyWhenItsImuIsSynthesised) {
   for (const ImuReading& r : got.imu) {
     const ImuReading ideal = idealImuReading(s.trajectory->at(s.trajectoryTime(r.utime)), 9.81, r.utime);
     const Vec3 w = ideal.angular_velocity, f = ideal.linear_acceleration;
-    const Vec3 wm(1.001 * w.x() + 1e-4 * f.x() + 0.01, 0.998 * w.y() - 2e-4 * f.y() - 0.02, 1.003 * w.z() + 3e-4 * f.z() + 0.03);
+    const Vec3 wm(1.001 * w.x() + 1e-4 * f.x() + 0.01, 0.998 * w.y() - 2e-4 * f.y() - 0.02,
+                  1.003 * w.z() + 3e-4 * f.z() + 0.03);
     const Vec3 fm(f.x() + 0.1, -0.004 * f.x() + f.y() + 0.2, 0.005 * f.x() - 0.006 * f.y() + f.z() - 0.3);
     EXPECT_LT((r.angular_velocity - wm).norm(), 1e-12);
     EXPECT_LT((r.linear_acceleration - fm).norm(), 1e-12);
@@ -347,20 +356,24 @@ TEST(CalibrationErrorsConfig, ErrorsNameTheFileAndKey) {
     EXPECT_NE(got.find(message), std::string::npos) << "got: " << got << "\nwanted: " << message;
   };
   expectError("  calibration_errors: {lidar: {translaton: [0.01, 0, 0]}}\n",
-              "calib.yaml: unknown key: sim.calibration_errors.lidar.translaton (did you mean sim.calibration_errors.lidar.translation?)");
-  expectError("  calibration_errors: {drw: true}\n", "sim.calibration_errors.drw (did you mean sim.calibration_errors.draw?)");
+              "calib.yaml: unknown key: sim.calibration_errors.lidar.translaton (did you mean "
+              "sim.calibration_errors.lidar.translation?)");
+  expectError("  calibration_errors: {drw: true}\n",
+              "sim.calibration_errors.drw (did you mean sim.calibration_errors.draw?)");
   expectError("  calibration_errors: {camera: {translation: [0.01, 0]}}\n",
               "calib.yaml: sim.calibration_errors.camera.translation: expected a list of 3 numbers");
   expectError("  imu: {gyro_scale_ppm: 300}\n", "calib.yaml: sim.imu.gyro_scale_ppm: expected a list of 3 numbers");
   expectError("  calibration_errors: {wheel: {rpy_deg: [20, 0, 0]}}\n",
               "sim.calibration_errors.wheel.rpy_deg: components must be within +-10");
-  expectError("  calibration_errors: {lidar_time_offset_s: 0.8}\n", "sim.calibration_errors.lidar_time_offset_s: must be within +-0.5");
+  expectError("  calibration_errors: {lidar_time_offset_s: 0.8}\n",
+              "sim.calibration_errors.lidar_time_offset_s: must be within +-0.5");
   expectError("  calibration_errors: {draw: true, camera_time_offset_s: -0.001}\n",
               "sim.calibration_errors.camera_time_offset_s: a 1-sigma (calibration_errors.draw) must be >= 0");
   expectError("  calibration_errors: {draw: true}\n  imu: {accel_scale_ppm: [100, -100, 100]}\n",
               "sim.imu.accel_scale_ppm: a 1-sigma (calibration_errors.draw) must be >= 0");
   expectError("  imu: {temperature: {start_c: 20, ramp_s: 0}}\n", "sim.imu.temperature.ramp_s: must be > 0");
-  expectError("  imu: {temperature: {start: 20}}\n", "sim.imu.temperature.start (did you mean sim.imu.temperature.start_c?)");
+  expectError("  imu: {temperature: {start: 20}}\n",
+              "sim.imu.temperature.start (did you mean sim.imu.temperature.start_c?)");
 
   const std::string imu_only = test::noiseFreeImuRig() + "sim:\n" + test::boxRoomScene() +
                                "  trajectory: {type: handheld, waypoints: [0,0,1, 2,0,1, 2,2,1]}\n";
@@ -373,11 +386,12 @@ TEST(CalibrationErrorsConfig, ErrorsNameTheFileAndKey) {
 
   const std::string data = std::string(LIVO_SHARED_DATA) + "/euroc_v1_01";
   const std::string recorded = test::noiseFreeImuRig() + "sim:\n" + test::boxRoomScene() +
-                               "  trajectory: {type: recorded, ground_truth: " + data + "/groundtruth.tum, imu: " + data +
-                               "/mav0/imu0/data.csv}\n";
+                               "  trajectory: {type: recorded, ground_truth: " + data +
+                               "/groundtruth.tum, imu: " + data + "/mav0/imu0/data.csv}\n";
   EXPECT_EQ(configError(recorded + "  calibration_errors: {lidar_time_offset_s: 0.0}\n"),
             "calib.yaml: sim.calibration_errors.lidar_time_offset_s: the rig has no lidar");
-  EXPECT_NE(configError(recorded + "  imu: {gyro_scale_ppm: [100, 0, 0]}\n")
-                .find("calib.yaml: sim.imu.gyro_scale_ppm: a recorded trajectory publishes its real IMU samples unchanged"),
-            std::string::npos);
+  EXPECT_NE(
+      configError(recorded + "  imu: {gyro_scale_ppm: [100, 0, 0]}\n")
+          .find("calib.yaml: sim.imu.gyro_scale_ppm: a recorded trajectory publishes its real IMU samples unchanged"),
+      std::string::npos);
 }

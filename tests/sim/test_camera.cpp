@@ -150,10 +150,12 @@ TEST(CameraRenderer, CheckerboardLandsOnThePredictedPixels) {
       const double t = (kPlaneZ - T_W_C.translation().z()) / d.z();
       const Vec3 p = T_W_C.translation() + t * d - kPlaneCenter;
       if (std::abs(p.x()) > 2.9 || std::abs(p.y()) > 2.9) continue;
-      const double fu = p.x() / kSquare - std::floor(p.x() / kSquare), fv = p.y() / kSquare - std::floor(p.y() / kSquare);
+      const double fu = p.x() / kSquare - std::floor(p.x() / kSquare),
+                   fv = p.y() / kSquare - std::floor(p.y() / kSquare);
       const double margin = 0.03 / kSquare;  // stay 3 cm (a few pixels) off the square edges
       if (fu < margin || fu > 1 - margin || fv < margin || fv > 1 - margin) continue;
-      const int64_t a = static_cast<int64_t>(std::floor(p.x() / kSquare)), b = static_cast<int64_t>(std::floor(p.y() / kSquare));
+      const int64_t a = static_cast<int64_t>(std::floor(p.x() / kSquare)),
+                    b = static_cast<int64_t>(std::floor(p.y() / kSquare));
       const bool is_white = ((a + b) % 2 + 2) % 2 == 0;
       const int expected = is_white ? 230 : 26;  // 255 * 0.9, 255 * 0.1
       ASSERT_NEAR(img.data[static_cast<size_t>(v) * rig.width + u], expected, 1) << "pixel " << u << ", " << v;

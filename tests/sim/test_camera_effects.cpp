@@ -217,7 +217,8 @@ TEST(Vignetting, CornersLoseTheConfiguredShareQuadraticallyWithRadius) {
   for (int v = 0; v < rig.height; v += 7)
     for (int u = 0; u < rig.width; u += 5) {
       const double r2 = (u - rig.cx) * (u - rig.cx) + (v - rig.cy) * (v - rig.cy);
-      EXPECT_NEAR(img.data[static_cast<size_t>(v) * rig.width + u], 204.0 * (1.0 - 0.3 * std::min(1.0, r2 / half_diag2)), 0.5 + 1e-6)
+      EXPECT_NEAR(img.data[static_cast<size_t>(v) * rig.width + u],
+                  204.0 * (1.0 - 0.3 * std::min(1.0, r2 / half_diag2)), 0.5 + 1e-6)
           << u << ", " << v;
     }
   // the corner pixel (0, 0) lies just inside the half diagonal: about 30 % darker than the centre

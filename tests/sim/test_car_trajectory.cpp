@@ -7,9 +7,9 @@
 #include <cmath>
 
 #include "livo/sim/car_trajectory.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -42,7 +42,9 @@ Vec3 velocityInB(const BodyState& s, const Pose3& T_I_B, const Vec3& p_B = Vec3:
   return T_I_B.linear().transpose() * v_I;
 }
 
-double yawRateOfB(const BodyState& s, const Pose3& T_I_B) { return (T_I_B.linear().transpose() * s.angular_velocity).z(); }
+double yawRateOfB(const BodyState& s, const Pose3& T_I_B) {
+  return (T_I_B.linear().transpose() * s.angular_velocity).z();
+}
 
 /// Sum over a shake's waves of amplitude and of amplitude x angular frequency (bounds of the
 /// value and of its rate per unit path time).

@@ -186,14 +186,17 @@ TEST(DepthImage, HolesAtDiscontinuitiesAndInBlobsNoneOnSky) {
           continue;
         }
         ++with_truth, holes += mm[k] == 0;
-        if (band[k]) ++in_band, band_holes += mm[k] == 0;
-        else ++interior, interior_holes += mm[k] == 0;
+        if (band[k])
+          ++in_band, band_holes += mm[k] == 0;
+        else
+          ++interior, interior_holes += mm[k] == 0;
       }
   }
   const double blob_share = static_cast<double>(interior_holes) / interior;
-  std::printf("depth holes: %.2f %% of the pixels with depth in range (band at jumps %.2f %% of them, all holes; "
-              "blobs %.2f %% of the rest); sky %lld pixels\n",
-              100.0 * holes / with_truth, 100.0 * in_band / with_truth, 100.0 * blob_share, static_cast<long long>(sky));
+  std::printf(
+      "depth holes: %.2f %% of the pixels with depth in range (band at jumps %.2f %% of them, all holes; "
+      "blobs %.2f %% of the rest); sky %lld pixels\n",
+      100.0 * holes / with_truth, 100.0 * in_band / with_truth, 100.0 * blob_share, static_cast<long long>(sky));
   EXPECT_GT(sky, 20000);
   EXPECT_GT(in_band, 20000);
   EXPECT_EQ(band_holes, in_band) << "every pixel within edge_hole_px of a discontinuity is a hole";
@@ -228,12 +231,13 @@ std::string roomYaml(bool depth) {
 
 /// Channel -> the payloads of its events in order, and the log's event order by channel.
 std::map<std::string, std::vector<std::vector<uint8_t>>> simulate(bool depth, uint64_t seed,
-                                                                   std::vector<std::string>* order) {
+                                                                  std::vector<std::string>* order) {
   SimOverrides o;
   o.duration_s = 0.35;
   o.seed = seed;
-  const SimulationSetup setup = loadSimulation(Config::fromString(roomYaml(depth), depth ? "room_depth.yaml" : "room.yaml"),
-                                               std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+  const SimulationSetup setup =
+      loadSimulation(Config::fromString(roomYaml(depth), depth ? "room_depth.yaml" : "room.yaml"),
+                     std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
   const std::string path = livo_test::tempPath("depth_") + (depth ? "on" : "off") + std::to_string(seed) + ".lcmlog";
   {
     LogWriter writer(path, setup.rig.channels);

@@ -193,9 +193,9 @@ TEST(Texture, CheckerSquaresAndFiltering) {
   o.grain = 0.0;
   o.variation = 0.0;
   Texture tex(o);
-  EXPECT_NEAR(tex.sample(0.125, 0.125, 1e-4)[0], 0.9f, 1e-4);   // square (0, 0)
-  EXPECT_NEAR(tex.sample(0.375, 0.125, 1e-4)[0], 0.1f, 1e-4);   // square (1, 0)
-  EXPECT_NEAR(tex.sample(-0.125, 0.125, 1e-4)[0], 0.1f, 1e-4);  // square (-1, 0)
+  EXPECT_NEAR(tex.sample(0.125, 0.125, 1e-4)[0], 0.9f, 1e-4);        // square (0, 0)
+  EXPECT_NEAR(tex.sample(0.375, 0.125, 1e-4)[0], 0.1f, 1e-4);        // square (1, 0)
+  EXPECT_NEAR(tex.sample(-0.125, 0.125, 1e-4)[0], 0.1f, 1e-4);       // square (-1, 0)
   EXPECT_NEAR(tex.sample(2.0 + 0.125, 0.125, 1e-4)[0], 0.9f, 1e-4);  // tiles
   // a footprint much larger than a square averages the two colours
   EXPECT_NEAR(tex.sample(0.3, 0.7, 10.0)[0], 0.5f, 1e-3);

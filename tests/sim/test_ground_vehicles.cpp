@@ -23,7 +23,9 @@ using namespace livo::sim;
 
 namespace {
 
-std::string configPath(const std::string& name) { return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml"; }
+std::string configPath(const std::string& name) {
+  return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml";
+}
 
 /// Stamps of k = 0, 1, ... at `rate_hz` from `start` (+ phase periods) that are within `duration`.
 void expectStampsAtRate(const std::vector<int64_t>& stamps, int64_t start, double rate_hz, double duration,
@@ -65,7 +67,8 @@ TEST(GroundVehicleConfigs, BridgeDeckAndTreeCampusLogEverySensorAtItsConfiguredR
     expectStampsAtRate(stampsOf(sink.imu), t0, rig.imu.rate_hz, 2.0, 0.0, "IMU");
     expectStampsAtRate(stampsOf(sink.wheel), t0, rig.wheel->rate_hz, 2.0, 0.0, "WHEEL");
     expectStampsAtRate(stampsOf(sink.poses), t0, setup.options.ground_truth_rate_hz, 2.0, 0.0, "GROUND_TRUTH");
-    expectStampsAtRate(stampsOf(sink.images), t0, rig.camera->rate_hz, 2.0, 0.5, "CAMERA");  // mid-exposure, halfway between ticks
+    expectStampsAtRate(stampsOf(sink.images), t0, rig.camera->rate_hz, 2.0, 0.5,
+                       "CAMERA");        // mid-exposure, halfway between ticks
     ASSERT_EQ(sink.sweeps.size(), 20u);  // only complete sweeps: 2 s at 10 Hz
     for (size_t k = 0; k < sink.sweeps.size(); ++k) {
       EXPECT_EQ(sink.sweeps[k].utime, t0 + static_cast<int64_t>(k) * 100'000);
@@ -89,10 +92,10 @@ namespace {
 
 struct Degeneracy {
   Eigen::Matrix3d H_tt = Eigen::Matrix3d::Zero();  // sum of n n^T over the planar points
-  Vec3 eigenvalues = Vec3::Zero();                  // of H_tt, ascending
-  Vec3 weakest = Vec3::Zero();                      // eigenvector of the smallest
+  Vec3 eigenvalues = Vec3::Zero();                 // of H_tt, ascending
+  Vec3 weakest = Vec3::Zero();                     // eigenvector of the smallest
   int points = 0, planar = 0;
-  Vec3 road = Vec3::Zero();                         // the direction of travel
+  Vec3 road = Vec3::Zero();  // the direction of travel
 };
 
 /// One sweep of `config` starting at trajectory time t (the TRUE LiDAR mounting, the configured
@@ -112,7 +115,8 @@ Degeneracy sweepDegeneracy(const std::string& config, double t) {
   }
   const double radius = 1.0, sample = 0.3;
   auto key = [](const Vec3& p, double cell) {
-    const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell)), y = static_cast<int64_t>(std::floor(p.y() / cell)),
+    const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell)),
+                  y = static_cast<int64_t>(std::floor(p.y() / cell)),
                   z = static_cast<int64_t>(std::floor(p.z() / cell));
     return ((x & 0x1fffff) << 42) | ((y & 0x1fffff) << 21) | (z & 0x1fffff);
   };
@@ -179,8 +183,8 @@ TEST(GroundVehicleConfigs, BridgeDeckLidarGeometryIsDegenerateAlongTheRoadUnlike
   const Degeneracy bridge = sweepDegeneracy("bridge_deck", 40.0);
   print("bridge_deck at 40 s", bridge);
   ASSERT_GT(bridge.planar, 300);
-  EXPECT_GT(std::abs(bridge.weakest.dot(bridge.road)), 0.99);    // along the road
-  EXPECT_GT(std::abs(bridge.road.x()), 0.999);                  // which is x
+  EXPECT_GT(std::abs(bridge.weakest.dot(bridge.road)), 0.99);      // along the road
+  EXPECT_GT(std::abs(bridge.road.x()), 0.999);                     // which is x
   EXPECT_LT(bridge.eigenvalues[0], 0.01 * bridge.eigenvalues[1]);  // and almost unconstrained
   // on the tree-lined road the curbs, trunks, poles and facades in the gaps hold the position along
   // it: its weakest direction is also along the road, but more than 10 times better constrained per

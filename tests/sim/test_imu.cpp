@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "livo/sim/imu_model.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/wheel_model.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -38,7 +38,8 @@ TEST(ImuModel, WhiteNoiseAndBiasWalkFollowTheDensities) {
   }
   const Eigen::Array3d mean_g = sum_g / n, mean_a = sum_a / n;
   const Eigen::Array3d std_g = (sq_g / n - mean_g.square()).sqrt(), std_a = (sq_a / n - mean_a.square()).sqrt();
-  const double sg = rig.gyro_noise_density * std::sqrt(rig.rate_hz), sa = rig.accel_noise_density * std::sqrt(rig.rate_hz);
+  const double sg = rig.gyro_noise_density * std::sqrt(rig.rate_hz),
+               sa = rig.accel_noise_density * std::sqrt(rig.rate_hz);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(mean_g[i], bg[i], 4 * sg / std::sqrt(n));
     EXPECT_NEAR(mean_a[i], ba[i], 4 * sa / std::sqrt(n));

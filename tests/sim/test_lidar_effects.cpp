@@ -6,9 +6,9 @@
 #include <cstring>
 
 #include "livo/sim/lidar_scanner.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -133,8 +133,8 @@ TEST(LidarEffects, RangeNoiseGrowsWithRangeAndFallingReflectivity) {
     double distance, reflectivity, expected_std;  // std of near-normal returns, from the datasheet-style model
   };
   // hypot(1 cm, 2 mm/m * D * sqrt(0.5 / reflectivity))
-  for (const Case& k : {Case{4, 0.5, 0.012806}, Case{16, 0.5, 0.033526}, Case{40, 0.5, 0.080623},
-                        Case{16, 0.125, 0.064777}}) {
+  for (const Case& k :
+       {Case{4, 0.5, 0.012806}, Case{16, 0.5, 0.033526}, Case{40, 0.5, 0.080623}, Case{16, 0.125, 0.064777}}) {
     const Scene scene = wallAt(k.distance, k.reflectivity);
     double sq_normal = 0, sq_scaled = 0;
     size_t n_normal = 0, n = 0;
@@ -219,9 +219,9 @@ Scene stepEdge(double board, double wall) {
 
 struct EdgeReturns {
   int board = 0, wall = 0, mixed = 0, other = 0;
-  int board_left_of_edge = 0;   // centre on the wall side, range of the board
-  int outside_footprint = 0;    // not a pure return of the side the beam centre is on
-  double widest_mixed = 0.0;    // largest |azimuth| * cos(elevation) of a mixed return (rad)
+  int board_left_of_edge = 0;  // centre on the wall side, range of the board
+  int outside_footprint = 0;   // not a pure return of the side the beam centre is on
+  double widest_mixed = 0.0;   // largest |azimuth| * cos(elevation) of a mixed return (rad)
 };
 
 /// Classifies the returns within 10 deg of the edge: pure board, pure wall, or between.
@@ -232,7 +232,7 @@ EdgeReturns edgeReturns(const LidarSweep& s, double board, double wall, double h
     const double az = std::atan2(d.y(), d.x()), cos_el = std::hypot(d.x(), d.y());
     if (std::abs(az) > 10 * M_PI / 180) continue;
     const double range = p.norm(), r_board = board / d.x(), r_wall = wall / d.x();
-    const bool is_board = std::abs(range - r_board) < 1e-4, is_wall = wall > 0 && std::abs(range - r_wall) < 1e-4;
+    const bool is_board = std::abs(range - r_board)<1e-4, is_wall = wall> 0 && std::abs(range - r_wall) < 1e-4;
     const bool between = range > r_board + 1e-3 && range < r_wall - 1e-3;
     r.board += is_board, r.wall += is_wall, r.mixed += between, r.other += !(is_board || is_wall || between);
     r.board_left_of_edge += is_board && az < 0;
@@ -246,8 +246,8 @@ EdgeReturns edgeReturns(const LidarSweep& s, double board, double wall, double h
 
 LidarScanner edgeScanner(double divergence_h_mrad, double divergence_v_mrad) {
   LidarPatternOptions pattern;
-  pattern.columns = 4096;                       // 1.53 mrad apart
-  pattern.start_azimuth_deg = 180.0 - 0.0229;   // a column 0.4 mrad right of the edge, the next 1.13 mrad left
+  pattern.columns = 4096;                      // 1.53 mrad apart
+  pattern.start_azimuth_deg = 180.0 - 0.0229;  // a column 0.4 mrad right of the edge, the next 1.13 mrad left
   LidarEffects effects;
   effects.beam_divergence_mrad = {{divergence_h_mrad, divergence_v_mrad}};
   effects.echo_separation_m = 1.0;
@@ -328,8 +328,9 @@ TEST(LidarEffects, ConfigKeysAreReadAndChecked) {
     return std::string();
   };
   EXPECT_FALSE(load("columns: 512").options.lidar_effects.any());
-  const LidarEffects e = load("range_noise_per_m: 0.001, noise_reflectivity_exponent: 1, max_range_at_10pct: 45, "
-                              "detection_softness: 0.3, beam_divergence_mrad: [2.3, 2.3], echo_separation_m: 0.8")
+  const LidarEffects e = load(
+                             "range_noise_per_m: 0.001, noise_reflectivity_exponent: 1, max_range_at_10pct: 45, "
+                             "detection_softness: 0.3, beam_divergence_mrad: [2.3, 2.3], echo_separation_m: 0.8")
                              .options.lidar_effects;
   EXPECT_EQ(e.range_noise_per_m, 0.001);
   EXPECT_EQ(e.noise_reflectivity_exponent, 1.0);
@@ -349,12 +350,13 @@ TEST(LidarEffects, ConfigKeysAreReadAndChecked) {
 }
 
 TEST(LidarEffects, SameSeedGivesTheSameSweepsWhateverTheThreads) {
-  const std::string yaml = test::noiseFreeImuRig() +
-                           "  lidar: {model: VLP-16, rate_hz: 10, min_range: 0.3, max_range: 100, range_noise_std: 0.01, "
-                           "dropout_probability: 0.02, T_I_L: {translation: [0,0,0.1], rpy_deg: [0,0,0]}}\n"
-                           "sim:\n  duration_s: 0.35\n  lidar: {range_noise_per_m: 0.002, max_range_at_10pct: 3, "
-                           "beam_divergence_mrad: [3, 1.5]}\n" +
-                           test::boxRoomScene() + "  trajectory: {type: handheld, waypoints: [0,0,1, 2,0,1, 2,2,1]}\n";
+  const std::string yaml =
+      test::noiseFreeImuRig() +
+      "  lidar: {model: VLP-16, rate_hz: 10, min_range: 0.3, max_range: 100, range_noise_std: 0.01, "
+      "dropout_probability: 0.02, T_I_L: {translation: [0,0,0.1], rpy_deg: [0,0,0]}}\n"
+      "sim:\n  duration_s: 0.35\n  lidar: {range_noise_per_m: 0.002, max_range_at_10pct: 3, "
+      "beam_divergence_mrad: [3, 1.5]}\n" +
+      test::boxRoomScene() + "  trajectory: {type: handheld, waypoints: [0,0,1, 2,0,1, 2,2,1]}\n";
   std::vector<LidarSweep> runs[2];
   for (int i = 0; i < 2; ++i) {
     SimOverrides o;

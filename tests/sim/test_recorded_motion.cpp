@@ -6,14 +6,14 @@
 
 #include <gtest/gtest.h>
 
-#include "livo/trajectory_io.hpp"
 #include "livo/sim/paths.hpp"
 #include "livo/sim/procedural_trajectory.hpp"
 #include "livo/sim/random.hpp"
 #include "livo/sim/recorded_trajectory.hpp"
 #include "livo/sim/sample_curves.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
+#include "livo/trajectory_io.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -22,7 +22,9 @@ namespace {
 
 const std::string kFr2Desk = std::string(LIVO_SHARED_DATA) + "/trajectories/fr2_desk_groundtruth.txt";
 
-std::string configPath(const std::string& name) { return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml"; }
+std::string configPath(const std::string& name) {
+  return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml";
+}
 
 /// A handheld walk (1 m/s, corners, step bobbing and wrist shake at half the built-in amplitude).
 ProceduralTrajectory handheldWalk() {
@@ -126,11 +128,13 @@ TEST(RecordedTrajectory, RepeatedStampsNeedSmoothing) {
     loadSimulation(Config::fromString(rig + trajectory + "}\n", "fr2.yaml"), "");
     ADD_FAILURE() << "interpolating through a repeated stamp was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("stamps do not increase at pose 10859 (smoothing_s > 0 accepts repeated stamps)"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("stamps do not increase at pose 10859 (smoothing_s > 0 accepts repeated stamps)"),
+        std::string::npos)
         << e.what();
   }
-  const SimulationSetup s = loadSimulation(Config::fromString(rig + trajectory + ", smoothing_s: 0.1}\n", "fr2.yaml"), "");
+  const SimulationSetup s =
+      loadSimulation(Config::fromString(rig + trajectory + ", smoothing_s: 0.1}\n", "fr2.yaml"), "");
   EXPECT_TRUE(s.recorded);
   EXPECT_FALSE(s.replaysRecordedImu());
   EXPECT_NEAR(s.options.duration_s, 99.3645, 1e-4);  // no duration_s: the whole recording
@@ -150,7 +154,8 @@ TEST(RecordedTrajectory, PlacementAndBodyFrameAreAppliedAsDocumented) {
   RecordedMotionOptions o;
   o.placement.linear() = so3::Exp(Vec3(0, 0, 0.7));
   o.placement.translation() = Vec3(-1.31, 1.14, 0.2);
-  o.body_in_recorded.linear() = (Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()) * Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitY())).toRotationMatrix();
+  o.body_in_recorded.linear() =
+      (Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()) * Eigen::AngleAxisd(-M_PI / 2, Vec3::UnitY())).toRotationMatrix();
   o.body_in_recorded.translation() = Vec3(0.0, 0.02, -0.08);
   const RecordedTrajectory placed(rec, o);
   EXPECT_DOUBLE_EQ(placed.startStamp(), 100.0);
@@ -169,14 +174,16 @@ TEST(RecordedTrajectory, PlacementAndBodyFrameAreAppliedAsDocumented) {
   EXPECT_LT(((c.T_W_I.translation() - a.T_W_I.translation()) / (2 * h) - b.velocity).norm(), 1e-6);
   EXPECT_LT(((c.velocity - a.velocity) / (2 * h) - b.acceleration).norm(), 1e-5);
   const Vec3 w_fd = (so3::Log(Mat3(b.T_W_I.linear().transpose() * c.T_W_I.linear())) -
-                     so3::Log(Mat3(b.T_W_I.linear().transpose() * a.T_W_I.linear()))) / (2 * h);
+                     so3::Log(Mat3(b.T_W_I.linear().transpose() * a.T_W_I.linear()))) /
+                    (2 * h);
   EXPECT_LT((w_fd - b.angular_velocity).norm(), 1e-6);
 }
 
 // start_offset_s moves the start into the recording; the default duration is what is left.
 TEST(RecordedTrajectory, StartOffsetPicksAWindow) {
   const std::string yaml = test::noiseFreeImuRig() + "sim:\n" + test::boxRoomScene() +
-                           "  trajectory: {type: recorded, ground_truth: " + kFr2Desk + ", smoothing_s: 0.1, start_offset_s: ";
+                           "  trajectory: {type: recorded, ground_truth: " + kFr2Desk +
+                           ", smoothing_s: 0.1, start_offset_s: ";
   const SimulationSetup s = loadSimulation(Config::fromString(yaml + "47}\n", "fr2.yaml"), "");
   const double first_stamp = 1311868163.8697;
   EXPECT_EQ(s.start_utime, static_cast<int64_t>(std::ceil((first_stamp + 47.0) * 1e6)));
@@ -186,7 +193,8 @@ TEST(RecordedTrajectory, StartOffsetPicksAWindow) {
     loadSimulation(Config::fromString(yaml + "100}\n", "fr2.yaml"), "");
     ADD_FAILURE() << "a start after the end was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("fr2.yaml: sim.trajectory.start_offset_s: starts at or after the end of the recording"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "fr2.yaml: sim.trajectory.start_offset_s: starts at or after the end of the recording"),
               std::string::npos)
         << e.what();
   }
@@ -215,8 +223,9 @@ TEST(RecordedTrajectory, Fr2DeskConfigPutsTheRigCameraOnTheRecordedCamera) {
     lo = lo.cwiseMin(b.T_W_I.translation()), hi = hi.cwiseMax(b.T_W_I.translation());
   }
   for (double t = 47.0; t < 99.3; t += 0.005)
-    specific_force_less_gravity.push_back((specificForce(s.trajectory->at(t), 9.81) -
-                                           s.trajectory->at(t).T_W_I.linear().transpose() * Vec3(0, 0, 9.81)).norm());
+    specific_force_less_gravity.push_back(
+        (specificForce(s.trajectory->at(t), 9.81) - s.trajectory->at(t).T_W_I.linear().transpose() * Vec3(0, 0, 9.81))
+            .norm());
   // within the smoothing's residual of the mocap poses (0.36 mm, 0.16 deg RMS measured)
   EXPECT_LT(percentile(position_error, 50), 1e-3);
   EXPECT_LT(percentile(position_error, 100), 5e-3);

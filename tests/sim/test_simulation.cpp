@@ -14,12 +14,12 @@
 #include "livo/imu_t.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/pose_t.hpp"
-#include "livo/trajectory_io.hpp"
-#include "livo/wheel_odometry_t.hpp"
 #include "livo/sim/log_writer.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
+#include "livo/trajectory_io.hpp"
+#include "livo/wheel_odometry_t.hpp"
+#include "sim_test_support.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -27,9 +27,12 @@ using namespace livo::sim;
 
 namespace {
 
-std::string configPath(const std::string& name) { return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml"; }
+std::string configPath(const std::string& name) {
+  return std::string(LIVO_SOURCE_DIR) + "/config/sim/" + name + ".yaml";
+}
 
-std::string simulateToLog(const std::string& config, double duration, uint64_t seed, int threads, const std::string& tag) {
+std::string simulateToLog(const std::string& config, double duration, uint64_t seed, int threads,
+                          const std::string& tag) {
   SimOverrides o;
   o.duration_s = duration;
   o.seed = seed;
@@ -63,8 +66,8 @@ struct ChannelCount {
 
 /// Reads a log, checks order, tie order and that each event's stamp is its message's utime.
 std::map<std::string, ChannelCount> checkLog(const std::string& path, const RigChannels& ch) {
-  const std::map<std::string, int> rank = {
-      {ch.imu, 0}, {ch.wheel, 1}, {ch.ground_truth, 2}, {ch.lidar, 3}, {ch.camera, 4}, {ch.depth, 5}};
+  const std::map<std::string, int> rank = {{ch.imu, 0},   {ch.wheel, 1},  {ch.ground_truth, 2},
+                                           {ch.lidar, 3}, {ch.camera, 4}, {ch.depth, 5}};
   lcm::LogFile log(path, "r");
   EXPECT_TRUE(log.good());
   std::map<std::string, ChannelCount> out;
@@ -72,12 +75,18 @@ std::map<std::string, ChannelCount> checkLog(const std::string& path, const RigC
   int prev_rank = -1;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     int64_t u = -1;
-    if (ev->channel == ch.imu) u = utimeOf<imu_t>(ev);
-    else if (ev->channel == ch.ground_truth) u = utimeOf<pose_t>(ev);
-    else if (ev->channel == ch.wheel) u = utimeOf<wheel_odometry_t>(ev);
-    else if (ev->channel == ch.lidar) u = utimeOf<point_cloud_t>(ev);
-    else if (ev->channel == ch.camera || ev->channel == ch.depth) u = utimeOf<image_t>(ev);
-    else ADD_FAILURE() << "unexpected channel " << ev->channel;
+    if (ev->channel == ch.imu)
+      u = utimeOf<imu_t>(ev);
+    else if (ev->channel == ch.ground_truth)
+      u = utimeOf<pose_t>(ev);
+    else if (ev->channel == ch.wheel)
+      u = utimeOf<wheel_odometry_t>(ev);
+    else if (ev->channel == ch.lidar)
+      u = utimeOf<point_cloud_t>(ev);
+    else if (ev->channel == ch.camera || ev->channel == ch.depth)
+      u = utimeOf<image_t>(ev);
+    else
+      ADD_FAILURE() << "unexpected channel " << ev->channel;
     EXPECT_EQ(u, ev->timestamp) << ev->channel;
     EXPECT_GE(ev->timestamp, prev_t);
     if (ev->timestamp == prev_t) {
@@ -175,8 +184,8 @@ TEST(Simulation, CameraTimeOffsetStampsImagesOnTheCameraClock) {
   yaml.insert(at, "    time_offset_s: 0.0042\n");
   SimOverrides o;
   o.duration_s = 0.3;
-  const SimulationSetup shifted = loadSimulation(Config::fromString(yaml, "room_offset.yaml"),
-                                                 std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
+  const SimulationSetup shifted =
+      loadSimulation(Config::fromString(yaml, "room_offset.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
   const SimulationSetup plain = loadSimulation(configPath("room"), o);
   ASSERT_TRUE(shifted.rig.camera);
   EXPECT_DOUBLE_EQ(shifted.rig.camera->time_offset_s, 0.0042);
@@ -193,9 +202,9 @@ TEST(Simulation, CameraTimeOffsetStampsImagesOnTheCameraClock) {
   ASSERT_EQ(a.images.size(), b.images.size());
   ASSERT_GE(a.images.size(), 5u);
   for (size_t i = 0; i < a.images.size(); ++i) {
-    EXPECT_EQ(a.images[i].log_utime, b.images[i].utime);       // logged at the IMU time
-    EXPECT_EQ(a.images[i].utime, b.images[i].utime - 4200);    // stamped on the camera clock
-    EXPECT_EQ(a.images[i].data, b.images[i].data);             // the same view
+    EXPECT_EQ(a.images[i].log_utime, b.images[i].utime);     // logged at the IMU time
+    EXPECT_EQ(a.images[i].utime, b.images[i].utime - 4200);  // stamped on the camera clock
+    EXPECT_EQ(a.images[i].data, b.images[i].data);           // the same view
   }
 }
 
@@ -311,7 +320,8 @@ TEST(Simulation, TriggeredCameraFiresAtTheSweepStartsOrEnds) {
     loadSimulation(Config::fromString(mismatched, "rates.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
     ADD_FAILURE() << "a 20 Hz camera triggered by a 10 Hz LiDAR was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("sim.camera.trigger: sweep_end fires once per sweep"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sim.camera.trigger: sweep_end fires once per sweep"), std::string::npos)
+        << e.what();
   }
   std::string unknown = yaml;
   unknown.replace(unknown.find("trigger: sweep_end"), 18, "trigger: strobe");
@@ -319,14 +329,15 @@ TEST(Simulation, TriggeredCameraFiresAtTheSweepStartsOrEnds) {
     loadSimulation(Config::fromString(unknown, "strobe.yaml"), std::string(LIVO_SOURCE_DIR) + "/config/sim", o);
     ADD_FAILURE() << "an unknown trigger was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("'strobe' is not free, sweep_start or sweep_end"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'strobe' is not free, sweep_start or sweep_end"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST(Simulation, ShippedConfigsLogTheirChannelsAtTheirRates) {
-  for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking", "hall_noisy", "room_hard",
-                                  "corridor_hard", "campus_loop_hard", "campus_loop_long_hard", "parking_hard", "room_fr2_desk",
-                                  "room_fr2_desk_hard", "bridge_deck", "tree_campus"}) {
+  for (const std::string name : {"room", "corridor", "campus_loop", "campus_loop_long", "parking", "hall_noisy",
+                                 "room_hard", "corridor_hard", "campus_loop_hard", "campus_loop_long_hard",
+                                 "parking_hard", "room_fr2_desk", "room_fr2_desk_hard", "bridge_deck", "tree_campus"}) {
     SCOPED_TRACE(name);
     const double duration = 0.5;
     const SimulationSetup setup = loadSimulation(configPath(name));
@@ -363,7 +374,7 @@ TEST(Simulation, EurocResimulationKeepsTheRealImuStream) {
   while (real[k].stamp_ns < setup.start_utime * 1000) ++k;
   for (size_t i = 0; i < sink.imu.size(); ++i, ++k) {
     EXPECT_EQ(sink.imu[i].utime, (real[k].stamp_ns + 500) / 1000);
-    EXPECT_EQ(sink.imu[i].angular_velocity, real[k].gyro);          // bit for bit
+    EXPECT_EQ(sink.imu[i].angular_velocity, real[k].gyro);  // bit for bit
     EXPECT_EQ(sink.imu[i].linear_acceleration, real[k].accel);
   }
   // the ray-cast sensors and the ground truth follow the recorded motion
@@ -384,26 +395,30 @@ TEST(SimulationConfig, ErrorsNameTheFileAndKey) {
   EXPECT_EQ(configError(rig + "sim:\n" + test::boxRoomScene() + good_traj), "");
 
   EXPECT_NE(configError("rig:\n  imu: {gyro_noise_density: 0, gyro_random_walk: 0, accel_noise_density: 0, "
-                        "accel_random_walk: 0}\nsim:\n" + test::boxRoomScene() + good_traj)
+                        "accel_random_walk: 0}\nsim:\n" +
+                        test::boxRoomScene() + good_traj)
                 .find("bad.yaml: rig.imu.rate_hz: missing required key"),
             std::string::npos);
   EXPECT_NE(configError(rig + "sim:\n  duraton_s: 3\n" + test::boxRoomScene() + good_traj)
                 .find("sim.duraton_s (did you mean sim.duration_s?)"),
             std::string::npos);
-  EXPECT_NE(configError(rig + "  lidar: {model: VLP-32, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
-                              "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
+  EXPECT_NE(configError(rig +
+                        "  lidar: {model: VLP-32, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
+                        "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
                         test::boxRoomScene() + good_traj)
                 .find("rig.lidar.model: unknown LiDAR model 'VLP-32'"),
             std::string::npos);
   // a real LiDAR the rig may name (config/rigs/) but that has no beam table in the simulator
-  EXPECT_NE(configError(rig + "  lidar: {model: VLP-32C, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
-                              "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
+  EXPECT_NE(configError(rig +
+                        "  lidar: {model: VLP-32C, rate_hz: 10, min_range: 1, max_range: 50, range_noise_std: 0, "
+                        "T_I_L: {translation: [0,0,0], rpy_deg: [0,0,0]}}\nsim:\n" +
                         test::boxRoomScene() + good_traj)
                 .find("rig.lidar.model: livo-sim cannot simulate a 'VLP-32C'"),
             std::string::npos);
   std::string bad_texture = test::boxRoomScene();
   bad_texture.replace(bad_texture.find("texture: grey"), 13, "texture: gray");
-  EXPECT_NE(configError(rig + "sim:\n" + bad_texture + good_traj).find("sim.scene.objects.room.texture: unknown texture 'gray'"),
+  EXPECT_NE(configError(rig + "sim:\n" + bad_texture + good_traj)
+                .find("sim.scene.objects.room.texture: unknown texture 'gray'"),
             std::string::npos);
   EXPECT_NE(configError(rig + "sim:\n" + test::boxRoomScene() + "  trajectory: {type: bicycle}\n")
                 .find("sim.trajectory.type: unknown trajectory type 'bicycle'"),
@@ -411,31 +426,40 @@ TEST(SimulationConfig, ErrorsNameTheFileAndKey) {
   EXPECT_NE(configError(rig + "sim:\n  scene_file: /nonexistent/scene.yaml\n" + good_traj)
                 .find("sim.scene_file: /nonexistent/scene.yaml: cannot open"),
             std::string::npos);
-  EXPECT_NE(configError(rig + "sim:\n" + test::boxRoomScene() +
-                        "  trajectory: {type: recorded, ground_truth: /nonexistent/gt.tum, imu: /nonexistent/imu.csv}\n")
-                .find("sim.trajectory.ground_truth: /nonexistent/gt.tum"),
-            std::string::npos);
+  EXPECT_NE(
+      configError(rig + "sim:\n" + test::boxRoomScene() +
+                  "  trajectory: {type: recorded, ground_truth: /nonexistent/gt.tum, imu: /nonexistent/imu.csv}\n")
+          .find("sim.trajectory.ground_truth: /nonexistent/gt.tum"),
+      std::string::npos);
   EXPECT_NE(configError(rig + "sim:\n  camera: {noise_std: 1}\n" + test::boxRoomScene() + good_traj)
                 .find("sim.camera: the rig has no camera"),
             std::string::npos);
   EXPECT_NE(configError(rig + "vio: {}\nsimulation: {}\n").find("simulation: unknown section"), std::string::npos);
-  EXPECT_NE(configError(rig + "sim:\n  duration_s: -1\n" + test::boxRoomScene() + good_traj).find("sim.duration_s: must be > 0"),
+  EXPECT_NE(configError(rig + "sim:\n  duration_s: -1\n" + test::boxRoomScene() + good_traj)
+                .find("sim.duration_s: must be > 0"),
             std::string::npos);
   // world and camera effects
   std::string scene_with = test::boxRoomScene();
   scene_with += "    movers:\n      bus: {type: bus, path: [0,0,0, 1,0,0], speed: 1, texture: grey}\n";
-  EXPECT_NE(configError(rig + "sim:\n" + scene_with + good_traj).find("sim.scene.movers.bus.type: unknown mover type 'bus'"),
-            std::string::npos);
+  EXPECT_NE(
+      configError(rig + "sim:\n" + scene_with + good_traj).find("sim.scene.movers.bus.type: unknown mover type 'bus'"),
+      std::string::npos);
   std::string glass = test::boxRoomScene();
   glass.replace(glass.find("reflectivity: 0.5}"), 18, "reflectivity: 0.5, material: glass, transmission: 1.5}");
-  EXPECT_NE(configError(rig + "sim:\n" + glass + good_traj).find("sim.scene.objects.room.transmission: must be in [0, 1]"),
-            std::string::npos);
+  EXPECT_NE(
+      configError(rig + "sim:\n" + glass + good_traj).find("sim.scene.objects.room.transmission: must be in [0, 1]"),
+      std::string::npos);
   std::string bush = test::boxRoomScene();
-  bush += "      bush: {type: vegetation, shape: cone, center: [0,0,1], radius: 1, height: 2, texture: grey, leaf_density: 1}\n";
-  EXPECT_NE(configError(rig + "sim:\n" + bush + good_traj).find("sim.scene.objects.bush.shape: unknown vegetation shape 'cone'"),
+  bush +=
+      "      bush: {type: vegetation, shape: cone, center: [0,0,1], radius: 1, height: 2, texture: grey, leaf_density: "
+      "1}\n";
+  EXPECT_NE(configError(rig + "sim:\n" + bush + good_traj)
+                .find("sim.scene.objects.bush.shape: unknown vegetation shape 'cone'"),
             std::string::npos);
-  const std::string cam_rig = rig + "  camera: {width: 64, height: 48, fx: 40, fy: 40, cx: 31.5, cy: 23.5, distortion: [0,0,0,0], "
-                                    "rate_hz: 20, T_I_C: {translation: [0,0,0], rpy_deg: [-90,0,-90]}}\n";
+  const std::string cam_rig =
+      rig +
+      "  camera: {width: 64, height: 48, fx: 40, fy: 40, cx: 31.5, cy: 23.5, distortion: [0,0,0,0], "
+      "rate_hz: 20, T_I_C: {translation: [0,0,0], rpy_deg: [-90,0,-90]}}\n";
   EXPECT_NE(configError(cam_rig + "sim:\n  camera: {rolling_shutter_s: 0.06}\n" + test::boxRoomScene() + good_traj)
                 .find("sim.camera.rolling_shutter_s: must be in [0, 1 / rate_hz]"),
             std::string::npos);

@@ -40,8 +40,7 @@ GradeProfile crown() {
   return p;
 }
 
-std::shared_ptr<const Terrain> terrain(std::vector<GradeProfile> profiles,
-                                       std::vector<ReliefWave> relief = {}) {
+std::shared_ptr<const Terrain> terrain(std::vector<GradeProfile> profiles, std::vector<ReliefWave> relief = {}) {
   TerrainOptions o;
   o.profiles = std::move(profiles);
   o.relief = std::move(relief);
@@ -52,8 +51,7 @@ std::shared_ptr<const Terrain> terrain(std::vector<GradeProfile> profiles,
 const std::vector<Vec3> kLoop = {
     {-100, -2.2, kHeight}, {300, -2.2, kHeight}, {300, 2.2, kHeight}, {-100, 2.2, kHeight}};
 
-CarTrajectory car(std::shared_ptr<const Terrain> ground, double shake,
-                  const Pose3& T_I_B = Pose3::Identity()) {
+CarTrajectory car(std::shared_ptr<const Terrain> ground, double shake, const Pose3& T_I_B = Pose3::Identity()) {
   CarTrajectoryOptions o;
   o.start_still_s = 0.5;
   o.ramp_s = 2.0;
@@ -85,8 +83,7 @@ double rollOf(const Mat3& R) { return std::atan2(R(2, 1), R(2, 2)); }
 std::vector<Vec3> contacts(const CarFrame& f, double clearance) {
   std::vector<Vec3> out;
   for (double ahead : {0.0, kWheelbase})
-    for (double left : {0.5 * kTrack, -0.5 * kTrack})
-      out.push_back(f.p + f.R * Vec3(ahead, left, -clearance));
+    for (double left : {0.5 * kTrack, -0.5 * kTrack}) out.push_back(f.p + f.R * Vec3(ahead, left, -clearance));
   return out;
 }
 
@@ -172,8 +169,7 @@ TEST(CarOnTerrain, PitchesWithAFivePercentRampAndClimbsIt) {
     EXPECT_LE(p, std::atan(kGrade) + 1e-12);
     last = p;
   }
-  const double climbed =
-      c.at(timeAtX(130.0)).T_W_I.translation().z() - c.at(timeAtX(20.0)).T_W_I.translation().z();
+  const double climbed = c.at(timeAtX(130.0)).T_W_I.translation().z() - c.at(timeAtX(20.0)).T_W_I.translation().z();
   EXPECT_NEAR(climbed, 2.5, 1e-9);
   EXPECT_NEAR(c.at(timeAtX(20.0)).T_W_I.translation().z(), kHeight, 1e-12);
 }
@@ -238,9 +234,8 @@ TEST(CarOnTerrain, MotionIsConsistentWithItsNumericDerivatives) {
   const double h = 1e-4;
   double worst_v = 0.0, worst_a = 0.0, worst_w = 0.0, worst_dw = 0.0;
   int checked = 0;
-  for (double t :
-       {timeAtX(-20.0) + 0.013, timeAtX(45.0) + 0.017, timeAtX(52.0) + 0.011, timeAtX(73.0) + 0.019,
-        timeAtX(104.0) + 0.007, timeAtX(280.0) + 0.021, timeAtX(285.0) + 3.0, timeAtX(285.0) + 4.6, 2.1}) {
+  for (double t : {timeAtX(-20.0) + 0.013, timeAtX(45.0) + 0.017, timeAtX(52.0) + 0.011, timeAtX(73.0) + 0.019,
+                   timeAtX(104.0) + 0.007, timeAtX(280.0) + 0.021, timeAtX(285.0) + 3.0, timeAtX(285.0) + 4.6, 2.1}) {
     const BodyState s = c.at(t), s0 = c.at(t - h), s1 = c.at(t + h);
     const Vec3 v_fd = (s1.T_W_I.translation() - s0.T_W_I.translation()) / (2 * h);
     const Vec3 a_fd = (s1.velocity - s0.velocity) / (2 * h);
@@ -331,9 +326,8 @@ TEST(TerrainScene, RaysHitTheRenderedGroundWhereHSaysIt) {
         ++hits;
       }
   }
-  std::printf(
-      "rendered terrain against h: straight down %.3g m, LiDAR beams %.3g m over %d hits (bound %.3g m)\n",
-      worst_down, worst_lidar, hits, bound);
+  std::printf("rendered terrain against h: straight down %.3g m, LiDAR beams %.3g m over %d hits (bound %.3g m)\n",
+              worst_down, worst_lidar, hits, bound);
   EXPECT_GT(hits, 10000);
   EXPECT_LT(worst_down, bound + 1e-9);
   EXPECT_LT(worst_lidar, bound + 1e-9);
@@ -354,21 +348,18 @@ TEST(TerrainScene, BadTerrainKeysAreErrorsNamingTheKey) {
       "9], radius: 1, texture: a}}\n";
   const std::string surface = "  surface: {center: [0, 0], size: [100, 20], resolution: 0.25, texture: a}\n";
   EXPECT_NE(
-      error(head + "terrain:\n  profiles: {r: {stations: [0, 10], heights: [0, 1], curve_length: 20}}\n" +
-            surface)
+      error(head + "terrain:\n  profiles: {r: {stations: [0, 10], heights: [0, 1], curve_length: 20}}\n" + surface)
           .find("terrain.profiles.r"),
       std::string::npos);
   EXPECT_NE(
-      error(head + "terrain:\n  profiles: {r: {stations: [0, 100], heights: [0, 5], curve_lenght: 20}}\n" +
-            surface)
+      error(head + "terrain:\n  profiles: {r: {stations: [0, 100], heights: [0, 5], curve_lenght: 20}}\n" + surface)
           .find("curve_lenght"),
       std::string::npos);
   EXPECT_NE(error(head + "terrain:\n  profiles: {r: {stations: [0, 100], heights: [0, 5]}}\n" +
                   "  surface: {center: [0, 0], size: [100, 20], resolution: 2, texture: a}\n")
                 .find("terrain.surface.resolution"),
             std::string::npos);
-  EXPECT_NE(error(head + "terrain:\n  profiles: {r: {stations: [0, 100], heights: [0, 5]}}\n")
-                .find("terrain.surface"),
+  EXPECT_NE(error(head + "terrain:\n  profiles: {r: {stations: [0, 100], heights: [0, 5]}}\n").find("terrain.surface"),
             std::string::npos);
 }
 

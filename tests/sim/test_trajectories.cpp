@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include "livo/sim/car_trajectory.hpp"
-#include "livo/trajectory_io.hpp"
 #include "livo/sim/paths.hpp"
 #include "livo/sim/procedural_trajectory.hpp"
 #include "livo/sim/recorded_trajectory.hpp"
-#include "sim_test_support.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
+#include "livo/trajectory_io.hpp"
+#include "sim_test_support.hpp"
 
 using namespace livo;
 using namespace livo::sim;
@@ -30,7 +30,8 @@ std::unique_ptr<BodyTrajectory> flight() {
   o.yaw_rate = 0.5;
   o.yaw_wave = {0.4, 0.2, 0.0};
   return std::make_unique<ProceduralTrajectory>(
-      std::make_unique<LissajousPath>(Vec3(0, 0, 1.5), Vec3(1.5, 1.2, 0.4), Vec3(0.31, 0.42, 0.53), Vec3(0, 0.5, 1.0)), o);
+      std::make_unique<LissajousPath>(Vec3(0, 0, 1.5), Vec3(1.5, 1.2, 0.4), Vec3(0.31, 0.42, 0.53), Vec3(0, 0.5, 1.0)),
+      o);
 }
 
 /// A car with a roof IMU 1.2 m ahead of and 1.5 m above the rear axle, mounted a little tilted.
@@ -50,7 +51,8 @@ void expectDerivativesConsistent(const BodyTrajectory& traj) {
     const Vec3 v_fd = (c.T_W_I.translation() - a.T_W_I.translation()) / (2 * h);
     const Vec3 a_fd = (c.velocity - a.velocity) / (2 * h);
     const Vec3 w_fd = (so3::Log(Mat3(b.T_W_I.linear().transpose() * c.T_W_I.linear())) -
-                       so3::Log(Mat3(b.T_W_I.linear().transpose() * a.T_W_I.linear()))) / (2 * h);
+                       so3::Log(Mat3(b.T_W_I.linear().transpose() * a.T_W_I.linear()))) /
+                      (2 * h);
     ASSERT_LT((v_fd - b.velocity).norm(), 1e-6 * (1 + b.velocity.norm())) << "t = " << t;
     ASSERT_LT((a_fd - b.acceleration).norm(), 1e-5 * (1 + b.acceleration.norm())) << "t = " << t;
     ASSERT_LT((w_fd - b.angular_velocity).norm(), 1e-6 * (1 + b.angular_velocity.norm())) << "t = " << t;
@@ -89,8 +91,8 @@ struct ImuIntegrator {
     for (size_t k = 0; k < steps; ++k) {
       const double dt = (imu[k + 1].utime - imu[k].utime) * 1e-6;
       const auto m0 = sampleAt(k, 0.0), mh = sampleAt(k, 0.5), m1 = sampleAt(k, 1.0);
-      const State k1 = derivative(x, m0), k2 = derivative(x + 0.5 * dt * k1, mh), k3 = derivative(x + 0.5 * dt * k2, mh),
-                  k4 = derivative(x + dt * k3, m1);
+      const State k1 = derivative(x, m0), k2 = derivative(x + 0.5 * dt * k1, mh),
+                  k3 = derivative(x + 0.5 * dt * k2, mh), k4 = derivative(x + dt * k3, m1);
       x += dt / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
       x.head<4>().normalize();
     }
@@ -99,8 +101,9 @@ struct ImuIntegrator {
 };
 
 void expectImuIntegratesToGroundTruth(const std::string& trajectory_yaml, const std::string& rig_extra = "") {
-  const std::string yaml = test::noiseFreeImuRig() + rig_extra + "sim:\n  duration_s: 10.5\n  ground_truth_rate_hz: 50\n" +
-                           test::boxRoomScene() + "  trajectory:\n" + trajectory_yaml;
+  const std::string yaml = test::noiseFreeImuRig() + rig_extra +
+                           "sim:\n  duration_s: 10.5\n  ground_truth_rate_hz: 50\n" + test::boxRoomScene() +
+                           "  trajectory:\n" + trajectory_yaml;
   const SimulationSetup setup = loadSimulation(Config::fromString(yaml, "imu_test.yaml"), "");
   test::CollectingSink sink;
   Simulator(setup).run(sink);
@@ -117,7 +120,8 @@ void expectImuIntegratesToGroundTruth(const std::string& trajectory_yaml, const 
   const PoseReading& gt = sink.poses.at(500);
   ASSERT_EQ(gt.utime, sink.imu[steps].utime);
   const double pos_err = (xe.tail<3>() - gt.T_W_I.translation()).norm();
-  const double rot_err = so3::Log(Mat3(gt.T_W_I.linear().transpose() * Quat(xe[0], xe[1], xe[2], xe[3]).toRotationMatrix())).norm();
+  const double rot_err =
+      so3::Log(Mat3(gt.T_W_I.linear().transpose() * Quat(xe[0], xe[1], xe[2], xe[3]).toRotationMatrix())).norm();
   const double travelled = (gt.T_W_I.translation() - s0.T_W_I.translation()).norm();
   EXPECT_LT(pos_err, 1e-3) << "after 10 s (moved " << travelled << " m)";
   EXPECT_LT(rot_err, 1e-5);
@@ -224,7 +228,8 @@ TEST(ImuIntegration, CarWithRearAxleBehindTheImuReproducesGroundTruth) {
     start_still_s: 0.5
     ramp_s: 2.0
 )",
-                                   "  wheel: {rate_hz: 50, track_width: 1.6, speed_noise_std: 0, T_I_B: {translation: [-1.2, 0.1, -1.5], rpy_deg: [1, -2, 3]}}\n");
+                                   "  wheel: {rate_hz: 50, track_width: 1.6, speed_noise_std: 0, T_I_B: {translation: "
+                                   "[-1.2, 0.1, -1.5], rpy_deg: [1, -2, 3]}}\n");
 }
 
 // A recording without IMU: the IMU is synthesised from the smoothed, placed motion (with the lever

@@ -157,8 +157,9 @@ TEST(WheelSlip, SimulatedSpeedsDeviateFromTheSlipFreeOnesInBoundedEpisodesAtTheC
   ASSERT_EQ(zero.size(), plain.size());
   for (size_t i = 0; i < plain.size(); ++i) ASSERT_TRUE(same(zero[i], plain[i])) << i;
 
-  const std::string slip = "    slip: {rate_per_min: 6, duration_s: [0.2, 1.5], spin: [0.1, 0.4], lock_probability: 0.25, "
-                           "both_probability: 0.3}\n";
+  const std::string slip =
+      "    slip: {rate_per_min: 6, duration_s: [0.2, 1.5], spin: [0.1, 0.4], lock_probability: 0.25, "
+      "both_probability: 0.3}\n";
   const std::vector<WheelReading> slipping = wheelReadings(slip);
   ASSERT_EQ(slipping.size(), plain.size());
   // episodes: maximal runs of samples that differ from the slip-free ones
@@ -171,8 +172,10 @@ TEST(WheelSlip, SimulatedSpeedsDeviateFromTheSlipFreeOnesInBoundedEpisodesAtTheC
     ASSERT_EQ(slipping[i].utime, plain[i].utime);
     if (same(slipping[i], plain[i])) continue;  // outside the episodes: the same noise, bit for bit
     ++deviating;
-    if (!runs.empty() && runs.back().last + 1 == i) runs.back().last = i;
-    else runs.push_back({i, i});
+    if (!runs.empty() && runs.back().last + 1 == i)
+      runs.back().last = i;
+    else
+      runs.push_back({i, i});
     // a wheel is off by (factor - 1) x its true speed: +10..40 % spinning, -100 % locked (noise 2 cm/s
     // at 5 m/s: 0.4 %; the car stands still for 2 s and ramps up for 2 s, so only from 4 s on)
     if (plain[i].utime - plain.front().utime < 4'000'000) continue;
@@ -203,8 +206,7 @@ TEST(WheelSlip, SimulatedSpeedsDeviateFromTheSlipFreeOnesInBoundedEpisodesAtTheC
   const std::vector<WheelReading> other = wheelReadings(slip, 2);
   const std::vector<WheelReading> other_plain = wheelReadings("", 2);
   size_t differ = 0;
-  for (size_t i = 0; i < plain.size(); ++i)
-    differ += same(other[i], other_plain[i]) != same(slipping[i], plain[i]);
+  for (size_t i = 0; i < plain.size(); ++i) differ += same(other[i], other_plain[i]) != same(slipping[i], plain[i]);
   EXPECT_GT(differ, 100u);
 }
 
@@ -218,12 +220,15 @@ TEST(WheelSlip, BadOptionsAreRejectedWithTheKey) {
     return std::string();
   };
   EXPECT_EQ(error("    slip: {rate_per_min: 2}\n"), "");
-  EXPECT_NE(error("    slip: {rate_per_min: -1}\n").find("sim.wheel.slip.rate_per_min: must be in [0, 600]"), std::string::npos);
-  EXPECT_NE(error("    slip: {rate_per_min: 2, duration_s: [1.5, 0.2]}\n").find("sim.wheel.slip.duration_s: must be [min, max]"),
+  EXPECT_NE(error("    slip: {rate_per_min: -1}\n").find("sim.wheel.slip.rate_per_min: must be in [0, 600]"),
+            std::string::npos);
+  EXPECT_NE(error("    slip: {rate_per_min: 2, duration_s: [1.5, 0.2]}\n")
+                .find("sim.wheel.slip.duration_s: must be [min, max]"),
             std::string::npos);
   EXPECT_NE(error("    slip: {rate_per_min: 2, spin: [0.1]}\n").find("sim.wheel.slip.spin: must be [min, max]"),
             std::string::npos);
-  EXPECT_NE(error("    slip: {rate_per_min: 2, lock_probability: 1.5}\n").find("sim.wheel.slip.lock_probability: must be in [0, 1]"),
+  EXPECT_NE(error("    slip: {rate_per_min: 2, lock_probability: 1.5}\n")
+                .find("sim.wheel.slip.lock_probability: must be in [0, 1]"),
             std::string::npos);
   EXPECT_NE(error("    slip: {rate: 2}\n").find("sim.wheel.slip.rate"), std::string::npos);  // unknown key
 }

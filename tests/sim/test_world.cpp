@@ -219,8 +219,10 @@ TEST(Glass, ALidarBeamReturnsFromTheGlassWithItsProbabilityElseFromBehind) {
       }
       ++crossing;
       const double at_glass = (4.995 - kSensor.x()) / d.x();
-      if (std::abs(q.norm() - at_glass) < 1e-4) ++from_glass;
-      else ASSERT_NEAR(q.norm(), behind, 1e-4) << "neither the glass nor the wall behind";
+      if (std::abs(q.norm() - at_glass) < 1e-4)
+        ++from_glass;
+      else
+        ASSERT_NEAR(q.norm(), behind, 1e-4) << "neither the glass nor the wall behind";
     }
   }
   ASSERT_GT(crossing, 10000);

@@ -137,8 +137,10 @@ TEST(CameraImage, PngOfEveryDepthAndChannelCount) {
     for (const int channels : {1, 3, 4}) {
       SCOPED_TRACE("depth " + std::to_string(depth) + ", channels " + std::to_string(channels));
       cv::Mat source;
-      if (channels == 1) source = grey_expected.clone();
-      else if (channels == 3) source = bgr.clone();
+      if (channels == 1)
+        source = grey_expected.clone();
+      else if (channels == 3)
+        source = bgr.clone();
       else {
         cv::cvtColor(bgr, source, cv::COLOR_BGR2BGRA);
         for (int y = 0; y < h; ++y)  // alpha varies: it must not matter
@@ -330,7 +332,8 @@ TEST(CameraImage, RawImageViewsTheMessage) {
   EXPECT_EQ(rawImage(m).size, 30u);
   m.size = -3;
   EXPECT_EQ(rawImage(m).size, 0u);
-  for (const float bad : {0.0f, -0.01f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+  for (const float bad :
+       {0.0f, -0.01f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
     m.exposure_time = bad;
     EXPECT_EQ(exposureTime(rawImage(m)), 0.0f) << bad;
   }

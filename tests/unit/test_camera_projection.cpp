@@ -179,7 +179,8 @@ TEST(CameraProjection, UndistortInvertsDistortOverTheField) {
         const Eigen::Vector2d d((u - rig.cx) / rig.fx, (v - rig.cy) / rig.fy);
         const Eigen::Vector2d xy = camera.undistort(d);
         worst_image = std::max(worst_image, rig.fx * (camera.distort(xy) - d).norm());
-        worst_normalised = std::max(worst_normalised, (camera.undistort(camera.distort(xy)) - xy).norm() / (1.0 + xy.norm()));
+        worst_normalised =
+            std::max(worst_normalised, (camera.undistort(camera.distort(xy)) - xy).norm() / (1.0 + xy.norm()));
       }
     EXPECT_LT(worst_image, 1e-8) << "distort(undistort(d)) - d, px";
     EXPECT_LT(worst_normalised, 1e-9) << "undistort(distort(xy)) - xy, relative";

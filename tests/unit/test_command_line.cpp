@@ -17,7 +17,10 @@ struct Argv {
 };
 livo::CommandLine make() {
   livo::CommandLine c("prog", "test");
-  c.positional("LOG", "log").option("--speed", "X", "speed", "1.0").option("--out", "F", "out").flag("--lockstep", "ls");
+  c.positional("LOG", "log")
+      .option("--speed", "X", "speed", "1.0")
+      .option("--out", "F", "out")
+      .flag("--lockstep", "ls");
   return c;
 }
 }  // namespace

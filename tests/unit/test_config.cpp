@@ -4,8 +4,8 @@
 #include <cmath>
 #include <fstream>
 
-#include "livo/config.hpp"
 #include "../temp_path.hpp"
+#include "livo/config.hpp"
 
 using livo::Config;
 using livo::ConfigError;

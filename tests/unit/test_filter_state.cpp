@@ -181,7 +181,8 @@ TEST(FilterState, MessageRoundTripKeepsTheCalibrationAndTheWholeCovariance) {
       {"camera_orientation", [&](filter_state_t& b) { b.camera_orientation[3] = nan; }},
       {"camera_position", [&](filter_state_t& b) { b.camera_position[2] = nan; }},
       {"camera_time_shift", [&](filter_state_t& b) { b.camera_time_shift = nan; }},
-      {"covariance (a calibration entry)", [&](filter_state_t& b) { b.covariance[kCameraDtRow + kCameraDt - 1] = nan; }},
+      {"covariance (a calibration entry)",
+       [&](filter_state_t& b) { b.covariance[kCameraDtRow + kCameraDt - 1] = nan; }},
   };
   for (const auto& [field, spoil] : poison) {
     bad = m;

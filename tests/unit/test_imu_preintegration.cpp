@@ -53,7 +53,8 @@ struct Motion {
     const Vec3 e = euler(t), de = eulerRate(t);
     const Mat3 Rx = Eigen::AngleAxisd(e.x(), Vec3::UnitX()).toRotationMatrix();
     const Mat3 Ry = Eigen::AngleAxisd(e.y(), Vec3::UnitY()).toRotationMatrix();
-    return de.x() * Vec3::UnitX() + Rx.transpose() * (de.y() * Vec3::UnitY() + Ry.transpose() * (de.z() * Vec3::UnitZ()));
+    return de.x() * Vec3::UnitX() +
+           Rx.transpose() * (de.y() * Vec3::UnitY() + Ry.transpose() * (de.z() * Vec3::UnitZ()));
   }
   Vec3 specificForce(double t) const { return rotation(t).transpose() * (acceleration(t) - kGravity); }
 };
@@ -149,7 +150,7 @@ TEST(ImuPreintegration, ResidualAtTruthIsThePredictionError) {
   Vec9 expected;
   expected << so3::Log(Mat3(R_pred.transpose() * R_j)), R_i.transpose() * (v_j - v_pred),
       R_i.transpose() * (p_j - p_pred);
-  EXPECT_GT(expected.norm(), 1e-7);  // the integration error is well above rounding ...
+  EXPECT_GT(expected.norm(), 1e-7);                // the integration error is well above rounding ...
   EXPECT_LT((at_truth - expected).norm(), 1e-13);  // ... and the residual is it, to rounding
 }
 
@@ -168,7 +169,8 @@ TEST(ImuPreintegration, BiasJacobiansMatchCentralDifferences) {
     const ImuPreintegration gp = preintegrate(m, t0, duration, rate, kGyroBias + d, kAccelBias);
     const ImuPreintegration gm = preintegrate(m, t0, duration, rate, kGyroBias - d, kAccelBias);
     R_g.col(i) = (so3::Log(Mat3(pre.deltaR().transpose() * gp.deltaR())) -
-                  so3::Log(Mat3(pre.deltaR().transpose() * gm.deltaR()))) / (2 * h);
+                  so3::Log(Mat3(pre.deltaR().transpose() * gm.deltaR()))) /
+                 (2 * h);
     V_g.col(i) = (gp.deltaV() - gm.deltaV()) / (2 * h);
     P_g.col(i) = (gp.deltaP() - gm.deltaP()) / (2 * h);
     const ImuPreintegration ap = preintegrate(m, t0, duration, rate, kGyroBias, kAccelBias + d);

@@ -7,8 +7,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "livo/imu_t.hpp"
-#include "livo/point_cloud_t.hpp"
 #include "livo/loginfo/log_summary.hpp"
+#include "livo/point_cloud_t.hpp"
 #include "temp_path.hpp"
 
 namespace {

@@ -128,7 +128,10 @@ TEST(MapInputs, TakeKeyframePoseAndMapCorrectionRefuseOnTheNode) {
   MapFrame::Placed shifted;
   shifted.placement = MapFrame::Placement::kUse;
   shifted.to_map = pose(1.0, 0.0);
-  const auto place = [&] { ++placements; return shifted; };
+  const auto place = [&] {
+    ++placements;
+    return shifted;
+  };
   Pose3 T;
   ASSERT_TRUE(takeKeyframePose(node, "KEYFRAME", k, true, place, &T));
   EXPECT_LT((T.matrix() - (pose(1.0, 0.0) * pose(2.0, 0.3)).matrix()).norm(), 1e-12);

@@ -99,7 +99,9 @@ TEST(Node, SpinStopsWhenDone) {
   imu_t m{};
   for (int i = 0; i < 3; ++i) lcm.publish("IMU", &m);
   bool flushed = false;
-  EXPECT_EQ(spin(lcm, node, [&] { flushed = true; }, [&] { return n == 3; }), 0);
+  EXPECT_EQ(spin(
+                lcm, node, [&] { flushed = true; }, [&] { return n == 3; }),
+            0);
   EXPECT_EQ(n, 3);
   EXPECT_TRUE(flushed);
 }

@@ -4,8 +4,8 @@
 
 #include "livo/reason_counts.hpp"
 
-using livo::ReasonCounts;
 using livo::parseReasonCounts;
+using livo::ReasonCounts;
 
 TEST(ReasonCounts, GroupsReasonsByTheirTextBeforeTheNumbers) {
   ReasonCounts r;
@@ -32,8 +32,8 @@ TEST(ReasonCounts, SummaryReadsBack) {
 }
 
 TEST(ReasonCounts, OtherTextIsNotASummary) {
-  for (const char* text : {"", "odometry reset to epoch 1: IMU gap", "priors kept by reason: ",
-                           "priors kept by reason: many x too few", "priors kept by reason: 3 too few",
-                           "priors kept by reason: -2 x too few", " by reason: 2 x too few"})
+  for (const char* text :
+       {"", "odometry reset to epoch 1: IMU gap", "priors kept by reason: ", "priors kept by reason: many x too few",
+        "priors kept by reason: 3 too few", "priors kept by reason: -2 x too few", " by reason: 2 x too few"})
     EXPECT_FALSE(parseReasonCounts(text).has_value()) << text;
 }

@@ -26,7 +26,9 @@ std::string rigYaml(const std::string& camera_extra, const std::string& channels
          camera_extra;
 }
 
-SensorRig readRig(const std::string& yaml) { return readSensorRig(Config::fromString(yaml, "rig.yaml").section("rig")); }
+SensorRig readRig(const std::string& yaml) {
+  return readSensorRig(Config::fromString(yaml, "rig.yaml").section("rig"));
+}
 
 std::string errorOf(const std::string& yaml) {
   try {
@@ -66,7 +68,8 @@ TEST(SensorRig, DepthCameraOnItsChannel) {
 }
 
 TEST(SensorRig, DistortionModelIsReadAndChecked) {
-  const SensorRig r = readRig(rigYaml("    distortion_model: equidistant\n    distortion: [0.01, -0.002, 0.0005, -0.0001]\n"));
+  const SensorRig r =
+      readRig(rigYaml("    distortion_model: equidistant\n    distortion: [0.01, -0.002, 0.0005, -0.0001]\n"));
   EXPECT_EQ(r.camera->distortion_model, DistortionModel::kEquidistant);
   EXPECT_DOUBLE_EQ(r.camera->distortion[2], 0.0005);
   std::ostringstream os;

@@ -12,8 +12,8 @@ namespace {
 std::vector<Vec3> testVectors() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Vec3> v = {Vec3::Zero(), Vec3(1e-9, -2e-9, 3e-9), Vec3(1e-6, 0, 0), Vec3(0.3, -0.2, 0.1),
-                         Vec3(0, 0, M_PI - 1e-4), Vec3(2.0, 1.0, -0.5).normalized() * 3.0};
+  std::vector<Vec3> v = {Vec3::Zero(),         Vec3(1e-9, -2e-9, 3e-9), Vec3(1e-6, 0, 0),
+                         Vec3(0.3, -0.2, 0.1), Vec3(0, 0, M_PI - 1e-4), Vec3(2.0, 1.0, -0.5).normalized() * 3.0};
   for (int i = 0; i < 20; ++i) v.push_back(Vec3(u(rng), u(rng), u(rng)) * 2.5);
   return v;
 }

@@ -58,9 +58,7 @@ TEST(SpillFile, ReleasedRecordsGiveTheirDiskSpaceBack) {
   EXPECT_EQ(back, c);
 }
 
-TEST(SpillFile, RefusesADirectoryItCannotWriteTo) {
-  EXPECT_THROW(SpillFile("/nonexistent/livo"), std::runtime_error);
-}
+TEST(SpillFile, RefusesADirectoryItCannotWriteTo) { EXPECT_THROW(SpillFile("/nonexistent/livo"), std::runtime_error); }
 
 TEST(KeyframeCloudStore, FloatCloudsComeBackExactly) {
   KeyframeCloudStore store(0.0);

@@ -38,7 +38,7 @@ TEST(SweepTiming, EmptySweepEndsAtItsDurationOrAtItsStart) {
 
 TEST(SweepTiming, EndsAtTheLaterOfTheDurationAndTheLastOffset) {
   EXPECT_EQ(sweepEndOffset(sweep(0.1, {0.0f, 0.125f, 0.25f, 0.0625f})), 0.25);  // points past the duration
-  EXPECT_EQ(sweepEndOffset(sweep(0.125, {0.0f, 0.0625f})), 0.125);             // the duration past the points
+  EXPECT_EQ(sweepEndOffset(sweep(0.125, {0.0f, 0.0625f})), 0.125);              // the duration past the points
   EXPECT_EQ(sweepTiming(sweep(0.1, {0.0f, 0.25f}), 0.0).end_utime, 1'250'000);
 }
 
@@ -53,7 +53,7 @@ TEST(SweepTiming, NegativeNonFiniteAndTooLargeOffsetsDoNotMoveTheEnd) {
   EXPECT_EQ(sweepEndOffset(sweep(0.0, {-0.5f, 0.0625f, -2.0f})), 0.0625);
   EXPECT_EQ(sweepEndOffset(sweep(0.0, {kNaN, kInf, -kInf, 0.125f})), 0.125);
   EXPECT_EQ(sweepEndOffset(sweep(0.1, {0.25f, 1.5f, 1000.0f})), 0.25);  // beyond the 1 s cap: garbage
-  EXPECT_EQ(sweepEndOffset(sweep(0.1, {0.25f, 1.0f})), 1.0);           // at the cap: kept
+  EXPECT_EQ(sweepEndOffset(sweep(0.1, {0.25f, 1.0f})), 1.0);            // at the cap: kept
   EXPECT_EQ(sweepEndOffset(sweep(std::nan(""), {kNaN, -1.0f, 2.0f})), 0.0);
 }
 

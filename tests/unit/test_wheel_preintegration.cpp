@@ -150,7 +150,8 @@ TEST(WheelPreintegration, TemplatedResidualEqualsDouble) {
   const WheelRig rig = testRig();
   const WheelPreintegration pre = drive(rig, 2.0, 0.4, 2.0);
   const Pose3 Ti = imuPose(rig, kStart, 2.0, 0.4, 0.0), Tj = imuPose(rig, kStart, 2.0, 0.4, 2.0);
-  const Mat3 R_i = Ti.linear() * so3::Exp(Vec3(0.02, -0.01, 0.03)), R_j = Tj.linear() * so3::Exp(Vec3(-0.02, 0.01, 0.02));
+  const Mat3 R_i = Ti.linear() * so3::Exp(Vec3(0.02, -0.01, 0.03)),
+             R_j = Tj.linear() * so3::Exp(Vec3(-0.02, 0.01, 0.02));
   const Vec3 p_i = Ti.translation() + Vec3(0.1, -0.05, 0.02), p_j = Tj.translation() + Vec3(-0.03, 0.2, 0.1);
   const Vec6 expected = pre.residual(R_i, p_i, R_j, p_j);
   const Eigen::Vector4d q_i = Quat(R_i).coeffs(), q_j = Quat(R_j).coeffs();
@@ -213,7 +214,8 @@ TEST(WheelPreintegration, CovarianceMatchesReadingNoise) {
   // readings' noise: [left_0 .. left_n, right_0 .. right_n]
   auto integrateWith = [&](const Eigen::VectorXd& e) {
     WheelPreintegration pre(rig, noise);
-    for (int k = 0; k < n; ++k) pre.integrate(left + e[k], right + e[n + 1 + k], left + e[k + 1], right + e[n + 2 + k], dt);
+    for (int k = 0; k < n; ++k)
+      pre.integrate(left + e[k], right + e[n + 1 + k], left + e[k + 1], right + e[n + 2 + k], dt);
     return pre;
   };
   const WheelPreintegration ref = integrateWith(Eigen::VectorXd::Zero(2 * (n + 1)));
@@ -271,8 +273,8 @@ TEST(WheelPreintegration, ScaleJacobiansMatchCentralDifferences) {
     const Vec3 dtheta = so3::Log(Mat3(minus.deltaR().transpose() * plus.deltaR())) / (2 * h);
     const Vec3 dp = (plus.deltaP() - minus.deltaP()) / (2 * h);
     EXPECT_LT((dtheta - pre.rotationScaleJacobian().col(i)).norm(), 1e-6) << "scale " << i;
-    EXPECT_LT((dp - pre.positionScaleJacobian().col(i)).norm(), 1e-5) << "scale " << i << ": " << dp.transpose()
-                                                                       << " vs " << pre.positionScaleJacobian().col(i).transpose();
+    EXPECT_LT((dp - pre.positionScaleJacobian().col(i)).norm(), 1e-5)
+        << "scale " << i << ": " << dp.transpose() << " vs " << pre.positionScaleJacobian().col(i).transpose();
   }
   // the yaw depends on the scales, the position too (3 s at about 2 m/s)
   EXPECT_GT(pre.rotationScaleJacobian().row(2).norm(), 1.0);
@@ -302,7 +304,8 @@ TEST(WheelPreintegration, ScaleCorrectionIsSecondOrder) {
     EXPECT_LT(at_truth.norm(), 1e-9);
     corrected_norm[k] = corrected.norm();
     uncorrected_norm[k] = uncorrected.norm();
-    EXPECT_LT(corrected_norm[k], 0.1 * uncorrected_norm[k]) << corrected.transpose() << " vs " << uncorrected.transpose();
+    EXPECT_LT(corrected_norm[k], 0.1 * uncorrected_norm[k])
+        << corrected.transpose() << " vs " << uncorrected.transpose();
   }
   EXPECT_NEAR(uncorrected_norm[0] / uncorrected_norm[1], 2.0, 0.2);
   EXPECT_NEAR(corrected_norm[0] / corrected_norm[1], 4.0, 0.4);
@@ -412,8 +415,7 @@ TEST(WheelPreintegrationJet, MountingDerivativesMatchCentralDifferences) {
   const Pose3 Tj = Ti * se3::fromRotationTranslation(so3::Exp(Vec3(0.02, -0.03, 0.5)), Vec3(5.0, 0.4, -0.2));
   for (const Vec3& delta : {Vec3::Zero().eval(), Vec3(0.012, -0.009, 0.017)}) {
     Eigen::Matrix<double, kParams, 1> x;
-    x << Quat(Ti.linear()).coeffs(), Ti.translation(), Quat(Tj.linear()).coeffs(), Tj.translation(), 1.01, 0.995,
-        delta;
+    x << Quat(Ti.linear()).coeffs(), Ti.translation(), Quat(Tj.linear()).coeffs(), Tj.translation(), 1.01, 0.995, delta;
     auto residual = [&](const auto* p) {
       using T = std::decay_t<decltype(*p)>;
       Eigen::Matrix<T, 6, 1> r;
@@ -431,8 +433,8 @@ TEST(WheelPreintegrationJet, MountingDerivativesMatchCentralDifferences) {
       const Vec6 numeric = (residual(xp.data()) - residual(xm.data())) / (2 * h);
       for (int k = 0; k < 6; ++k) {
         ASSERT_TRUE(std::isfinite(rj[k].v[i]));
-        EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7) << "delta " << delta.transpose() << " residual " << k
-                                                  << " parameter " << i;
+        EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7)
+            << "delta " << delta.transpose() << " residual " << k << " parameter " << i;
       }
     }
     // the mounting moves the translation residual by about the distance driven (5 m) per radian

@@ -28,7 +28,8 @@ TEST(WorkerThreads, EveryIndexIsHandledExactlyOnceInContiguousShares) {
               shares.emplace_back(b, e);
             },
             min_share);
-        for (size_t i = 0; i < n; ++i) ASSERT_EQ(count[i], 1) << "index " << i << " of " << n << ", " << threads << " threads";
+        for (size_t i = 0; i < n; ++i)
+          ASSERT_EQ(count[i], 1) << "index " << i << " of " << n << ", " << threads << " threads";
         const size_t expected = std::max<size_t>(1, std::min<size_t>(threads, n / min_share));
         EXPECT_EQ(shares.size(), expected) << n << " indices, " << threads << " threads, min_share " << min_share;
         if (shares.size() > 1) {

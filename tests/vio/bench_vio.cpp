@@ -31,7 +31,7 @@ double cpuSeconds() {
 struct Frame {
   double t;
   GreyImage image;
-  FilterState prior;       // with the rig's camera calibration
+  FilterState prior;  // with the rig's camera calibration
   Vec3 body_rate = Vec3::Zero();
   std::vector<Vec3> scan;  // the sweep that ended just before the image, if one did
   int64_t scan_utime = 0;
@@ -48,7 +48,8 @@ const std::vector<Frame>& frames() {
       fr.t = t0 + 0.05 * k;
       fr.image = s.image(fr.t, static_cast<uint64_t>(k));
       StateVector d = StateVector::Zero();
-      d.head<3>() = Vec3(std::sin(1.3 * k), std::cos(0.7 * k), std::sin(0.4 * k + 1.0)).normalized() * (0.2 * M_PI / 180.0);
+      d.head<3>() =
+          Vec3(std::sin(1.3 * k), std::cos(0.7 * k), std::sin(0.4 * k + 1.0)).normalized() * (0.2 * M_PI / 180.0);
       d.segment<3>(3) = Vec3(std::cos(1.1 * k), std::sin(0.9 * k), std::cos(0.3 * k + 2.0)).normalized() * 0.01;
       fr.prior = s.trueState(fr.t).boxplus(d);
       fr.body_rate = s.bodyRate(fr.t);

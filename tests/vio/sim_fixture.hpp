@@ -12,11 +12,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "livo/filter_state.hpp"
 #include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/lidar_scanner.hpp"
-#include "livo/filter_state.hpp"
-#include "livo/vio/grey_image.hpp"
 #include "livo/sim/simulation_setup.hpp"
+#include "livo/vio/grey_image.hpp"
 
 namespace livo_test {
 
@@ -80,8 +80,10 @@ class SimScene {
     g.utime = c.utime;
     g.exposure_time = c.exposure_time;
     const cv::Mat view(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data()));
-    if (c.color) cv::cvtColor(view, g.pixels, cv::COLOR_RGB2GRAY);
-    else g.pixels = view.clone();
+    if (c.color)
+      cv::cvtColor(view, g.pixels, cv::COLOR_RGB2GRAY);
+    else
+      g.pixels = view.clone();
     return g;
   }
 

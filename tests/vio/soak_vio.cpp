@@ -118,7 +118,8 @@ class LivoDriver : public livo_soak::SimLioDriver {
     livo::FilterState x;
     livo::StateCovariance P;
     std::string why;
-    if (posterior.valid && livo::fromFilterState(posterior, &x, &P) && lio.adoptPosterior(posterior.utime, x, P, &why)) {
+    if (posterior.valid && livo::fromFilterState(posterior, &x, &P) &&
+        lio.adoptPosterior(posterior.utime, x, P, &why)) {
       ++adopted_;
       ++period_.adopted;
     } else if (posterior.valid) {
@@ -156,8 +157,7 @@ class LivoDriver : public livo_soak::SimLioDriver {
     image_total_.add(s);
     if (!r.valid) return keep(prior, r.why);
     ++vio_updated_;
-    return livo::vio::toPosterior(prior, vio_opts_.name, r.state, r.covariance, true, r.iterations,
-                                  r.num_measurements);
+    return livo::vio::toPosterior(prior, vio_opts_.name, r.state, r.covariance, true, r.iterations, r.num_measurements);
   }
 
   filter_state_t keep(const filter_state_t& prior, const std::string& why) {
@@ -212,9 +212,8 @@ Sample takeSample(double sim_s, LivoDriver& d) {
 }
 
 void printHeader() {
-  std::printf("%6s %7s %7s %7s %7s %7s %6s %6s %7s %4s %5s %6s %6s %5s %6s\n", "sim_s", "rss_mb", "peak_mb",
-              "heap_mb", "vio_pts", "patches", "vio_mb", "scan_p", "voxels", "kfs", "imgs", "img_ms", "swp_ms", "valid",
-              "err_m");
+  std::printf("%6s %7s %7s %7s %7s %7s %6s %6s %7s %4s %5s %6s %6s %5s %6s\n", "sim_s", "rss_mb", "peak_mb", "heap_mb",
+              "vio_pts", "patches", "vio_mb", "scan_p", "voxels", "kfs", "imgs", "img_ms", "swp_ms", "valid", "err_m");
 }
 
 void printSample(const Sample& s) {
@@ -287,25 +286,28 @@ int main(int argc, char** argv) {
 
     const Sample* at_early = livo_soak::sampleAtOrAfter(samples, early);
     const Sample& last = samples.back();
-    std::printf("\nsimulated %.0f s in %.0f s wall, camera at %.3g Hz; %lld sweeps with output (%lld tracked, %lld "
-                "predicted, %lld rejected, %lld initialising); %lld re-initialisations; %lld IMU samples refused\n",
-                stats.sim_seconds, stats.wall_seconds, camera_rate, static_cast<long long>(livo_driver.sweeps()),
-                static_cast<long long>(livo_driver.count(ScanResult::Status::kTracked)),
-                static_cast<long long>(livo_driver.count(ScanResult::Status::kPredicted)),
-                static_cast<long long>(livo_driver.count(ScanResult::Status::kRejected)),
-                static_cast<long long>(livo_driver.count(ScanResult::Status::kInitializing)),
-                static_cast<long long>(livo_driver.resets()), static_cast<long long>(livo_driver.refusedImu()));
+    std::printf(
+        "\nsimulated %.0f s in %.0f s wall, camera at %.3g Hz; %lld sweeps with output (%lld tracked, %lld "
+        "predicted, %lld rejected, %lld initialising); %lld re-initialisations; %lld IMU samples refused\n",
+        stats.sim_seconds, stats.wall_seconds, camera_rate, static_cast<long long>(livo_driver.sweeps()),
+        static_cast<long long>(livo_driver.count(ScanResult::Status::kTracked)),
+        static_cast<long long>(livo_driver.count(ScanResult::Status::kPredicted)),
+        static_cast<long long>(livo_driver.count(ScanResult::Status::kRejected)),
+        static_cast<long long>(livo_driver.count(ScanResult::Status::kInitializing)),
+        static_cast<long long>(livo_driver.resets()), static_cast<long long>(livo_driver.refusedImu()));
     const int64_t priors = livo_driver.priors();
-    std::printf("images: %lld handed off (priors), %lld updated by the VIO, %lld adopted by the LIO (%.1f %%), %lld "
-                "skipped (LIO not tracking or past them); %lld registered scans refused\n",
-                static_cast<long long>(priors), static_cast<long long>(livo_driver.vioUpdated()),
-                static_cast<long long>(livo_driver.adopted()),
-                priors > 0 ? 100.0 * static_cast<double>(livo_driver.adopted()) / static_cast<double>(priors) : 0.0,
-                static_cast<long long>(livo_driver.imagesSkipped()), static_cast<long long>(livo_driver.scansRefused()));
+    std::printf(
+        "images: %lld handed off (priors), %lld updated by the VIO, %lld adopted by the LIO (%.1f %%), %lld "
+        "skipped (LIO not tracking or past them); %lld registered scans refused\n",
+        static_cast<long long>(priors), static_cast<long long>(livo_driver.vioUpdated()),
+        static_cast<long long>(livo_driver.adopted()),
+        priors > 0 ? 100.0 * static_cast<double>(livo_driver.adopted()) / static_cast<double>(priors) : 0.0,
+        static_cast<long long>(livo_driver.imagesSkipped()), static_cast<long long>(livo_driver.scansRefused()));
     for (const auto& [why, n] : livo_driver.keptReasons())
       std::printf("  prior kept %lld times: %s\n", static_cast<long long>(n), why.c_str());
     std::printf("per image (processImage): median %.2f ms, p90 %.2f ms, max %.2f ms\n",
-                livo_driver.imageStats().medianMs(), livo_driver.imageStats().p90Ms(), livo_driver.imageStats().maxMs());
+                livo_driver.imageStats().medianMs(), livo_driver.imageStats().p90Ms(),
+                livo_driver.imageStats().maxMs());
     std::printf("per sweep (LIO addScan): median %.2f ms, p90 %.2f ms, max %.2f ms; VIO addScan: median %.2f ms\n",
                 livo_driver.totalStats().medianMs(), livo_driver.totalStats().p90Ms(), livo_driver.totalStats().maxMs(),
                 livo_driver.vioScanStats().medianMs());
@@ -318,10 +320,11 @@ int main(int argc, char** argv) {
       std::printf("the run is shorter than --early (%.0f s): no ratio\n", early);
     }
     if (livo_driver.estimated().size() >= 3) {
-      std::printf("ATE (SE(3)-aligned position RMSE over %zu sweeps): %.3f m; final position error (first pose aligned): %.3f m\n",
-                  livo_driver.estimated().size(),
-                  livo_soak::ateRmse(livo_driver.estimated(), livo_driver.groundTruth()),
-                  livo_driver.lastPositionError());
+      std::printf(
+          "ATE (SE(3)-aligned position RMSE over %zu sweeps): %.3f m; final position error (first pose aligned): %.3f "
+          "m\n",
+          livo_driver.estimated().size(), livo_soak::ateRmse(livo_driver.estimated(), livo_driver.groundTruth()),
+          livo_driver.lastPositionError());
     }
   } catch (const std::exception& e) {
     std::cerr << "livo_vio_soak: " << e.what() << "\n";

@@ -23,7 +23,8 @@ namespace {
 cv::Mat pattern(int w, int h) {
   cv::Mat img(h, w, CV_8UC1);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) img.at<uint8_t>(y, x) = static_cast<uint8_t>((x * 7 + y * 13 + (x * y) % 11) % 200 + 20);
+    for (int x = 0; x < w; ++x)
+      img.at<uint8_t>(y, x) = static_cast<uint8_t>((x * 7 + y * 13 + (x * y) % 11) % 200 + 20);
   return img;
 }
 
@@ -98,8 +99,8 @@ TEST(VioImage, PyramidAveragesAndSamplesConsistently) {
   ASSERT_TRUE(pyr.sampleGrid(0, c, 5, grid));
   for (int j = 0; j < 5; ++j)
     for (int i = 0; i < 5; ++i) EXPECT_NEAR(grid[j * 5 + i], pyr.sample(0, c.x() + i - 2, c.y() + j - 2), 1e-3);
-  EXPECT_FALSE(pyr.sampleGrid(0, Eigen::Vector2d(1.0, 20.0), 5, grid));   // leaves on the left
-  EXPECT_FALSE(pyr.sampleGrid(2, Eigen::Vector2d(14.0, 6.0), 5, grid));   // and on the right at level 2
+  EXPECT_FALSE(pyr.sampleGrid(0, Eigen::Vector2d(1.0, 20.0), 5, grid));  // leaves on the left
+  EXPECT_FALSE(pyr.sampleGrid(2, Eigen::Vector2d(14.0, 6.0), 5, grid));  // and on the right at level 2
 }
 
 TEST(VioImage, StoredPatchAndIdentityWarpReproduceTheImage) {
@@ -111,8 +112,8 @@ TEST(VioImage, StoredPatchAndIdentityWarpReproduceTheImage) {
   ASSERT_TRUE(extractStoredPatches(pyr, u0, 3, stored.data()));
   float warped[kPatchArea];
   for (int l = 0; l < 3; ++l) {
-    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero(),
-                                   warped));
+    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(),
+                                   Eigen::Vector2d::Zero(), warped));
     const Eigen::Vector2d ul = ImagePyramid::toLevel(u0, l);
     for (int j = 0; j < kPatch; ++j)
       for (int i = 0; i < kPatch; ++i)
@@ -127,7 +128,8 @@ TEST(VioImage, StoredPatchAndIdentityWarpReproduceTheImage) {
     // the derivative of each sample along a (fractional) shift: that of the bilinear interpolant
     const Eigen::Vector2d shift(1.6, -2.3);
     float gx[kPatchArea], gy[kPatchArea], ahead[kPatchArea];
-    ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), shift, warped, gx, gy));
+    ASSERT_TRUE(
+        warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(), shift, warped, gx, gy));
     const double h = 0.01;  // within one bilinear cell: the interpolant is linear in each coordinate
     ASSERT_TRUE(warpReferencePatch(stored.data() + l * kStoredArea, Eigen::Matrix2d::Identity(),
                                    shift + Eigen::Vector2d(h, 0.0), ahead));
@@ -207,8 +209,8 @@ TEST(VioImage, VectorisedSamplingIsTheScalarFormulaBitForBit) {
     Eigen::Matrix2d A;
     A << 0.7 + 0.6 * u(rng), 0.4 * (u(rng) - 0.5), 0.4 * (u(rng) - 0.5), 0.7 + 0.6 * u(rng);
     // half the trials re-centred by a shift of up to 1.5 pixels
-    const Eigen::Vector2d shift = trial % 2 == 0 ? Eigen::Vector2d::Zero()
-                                                 : Eigen::Vector2d(3.0 * (u(rng) - 0.5), 3.0 * (u(rng) - 0.5));
+    const Eigen::Vector2d shift =
+        trial % 2 == 0 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(3.0 * (u(rng) - 0.5), 3.0 * (u(rng) - 0.5));
     float warped[kPatchArea], scalar[kPatchArea], gx[kPatchArea], gy[kPatchArea], sgx[kPatchArea], sgy[kPatchArea];
     if (!warpReferencePatch(stored.data(), A, shift, warped, gx, gy)) continue;
     warpReference(stored.data(), A, shift, scalar, sgx, sgy);
@@ -326,7 +328,7 @@ TEST(VioSelection, DepthEdgeTellsSlantedPlanesFromSteps) {
   // a box face at 3.4 m in front of a wall at 4 m, its edge 5 px left of the point
   auto step = [&](double u, double) { return u < px.x() - 5.0 ? 4.0 : 3.4; };
   fill(&g, step);
-  EXPECT_TRUE(g.depthEdge(px, 3.4, 16.0, 0.03, 0.03));   // on the box, next to the edge
+  EXPECT_TRUE(g.depthEdge(px, 3.4, 16.0, 0.03, 0.03));                                // on the box, next to the edge
   EXPECT_FALSE(g.depthEdge(px + Eigen::Vector2d(30.0, 0.0), 3.4, 16.0, 0.03, 0.03));  // well inside the face
   // on a LiDAR row (v = 146): the wall behind the box is hidden, the box itself is not; between
   // rows nothing is known

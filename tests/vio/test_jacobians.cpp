@@ -62,7 +62,8 @@ cv::Mat saddleImage(int w, int h, int level, int i0, int j0) {
 
 TEST(VioJacobians, DistortionJacobianMatchesNumeric) {
   const CameraProjection cam(distortedCamera());
-  for (const Eigen::Vector2d& xy : {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.41, -0.33), Eigen::Vector2d(-0.62, 0.47)}) {
+  for (const Eigen::Vector2d& xy :
+       {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.41, -0.33), Eigen::Vector2d(-0.62, 0.47)}) {
     const Eigen::Matrix2d J = cam.distortJacobian(xy);
     const double h = 1e-6;
     for (int k = 0; k < 2; ++k) {
@@ -132,7 +133,8 @@ FilterState calibratedState(const CameraRig& rig) {
   FilterState x = bodyState();
   x.vel = Vec3(0.8, -0.4, 0.3);
   x.camera = SensorCalibration::fromPose(
-      rig.T_I_C * se3::fromRotationTranslation(so3::Exp(Vec3(0.004, -0.003, 0.005)), Vec3(0.002, -0.001, 0.003)), 0.004);
+      rig.T_I_C * se3::fromRotationTranslation(so3::Exp(Vec3(0.004, -0.003, 0.005)), Vec3(0.002, -0.001, 0.003)),
+      0.004);
   return x;
 }
 
@@ -218,8 +220,8 @@ TEST(VioJacobians, PhotometricJacobianWrtTheStateMatchesNumeric) {
         // image (the affine case): there the reference's gradient is the image's through the warp,
         // as the residual takes it (photometric_residual.hpp)
         for (int k = 0; k < (affine ? kMeasuredDim : 6); ++k)
-          EXPECT_LT((J.col(k) - N.col(k)).norm(), 3e-3 * N.norm()) << "affine " << affine << " level " << level
-                                                                   << " column " << k;
+          EXPECT_LT((J.col(k) - N.col(k)).norm(), 3e-3 * N.norm())
+              << "affine " << affine << " level " << level << " column " << k;
         // the reference view moves with the calibration: its columns are not the current pixel's alone
         EXPECT_GT((e.G.rightCols<2>() * e.B.bottomRows<2>()).norm(), 0.01 * J.norm());
         ++checked;
@@ -282,7 +284,7 @@ TEST(VioRollingShutter, PointIsSeenFromThePoseOfItsRow) {
   const FilterState x = movingState();
   const RollingShutter s = brisk(rig);
   EXPECT_DOUBLE_EQ(s.line_time, 0.02 / 512);
-  EXPECT_DOUBLE_EQ(s.rowTime(255.5), 0.0);   // the stamp is the centre row's
+  EXPECT_DOUBLE_EQ(s.rowTime(255.5), 0.0);                 // the stamp is the centre row's
   EXPECT_DOUBLE_EQ(s.rowTime(511.0), 255.5 * 0.02 / 512);  // the last row: half a readout (less half a line) later
   for (const Eigen::Vector3d& uvz : {Vec3(0.1, -0.5, 2.5), Vec3(-0.55, 0.4, 4.0), Vec3(0.6, 0.45, 1.2)}) {
     const Vec3 p_W = worldPoint(rig, x, uvz.x(), uvz.y(), uvz.z());

@@ -57,7 +57,8 @@ void seed(const livo_test::SimScene& s, VioEstimator* vio, double t0, double swe
 
 StateVector offsetOf(double rot_deg, double pos_m, int k) {
   StateVector d = StateVector::Zero();
-  d.head<3>() = Vec3(std::sin(1.3 * k + 0.2), std::cos(0.7 * k), std::sin(0.4 * k + 1.0)).normalized() * (rot_deg * M_PI / 180.0);
+  d.head<3>() =
+      Vec3(std::sin(1.3 * k + 0.2), std::cos(0.7 * k), std::sin(0.4 * k + 1.0)).normalized() * (rot_deg * M_PI / 180.0);
   d.segment<3>(3) = Vec3(std::cos(1.1 * k), std::sin(0.9 * k + 0.5), std::cos(0.3 * k + 2.0)).normalized() * pos_m;
   return d;
 }
@@ -78,13 +79,16 @@ TEST(VioEstimator, SingleImageUpdateRecoversAKnownPoseOffset) {
   const FilterState prior = truth.boxplus(offset);
   const StateCovariance P = livo_test::priorCovariance(1.0 * M_PI / 180.0, 0.05);
   const ImageResult r = vio.processImage(s.image(t1, 2), prior, P, s.bodyRate(t1));
-  ASSERT_TRUE(r.valid) << r.why << " (in view " << r.selection.in_view << ", occluded " << r.selection.occluded << ", depth edge " << r.selection.depth_edge << ", no reference " << r.selection.no_reference << ", selected " << r.selection.selected << ")";
+  ASSERT_TRUE(r.valid) << r.why << " (in view " << r.selection.in_view << ", occluded " << r.selection.occluded
+                       << ", depth edge " << r.selection.depth_edge << ", no reference " << r.selection.no_reference
+                       << ", selected " << r.selection.selected << ")";
   const PoseError before = poseError(prior, truth), after = poseError(r.state, truth);
-  std::printf("prior error %.3f deg %.4f m -> posterior %.3f deg %.4f m; %d patches, %d residuals, %d iterations, "
-              "NIS %.2f (%d dof, gate %.2f), cost %.2f -> %.2f, selection in view %d occluded %d no ref %d\n",
-              before.rot_deg, before.pos_m, after.rot_deg, after.pos_m, r.patches, r.num_measurements, r.iterations,
-              r.consistency.nis, r.consistency.dof, r.consistency.threshold, r.cost_prior, r.cost_post,
-              r.selection.in_view, r.selection.occluded, r.selection.no_reference);
+  std::printf(
+      "prior error %.3f deg %.4f m -> posterior %.3f deg %.4f m; %d patches, %d residuals, %d iterations, "
+      "NIS %.2f (%d dof, gate %.2f), cost %.2f -> %.2f, selection in view %d occluded %d no ref %d\n",
+      before.rot_deg, before.pos_m, after.rot_deg, after.pos_m, r.patches, r.num_measurements, r.iterations,
+      r.consistency.nis, r.consistency.dof, r.consistency.threshold, r.cost_prior, r.cost_post, r.selection.in_view,
+      r.selection.occluded, r.selection.no_reference);
   EXPECT_NEAR(before.rot_deg, 0.5, 1e-9);
   EXPECT_NEAR(before.pos_m, 0.03, 1e-9);
   EXPECT_LT(after.rot_deg, 0.1 * before.rot_deg);
@@ -118,8 +122,8 @@ TEST(VioEstimator, TracksASequenceAndMaintainsTheMap) {
     const double t = t0 + 0.05 * k;
     if (k % 2 == 0) vio.addScan(s.utime(t), s.sweep(t - 0.1, static_cast<uint64_t>(10 + k)));
     const FilterState truth = s.trueState(t);
-    const ImageResult r =
-        vio.processImage(s.image(t, static_cast<uint64_t>(10 + k)), truth.boxplus(offsetOf(0.2, 0.01, k)), P, s.bodyRate(t));
+    const ImageResult r = vio.processImage(s.image(t, static_cast<uint64_t>(10 + k)),
+                                           truth.boxplus(offsetOf(0.2, 0.01, k)), P, s.bodyRate(t));
     valid += r.valid;
     new_points += r.new_points;
     new_patches += r.new_patches;
@@ -130,15 +134,16 @@ TEST(VioEstimator, TracksASequenceAndMaintainsTheMap) {
   }
   std::sort(pos_err.begin(), pos_err.end());
   std::sort(rot_err.begin(), rot_err.end());
-  std::printf("sequence: %d/30 valid, median error %.4f m %.4f deg, worst %.4f m %.4f deg, %d new points, "
-              "%d new patches, map %zu points\n",
-              valid, pos_err[15], rot_err[15], pos_err.back(), rot_err.back(), new_points, new_patches, vio.map().size());
+  std::printf(
+      "sequence: %d/30 valid, median error %.4f m %.4f deg, worst %.4f m %.4f deg, %d new points, "
+      "%d new patches, map %zu points\n",
+      valid, pos_err[15], rot_err[15], pos_err.back(), rot_err.back(), new_points, new_patches, vio.map().size());
   EXPECT_GE(valid, 28);
-  EXPECT_LT(pos_err[15], 0.004);       // from 10 mm
-  EXPECT_LT(rot_err[15], 0.05);        // from 0.2 deg
+  EXPECT_LT(pos_err[15], 0.004);  // from 10 mm
+  EXPECT_LT(rot_err[15], 0.05);   // from 0.2 deg
   EXPECT_LT(pos_err.back(), 0.01);
-  EXPECT_GT(new_points, 20);           // the map grows as the view moves on
-  EXPECT_GT(new_patches, 5);           // and tracked points get new patches as their view changes
+  EXPECT_GT(new_points, 20);  // the map grows as the view moves on
+  EXPECT_GT(new_patches, 5);  // and tracked points get new patches as their view changes
 }
 
 TEST(VioEstimator, SolidStateLidarPointsWorkTheSame) {
@@ -270,7 +275,8 @@ TEST(VioEstimator, RollingShutterRowsArePlacedWithTheGivenBodyRate) {
       min_row = std::min(min_row, row);
       max_row = std::max(max_row, row);
       const double dt = shift + row;
-      worst_rot = std::max(worst_rot, so3::Log((prior.rot * so3::Exp(rate * dt)).transpose() * v.T_W_I.linear()).norm());
+      worst_rot =
+          std::max(worst_rot, so3::Log((prior.rot * so3::Exp(rate * dt)).transpose() * v.T_W_I.linear()).norm());
       worst_pos = std::max(worst_pos, (v.T_W_I.translation() - (prior.pos + prior.vel * dt)).norm());
     }
     // (the row time is that of the projection before the last fixed-point step: a few hundredths
@@ -298,7 +304,7 @@ TEST(VioEstimator, VoxelPointsSnapFlatVoxelsOntoTheirPlane) {
   auto add = [&](double a, double b, double c) { x.push_back(a), y.push_back(b), z.push_back(c); };
   add(0.15, 0.15, 0.15 + 0.06);  // the wall's first point, 2 sigma off
   for (int i = 0; i < 60; ++i) add(u(rng), u(rng), std::clamp(0.15 + noise(rng), 0.001, 0.299));
-  add(std::nan(""), 0.1, 0.1);   // skipped
+  add(std::nan(""), 0.1, 0.1);  // skipped
   // corner voxel at x in [1.2, 1.5): half the points on z = 0.05, half on x = 1.25
   add(1.4, 0.15, 0.12);
   for (int i = 0; i < 30; ++i) add(1.2 + u(rng), u(rng), 0.05), add(1.25, u(rng), u(rng));
@@ -340,7 +346,7 @@ TEST(VioEstimator, VoxelPointsGiveTheNormalsOfPlanarVoxelsOnly) {
   EXPECT_EQ(normals[2], Vec3::Zero());
   EXPECT_EQ(normals[3], Vec3::Zero());
   EXPECT_TRUE(points[0].isApprox(Vec3(x[0], y[0], z[0]), 1e-6));  // normals do not move the points
-  o.normal_max_rms = 0.0;  // off: no normals
+  o.normal_max_rms = 0.0;                                         // off: no normals
   voxelPoints(x.data(), y.data(), z.data(), x.size(), o, &normals);
   ASSERT_EQ(normals.size(), 4u);
   EXPECT_EQ(normals[0], Vec3::Zero());
@@ -493,7 +499,8 @@ CalibrationRun runCalibration(const Pose3& T_err, double time_shift, double t0, 
     prior.camera = camera;
     StateCovariance P = P_nav;
     P.block<7, 7>(c, c) = P_camera;
-    const ImageResult r = vio.processImage(s.image(t, static_cast<uint64_t>(100 + k), time_shift), prior, P, s.bodyRate(t));
+    const ImageResult r =
+        vio.processImage(s.image(t, static_cast<uint64_t>(100 + k), time_shift), prior, P, s.bodyRate(t));
     ++run.images;
     if (!r.valid) ++run.why[r.why.substr(0, r.why.find(" ("))];
     if (r.valid) {
@@ -509,11 +516,13 @@ CalibrationRun runCalibration(const Pose3& T_err, double time_shift, double t0, 
     run.covariance.push_back(P_camera);
     if (verbose) {
       const Vec7& e = run.error.back();
-      std::printf("    %5.2f %d %3d patches, NIS %6.2f / %6.2f (%d dof), pose err %.3f deg %.4f m, cal err [%.3f %.3f %.3f] deg "
-                  "%.3f ms %s\n",
-                  t, r.valid, r.patches, r.consistency.nis, r.consistency.threshold, r.consistency.dof,
-                  poseError(r.state, s.trueState(t)).rot_deg, poseError(r.state, s.trueState(t)).pos_m,
-                  e[0] * 180.0 / M_PI, e[1] * 180.0 / M_PI, e[2] * 180.0 / M_PI, e[6] * 1e3, r.why.c_str());
+      std::printf(
+          "    %5.2f %d %3d patches, NIS %6.2f / %6.2f (%d dof), pose err %.3f deg %.4f m, cal err [%.3f %.3f %.3f] "
+          "deg "
+          "%.3f ms %s\n",
+          t, r.valid, r.patches, r.consistency.nis, r.consistency.threshold, r.consistency.dof,
+          poseError(r.state, s.trueState(t)).rot_deg, poseError(r.state, s.trueState(t)).pos_m, e[0] * 180.0 / M_PI,
+          e[1] * 180.0 / M_PI, e[2] * 180.0 / M_PI, e[6] * 1e3, r.why.c_str());
     }
   }
   run.final_translation_change = camera.pos - s.camera().T_I_C.translation();
@@ -561,9 +570,8 @@ TEST(VioEstimator, RecoversAPlantedCameraRotationAndTimeShift) {
   for (size_t i = 0; i < none.t.size(); ++i) {
     const Vec7 sd0 = none.covariance[i].diagonal().cwiseSqrt();
     for (const int k : {0, 1, 2, 6})
-      EXPECT_LT(std::abs(none.error[i][k]), 3.0 * sd0[k])
-          << "nothing planted: t " << none.t[i] << " component " << k << " error " << none.error[i][k] << " sigma "
-          << sd0[k];
+      EXPECT_LT(std::abs(none.error[i][k]), 3.0 * sd0[k]) << "nothing planted: t " << none.t[i] << " component " << k
+                                                          << " error " << none.error[i][k] << " sigma " << sd0[k];
   }
   EXPECT_LT(e.segment<3>(0).norm(), rig_error.segment<3>(0).norm() / 3.0)
       << "rotation error " << e.segment<3>(0).norm() * 180.0 / M_PI << " deg";

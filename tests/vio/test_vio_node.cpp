@@ -162,7 +162,9 @@ struct Harness {
   }
 };
 
-double positionError(const filter_state_t& m, const FilterState& truth) { return (vec3From(m.position) - truth.pos).norm(); }
+double positionError(const filter_state_t& m, const FilterState& truth) {
+  return (vec3From(m.position) - truth.pos).norm();
+}
 
 }  // namespace
 
@@ -319,7 +321,8 @@ TEST(VioNode, APriorWithoutItsImageIsKeptWhenANewerImageOrPriorComes) {
   EXPECT_EQ(h.posteriors[1].valid, 0);
   EXPECT_EQ(h.posteriors[1].utime, s.utime(kT1));
   // the kept prior is echoed
-  EXPECT_EQ(std::vector<double>(h.posteriors[1].covariance, h.posteriors[1].covariance + FilterState::kDim * FilterState::kDim),
+  EXPECT_EQ(std::vector<double>(h.posteriors[1].covariance,
+                                h.posteriors[1].covariance + FilterState::kDim * FilterState::kDim),
             std::vector<double>(priorP().data(), priorP().data() + FilterState::kDim * FilterState::kDim));
   // the image of kT2 still serves its own prior
   h.send("STATE_PRIOR", priorMsg(s.utime(kT2), 3, offsetState(s.trueState(kT2)), priorP()));

@@ -98,17 +98,17 @@ BENCHMARK(BM_TrackImage)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMill
 
 // ---- the whole visual subsystem ------------------------------------------------------------------
 
-constexpr double kImageDt = 0.05;     // 20 Hz
-constexpr double kWarmUpEnd = 5.0;    // s: images up to here initialise and fill the window
+constexpr double kImageDt = 0.05;   // 20 Hz
+constexpr double kWarmUpEnd = 5.0;  // s: images up to here initialise and fill the window
 constexpr int kTimedImages = 120;
 
 struct Subsystem {
   std::string config;
   std::unique_ptr<livo_test::RenderedSequence> sequence;
   vio_feature::VioFeatureNodeOptions options;
-  std::vector<double> times;       // trajectory time of each image
+  std::vector<double> times;  // trajectory time of each image
   std::vector<cv::Mat> images;
-  std::vector<cv::Mat> depths;     // empty without a depth image
+  std::vector<cv::Mat> depths;              // empty without a depth image
   std::vector<std::vector<ImuSample>> imu;  // before each image: the samples up to its time
 };
 
@@ -120,8 +120,8 @@ const Subsystem& subsystem(int which) {
   out->config = configs[which];
   out->sequence = std::make_unique<livo_test::RenderedSequence>(out->config);
   out->options = vio_feature::readVioFeatureNodeOptions(Config::load(std::string(LIVO_SOURCE_DIR) + "/" + out->config));
-  out->options.core.use_lidar_depth = false;  // no LIO here
-  out->options.core.window.use_wheel = false; // IMU and camera only
+  out->options.core.use_lidar_depth = false;   // no LIO here
+  out->options.core.window.use_wheel = false;  // IMU and camera only
   const bool depth = which == 2;
   out->options.core.use_depth_image = depth;
   int imu_k = 0;
@@ -209,7 +209,12 @@ void BM_VisualSubsystemPerImage(benchmark::State& state) {
   state.counters["restarts"] = vs.epoch();
   state.SetLabel(sub.config);
 }
-BENCHMARK(BM_VisualSubsystemPerImage)->Arg(0)->Arg(1)->Arg(2)->UseManualTime()->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_VisualSubsystemPerImage)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
     ->Iterations(kTimedImages);
 
 }  // namespace

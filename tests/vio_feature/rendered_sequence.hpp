@@ -14,9 +14,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "livo/sensor_samples.hpp"
 #include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/depth_effects.hpp"
-#include "livo/sensor_samples.hpp"
 #include "livo/sim/simulation_setup.hpp"
 
 namespace livo_test {
@@ -40,7 +40,10 @@ class RenderedSequence {
   /// A scene and trajectory of a test's own.
   RenderedSequence(std::unique_ptr<livo::sim::Scene> scene, std::unique_ptr<livo::sim::BodyTrajectory> trajectory,
                    const livo::CameraRig& camera, const livo::sim::CameraEffects& effects)
-      : camera_(camera), effects_(effects), scene_(std::move(scene)), trajectory_(std::move(trajectory)),
+      : camera_(camera),
+        effects_(effects),
+        scene_(std::move(scene)),
+        trajectory_(std::move(trajectory)),
         renderer_(std::make_unique<livo::sim::CameraRenderer>(camera, effects)) {}
 
   /// From now on renders (and answers for) another camera in the same mount: its size,
@@ -57,7 +60,8 @@ class RenderedSequence {
 
   /// The grey image at trajectory time t (noise stream k).
   cv::Mat image(double t, uint64_t k = 0) const {
-    const livo::sim::CameraImage c = renderer_->render(*scene_, *trajectory_, t, utime(t), livo::sim::Random(seed_, 7, k));
+    const livo::sim::CameraImage c =
+        renderer_->render(*scene_, *trajectory_, t, utime(t), livo::sim::Random(seed_, 7, k));
     const cv::Mat view(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data()));
     return view.clone();
   }
@@ -70,7 +74,8 @@ class RenderedSequence {
     const livo::sim::CameraImage c =
         renderer_->render(*scene_, *trajectory_, t, utime(t), livo::sim::Random(seed_, 7, k), setting, &z);
     *grey = cv::Mat(c.height, c.width, c.color ? CV_8UC3 : CV_8UC1, const_cast<uint8_t*>(c.data.data())).clone();
-    std::vector<uint16_t> mm = livo::sim::measureDepth(z, c.width, c.height, depth_effects_, livo::sim::Random(seed_, 8, k));
+    std::vector<uint16_t> mm =
+        livo::sim::measureDepth(z, c.width, c.height, depth_effects_, livo::sim::Random(seed_, 8, k));
     cv::Mat(c.height, c.width, CV_16UC1, mm.data()).convertTo(*depth, CV_32F, 1e-3);
   }
 

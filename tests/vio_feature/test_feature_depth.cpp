@@ -47,7 +47,8 @@ std::optional<double> cast(const std::vector<Surface>& scene, const Vec3& origin
     const double t = (s.d - s.normal.dot(origin)) / den;
     if (t <= 0.0 || (best && t >= *best)) continue;
     const Vec3 p = origin + t * ray;
-    if (s.bounded && (std::abs(p.x() - s.centre.x()) > s.half.x() || std::abs(p.y() - s.centre.y()) > s.half.y())) continue;
+    if (s.bounded && (std::abs(p.x() - s.centre.x()) > s.half.x() || std::abs(p.y() - s.centre.y()) > s.half.y()))
+      continue;
     best = t;
   }
   return best;
@@ -128,14 +129,14 @@ TEST(FeatureDepth, FromADepthImageOnlyWhereTheWindowAgrees) {
   depth.at<float>(100, 102) = std::nanf("");
 
   std::vector<FeatureObservation> f = {
-      at(100, 100),     // background (a NaN in the window does not count)
-      at(300, 240),     // foreground
-      at(200.2, 240),   // on the rectangle's left edge: both depths in the window
-      at(203, 240),     // just inside it
-      at(399.6, 200),   // on the right edge
-      at(520, 70),      // in the hole
-      at(500.6, 70),    // on the hole's edge: too few valid pixels
-      at(1, 1),         // the image corner: a clipped window
+      at(100, 100),    // background (a NaN in the window does not count)
+      at(300, 240),    // foreground
+      at(200.2, 240),  // on the rectangle's left edge: both depths in the window
+      at(203, 240),    // just inside it
+      at(399.6, 200),  // on the right edge
+      at(520, 70),     // in the hole
+      at(500.6, 70),   // on the hole's edge: too few valid pixels
+      at(1, 1),        // the image corner: a clipped window
   };
   f[1].depth = 99.0;  // overwritten
   EXPECT_EQ(depthFromImage(depth, DepthImageOptions{}, &f), 4);
@@ -158,8 +159,8 @@ TEST(FeatureDepth, FromLidarNeverTakesTheOtherSurfacesDepth) {
   scene[0] = Surface{Vec3::UnitZ(), 8.0};
   scene[1] = Surface{Vec3::UnitZ(), 3.0, true, Eigen::Vector2d(-0.2, 0.0), Eigen::Vector2d(0.6, 0.5)};
   const LidarResult r = checkLidarDepth(scene, 15.0);
-  std::cout << "board before a wall: " << r.assigned << " of " << r.covered << " features away from the edges given a depth, "
-            << r.wrong << " wrong\n";
+  std::cout << "board before a wall: " << r.assigned << " of " << r.covered
+            << " features away from the edges given a depth, " << r.wrong << " wrong\n";
   EXPECT_EQ(r.wrong, 0);
   EXPECT_GT(r.assigned, 0.8 * r.covered);
 }
@@ -172,7 +173,8 @@ TEST(FeatureDepth, FromLidarOnASlantedWall) {
   const double a = 50.0 * M_PI / 180.0;
   scene[0] = Surface{Vec3(std::sin(a), 0.0, std::cos(a)), 4.0 * std::cos(a)};
   const LidarResult r = checkLidarDepth(scene, 15.0);
-  std::cout << "slanted wall: " << r.assigned << " of " << r.covered << " features given a depth, " << r.wrong << " wrong\n";
+  std::cout << "slanted wall: " << r.assigned << " of " << r.covered << " features given a depth, " << r.wrong
+            << " wrong\n";
   EXPECT_EQ(r.wrong, 0);
   EXPECT_GT(r.assigned, 0.8 * r.covered);
 }

@@ -137,10 +137,10 @@ void trackAndCheckTheWalk(const char* name, const RoomFrames& room, bool rotatio
   }
   const double median = checker.quantile(0.5), p95 = checker.quantile(0.95);
   std::cout << name << (rotation_hint ? ", with" : ", without") << " rotation hint: " << checker.errors.size()
-            << " checked observations, median " << median << " px, p95 " << p95 << " px, max "
-            << checker.quantile(1.0) << " px, > 3 px: " << checker.countAbove(3.0) << ", hidden " << checker.hidden
-            << "; tracked per image " << tracked / double(room.images.size() - 1) << ", rejected RANSAC "
-            << rejected_ransac << ", backward " << rejected_backward << "\n";
+            << " checked observations, median " << median << " px, p95 " << p95 << " px, max " << checker.quantile(1.0)
+            << " px, > 3 px: " << checker.countAbove(3.0) << ", hidden " << checker.hidden << "; tracked per image "
+            << tracked / double(room.images.size() - 1) << ", rejected RANSAC " << rejected_ransac << ", backward "
+            << rejected_backward << "\n";
   EXPECT_GT(checker.errors.size(), 3000u);
   EXPECT_LT(median, 0.5);
   EXPECT_LT(p95, 1.5);
@@ -151,7 +151,9 @@ void trackAndCheckTheWalk(const char* name, const RoomFrames& room, bool rotatio
 
 TEST(FeatureTracker, TracksLandOnTheSimulatorsPoints) { trackAndCheckTheWalk("room", walkingFrames(), false); }
 
-TEST(FeatureTracker, TracksLandOnTheSimulatorsPointsWithARotationHint) { trackAndCheckTheWalk("room", walkingFrames(), true); }
+TEST(FeatureTracker, TracksLandOnTheSimulatorsPointsWithARotationHint) {
+  trackAndCheckTheWalk("room", walkingFrames(), true);
+}
 
 TEST(FeatureTracker, TracksLandOnTheSimulatorsPointsThroughAStronglyDistortedLens) {
   trackAndCheckTheWalk("EuRoC lens", walkingFramesThroughEurocLens(), true);
@@ -189,8 +191,10 @@ TEST(FeatureTracker, NoKeyframesWhileStillKeyframesWhileWalking) {
   for (int k = 0; k < 20; ++k) {
     const double t = 0.2 + k * kFrameDt;
     const TrackedFrame frame = still_tracker.track(room.utime(t), room.image(t, static_cast<uint64_t>(k)));
-    if (k > 0) still_keyframes += frame.keyframe, max_still_parallax = std::max(max_still_parallax, frame.parallax_px);
-    else EXPECT_TRUE(frame.keyframe);  // the first image is one
+    if (k > 0)
+      still_keyframes += frame.keyframe, max_still_parallax = std::max(max_still_parallax, frame.parallax_px);
+    else
+      EXPECT_TRUE(frame.keyframe);  // the first image is one
   }
   EXPECT_EQ(still_keyframes, 0);
   EXPECT_LT(max_still_parallax, 1.0);
@@ -217,7 +221,8 @@ TEST(FeatureTracker, AJumpedFrameLeavesNoWrongTracks) {
   // as the hint, as the node passes it): most tracks are lost, and those kept must be right. A few
   // survivors slip by a whole brick course (6 px on the east wall): aliasing on a repeated texture
   // that neither check can see, left to the back end's reprojection test.
-  for (size_t k : {0u, 1u, 2u}) checker.check(tracker.track(room.sequence.utime(room.times[k]), room.images[k]), room.times[k]);
+  for (size_t k : {0u, 1u, 2u})
+    checker.check(tracker.track(room.sequence.utime(room.times[k]), room.images[k]), room.times[k]);
   const size_t before = checker.errors.size();
   const Mat3 R = room.sequence.rotationCurPrev(room.times[12], room.times[2]);
   const TrackedFrame jumped = tracker.track(room.sequence.utime(room.times[12]), room.images[12], &R);

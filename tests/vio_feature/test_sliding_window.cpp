@@ -145,8 +145,12 @@ class SyntheticTracks {
   SyntheticTracks(std::function<Pose3(double)> pose, const Pose3& T_I_C, double pixel_noise, double depth_fraction,
                   double depth_noise_rel, unsigned seed, const Vec3& lo = Vec3(-14.0, -7.0, 0.0),
                   const Vec3& hi = Vec3(14.0, 7.0, 4.0), int count = 4000)
-      : pose_(std::move(pose)), T_I_C_(T_I_C), pixel_noise_(pixel_noise), depth_fraction_(depth_fraction),
-        depth_noise_rel_(depth_noise_rel), rng_(seed) {
+      : pose_(std::move(pose)),
+        T_I_C_(T_I_C),
+        pixel_noise_(pixel_noise),
+        depth_fraction_(depth_fraction),
+        depth_noise_rel_(depth_noise_rel),
+        rng_(seed) {
     std::uniform_real_distribution<double> x(lo.x(), hi.x()), y(lo.y(), hi.y()), z(lo.z(), hi.z());
     for (int i = 0; i < count; ++i) landmarks_.push_back(Vec3(x(rng_), y(rng_), z(rng_)));
   }
@@ -197,8 +201,8 @@ class SyntheticTracks {
       auto it = last_key_.find(i);
       if (it != last_key_.end()) parallax += (px - it->second).norm(), ++common;
     }
-    out.keyframe = last_key_.empty() || common < 0.5 * static_cast<double>(alive.size()) ||
-                   parallax / std::max(common, 1) > 10.0;
+    out.keyframe =
+        last_key_.empty() || common < 0.5 * static_cast<double>(alive.size()) || parallax / std::max(common, 1) > 10.0;
     if (out.keyframe) last_key_ = pixels;
     return out;
   }
@@ -277,9 +281,9 @@ TEST(SlidingWindowEstimator, FollowsTheRoomWalkStartedAtRest) {
   EXPECT_TRUE(r.first.static_start);
   const double drift = r.ate / r.distance;
   std::cout << "room walk, monocular + IMU: ATE " << r.ate << " m over " << r.distance << " m (" << 100.0 * drift
-            << " %), accel bias " << r.last.accel_bias.transpose() << " (truth " << spec.imu_error.accel_bias.transpose()
-            << "), gyro bias " << r.last.gyro_bias.transpose() << " (truth " << spec.imu_error.gyro_bias.transpose()
-            << ")\n";
+            << " %), accel bias " << r.last.accel_bias.transpose() << " (truth "
+            << spec.imu_error.accel_bias.transpose() << "), gyro bias " << r.last.gyro_bias.transpose() << " (truth "
+            << spec.imu_error.gyro_bias.transpose() << ")\n";
   EXPECT_LT(drift, 0.01);
   EXPECT_LT((r.last.gyro_bias - spec.imu_error.gyro_bias).norm(), 2e-3);
   EXPECT_LT((r.last.accel_bias - spec.imu_error.accel_bias).norm(), 0.05);
@@ -350,7 +354,8 @@ class CarMotion {
     const Vec3 a_W = R * Vec3(acceleration(t), speed(t) * yawRate(t), 0.0);
     const Vec3 f = R_IO * (R.transpose() * (a_W - Vec3(0.0, 0.0, -9.81)));
     const double sg = err.noise.gyro_noise_density / std::sqrt(dt), sa = err.noise.accel_noise_density / std::sqrt(dt);
-    return ImuSample{utime, R_IO * Vec3(0.0, 0.0, yawRate(t)) + err.gyro_bias + sg * Vec3(n01(*rng), n01(*rng), n01(*rng)),
+    return ImuSample{utime,
+                     R_IO * Vec3(0.0, 0.0, yawRate(t)) + err.gyro_bias + sg * Vec3(n01(*rng), n01(*rng), n01(*rng)),
                      f + err.accel_bias + sa * Vec3(n01(*rng), n01(*rng), n01(*rng))};
   }
 
@@ -423,8 +428,8 @@ TEST(SlidingWindowEstimator, StartsInMotionFromTheWheels) {
   const Vec3 v_body_true = truth.linear().transpose() * car.velocity(t0);
   const double ate = synth::alignedRmse(e, g);
   std::cout << "moving start at " << v_body_true.norm() << " m/s: gravity off by " << tilt_deg
-            << " deg, body velocity off by " << (v_body_est - v_body_true).norm() << " m/s; ATE " << ate
-            << " m over " << distance << " m (" << 100.0 * ate / distance << " %)\n";
+            << " deg, body velocity off by " << (v_body_est - v_body_true).norm() << " m/s; ATE " << ate << " m over "
+            << distance << " m (" << 100.0 * ate / distance << " %)\n";
   EXPECT_LT(tilt_deg, 0.5);
   EXPECT_LT((v_body_est - v_body_true).norm(), 0.05);
   EXPECT_LT(ate / distance, 0.01);
@@ -556,8 +561,9 @@ TEST(SlidingWindowEstimator, KeepsTheTyreScalesAcrossARestart) {
   const double s_left = 1.03, s_right = 0.98;
   const CarRun r = driveCar(0.02, s_left, s_right, 18.0, 0.3, 12.0);
   std::cout << "restart at 13 s: scales " << r.wheel_scale_before_gap.transpose() << " before, "
-            << r.wheel_scale_first_of_epoch.transpose() << " at the new epoch's first state, " << r.wheel_scale.transpose()
-            << " at the end; ATE of the new epoch " << r.ate << " m over " << r.distance << " m\n";
+            << r.wheel_scale_first_of_epoch.transpose() << " at the new epoch's first state, "
+            << r.wheel_scale.transpose() << " at the end; ATE of the new epoch " << r.ate << " m over " << r.distance
+            << " m\n";
   ASSERT_EQ(r.restarts, 1);
   EXPECT_TRUE(r.wheel_scale_after_restart == r.wheel_scale_before_gap);
   EXPECT_TRUE(r.wheel_scale_first_of_epoch == r.wheel_scale_before_gap);

@@ -99,9 +99,8 @@ TEST(VioFeatureEstimator, FollowsTheRenderedRoomWithoutLcm) {
     distance += (G.translation() - prev).norm();
     prev = G.translation();
   }
-  std::cout << states.size() << " states of " << images << " images over " << distance
-            << " m: worst position error " << worst_position << " m, worst rotation error " << worst_rotation_deg
-            << " deg\n";
+  std::cout << states.size() << " states of " << images << " images over " << distance << " m: worst position error "
+            << worst_position << " m, worst rotation error " << worst_rotation_deg << " deg\n";
   // measured: 152 states over 4.69 m, worst 0.023 m and 0.25 deg
   EXPECT_GT(distance, 3.0);
   EXPECT_LT(worst_position, 0.035);

@@ -13,8 +13,8 @@
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
-#include "livo/visual_state_t.hpp"
 #include "livo/vio_feature/vio_feature_node.hpp"
+#include "livo/visual_state_t.hpp"
 #include "rendered_sequence.hpp"
 
 using namespace livo;
@@ -22,8 +22,8 @@ using namespace livo::vio_feature;
 
 namespace {
 
-using livo_test::Message;
 using livo_test::encode;
+using livo_test::Message;
 
 /// The room's first `duration` s (2 s at rest, then walking): IMU at 200 Hz from the trajectory's
 /// exact motion, grey images at 20 Hz; `image_lag_us` delays the images' place in the stream.
@@ -194,13 +194,15 @@ TEST(VioFeatureNode, ReadsTheTyreScalesSigma) {
   EXPECT_TRUE(defaults.core.window.use_wheel);
   EXPECT_EQ(defaults.core.window.wheel_scale_std, 0.02);  // it has a depth image
   // without a depth source the tyres stay nominal unless asked for
-  EXPECT_EQ(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false}\n"))
-                .core.window.wheel_scale_std,
-            0.0);
-  EXPECT_EQ(readVioFeatureNodeOptions(
-                Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false, wheel_scale_std: 0.03}\n"))
-                .core.window.wheel_scale_std,
-            0.03);
+  EXPECT_EQ(
+      readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false}\n"))
+          .core.window.wheel_scale_std,
+      0.0);
+  EXPECT_EQ(
+      readVioFeatureNodeOptions(
+          Config::fromString(rig + "vio_feature: {depth_image: false, lidar_depth: false, wheel_scale_std: 0.03}\n"))
+          .core.window.wheel_scale_std,
+      0.03);
   EXPECT_EQ(readVioFeatureNodeOptions(Config::fromString(rig + "vio_feature: {wheel_scale_std: 0}\n"))
                 .core.window.wheel_scale_std,
             0.0);

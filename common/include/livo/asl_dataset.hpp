@@ -28,13 +28,13 @@ struct AslImage {
 std::vector<AslImage> listAslImages(const std::string& camera_dir);
 
 struct AslSensorYaml {
-  Pose3 T_body_sensor = Pose3::Identity();   // T_BS
+  Pose3 T_body_sensor = Pose3::Identity();  // T_BS
   double rate_hz = 0.0;
   // cameras
-  std::vector<double> intrinsics;            // fu fv cu cv
+  std::vector<double> intrinsics;                               // fu fv cu cv
   DistortionModel distortion_model = DistortionModel::kRadtan;  // distortion_model: radial-tangential
                                                                 // (EuRoC) or equidistant (TUM-VI)
-  std::vector<double> distortion;            // radtan: k1 k2 p1 p2; equidistant: k1 k2 k3 k4
+  std::vector<double> distortion;                               // radtan: k1 k2 p1 p2; equidistant: k1 k2 k3 k4
   int width = 0, height = 0;
   // IMUs
   double gyro_noise_density = 0.0, gyro_random_walk = 0.0;

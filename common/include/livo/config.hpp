@@ -24,10 +24,11 @@ class Node;  // yaml-cpp stays inside config.cpp
 namespace livo {
 
 // The value types Config reads (see the end of this file), as an X-macro: X(T) for each.
-#define LIVO_CONFIG_VALUE_TYPES(X)                                                              \
-  X(bool) X(int) X(int64_t) X(double) X(float) X(std::string) X(std::vector<double>) X(std::vector<int>) \
-  X(std::vector<std::string>) X(Eigen::Vector3d) X(Eigen::Matrix3d) X(Eigen::Matrix4d) X(Eigen::Quaterniond) \
-  X(Eigen::Isometry3d)
+#define LIVO_CONFIG_VALUE_TYPES(X)                                                                                    \
+  X(bool)                                                                                                             \
+  X(int)                                                                                                              \
+  X(int64_t) X(double) X(float) X(std::string) X(std::vector<double>) X(std::vector<int>) X(std::vector<std::string>) \
+      X(Eigen::Vector3d) X(Eigen::Matrix3d) X(Eigen::Matrix4d) X(Eigen::Quaterniond) X(Eigen::Isometry3d)
 
 class ConfigError : public std::runtime_error {
  public:
@@ -88,9 +89,9 @@ class Config {
  private:
   struct State {
     std::string file;
-    std::set<std::string> used;   // full key paths read or ignored
-    std::set<std::string> opened; // sections opened with section()/optionalSection()
-    std::set<std::string> asked;  // every key path asked for, present or not (for suggestions)
+    std::set<std::string> used;    // full key paths read or ignored
+    std::set<std::string> opened;  // sections opened with section()/optionalSection()
+    std::set<std::string> asked;   // every key path asked for, present or not (for suggestions)
   };
   Config(const YAML::Node& node, std::shared_ptr<State> state, std::string path);
 
@@ -109,7 +110,6 @@ class Config {
   std::shared_ptr<State> state_;
   std::string path_;
 };
-
 
 // Supported value types (defined in config.cpp): bool, int, int64_t, double, float,
 // std::string, std::vector<double|int|std::string>, Eigen::Vector3d, Eigen::Matrix3d (9 numbers,

@@ -73,9 +73,9 @@ class MapFrame {
   Placed place(int32_t epoch, int64_t correction_id, const std::function<void(int32_t)>& close_epoch);
 
   struct CorrectionStep {
-    bool apply = false;               // the map moves: corrected keyframe poses, `unlisted` for the rest
+    bool apply = false;                  // the map moves: corrected keyframe poses, `unlisted` for the rest
     Pose3 unlisted = Pose3::Identity();  // T_Ck_Cmap: for map content of keyframes the correction does not list
-    std::string why;                  // when !apply: why it is not applied now
+    std::string why;                     // when !apply: why it is not applied now
   };
   /// Records a correction (always, for later placements) and says whether the map moves to it:
   /// only a correction of the map's epoch newer than the map frame does.

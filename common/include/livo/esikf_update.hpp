@@ -25,8 +25,8 @@ struct MeasurementInformation {
   Mat13 HtRinvH = Mat13::Zero();
   Vec13 HtRinvz = Vec13::Zero();
   int calibration_block = FilterState::kLidar;
-  int count = 0;               // scalar residuals
-  Mat6 geometry = Mat6::Zero();// scale-free pose information for the degeneracy test (see Degeneracy)
+  int count = 0;                 // scalar residuals
+  Mat6 geometry = Mat6::Zero();  // scale-free pose information for the degeneracy test (see Degeneracy)
 
   Mat6 pose() const { return HtRinvH.topLeftCorner<6, 6>(); }
   /// The error-state index of row/column k of S.
@@ -59,7 +59,8 @@ void informationStep(const FilterState& x, const FilterState& prior, const State
                      const StateVector* estimated = nullptr);
 /// The same for a measurement of the pose alone (information S, gradient g).
 void informationStep(const FilterState& x, const FilterState& prior, const StateCovariance& P_prior, const Mat6& S,
-                     const Vec6& g, StateVector* delta, StateCovariance* P_post, const StateVector* estimated = nullptr);
+                     const Vec6& g, StateVector* delta, StateCovariance* P_post,
+                     const StateVector* estimated = nullptr);
 
 /// The measured states' part of P (rows and columns in MeasurementInformation's order).
 Mat13 measuredCovariance(const StateCovariance& P, int calibration_block);

@@ -39,14 +39,14 @@ struct FilterState {
   static constexpr int kCalPos = 3;
   static constexpr int kCalDt = 6;
 
-  Mat3 rot = Mat3::Identity();   // W_R_I
-  Vec3 pos = Vec3::Zero();       // W_p_I
-  Vec3 vel = Vec3::Zero();       // W_v_I
+  Mat3 rot = Mat3::Identity();  // W_R_I
+  Vec3 pos = Vec3::Zero();      // W_p_I
+  Vec3 vel = Vec3::Zero();      // W_v_I
   Vec3 gyro_bias = Vec3::Zero();
   Vec3 accel_bias = Vec3::Zero();
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);
-  SensorCalibration lidar;       // T_I_L and its time shift
-  SensorCalibration camera;      // T_I_C and its time shift
+  SensorCalibration lidar;   // T_I_L and its time shift
+  SensorCalibration camera;  // T_I_C and its time shift
 
   using Vector = Eigen::Matrix<double, kDim, 1>;
   using Covariance = Eigen::Matrix<double, kDim, kDim>;

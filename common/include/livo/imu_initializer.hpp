@@ -19,25 +19,25 @@ namespace livo {
 
 struct ImuInitOptions {
   enum class Mode { kAuto, kStatic, kMoving };
-  Mode mode = Mode::kAuto;        // auto: static if the window is still, moving otherwise
-  double window_s = 0.5;          // IMU window collected before initialising
-  double gravity = 9.81;          // m/s^2 (rig imu.gravity)
-  double max_gyro_std = 0.02;     // rad/s: stillness test, per axis
-  double max_accel_std = 0.1;     // m/s^2: stillness test, per axis
+  Mode mode = Mode::kAuto;     // auto: static if the window is still, moving otherwise
+  double window_s = 0.5;       // IMU window collected before initialising
+  double gravity = 9.81;       // m/s^2 (rig imu.gravity)
+  double max_gyro_std = 0.02;  // rad/s: stillness test, per axis
+  double max_accel_std = 0.1;  // m/s^2: stillness test, per axis
   // initial standard deviations, static start
-  double static_rot_std = 0.01;       // rad, roll and pitch
-  double static_vel_std = 0.01;       // m/s
-  double accel_bias_std = 0.05;       // m/s^2 (both modes; static: across "up" only)
-  double static_up_bias_floor = 2e-3; // m/s^2, added to the mean's standard error along "up"
-  double gravity_std = 1e-3;          // m/s^2 per axis
+  double static_rot_std = 0.01;        // rad, roll and pitch
+  double static_vel_std = 0.01;        // m/s
+  double accel_bias_std = 0.05;        // m/s^2 (both modes; static: across "up" only)
+  double static_up_bias_floor = 2e-3;  // m/s^2, added to the mean's standard error along "up"
+  double gravity_std = 1e-3;           // m/s^2 per axis
   // initial standard deviations, moving start
-  double moving_rot_std = 0.1;        // rad, roll and pitch
-  double moving_vel_std = 1.0;        // m/s
-  double moving_gyro_bias_std = 0.01; // rad/s
-  double moving_gravity_std = 0.1;    // m/s^2 per axis
+  double moving_rot_std = 0.1;         // rad, roll and pitch
+  double moving_vel_std = 1.0;         // m/s
+  double moving_gyro_bias_std = 0.01;  // rad/s
+  double moving_gravity_std = 0.1;     // m/s^2 per axis
   // fixed gauge: yaw and position at the start
-  double yaw_std = 1e-4;              // rad
-  double pos_std = 1e-4;              // m
+  double yaw_std = 1e-4;  // rad
+  double pos_std = 1e-4;  // m
 };
 
 struct ImuInitResult {
@@ -45,7 +45,7 @@ struct ImuInitResult {
   bool static_start = false;
   FilterState state;
   Mat18 covariance = Mat18::Identity();
-  ImuSample last;          // the last sample of the window: the state refers to its time
+  ImuSample last;  // the last sample of the window: the state refers to its time
   std::string message;
 };
 

@@ -52,8 +52,8 @@ Eigen::Quaternion<T> quaternionExp(const Eigen::Matrix<T, 3, 1>& r) {
   const T theta2 = r.squaredNorm();
   T w, k;  // q = [k r, w]
   if (theta2 < T(kQuaternionSeriesThreshold2)) {
-    w = T(1.0) - theta2 / T(8.0);    // cos(θ/2)
-    k = T(0.5) - theta2 / T(48.0);   // sin(θ/2) / θ
+    w = T(1.0) - theta2 / T(8.0);   // cos(θ/2)
+    k = T(0.5) - theta2 / T(48.0);  // sin(θ/2) / θ
   } else {
     const T theta = sqrt(theta2);
     w = cos(T(0.5) * theta);
@@ -161,16 +161,16 @@ class ImuPreintegration {
 
   /// The state at j from the state at i (world frame, gravity_W e.g. (0, 0, -9.81)) with the
   /// increments corrected to the biases (bg, ba).
-  void predict(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Vec3& bg, const Vec3& ba,
-               const Vec3& gravity_W, Mat3* R_j, Vec3* p_j, Vec3* v_j) const;
+  void predict(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Vec3& bg, const Vec3& ba, const Vec3& gravity_W,
+               Mat3* R_j, Vec3* p_j, Vec3* v_j) const;
 
   /// [r_R, r_v, r_p] of Forster eq. 45 with the corrected increments:
   ///   r_R = Log(ΔR̂^T R_i^T R_j),
   ///   r_v = R_i^T (v_j - v_i - g Δt) - Δv̂,
   ///   r_p = R_i^T (p_j - p_i - v_i Δt - ½ g Δt²) - Δp̂.
   /// Its covariance is covariance() (r_R = -δφ to first order).
-  Vec9 residual(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Mat3& R_j, const Vec3& p_j,
-                const Vec3& v_j, const Vec3& bg, const Vec3& ba, const Vec3& gravity_W) const;
+  Vec9 residual(const Mat3& R_i, const Vec3& p_i, const Vec3& v_i, const Mat3& R_j, const Vec3& p_j, const Vec3& v_j,
+                const Vec3& bg, const Vec3& ba, const Vec3& gravity_W) const;
 
   /// The same residual on raw parameter blocks for Ceres AutoDiff: unit quaternions q = W_R_I in
   /// Eigen's order [x, y, z, w], 3-vectors otherwise; r has 9 entries.

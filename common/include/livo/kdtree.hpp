@@ -62,7 +62,9 @@ class KdTree {
     size_t kdtree_get_point_count() const { return data.size(); }
     Scalar kdtree_get_pt(size_t i, size_t d) const { return data[i][static_cast<int>(d)]; }
     template <class Box>
-    bool kdtree_get_bbox(Box&) const { return false; }
+    bool kdtree_get_bbox(Box&) const {
+      return false;
+    }
   };
   struct BoundedNearest {  // a nanoflann result set: one neighbour, searched only within a bound
     explicit BoundedNearest(Scalar bound) : distance(bound) {}
@@ -80,7 +82,8 @@ class KdTree {
       return true;
     }
   };
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<Scalar, Adaptor>, Adaptor, kDim, size_t>;
+  using Index =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<Scalar, Adaptor>, Adaptor, kDim, size_t>;
   Adaptor adaptor_;
   Index index_;
 };

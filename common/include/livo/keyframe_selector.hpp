@@ -6,9 +6,9 @@
 namespace livo {
 
 struct KeyframeOptions {
-  double min_distance = 1.0;   // m
-  double min_angle_deg = 10.0; // degrees
-  double cloud_voxel = 0.2;    // m, downsampling of the keyframe's body-frame cloud
+  double min_distance = 1.0;    // m
+  double min_angle_deg = 10.0;  // degrees
+  double cloud_voxel = 0.2;     // m, downsampling of the keyframe's body-frame cloud
 };
 
 class KeyframeSelector {

@@ -10,8 +10,8 @@
 #include <set>
 #include <vector>
 
-#include <Eigen/Core>
 #include <ceres/ceres.h>
+#include <Eigen/Core>
 
 #include "livo/so3.hpp"
 
@@ -21,10 +21,10 @@ namespace livo {
 /// difference; Log(q0^-1 q) for quaternions).
 struct MarginalPrior {
   std::vector<double*> blocks;
-  std::vector<int> sizes;         // ambient
+  std::vector<int> sizes;  // ambient
   std::vector<bool> quaternion;
   std::vector<Eigen::VectorXd> x0;
-  Eigen::MatrixXd J;              // rows: rank, columns: sum of tangent sizes
+  Eigen::MatrixXd J;  // rows: rank, columns: sum of tangent sizes
   Eigen::VectorXd r0;
   int tangentSize() const { return static_cast<int>(J.cols()); }
 };

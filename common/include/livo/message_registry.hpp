@@ -8,9 +8,9 @@
 namespace livo {
 
 struct MessageType {
-  std::string name;      // package-qualified, e.g. "livo.point_cloud_t"
-  int64_t fingerprint;   // the 8 bytes every encoded message starts with
-  bool leading_utime;    // its first field is `int64_t utime` (bytes 8..15, big-endian)
+  std::string name;     // package-qualified, e.g. "livo.point_cloud_t"
+  int64_t fingerprint;  // the 8 bytes every encoded message starts with
+  bool leading_utime;   // its first field is `int64_t utime` (bytes 8..15, big-endian)
 };
 
 /// All project types.

@@ -15,8 +15,8 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 #include <random>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -30,12 +30,12 @@
 namespace livo {
 
 struct NodeOptions {
-  std::string name;                      // unique on the bus; PROGRESS and HEALTH carry it
+  std::string name;  // unique on the bus; PROGRESS and HEALTH carry it
   std::string progress_channel = "PROGRESS";
   std::string health_channel = "HEALTH";
-  double health_period_s = 1.0;          // wall-clock period of HEALTH messages; 0 disables
-  bool publish_progress = true;          // a PROGRESS message after every handled input
-  bool quiet = false;                    // no summary on stderr at shutdown
+  double health_period_s = 1.0;  // wall-clock period of HEALTH messages; 0 disables
+  bool publish_progress = true;  // a PROGRESS message after every handled input
+  bool quiet = false;            // no summary on stderr at shutdown
   // Test hook for loss detection: messages on these channels with these 1-based indices are
   // dropped on arrival as if the bus had lost them (never handled, never counted). Filled from
   // LIVO_TEST_DROP_RECEIVED="CHANNEL:N[,CHANNEL:N...]" when the node is made; empty otherwise.
@@ -174,9 +174,13 @@ class Node {
   static void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Subscription* sub);
   static void onPeerProgress(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Node* node);
   template <class M>
-  static constexpr auto hasUtime(int) -> decltype(std::declval<M>().utime, bool()) { return true; }
+  static constexpr auto hasUtime(int) -> decltype(std::declval<M>().utime, bool()) {
+    return true;
+  }
   template <class M>
-  static constexpr bool hasUtime(...) { return false; }
+  static constexpr bool hasUtime(...) {
+    return false;
+  }
 
   void decodeFailed(const std::string& channel, const char* type, int size);
   void report(int8_t level, const std::string& message);

@@ -14,8 +14,8 @@ namespace livo {
 /// loop correction adopted in it.
 struct OdometryFrame {
   int32_t epoch = 0;
-  int64_t correction_id = 0;             // 0: the raw odometry frame O of the epoch
-  Pose3 T_C_O = Pose3::Identity();       // odometry_to_corrected of that correction
+  int64_t correction_id = 0;        // 0: the raw odometry frame O of the epoch
+  Pose3 T_C_O = Pose3::Identity();  // odometry_to_corrected of that correction
 };
 
 /// A corrected keyframe pose of a loop correction.
@@ -36,7 +36,7 @@ struct LoopCorrection {
 /// the frame is the correction's predecessor j, T_Ck_O * T_C_O^-1 when corrections were missed.
 inline Pose3 correctionStep(const OdometryFrame& frame, const LoopCorrection& correction) {
   return correction.previous_id == frame.correction_id ? correction.T_Ck_Cj
-                                                        : Pose3(correction.T_Ck_O * frame.T_C_O.inverse());
+                                                       : Pose3(correction.T_Ck_O * frame.T_C_O.inverse());
 }
 
 }  // namespace livo

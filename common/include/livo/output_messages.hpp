@@ -25,15 +25,14 @@ struct OutputFrame {
 /// process uses to pick images). Point i is input point input_index[i]: its intensity, time offset
 /// and ring come from `input`, as do the pattern, rings and sweep duration.
 registered_scan_t registeredScanMessage(int64_t utime, int64_t sweep_start_utime, const Pose3& pose,
-                                        const std::vector<Vec3>& world_points,
-                                        const std::vector<uint32_t>& input_index, const point_cloud_t& input,
-                                        const OutputFrame& frame);
+                                        const std::vector<Vec3>& world_points, const std::vector<uint32_t>& input_index,
+                                        const point_cloud_t& input, const OutputFrame& frame);
 
 /// The odometry increment a keyframe carries from the previous one (keyframe_t.relative_*).
 struct KeyframeIncrement {
-  int64_t from_id = -1;                       // the previous keyframe (-1: no increment given)
-  Mat6 covariance = Mat6::Zero();             // [rotation; translation in this frame], all of it
-  Mat6 held_calibration = Mat6::Zero();       // the part of `covariance` held calibration adds
+  int64_t from_id = -1;                  // the previous keyframe (-1: no increment given)
+  Mat6 covariance = Mat6::Zero();        // [rotation; translation in this frame], all of it
+  Mat6 held_calibration = Mat6::Zero();  // the part of `covariance` held calibration adds
 };
 
 /// A keyframe's body-frame cloud (frame "I", time offsets zero: undistorted to `utime`) and its

@@ -2,8 +2,8 @@
 // of every information matrix here, and the square root of an information matrix.
 #pragma once
 
-#include <Eigen/Core>
 #include <ceres/manifold.h>
+#include <Eigen/Core>
 
 namespace livo {
 

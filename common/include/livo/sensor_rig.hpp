@@ -19,7 +19,7 @@ struct RigChannels {
   std::string imu = "IMU";
   std::string lidar = "LIDAR";
   std::string camera = "CAMERA";
-  std::string depth = "DEPTH";          // depth images registered to the camera (CameraRig::depth)
+  std::string depth = "DEPTH";  // depth images registered to the camera (CameraRig::depth)
   std::string wheel = "WHEEL";
   std::string ground_truth = "GROUND_TRUTH";
 };
@@ -55,16 +55,17 @@ struct LidarRig {
   double rate_hz = 10.0;
   double min_range = 0.5;
   double max_range = 100.0;
-  double range_noise_std = 0.01;      // m
+  double range_noise_std = 0.01;  // m
   double dropout_probability = 0.0;
-  Pose3 T_I_L = Pose3::Identity();    // p_I = T_I_L * p_L
+  Pose3 T_I_L = Pose3::Identity();         // p_I = T_I_L * p_L
   CalibrationUncertainty calibration_std;  // of T_I_L and the LiDAR's time offset (0: exact)
 };
 
 /// The lens distortion of a CameraRig, as OpenCV and Kalibr name them.
 enum class DistortionModel {
   kRadtan,       // radial-tangential (cv::projectPoints): k1 k2 p1 p2
-  kEquidistant,  // Kannala-Brandt (cv::fisheye): theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8)
+  kEquidistant,  // Kannala-Brandt (cv::fisheye): theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4
+                 // theta^8)
 };
 /// "radtan" or "equidistant" (the names of the yaml key camera.distortion_model).
 const char* distortionModelName(DistortionModel m);
@@ -77,21 +78,21 @@ struct CameraRig {
   DistortionModel distortion_model = DistortionModel::kRadtan;
   std::array<double, 4> distortion{{0.0, 0.0, 0.0, 0.0}};  // radtan: k1 k2 p1 p2; equidistant: k1 k2 k3 k4
   double rate_hz = 20.0;
-  bool color = false;                 // RGB8 if true, else GRAY8
-  bool depth = false;                 // also a depth image registered to it (same intrinsics, size and
-                                      // stamp, as an RGB-D camera's aligned depth), on RigChannels::depth
-  Pose3 T_I_C = Pose3::Identity();    // p_I = T_I_C * p_C
-  double time_offset_s = 0.0;         // image utime + time_offset_s = the same instant on the IMU clock
-  double rolling_shutter_s = 0.0;     // readout time, first to last row (0: global shutter); the
-                                      // stamp is the centre row's
+  bool color = false;                      // RGB8 if true, else GRAY8
+  bool depth = false;                      // also a depth image registered to it (same intrinsics, size and
+                                           // stamp, as an RGB-D camera's aligned depth), on RigChannels::depth
+  Pose3 T_I_C = Pose3::Identity();         // p_I = T_I_C * p_C
+  double time_offset_s = 0.0;              // image utime + time_offset_s = the same instant on the IMU clock
+  double rolling_shutter_s = 0.0;          // readout time, first to last row (0: global shutter); the
+                                           // stamp is the centre row's
   CalibrationUncertainty calibration_std;  // of T_I_C and time_offset_s (0: exact)
 };
 
 /// Differential-drive wheel encoder; base frame B: x forward, z up.
 struct WheelRig {
   double rate_hz = 50.0;
-  double track_width = 0.5;           // m
-  double speed_noise_std = 0.02;      // m/s per wheel
+  double track_width = 0.5;       // m
+  double speed_noise_std = 0.02;  // m/s per wheel
   Pose3 T_I_B = Pose3::Identity();
   CalibrationUncertainty calibration_std;  // of T_I_B's rotation only (0: exact, not estimated)
 
@@ -104,9 +105,9 @@ struct WheelRig {
 struct SensorRig {
   RigChannels channels;
   ImuRig imu;
-  std::optional<LidarRig> lidar;      // absent: no LiDAR
-  std::optional<CameraRig> camera;    // absent: no camera
-  std::optional<WheelRig> wheel;      // absent: no wheel encoder
+  std::optional<LidarRig> lidar;    // absent: no LiDAR
+  std::optional<CameraRig> camera;  // absent: no camera
+  std::optional<WheelRig> wheel;    // absent: no wheel encoder
 };
 
 /// LiDAR models the rig may name: the five livo-sim has a beam table for (VLP-16, OS1-16, OS1-64,

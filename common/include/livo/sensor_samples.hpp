@@ -25,12 +25,12 @@ struct WheelSample {
 
 /// One LiDAR sweep: points in the LiDAR frame L with per-point time offsets.
 struct LidarScan {
-  int64_t utime = 0;             // sweep start, LiDAR clock (µs)
-  double sweep_duration = 0.1;   // s; the scan ends at utime + max(sweep_duration, last offset)
-  std::vector<Vec3> points;      // frame L
-  std::vector<float> time_offset;// s after utime, one per point
-  std::vector<float> intensity;  // one per point (may be empty: zeros)
-  std::vector<int16_t> ring;     // one per point (may be empty: no rings)
+  int64_t utime = 0;               // sweep start, LiDAR clock (µs)
+  double sweep_duration = 0.1;     // s; the scan ends at utime + max(sweep_duration, last offset)
+  std::vector<Vec3> points;        // frame L
+  std::vector<float> time_offset;  // s after utime, one per point
+  std::vector<float> intensity;    // one per point (may be empty: zeros)
+  std::vector<int16_t> ring;       // one per point (may be empty: no rings)
 };
 
 /// LiDAR-IMU extrinsic and time offset: p_I = T_I_L p_L; t_imu = t_lidar + time_offset_s.

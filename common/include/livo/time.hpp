@@ -71,8 +71,7 @@ class TimeBuffer {
 template <class Seq, class StampOf>
 bool bracket(const Seq& seq, int64_t t, StampOf stamp_of, size_t* index, double* alpha) {
   if (seq.empty() || t < stamp_of(seq.front()) || t > stamp_of(seq.back())) return false;
-  auto it = std::upper_bound(seq.begin(), seq.end(), t,
-                             [&](int64_t tt, const auto& e) { return tt < stamp_of(e); });
+  auto it = std::upper_bound(seq.begin(), seq.end(), t, [&](int64_t tt, const auto& e) { return tt < stamp_of(e); });
   size_t i = static_cast<size_t>(std::distance(seq.begin(), it));
   if (i == seq.size()) {  // t == back
     *index = seq.size() >= 2 ? seq.size() - 2 : 0;

@@ -55,11 +55,11 @@ std::string wheelMountingText(const Vec3& mounting);
 std::string wheelFactorText(const WheelRig& rig, double scale_std);
 
 struct WheelPreintegrationNoise {
-  double speed_std = 0.02;            // m/s per wheel (WheelRig::speed_noise_std)
+  double speed_std = 0.02;  // m/s per wheel (WheelRig::speed_noise_std)
   // The planar-motion assumption; defaults for a car on a road, as the LIO's wheel update:
-  double lateral_speed_std = 0.05;    // m/s, sideways slip
-  double vertical_speed_std = 0.1;    // m/s, the suspension moving the body-fixed frame
-  double roll_pitch_rate_std = 0.1;   // rad/s, body roll and pitch on bumps and in turns
+  double lateral_speed_std = 0.05;   // m/s, sideways slip
+  double vertical_speed_std = 0.1;   // m/s, the suspension moving the body-fixed frame
+  double roll_pitch_rate_std = 0.1;  // rad/s, body roll and pitch on bumps and in turns
 
   /// speed_std from the rig, the planar-motion sigmas at their defaults.
   static WheelPreintegrationNoise fromRig(const WheelRig& rig);
@@ -102,8 +102,7 @@ class WheelPreintegration {
   /// The same with the wheel frame turned by the mounting correction δ (3 entries, a rotation
   /// vector): R_IO = R_IB Exp(δ) (above); δ = 0 gives the overload without it exactly.
   template <class T>
-  void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, const T* mounting,
-                T* r) const;
+  void residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, const T* mounting, T* r) const;
 
  private:
   double track_width_;
@@ -121,8 +120,8 @@ class WheelPreintegration {
 
   /// The residual with O's orientation in the body q_IO (the rig's q_IB, or it turned by δ).
   template <class T>
-  void residualWithWheelFrame(const Eigen::Quaternion<T>& q_IO, const T* q_i, const T* p_i, const T* q_j,
-                              const T* p_j, const T* scale, T* r) const;
+  void residualWithWheelFrame(const Eigen::Quaternion<T>& q_IO, const T* q_i, const T* p_i, const T* q_j, const T* p_j,
+                              const T* scale, T* r) const;
 };
 
 template <class T>
@@ -132,8 +131,7 @@ void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, con
 }
 
 template <class T>
-void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale,
-                                   T* r) const {
+void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale, T* r) const {
   residualWithWheelFrame(Eigen::Quaternion<T>(q_IB_.cast<T>()), q_i, p_i, q_j, p_j, scale, r);
 }
 
@@ -141,8 +139,7 @@ template <class T>
 void WheelPreintegration::residual(const T* q_i, const T* p_i, const T* q_j, const T* p_j, const T* scale,
                                    const T* mounting, T* r) const {
   const Eigen::Matrix<T, 3, 1> delta(mounting[0], mounting[1], mounting[2]);
-  residualWithWheelFrame(Eigen::Quaternion<T>(q_IB_.cast<T>() * quaternionExp<T>(delta)), q_i, p_i, q_j, p_j, scale,
-                         r);
+  residualWithWheelFrame(Eigen::Quaternion<T>(q_IB_.cast<T>() * quaternionExp<T>(delta)), q_i, p_i, q_j, p_j, scale, r);
 }
 
 template <class T>

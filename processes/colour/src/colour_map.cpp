@@ -190,7 +190,8 @@ void ColourMap::addPoints(const std::vector<Eigen::Vector3f>& points, int64_t an
   }
 }
 
-uint32_t ColourMap::addToVoxel(uint64_t voxel_key, const Eigen::Vector3f& p, int64_t anchor, Tile* tile, bool* created) {
+uint32_t ColourMap::addToVoxel(uint64_t voxel_key, const Eigen::Vector3f& p, int64_t anchor, Tile* tile,
+                               bool* created) {
   const uint32_t next = free_.empty() ? static_cast<uint32_t>(points_.size()) : free_.back();
   bool inserted = false;
   const uint32_t id = index_.findOrInsert(voxel_key, next, &inserted);
@@ -248,7 +249,8 @@ size_t ColourMap::colouredCount() const {
 }
 
 size_t ColourMap::residentTiles() const {
-  return static_cast<size_t>(std::count_if(tiles_.begin(), tiles_.end(), [](const auto& kt) { return !kt.second.spilled; }));
+  return static_cast<size_t>(
+      std::count_if(tiles_.begin(), tiles_.end(), [](const auto& kt) { return !kt.second.spilled; }));
 }
 
 void ColourMap::transform(const std::function<bool(int64_t, Pose3*)>& delta) {
@@ -382,7 +384,8 @@ void ColourMap::appendRecord(Tile* tile, const std::vector<MapPoint>& pts) {
   if (tile->records.empty()) tile->epoch = epoch_;
   tile->records.push_back(spill_->append(bytes.data(), bytes.size()));
   tile->spilled = true;
-  tile->spilled_coloured += static_cast<size_t>(std::count_if(pts.begin(), pts.end(), [](const MapPoint& p) { return p.coloured(); }));
+  tile->spilled_coloured +=
+      static_cast<size_t>(std::count_if(pts.begin(), pts.end(), [](const MapPoint& p) { return p.coloured(); }));
 }
 
 void ColourMap::spill(Tile* tile, std::vector<uint32_t>* freed) {

@@ -37,7 +37,8 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
 
   node_.subscribe<registered_scan_t>(options_.registered_scan_channel, [this](const registered_scan_t& m) {
     const auto add = [this](const RegisteredScanView& v, std::string* why) { return pipeline_.addScan(v, why); };
-    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add)) return;
+    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add))
+      return;
     publishRecoloured(m.utime);
     if (first_scan_utime_ == INT64_MIN) first_scan_utime_ = m.utime;
     if (m.utime - last_status_utime_ >= kStatusPeriodUs) {
@@ -46,10 +47,9 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
       const ColourMap& map = pipeline_.map();
       std::ostringstream s;
       s << "map after " << std::fixed << std::setprecision(0) << (m.utime - first_scan_utime_) * 1e-6
-        << " s of scans: " << map.residentPoints()
-        << " points in " << map.residentTiles() << " tiles in memory, " << map.spilledTiles() << " tiles on disk ("
-        << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB), " << map.tilesEvictedForMemory()
-        << " sent early for memory; voxel index " << map.indexBytes() / 1e6 << " MB";
+        << " s of scans: " << map.residentPoints() << " points in " << map.residentTiles() << " tiles in memory, "
+        << map.spilledTiles() << " tiles on disk (" << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB), "
+        << map.tilesEvictedForMemory() << " sent early for memory; voxel index " << map.indexBytes() / 1e6 << " MB";
       node_.info(s.str());
     }
   });
@@ -83,8 +83,8 @@ ColourNode::ColourNode(lcm::LCM& lcm, const NodeOptions& node_options, const Col
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
     Pose3 T_map_I;
     const bool cloud = false;  // the colour map keeps only the keyframe poses
-    if (takeKeyframePose(node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); },
-                         &T_map_I))
+    if (takeKeyframePose(
+            node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); }, &T_map_I))
       pipeline_.addKeyframe(m.id, m.utime, T_map_I);
   });
   node_.subscribe<loop_correction_t>(options_.loop_correction_channel, [this](const loop_correction_t& m) {
@@ -174,9 +174,9 @@ bool ColourNode::saveMap(const std::string& name) {
   }
   const ColourMap& map = pipeline_.map();
   std::ostringstream s;
-  s << "wrote " << pts.count << " coloured points to " << ply << " and " << pcd << " (map tiles: "
-    << map.residentTiles() << " in memory with " << map.residentPoints() << " points, " << map.tilesEvictedForMemory()
-    << " sent to disk early for memory, " << map.spilledTiles()
+  s << "wrote " << pts.count << " coloured points to " << ply << " and " << pcd
+    << " (map tiles: " << map.residentTiles() << " in memory with " << map.residentPoints() << " points, "
+    << map.tilesEvictedForMemory() << " sent to disk early for memory, " << map.spilledTiles()
     << " on disk; spill file " << std::fixed << std::setprecision(1) << map.spilledBytes() / 1e6 << " MB live of "
     << map.spillWrittenBytes() / 1e6 << " MB written; scan points left out: " << pipeline_.stats().points_out_of_reach
     << " out of reach, " << pipeline_.stats().points_out_of_view << " outside the view cone, "

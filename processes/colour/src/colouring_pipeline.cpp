@@ -29,10 +29,10 @@ ColouringPipeline::ColouringPipeline(const ColourOptions& options, const CameraR
       depth_(camera.width, camera.height, std::max(camera.fx, camera.fy), depthOptions(options)),
       map_(options.voxel_size,
            // a tile stays while the scans an image may still need (2 windows + 1 s) can touch it
-           TileOptions{options.tile_size,
-                       options.tile_idle_s > 0 ? std::max(options.tile_idle_s, 2 * options.max_time_difference + 2.0) : 0.0,
-                       "", static_cast<size_t>(std::max(0, options.max_resident_points)),
-                       2 * options.max_time_difference + 2.0}),
+           TileOptions{
+               options.tile_size,
+               options.tile_idle_s > 0 ? std::max(options.tile_idle_s, 2 * options.max_time_difference + 2.0) : 0.0, "",
+               static_cast<size_t>(std::max(0, options.max_resident_points)), 2 * options.max_time_difference + 2.0}),
       reference_exposure_(options.reference_exposure_s) {
   // the camera's field: its axis to the farthest ray through the image border
   const CameraRig& rig = camera_.rig();
@@ -392,9 +392,9 @@ int ColouringPipeline::applyCorrection(const std::map<int64_t, Pose3>& corrected
   last_scan_.swap(last_scan);
   for (ActiveScan& s : active_) {
     for (auto& pt : s.points) pt.first = remap[pt.first];
-    s.points.erase(std::remove_if(s.points.begin(), s.points.end(),
-                                  [](const auto& pt) { return pt.first == ColourMap::kGone; }),
-                   s.points.end());
+    s.points.erase(
+        std::remove_if(s.points.begin(), s.points.end(), [](const auto& pt) { return pt.first == ColourMap::kGone; }),
+        s.points.end());
   }
   std::vector<uint32_t> rec;
   for (uint32_t id : recoloured_)

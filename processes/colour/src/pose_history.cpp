@@ -8,8 +8,10 @@ bool PoseHistory::add(int64_t utime, const Pose3& T) {
   if (!T.matrix().allFinite()) return false;
   auto it = std::lower_bound(poses_.begin(), poses_.end(), utime,
                              [](const std::pair<int64_t, Pose3>& e, int64_t t) { return e.first < t; });
-  if (it != poses_.end() && it->first == utime) it->second = T;
-  else poses_.insert(it, {utime, T});
+  if (it != poses_.end() && it->first == utime)
+    it->second = T;
+  else
+    poses_.insert(it, {utime, T});
   return true;
 }
 

@@ -1,7 +1,7 @@
 #include "livo/colour/view_cone.hpp"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 
 namespace livo::colour {
 
@@ -9,7 +9,8 @@ void ViewCone::prepare() {
   // the shortcut's margin (1e-6 rad, a cosine margin of sin(angle) * 1e-6) dwarfs the rounding of
   // either test, so it only ever says "inside" where the exact test does
   constexpr double kMargin = 1e-6;
-  if (half_angle - kMargin > 0.01 && half_angle - kMargin < M_PI - 0.01) cos_surely_inside = std::cos(half_angle - kMargin);
+  if (half_angle - kMargin > 0.01 && half_angle - kMargin < M_PI - 0.01)
+    cos_surely_inside = std::cos(half_angle - kMargin);
   const double outside = half_angle + std::asin(0.2) + kMargin;
   far_range = 5.0 * travel;
   if (outside > 0.01 && outside < M_PI - 0.01) cos_surely_outside = std::cos(outside);
@@ -35,7 +36,7 @@ bool ViewCone::contains(const Eigen::Vector3d& p) const {
   const double r = v.norm();
   if (r <= travel) return true;
   const double along = v.dot(axis);
-  if (along > cos_surely_inside * r) return true;                       // well inside
+  if (along > cos_surely_inside * r) return true;                      // well inside
   if (r >= far_range && along < cos_surely_outside * r) return false;  // well outside
   const double s = travel / r;
   if (s < s_limit) {

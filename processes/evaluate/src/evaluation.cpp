@@ -22,14 +22,18 @@ Alignment parseAlignment(const std::string& name) {
   if (name == "sim3") return Alignment::kSim3;
   if (name == "none") return Alignment::kNone;
   if (name == "4dof") return Alignment::kFourDof;
-  throw std::invalid_argument("--align: expected se3, sim3 or none, or 4dof (yaw about z and translation), "
-                              "got '" + name + "'");
+  throw std::invalid_argument(
+      "--align: expected se3, sim3 or none, or 4dof (yaw about z and translation), "
+      "got '" +
+      name + "'");
 }
 
 void EvaluationOptions::validate() const {
-  if (!(max_dt >= 0.0) || !std::isfinite(max_dt)) throw std::invalid_argument("--max-dt must be a non-negative number of seconds");
+  if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
+    throw std::invalid_argument("--max-dt must be a non-negative number of seconds");
   if (!gt_offset.allFinite()) throw std::invalid_argument("--gt-offset must be three finite numbers");
-  if (!(coverage_gap >= 0.0) || !std::isfinite(coverage_gap)) throw std::invalid_argument("--coverage-gap must be a non-negative number of seconds");
+  if (!(coverage_gap >= 0.0) || !std::isfinite(coverage_gap))
+    throw std::invalid_argument("--coverage-gap must be a non-negative number of seconds");
   if (rpe.delta < 1) throw std::invalid_argument("--rpe-delta must be at least 1 frame");
   if (drift.step < 1) throw std::invalid_argument("--drift-step must be at least 1 pose");
   if (drift.segment_lengths.empty()) throw std::invalid_argument("--drift-lengths needs at least one length");
@@ -105,7 +109,8 @@ void addGroundVehicleMetrics(Evaluation& ev, const std::vector<Pose3>& est_as_re
 }
 }  // namespace
 
-Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInput& gt_in, const EvaluationOptions& options) {
+Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInput& gt_in,
+                              const EvaluationOptions& options) {
   options.validate();
   Trajectory est = est_in.poses;
   const Trajectory& gt = gt_in.poses;
@@ -116,7 +121,8 @@ Evaluation evaluateTrajectory(const TrajectoryInput& est_in, const TrajectoryInp
   ev.est_poses = est.size();
   ev.gt_poses = gt.size();
   try {
-    ev.pairs = est_in.has_stamps && gt_in.has_stamps ? associateByTime(est, gt, options.max_dt) : associateByIndex(est, gt);
+    ev.pairs =
+        est_in.has_stamps && gt_in.has_stamps ? associateByTime(est, gt, options.max_dt) : associateByIndex(est, gt);
   } catch (const AssociationError& e) {
     throw EvaluationError(std::string(e.what()) + " (" + est_in.path + " and " + gt_in.path +
                           "; a KITTI pose file has no time stamps, so poses pair by index)");

@@ -41,8 +41,6 @@ Similarity3 fourDofAlignment(const std::vector<Vec3>& source, const std::vector<
   return sim;
 }
 
-double yawOf(const Mat3& rotation_about_z) {
-  return std::atan2(rotation_about_z(1, 0), rotation_about_z(0, 0));
-}
+double yawOf(const Mat3& rotation_about_z) { return std::atan2(rotation_about_z(1, 0), rotation_about_z(0, 0)); }
 
 }  // namespace livo::evaluate

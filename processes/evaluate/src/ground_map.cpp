@@ -119,12 +119,15 @@ class GroundMapBuilder {
       return;
     }
     ++result_.scans;
-    forEachPoint(scan, true_from_est, [&](const Vec3&, const Vec3& q, VoxelKey key) {
-      const int32_t cell = cells_.insert(key, static_cast<int32_t>(histograms_.size()));
-      if (cell == static_cast<int32_t>(histograms_.size())) histograms_.emplace_back();
-      histograms_[static_cast<size_t>(cell)].add(floorToInt(q.z() * kBinsPerMetre));
-      ++result_.points_binned;
-    }, &result_.points_skipped);
+    forEachPoint(
+        scan, true_from_est,
+        [&](const Vec3&, const Vec3& q, VoxelKey key) {
+          const int32_t cell = cells_.insert(key, static_cast<int32_t>(histograms_.size()));
+          if (cell == static_cast<int32_t>(histograms_.size())) histograms_.emplace_back();
+          histograms_[static_cast<size_t>(cell)].add(floorToInt(q.z() * kBinsPerMetre));
+          ++result_.points_binned;
+        },
+        &result_.points_skipped);
   }
 
   /// Each cell's floor from its histogram; the histograms are not needed after this.
@@ -142,14 +145,17 @@ class GroundMapBuilder {
     if (!usable(scan, &true_from_est)) return;
     size_t skipped = 0;  // counted in the first pass
     const double band_bins = options_.band_m * kBinsPerMetre;
-    forEachPoint(scan, true_from_est, [&](const Vec3& p, const Vec3& q, VoxelKey key) {
-      const int32_t cell = cells_.find(key);
-      if (cell < 0) return;  // a source that gave other scans the second time
-      GroundLayer& layer = layers_[static_cast<size_t>(cell)];
-      // in bins, as the first pass binned: the point at the percentile is in the band whatever the rounding
-      const double height = q.z() * kBinsPerMetre, floor = static_cast<double>(layer.floor_bin);
-      if (height >= floor && height <= floor + band_bins) layer.add(p.z(), q.z(), scan_no_);
-    }, &skipped);
+    forEachPoint(
+        scan, true_from_est,
+        [&](const Vec3& p, const Vec3& q, VoxelKey key) {
+          const int32_t cell = cells_.find(key);
+          if (cell < 0) return;  // a source that gave other scans the second time
+          GroundLayer& layer = layers_[static_cast<size_t>(cell)];
+          // in bins, as the first pass binned: the point at the percentile is in the band whatever the rounding
+          const double height = q.z() * kBinsPerMetre, floor = static_cast<double>(layer.floor_bin);
+          if (height >= floor && height <= floor + band_bins) layer.add(p.z(), q.z(), scan_no_);
+        },
+        &skipped);
     ++scan_no_;
   }
 
@@ -219,15 +225,18 @@ class GroundMapBuilder {
 }  // namespace
 
 void GroundMapOptions::validate() const {
-  if (!(cell_m > 0.0) || !std::isfinite(cell_m)) throw std::invalid_argument("--ground-cell must be a positive number of metres");
-  if (!(band_m > 0.0) || !std::isfinite(band_m)) throw std::invalid_argument("--ground-band must be a positive number of metres");
+  if (!(cell_m > 0.0) || !std::isfinite(cell_m))
+    throw std::invalid_argument("--ground-cell must be a positive number of metres");
+  if (!(band_m > 0.0) || !std::isfinite(band_m))
+    throw std::invalid_argument("--ground-band must be a positive number of metres");
   if (!(max_dt >= 0.0) || !std::isfinite(max_dt))
     throw std::invalid_argument("--ground-max-dt must be a non-negative number of seconds");
   if (!gt_offset.allFinite()) throw std::invalid_argument("--gt-offset must be three finite numbers");
 }
 
 bool groundTruthAt(const Trajectory& gt, double t, double max_dt, Pose3* T) {
-  const auto after = std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& s, double v) { return s.stamp < v; });
+  const auto after =
+      std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& s, double v) { return s.stamp < v; });
   if (after == gt.end()) return false;
   if (after->stamp == t) {
     *T = after->pose;

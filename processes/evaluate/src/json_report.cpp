@@ -9,8 +9,9 @@ namespace {
 using nlohmann::json;
 
 json statistics(const ErrorStatistics& s) {
-  if (s.count == 0) return json{{"count", 0}, {"rmse", nullptr}, {"mean", nullptr}, {"median", nullptr},
-                                {"std", nullptr}, {"min", nullptr}, {"max", nullptr}, {"sse", nullptr}};
+  if (s.count == 0)
+    return json{{"count", 0},     {"rmse", nullptr}, {"mean", nullptr}, {"median", nullptr},
+                {"std", nullptr}, {"min", nullptr},  {"max", nullptr},  {"sse", nullptr}};
   return json{{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
               {"std", s.std},     {"min", s.min},   {"max", s.max},   {"sse", s.sse}};
 }
@@ -30,8 +31,8 @@ json verticalDrift(const VerticalDrift& v) {
 
 json attitude(const AttitudeError& a) {
   if (a.tilt.count == 0)
-    return json{{"roll_rmse_deg", nullptr}, {"pitch_rmse_deg", nullptr}, {"tilt_rmse_deg", nullptr},
-                {"tilt_max_deg", nullptr}};
+    return json{
+        {"roll_rmse_deg", nullptr}, {"pitch_rmse_deg", nullptr}, {"tilt_rmse_deg", nullptr}, {"tilt_max_deg", nullptr}};
   return json{{"roll_rmse_deg", a.roll.rmse},
               {"pitch_rmse_deg", a.pitch.rmse},
               {"tilt_rmse_deg", a.tilt.rmse},
@@ -67,7 +68,8 @@ json evaluationJson(const Evaluation& ev, const TrajectoryInput& est, const Traj
                       {"pairs", ev.pairs.size()},
                       {"estimate_fraction", static_cast<double>(ev.pairs.size()) / static_cast<double>(ev.est_poses)}};
   json rotation = json::array();
-  for (int r = 0; r < 3; ++r) rotation.push_back({ev.alignment.rotation(r, 0), ev.alignment.rotation(r, 1), ev.alignment.rotation(r, 2)});
+  for (int r = 0; r < 3; ++r)
+    rotation.push_back({ev.alignment.rotation(r, 0), ev.alignment.rotation(r, 1), ev.alignment.rotation(r, 2)});
   j["alignment"] = {{"mode", alignmentName(options.alignment)},
                     {"scale", ev.alignment.scale},
                     {"rotation", rotation},

@@ -30,8 +30,7 @@ Message decodeOrThrow(const lcm::LogEvent& ev, const std::string& where) {
 
 StampedPose stampedPoseOf(int64_t utime, const double position[3], const double orientation[4],
                           const std::string& where) {
-  if (!allFinite(position, 3) || !allFinite(orientation, 4))
-    throw PoseLogError(where + ": pose is not finite");
+  if (!allFinite(position, 3) || !allFinite(orientation, 4)) throw PoseLogError(where + ": pose is not finite");
   const double qn = std::sqrt(orientation[0] * orientation[0] + orientation[1] * orientation[1] +
                               orientation[2] * orientation[2] + orientation[3] * orientation[3]);
   if (!(qn > 0.5 && qn < 1.5))
@@ -76,9 +75,10 @@ PoseLog readPoseLog(const std::string& path, const std::string& channel) {
   }
   if (out.poses.empty()) {
     std::string present;
-    for (const auto& [name, count] : channels) present += (present.empty() ? "" : ", ") + name + " (" + std::to_string(count) + ")";
-    throw PoseLogError(path + ": no messages on channel " + channel + " (channels in the log: " +
-                       (present.empty() ? std::string("none") : present) + ")");
+    for (const auto& [name, count] : channels)
+      present += (present.empty() ? "" : ", ") + name + " (" + std::to_string(count) + ")";
+    throw PoseLogError(path + ": no messages on channel " + channel +
+                       " (channels in the log: " + (present.empty() ? std::string("none") : present) + ")");
   }
   std::stable_sort(out.poses.begin(), out.poses.end(),
                    [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });

@@ -17,7 +17,8 @@ constexpr const char* kScanType = "livo.registered_scan_t";
 
 std::string channelList(const std::map<std::string, size_t>& channels) {
   std::string present;
-  for (const auto& [name, count] : channels) present += (present.empty() ? "" : ", ") + name + " (" + std::to_string(count) + ")";
+  for (const auto& [name, count] : channels)
+    present += (present.empty() ? "" : ", ") + name + " (" + std::to_string(count) + ")";
   return present.empty() ? std::string("none") : present;
 }
 
@@ -27,7 +28,8 @@ registered_scan_t decodeScan(const lcm::LogEvent& ev, const std::string& where) 
   const std::string type_name = type ? type->name : "an unknown type";
   if (type_name != kScanType) throw ScanLogError(where + ": is " + type_name + ", expected " + kScanType);
   registered_scan_t m;
-  if (m.decode(ev.data, 0, static_cast<int>(ev.datalen)) < 0) throw ScanLogError(where + ": does not decode as " + kScanType);
+  if (m.decode(ev.data, 0, static_cast<int>(ev.datalen)) < 0)
+    throw ScanLogError(where + ": does not decode as " + kScanType);
   if (m.cloud.num_points == 0) return m;  // empty: the thickness counts it as skipped
   const std::string problem = registeredScanProblem(m);
   if (!problem.empty()) throw ScanLogError(where + ": " + problem);
@@ -62,8 +64,8 @@ void readScans(const ScanLogInput& in, const GroundScanVisitor& visit) {
     ++scans;
   }
   if (scans == 0)
-    throw ScanLogError(in.path + ": no messages on channel " + in.channel + " (channels in the log: " +
-                       channelList(channels) + ")");
+    throw ScanLogError(in.path + ": no messages on channel " + in.channel +
+                       " (channels in the log: " + channelList(channels) + ")");
 }
 }  // namespace
 

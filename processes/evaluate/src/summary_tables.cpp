@@ -75,8 +75,8 @@ Table errorTable(const Evaluation& ev) {
       t.rows.push_back({name, "-", "-", "-", "-", "-", "-", "0"});
       return;
     }
-    t.rows.push_back({name, num(s.rmse), num(s.mean), num(s.median), num(s.std), num(s.min), num(s.max),
-                      std::to_string(s.count)});
+    t.rows.push_back(
+        {name, num(s.rmse), num(s.mean), num(s.median), num(s.std), num(s.min), num(s.max), std::to_string(s.count)});
   };
   row("ATE translation (m)", ev.ate);
   row("RPE translation (m)", ev.rpe_translation_m);
@@ -90,8 +90,8 @@ Table driftTable(const Evaluation& ev) {
     if (d.segments == 0)
       t.rows.push_back({num(d.length_m), "0", "-", "-"});
     else
-      t.rows.push_back({num(d.length_m), std::to_string(d.segments), fixed(d.translation_percent, 4),
-                        num(d.rotation_deg_per_m, 6)});
+      t.rows.push_back(
+          {num(d.length_m), std::to_string(d.segments), fixed(d.translation_percent, 4), num(d.rotation_deg_per_m, 6)});
   }
   if (ev.drift.segments > 0)
     t.rows.push_back({"all", std::to_string(ev.drift.segments), fixed(ev.drift.translation_percent, 4),
@@ -104,16 +104,16 @@ Table inputTable(const Evaluation& ev, const TrajectoryInput& est, const Traject
   Table t{{"input", "value"}, {}, false};
   t.rows.push_back({"estimate", est.spec + " (" + est.format + ", " + std::to_string(est.poses.size()) + " poses)"});
   t.rows.push_back({"ground truth", gt.spec + " (" + gt.format + ", " + std::to_string(gt.poses.size()) + " poses)"});
-  std::string pairing = std::to_string(ev.pairs.size()) + " pairs " +
-                        (ev.pairs.by_index ? std::string("by index") : "by time, max dt " + num(options.max_dt) + " s") +
-                        ", " + fixed(100.0 * static_cast<double>(ev.pairs.size()) / static_cast<double>(ev.est_poses), 1) +
-                        " % of the estimate";
+  std::string pairing =
+      std::to_string(ev.pairs.size()) + " pairs " +
+      (ev.pairs.by_index ? std::string("by index") : "by time, max dt " + num(options.max_dt) + " s") + ", " +
+      fixed(100.0 * static_cast<double>(ev.pairs.size()) / static_cast<double>(ev.est_poses), 1) + " % of the estimate";
   t.rows.push_back({"pairs", pairing});
   std::string alignment = alignmentName(options.alignment);
   if (options.alignment == Alignment::kSim3) alignment += ", scale " + num(ev.alignment.scale, 8);
   if (options.alignment == Alignment::kFourDof)
-    alignment += " (yaw about z and translation), yaw " + fixed(yawOf(ev.alignment.rotation) * 180.0 / M_PI, 4) +
-                 " deg";
+    alignment +=
+        " (yaw about z and translation), yaw " + fixed(yawOf(ev.alignment.rotation) * 180.0 / M_PI, 4) + " deg";
   t.rows.push_back({"alignment", alignment});
   if (!options.gt_offset.isZero())
     t.rows.push_back({"gt offset (body, m)", num(options.gt_offset.x()) + ", " + num(options.gt_offset.y()) + ", " +
@@ -146,16 +146,16 @@ std::string verticalDriftLine(const Evaluation& ev) {
   os << "Vertical drift (z error, heights anchored at the first pose): " << signedFixed(ev.vertical.end_m, 4)
      << " m at the end";
   if (ev.vertical.hasPath()) os << ", " << signedFixed(ev.vertical.per100m(), 4) << " m per 100 m";
-  os << " over " << fixed(ev.vertical.path_length_m, 1) << " m; largest |z error| "
-     << fixed(ev.vertical.max_abs_m, 4) << " m";
+  os << " over " << fixed(ev.vertical.path_length_m, 1) << " m; largest |z error| " << fixed(ev.vertical.max_abs_m, 4)
+     << " m";
   return os.str();
 }
 
 std::string attitudeLine(const Evaluation& ev) {
   const AttitudeError& a = ev.attitude;
-  return "Roll / pitch error (gravity direction in the body, rmse): roll " + fixed(a.roll.rmse, 4) +
-         " deg, pitch " + fixed(a.pitch.rmse, 4) + " deg, tilt " + fixed(a.tilt.rmse, 4) + " deg (largest tilt " +
-         fixed(a.tilt.max, 4) + " deg)";
+  return "Roll / pitch error (gravity direction in the body, rmse): roll " + fixed(a.roll.rmse, 4) + " deg, pitch " +
+         fixed(a.pitch.rmse, 4) + " deg, tilt " + fixed(a.tilt.rmse, 4) + " deg (largest tilt " + fixed(a.tilt.max, 4) +
+         " deg)";
 }
 
 std::string groundMapLine(const GroundMapThickness& g) {
@@ -169,15 +169,17 @@ std::string groundMapLine(const GroundMapThickness& g) {
        << " m; truth floor rms " << fixed(g.truth.rmse, 4) << " m, median " << fixed(g.truth.median, 4) << " m; "
        << g.cells << " cells, " << g.points << " ground points";
   os << "; " << g.scans << " scans";
-  if (g.scans_skipped > 0) os << ", " << g.scans_skipped << " skipped (" << g.scans_empty << " empty, the rest without ground truth)";
+  if (g.scans_skipped > 0)
+    os << ", " << g.scans_skipped << " skipped (" << g.scans_empty << " empty, the rest without ground truth)";
   if (g.points_skipped > 0) os << ", " << g.points_skipped << " points skipped (not finite, or beyond the cell grid)";
   return os.str();
 }
 
 /// The lines of the metrics for a ground vehicle, each ending in a newline; `separator` between them.
 void groundVehicleLines(std::ostream& os, const Evaluation& ev, const std::string& separator) {
-  os << fourDofAteLine(ev) << "\n" << separator << verticalDriftLine(ev) << "\n" << separator
-     << attitudeLine(ev) << "\n";
+  os << fourDofAteLine(ev) << "\n"
+     << separator << verticalDriftLine(ev) << "\n"
+     << separator << attitudeLine(ev) << "\n";
   if (ev.ground_map) os << separator << groundMapLine(*ev.ground_map) << "\n";
 }
 
@@ -205,9 +207,8 @@ void writeMarkdownReport(const std::string& path, const Evaluation& ev, const Tr
   if (!out) throw std::runtime_error(path + ": cannot write");
   out << "# Trajectory evaluation\n\n";
   inputTable(ev, est, gt, options).markdown(out);
-  out << "\n## Errors\n\nATE after " << alignmentName(options.alignment)
-      << " alignment; RPE of the relative pose over " << options.rpe.delta << " frame"
-      << (options.rpe.delta == 1 ? "" : "s") << ".\n\n";
+  out << "\n## Errors\n\nATE after " << alignmentName(options.alignment) << " alignment; RPE of the relative pose over "
+      << options.rpe.delta << " frame" << (options.rpe.delta == 1 ? "" : "s") << ".\n\n";
   errorTable(ev).markdown(out);
   out << "\n" << endPointLine(ev) << "\n";
   out << "\n";
@@ -224,7 +225,8 @@ void writeMarkdownReport(const std::string& path, const Evaluation& ev, const Tr
   if (!plot_path.empty()) {
     namespace fs = std::filesystem;
     const fs::path report_dir = fs::absolute(fs::path(path)).parent_path();
-    const std::string rel = fs::absolute(fs::path(plot_path)).lexically_normal().lexically_relative(report_dir.lexically_normal()).string();
+    const std::string rel =
+        fs::absolute(fs::path(plot_path)).lexically_normal().lexically_relative(report_dir.lexically_normal()).string();
     out << "\n## Figures\n\n![Top view coloured by ATE, and errors over time](" << rel << ")\n";
   }
   if (!out) throw std::runtime_error(path + ": write failed");

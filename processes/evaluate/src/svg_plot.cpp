@@ -36,12 +36,13 @@ class Svg {
   std::ostringstream os;
 
   void text(double x, double y, const std::string& s, int size, const char* anchor = "start", const char* extra = "") {
-    os << "<text x=\"" << fixed1(x) << "\" y=\"" << fixed1(y) << "\" font-size=\"" << size << "\" text-anchor=\"" << anchor
-       << "\" " << kFont << " " << extra << ">" << escapeMarkup(s) << "</text>\n";
+    os << "<text x=\"" << fixed1(x) << "\" y=\"" << fixed1(y) << "\" font-size=\"" << size << "\" text-anchor=\""
+       << anchor << "\" " << kFont << " " << extra << ">" << escapeMarkup(s) << "</text>\n";
   }
-  void line(double x0, double y0, double x1, double y1, const std::string& stroke, double width, const char* extra = "") {
-    os << "<line x1=\"" << fixed1(x0) << "\" y1=\"" << fixed1(y0) << "\" x2=\"" << fixed1(x1) << "\" y2=\"" << fixed1(y1)
-       << "\" stroke=\"" << stroke << "\" stroke-width=\"" << width << "\" " << extra << "/>\n";
+  void line(double x0, double y0, double x1, double y1, const std::string& stroke, double width,
+            const char* extra = "") {
+    os << "<line x1=\"" << fixed1(x0) << "\" y1=\"" << fixed1(y0) << "\" x2=\"" << fixed1(x1) << "\" y2=\""
+       << fixed1(y1) << "\" stroke=\"" << stroke << "\" stroke-width=\"" << width << "\" " << extra << "/>\n";
   }
   void dot(double x, double y, double r, const std::string& fill) {
     os << "<circle cx=\"" << fixed1(x) << "\" cy=\"" << fixed1(y) << "\" r=\"" << r << "\" fill=\"" << fill << "\"/>\n";
@@ -60,7 +61,8 @@ class Svg {
 std::vector<std::pair<double, double>> thin(const std::vector<std::pair<double, double>>& pts, double min_px) {
   std::vector<std::pair<double, double>> out;
   for (size_t i = 0; i < pts.size(); ++i) {
-    if (!out.empty() && i + 1 < pts.size() && std::hypot(pts[i].first - out.back().first, pts[i].second - out.back().second) < min_px)
+    if (!out.empty() && i + 1 < pts.size() &&
+        std::hypot(pts[i].first - out.back().first, pts[i].second - out.back().second) < min_px)
       continue;
     out.push_back(pts[i]);
   }
@@ -148,8 +150,8 @@ bool loopLines(Svg& svg, const std::vector<std::pair<double, double>>& px, const
 std::pair<LinearScale, LinearScale> axes(Svg& svg, const Rect& r, double xlo, double xhi, double ylo, double yhi,
                                          const std::string& xtitle, const std::string& ytitle, int xticks, int yticks) {
   LinearScale sx{xlo, xhi, r.x, r.x + r.w}, sy{ylo, yhi, r.y + r.h, r.y};
-  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\"" << fixed1(r.h)
-         << "\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"1\"/>\n";
+  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\""
+         << fixed1(r.h) << "\" fill=\"#ffffff\" stroke=\"#444444\" stroke-width=\"1\"/>\n";
   const auto xt = niceTicks(xlo, xhi, xticks), yt = niceTicks(ylo, yhi, yticks);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   for (double v : xt) {
@@ -191,8 +193,8 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
   const double cx = 0.5 * (xlo + xhi), cy = 0.5 * (ylo + yhi);
   xlo = cx - 0.5 * area.w * m_per_px, xhi = cx + 0.5 * area.w * m_per_px;
   ylo = cy - 0.5 * area.h * m_per_px, yhi = cy + 0.5 * area.h * m_per_px;
-  const auto [sx, sy] = axes(svg, area, xlo, xhi, ylo, yhi, std::string(names[a]) + " (m)",
-                             std::string(names[b]) + " (m)", 7, 7);
+  const auto [sx, sy] =
+      axes(svg, area, xlo, xhi, ylo, yhi, std::string(names[a]) + " (m)", std::string(names[b]) + " (m)", 7, 7);
 
   std::vector<std::pair<double, double>> gt_px;
   for (const auto& p : ev.gt_path) gt_px.emplace_back(sx(p[a]), sy(p[b]));
@@ -271,9 +273,11 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
     svg.text(lx + 38, y + 5, rows[i].second, 13);
   }
   const double ey = ly + 4 + row_h * static_cast<double>(rows.size());
-  svg.os << "<circle cx=\"" << fixed1(lx + 8) << "\" cy=\"" << fixed1(ey) << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.os << "<circle cx=\"" << fixed1(lx + 8) << "\" cy=\"" << fixed1(ey)
+         << "\" r=\"5\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
   svg.text(lx + 18, ey + 5, "start", 13);
-  svg.os << "<rect x=\"" << fixed1(lx + 64) << "\" y=\"" << fixed1(ey - 5) << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
+  svg.os << "<rect x=\"" << fixed1(lx + 64) << "\" y=\"" << fixed1(ey - 5)
+         << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
   svg.text(lx + 80, ey + 5, "end", 13);
 }
 
@@ -282,8 +286,8 @@ void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
   for (int i = 0; i <= 8; ++i)
     svg.os << "<stop offset=\"" << i / 8.0 << "\" stop-color=\"" << errorColour(i / 8.0) << "\"/>";
   svg.os << "</linearGradient></defs>\n";
-  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\"" << fixed1(r.h)
-         << "\" fill=\"url(#ate)\" stroke=\"#444444\"/>\n";
+  svg.os << "<rect x=\"" << fixed1(r.x) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(r.w) << "\" height=\""
+         << fixed1(r.h) << "\" fill=\"url(#ate)\" stroke=\"#444444\"/>\n";
   LinearScale s{err_lo, err_hi, r.y + r.h, r.y};
   const auto ticks = niceTicks(err_lo, err_hi, 6);
   const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
@@ -303,8 +307,9 @@ void shadeTimeMarks(Svg& svg, const Rect& r, const LinearScale& sx, const TimeMa
     for (const auto& [from, to] : spans) {
       if (to < sx.lo || from > sx.hi) continue;
       const double x0 = sx(std::max(from, sx.lo)), x1 = sx(std::min(to, sx.hi));
-      svg.os << "<rect x=\"" << fixed1(x0) << "\" y=\"" << fixed1(r.y) << "\" width=\"" << fixed1(std::max(1.5, x1 - x0))
-             << "\" height=\"" << fixed1(r.h) << "\" fill=\"" << colour << "\" fill-opacity=\"0.2\"/>\n";
+      svg.os << "<rect x=\"" << fixed1(x0) << "\" y=\"" << fixed1(r.y) << "\" width=\""
+             << fixed1(std::max(1.5, x1 - x0)) << "\" height=\"" << fixed1(r.h) << "\" fill=\"" << colour
+             << "\" fill-opacity=\"0.2\"/>\n";
     }
   };
   shade(marks.degenerate, kDegenerateColour);
@@ -378,8 +383,8 @@ void seriesPanel(Svg& svg, const Rect& r, const std::vector<double>& t, const st
   if (clipped) max_label += " (" + std::to_string(clipped) + " above the axis)";
   auto width = [](const std::string& text) { return 7.4 * static_cast<double>(text.size()); };  // 13 px sans
   const double sample = 26, pad = 8, space = 16;
-  const double kw = pad + sample + 6 + width(rmse_label) + space + sample + 6 + width(median_label) + space +
-                    width(max_label) + pad;
+  const double kw =
+      pad + sample + 6 + width(rmse_label) + space + sample + 6 + width(median_label) + space + width(max_label) + pad;
   const double kx = r.x + r.w - kw - 6, ky = r.y + 6;
   svg.os << "<rect x=\"" << fixed1(kx) << "\" y=\"" << fixed1(ky) << "\" width=\"" << fixed1(kw) << "\" height=\"22\" "
          << "fill=\"#ffffff\" fill-opacity=\"0.9\" stroke=\"#bbbbbb\"/>\n";
@@ -441,7 +446,8 @@ std::string evaluationSvg(const Evaluation& ev, const PlotOptions& options) {
   const double rx = view.x + view.w + 200, rw = W - rx - 30;
   const double gap = 62, ph = (view.h - 2 * gap) / 3.0;
   // RPE samples are one pair stride apart.
-  const double rpe_step = ev.rpe.from.size() > 1 ? max_step * static_cast<double>(ev.rpe.from[1] - ev.rpe.from[0]) : max_step;
+  const double rpe_step =
+      ev.rpe.from.size() > 1 ? max_step * static_cast<double>(ev.rpe.from[1] - ev.rpe.from[0]) : max_step;
   const TimeMarks time_marks = marksSinceStart(marks, t0);
   seriesPanel(svg, Rect{rx, top, rw, ph}, t_ate, ev.ate_m, tmin, tmax, max_step, xtitle, "ATE (m)", "#d7191c", ev.ate,
               time_marks);

@@ -1,7 +1,7 @@
 #include "livo/evaluate/trajectory_input.hpp"
 
-#include <cmath>
 #include <sys/stat.h>
+#include <cmath>
 
 #include "livo/evaluate/pose_log.hpp"
 
@@ -30,8 +30,7 @@ LogSpec splitLogSpec(const std::string& spec) {
     throw InputError(spec + ": no such file");
   LogSpec named{spec.substr(0, colon), spec.substr(colon + 1)};
   if (named.channel.empty()) throw InputError(spec + ": empty channel name after ':'");
-  if (!isLcmLog(named.path))
-    throw InputError(spec + ": a channel was named, but " + named.path + " is not an LCM log");
+  if (!isLcmLog(named.path)) throw InputError(spec + ": a channel was named, but " + named.path + " is not an LCM log");
   return named;
 }
 

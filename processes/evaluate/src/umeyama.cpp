@@ -22,8 +22,8 @@ Eigen::Matrix4d Similarity3::matrix() const {
 
 PairedCentroids pairedCentroids(const std::vector<Vec3>& source, const std::vector<Vec3>& target) {
   if (source.size() != target.size())
-    throw AlignmentError("alignment needs as many source as target points (" + std::to_string(source.size()) +
-                         " vs " + std::to_string(target.size()) + ")");
+    throw AlignmentError("alignment needs as many source as target points (" + std::to_string(source.size()) + " vs " +
+                         std::to_string(target.size()) + ")");
   if (source.empty()) throw AlignmentError("alignment needs at least one pair of points");
   PairedCentroids c;
   for (size_t i = 0; i < source.size(); ++i) {
@@ -40,7 +40,7 @@ Similarity3 umeyamaAlignment(const std::vector<Vec3>& source, const std::vector<
   const PairedCentroids centroids = pairedCentroids(source, target);
   const Vec3 &mean_x = centroids.source, &mean_y = centroids.target;
 
-  double sigma_x = 0.0;  // variance of the source, eq. 36
+  double sigma_x = 0.0;     // variance of the source, eq. 36
   Mat3 cov = Mat3::Zero();  // cross-covariance, eq. 38
   for (size_t i = 0; i < source.size(); ++i) {
     const Vec3 dx = source[i] - mean_x;
@@ -63,9 +63,9 @@ Similarity3 umeyamaAlignment(const std::vector<Vec3>& source, const std::vector<
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) S(2, 2) = -1.0;
 
   Similarity3 sim;
-  sim.rotation = svd.matrixU() * S * svd.matrixV().transpose();  // eq. 40
+  sim.rotation = svd.matrixU() * S * svd.matrixV().transpose();           // eq. 40
   sim.scale = with_scale ? (d.asDiagonal() * S).trace() / sigma_x : 1.0;  // eq. 42
-  sim.translation = mean_y - sim.scale * (sim.rotation * mean_x);  // eq. 41
+  sim.translation = mean_y - sim.scale * (sim.rotation * mean_x);         // eq. 41
   return sim;
 }
 

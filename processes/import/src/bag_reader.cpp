@@ -216,8 +216,7 @@ void BagReader::readAll(const std::function<void(const BagMessage&)>& fn) {
       const uint32_t usize = fieldAs<uint32_t>(r.header, "size", where);
       ++chunk_compressions_[compression];
       DecompressedChunk chunk = decompressChunk(compression, r.data, r.size, usize);
-      if (!chunk.error.empty() && chunk.data.empty())
-        throw BagError(where + ": chunk: " + chunk.error);
+      if (!chunk.error.empty() && chunk.data.empty()) throw BagError(where + ": chunk: " + chunk.error);
       try {
         parseChunk(chunk.data.data(), chunk.data.size(), offset, fn);
       } catch (const DecodeError& e) {

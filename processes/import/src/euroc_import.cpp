@@ -2,13 +2,13 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "livo/asl_dataset.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/ground_truth_file.hpp"
 #include "livo/import/image_encoding.hpp"
-#include "livo/asl_dataset.hpp"
-#include "livo/imu_t.hpp"
 #include "livo/import/progress_line.hpp"
 #include "livo/import/stamp_conversion.hpp"
+#include "livo/imu_t.hpp"
 
 namespace livo::import {
 
@@ -33,7 +33,8 @@ void sensorMetadata(const std::string& yaml, const std::string& prefix, ImportRe
     InputCalibration& cal = report.calibration();
     const std::string source = prefix + "/sensor.yaml";
     if (prefix == "imu0" && s.gyro_noise_density > 0)
-      cal.imu_noise = ImuNoise{s.gyro_noise_density, s.gyro_random_walk, s.accel_noise_density, s.accel_random_walk, source};
+      cal.imu_noise =
+          ImuNoise{s.gyro_noise_density, s.gyro_random_walk, s.accel_noise_density, s.accel_random_walk, source};
     if (prefix == "cam0" && s.intrinsics.size() == 4 && s.width > 0) {
       CameraIntrinsics k;
       k.width = s.width;
@@ -154,8 +155,10 @@ void importEuroc(const std::string& root, const EurocImportOptions& o, SortedLog
     gt = joinPath(dataset_dir, "groundtruth.tum");
     report.note("ground truth from " + gt + " (no state_groundtruth_estimate0/data.csv)");
   }
-  if (!gt.empty()) importGroundTruthFile(gt, o.channels.ground_truth, "I", writer, report);
-  else report.note("no ground truth found (give one with --ground-truth FILE)");
+  if (!gt.empty())
+    importGroundTruthFile(gt, o.channels.ground_truth, "I", writer, report);
+  else
+    report.note("no ground truth found (give one with --ground-truth FILE)");
   report.metadataString("body_frame", "I = IMU (imu0); camera poses in the body: camN_T_body_sensor");
 }
 

@@ -1,10 +1,10 @@
 #include "livo/import/file_utils.hpp"
 
-#include <algorithm>
 #include <dirent.h>
+#include <sys/stat.h>
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
-#include <sys/stat.h>
 
 namespace livo::import {
 

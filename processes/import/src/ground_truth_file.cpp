@@ -1,9 +1,9 @@
 #include "livo/import/ground_truth_file.hpp"
 
+#include "livo/import/stamp_conversion.hpp"
 #include "livo/messages.hpp"
 #include "livo/pose_t.hpp"
 #include "livo/trajectory_io.hpp"
-#include "livo/import/stamp_conversion.hpp"
 
 namespace livo::import {
 

@@ -8,7 +8,9 @@
 namespace livo::import {
 
 namespace {
-uint32_t be32(const uint8_t* p) { return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3]; }
+uint32_t be32(const uint8_t* p) {
+  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
+}
 uint16_t be16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
 }  // namespace
 
@@ -33,8 +35,14 @@ CompressedImageInfo sniffCompressedImage(const uint8_t* d, size_t n) {
     while (i + 4 <= n) {
       if (d[i] != 0xff) break;
       const uint8_t marker = d[i + 1];
-      if (marker == 0xff) { ++i; continue; }
-      if (marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7) || marker == 0x01) { i += 2; continue; }
+      if (marker == 0xff) {
+        ++i;
+        continue;
+      }
+      if (marker == 0xd8 || (marker >= 0xd0 && marker <= 0xd7) || marker == 0x01) {
+        i += 2;
+        continue;
+      }
       const uint16_t len = be16(d + i + 2);
       const bool sof = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
       if (sof && i + 9 <= n) {
@@ -66,12 +74,15 @@ image_t convertRosImage(const RosImage& m, const std::string& frame, const std::
   } else if (m.encoding == "bgr8" || m.encoding == "8UC3") {
     img.encoding = image_t::ENCODING_BGR8, channels = 3;
   } else if (isRosDepthEncoding(m.encoding)) {
-    throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is depth, not a camera image (map the topic with --depth)");
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding +
+                      "' is depth, not a camera image (map the topic with --depth)");
   } else {
-    throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding +
+                      "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
   }
   if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * channels)
-    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " + std::to_string(channels));
+    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " +
+                      std::to_string(channels));
   if (static_cast<uint64_t>(m.step) * m.height > m.data_size)
     throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
                       std::to_string(static_cast<uint64_t>(m.step) * m.height));
@@ -91,7 +102,8 @@ image_t convertRosDepthImage(const RosImage& m, const std::string& frame, const 
   const bool metres = m.encoding == "32FC1";
   const uint64_t bytes = metres ? 4 : 2;
   if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * bytes)
-    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " + std::to_string(bytes));
+    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " +
+                      std::to_string(bytes));
   const uint64_t size = static_cast<uint64_t>(m.step) * m.height;
   if (size > m.data_size)
     throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
@@ -117,8 +129,7 @@ image_t convertRosDepthImage(const RosImage& m, const std::string& frame, const 
 
 image_t convertRosCompressedImage(const RosCompressedImage& m, const std::string& frame, const std::string& where) {
   const CompressedImageInfo info = sniffCompressedImage(m.data, m.data_size);
-  if (info.encoding < 0)
-    throw DecodeError(where + ": field 'data': neither JPEG nor PNG (format '" + m.format + "')");
+  if (info.encoding < 0) throw DecodeError(where + ": field 'data': neither JPEG nor PNG (format '" + m.format + "')");
   image_t img;
   img.utime = nsToUtime(m.header.stampNs());
   img.frame = frame;

@@ -63,7 +63,8 @@ void presetCalibration(const RosbagPreset& p, const RosbagImportOptions& r, Impo
 
 void printRigFindings(const std::vector<RigFinding>& findings, const std::string& rig_file, std::ostream* summary,
                       bool quiet) {
-  if (summary) *summary << "rig check against " << rig_file << ": " << (findings.empty() ? "the log fits it" : "") << "\n";
+  if (summary)
+    *summary << "rig check against " << rig_file << ": " << (findings.empty() ? "the log fits it" : "") << "\n";
   for (const RigFinding& f : findings) {
     const std::string line = std::string(f.error ? "error: " : "warning: ") + f.message;
     if (summary) *summary << "  " << line << "\n";
@@ -78,12 +79,9 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
   ImportReport& report = out.report;
   report.setQuiet(job.quiet);
   const ChannelNames& ch = job.channels;
-  out.channel_types = {{ch.imu, "livo.imu_t"},
-                       {ch.lidar, "livo.point_cloud_t"},
-                       {ch.camera, "livo.image_t"},
-                       {ch.camera_right, "livo.image_t"},
-                       {ch.depth, "livo.image_t"},
-                       {ch.ground_truth, "livo.pose_t"}};
+  out.channel_types = {{ch.imu, "livo.imu_t"},      {ch.lidar, "livo.point_cloud_t"},
+                       {ch.camera, "livo.image_t"}, {ch.camera_right, "livo.image_t"},
+                       {ch.depth, "livo.image_t"},  {ch.ground_truth, "livo.pose_t"}};
   SortedLogWriterOptions wo;
   wo.max_buffer_bytes = job.max_buffer_mb << 20;
   SortedLogWriter writer(job.out, wo);

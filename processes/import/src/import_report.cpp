@@ -13,7 +13,9 @@ void ImportReport::skip(const std::string& reason, const std::string& where, int
   Skipped& s = skipped_[reason];
   if (s.count == 0) {
     s.first_where = where;
-    if (!quiet_ && warn) std::cerr << "livo-import: warning: skipped: " << reason << "\n    first at: " << where << " (further ones counted)\n";
+    if (!quiet_ && warn)
+      std::cerr << "livo-import: warning: skipped: " << reason << "\n    first at: " << where
+                << " (further ones counted)\n";
   }
   s.count += count;
 }
@@ -53,7 +55,8 @@ void ImportReport::print(std::ostream& os, const std::map<std::string, int64_t>&
   size_t w = 7;
   for (const auto& kv : channel_counts) w = std::max(w, kv.first.size());
   os << std::left << std::setw(static_cast<int>(w) + 2) << "channel" << std::setw(22) << "type" << std::right
-     << std::setw(10) << "messages" << "\n";
+     << std::setw(10) << "messages"
+     << "\n";
   int64_t total = 0;
   for (const auto& [channel, count] : channel_counts) {
     const auto t = channel_types.find(channel);
@@ -77,7 +80,8 @@ void ImportReport::print(std::ostream& os, const std::map<std::string, int64_t>&
 }
 
 void ImportReport::writeSidecar(const std::string& path, const std::string& format, const std::string& input,
-                                const std::string& log_path, const std::map<std::string, int64_t>& channel_counts) const {
+                                const std::string& log_path,
+                                const std::map<std::string, int64_t>& channel_counts) const {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write the metadata sidecar");
   out << "# Written by livo-import beside " << log_path << ": what the log's messages cannot carry.\n";
@@ -119,7 +123,7 @@ std::string yamlQuote(const std::string& s) {
 }
 
 std::string yamlNumber(double v) {
-  v += 0.0;  // no "-0"
+  v += 0.0;                                                 // no "-0"
   for (int precision = 15; precision <= 17; ++precision) {  // shortest text that reads back exactly
     std::ostringstream os;
     os << std::setprecision(precision) << v;

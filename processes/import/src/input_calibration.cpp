@@ -33,7 +33,8 @@ std::optional<CameraIntrinsics> intrinsicsFromCameraInfo(const RosCameraInfo& m,
   } else {
     c.distortion_model = DistortionModel::kRadtan;
     if (model != "plumb_bob" && model != "radtan" && !(model.empty() && m.D.empty()))
-      note = "distortion model '" + m.distortion_model + "' is not radtan or equidistant: its first four coefficients "
+      note = "distortion model '" + m.distortion_model +
+             "' is not radtan or equidistant: its first four coefficients "
              "are written as radtan";
   }
   for (size_t i = 0; i < 4 && i < m.D.size(); ++i) c.distortion[i] = m.D[i];

@@ -13,12 +13,12 @@
 #include "livo/import/file_utils.hpp"
 #include "livo/import/image_encoding.hpp"
 #include "livo/import/kitti_oxts.hpp"
+#include "livo/import/progress_line.hpp"
+#include "livo/import/stamp_conversion.hpp"
 #include "livo/imu_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/pose_t.hpp"
 #include "livo/trajectory_io.hpp"
-#include "livo/import/progress_line.hpp"
-#include "livo/import/stamp_conversion.hpp"
 
 namespace livo::import {
 
@@ -112,8 +112,8 @@ void writeScans(const std::string& dir, const std::vector<std::string>& files,
   }
 }
 
-void importImages(const std::string& dir, const std::string& channel, const std::string& frame,
-                  ImportReport& report, SortedLogWriter& writer) {
+void importImages(const std::string& dir, const std::string& channel, const std::string& frame, ImportReport& report,
+                  SortedLogWriter& writer) {
   const std::string ts_path = joinPath(dir, "timestamps.txt");
   if (!isFile(ts_path)) {
     report.skip("camera folder without timestamps.txt", dir);
@@ -205,7 +205,8 @@ void importRawDrive(const std::string& folder, const KittiImportOptions& o, Sort
       start = readKittiTimestamps(joinPath(velo, "timestamps_start.txt"), report);
     if (isFile(joinPath(velo, "timestamps_end.txt")))
       end = readKittiTimestamps(joinPath(velo, "timestamps_end.txt"), report);
-    report.metadataString("lidar_sweep_start", start.empty() ? "timestamps.txt - sweep_duration / 2" : "timestamps_start.txt");
+    report.metadataString("lidar_sweep_start",
+                          start.empty() ? "timestamps.txt - sweep_duration / 2" : "timestamps_start.txt");
     auto stamp_of = [&](long i, ScanStamp* st) {
       const size_t k = static_cast<size_t>(i);
       st->duration = o.sweep_duration;
@@ -227,7 +228,8 @@ void importRawDrive(const std::string& folder, const KittiImportOptions& o, Sort
     writeScans(data, files, stamp_of, o, writer, report);
   }
   if (isDirectory(joinPath(folder, "oxts"))) importOxts(joinPath(folder, "oxts"), o, writer, report);
-  if (isDirectory(joinPath(folder, "image_02"))) importImages(joinPath(folder, "image_02"), o.channels.camera, "C", report, writer);
+  if (isDirectory(joinPath(folder, "image_02")))
+    importImages(joinPath(folder, "image_02"), o.channels.camera, "C", report, writer);
   if (isDirectory(joinPath(folder, "image_03")))
     importImages(joinPath(folder, "image_03"), o.channels.camera_right, "C1", report, writer);
 }
@@ -293,8 +295,9 @@ void importOdometry(const std::string& folder, const std::string& velo_dir, cons
   Pose3 T_cam_velo = Pose3::Identity();
   const bool to_lidar = readVeloToCam(joinPath(folder, "calib.txt"), &T_cam_velo);
   report.metadataString("ground_truth_file", poses);
-  report.metadataString("ground_truth_frame", to_lidar ? "LiDAR (velodyne) poses in the first LiDAR frame, from cam0 poses and calib.txt Tr"
-                                                       : "cam0 poses as given (no calib.txt Tr): child frame C");
+  report.metadataString("ground_truth_frame",
+                        to_lidar ? "LiDAR (velodyne) poses in the first LiDAR frame, from cam0 poses and calib.txt Tr"
+                                 : "cam0 poses as given (no calib.txt Tr): child frame C");
   for (size_t i = 0; i < traj.size(); ++i) {
     double t;
     if (!times.empty()) {
@@ -315,13 +318,13 @@ void importOdometry(const std::string& folder, const std::string& velo_dir, cons
     writer.add(o.channels.ground_truth, gt);
   }
   if (to_lidar) report.metadataString("body_frame", "I = LiDAR (KITTI odometry has no IMU)");
-  if (times.empty())
-    report.note("ground-truth poses stamped at the scans' mid-sweep instants (no times.txt)");
+  if (times.empty()) report.note("ground-truth poses stamped at the scans' mid-sweep instants (no times.txt)");
 }
 
 }  // namespace
 
-void importKitti(const std::string& folder, const KittiImportOptions& o, SortedLogWriter& writer, ImportReport& report) {
+void importKitti(const std::string& folder, const KittiImportOptions& o, SortedLogWriter& writer,
+                 ImportReport& report) {
   if (!isDirectory(folder)) {
     report.error(folder + ": not a folder");
     return;

@@ -8,10 +8,10 @@
 namespace livo::import {
 
 namespace {
-const char* const kOxtsFields[30] = {"lat", "lon", "alt", "roll", "pitch", "yaw", "vn", "ve", "vf", "vl",
-                                     "vu", "ax", "ay", "az", "af", "al", "au", "wx", "wy", "wz",
-                                     "wf", "wl", "wu", "pos_accuracy", "vel_accuracy", "navstat", "numsats",
-                                     "posmode", "velmode", "orimode"};
+const char* const kOxtsFields[30] = {
+    "lat", "lon", "alt", "roll",         "pitch",        "yaw",     "vn",      "ve",      "vf",      "vl",
+    "vu",  "ax",  "ay",  "az",           "af",           "al",      "au",      "wx",      "wy",      "wz",
+    "wf",  "wl",  "wu",  "pos_accuracy", "vel_accuracy", "navstat", "numsats", "posmode", "velmode", "orimode"};
 constexpr double kEarthRadius = 6378137.0;
 }  // namespace
 
@@ -24,7 +24,8 @@ OxtsPacket readOxtsFile(const std::string& path) {
   OxtsPacket p;
   for (int i = 0; i < 30; ++i) {
     std::string tok;
-    if (!(ss >> tok)) throw std::runtime_error(path + ": field '" + kOxtsFields[i] + "' (" + std::to_string(i + 1) + " of 30) missing");
+    if (!(ss >> tok))
+      throw std::runtime_error(path + ": field '" + kOxtsFields[i] + "' (" + std::to_string(i + 1) + " of 30) missing");
     try {
       size_t used = 0;
       p.v[i] = std::stod(tok, &used);

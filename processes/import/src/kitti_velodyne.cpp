@@ -32,9 +32,10 @@ KittiScan readKittiBin(const std::string& path, KittiPointFields fields, KittiPo
   }
   const size_t stride = fields == KittiPointFields::kXyzi ? 16 : 12;
   if (fields == KittiPointFields::kAuto || n % stride != 0)
-    throw std::runtime_error(path + ": " + std::to_string(n) + " bytes is not a whole number of " +
-                             (fields == KittiPointFields::kAuto ? std::string("12- or 16-byte") : std::to_string(stride) + "-byte") +
-                             " points (truncated?)");
+    throw std::runtime_error(
+        path + ": " + std::to_string(n) + " bytes is not a whole number of " +
+        (fields == KittiPointFields::kAuto ? std::string("12- or 16-byte") : std::to_string(stride) + "-byte") +
+        " points (truncated?)");
   if (used) *used = fields;
   KittiScan s;
   const size_t count = n / stride;
@@ -100,7 +101,8 @@ point_cloud_t kittiScanToCloud(const KittiScan& s, int64_t start_utime, double s
     c.x.push_back(x), c.y.push_back(y), c.z.push_back(z), c.intensity.push_back(s.intensity[i]);
     const float t = static_cast<float>(kittiTimeOffset(x, y, sweep_duration));
     c.time_offset.push_back(std::min(t, std::nextafter(c.sweep_duration, 0.0f)));
-    c.ring.push_back(static_cast<int16_t>(hdl64RingFromElevation(std::atan2(double(z), std::hypot(double(x), double(y))))));
+    c.ring.push_back(
+        static_cast<int16_t>(hdl64RingFromElevation(std::atan2(double(z), std::hypot(double(x), double(y))))));
   }
   c.num_points = static_cast<int32_t>(c.x.size());
   if (dropped) *dropped = bad;

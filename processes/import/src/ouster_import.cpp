@@ -5,14 +5,14 @@
 #include <optional>
 
 #include "livo/import/file_utils.hpp"
-#include "livo/imu_t.hpp"
-#include "livo/point_cloud_t.hpp"
-#include "livo/messages.hpp"
 #include "livo/import/imu_units.hpp"
 #include "livo/import/ouster_packets.hpp"
 #include "livo/import/pcap_reader.hpp"
 #include "livo/import/progress_line.hpp"
 #include "livo/import/stamp_conversion.hpp"
+#include "livo/imu_t.hpp"
+#include "livo/messages.hpp"
+#include "livo/point_cloud_t.hpp"
 
 namespace livo::import {
 
@@ -158,7 +158,8 @@ std::string findOusterMetadata(const std::string& pcap) {
   const size_t dot = pcap.rfind('.');
   const size_t slash = pcap.rfind('/');
   const std::string dir = slash == std::string::npos ? "." : pcap.substr(0, slash);
-  const std::string stem = dot == std::string::npos || (slash != std::string::npos && dot < slash) ? pcap : pcap.substr(0, dot);
+  const std::string stem =
+      dot == std::string::npos || (slash != std::string::npos && dot < slash) ? pcap : pcap.substr(0, dot);
   if (isFile(stem + ".json")) return stem + ".json";
   // Captures named "<metadata stem>_<suffix>.pcap" (e.g. the SDK's test files): the longest
   // .json stem that prefixes the pcap's name.
@@ -174,7 +175,8 @@ std::string findOusterMetadata(const std::string& pcap) {
   return "";
 }
 
-void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedLogWriter& writer, ImportReport& report) {
+void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedLogWriter& writer,
+                  ImportReport& report) {
   const std::string meta_path = o.metadata_file.empty() ? findOusterMetadata(pcap) : o.metadata_file;
   if (meta_path.empty()) {
     report.error(pcap + ": no metadata JSON found beside it (give one with --metadata FILE)");
@@ -205,7 +207,8 @@ void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedL
   T_I_L.translation() *= 1e-3;
   report.calibration().T_I_L = KnownExtrinsic{T_I_L, "", "the metadata's imu_to_sensor_transform, inverted (mm -> m)"};
   std::string model = meta.prod_line;
-  if (model.rfind("OS-", 0) == 0 && model.size() > 4 && model[4] == '-') model = "OS" + model.substr(3, 1) + model.substr(4);
+  if (model.rfind("OS-", 0) == 0 && model.size() > 4 && model[4] == '-')
+    model = "OS" + model.substr(3, 1) + model.substr(4);
   report.calibration().lidar_model = model;
   report.calibration().lidar_model_source = "Ouster metadata prod_line " + meta.prod_line;
 
@@ -232,7 +235,8 @@ void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedL
           }
           writer.add(o.channels.imu, m);
         } else {
-          report.skip("UDP datagram to port " + std::to_string(u.dst_port) + " (neither LiDAR nor IMU port)", where, 1, false);
+          report.skip("UDP datagram to port " + std::to_string(u.dst_port) + " (neither LiDAR nor IMU port)", where, 1,
+                      false);
         }
       } catch (const std::exception& e) {
         report.skip("undecodable Ouster packet", where + ": " + e.what());
@@ -248,7 +252,8 @@ void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedL
     report.error(e.what());
   }
   sweeps.flush();
-  if (sweeps.invalidColumns()) report.skip("LiDAR columns flagged invalid by the sensor", pcap, sweeps.invalidColumns(), false);
+  if (sweeps.invalidColumns())
+    report.skip("LiDAR columns flagged invalid by the sensor", pcap, sweeps.invalidColumns(), false);
   report.metadata("ouster_lidar_packets", std::to_string(lidar_packets));
   report.metadata("ouster_imu_packets", std::to_string(imu_packets));
 }

@@ -70,8 +70,10 @@ OusterMetadata readOusterMetadata(const std::string& path) {
     } else {
       m.beam_to_lidar(0, 3) = m.lidar_origin_to_beam_origin_mm;
     }
-    if (auto j = optional("lidar_to_sensor_transform")) m.lidar_to_sensor = matrixOf(*j, path + ": lidar_to_sensor_transform");
-    if (auto j = optional("imu_to_sensor_transform")) m.imu_to_sensor = matrixOf(*j, path + ": imu_to_sensor_transform");
+    if (auto j = optional("lidar_to_sensor_transform"))
+      m.lidar_to_sensor = matrixOf(*j, path + ": lidar_to_sensor_transform");
+    if (auto j = optional("imu_to_sensor_transform"))
+      m.imu_to_sensor = matrixOf(*j, path + ": imu_to_sensor_transform");
     if (auto j = optional("udp_port_lidar")) m.udp_port_lidar = j->is_number() ? j->get<int>() : m.udp_port_lidar;
     if (auto j = optional("udp_port_imu")) m.udp_port_imu = j->is_number() ? j->get<int>() : m.udp_port_imu;
   } catch (const nlohmann::json::exception& e) {

@@ -26,7 +26,8 @@ OusterPacketFormat::OusterPacketFormat(const OusterMetadata& m)
   } else if (p == "RNG15_RFL8_NIR8") {
     pixel_ = Pixel::kLowDataRate, pixel_bytes_ = 4;
   } else {
-    throw std::invalid_argument("udp_profile_lidar '" + p + "' is not supported (LEGACY, RNG19_RFL8_SIG16_NIR16, "
+    throw std::invalid_argument("udp_profile_lidar '" + p +
+                                "' is not supported (LEGACY, RNG19_RFL8_SIG16_NIR16, "
                                 "RNG19_RFL8_SIG16_NIR16_DUAL, RNG15_RFL8_NIR8)");
   }
   legacy_ = pixel_ == Pixel::kLegacy;

@@ -6,7 +6,9 @@ namespace livo::import {
 
 namespace {
 uint16_t be16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
-uint32_t be32(const uint8_t* p) { return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3]; }
+uint32_t be32(const uint8_t* p) {
+  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3];
+}
 uint32_t swap32(uint32_t v) { return __builtin_bswap32(v); }
 constexpr size_t kMaxPendingDatagrams = 256;  // bound on half-reassembled datagrams kept
 constexpr uint32_t kLinkEthernet = 1, kLinkRaw = 101, kLinkIpv4 = 228, kLinkSll = 113, kLinkLoop = 0;
@@ -60,7 +62,8 @@ void PcapReader::readAll(const std::function<void(const UdpDatagram&)>& fn) {
     if (swapped_)
       for (uint32_t& v : rh) v = swap32(v);
     const uint32_t incl = rh[2], orig = rh[3];
-    if (incl > (256u << 10)) throw PcapError(where + ": field 'incl_len' " + std::to_string(incl) + " is implausible (corrupt)");
+    if (incl > (256u << 10))
+      throw PcapError(where + ": field 'incl_len' " + std::to_string(incl) + " is implausible (corrupt)");
     frame.resize(incl);
     const size_t body = std::fread(frame.data(), 1, incl, file_);
     position_ += 16 + body;
@@ -69,7 +72,8 @@ void PcapReader::readAll(const std::function<void(const UdpDatagram&)>& fn) {
                       std::to_string(body) + " (truncated)");
     ++stats_.records;
     if (incl < orig) ++stats_.truncated_records;
-    const int64_t t = static_cast<int64_t>(rh[0]) * 1000000000LL + static_cast<int64_t>(rh[1]) * (nanoseconds_ ? 1 : 1000);
+    const int64_t t =
+        static_cast<int64_t>(rh[0]) * 1000000000LL + static_cast<int64_t>(rh[1]) * (nanoseconds_ ? 1 : 1000);
     handleFrame(frame.data(), frame.size(), t, fn);
   }
   stats_.incomplete_datagrams += static_cast<int64_t>(pending_.size());

@@ -26,14 +26,46 @@ double readValue(const uint8_t* p, uint8_t type, bool big_endian) {
   else
     std::memcpy(b, p, n);
   switch (type) {
-    case 1: { int8_t v; std::memcpy(&v, b, 1); return v; }
-    case 2: { uint8_t v; std::memcpy(&v, b, 1); return v; }
-    case 3: { int16_t v; std::memcpy(&v, b, 2); return v; }
-    case 4: { uint16_t v; std::memcpy(&v, b, 2); return v; }
-    case 5: { int32_t v; std::memcpy(&v, b, 4); return v; }
-    case 6: { uint32_t v; std::memcpy(&v, b, 4); return v; }
-    case 7: { float v; std::memcpy(&v, b, 4); return v; }
-    case 8: { double v; std::memcpy(&v, b, 8); return v; }
+    case 1: {
+      int8_t v;
+      std::memcpy(&v, b, 1);
+      return v;
+    }
+    case 2: {
+      uint8_t v;
+      std::memcpy(&v, b, 1);
+      return v;
+    }
+    case 3: {
+      int16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
+    case 4: {
+      uint16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
+    case 5: {
+      int32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case 6: {
+      uint32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case 7: {
+      float v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case 8: {
+      double v;
+      std::memcpy(&v, b, 8);
+      return v;
+    }
     default: return std::numeric_limits<double>::quiet_NaN();
   }
 }
@@ -123,7 +155,8 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
                            std::to_string(static_cast<uint64_t>(m.row_step) * m.height));
   const Field fi = find(m, {"intensity", "reflectivity", "signal"});
   const Field fr = find(m, {"ring", "channel", "line"});
-  Field ft = o.time_field.empty() ? find(m, {"time", "t", "offset_time", "timestamp"}) : find(m, {o.time_field.c_str()});
+  Field ft =
+      o.time_field.empty() ? find(m, {"time", "t", "offset_time", "timestamp"}) : find(m, {o.time_field.c_str()});
   if (!o.time_field.empty() && !ft) throw fail(o.time_field, "missing (asked for with --lidar-time-field)");
   for (Field f : {fi, fr, ft})
     if (f && pointFieldSize(f.f->datatype) == 0)
@@ -140,7 +173,7 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
   std::vector<float> xs, ys, zs, is;
   std::vector<int16_t> rings;
   std::vector<uint32_t> place;  // without a time field: column (organised) or index (firing order)
-  std::vector<double> times;  // raw time values, scaled to seconds (relative) or kept (absolute)
+  std::vector<double> times;    // raw time values, scaled to seconds (relative) or kept (absolute)
   xs.reserve(points), ys.reserve(points), zs.reserve(points), is.reserve(points), rings.reserve(points);
   double scale = 1.0;
   if (ft) {
@@ -197,7 +230,8 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
     if (!absolute_time) {
       const double span = (mx - mn) * scale;
       if (!(span <= o.max_relative_span_s))
-        throw fail(ft.f->name, "per-point times span " + std::to_string(span) + " s, more than a sweep can last: wrong unit? (force one with --lidar-time-unit)");
+        throw fail(ft.f->name, "per-point times span " + std::to_string(span) +
+                                   " s, more than a sweep can last: wrong unit? (force one with --lidar-time-unit)");
       // Offsets that go negative can only be relative to the stamp itself (a stamp at the end).
       const int64_t ref_ns = mn < 0.0 ? stamp_ns : base_ns;
       const double first_s = mn * scale;
@@ -214,7 +248,9 @@ PointCloudConversion convertPointCloud2(const RosPointCloud2& m, const PointClou
         else if (std::fabs(mn * 1e-9 - stamp_s) < 10.0)
           abs_scale = 1e-9;
         else
-          throw fail(ft.f->name, "absolute point time " + std::to_string(mn) + " is neither seconds nor nanoseconds near the header stamp " + std::to_string(stamp_s) + " s: wrong unit?");
+          throw fail(ft.f->name, "absolute point time " + std::to_string(mn) +
+                                     " is neither seconds nor nanoseconds near the header stamp " +
+                                     std::to_string(stamp_s) + " s: wrong unit?");
       }
       if (!((mx - mn) * abs_scale <= o.max_relative_span_s))
         throw fail(ft.f->name, "per-point times span " + std::to_string((mx - mn) * abs_scale) + " s: wrong unit?");

@@ -1,7 +1,7 @@
 #include "livo/import/progress_line.hpp"
 
-#include <cstdio>
 #include <unistd.h>
+#include <cstdio>
 
 namespace livo::import {
 

@@ -34,7 +34,8 @@ class Findings {
       warning(sensor + " rate: " + says(key, fmt(rig_hz) + " Hz", "the log's stamps " + fmt(r.hz, 4) + " Hz"));
   }
   std::vector<RigFinding> sorted() {
-    std::stable_sort(out_.begin(), out_.end(), [](const RigFinding& a, const RigFinding& b) { return a.error && !b.error; });
+    std::stable_sort(out_.begin(), out_.end(),
+                     [](const RigFinding& a, const RigFinding& b) { return a.error && !b.error; });
     return out_;
   }
 
@@ -45,13 +46,14 @@ class Findings {
 
 void checkChannel(Findings& f, const char* sensor, const std::string& rig_channel, const std::string& written) {
   if (rig_channel != written)
-    f.error(std::string(sensor) + " channel: " + f.says(std::string("channels.") + sensor, rig_channel,
-                                                         "the log has it on " + written));
+    f.error(std::string(sensor) +
+            " channel: " + f.says(std::string("channels.") + sensor, rig_channel, "the log has it on " + written));
 }
 
 void checkImu(Findings& f, const SensorRig& rig, const SensorSurvey& s) {
   if (!s.imu) {
-    f.error("IMU: the log has none, and every estimator needs one (pick the topic with --imu; --list-topics shows them)");
+    f.error(
+        "IMU: the log has none, and every estimator needs one (pick the topic with --imu; --list-topics shows them)");
     return;
   }
   f.rate("IMU", "imu.rate_hz", rig.imu.rate_hz, s.imu->rate);
@@ -75,19 +77,22 @@ void checkLidar(Findings& f, const SensorRig& rig, const SensorSurvey& s) {
   f.rate("LiDAR", "lidar.rate_hz", rig.lidar->rate_hz, l.rate);
   if (const LidarModelFacts* m = findLidarModel(rig.lidar->model)) {
     if (m->rings != l.rings)
-      f.warning("LiDAR rings: " + f.says("lidar.model", rig.lidar->model + " (" + std::to_string(m->rings) + " " +
-                                                            (m->solid_state ? "scan lines" : "rings") + ")",
+      f.warning("LiDAR rings: " + f.says("lidar.model",
+                                         rig.lidar->model + " (" + std::to_string(m->rings) + " " +
+                                             (m->solid_state ? "scan lines" : "rings") + ")",
                                          "the log's sweeps have " + std::to_string(l.rings)));
     if (m->solid_state != l.solid_state)
-      f.warning("LiDAR pattern: " + f.says("lidar.model", rig.lidar->model + (m->solid_state ? " (solid-state)" : " (spinning)"),
-                                           std::string("the log's sweeps are ") + (l.solid_state ? "solid-state" : "spinning")));
+      f.warning("LiDAR pattern: " +
+                f.says("lidar.model", rig.lidar->model + (m->solid_state ? " (solid-state)" : " (spinning)"),
+                       std::string("the log's sweeps are ") + (l.solid_state ? "solid-state" : "spinning")));
   }
 }
 
 void checkIntrinsics(Findings& f, const CameraRig& c, const CameraIntrinsics& k, const CameraSurvey& img) {
   if (k.width > 0 && (k.width != img.width || k.height != img.height))
-    f.warning("camera calibration size: " + k.source + " is for " + size(k.width, k.height) + ", the images in the log are " +
-              size(img.width, img.height) + " (binned or cropped images: the intrinsics need scaling)");
+    f.warning("camera calibration size: " + k.source + " is for " + size(k.width, k.height) +
+              ", the images in the log are " + size(img.width, img.height) +
+              " (binned or cropped images: the intrinsics need scaling)");
   const std::pair<const char*, std::pair<double, double>> values[] = {
       {"fx", {c.fx, k.fx}}, {"fy", {c.fy, k.fy}}, {"cx", {c.cx, k.cx}}, {"cy", {c.cy, k.cy}}};
   std::string differ_rig, differ_log;
@@ -114,8 +119,9 @@ void checkIntrinsics(Findings& f, const CameraRig& c, const CameraIntrinsics& k,
 
 void checkCamera(Findings& f, const SensorRig& rig, const SensorSurvey& s, const InputCalibration& cal) {
   if (rig.camera && !s.camera) {
-    f.warning("camera: the rig has one but the log has no images: livo-vio and livo-colour get nothing (pick the topic "
-              "with --camera)");
+    f.warning(
+        "camera: the rig has one but the log has no images: livo-vio and livo-colour get nothing (pick the topic "
+        "with --camera)");
     return;
   }
   if (!rig.camera) {
@@ -140,8 +146,9 @@ void checkCamera(Findings& f, const SensorRig& rig, const SensorSurvey& s, const
 
 }  // namespace
 
-std::vector<RigFinding> checkRigAgainstLog(const SensorRig& rig, const std::string& rig_file, const SensorSurvey& survey,
-                                           const InputCalibration& calibration, const ChannelNames& written) {
+std::vector<RigFinding> checkRigAgainstLog(const SensorRig& rig, const std::string& rig_file,
+                                           const SensorSurvey& survey, const InputCalibration& calibration,
+                                           const ChannelNames& written) {
   Findings f(rig_file);
   if (survey.imu) checkChannel(f, "imu", rig.channels.imu, written.imu);
   if (survey.lidar && rig.lidar) checkChannel(f, "lidar", rig.channels.lidar, written.lidar);

@@ -89,8 +89,10 @@ void RigSurvey::observe(const std::string& channel, const image_t& m) {
   c.width = m.width;
   c.height = m.height;
   c.encoding = encodingName(m.encoding);
-  if (m.encoding == image_t::ENCODING_GRAY8) c.channels = 1;
-  else if (m.encoding == image_t::ENCODING_RGB8 || m.encoding == image_t::ENCODING_BGR8) c.channels = 3;
+  if (m.encoding == image_t::ENCODING_GRAY8)
+    c.channels = 1;
+  else if (m.encoding == image_t::ENCODING_RGB8 || m.encoding == image_t::ENCODING_BGR8)
+    c.channels = 3;
   else if (m.encoding == image_t::ENCODING_JPEG || m.encoding == image_t::ENCODING_PNG)
     c.channels = sniffCompressedImage(m.data.data(), m.data.size()).channels;
   camera_ = c;
@@ -116,7 +118,8 @@ SensorSurvey RigSurvey::result() const {
     }
     const double n = static_cast<double>(imu.first_second_samples);
     imu.first_second_accel_norm = sum / n;
-    imu.first_second_accel_std = std::sqrt(std::max(0.0, sum2 / n - imu.first_second_accel_norm * imu.first_second_accel_norm));
+    imu.first_second_accel_std =
+        std::sqrt(std::max(0.0, sum2 / n - imu.first_second_accel_norm * imu.first_second_accel_norm));
     s.imu = imu;
   }
   if (!lidar_stamps_.empty()) {
@@ -156,7 +159,8 @@ void addSurveyMetadata(const SensorSurvey& s, const ChannelNames& ch, ImportRepo
     report.metadata("lidar_sweep_duration", yamlNumber(std::round(s.lidar->sweep_duration_s * 1e5) / 1e5));
   }
   if (s.camera) {
-    report.metadata("camera_resolution", "[" + std::to_string(s.camera->width) + ", " + std::to_string(s.camera->height) + "]");
+    report.metadata("camera_resolution",
+                    "[" + std::to_string(s.camera->width) + ", " + std::to_string(s.camera->height) + "]");
     if (s.camera->channels) report.metadata("camera_color", s.camera->channels >= 3 ? "true" : "false");
   }
 }

@@ -14,7 +14,8 @@ RosHeader decodeRosHeader(ByteReader& r) {
 RosTypeInfo rosTypeInfo(const std::string& type) {
   RosTypeInfo t;
   if (type == "sensor_msgs/Imu") t = {RosMessageKind::kImu, "6a62c6daae103f4ff57a132d6f95cec2", nullptr};
-  if (type == "sensor_msgs/PointCloud2") t = {RosMessageKind::kPointCloud2, "1158d486dd51d683ce2f1be655c3c181", nullptr};
+  if (type == "sensor_msgs/PointCloud2")
+    t = {RosMessageKind::kPointCloud2, "1158d486dd51d683ce2f1be655c3c181", nullptr};
   if (type == "sensor_msgs/Image") t = {RosMessageKind::kImage, "060021388200f6f0f447d0fcd9c64743", nullptr};
   if (type == "sensor_msgs/CompressedImage")
     t = {RosMessageKind::kCompressedImage, "8f7a12909da2c9d3332d540a0977563f", nullptr};

@@ -4,9 +4,13 @@ namespace livo::import {
 
 int pointFieldSize(uint8_t datatype) {
   switch (datatype) {
-    case 1: case 2: return 1;
-    case 3: case 4: return 2;
-    case 5: case 6: case 7: return 4;
+    case 1:
+    case 2: return 1;
+    case 3:
+    case 4: return 2;
+    case 5:
+    case 6:
+    case 7: return 4;
     case 8: return 8;
     default: return 0;
   }

@@ -10,10 +10,10 @@
 #include "livo/import/bag_reader.hpp"
 #include "livo/import/ground_truth_file.hpp"
 #include "livo/import/image_encoding.hpp"
-#include "livo/pose_t.hpp"
 #include "livo/import/progress_line.hpp"
 #include "livo/import/ros_messages.hpp"
 #include "livo/import/stamp_conversion.hpp"
+#include "livo/pose_t.hpp"
 
 namespace livo::import {
 
@@ -150,8 +150,8 @@ class BagConverter {
       return;
     }
     topics_[Role::kCameraInfo] = chosen;
-    report_.note("--camera-info not given: using " + chosen + (candidates.size() == 1 ? " (the bag's only CameraInfo topic)"
-                                                                                     : " (in the camera's namespace)"));
+    report_.note("--camera-info not given: using " + chosen +
+                 (candidates.size() == 1 ? " (the bag's only CameraInfo topic)" : " (in the camera's namespace)"));
   }
 
   void handle(const BagMessage& m, const std::string& bag) {
@@ -168,13 +168,14 @@ class BagConverter {
       return;
     }
     if (c.md5sum != info.md5 && c.md5sum != "*") {
-      report_.skip("md5sum " + c.md5sum + " of " + c.type + " on " + c.topic + " differs from the known definition " +
-                       info.md5,
-                   where);
+      report_.skip(
+          "md5sum " + c.md5sum + " of " + c.type + " on " + c.topic + " differs from the known definition " + info.md5,
+          where);
       return;
     }
     if (!fits(role, info.kind)) {
-      report_.skip(std::string("topic ") + c.topic + " is " + c.type + ", which cannot be the " + roleName(role), where);
+      report_.skip(std::string("topic ") + c.topic + " is " + c.type + ", which cannot be the " + roleName(role),
+                   where);
       return;
     }
     ByteReader r(m.data, m.size, where);
@@ -184,8 +185,10 @@ class BagConverter {
         case RosMessageKind::kPointCloud2: return cloud(decodeRosPointCloud2(r), m, where);
         case RosMessageKind::kImage: {
           const RosImage msg = decodeRosImage(r);
-          return image(role, role == Role::kDepth ? convertRosDepthImage(msg, frameOf(role), where)
-                                                  : convertRosImage(msg, frameOf(role), where), m);
+          return image(role,
+                       role == Role::kDepth ? convertRosDepthImage(msg, frameOf(role), where)
+                                            : convertRosImage(msg, frameOf(role), where),
+                       m);
         }
         case RosMessageKind::kCompressedImage:
           return image(role, convertRosCompressedImage(decodeRosCompressedImage(r), frameOf(role), where), m);
@@ -265,8 +268,8 @@ class BagConverter {
   void image(Role role, image_t img, const BagMessage& m) {
     if (o_.use_bag_time) img.utime = nsToUtime(m.record_time_ns);
     writer_.add(role == Role::kCameraRight ? o_.channels.camera_right
-                : role == Role::kDepth        ? o_.channels.depth
-                                              : o_.channels.camera,
+                : role == Role::kDepth     ? o_.channels.depth
+                                           : o_.channels.camera,
                 img);
   }
 
@@ -281,8 +284,10 @@ class BagConverter {
                                           ", K: " + yamlList(std::vector<double>(msg.K.begin(), msg.K.end())) + "}");
       first_camera_info_ = msg;
       const std::optional<CameraIntrinsics> k = intrinsicsFromCameraInfo(msg, topic);
-      if (!k) report_.note("camera_info on " + topic + " is uncalibrated (K[0] = 0): no intrinsics from it");
-      else if (!report_.calibration().camera) report_.calibration().camera = k;
+      if (!k)
+        report_.note("camera_info on " + topic + " is uncalibrated (K[0] = 0): no intrinsics from it");
+      else if (!report_.calibration().camera)
+        report_.calibration().camera = k;
       return;
     }
     if (!camera_info_changed_ && (msg.K != first_camera_info_.K || msg.D != first_camera_info_.D ||
@@ -363,7 +368,8 @@ void importRosbag(const std::vector<std::string>& bags, const RosbagImportOption
       });
       progress.finish();
       std::string chunks;
-      for (const auto& [c, n] : reader.chunkCompressions()) chunks += (chunks.empty() ? "" : ", ") + c + ": " + std::to_string(n);
+      for (const auto& [c, n] : reader.chunkCompressions())
+        chunks += (chunks.empty() ? "" : ", ") + c + ": " + std::to_string(n);
       report.metadata("bag_chunks", "{" + chunks + "}");
     } catch (const std::exception& e) {
       report.error(e.what());

@@ -11,8 +11,9 @@ const std::vector<RosbagPreset>& rosbagPresets() {
     // sweep with `t` counted from its start; the ground truth is the prism's position only.
     RosbagPreset ntu;
     ntu.name = "ntu_viral";
-    ntu.description = "NTU VIRAL: /imu/imu, /os1_cloud_node1/points (end-of-sweep stamps), /left|right/image_raw, "
-                      "/leica/pose/relative (prism position)";
+    ntu.description =
+        "NTU VIRAL: /imu/imu, /os1_cloud_node1/points (end-of-sweep stamps), /left|right/image_raw, "
+        "/leica/pose/relative (prism position)";
     ntu.imu_topic = "/imu/imu";
     ntu.lidar_topic = "/os1_cloud_node1/points";
     ntu.camera_topic = "/left/image_raw";
@@ -25,15 +26,17 @@ const std::vector<RosbagPreset>& rosbagPresets() {
     ntu.metadata = {
         {"ground_truth_point", "\"Leica prism position in W (geometry_msgs/PointStamped): no orientation\""},
         {"prism_offset_body", "[-0.293656, -0.012288, -0.273095]"},
-        {"prism_offset_note", "\"p_W_prism = p_W_I + R_W_I * prism_offset_body; pass it to livo-evaluate --gt-offset\""},
+        {"prism_offset_note",
+         "\"p_W_prism = p_W_I + R_W_I * prism_offset_body; pass it to livo-evaluate --gt-offset\""},
         {"lidar_stamp", "\"end of sweep in the bag; converted to start (stamp - 0.1 s)\""},
         {"extrinsic_body_lidar_horizontal", "{translation: [-0.05, 0.0, 0.055], rotation: [1.0, 0.0, 0.0, 0.0]}"},
         {"frames_note", "\"the IMU and horizontal LiDAR z axes point down (dataset calibration)\""},
     };
     ntu.calibrated_rig = "config/rigs/ntu_viral.yaml";
     ntu.T_I_L = "{translation: [-0.05, 0.0, 0.055], rpy_deg: [0, 0, 0]}";
-    ntu.T_I_C = "[0.02183084, -0.01312053, 0.99967558, 0.00552943, 0.99975965, 0.00230088, -0.02180248, -0.12431302, "
-                "-0.00201407, 0.99991127, 0.01316761, 0.01614686, 0.0, 0.0, 0.0, 1.0]";
+    ntu.T_I_C =
+        "[0.02183084, -0.01312053, 0.99967558, 0.00552943, 0.99975965, 0.00230088, -0.02180248, -0.12431302, "
+        "-0.00201407, 0.99991127, 0.01316761, 0.01614686, 0.0, 0.0, 0.0, 1.0]";
     ntu.extrinsics_source = "NTU VIRAL's lidar_horz.yaml / camera_left.yaml T_Body_* (config/rigs/ntu_viral.yaml)";
     v.push_back(ntu);
 
@@ -41,8 +44,9 @@ const std::vector<RosbagPreset>& rosbagPresets() {
     // ground truth comes as separate TUM files (pass with --ground-truth FILE).
     RosbagPreset m2dgr;
     m2dgr.name = "m2dgr";
-    m2dgr.description = "M2DGR: /handsfree/imu, /velodyne_points (VLP-32C), /camera/color/image_raw/compressed; "
-                        "ground truth from the sequence's TUM file";
+    m2dgr.description =
+        "M2DGR: /handsfree/imu, /velodyne_points (VLP-32C), /camera/color/image_raw/compressed; "
+        "ground truth from the sequence's TUM file";
     m2dgr.imu_topic = "/handsfree/imu";
     m2dgr.lidar_topic = "/velodyne_points";
     m2dgr.camera_topic = "/camera/color/image_raw/compressed";

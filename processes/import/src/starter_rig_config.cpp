@@ -60,7 +60,8 @@ void writeHeader(YamlText& y, const StarterRigInputs& in) {
   if (!in.calibration.calibrated_rig.empty())
     y.comment(in.calibration.calibrated_rig + " is this dataset's calibrated rig: prefer it to this starter.");
   std::string counts;
-  for (const auto& [channel, n] : in.channel_counts) counts += (counts.empty() ? "" : ", ") + channel + " " + std::to_string(n);
+  for (const auto& [channel, n] : in.channel_counts)
+    counts += (counts.empty() ? "" : ", ") + channel + " " + std::to_string(n);
   y.comment("Messages in the log: " + (counts.empty() ? std::string("none") : counts));
 }
 
@@ -77,31 +78,39 @@ void writeChannels(YamlText& y, const StarterRigInputs& in) {
 void writeImu(YamlText& y, const StarterRigInputs& in) {
   const std::optional<ImuSurvey>& imu = in.survey.imu;
   const std::optional<ImuNoise>& noise = in.calibration.imu_noise;
-  y.line(2, "imu", "", imu ? "the body frame is the IMU's" : "REPLACE: the log has no IMU; livo-lio needs one (placeholders below)");
+  y.line(2, "imu", "",
+         imu ? "the body frame is the IMU's" : "REPLACE: the log has no IMU; livo-lio needs one (placeholders below)");
   if (imu && imu->rate.hz > 0)
     y.line(4, "rate_hz", num(roundedRate(imu->rate.hz)), measuredRateComment(imu->rate, "IMU"));
   else
     y.line(4, "rate_hz", "200", "REPLACE: the IMU's rate, Hz (placeholder: 200; not measured)");
   if (noise) {
     y.raw("    # " + noise->source + "'s white noise is the sensor's at rest: where motors shake the IMU (a drone's");
-    y.raw("    # rotors, an engine), state what it reads with them running (processes/lio/README.md, \"The IMU's noise on a drone\")");
+    y.raw(
+        "    # rotors, an engine), state what it reads with them running (processes/lio/README.md, \"The IMU's noise "
+        "on a drone\")");
     y.line(4, "gyro_noise_density", num(noise->gyro_noise_density), noise->source + ": rad/s/sqrt(Hz)");
     y.line(4, "gyro_random_walk", num(noise->gyro_random_walk), noise->source + ": rad/s^2/sqrt(Hz)");
     y.line(4, "accel_noise_density", num(noise->accel_noise_density), noise->source + ": m/s^2/sqrt(Hz)");
     y.line(4, "accel_random_walk", num(noise->accel_random_walk), noise->source + ": m/s^3/sqrt(Hz)");
   } else {
     y.line(4, "gyro_noise_density", "2.4e-4",
-           "REPLACE: rad/s/sqrt(Hz), datasheet or Allan variance (placeholder: a BMI088-class MEMS, 0.014 deg/s/sqrt(Hz))");
-    y.line(4, "gyro_random_walk", "2.0e-5", "REPLACE: rad/s^2/sqrt(Hz), Allan variance (placeholder: a consumer MEMS gyro)");
-    y.line(4, "accel_noise_density", "1.7e-3", "REPLACE: m/s^2/sqrt(Hz) (placeholder: a BMI088-class MEMS, 175 ug/sqrt(Hz))");
-    y.line(4, "accel_random_walk", "1.0e-3", "REPLACE: m/s^3/sqrt(Hz), Allan variance (placeholder: a consumer MEMS accelerometer)");
+           "REPLACE: rad/s/sqrt(Hz), datasheet or Allan variance (placeholder: a BMI088-class MEMS, 0.014 "
+           "deg/s/sqrt(Hz))");
+    y.line(4, "gyro_random_walk", "2.0e-5",
+           "REPLACE: rad/s^2/sqrt(Hz), Allan variance (placeholder: a consumer MEMS gyro)");
+    y.line(4, "accel_noise_density", "1.7e-3",
+           "REPLACE: m/s^2/sqrt(Hz) (placeholder: a BMI088-class MEMS, 175 ug/sqrt(Hz))");
+    y.line(4, "accel_random_walk", "1.0e-3",
+           "REPLACE: m/s^3/sqrt(Hz), Allan variance (placeholder: a consumer MEMS accelerometer)");
   }
   std::string gravity = "REPLACE: local gravity, m/s^2 (placeholder: 9.81; 9.78 at the equator, 9.83 at the poles)";
   if (imu && imu->first_second_samples > 1) {
     std::ostringstream os;
     os.precision(4);
     os << std::fixed << "; the log's first second reads |accel| " << imu->first_second_accel_norm << " +- "
-       << imu->first_second_accel_std << (imu->first_second_accel_std < 0.05 ? " (at rest: gravity + bias)" : " (moving)");
+       << imu->first_second_accel_std
+       << (imu->first_second_accel_std < 0.05 ? " (at rest: gravity + bias)" : " (moving)");
     gravity += os.str();
   }
   y.line(4, "gravity", "9.81", gravity);
@@ -112,12 +121,15 @@ void writeLidar(YamlText& y, const StarterRigInputs& in) {
   const LidarModelGuess guess = guessLidarModel(l.rings, l.solid_state, in.lidar_layout, in.calibration.lidar_model);
   const LidarModelFacts& f = *guess.facts;
   if (!in.lidar_layout.empty()) y.raw("  # point layout in the input: " + in.lidar_layout);
-  y.line(2, "lidar", "", l.point_times ? "" : "the sweeps carry no per-point times: motion within a sweep is not undone");
+  y.line(2, "lidar", "",
+         l.point_times ? "" : "the sweeps carry no per-point times: motion within a sweep is not undone");
   std::string model_comment = guess.reason == "named by the input"
                                   ? "named by the input (" + in.calibration.lidar_model_source + ")"
                                   : "guessed from the log: " + guess.reason;
-  if (!guess.exact) model_comment = "REPLACE: " + model_comment;
-  else model_comment += " (a label: the estimators use the rate, ranges, noise and T_I_L)";
+  if (!guess.exact)
+    model_comment = "REPLACE: " + model_comment;
+  else
+    model_comment += " (a label: the estimators use the rate, ranges, noise and T_I_L)";
   y.line(4, "model", f.model, model_comment);
   if (l.rate.hz > 0) {
     std::ostringstream sweep;
@@ -128,8 +140,8 @@ void writeLidar(YamlText& y, const StarterRigInputs& in) {
     y.line(4, "rate_hz", "10", "REPLACE: the sweep rate, Hz (placeholder: 10; a single sweep in the log)");
   }
   y.line(4, "min_range", l.solid_state ? "1.0" : "0.5",
-         std::string("REPLACE: m, larger if the sensor sees your vehicle (placeholder: ") + (l.solid_state ? "1.0" : "0.5") +
-             ", near returns off the mount)");
+         std::string("REPLACE: m, larger if the sensor sees your vehicle (placeholder: ") +
+             (l.solid_state ? "1.0" : "0.5") + ", near returns off the mount)");
   const std::string of_model = guess.reason == "named by the input" ? "" : " (the guessed model's)";
   y.line(4, "max_range", num(f.max_range), f.source + of_model + (guess.exact ? "" : "; REPLACE: with your model's"));
   y.line(4, "range_noise_std", num(f.range_noise_std),
@@ -138,13 +150,15 @@ void writeLidar(YamlText& y, const StarterRigInputs& in) {
     y.line(4, "T_I_L", T->yaml.empty() ? extrinsicYaml(T->T) : T->yaml, "p_I = T_I_L p_L: " + T->source);
   else
     y.line(4, "T_I_L", "{translation: [0.0, 0.0, 0.0], rpy_deg: [0, 0, 0]}",
-           "REPLACE: p_I = T_I_L p_L, from CAD or a LiDAR-IMU calibration (placeholder: identity, the LiDAR at the IMU, axes aligned)");
+           "REPLACE: p_I = T_I_L p_L, from CAD or a LiDAR-IMU calibration (placeholder: identity, the LiDAR at the "
+           "IMU, axes aligned)");
 }
 
 void writeCamera(YamlText& y, const StarterRigInputs& in) {
   const CameraSurvey& c = *in.survey.camera;
   const std::optional<CameraIntrinsics>& k = in.calibration.camera;
-  y.line(2, "camera", "", k ? "calibration from " + k->source : "REPLACE: the input held no calibration of this camera");
+  y.line(2, "camera", "",
+         k ? "calibration from " + k->source : "REPLACE: the input held no calibration of this camera");
   const std::string images = std::to_string(c.rate.messages) + " " + c.encoding + " images";
   std::string size_note;
   if (c.other_sizes) size_note = "; " + std::to_string(c.other_sizes) + " images have another size";
@@ -180,12 +194,15 @@ void writeCamera(YamlText& y, const StarterRigInputs& in) {
     y.line(4, "color", c.channels >= 3 ? "true" : "false",
            "measured: the images are " + std::string(c.channels >= 3 ? "colour" : "grey") + " (" + c.encoding + ")");
   else
-    y.line(4, "color", "true", "REPLACE: true for a colour camera, false for grey (the " + c.encoding + " header was cut short)");
+    y.line(4, "color", "true",
+           "REPLACE: true for a colour camera, false for grey (the " + c.encoding + " header was cut short)");
   if (in.survey.depth_images)
-    y.line(4, "depth", "true", "measured: " + std::to_string(in.survey.depth_images) + " depth images registered to it on " +
-                                   in.channels.depth);
+    y.line(4, "depth", "true",
+           "measured: " + std::to_string(in.survey.depth_images) + " depth images registered to it on " +
+               in.channels.depth);
   y.line(4, "time_offset_s", "0.0",
-         "REPLACE: image stamp + offset = the same instant on the IMU clock (Kalibr's timeshift_cam_imu), 0 if triggered or unknown");
+         "REPLACE: image stamp + offset = the same instant on the IMU clock (Kalibr's timeshift_cam_imu), 0 if "
+         "triggered or unknown");
   if (const std::optional<KnownExtrinsic>& T = in.calibration.T_I_C) {
     y.line(4, "T_I_C", T->yaml.empty() ? extrinsicYaml(T->T) : T->yaml, "p_I = T_I_C p_C: " + T->source);
   } else {
@@ -209,7 +226,8 @@ void writePipeline(YamlText& y, const StarterRigInputs& in) {
       y.line(0, "lio", "{}", "no camera in the log: LiDAR-inertial only (no vio:, colour:)");
     }
     y.raw("loop:");
-    y.line(2, "output_dir", ".", "run_pipeline.sh runs processes in DIR: loops.json, keyframes.tum, global_map.ply land there");
+    y.line(2, "output_dir", ".",
+           "run_pipeline.sh runs processes in DIR: loops.json, keyframes.tum, global_map.ply land there");
     if (camera) y.raw("colour: {}");
     y.raw("octomap: {}");
   } else if (camera) {

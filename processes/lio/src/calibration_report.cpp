@@ -27,9 +27,10 @@ SensorCalibrationChange change(const SensorCalibration& c, const Pose3& rig, con
 void put(std::ostream& os, const char* name, const SensorCalibrationChange& s) {
   os << name << " rotation (" << s.rotation_deg.x() << ", " << s.rotation_deg.y() << ", " << s.rotation_deg.z()
      << ") deg +/- (" << s.rotation_std_deg.x() << ", " << s.rotation_std_deg.y() << ", " << s.rotation_std_deg.z()
-     << "), translation (" << 1e3 * s.translation.x() << ", " << 1e3 * s.translation.y() << ", " << 1e3 * s.translation.z()
-     << ") mm +/- (" << 1e3 * s.translation_std.x() << ", " << 1e3 * s.translation_std.y() << ", "
-     << 1e3 * s.translation_std.z() << "), time shift " << s.time_shift_ms << " +/- " << s.time_shift_std_ms << " ms";
+     << "), translation (" << 1e3 * s.translation.x() << ", " << 1e3 * s.translation.y() << ", "
+     << 1e3 * s.translation.z() << ") mm +/- (" << 1e3 * s.translation_std.x() << ", " << 1e3 * s.translation_std.y()
+     << ", " << 1e3 * s.translation_std.z() << "), time shift " << s.time_shift_ms << " +/- " << s.time_shift_std_ms
+     << " ms";
 }
 
 void row(std::ostream& os, const SensorCalibrationChange& s) {

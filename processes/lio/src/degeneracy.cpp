@@ -61,8 +61,8 @@ void removeDegenerateInformation(const DegeneracyReport& report, Mat6* S, Vec6* 
   const double tol = 1e-12 * std::max(1.0, Su.diagonal().cwiseAbs().maxCoeff());
   Eigen::VectorXd inverse = es.eigenvalues();
   for (int i = 0; i < m; ++i) inverse[i] = inverse[i] > tol ? 1.0 / inverse[i] : 0.0;
-  const Eigen::MatrixXd K = Su.bottomLeftCorner(6 - m, m) * es.eigenvectors() * inverse.asDiagonal() *
-                            es.eigenvectors().transpose();
+  const Eigen::MatrixXd K =
+      Su.bottomLeftCorner(6 - m, m) * es.eigenvectors() * inverse.asDiagonal() * es.eigenvectors().transpose();
   // the Schur complement: what the rows say about the rest with the degenerate directions free
   const Eigen::MatrixXd S_rest = Su.bottomRightCorner(6 - m, 6 - m) - K * Su.topRightCorner(m, 6 - m);
   const Eigen::VectorXd g_rest = gu.tail(6 - m) - K * gu.head(m);

@@ -24,8 +24,8 @@ FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& a
   return x.boxplus(f * dt);
 }
 
-void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx,
-                          Mat18x12* Fw, const ImuIntrinsics& intrinsics, IntrinsicsJacobian* Fm) {
+void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx, Mat18x12* Fw,
+                          const ImuIntrinsics& intrinsics, IntrinsicsJacobian* Fm) {
   using S = FilterState;
   const Vec3 w = correctedRate(gyro, x, intrinsics);
   const Vec3 a = correctedForce(accel, x, intrinsics);

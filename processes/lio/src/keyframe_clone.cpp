@@ -6,8 +6,7 @@
 
 namespace livo::lio {
 
-Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb,
-                            const Mat6& P_ba) {
+Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb, const Mat6& P_ba) {
   // R_a = R̂_a Exp(δa_r), p_a = p̂_a + δa_p (and b alike); T_rel = T_a^-1 T_b:
   //   phi = δb_r - R_rel^T δa_r
   //   tau = R_rel^T [p_rel]x δa_r + R_b^T (δb_p - δa_p)

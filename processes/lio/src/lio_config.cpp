@@ -110,10 +110,14 @@ void readLio(const Config& c, LioNodeOptions* o) {
   const Config init = c.optionalSection("init");
   std::string mode;
   if (init.readOptional("mode", mode)) {
-    if (mode == "auto") l.init.mode = ImuInitOptions::Mode::kAuto;
-    else if (mode == "static") l.init.mode = ImuInitOptions::Mode::kStatic;
-    else if (mode == "moving") l.init.mode = ImuInitOptions::Mode::kMoving;
-    else throw ConfigError(init.where("mode") + ": expected auto, static or moving, got '" + mode + "'");
+    if (mode == "auto")
+      l.init.mode = ImuInitOptions::Mode::kAuto;
+    else if (mode == "static")
+      l.init.mode = ImuInitOptions::Mode::kStatic;
+    else if (mode == "moving")
+      l.init.mode = ImuInitOptions::Mode::kMoving;
+    else
+      throw ConfigError(init.where("mode") + ": expected auto, static or moving, got '" + mode + "'");
   }
   init.readOptional("window_s", l.init.window_s);
   init.readOptional("max_gyro_std", l.init.max_gyro_std);
@@ -131,10 +135,14 @@ void readLio(const Config& c, LioNodeOptions* o) {
   std::string imu_axes;
   if (cal.readOptional("imu_axes", imu_axes)) {
     using A = CalibrationEstimation::ImuAxes;
-    if (imu_axes == "budget") l.calibration.imu_axes = A::kBudget;
-    else if (imu_axes == "consider") l.calibration.imu_axes = A::kConsider;
-    else if (imu_axes == "estimate") l.calibration.imu_axes = A::kEstimate;
-    else throw ConfigError(cal.where("imu_axes") + ": must be budget, consider or estimate (got '" + imu_axes + "')");
+    if (imu_axes == "budget")
+      l.calibration.imu_axes = A::kBudget;
+    else if (imu_axes == "consider")
+      l.calibration.imu_axes = A::kConsider;
+    else if (imu_axes == "estimate")
+      l.calibration.imu_axes = A::kEstimate;
+    else
+      throw ConfigError(cal.where("imu_axes") + ": must be budget, consider or estimate (got '" + imu_axes + "')");
   }
   c.readOptional("point_stride", l.point_stride);
   c.readOptional("scan_voxel_size", l.scan_voxel_size);
@@ -252,7 +260,8 @@ void readLio(const Config& c, LioNodeOptions* o) {
   };
   check(l.map.voxel_size > 0, "map.voxel_size", "must be positive");
   check(l.map.max_points_per_voxel > 0, "map.max_points_per_voxel", "must be positive");
-  check(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0, "map.refresh_range_ratio", "must be in [0, 1)");
+  check(l.map.refresh_range_ratio >= 0.0 && l.map.refresh_range_ratio < 1.0, "map.refresh_range_ratio",
+        "must be in [0, 1)");
   try {
     VoxelPlanes check_planes(l.planes);
   } catch (const std::invalid_argument& e) {
@@ -265,12 +274,14 @@ void readLio(const Config& c, LioNodeOptions* o) {
   check(st.end_margin_fraction >= 0, "map.seen_through.end_margin_fraction", "must be >= 0");
   check(st.min_range >= 0, "map.seen_through.min_range", "must be >= 0");
   check(st.max_range > st.min_range, "map.seen_through.max_range", "must be above map.seen_through.min_range");
-  check(st.misses_to_remove >= 1 && st.misses_to_remove <= 100, "map.seen_through.misses_to_remove", "must be 1 to 100");
+  check(st.misses_to_remove >= 1 && st.misses_to_remove <= 100, "map.seen_through.misses_to_remove",
+        "must be 1 to 100");
   check(st.ray_stride >= 1, "map.seen_through.ray_stride", "must be >= 1");
   check(l.scan_voxel_size > 0, "scan_voxel_size", "must be positive");
   check(l.point_stride > 0, "point_stride", "must be positive");
   check(l.search_threads >= 1 && l.search_threads <= 64, "search_threads", "must be 1 to 64");
-  check(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors", "must be 3 to 32");
+  check(l.matching.plane.num_neighbors >= 3 && l.matching.plane.num_neighbors <= 32, "matching.num_neighbors",
+        "must be 3 to 32");
   check(l.matching.point_noise_std > 0, "matching.point_noise_std", "must be positive");
   check(l.esikf.max_iterations > 0, "esikf.max_iterations", "must be positive");
   check(l.init.window_s > 0, "init.window_s", "must be positive");
@@ -321,10 +332,9 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << "  imu noise: gyro " << l.imu_noise.gyro_noise_density << " / " << l.imu_noise.gyro_random_walk << ", accel "
      << l.imu_noise.accel_noise_density << " / " << l.imu_noise.accel_random_walk << ", gyro scale "
      << l.imu_noise.gyro_scale_std << " and misalignment " << l.imu_noise.gyro_misalignment_std << " rad, accel "
-     << l.imu_noise.accel_scale_std << " and " << l.imu_noise.accel_misalignment_std
-     << " rad (" << imuAxesModel(l) << ")"
-     << ", gravity " << l.init.gravity
-     << ", init window " << l.init.window_s << " s\n"
+     << l.imu_noise.accel_scale_std << " and " << l.imu_noise.accel_misalignment_std << " rad (" << imuAxesModel(l)
+     << ")"
+     << ", gravity " << l.init.gravity << ", init window " << l.init.window_s << " s\n"
      << "  T_I_L translation [" << t.transpose() << "], time offset " << l.extrinsics.time_offset_s << " s, range ["
      << l.min_range << ", " << l.max_range << "] m\n"
      << "  calibration in the filter (1-sigma rotation deg / translation m / time ms): LiDAR "
@@ -344,7 +354,8 @@ void printOptions(const LioNodeOptions& o, std::ostream& os) {
      << " m, Cauchy scale " << l.matching.robust_scale << " m; iterations " << l.esikf.max_iterations
      << "; degeneracy threshold " << l.matching.degeneracy_threshold << "; " << l.search_threads
      << (l.search_threads == 1 ? " search thread" : " search threads") << "\n"
-     << "  camera hand-off " << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
+     << "  camera hand-off "
+     << (o.camera_handoff ? "on (" + o.camera_channel + " -> " + o.state_prior_channel + ")" : std::string("off"))
      << "\n"
      << "  keyframes every " << l.keyframe.min_distance << " m / " << l.keyframe.min_angle_deg << " deg; wheel "
      << (l.wheel.enabled ? "on" : "off");

@@ -8,9 +8,9 @@
 #include <cmath>
 
 #include "livo/lio/scan_to_map.hpp"
+#include "livo/lio/undistorter.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
-#include "livo/lio/undistorter.hpp"
 
 namespace livo::lio {
 
@@ -143,8 +143,8 @@ void LioEstimator::tryInitialize(std::string* note) {
     appendNote(note, "IMU initialisation: " + r.message);
     // slide the window by half its length
     const int64_t cut = init_window_.back().utime - toUtime(0.5 * opts_.init.window_s);
-    init_window_.erase(init_window_.begin(),
-                       std::find_if(init_window_.begin(), init_window_.end(), [&](const ImuSample& s) { return s.utime >= cut; }));
+    init_window_.erase(init_window_.begin(), std::find_if(init_window_.begin(), init_window_.end(),
+                                                          [&](const ImuSample& s) { return s.utime >= cut; }));
     return;
   }
   prop_.reset(initialState(r), initialCovariance(r), r.last);
@@ -259,7 +259,8 @@ void LioEstimator::drainBacklog(int64_t newest) {
   while (!imu_.empty() && imu_.front().utime < newest - backlog / 2) {
     const ImuSample s = imu_.front();
     // a sweep may still come for an IMU gap that ended less than a backlog ago: leave it to addScan
-    if (static_cast<double>(s.utime - prop_.utime()) * 1e-6 > opts_.reset_imu_gap_s && newest - s.utime < backlog) break;
+    if (static_cast<double>(s.utime - prop_.utime()) * 1e-6 > opts_.reset_imu_gap_s && newest - s.utime < backlog)
+      break;
     imu_.pop_front();
     stepTo(s, &worst_gap, nullptr);
   }
@@ -279,7 +280,8 @@ bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
     const ImuSample next = has_next ? imu_.front() : prop_.lastSample();
     const double gap = static_cast<double>((has_next ? next.utime : t_end) - prop_.utime()) * 1e-6;
     const double step = static_cast<double>(t_end - prop_.utime()) * 1e-6;
-    if (!has_next) appendNote(note, "IMU data ends " + formatSignificant(gap) + " s before the sweep end: last sample held");
+    if (!has_next)
+      appendNote(note, "IMU data ends " + formatSignificant(gap) + " s before the sweep end: last sample held");
     if (gap > reset_gap) {
       ImuSample at = next;
       at.utime = t_end;
@@ -305,7 +307,8 @@ bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed, double* scale_vari
     const WheelSample& b = wheel_[i];
     if (a.utime <= utime && utime <= b.utime) {
       if (static_cast<double>(b.utime - a.utime) * 1e-6 > opts_.wheel.max_sample_gap_s) return false;
-      const double alpha = b.utime > a.utime ? static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime) : 0.0;
+      const double alpha =
+          b.utime > a.utime ? static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime) : 0.0;
       // scales of exactly 1 (calibration off) leave the speeds bit for bit as they came
       const WheelSample ca = wheel_scale_.correct(a), cb = wheel_scale_.correct(b);
       *speed = 0.5 * ((1.0 - alpha) * (ca.left_speed + ca.right_speed) + alpha * (cb.left_speed + cb.right_speed));
@@ -470,8 +473,8 @@ void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, c
   // body_ and reg_ hold the points through the calibration of the undistortion, as if taken at the
   // filter's time; the sweep was seen through x's extrinsic at the state's time plus what the time
   // shift moved beyond the undistortion's (ScanToMap): A = T_W_I^-1 T_W_I(end) T_I_L(x) T_I_L(undistortion)^-1
-  const bool same = x.lidar.dt == undistorted_with.dt && x.lidar.rot == undistorted_with.rot &&
-                    x.lidar.pos == undistorted_with.pos;
+  const bool same =
+      x.lidar.dt == undistorted_with.dt && x.lidar.rot == undistorted_with.rot && x.lidar.pos == undistorted_with.pos;
   if (same) return;
   const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate_, undistorted_with.dt) * x.lidar.pose() *
                   undistorted_with.pose().inverse();
@@ -557,16 +560,15 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
   return status;
 }
 
-ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg,
-                                               const SensorCalibration& undistorted_with, FilterState* x,
-                                               StateCovariance* P, ScanResult* res) {
+ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, const SensorCalibration& undistorted_with,
+                                               FilterState* x, StateCovariance* P, ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate_);
+  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with,
+                body_rate_);
   FilterState post;
   StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
-      *x, *P,
-      [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m.evaluate(xi, it, info); },
+      *x, *P, [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m.evaluate(xi, it, info); },
       opts_.esikf, &post, &P_post);
   const ScanToMap* fitted = &s2m;
   std::optional<ScanToMap> s2m_still;
@@ -578,7 +580,8 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg,
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate_);
+    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with,
+                      body_rate_);
     FilterState post_still;
     StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(
@@ -646,7 +649,8 @@ HeldCalibration LioEstimator::heldCalibration(const FilterState& x) const {
 }
 
 Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<size_t>& valid,
-                                    const std::vector<Vec3>& body, const FilterState& x, const StateCovariance& P, int64_t t_end) {
+                                    const std::vector<Vec3>& body, const FilterState& x, const StateCovariance& P,
+                                    int64_t t_end) {
   Keyframe kf;
   kf.id = next_keyframe_id_++;
   kf.utime = t_end;
@@ -656,7 +660,8 @@ Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<siz
     kf.relative_to_id = clone_.keyframe_id;
     kf.relative_covariance = relativePoseCovariance(clone_.pose, kf.pose, clone_.covariance, kf.pose_covariance,
                                                     prop_.cloneCross().topRows<6>());
-    kf.relative_covariance_held_calibration = heldCalibrationCovariance(clone_.pose.inverse() * kf.pose, heldCalibration(x));
+    kf.relative_covariance_held_calibration =
+        heldCalibrationCovariance(clone_.pose.inverse() * kf.pose, heldCalibration(x));
     kf.relative_covariance += kf.relative_covariance_held_calibration;
   }
   // the next keyframe's increment starts here: Cov(δx, δpose) is P's pose columns
@@ -705,7 +710,8 @@ bool LioEstimator::adoptPosterior(int64_t utime, const FilterState& x, const Sta
   if (!isUsableCovariance(Ps)) return fail("posterior covariance not positive definite");
   // a calibration the filter holds fixed stays fixed: a posterior may not start estimating it
   for (int i = FilterState::kNavDim; i < FilterState::kDim; ++i)
-    if ((prop_.covariance()(i, i) == 0.0) != (Ps(i, i) == 0.0)) return fail("posterior estimates a calibration the filter holds fixed");
+    if ((prop_.covariance()(i, i) == 0.0) != (Ps(i, i) == 0.0))
+      return fail("posterior estimates a calibration the filter holds fixed");
   // the sweep in progress is undistorted along the recorded segments: move them with the state
   const FilterState& prior = prop_.state();
   Pose3 T = Pose3::Identity();

@@ -60,8 +60,8 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
     if (f >> epoch_key >> epoch >> id_key >> next_id && epoch_key == "epoch" && id_key == "next_keyframe_id" &&
         epoch >= 0 && next_id >= 0) {
       lio_.continueNumbering(epoch + 1, next_id);
-      node_.warn("restarted: odometry goes on in epoch " + std::to_string(epoch + 1) + " (a new frame), keyframe ids from " +
-                 std::to_string(next_id));
+      node_.warn("restarted: odometry goes on in epoch " + std::to_string(epoch + 1) +
+                 " (a new frame), keyframe ids from " + std::to_string(next_id));
     } else {
       node_.warn("restarted, but " + opts_.numbering_file + " holds no numbering: starting at epoch 0");
     }
@@ -104,19 +104,21 @@ void LioNode::onImu(const imu_t& m) {
     return;
   }
   if (s.gyro.norm() > opts_.imu_max_angular_velocity || s.accel.norm() > opts_.imu_max_acceleration) {
-    node_.reject(opts_.imu_channel, "IMU sample beyond the sensor's range (imu_max_angular_velocity, "
-                                    "imu_max_acceleration): corrupted");
+    node_.reject(opts_.imu_channel,
+                 "IMU sample beyond the sensor's range (imu_max_angular_velocity, "
+                 "imu_max_acceleration): corrupted");
     return;
   }
   // A stamp that jumps (ahead by clock_jump_s or back by clock_reset_s) is held until the next
   // sample confirms the new clock by following it closely; otherwise it was one corrupted stamp.
   if (has_imu_) {
-    const bool jumps = s.utime > newest_imu_ + toUtime(opts_.clock_jump_s) ||
-                       s.utime < newest_imu_ - toUtime(opts_.clock_reset_s);
-    const bool confirms = held_jump_ && s.utime > held_jump_->utime &&
-                          s.utime - held_jump_->utime <= toUtime(opts_.clock_jump_s);
+    const bool jumps =
+        s.utime > newest_imu_ + toUtime(opts_.clock_jump_s) || s.utime < newest_imu_ - toUtime(opts_.clock_reset_s);
+    const bool confirms =
+        held_jump_ && s.utime > held_jump_->utime && s.utime - held_jump_->utime <= toUtime(opts_.clock_jump_s);
     if (jumps && !confirms) {
-      if (held_jump_) node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
+      if (held_jump_)
+        node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
       held_jump_ = s;
       node_.reject(opts_.imu_channel, "IMU stamp jumps by " + std::to_string(toSeconds(s.utime - newest_imu_)) +
                                           " s: held until the next sample confirms the new clock");
@@ -232,8 +234,8 @@ void LioNode::advance() {
       const bool vio_gone = !node_.hasConsumers(opts_.state_prior_channel);
       if (!vio_gone && fed_imu_ <= pending_->utime + toUtime(opts_.posterior_max_wait_s)) break;
       ++handoff_.missing;
-      node_.warn("no STATE_POSTERIOR for the image at " + std::to_string(pending_->utime) +
-                 ": going on LiDAR-only (" + std::to_string(handoff_.missing) + " so far)");
+      node_.warn("no STATE_POSTERIOR for the image at " + std::to_string(pending_->utime) + ": going on LiDAR-only (" +
+                 std::to_string(handoff_.missing) + " so far)");
       pending_.reset();
     }
     const NextEvent next = nextEvent();
@@ -382,8 +384,8 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   } else if (opts_.lio.wheel.enabled) {
     // the filter is past the sweep's end and it waits for the wheels: a reading past its end would
     // let it go; readings up to its end cannot
-    const bool sweep_waits_for_wheels = next.kind == NextEvent::kSweep &&
-                                        !(!wheel_.empty() && wheel_.back().utime > next.utime);
+    const bool sweep_waits_for_wheels =
+        next.kind == NextEvent::kSweep && !(!wheel_.empty() && wheel_.back().utime > next.utime);
     if (sweep_waits_for_wheels)
       out.push_back({opts_.wheel_channel, std::numeric_limits<int64_t>::min(), next.utime + 1});
     else
@@ -473,8 +475,9 @@ void LioNode::writeCalibrationFiles() {
   std::string error;
   const std::string csv = opts_.output_dir + "/calibration.csv", yaml = opts_.output_dir + "/calibration.yaml";
   if (!writeFileAtomically(csv, {calibration_csv_.empty() ? calibrationCsvHeader() : calibration_csv_}, &error) ||
-      !writeFileAtomically(yaml, {calibrationOverlay(lio_.state(), opts_.lio.extrinsics.time_offset_s,
-                                                     opts_.camera_time_offset_s, opts_.camera_handoff, e)},
+      !writeFileAtomically(yaml,
+                           {calibrationOverlay(lio_.state(), opts_.lio.extrinsics.time_offset_s,
+                                               opts_.camera_time_offset_s, opts_.camera_handoff, e)},
                            &error))
     node_.error("calibration files: " + error);
   else

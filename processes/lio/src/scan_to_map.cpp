@@ -16,8 +16,8 @@ ScanToMapOptions matchingForRangeNoise(double range_noise_std, const ScanToMapOp
   o.plane.max_plane_thickness = std::max(base.plane.max_plane_thickness, 2.0 * sigma);
   // the model error of the tuning (curvature, discretisation), as large as the planes it accepts are thick
   const double tuned_k = base.plane.num_neighbors;
-  const double tuned_floor2 = std::max(0.0, base.point_noise_std * base.point_noise_std -
-                                                (1.0 + 1.0 / tuned_k) * kTunedNoise * kTunedNoise);
+  const double tuned_floor2 =
+      std::max(0.0, base.point_noise_std * base.point_noise_std - (1.0 + 1.0 / tuned_k) * kTunedNoise * kTunedNoise);
   const double thicker = o.plane.max_plane_thickness / base.plane.max_plane_thickness;
   o.point_noise_std = std::max(base.point_noise_std, std::sqrt(thicker * thicker * tuned_floor2 +
                                                                (1.0 + 1.0 / o.plane.num_neighbors) * sigma * sigma));
@@ -31,8 +31,8 @@ constexpr size_t kMinSearchesPerThread = 256;
 }  // namespace
 
 ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::vector<Vec3>& body_points,
-                     const ScanToMapOptions& options,
-                     WorkerThreads* threads, const SensorCalibration& undistorted_with, const Vec3& body_rate)
+                     const ScanToMapOptions& options, WorkerThreads* threads, const SensorCalibration& undistorted_with,
+                     const Vec3& body_rate)
     : map_(map),
       planes_(planes),
       points_(body_points.size()),
@@ -49,7 +49,8 @@ ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::
     gate_[i] = opts_.residual_range_factor * std::sqrt(body_points[i].norm());
   }
   floor_.diagonal().head<3>().setConstant(opts_.registration_floor_rotation * opts_.registration_floor_rotation);
-  floor_.diagonal().segment<3>(3).setConstant(opts_.registration_floor_translation * opts_.registration_floor_translation);
+  floor_.diagonal().segment<3>(3).setConstant(opts_.registration_floor_translation *
+                                              opts_.registration_floor_translation);
 }
 
 int ScanToMap::numMatched() const {
@@ -87,9 +88,9 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
         m.has_plane = m.observes_normal = true;
         continue;
       }
-      m.has_plane = map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
-                    fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity,
-                             &m.observes_normal);
+      m.has_plane =
+          map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
+          fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity, &m.observes_normal);
     }
   };
   if (threads_)

@@ -129,8 +129,8 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
       return lo[0] <= x && x <= hi[0] && lo[1] <= y && y <= hi[1] && lo[2] <= z && z <= hi[2];
     }
   };
-  Box inner;            // the previous stage's box ...
-  double inner2 = -1.0; // ... whose voxels with d2 <= inner2 were visited
+  Box inner;             // the previous stage's box ...
+  double inner2 = -1.0;  // ... whose voxels with d2 <= inner2 were visited
   uint64_t heap_small[64];
   double d2_small[64];  // by place in the stage's box
   std::vector<uint64_t> heap_large;
@@ -321,8 +321,8 @@ void VoxelMap::forEachVoxelNearBeams(const Vec3& origin, const std::vector<Vec3>
   }
 }
 
-size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints,
-                                   const SeenThroughOptions& o, WorkerThreads* threads) {
+size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& o,
+                                   WorkerThreads* threads) {
   if (!o.enabled || voxels_.empty() || !origin.allFinite()) return 0;
   std::vector<int32_t> touched;  // voxels holding a point seen through in this sweep
   const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));

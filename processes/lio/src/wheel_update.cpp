@@ -28,8 +28,8 @@ WheelUpdateResult wheelVelocityUpdate(FilterState* x, StateCovariance* P, const 
   const Mat3xState H = wheelVelocityJacobian(*x, gyro, o.T_I_B);
   Mat3 R = Mat3::Zero();
   // the mean of two wheels: variance halves
-  R.diagonal() << 0.5 * o.speed_noise_std * o.speed_noise_std + extra_forward_variance, o.lateral_noise_std * o.lateral_noise_std,
-      o.vertical_noise_std * o.vertical_noise_std;
+  R.diagonal() << 0.5 * o.speed_noise_std * o.speed_noise_std + extra_forward_variance,
+      o.lateral_noise_std * o.lateral_noise_std, o.vertical_noise_std * o.vertical_noise_std;
   const Eigen::Matrix<double, FilterState::kDim, 3> PHt = (*P) * H.transpose();
   const Mat3 Sinn = H * PHt + R;
   const Eigen::LLT<Mat3> llt(Sinn);

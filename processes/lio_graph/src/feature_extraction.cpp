@@ -10,14 +10,14 @@ namespace livo::lio_graph {
 namespace {
 
 struct RingPoint {
-  int index;     // into the cloud
-  float time;    // ordering along the ring
+  int index;   // into the cloud
+  float time;  // ordering along the ring
   double range;
 };
 
 /// Marks the features of one ring (points in ring order); appends them to `out`.
-void ringFeatures(const std::vector<RingPoint>& ring, const FeatureOptions& o,
-                  std::vector<int>* edges, std::vector<int>* surfaces) {
+void ringFeatures(const std::vector<RingPoint>& ring, const FeatureOptions& o, std::vector<int>* edges,
+                  std::vector<int>* surfaces) {
   const int k = std::max(1, o.neighbours);
   const int n = static_cast<int>(ring.size());
   if (n < 2 * k + 1) return;
@@ -55,9 +55,8 @@ void ringFeatures(const std::vector<RingPoint>& ring, const FeatureOptions& o,
     order.clear();
     for (int i = a; i < b; ++i)
       if (roughness[i] > o.edge_threshold) order.push_back(i);
-    std::sort(order.begin(), order.end(), [&](int x, int y) {
-      return roughness[x] > roughness[y] || (roughness[x] == roughness[y] && x < y);
-    });
+    std::sort(order.begin(), order.end(),
+              [&](int x, int y) { return roughness[x] > roughness[y] || (roughness[x] == roughness[y] && x < y); });
     int picked = 0;
     for (int i : order) {
       if (picked >= o.max_edges_per_sector || roughness[i] <= o.edge_threshold) break;
@@ -89,7 +88,8 @@ ScanFeatures extractFeatures(const RingCloud& cloud, const FeatureOptions& o) {
       rings[cloud.ring[i]].push_back({static_cast<int>(i), cloud.time_offset[i], range});
     }
     for (auto& ring : rings) {
-      std::stable_sort(ring.begin(), ring.end(), [](const RingPoint& a, const RingPoint& b) { return a.time < b.time; });
+      std::stable_sort(ring.begin(), ring.end(),
+                       [](const RingPoint& a, const RingPoint& b) { return a.time < b.time; });
       ringFeatures(ring, o, &edges, &surfaces);
     }
   } else {

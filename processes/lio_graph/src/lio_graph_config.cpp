@@ -122,11 +122,12 @@ void printOptions(const LioGraphNodeOptions& n, std::ostream& os) {
   const LioGraphOptions& o = n.core;
   os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.lidar_channel
      << (o.use_wheel ? ", " + n.wheel_channel : std::string())
-     << (o.use_visual_motion ? ", " + n.visual_state_channel : std::string()) << ", " << n.loop_correction_channel << "; outputs " << n.odometry_channel << ", "
-     << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
+     << (o.use_visual_motion ? ", " + n.visual_state_channel : std::string()) << ", " << n.loop_correction_channel
+     << "; outputs " << n.odometry_channel << ", " << n.registered_scan_channel << ", " << n.keyframe_channel << "\n"
      << "  window " << o.window_states << " sweeps, " << o.solver_iterations << " solver iterations; factors: IMU "
      << "preintegration, bias walk, LiDAR pose (sigma " << o.lidar_point_sigma << " m x scale "
-     << o.lidar_information_scale << ")" << (o.use_wheel ? ", " + wheelFactorText(o.wheel_rig, o.wheel_scale_std) : std::string())
+     << o.lidar_information_scale << ")"
+     << (o.use_wheel ? ", " + wheelFactorText(o.wheel_rig, o.wheel_scale_std) : std::string())
      << (o.planar_factors ? (o.planar_ground_only ? ", adaptive planar factors (the ground)"
                                                   : ", adaptive planar factors (every plane)")
                           : "")

@@ -77,13 +77,13 @@ struct LioGraphEstimator::Node {
   // What the factors holding world-frame quantities were made from, to remake them when a loop
   // correction moves the world (the wheel, visual and bias factors are relative: they never move).
   std::optional<ImuPreintegration> imu_preintegration;  // its factor holds the world gravity
-  Pose3 lidar_pose = Pose3::Identity();   // the matched W_T_I ...
-  Mat6 lidar_information = Mat6::Zero();  // ... and its information [dtheta (right), dp]
+  Pose3 lidar_pose = Pose3::Identity();                 // the matched W_T_I ...
+  Mat6 lidar_information = Mat6::Zero();                // ... and its information [dtheta (right), dp]
   /// A prior of the first state (the initialisation).
   struct Unary {
     enum class Kind { kPose, kVelocity, kBias, kWheelScale, kWheelMounting, kVisualScale } kind;
     std::vector<double*> blocks;
-    Pose3 pose = Pose3::Identity();   // kPose: W_T_I and its information
+    Pose3 pose = Pose3::Identity();  // kPose: W_T_I and its information
     Mat6 information = Mat6::Zero();
     // kVelocity (world frame), kBias, kWheelMounting (body frame); kWheelScale: head<2>, sigma(0); kVisualScale: (0)
     Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();
@@ -101,14 +101,12 @@ struct LioGraphEstimator::Node {
   std::vector<Unary> priors;  // the first state's
   struct PlaneObservation {
     PlaneLandmark* landmark;
-    Vec3 normal;     // the measured plane, body frame (n.x + offset = 0) ...
+    Vec3 normal;  // the measured plane, body frame (n.x + offset = 0) ...
     double offset;
     double sigma_angle, sigma_distance;  // ... and its sigmas
     std::unique_ptr<ceres::CostFunction> cost;
     /// The factor against the landmark's current anchor.
-    void remake() {
-      cost.reset(makePlaneFactor(landmark->anchor, normal, offset, sigma_angle, sigma_distance));
-    }
+    void remake() { cost.reset(makePlaneFactor(landmark->anchor, normal, offset, sigma_angle, sigma_distance)); }
   };
   std::vector<PlaneObservation> planes;
 
@@ -327,7 +325,8 @@ void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std
       while (seg + 1 < steps.size() - 1 && steps[seg + 1].utime < t) ++seg;
       const ImuStep& a = steps[seg];
       const ImuStep& b = steps[std::min(seg + 1, steps.size() - 1)];
-      const double s = b.utime > a.utime ? std::clamp(static_cast<double>(t - a.utime) / (b.utime - a.utime), 0.0, 1.0) : 1.0;
+      const double s =
+          b.utime > a.utime ? std::clamp(static_cast<double>(t - a.utime) / (b.utime - a.utime), 0.0, 1.0) : 1.0;
       T_W_I = se3::interpolate(a.pose, b.pose, s);
     }
     body->push_back(T_end_inv * (T_W_I * (T_I_L * pl)));
@@ -425,8 +424,8 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTim
     if (match.valid) {
       n->setPose(match.T_W_I);
       n->lidar_pose = match.T_W_I;
-      n->lidar_information = match.hessian * (opts_.lidar_information_scale /
-                                              (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
+      n->lidar_information =
+          match.hessian * (opts_.lidar_information_scale / (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
       n->lidar.reset(makePoseFactor(n->lidar_pose, n->lidar_information));
       res.status = GraphScanResult::Status::kTracked;
     } else {
@@ -438,8 +437,8 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTim
     // 4. the new state's factors, the window optimised, the oldest state marginalised
     n->imu_preintegration = pre;
     n->imu.reset(makeImuFactor(pre, gravity_W_));
-    n->bias_walk.reset(makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk,
-                                          pre.duration()));
+    n->bias_walk.reset(
+        makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk, pre.duration()));
     if (opts_.use_wheel) {
       if (auto w = wheelBetween(prev.utime, t_end)) {
         n->wheel.reset(makeWheelFactor(*w, {estimatesWheelScale(), estimatesWheelMounting()}));
@@ -540,8 +539,12 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
     }
     used.push_back(best);
     ++best->observers;
-    Node::PlaneObservation o{best, e.plane.normal, e.plane.offset, opts_.plane_sigma_angle_deg * M_PI / 180.0,
-                             std::max(opts_.plane_sigma_distance, e.quality), nullptr};
+    Node::PlaneObservation o{best,
+                             e.plane.normal,
+                             e.plane.offset,
+                             opts_.plane_sigma_angle_deg * M_PI / 180.0,
+                             std::max(opts_.plane_sigma_distance, e.quality),
+                             nullptr};
     o.remake();
     node->planes.push_back(std::move(o));
     ++res->planes;
@@ -649,7 +652,8 @@ std::vector<const LioGraphEstimator::StoredKeyframe*> LioGraphEstimator::localMa
   const double r2 = opts_.local_map_radius * opts_.local_map_radius;
   std::vector<size_t> older, newest;
   for (size_t i = 0; i < keyframes_.size(); ++i)
-    if ((keyframes_[i].kf.pose.translation() - here).squaredNorm() <= r2) (i < first_newest ? older : newest).push_back(i);
+    if ((keyframes_[i].kf.pose.translation() - here).squaredNorm() <= r2)
+      (i < first_newest ? older : newest).push_back(i);
   std::vector<const StoredKeyframe*> chosen;  // oldest first
   for (size_t i : firstKeyframePerCell(older)) chosen.push_back(&keyframes_[i]);
   for (size_t i : newest) chosen.push_back(&keyframes_[i]);

@@ -38,8 +38,8 @@ registered_scan_t toRegisteredScan(const GraphScanResult& r, const point_cloud_t
 }
 
 keyframe_t toKeyframe(const GraphKeyframe& k, int16_t num_rings, const OdometryFrame& frame) {
-  return keyframeMessage(k.id, k.utime, k.pose, k.pose_covariance, KeyframeIncrement{}, k.cloud, k.intensity,
-                         num_rings, OutputFrame{frame.epoch, frame.correction_id});
+  return keyframeMessage(k.id, k.utime, k.pose, k.pose_covariance, KeyframeIncrement{}, k.cloud, k.intensity, num_rings,
+                         OutputFrame{frame.epoch, frame.correction_id});
 }
 
 }  // namespace livo::lio_graph

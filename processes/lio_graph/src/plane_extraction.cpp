@@ -197,7 +197,8 @@ class LocalNormals {
     done_[i] = 1;
     for (size_t j = 0; j < k_; ++j) nb_[j] = points_[idx_[j]];
     PlaneFit fit;
-    if (fitPlane(nb_.data(), static_cast<int>(k_), &fit) && fit.spread[1] > 1e-3 * fit.spread[2]) normal_[i] = fit.plane.normal;
+    if (fitPlane(nb_.data(), static_cast<int>(k_), &fit) && fit.spread[1] > 1e-3 * fit.spread[2])
+      normal_[i] = fit.plane.normal;
   }
 
   const std::vector<Vec3>& points_;

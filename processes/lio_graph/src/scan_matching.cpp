@@ -22,8 +22,8 @@ namespace {
 /// One linearised residual: r = n^T (p_w - q) with unit normal n.
 struct Residual {
   Vec3 normal;
-  Vec3 anchor;   // a point on the line or plane
-  Vec3 body;     // the feature point, body frame
+  Vec3 anchor;  // a point on the line or plane
+  Vec3 body;    // the feature point, body frame
   double weight;
 };
 

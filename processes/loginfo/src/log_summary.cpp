@@ -1,11 +1,11 @@
 #include "livo/loginfo/log_summary.hpp"
 
+#include <sys/stat.h>
 #include <cstdio>
 #include <iomanip>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
-#include <sys/stat.h>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -92,8 +92,9 @@ void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest, bo
   for (const auto& [name, c] : s.channels) w = std::max(w, name.size());
   size_t tw = 4;
   for (const auto& [name, c] : s.channels) tw = std::max(tw, c.type.size());
-  os << "\n" << std::left << std::setw(static_cast<int>(w) + 2) << "channel" << std::setw(static_cast<int>(tw) + 2)
-     << "type" << std::right << std::setw(10) << "count" << std::setw(11) << "rate Hz" << std::setw(12) << "bytes";
+  os << "\n"
+     << std::left << std::setw(static_cast<int>(w) + 2) << "channel" << std::setw(static_cast<int>(tw) + 2) << "type"
+     << std::right << std::setw(10) << "count" << std::setw(11) << "rate Hz" << std::setw(12) << "bytes";
   if (with_digest) os << "  digest";
   if (with_non_finite) os << "  non-finite";
   os << "\n";
@@ -101,7 +102,8 @@ void printLogSummary(const LogSummary& s, std::ostream& os, bool with_digest, bo
     os << std::left << std::setw(static_cast<int>(w) + 2) << name << std::setw(static_cast<int>(tw) + 2) << c.type
        << std::right << std::setw(10) << c.count << std::setw(11) << std::setprecision(2) << c.rateHz() << std::setw(12)
        << humanBytes(static_cast<double>(c.bytes));
-    if (with_digest) os << "  " << std::hex << std::setw(16) << std::setfill('0') << c.digest << std::dec << std::setfill(' ');
+    if (with_digest)
+      os << "  " << std::hex << std::setw(16) << std::setfill('0') << c.digest << std::dec << std::setfill(' ');
     if (with_non_finite) os << "  " << std::setw(10) << c.non_finite_messages;
     if (c.out_of_order) os << "  (" << c.out_of_order << " out of order)";
     os << "\n";

@@ -19,8 +19,7 @@ bool Descriptor::isZero() const {
 
 Descriptor quantise(const Fpfh& feature) {
   Descriptor d;
-  for (int k = 0; k < kFpfhSize; ++k)
-    d.bins[k] = static_cast<uint8_t>(std::clamp(std::lround(feature[k]), 0L, 255L));
+  for (int k = 0; k < kFpfhSize; ++k) d.bins[k] = static_cast<uint8_t>(std::clamp(std::lround(feature[k]), 0L, 255L));
   return d;
 }
 

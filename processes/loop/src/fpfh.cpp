@@ -79,8 +79,10 @@ Features computeFpfh(const Points& points, const Points& normals, const PointTre
   for (size_t i = 0; i < n; ++i) {
     if (!needed[i] || normals[i].isZero()) continue;
     const std::vector<std::pair<size_t, double>>* neighbours = &searched;
-    if (keypoint_of[i] >= 0) neighbours = &around[keypoint_of[i]];
-    else tree.radius(points[i], radius, searched, false);
+    if (keypoint_of[i] >= 0)
+      neighbours = &around[keypoint_of[i]];
+    else
+      tree.radius(points[i], radius, searched, false);
     for (const auto& [j, d2] : *neighbours) {
       if (j == i || normals[j].isZero() || (needed[j] && j < i)) continue;  // j < i: added when j was visited
       int b[3];

@@ -104,9 +104,9 @@ GicpResult gicpRegister(const GicpCloud& source, const GicpCloud& target, const 
   const double max_d2 = options.max_correspondence_distance * options.max_correspondence_distance;
   const double overlap_d2 = std::min(options.overlap_distance * options.overlap_distance, max_d2);
   // Every stride-th source point (the cloud is in voxel order, so this thins it evenly).
-  const size_t stride = options.max_source_points > 0
-                            ? (source.size() + options.max_source_points - 1) / static_cast<size_t>(options.max_source_points)
-                            : 1;
+  const size_t stride = options.max_source_points > 0 ? (source.size() + options.max_source_points - 1) /
+                                                            static_cast<size_t>(options.max_source_points)
+                                                      : 1;
   const size_t used = (source.size() + stride - 1) / stride;
   Pose3 T = initial;
   Linearisation L;

@@ -40,8 +40,7 @@ std::vector<Neighbourhood> analyseNeighbourhoods(const Points& points, const Poi
   return out;
 }
 
-Covariances estimateCovariances(const Points& points, const PointTree& tree, int num_neighbors,
-                                double plane_epsilon) {
+Covariances estimateCovariances(const Points& points, const PointTree& tree, int num_neighbors, double plane_epsilon) {
   Covariances covs(points.size(), Mat3::Identity());
   const size_t k = static_cast<size_t>(std::max(num_neighbors, 3));
   std::vector<size_t> idx(k);

@@ -25,7 +25,8 @@ Mat3 rollPitch(const Mat3& W_R_I) {
 // in its frame is up_in_body: the odometry's attitude to gravity, kept under a new yaw and position.
 Pose3 withUpInBody(const Pose3& T, const Vec3& up_in_body) {
   Pose3 out = T;
-  out.linear() = so3::normalize(Quat::FromTwoVectors(T.linear() * up_in_body, Vec3::UnitZ()).toRotationMatrix() * T.linear());
+  out.linear() =
+      so3::normalize(Quat::FromTwoVectors(T.linear() * up_in_body, Vec3::UnitZ()).toRotationMatrix() * T.linear());
   return out;
 }
 Pose3 rotationOnly(const Mat3& R) {
@@ -45,9 +46,8 @@ std::string LoopCloser::problem(const KeyframeInput& input) const {
              ", before the newest keyframe's (" + std::to_string(newest_.epoch) + ")";
   }
   if (!published_.odometryToCorrected(input.epoch, input.correction_id))
-    return "keyframe " + std::to_string(input.id) + " includes loop correction " +
-           std::to_string(input.correction_id) + ", which this process did not publish for odometry epoch " +
-           std::to_string(input.epoch);
+    return "keyframe " + std::to_string(input.id) + " includes loop correction " + std::to_string(input.correction_id) +
+           ", which this process did not publish for odometry epoch " + std::to_string(input.epoch);
   return "";
 }
 
@@ -64,8 +64,7 @@ size_t LoopCloser::odometryEdgesAcrossEpochs() const {
   return n;
 }
 
-std::vector<int64_t> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p,
-                                                double radius) const {
+std::vector<int64_t> LoopCloser::olderNodesNear(int64_t kf_id, const Keyframe& kf, const Vec3& p, double radius) const {
   const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
   std::vector<std::pair<double, int64_t>> near;
   for (const auto& [id, node] : nodes_) {
@@ -295,10 +294,10 @@ Mat6 LoopCloser::chainOdometryCovariance(const Keyframe& to) const {
   if (options_.odometry_covariance_from_filter && chain_.filter_covariance) return chain_.odometry_covariance;
   // the drift model: the increment's covariance from the absolute ones, floored by the drift
   // model over the path
-  return relativeInformation(chain_.start_keyframe.covariance, to.covariance,
-                             std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
-                             std::hypot(options_.odometry_translation_floor,
-                                        options_.odometry_translation_per_m * chain_.path))
+  return relativeInformation(
+             chain_.start_keyframe.covariance, to.covariance,
+             std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+             std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
       .inverse();
 }
 
@@ -404,8 +403,7 @@ bool LoopCloser::optimizePendingLoops() {
 
 void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, const FloatCloud& cloud) {
   graph_.addNode(id, estimate);
-  if (options_.gravity_prior_sigma > 0.0)
-    graph_.addGravityPrior(id, upInBody(kf), options_.gravity_prior_sigma);
+  if (options_.gravity_prior_sigma > 0.0) graph_.addGravityPrior(id, upInBody(kf), options_.gravity_prior_sigma);
   nodes_.emplace(id, kf);
   clouds_.put(id, cloud);
   placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity(), upInBody(kf)});
@@ -512,13 +510,13 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
     e.T_from_to = T_node_kf;
     e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
     const bool from_filter = options_.odometry_covariance_from_filter && chain_.filter_covariance;
-    e.information = chain_.via_loop || from_filter
-                        ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
-                        : relativeInformation(chain_.start_keyframe.covariance, kf.covariance,
-                                              std::hypot(options_.odometry_rotation_floor,
-                                                         options_.odometry_rotation_per_m * chain_.path),
-                                              std::hypot(options_.odometry_translation_floor,
-                                                         options_.odometry_translation_per_m * chain_.path));
+    e.information =
+        chain_.via_loop || from_filter
+            ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
+            : relativeInformation(
+                  chain_.start_keyframe.covariance, kf.covariance,
+                  std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+                  std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path));
     addNode(input.id, kf, estimate, cloud_f);
     graph_.addEdge(e);
     chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};

@@ -71,8 +71,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   const LoopInformationOptions& li = c.loop_information;
   if (!(li.min_rotation_sigma > 0 && li.min_translation_sigma > 0 && li.max_rotation_sigma > li.min_rotation_sigma &&
         li.max_translation_sigma > li.min_translation_sigma && li.min_constrained_fraction >= 0 &&
-        li.fitness_rotation_sigma >= 0 && li.roll_pitch_sigma >= 0 &&
-        li.min_constrained_fraction < 1))
+        li.fitness_rotation_sigma >= 0 && li.roll_pitch_sigma >= 0 && li.min_constrained_fraction < 1))
     throw ConfigError(s.where("loop_min_rotation_sigma") +
                       ": loop_min_*_sigma must be > 0, loop_max_*_sigma greater than them and "
                       "loop_min_constrained_fraction in [0, 1)");
@@ -92,11 +91,10 @@ void printOptions(const LoopNodeOptions& o, std::ostream& os) {
      << " keyframes of cooldown\n  coarse: voxel " << c.coarse.voxel_size << " m, FPFH radius "
      << c.coarse.feature_radius << " m, at most " << c.coarse.max_keypoints << " keypoints, noise bound "
      << c.registration.quatro.noise_bound << " m; fine: voxel " << c.fine_voxel_size << " m, GICP max distance "
-     << c.registration.gicp.max_correspondence_distance << " m\n  accepted with at least "
-     << a.min_coarse_inliers << " coarse inliers, fitness <= " << a.max_fitness << ", overlap >= " << a.min_overlap
-     << "; consistency check " << (c.consistency_check ? "on" : "off") << " (chi2 " << c.consistency_chi2
-     << "); a correction only beyond " << c.min_correction_translation << " m / " << c.min_correction_rotation
-     << " rad and chi2 " << c.correction_chi2
+     << c.registration.gicp.max_correspondence_distance << " m\n  accepted with at least " << a.min_coarse_inliers
+     << " coarse inliers, fitness <= " << a.max_fitness << ", overlap >= " << a.min_overlap << "; consistency check "
+     << (c.consistency_check ? "on" : "off") << " (chi2 " << c.consistency_chi2 << "); a correction only beyond "
+     << c.min_correction_translation << " m / " << c.min_correction_rotation << " rad and chi2 " << c.correction_chi2
      << (c.correction_from_optimum ? ", where the optimum moves the keyframe as much" : "")
      << "; odometry edges weighted by "
      << (c.odometry_covariance_from_filter ? "the odometry's increment covariances (the drift model where none)"

@@ -9,7 +9,8 @@ namespace livo::loop {
 Mat6 driftCovariance(double path_m, const DriftModel& m) {
   const double L = std::abs(path_m);
   const double sr = std::hypot(m.rotation_floor, m.rotation_per_m * L);
-  const double st = std::hypot(std::hypot(m.translation_floor, m.translation_per_m * L), 0.5 * m.rotation_per_m * L * L);
+  const double st =
+      std::hypot(std::hypot(m.translation_floor, m.translation_per_m * L), 0.5 * m.rotation_per_m * L * L);
   Vec6 var;
   var << Vec3::Constant(sr * sr), Vec3::Constant(st * st);
   return var.asDiagonal();

@@ -22,12 +22,13 @@ Mat6 symmetric(const Mat6& m) { return 0.5 * (m + m.transpose()); }
 // direction is projected out, with its coupling to the rotations.
 Mat6 constrainedPart(const GicpResult& fine, double fraction) {
   if (!fine.plane_information.allFinite() || fine.plane_correspondences <= 6) return Mat6::Zero();
-  const Mat3 per_point = fine.plane_information.bottomRightCorner<3, 3>() *
-                         (fine.plane_residual_variance / fine.plane_correspondences);
+  const Mat3 per_point =
+      fine.plane_information.bottomRightCorner<3, 3>() * (fine.plane_residual_variance / fine.plane_correspondences);
   Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (per_point + per_point.transpose()));
   Mat6 P = Mat6::Identity();
   for (int i = 0; i < 3; ++i)
-    if (es.eigenvalues()(i) < fraction) P.bottomRightCorner<3, 3>() -= es.eigenvectors().col(i) * es.eigenvectors().col(i).transpose();
+    if (es.eigenvalues()(i) < fraction)
+      P.bottomRightCorner<3, 3>() -= es.eigenvectors().col(i) * es.eigenvectors().col(i).transpose();
   return symmetric(P * fine.plane_information * P);
 }
 }  // namespace

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "livo/loop/loop_outputs.hpp"
 #include "livo/loop_correction_t.hpp"
 #include "livo/messages.hpp"
-#include "livo/loop/loop_outputs.hpp"
 
 namespace livo::loop {
 
@@ -56,8 +56,10 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   size_t non_finite = 0;
   for (size_t i = 0; i < c.x.size(); ++i) {
     const Vec3 p(c.x[i], c.y[i], c.z[i]);
-    if (p.allFinite()) in.cloud.push_back(p);
-    else ++non_finite;
+    if (p.allFinite())
+      in.cloud.push_back(p);
+    else
+      ++non_finite;
   }
   if (non_finite > 0)
     node_.warn("keyframe " + std::to_string(m.id) + ": dropped " + std::to_string(non_finite) + " non-finite points");
@@ -79,14 +81,14 @@ void LoopNode::onKeyframe(const keyframe_t& m) {
   }
   for (const RefusedLoop& f : r.refused)
     node_.warn((f.merged ? "keyframe " : "loop ") + std::to_string(f.from_id) + (f.merged ? " joining " : " -> ") +
-               std::to_string(f.to_id) + " refused (" + std::to_string(closer_.refusedLoops().size()) + " so far): " +
-               f.reason);
+               std::to_string(f.to_id) + " refused (" + std::to_string(closer_.refusedLoops().size()) +
+               " so far): " + f.reason);
   if (r.loop) {
     std::ostringstream s;
     s << (r.loop->merged ? "keyframe " : "loop ") << r.loop->from_id << (r.loop->merged ? " joins " : " -> ")
-      << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers
-      << ", fitness " << r.loop->fitness << ", overlap " << r.loop->overlap << "; residual "
-      << r.loop->residual_translation << " m, " << r.loop->residual_rotation * 180.0 / M_PI << " deg)";
+      << r.loop->to_id << " accepted (inliers " << r.loop->coarse_inliers << ", fitness " << r.loop->fitness
+      << ", overlap " << r.loop->overlap << "; residual " << r.loop->residual_translation << " m, "
+      << r.loop->residual_rotation * 180.0 / M_PI << " deg)";
     if (!r.correction) s << ": the estimate agrees, no correction";
     node_.info(s.str());
     if (r.correction) publishCorrection(*r.loop, *r.correction, m.utime);

@@ -10,11 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "livo/loop/loop_information.hpp"
+#include "livo/loop/voxel_grid.hpp"
 #include "livo/spill_file.hpp"
 #include "livo/time.hpp"
 #include "livo/trajectory_io.hpp"
-#include "livo/loop/loop_information.hpp"
-#include "livo/loop/voxel_grid.hpp"
 
 namespace livo::loop {
 
@@ -38,30 +38,34 @@ void writeLoopsJson(const std::string& path, const LoopCloser& closer) {
   for (const AcceptedLoop& l : closer.loops()) {
     const Quat q(l.T_to_from.linear());
     const Vec3 t = l.T_to_from.translation();
-    loops.push_back({{"from_id", l.from_id},
-                     {"to_id", l.to_id},
-                     {"from_time", toSeconds(l.from_utime)},
-                     {"to_time", toSeconds(l.to_utime)},
-                     {"T_to_from", {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
-                     {"information", rowMajor(informationFromCovariance(l.covariance))},
-                     {"coarse_inliers", l.coarse_inliers},
-                     {"fitness", l.fitness},
-                     {"overlap", l.overlap},
-                     {"residual_translation", l.residual_translation},
-                     {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
-                     {"correction_chi2", l.correction_chi2},
-                     {"optimum_shift_translation", l.optimum_shift_translation},
-                     {"optimum_shift_rotation_deg", l.optimum_shift_rotation * 180.0 / M_PI},
-                     {"odometry_sigma_rotation_deg", {std::sqrt(l.odometry_covariance(0, 0)) * 180.0 / M_PI,
-                                                      std::sqrt(l.odometry_covariance(1, 1)) * 180.0 / M_PI,
-                                                      std::sqrt(l.odometry_covariance(2, 2)) * 180.0 / M_PI}},
-                     {"odometry_sigma_translation", {std::sqrt(l.odometry_covariance(3, 3)), std::sqrt(l.odometry_covariance(4, 4)),
-                                                     std::sqrt(l.odometry_covariance(5, 5))}},
-                     {"corrected", l.corrected},
-                     {"merged", l.merged},
-                     {"sigma_rotation_deg", {std::sqrt(l.covariance(0, 0)) * 180.0 / M_PI, std::sqrt(l.covariance(1, 1)) * 180.0 / M_PI,
-                                             std::sqrt(l.covariance(2, 2)) * 180.0 / M_PI}},
-                     {"sigma_translation", {std::sqrt(l.covariance(3, 3)), std::sqrt(l.covariance(4, 4)), std::sqrt(l.covariance(5, 5))}}});
+    loops.push_back(
+        {{"from_id", l.from_id},
+         {"to_id", l.to_id},
+         {"from_time", toSeconds(l.from_utime)},
+         {"to_time", toSeconds(l.to_utime)},
+         {"T_to_from", {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}}},
+         {"information", rowMajor(informationFromCovariance(l.covariance))},
+         {"coarse_inliers", l.coarse_inliers},
+         {"fitness", l.fitness},
+         {"overlap", l.overlap},
+         {"residual_translation", l.residual_translation},
+         {"residual_rotation_deg", l.residual_rotation * 180.0 / M_PI},
+         {"correction_chi2", l.correction_chi2},
+         {"optimum_shift_translation", l.optimum_shift_translation},
+         {"optimum_shift_rotation_deg", l.optimum_shift_rotation * 180.0 / M_PI},
+         {"odometry_sigma_rotation_deg",
+          {std::sqrt(l.odometry_covariance(0, 0)) * 180.0 / M_PI, std::sqrt(l.odometry_covariance(1, 1)) * 180.0 / M_PI,
+           std::sqrt(l.odometry_covariance(2, 2)) * 180.0 / M_PI}},
+         {"odometry_sigma_translation",
+          {std::sqrt(l.odometry_covariance(3, 3)), std::sqrt(l.odometry_covariance(4, 4)),
+           std::sqrt(l.odometry_covariance(5, 5))}},
+         {"corrected", l.corrected},
+         {"merged", l.merged},
+         {"sigma_rotation_deg",
+          {std::sqrt(l.covariance(0, 0)) * 180.0 / M_PI, std::sqrt(l.covariance(1, 1)) * 180.0 / M_PI,
+           std::sqrt(l.covariance(2, 2)) * 180.0 / M_PI}},
+         {"sigma_translation",
+          {std::sqrt(l.covariance(3, 3)), std::sqrt(l.covariance(4, 4)), std::sqrt(l.covariance(5, 5))}}});
   }
   nlohmann::json refused = nlohmann::json::array();
   size_t refused_by_odometry = 0;

@@ -25,7 +25,8 @@ LoopRegistrationResult registerLoop(const CoarseFeatures& source_coarse, const C
                                     const LoopRegistrationOptions& options) {
   LoopRegistrationResult r;
   const auto t0 = std::chrono::steady_clock::now();
-  const Correspondences matches = matchDescriptors(source_coarse.descriptors, target_coarse.descriptors, options.matching);
+  const Correspondences matches =
+      matchDescriptors(source_coarse.descriptors, target_coarse.descriptors, options.matching);
   r.coarse = quatroRegister(source_coarse.points, target_coarse.points, matches, options.quatro);
   r.coarse_ms = msSince(t0);
   const AcceptanceOptions& a = options.acceptance;

@@ -124,7 +124,8 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
   // Degeneracy order by repeatedly removing a vertex of minimum remaining degree (bucket queue).
   std::vector<int> degree(n), core(n), position(n);
   int max_degree = 0;
-  for (int v = 0; v < n; ++v) max_degree = std::max(max_degree, degree[v] = static_cast<int>(graph.adjacency[v].size()));
+  for (int v = 0; v < n; ++v)
+    max_degree = std::max(max_degree, degree[v] = static_cast<int>(graph.adjacency[v].size()));
   std::vector<std::vector<int>> buckets(max_degree + 1);
   for (int v = 0; v < n; ++v) buckets[degree[v]].push_back(v);
   std::vector<char> removed(n, 0);
@@ -169,8 +170,10 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
       if (eligible_for != best.size()) {
         eligible_for = best.size();
         for (int u = 0; u < n; ++u) {
-          if (core[u] + 1 > static_cast<int>(best.size())) set(eligible, u);
-          else clear(eligible, u);
+          if (core[u] + 1 > static_cast<int>(best.size()))
+            set(eligible, u);
+          else
+            clear(eligible, u);
         }
       }
       Bits P(words);

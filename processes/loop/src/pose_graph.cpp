@@ -286,7 +286,8 @@ PoseGraphSummary PoseGraph::optimize() {
   return out;
 }
 
-Mat6 relativeInformation(const Mat6& cov_from, const Mat6& cov_to, double rotation_floor_rad, double translation_floor_m) {
+Mat6 relativeInformation(const Mat6& cov_from, const Mat6& cov_to, double rotation_floor_rad,
+                         double translation_floor_m) {
   Mat6 d = cov_to - cov_from;
   d = (0.5 * (d + d.transpose())).eval();  // .eval(): the right side reads what the left writes
   if (!d.allFinite()) d.setZero();

@@ -46,9 +46,12 @@ Mat3 gncTlsRotation(const Points& a, const Points& b, double noise_bound, bool y
     for (int it = 0; it < options.gnc_max_iterations; ++it) {
       const double th_in = mu / (mu + 1.0) * c2, th_out = (mu + 1.0) / mu * c2;
       for (size_t i = 0; i < n; ++i) {
-        if (r2[i] <= th_in) w[i] = 1.0;
-        else if (r2[i] >= th_out) w[i] = 0.0;
-        else w[i] = std::sqrt(c2 * mu * (mu + 1.0) / r2[i]) - mu;
+        if (r2[i] <= th_in)
+          w[i] = 1.0;
+        else if (r2[i] >= th_out)
+          w[i] = 0.0;
+        else
+          w[i] = std::sqrt(c2 * mu * (mu + 1.0) / r2[i]) - mu;
       }
       R = weightedRotation(a, b, w, yaw_only);
       residuals(R);
@@ -147,7 +150,8 @@ QuatroResult quatroRegister(const Points& source, const Points& target, const Co
   res.T_target_source.translation() = t;
   for (int ci : clique) {
     const Correspondence& c = matches[ci];
-    if ((res.T_target_source * source[c.source] - target[c.target]).norm() <= 2.0 * options.noise_bound) ++res.num_inliers;
+    if ((res.T_target_source * source[c.source] - target[c.target]).norm() <= 2.0 * options.noise_bound)
+      ++res.num_inliers;
   }
   res.valid = res.num_inliers >= 3;
   return res;

@@ -92,8 +92,9 @@ Points VoxelCentroids::centroids() const {
   std::vector<std::pair<Key, const Sum*>> keyed;
   keyed.reserve(sums_.size());
   for (const auto& [k, s] : sums_) keyed.emplace_back(k, &s);
-  std::sort(keyed.begin(), keyed.end(),
-            [](const auto& a, const auto& b) { return std::tie(a.first.x, a.first.y, a.first.z) < std::tie(b.first.x, b.first.y, b.first.z); });
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first.x, a.first.y, a.first.z) < std::tie(b.first.x, b.first.y, b.first.z);
+  });
   Points out;
   out.reserve(keyed.size());
   for (const auto& [k, s] : keyed) out.push_back(s->sum / static_cast<double>(s->count));

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
 #include <functional>
 #include <iterator>
-#include <memory>
 #include <limits>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include <octomap/ColorOcTree.h>
@@ -89,8 +89,8 @@ class SweepVoxels {
           m &= m - 1;
           const unsigned c = tables().coords[(w << 6) | bit];
           const ::octomap::OcTreeKey k(static_cast<::octomap::key_type>(x0 | (c & kMask)),
-                                      static_cast<::octomap::key_type>(y0 | ((c >> kBits) & kMask)),
-                                      static_cast<::octomap::key_type>(z0 | (c >> (2 * kBits))));
+                                       static_cast<::octomap::key_type>(y0 | ((c >> kBits) & kMask)),
+                                       static_cast<::octomap::key_type>(z0 | (c >> (2 * kBits))));
           f(k, (b->hit[w] >> bit) & 1);
         }
       }
@@ -110,7 +110,7 @@ class SweepVoxels {
     Block* block = nullptr;
   };
   struct Tables {
-    std::array<uint16_t, 1 << kBits> spread{};         // kBits bits -> every third bit
+    std::array<uint16_t, 1 << kBits> spread{};        // kBits bits -> every third bit
     std::array<uint16_t, 1 << (3 * kBits)> coords{};  // Morton index -> x | y << kBits | z << 2 kBits
     Tables() {
       for (unsigned v = 0; v < (1u << kBits); ++v)
@@ -164,7 +164,8 @@ class SweepVoxels {
   static uint64_t morton(uint64_t key) {
     const uint64_t x = key >> 32, y = (key >> 16) & 0xFFFF, z = key & 0xFFFF;
     uint64_t code = 0;
-    for (int d = 16 - kBits - 1; d >= 0; --d) code = (code << 3) | ((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2);
+    for (int d = 16 - kBits - 1; d >= 0; --d)
+      code = (code << 3) | ((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2);
     return code;
   }
   __attribute__((always_inline)) void set(const ::octomap::OcTreeKey& k, uint64_t (Block::*bits)[kWords]) {
@@ -212,7 +213,7 @@ class SweepVoxels {
   }
 
   std::vector<Slot> slots_;
-  int slot_shift_ = 64;  // 64 - log2(slots_.size())
+  int slot_shift_ = 64;                         // 64 - log2(slots_.size())
   std::vector<std::unique_ptr<Block>> blocks_;  // [0, used_) in use this sweep
   size_t used_ = 0;
   Block* last_ = nullptr;
@@ -229,20 +230,20 @@ struct OccupancyMap::Scratch {
 // size of its subtree in the format being written.
 struct OccupancyMap::TileSummary {
   uint64_t index = 0;
-  uint64_t morton = 0;     // the tile's place in the tree's depth-first order
-  float log_odds = 0.f;    // full format: the root's value and colour
+  uint64_t morton = 0;   // the tile's place in the tree's depth-first order
+  float log_odds = 0.f;  // full format: the root's value and colour
   std::array<uint8_t, 3> rgb{{255, 255, 255}};
-  bool leaf = false;       // binary: the root is a (maximum-likelihood) leaf ...
-  bool occupied = false;   // ... and occupied
-  uint64_t nodes = 0;      // nodes of its subtree in this format
-  bool present = false;    // the tile holds a node at all
+  bool leaf = false;      // binary: the root is a (maximum-likelihood) leaf ...
+  bool occupied = false;  // ... and occupied
+  uint64_t nodes = 0;     // nodes of its subtree in this format
+  bool present = false;   // the tile holds a node at all
 };
 
 struct OccupancyMap::Tile {
   std::unique_ptr<::octomap::AbstractOccupancyOcTree> tree;  // resident
   bool spilled = false;
   int64_t last_used = INT64_MIN;
-  bool dirty = false;        // inner nodes not refreshed since the last update
+  bool dirty = false;  // inner nodes not refreshed since the last update
   // on disk: the tree's node stream (octomap's full format from the root: after the levels above
   // the tile's root it is the tile's part of a .ot as it is) and the tile's part of a .bt, with
   // what the levels above need of each, so a file is written without decoding a tile on disk
@@ -250,7 +251,7 @@ struct OccupancyMap::Tile {
   uint64_t full_offset = 0;  // bytes of `record` before the tile's root
   SpillFile::Record binary;
   TileSummary full_summary, binary_summary;
-  size_t leaves = 0;         // on disk: its leaf count
+  size_t leaves = 0;  // on disk: its leaf count
 };
 
 namespace {
@@ -311,7 +312,8 @@ class LeafUpdater {
  private:
   // no change: the value is at the clamping bound the update goes to
   bool clamped(float value, float log_odds) const {
-    return (log_odds >= 0 && value >= t_.getClampingThresMaxLog()) || (log_odds <= 0 && value <= t_.getClampingThresMinLog());
+    return (log_odds >= 0 && value >= t_.getClampingThresMaxLog()) ||
+           (log_odds <= 0 && value <= t_.getClampingThresMinLog());
   }
   // path_[d] has no child `pos` on the key's way: as octomap's updateNode, a node without children
   // (a pruned one: search() ends there) that is clamped is left as it is, else expanded; a node
@@ -359,7 +361,7 @@ class LeafUpdater {
   Tree& t_;
   const int depth_;
   std::array<Pending, kAhead> pending_{};
-  size_t queued_ = 0;  // updates queued; the last min(queued_, kAhead) are pending
+  size_t queued_ = 0;             // updates queued; the last min(queued_, kAhead) are pending
   std::array<Node*, 17> path_{};  // path_[d]: node at depth d (tree depth <= 16)
   ::octomap::OcTreeKey prev_;
   int valid_ = 0;  // path_[0 .. valid_] matches prev_
@@ -534,7 +536,9 @@ std::string header(bool colour, double resolution, bool binary, uint64_t nodes) 
 }  // namespace
 
 OccupancyMap::OccupancyMap(const OctomapOptions& options)
-    : options_(options), keys_(std::make_unique<::octomap::OcTree>(options.resolution)), scratch_(std::make_unique<Scratch>()) {
+    : options_(options),
+      keys_(std::make_unique<::octomap::OcTree>(options.resolution)),
+      scratch_(std::make_unique<Scratch>()) {
   configure(keys_.get(), options_);
   if (options_.tile_size > 0.0) {
     const double voxels = options_.tile_size / options_.resolution;
@@ -581,8 +585,8 @@ OccupancyMap::Tile& OccupancyMap::residentTile(uint64_t tile_index) {
   return t;
 }
 
-::octomap::AbstractOccupancyOcTree& OccupancyMap::treeOf(const Tile& tile,
-                                                      std::unique_ptr<::octomap::AbstractOccupancyOcTree>* holder) const {
+::octomap::AbstractOccupancyOcTree& OccupancyMap::treeOf(
+    const Tile& tile, std::unique_ptr<::octomap::AbstractOccupancyOcTree>* holder) const {
   if (!tile.spilled) return *tile.tree;
   std::vector<uint8_t> bytes;
   spill_->read(tile.record, &bytes);
@@ -597,7 +601,7 @@ OccupancyMap::Tile& OccupancyMap::residentTile(uint64_t tile_index) {
 }
 
 OccupancyMap::TileSummary OccupancyMap::summarize(const ::octomap::AbstractOccupancyOcTree& tree, Format format,
-                                                   std::string* payload) const {
+                                                  std::string* payload) const {
   const int depth = kTreeDepth - tile_bits_;
   TileSummary s;
   withTree(options_.colour, const_cast<::octomap::AbstractOccupancyOcTree&>(tree), [&](auto& t) {
@@ -679,7 +683,8 @@ size_t OccupancyMap::evictIdle() {
 }
 
 size_t OccupancyMap::residentTiles() const {
-  return static_cast<size_t>(std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return !t.second->spilled; }));
+  return static_cast<size_t>(
+      std::count_if(tiles_.begin(), tiles_.end(), [](const auto& t) { return !t.second->spilled; }));
 }
 size_t OccupancyMap::spilledTiles() const { return tiles_.size() - residentTiles(); }
 uint64_t OccupancyMap::spilledBytes() const { return spill_ ? spill_->liveBytes() : 0; }
@@ -717,7 +722,8 @@ size_t OccupancyMap::insertSweep(const std::vector<Slice>& slices) {
       [&](uint64_t i) { return static_cast<::octomap::OcTree*>(residentTile(i).tree.get()); }, tile_of);
 }
 
-size_t OccupancyMap::setColours(const std::vector<Eigen::Vector3f>& points, const std::vector<std::array<uint8_t, 3>>& rgb) {
+size_t OccupancyMap::setColours(const std::vector<Eigen::Vector3f>& points,
+                                const std::vector<std::array<uint8_t, 3>>& rgb) {
   if (!options_.colour) return 0;
   size_t n = 0;
   for (size_t i = 0; i < points.size() && i < rgb.size(); ++i) {
@@ -780,7 +786,8 @@ size_t OccupancyMap::leafCount() const {
   refreshResident();
   size_t n = 0;
   for (const auto& [index, tile] : tiles_)
-    n += tile->spilled ? tile->leaves : withTree(options_.colour, *tile->tree, [](auto& t) { return t.getNumLeafNodes(); });
+    n += tile->spilled ? tile->leaves
+                       : withTree(options_.colour, *tile->tree, [](auto& t) { return t.getNumLeafNodes(); });
   return n;
 }
 
@@ -795,8 +802,8 @@ bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_onl
   std::vector<TileSummary> tiles;
   for (const auto& [index, tile] : tiles_) {
     if (resident_only && tile->spilled) continue;
-    TileSummary s = tile->spilled ? (binary ? tile->binary_summary : tile->full_summary)
-                                  : summarize(*tile->tree, format, nullptr);
+    TileSummary s =
+        tile->spilled ? (binary ? tile->binary_summary : tile->full_summary) : summarize(*tile->tree, format, nullptr);
     if (!s.present) continue;
     s.index = index;
     // depth-first order: at every level the child index (x bit 1, y bit 2, z bit 4)

@@ -27,7 +27,8 @@ bool OctomapBuilder::addScan(const RegisteredScanView& scan, std::string* error)
     if (!p.allFinite()) continue;
     int s = segments - 1;
     if (segments > 1 && scan.time_offset && std::isfinite(scan.time_offset[j])) {
-      const double a = (scan.cloud_utime + scan.time_offset[j] * 1e6 - previous_utime_) / double(scan.utime - previous_utime_);
+      const double a =
+          (scan.cloud_utime + scan.time_offset[j] * 1e6 - previous_utime_) / double(scan.utime - previous_utime_);
       s = std::clamp(static_cast<int>(a * segments), 0, segments - 1);
     }
     slices[s].push_back(p);
@@ -95,8 +96,10 @@ int OctomapBuilder::applyCorrection(const std::map<int64_t, Pose3>& corrected, c
   // taken up by the next rebuild, when it ends); else the map is rebuilt at once or staged
   if (last_rebuilt_ && staged_) last_rebuilt_ = false;
   if (last_rebuilt_) {
-    if (options_.rebuild_keyframes_per_scan > 0) startStagedRebuild();
-    else rebuild();
+    if (options_.rebuild_keyframes_per_scan > 0)
+      startStagedRebuild();
+    else
+      rebuild();
   }
   // the next scan comes in the corrected frame: do not interpolate across the jump
   have_previous_ = false;

@@ -49,7 +49,8 @@ OctomapNodeOptions readOctomapNodeOptions(const Config& root) {
   if (o.origin_segments < 1) fail("origin_segments", "must be >= 1");
   if (!(o.rebuild_tolerance >= 0.0)) fail("rebuild_tolerance", "must be >= 0");
   if (!(o.keyframe_step >= 0.0 && o.keyframe_step <= 0.1)) fail("keyframe_step", "must be in [0, 0.1] m");
-  if (!(o.tile_size == 0.0 || o.tile_size >= 2.0 * o.resolution)) fail("tile_size", "must be 0 (one tile) or >= 2 voxels");
+  if (!(o.tile_size == 0.0 || o.tile_size >= 2.0 * o.resolution))
+    fail("tile_size", "must be 0 (one tile) or >= 2 voxels");
   if (!(o.tile_idle_s >= 0.0)) fail("tile_idle_s", "must be >= 0");
   if (o.rebuild_keyframes_per_scan < 0) fail("rebuild_keyframes_per_scan", "must be >= 0");
   if (!(o.keyframe_spacing >= 0.0)) fail("keyframe_spacing", "must be >= 0");

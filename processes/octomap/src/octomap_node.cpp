@@ -23,10 +23,11 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
   if (options_.publish_period_s > 0) node_.declareOutput(options_.octomap_channel);
   node_.subscribe<registered_scan_t>(options_.registered_scan_channel, [this](const registered_scan_t& m) {
     const auto add = [this](const RegisteredScanView& v, std::string* why) { return builder_.addScan(v, why); };
-    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add)) return;
+    if (!takeRegisteredScan(node_, options_.registered_scan_channel, m, placeInMap(m.epoch, m.correction_id), add))
+      return;
     if (builder_.takeRebuildFinished()) {
-      node_.info("staged rebuild done: the map is rebuilt from " + std::to_string(builder_.keyframes()) +
-                 " keyframes" + (builder_.rebuilding() ? " (another started: keyframes moved while it ran)" : ""));
+      node_.info("staged rebuild done: the map is rebuilt from " + std::to_string(builder_.keyframes()) + " keyframes" +
+                 (builder_.rebuilding() ? " (another started: keyframes moved while it ran)" : ""));
       publishTree(m.utime);
     }
     periodic(m.utime);
@@ -50,8 +51,8 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) {
     Keyframe k;
     const bool cloud = true;  // rebuilds cast the keyframe's cloud
-    if (!takeKeyframePose(node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); },
-                          &k.T_W_I))
+    if (!takeKeyframePose(
+            node_, options_.keyframe_channel, m, cloud, [&] { return placeInMap(m.epoch, m.correction_id); }, &k.T_W_I))
       return;
     const point_cloud_t& c = m.cloud;
     k.utime = m.utime;
@@ -66,15 +67,18 @@ OctomapNode::OctomapNode(lcm::LCM& lcm, const NodeOptions& node_options, const O
     if (!takeMapCorrection(node_, options_.loop_correction_channel, m, &frame_, &c)) return;
     const int moved = builder_.applyCorrection(c.corrected, c.step.unlisted);
     std::ostringstream s;
-    s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved, points by up to " << builder_.lastCorrectionShift()
-      << " m; ";
+    s << "loop correction " << m.correction_id << ": " << moved << " keyframes moved, points by up to "
+      << builder_.lastCorrectionShift() << " m; ";
     const bool staged = options_.core.rebuild_keyframes_per_scan > 0;
     if (builder_.lastCorrectionRebuilt() && staged)
       s << "staged rebuild from " << builder_.keyframes() << " keyframes, " << options_.core.rebuild_keyframes_per_scan
         << " a scan";
-    else if (builder_.lastCorrectionRebuilt()) s << "rebuilt from " << builder_.keyframes() << " keyframes";
-    else if (builder_.rebuilding()) s << "a staged rebuild is under way (what it cast before is taken up when it ends)";
-    else s << "tree kept (rebuild_tolerance " << options_.core.rebuild_tolerance << " m)";
+    else if (builder_.lastCorrectionRebuilt())
+      s << "rebuilt from " << builder_.keyframes() << " keyframes";
+    else if (builder_.rebuilding())
+      s << "a staged rebuild is under way (what it cast before is taken up when it ends)";
+    else
+      s << "tree kept (rebuild_tolerance " << options_.core.rebuild_tolerance << " m)";
     node_.info(s.str());
     if (builder_.lastCorrectionRebuilt() && !staged) publishTree(m.utime);
   });
@@ -144,8 +148,8 @@ void OctomapNode::finish() {
   finished_ = true;
   builder_.finishRebuild();
   if (writeFiles())
-    node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) + " leaves; " +
-               std::to_string(builder_.keyframes()) + " keyframe clouds on disk (" +
+    node_.info("wrote " + btPath() + " and " + otPath() + " (" + std::to_string(builder_.map().leafCount()) +
+               " leaves; " + std::to_string(builder_.keyframes()) + " keyframe clouds on disk (" +
                std::to_string(builder_.keyframesNotKept()) + " not kept: keyframe_spacing), " +
                std::to_string(builder_.storedKeyframeBytes() / 1000000) + " MB; tiles " +
                std::to_string(builder_.map().residentTiles()) + " in memory, " +

@@ -82,11 +82,15 @@ std::string describe(const Fault& f) {
   switch (f.kind) {
     case Fault::Kind::kDrop: os << "drop " << f.fraction * 100 << "% of " << f.channel; break;
     case Fault::Kind::kDuplicate: os << "duplicate " << f.fraction * 100 << "% of " << f.channel; break;
-    case Fault::Kind::kDelay: os << "delay " << f.fraction * 100 << "% of " << f.channel << " by " << f.seconds << " s"; break;
+    case Fault::Kind::kDelay:
+      os << "delay " << f.fraction * 100 << "% of " << f.channel << " by " << f.seconds << " s";
+      break;
     case Fault::Kind::kReorder: os << "swap " << f.fraction * 100 << "% of " << f.channel << " with the next"; break;
     case Fault::Kind::kCorrupt: os << "corrupt bytes of " << f.fraction * 100 << "% of " << f.channel; break;
     case Fault::Kind::kNanPoints: os << "NaN points in " << f.fraction * 100 << "% of " << f.channel; break;
-    case Fault::Kind::kTimeJump: os << "stamps of " << f.channel << " jump by " << f.seconds << " s at " << f.from_s << " s"; break;
+    case Fault::Kind::kTimeJump:
+      os << "stamps of " << f.channel << " jump by " << f.seconds << " s at " << f.from_s << " s";
+      break;
     case Fault::Kind::kCut: os << "cut " << f.channel << " from " << f.from_s << " s to " << f.to_s << " s"; break;
   }
   return os.str();

@@ -8,8 +8,8 @@
 namespace livo::playback {
 
 namespace {
-constexpr double kPublishHistoryS = 60.0;  // how far back publish times are kept (>> loss_grace_s)
-constexpr size_t kUtimeHistory = 1024;     // playback stamps kept per channel for quiet promises
+constexpr double kPublishHistoryS = 60.0;      // how far back publish times are kept (>> loss_grace_s)
+constexpr size_t kUtimeHistory = 1024;         // playback stamps kept per channel for quiet promises
 constexpr int64_t kMaxAlwaysQuietBacklog = 8;  // messages a promise for a whole channel lets wait
 }  // namespace
 
@@ -76,7 +76,8 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     v = p.handled[i];
   }
   for (int i = 0; i < p.num_outputs; ++i) {
-    if (static_cast<size_t>(i) < p.published_bytes.size()) n.published_bytes[p.output_channel[i]] = p.published_bytes[i];
+    if (static_cast<size_t>(i) < p.published_bytes.size())
+      n.published_bytes[p.output_channel[i]] = p.published_bytes[i];
     int64_t& v = n.published[p.output_channel[i]];
     if (v != p.published[i]) {
       changed = true;
@@ -184,8 +185,8 @@ void LockstepGate::checkSilent(double now_s) {
       it->second.away = true;
       it->second.away_since_s = now_s;
       std::ostringstream os;
-      os << "consumer " << c << " silent for " << std::fixed << std::setprecision(1)
-         << now_s - it->second.last_heard_s << " s; not waited for until it reports again";
+      os << "consumer " << c << " silent for " << std::fixed << std::setprecision(1) << now_s - it->second.last_heard_s
+         << " s; not waited for until it reports again";
       events_.push_back(os.str());
     }
   }
@@ -255,7 +256,8 @@ int64_t LockstepGate::behindBytes(const NodeState& n) const {
     if (auto pb = playback_bytes_.find(channel); pb != playback_bytes_.end()) bytes += pb->second;
     for (const auto& [name, node] : nodes_) {
       if (auto b = node.published_bytes.find(channel); b != node.published_bytes.end()) bytes += b->second;
-      if (auto b = node.published_bytes_before.find(channel); b != node.published_bytes_before.end()) bytes += b->second;
+      if (auto b = node.published_bytes_before.find(channel); b != node.published_bytes_before.end())
+        bytes += b->second;
     }
     const int64_t count = totalPublished(channel);
     if (count > 0) total += static_cast<double>(d) * static_cast<double>(bytes) / static_cast<double>(count);
@@ -392,8 +394,7 @@ bool LockstepGate::promisedQuiet(const NodeState& n, const std::string& channel)
   if (pb == playback_published_.end() || totalPublished(channel) != pb->second) return false;  // nodes publish it too
   auto h = n.handled.find(channel);
   auto o = n.offset.find(channel);
-  const int64_t first_unhandled =
-      (h == n.handled.end() ? 0 : h->second) + (o == n.offset.end() ? 0 : o->second) + 1;
+  const int64_t first_unhandled = (h == n.handled.end() ? 0 : h->second) + (o == n.offset.end() ? 0 : o->second) + 1;
   const auto& stamps = playback_utimes_.at(channel);
   if (stamps.empty() || stamps.front().first > first_unhandled) return false;  // older than the history
   for (auto it = stamps.rbegin(); it != stamps.rend() && it->first >= first_unhandled; ++it)

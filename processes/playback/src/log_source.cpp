@@ -1,8 +1,8 @@
 #include "livo/playback/log_source.hpp"
 
+#include <sys/stat.h>
 #include <cstdio>
 #include <stdexcept>
-#include <sys/stat.h>
 
 #include <lcm/lcm-cpp.hpp>
 

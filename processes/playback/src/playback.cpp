@@ -87,7 +87,8 @@ class LogClockFile {
       f << std::fixed << std::setprecision(3) << log_s << "\n";
       if (!f) throw std::runtime_error("--clock-file: cannot write " + tmp);
     }
-    if (std::rename(tmp.c_str(), path_.c_str()) != 0) throw std::runtime_error("--clock-file: cannot rename " + tmp + " to " + path_);
+    if (std::rename(tmp.c_str(), path_.c_str()) != 0)
+      throw std::runtime_error("--clock-file: cannot rename " + tmp + " to " + path_);
   }
 
  private:
@@ -249,12 +250,14 @@ class PlaybackRun {
   /// One event out: paced in real time, or (lockstep) once the consumers let it go.
   std::string publish(const LogEvent& e) {
     if (!lockstep_ && !sink_.toFile() && options_.speed > 0.0) {
-      const auto target = pace_start_ + std::chrono::microseconds(static_cast<int64_t>((e.utime - first_) / options_.speed));
+      const auto target =
+          pace_start_ + std::chrono::microseconds(static_cast<int64_t>((e.utime - first_) / options_.speed));
       std::this_thread::sleep_until(target);
     }
     // the message's own stamp (what a quiet promise is about), not the log event's
     int64_t utime = LockstepGate::kNoUtime;
-    if (lockstep_ && !messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime)) utime = LockstepGate::kNoUtime;
+    if (lockstep_ && !messageUtime(e.data.data(), static_cast<int>(e.data.size()), &utime))
+      utime = LockstepGate::kNoUtime;
     if (lockstep_ && result_.published > 0) {
       // the wait after the previous message, until this one may go (counted for the previous one)
       const bool must_wait = !gate_.mayPublish(e.channel, utime);
@@ -313,8 +316,7 @@ class PlaybackRun {
         return "lockstep: consumer " + dead.front() + " exited; still waiting for: " + gate_.pendingDescription();
       if (gate_.stalledFor(now_s()) > options_.stall_timeout_s) {
         std::ostringstream os;
-        os << "lockstep: stalled: no progress for " << options_.stall_timeout_s
-           << " s on what is awaited after ";
+        os << "lockstep: stalled: no progress for " << options_.stall_timeout_s << " s on what is awaited after ";
         if (next_channel)
           os << "message " << result_.published << " (" << last_channel_ << " at " << std::fixed << std::setprecision(3)
              << last_log_seconds_ << " s of log)";
@@ -340,7 +342,7 @@ class PlaybackRun {
   LockstepGate gate_;
   std::optional<ProgressLine> progress_line_;
   LogClockFile clock_file_{options_.clock_file};
-  std::string last_channel_;        // lockstep: of the message published last
+  std::string last_channel_;  // lockstep: of the message published last
   double last_log_seconds_ = 0.0;
   ProgressContext context_;
   lcm::Subscription* subscription_ = nullptr;
@@ -364,8 +366,8 @@ std::vector<std::string> describeWaits(const std::map<std::string, LockstepWaits
     std::vector<std::pair<std::string, double>> by(w->seconds_by_last.begin(), w->seconds_by_last.end());
     std::stable_sort(by.begin(), by.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
     std::ostringstream os;
-    os << std::fixed << std::setprecision(2) << channel << ": " << w->waited << " of " << w->messages
-       << " waited for, " << w->seconds << " s (";
+    os << std::fixed << std::setprecision(2) << channel << ": " << w->waited << " of " << w->messages << " waited for, "
+       << w->seconds << " s (";
     for (size_t i = 0; i < by.size(); ++i)
       os << (i ? ", " : "") << (by[i].first.empty() ? "?" : by[i].first) << " " << by[i].second;
     os << ")";

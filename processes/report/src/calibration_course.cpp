@@ -44,7 +44,8 @@ std::vector<CalibrationRow> readCalibrationCsv(const std::string& path) {
     ++n;
     if (line.empty()) continue;
     const std::vector<std::string> v = split(line);
-    if (v.size() != header.size()) throw std::runtime_error(path + ":" + std::to_string(n) + ": wrong number of fields");
+    if (v.size() != header.size())
+      throw std::runtime_error(path + ":" + std::to_string(n) + ": wrong number of fields");
     auto get = [&](const std::string& name) {
       try {
         return std::stod(v[index(name)]);

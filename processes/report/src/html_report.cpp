@@ -87,7 +87,8 @@ std::string inDir(const std::string& dir, const std::string& file) {
 std::string scriptSafe(std::string js) {
   for (const auto& [from, to] : {std::make_pair(std::string("</script"), std::string("<\\/script")),
                                  std::make_pair(std::string("<!--"), std::string("<\\!--"))})
-    for (size_t at = js.find(from); at != std::string::npos; at = js.find(from, at + to.size())) js.replace(at, from.size(), to);
+    for (size_t at = js.find(from); at != std::string::npos; at = js.find(from, at + to.size()))
+      js.replace(at, from.size(), to);
   return js;
 }
 
@@ -170,10 +171,14 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
   const Trajectory path = newestEpoch(readTrajectoryIfAny(dir, &path_name), resetStamps(dir));  // the map's epoch
   if (map.size() == 0 && path.empty()) return "";
   if (!have_three) {
-    return "<section id=\"map-3d\">\n<h2 id=\"map-in-3d\">Map in 3D</h2>\n<p class=\"viewer-note\" id=\"viewer-status\" "
+    return "<section id=\"map-3d\">\n<h2 id=\"map-in-3d\">Map in 3D</h2>\n<p class=\"viewer-note\" "
+           "id=\"viewer-status\" "
            "data-state=\"no-three\">No 3D view: it needs three.js from Debian's <code>libjs-three</code> when the page "
-           "is made (<code>sudo apt-get install libjs-three</code>, then <code>livo-report html --dir DIR</code> again): "
-           "<code>" + escapeMarkup(o.three_dir) + "/three.min.js</code> or its <code>examples/js/controls/OrbitControls.js"
+           "is made (<code>sudo apt-get install libjs-three</code>, then <code>livo-report html --dir DIR</code> "
+           "again): "
+           "<code>" +
+           escapeMarkup(o.three_dir) +
+           "/three.min.js</code> or its <code>examples/js/controls/OrbitControls.js"
            "</code> is missing. The rest of this report is complete.</p>\n</section>\n";
   }
   const ViewerScene scene = viewerScene(map, path, {}, o.viewer);
@@ -193,8 +198,9 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
   if (!path.empty())
     description += std::string(scene.size() > 0 ? ", " : " ") + "the trajectory (<code>" + path_name +
                    "</code>) in cyan from the green dot to the red one";
-  description += ". Drag to turn, right-drag (or ctrl-drag) to pan, wheel to zoom; the cut leaves out what is "
-                 "above a height (a ceiling), the start view cuts 1 m above the trajectory.";
+  description +=
+      ". Drag to turn, right-drag (or ctrl-drag) to pan, wheel to zoom; the cut leaves out what is "
+      "above a height (a ceiling), the start view cuts 1 m above the trajectory.";
   if (!map_note.empty() && scene.size() > 0) description += " " + map_note;
   return viewerSection(scene, description);
 }
@@ -204,7 +210,7 @@ std::string mapSection(const std::string& dir, const HtmlOptions& o, bool have_t
 std::string dataUri(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const char* type = ext == ".png"                    ? "image/png"
+  const char* type = ext == ".png"                     ? "image/png"
                      : ext == ".jpg" || ext == ".jpeg" ? "image/jpeg"
                      : ext == ".gif"                   ? "image/gif"
                      : ext == ".svg"                   ? "image/svg+xml"

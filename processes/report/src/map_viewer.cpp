@@ -164,7 +164,8 @@ ViewerScene viewerScene(const ColouredPoints& map, const Trajectory& trajectory,
     // grids point_size_m x 1.25^k; the search starts where a surface sampled at point_size_m
     // would fit and walks to the smallest k that fits
     const auto grid = [&](int k) { return options.point_size_m * std::pow(1.25, k); };
-    const double ratio = static_cast<double>(kept.size()) / static_cast<double>(std::max<size_t>(options.max_points, 1));
+    const double ratio =
+        static_cast<double>(kept.size()) / static_cast<double>(std::max<size_t>(options.max_points, 1));
     int k = static_cast<int>(std::lround(std::log(std::max(1.0, 0.8 * std::sqrt(ratio))) / std::log(1.25)));
     kept = firstPointPerVoxel(xyz, finite, grid(k));
     if (kept.size() <= options.max_points) {
@@ -274,7 +275,9 @@ std::string viewerSection(const ViewerScene& scene, const std::string& descripti
   out += "<label>cut above <input type=\"range\" id=\"viewer-cut\" min=\"" + formatFixed(scene.z_min, 2) + "\" max=\"" +
          formatFixed(scene.z_max + step, 2) + "\" step=\"" + formatFixed(step, 3) + "\" value=\"" +
          formatFixed(scene.cut_z, 2) + "\"> <span id=\"viewer-cut-value\"></span></label>\n";
-  out += "<label>point size <input type=\"range\" id=\"viewer-size\" min=\"0.25\" max=\"4\" step=\"0.25\" value=\"1\"></label>\n";
+  out +=
+      "<label>point size <input type=\"range\" id=\"viewer-size\" min=\"0.25\" max=\"4\" step=\"0.25\" "
+      "value=\"1\"></label>\n";
   out += "<label><input type=\"checkbox\" id=\"viewer-path\" checked> trajectory</label>\n";
   out += "<button type=\"button\" id=\"viewer-home\">start view</button>\n</div>\n";
   out += "<p id=\"viewer-status\" data-state=\"loading\">The 3D view needs JavaScript and WebGL.</p>\n";

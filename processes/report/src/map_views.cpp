@@ -32,7 +32,7 @@ int splatStart(int centre, int size) { return centre - (size - 1) / 2; }
 void eyeDomeShade(cv::Mat& image, const cv::Mat1f& depth, double strength, bool log_depth) {
   if (strength <= 0.0) return;
   constexpr int kStep = 2;
-  const int offsets[8][2] = {{-kStep, 0}, {kStep, 0}, {0, -kStep}, {0, kStep},
+  const int offsets[8][2] = {{-kStep, 0},      {kStep, 0},     {0, -kStep},     {0, kStep},
                              {-kStep, -kStep}, {kStep, kStep}, {-kStep, kStep}, {kStep, -kStep}};
   cv::Mat1f d(depth.size(), kInf);
   for (int v = 0; v < depth.rows; ++v)
@@ -199,8 +199,7 @@ cv::Mat cropToContent(const cv::Mat& image, const cv::Vec3b& background, int mar
   return image(cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1)).clone();
 }
 
-ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height,
-                                      double cut_above_m) {
+ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height, double cut_above_m) {
   ColouredPoints out;
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points.position[i];
@@ -213,9 +212,11 @@ ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeig
 
 cv::Mat renderTopView(const ColouredPoints& points, const TopViewFrame& frame, const SplatStyle& style,
                       cv::Mat1f* top_z) {
-  cv::Mat image(frame.height, frame.width, CV_8UC3, cv::Scalar(style.background[0], style.background[1], style.background[2]));
+  cv::Mat image(frame.height, frame.width, CV_8UC3,
+                cv::Scalar(style.background[0], style.background[1], style.background[2]));
   cv::Mat1f depth(frame.height, frame.width, kInf);  // -z: the highest point is the nearest
-  const int size = std::clamp(static_cast<int>(std::lround(style.point_size_m / frame.metres_per_pixel)), 1, style.max_px);
+  const int size =
+      std::clamp(static_cast<int>(std::lround(style.point_size_m / frame.metres_per_pixel)), 1, style.max_px);
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points.position[i];
     if (!p.allFinite()) continue;
@@ -244,7 +245,8 @@ cv::Mat renderTopView(const ColouredPoints& points, const TopViewFrame& frame, c
 
 cv::Mat renderPerspective(const ColouredPoints& points, const PerspectiveView& view, const SplatStyle& style,
                           cv::Mat1f* depth_out) {
-  cv::Mat image(view.height, view.width, CV_8UC3, cv::Scalar(style.background[0], style.background[1], style.background[2]));
+  cv::Mat image(view.height, view.width, CV_8UC3,
+                cv::Scalar(style.background[0], style.background[1], style.background[2]));
   cv::Mat1f depth(view.height, view.width, kInf);
   for (size_t i = 0; i < points.size(); ++i) {
     cv::Point2d px;
@@ -268,7 +270,8 @@ cv::Mat renderPerspective(const ColouredPoints& points, const PerspectiveView& v
   return image;
 }
 
-std::vector<std::pair<size_t, size_t>> pathPieces(const Trajectory& trajectory, const std::vector<double>& reset_stamps) {
+std::vector<std::pair<size_t, size_t>> pathPieces(const Trajectory& trajectory,
+                                                  const std::vector<double>& reset_stamps) {
   std::vector<double> steps;
   for (size_t i = 1; i < trajectory.size(); ++i) {
     const double d = (trajectory[i].pose.translation() - trajectory[i - 1].pose.translation()).norm();

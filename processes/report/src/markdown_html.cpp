@@ -13,7 +13,9 @@ namespace {
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 bool isPunct(char c) { return std::ispunct(static_cast<unsigned char>(c)) != 0; }
-bool isAlnum(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || (static_cast<unsigned char>(c) & 0x80); }
+bool isAlnum(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) != 0 || (static_cast<unsigned char>(c) & 0x80);
+}
 
 std::string trim(const std::string& s) {
   size_t a = 0, b = s.size();
@@ -27,9 +29,12 @@ bool blank(const std::string& line) { return trim(line).empty(); }
 int indentOf(const std::string& line) {
   int n = 0;
   for (char c : line) {
-    if (c == ' ') ++n;
-    else if (c == '\t') n += 4 - n % 4;
-    else break;
+    if (c == ' ')
+      ++n;
+    else if (c == '\t')
+      n += 4 - n % 4;
+    else
+      break;
   }
   return n;
 }
@@ -88,8 +93,10 @@ class InlineRenderer {
   static std::string plain(const std::string& s) {
     std::string out;
     for (size_t i = 0; i < s.size(); ++i) {
-      if (s[i] == '\\' && i + 1 < s.size() && isPunct(s[i + 1])) out += s[++i];
-      else if (s[i] != '`' && s[i] != '*') out += s[i];
+      if (s[i] == '\\' && i + 1 < s.size() && isPunct(s[i + 1]))
+        out += s[++i];
+      else if (s[i] != '`' && s[i] != '*')
+        out += s[i];
     }
     return out;
   }
@@ -123,7 +130,8 @@ class InlineRenderer {
     std::string code = s.substr(i + n, end - n - (i + n));
     for (char& c : code)
       if (c == '\n') c = ' ';
-    if (code.size() >= 2 && code.front() == ' ' && code.back() == ' ' && !blank(code)) code = code.substr(1, code.size() - 2);
+    if (code.size() >= 2 && code.front() == ' ' && code.back() == ' ' && !blank(code))
+      code = code.substr(1, code.size() - 2);
     *out += "<code>" + escapeMarkup(code) + "</code>";
     return end;
   }
@@ -132,12 +140,15 @@ class InlineRenderer {
   static size_t closingBracket(const std::string& s, size_t i) {
     int depth = 0;
     for (size_t j = i; j < s.size(); ++j) {
-      if (s[j] == '\\') ++j;
+      if (s[j] == '\\')
+        ++j;
       else if (s[j] == '`') {
         const size_t end = codeSpanEnd(s, j);
         if (end != std::string::npos) j = end - 1;
-      } else if (s[j] == '[') ++depth;
-      else if (s[j] == ']' && --depth == 0) return j;
+      } else if (s[j] == '[')
+        ++depth;
+      else if (s[j] == ']' && --depth == 0)
+        return j;
     }
     return std::string::npos;
   }
@@ -272,12 +283,12 @@ std::optional<std::string> quoted(const std::string& line) {
 const std::regex kTableSeparator(R"(^ {0,3}\|?[ \t]*:?-+:?[ \t]*(\|[ \t]*:?-+:?[ \t]*)*\|?[ \t]*$)");
 
 struct ListMarker {
-  int indent = 0;         // columns before the marker
+  int indent = 0;  // columns before the marker
   bool ordered = false;
-  char delimiter = '-';   // -, *, + or . )
+  char delimiter = '-';  // -, *, + or . )
   long start = 1;
-  int content = 0;        // the column the item's content starts at
-  std::string first;      // the first line's content
+  int content = 0;    // the column the item's content starts at
+  std::string first;  // the first line's content
 };
 
 std::optional<ListMarker> listMarker(const std::string& line) {
@@ -391,8 +402,8 @@ class BlockRenderer {
       if (t.size() >= marker.size() && t.find_first_not_of(marker[0]) == std::string::npos) break;
       code += escapeMarkup(dedent(lines[j], indent)) + "\n";
     }
-    *out += "<pre><code" + (language.empty() ? std::string() : " class=\"language-" + escapeMarkup(language) + "\"") + ">" +
-            code + "</code></pre>\n";
+    *out += "<pre><code" + (language.empty() ? std::string() : " class=\"language-" + escapeMarkup(language) + "\"") +
+            ">" + code + "</code></pre>\n";
     return j < lines.size() ? j + 1 : j;
   }
 
@@ -458,14 +469,15 @@ class BlockRenderer {
       items.push_back(item);
       // the next item of the same list?
       const auto next = i < lines.size() ? listMarker(lines[i]) : std::nullopt;
-      if (!next || next->ordered != first.ordered || next->delimiter != first.delimiter || next->indent > first.indent + 3)
+      if (!next || next->ordered != first.ordered || next->delimiter != first.delimiter ||
+          next->indent > first.indent + 3)
         break;
       loose = loose || blank_pending;
       marker = *next;
     }
     const char* tag = first.ordered ? "ol" : "ul";
-    *out += std::string("<") + tag + (first.ordered && first.start != 1 ? " start=\"" + std::to_string(first.start) + "\"" : "") +
-            ">\n";
+    *out += std::string("<") + tag +
+            (first.ordered && first.start != 1 ? " start=\"" + std::to_string(first.start) + "\"" : "") + ">\n";
     for (const auto& item : items) {
       std::string html = render(item, !loose);
       while (!html.empty() && html.back() == '\n') html.pop_back();
@@ -481,8 +493,10 @@ class BlockRenderer {
 std::string headingId(const std::string& text) {
   std::string id;
   for (char c : trim(text)) {
-    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') id += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    else if (c == ' ') id += '-';
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_')
+      id += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    else if (c == ' ')
+      id += '-';
   }
   return id;
 }

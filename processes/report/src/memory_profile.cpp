@@ -39,7 +39,8 @@ MemoryProfile readMemoryProfile(const std::string& log_path, const std::string& 
   }
   MemoryProfile p;
   if (all.empty()) return p;
-  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
   p.first_seconds = std::get<0>(all.front()) * 1e-6;
   p.last_seconds = std::get<0>(all.back()) * 1e-6;
   for (const auto& [utime, node, mb] : all) p.samples[node].emplace_back(utime * 1e-6 - p.first_seconds, mb);

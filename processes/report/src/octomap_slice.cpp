@@ -54,7 +54,8 @@ cv::Mat renderSlice(const std::vector<OccupiedVoxel>& voxels, const TopViewFrame
   for (size_t k : order) {
     const OccupiedVoxel& v = voxels[k];
     const double h = 0.5 * v.size;
-    const cv::Point2d a = frame.pixel(v.centre.x() - h, v.centre.y() + h), b = frame.pixel(v.centre.x() + h, v.centre.y() - h);
+    const cv::Point2d a = frame.pixel(v.centre.x() - h, v.centre.y() + h),
+                      b = frame.pixel(v.centre.x() + h, v.centre.y() - h);
     // the pixels whose centres lie in the square, at least the one holding the voxel's centre
     int u0 = static_cast<int>(std::ceil(a.x - 0.5)), u1 = static_cast<int>(std::floor(b.x - 0.5));
     int v0 = static_cast<int>(std::ceil(a.y - 0.5)), v1 = static_cast<int>(std::floor(b.y - 0.5));

@@ -65,8 +65,8 @@ void drawScaleBar(cv::Mat& image, double metres_per_pixel) {
   const std::string label = lengthLabel(length);
   const cv::Size t = textSize(label, k);
   const int x = px(14, k), y = image.rows - px(14, k);
-  cv::rectangle(image, cv::Point(x - px(8, k), y - px(20, k) - t.height), cv::Point(x + std::max(bar, t.width) + px(8, k), y + px(8, k)),
-                kPaper, cv::FILLED);
+  cv::rectangle(image, cv::Point(x - px(8, k), y - px(20, k) - t.height),
+                cv::Point(x + std::max(bar, t.width) + px(8, k), y + px(8, k)), kPaper, cv::FILLED);
   cv::rectangle(image, cv::Point(x, y - px(7, k)), cv::Point(x + bar, y), kInk, cv::FILLED);
   text(image, label, cv::Point(x, y - px(15, k)), k);
 }
@@ -74,8 +74,8 @@ void drawScaleBar(cv::Mat& image, double metres_per_pixel) {
 void drawAxesTopView(cv::Mat& image) {
   const double k = scaleOf(image);
   const int len = px(50, k), x = image.cols - px(36, k) - len, y = image.rows - px(20, k);
-  cv::rectangle(image, cv::Point(x - px(14, k), y - len - px(28, k)), cv::Point(image.cols - px(6, k), y + px(12, k)), kPaper,
-                cv::FILLED);
+  cv::rectangle(image, cv::Point(x - px(14, k), y - len - px(28, k)), cv::Point(image.cols - px(6, k), y + px(12, k)),
+                kPaper, cv::FILLED);
   cv::arrowedLine(image, cv::Point(x, y), cv::Point(x + len, y), kInk, 2, cv::LINE_AA, 0, 0.25);
   cv::arrowedLine(image, cv::Point(x, y), cv::Point(x, y - len), kInk, 2, cv::LINE_AA, 0, 0.25);
   text(image, "x", cv::Point(x + len + px(5, k), y + px(8, k)), k);

@@ -6,15 +6,16 @@ namespace livo::report {
 
 nlohmann::json picturesJson(const PictureSet& set) {
   nlohmann::json pictures = nlohmann::json::array();
-  for (const Picture& p : set.pictures) pictures.push_back({{"file", p.file}, {"title", p.title}, {"caption", p.caption}});
+  for (const Picture& p : set.pictures)
+    pictures.push_back({{"file", p.file}, {"title", p.title}, {"caption", p.caption}});
   return {{"pictures", pictures}, {"notes", set.notes}};
 }
 
 PictureSet picturesFromJson(const nlohmann::json& j) {
   PictureSet set;
   for (const auto& p : j.at("pictures"))
-    set.pictures.push_back({p.at("file").get<std::string>(), p.at("title").get<std::string>(),
-                            p.at("caption").get<std::string>()});
+    set.pictures.push_back(
+        {p.at("file").get<std::string>(), p.at("title").get<std::string>(), p.at("caption").get<std::string>()});
   set.notes = j.at("notes").get<std::vector<std::string>>();
   return set;
 }

@@ -89,7 +89,8 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
         ++out.undecodable;
         continue;
       }
-      out.keyframes.push_back({m.id, toSeconds(m.utime), poseFrom(m.position, m.orientation), {m.epoch, m.correction_id}});
+      out.keyframes.push_back(
+          {m.id, toSeconds(m.utime), poseFrom(m.position, m.orientation), {m.epoch, m.correction_id}});
     } else if (ev->channel == ch.loop_correction) {
       loop_correction_t m;
       if (!decodeInto(ev, m)) {

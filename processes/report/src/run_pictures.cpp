@@ -36,7 +36,9 @@ std::string thousands(size_t n) {  // 79102 -> "79,102"
   return s;
 }
 
-std::string counted(size_t n, const char* one, const char* many) { return std::to_string(n) + " " + (n == 1 ? one : many); }
+std::string counted(size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
 
 std::string metres(double v) { return formatSignificant(v, 3) + " m"; }
 
@@ -134,7 +136,8 @@ void trajectoryPicture(const std::string& dir, const RunFiles& run, PictureSet* 
   } else {
     std::vector<std::string> marked;
     if (!run.marks.degenerate.empty())
-      marked.push_back(counted(run.marks.degenerate.size(), "stretch", "stretches") + " of degenerate sweeps in orange");
+      marked.push_back(counted(run.marks.degenerate.size(), "stretch", "stretches") +
+                       " of degenerate sweeps in orange");
     if (!run.marks.predicted.empty())
       marked.push_back(counted(run.marks.predicted.size(), "stretch", "stretches") +
                        " of sweeps predicted without a LiDAR update in grey");
@@ -153,7 +156,8 @@ void colourMapPictures(const std::string& dir, const RunFiles& run, const Trajec
   const std::string path = inDir(dir, o.colour_map);
   const std::string name = "`" + fs::path(o.colour_map).filename().string() + "`";
   if (!fs::exists(path)) {
-    set->notes.push_back("No RGB map pictures: no " + name + " (livo-colour did not run: the rig has no camera, or "
+    set->notes.push_back("No RGB map pictures: no " + name +
+                         " (livo-colour did not run: the rig has no camera, or "
                          "the run left it out).");
     return;
   }
@@ -165,7 +169,8 @@ void colourMapPictures(const std::string& dir, const RunFiles& run, const Trajec
   }
   const ColouredPoints points = height.empty() ? all : pointsBelowCut(all, height, o.cut_above_m);
   if (points.size() == 0) {
-    set->notes.push_back("No RGB map pictures: " + name + " holds no point" + (all.size() ? " below the cut" : "") + ".");
+    set->notes.push_back("No RGB map pictures: " + name + " holds no point" + (all.size() ? " below the cut" : "") +
+                         ".");
     return;
   }
   const std::vector<Vec3> xyz = framingSample(points);
@@ -201,8 +206,8 @@ void colourMapPictures(const std::string& dir, const RunFiles& run, const Trajec
                                "; the trajectory in cyan where no point hides it."});
 }
 
-void octomapPicture(const std::string& dir, const RunFiles& run, const TrajectoryHeight& height, const PictureOptions& o,
-                    PictureSet* set) {
+void octomapPicture(const std::string& dir, const RunFiles& run, const TrajectoryHeight& height,
+                    const PictureOptions& o, PictureSet* set) {
   const std::string path = inDir(dir, o.octomap);
   const std::string name = "`" + fs::path(o.octomap).filename().string() + "`";
   if (!fs::exists(path)) {
@@ -233,12 +238,14 @@ void octomapPicture(const std::string& dir, const RunFiles& run, const Trajector
   drawPathTopView(slice, run.map_path, frame);
   drawScaleBar(slice, frame.metres_per_pixel);
   drawAxesTopView(slice);
-  writePng(inDir(dir, kSliceFile), withHeightLegend(slice, -o.band.below_m, o.band.above_m, "height above\nthe trajectory"));
+  writePng(inDir(dir, kSliceFile),
+           withHeightLegend(slice, -o.band.below_m, o.band.above_m, "height above\nthe trajectory"));
   set->pictures.push_back(
       {kSliceFile, "OctoMap slice",
        "the occupied voxels of " + name + " (" + metres(tree->getResolution()) + ", " + thousands(voxels.size()) +
            " in the band; open it in `octovis`) from " + metres(o.band.below_m) + " below to " +
-           metres(o.band.above_m) + " above the trajectory's height, from above, coloured by their height above the "
+           metres(o.band.above_m) +
+           " above the trajectory's height, from above, coloured by their height above the "
            "trajectory (the scale on the right); the highest voxel shows. The trajectory in cyan."});
 }
 
@@ -268,7 +275,8 @@ PictureSet makePictures(const std::string& dir, const PictureOptions& options, s
     }
     if (progress)
       *progress << "livo-report pictures: " << what << ": "
-                << formatFixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2) << " s\n";
+                << formatFixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2)
+                << " s\n";
   }
   for (const std::string& f : pictureFiles()) {
     bool drawn = false;

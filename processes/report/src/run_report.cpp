@@ -17,9 +17,12 @@ nlohmann::json timingJson(const std::map<std::string, health_t>& final_health) {
     const channel_stats_t* busiest = nullptr;
     int64_t total = 0;
     for (const auto& c : h.channels) {
-      channels[c.channel] = {{"messages", c.messages},   {"median_ms", c.median_ms},
-                             {"p90_ms", c.p90_ms},       {"max_ms", c.max_ms},
-                             {"decode_failures", c.decode_failures}, {"rejected", c.rejected}};
+      channels[c.channel] = {{"messages", c.messages},
+                             {"median_ms", c.median_ms},
+                             {"p90_ms", c.p90_ms},
+                             {"max_ms", c.max_ms},
+                             {"decode_failures", c.decode_failures},
+                             {"rejected", c.rejected}};
       total += c.messages;
       if (!busiest || c.median_ms * c.messages > busiest->median_ms * busiest->messages) busiest = &c;
     }
@@ -116,10 +119,10 @@ std::string reportMarkdown(const ReportInputs& in) {
          << " | " << fixed(num(j, {"rpe", "rotation", "rmse"}), 3) << " |\n";
     }
     const nlohmann::json& first = in.evaluations.front().second;
-    const std::string mode = first.contains("alignment") && first["alignment"].contains("mode") &&
-                                     first["alignment"]["mode"].is_string()
-                                 ? first["alignment"]["mode"].get<std::string>()
-                                 : std::string("?");
+    const std::string mode =
+        first.contains("alignment") && first["alignment"].contains("mode") && first["alignment"]["mode"].is_string()
+            ? first["alignment"]["mode"].get<std::string>()
+            : std::string("?");
     md << "\nATE: translation error after `" << mode << "` Umeyama alignment (`livo-evaluate`, as evo's `evo_ape`); "
        << "RPE between consecutive poses.\n\n";
   } else {

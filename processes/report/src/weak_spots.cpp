@@ -151,8 +151,8 @@ std::string shorterStretches(const std::vector<TimeSpan>& longest, size_t first,
     samples += longest[i].count;
     most = std::max(most, longest[i].count);
   }
-  return "and " + counted(static_cast<int64_t>(longest.size() - first), "shorter stretch", "shorter stretches") +
-         " (" + counted(samples, one, many) + ", at most " + std::to_string(most) + " each)";
+  return "and " + counted(static_cast<int64_t>(longest.size() - first), "shorter stretch", "shorter stretches") + " (" +
+         counted(samples, one, many) + ", at most " + std::to_string(most) + " each)";
 }
 
 /// "3.1–5.2 s (20), 7.0 s (1)": the longest spans, then how many more.
@@ -388,18 +388,30 @@ nlohmann::json weakSpotsJson(const WeakSpots& w) {
   }
   nlohmann::json visual = nlohmann::json::array();
   for (const VisualRefusals& v : w.visual)
-    visual.push_back({{"node", v.node}, {"what", v.what}, {"refused", v.refused}, {"of", v.of},
-                      {"reasons", v.reasons}, {"spans", spansJson(v.spans)}});
+    visual.push_back({{"node", v.node},
+                      {"what", v.what},
+                      {"refused", v.refused},
+                      {"of", v.of},
+                      {"reasons", v.reasons},
+                      {"spans", spansJson(v.spans)}});
   nlohmann::json loops = nlohmann::json::array();
   for (const LoopMark& l : w.loops)
-    loops.push_back({{"correction_id", l.event.correction_id}, {"epoch", l.event.epoch}, {"time", l.event.stamp},
-                     {"from_id", l.event.from_id}, {"from_time", l.from_stamp}, {"to_id", l.event.to_id},
-                     {"to_time", l.to_stamp}, {"fitness_m2", l.event.fitness}, {"shift_m", l.event.shift_m},
+    loops.push_back({{"correction_id", l.event.correction_id},
+                     {"epoch", l.event.epoch},
+                     {"time", l.event.stamp},
+                     {"from_id", l.event.from_id},
+                     {"from_time", l.from_stamp},
+                     {"to_id", l.event.to_id},
+                     {"to_time", l.to_stamp},
+                     {"fitness_m2", l.event.fitness},
+                     {"shift_m", l.event.shift_m},
                      {"turn_deg", l.event.turn_deg}});
   return {{"start", w.start},
           {"sweeps", w.sweeps},
           {"degenerate",
-           {{"count", w.degenerate}, {"direction", w.direction}, {"direction_share", w.direction_share},
+           {{"count", w.degenerate},
+            {"direction", w.direction},
+            {"direction_share", w.direction_share},
             {"spans", stretches}}},
           {"predicted", {{"count", w.predicted}, {"spans", spansJson(w.predicted_spans)}}},
           {"state_priors", w.state_priors},
@@ -415,14 +427,15 @@ WeakSpots weakSpotsFromJson(const nlohmann::json& j) {
   w.degenerate = d.at("count").get<int64_t>();
   w.direction = d.at("direction").get<std::string>();
   w.direction_share = d.at("direction_share").get<double>();
-  for (const auto& s : d.at("spans")) w.degenerate_stretches.push_back({spanFrom(s), s.at("direction").get<std::string>()});
+  for (const auto& s : d.at("spans"))
+    w.degenerate_stretches.push_back({spanFrom(s), s.at("direction").get<std::string>()});
   w.predicted = j.at("predicted").at("count").get<int64_t>();
   w.predicted_spans = spansFrom(j.at("predicted").at("spans"));
   w.state_priors = j.at("state_priors").get<int64_t>();
   for (const auto& v : j.at("vio"))
-    w.visual.push_back({v.at("node").get<std::string>(), v.at("what").get<std::string>(), v.at("refused").get<int64_t>(),
-                        v.at("of").get<int64_t>(), v.at("reasons").get<std::map<std::string, int64_t>>(),
-                        spansFrom(v.at("spans"))});
+    w.visual.push_back({v.at("node").get<std::string>(), v.at("what").get<std::string>(),
+                        v.at("refused").get<int64_t>(), v.at("of").get<int64_t>(),
+                        v.at("reasons").get<std::map<std::string, int64_t>>(), spansFrom(v.at("spans"))});
   for (const auto& l : j.at("loops")) {
     LoopMark m;
     m.event.correction_id = l.at("correction_id").get<int64_t>();

@@ -11,7 +11,8 @@ CameraRenderer::CameraRenderer(const CameraRig& rig, const CameraEffects& effect
   const size_t n = static_cast<size_t>(rig.width) * rig.height;
   rays_.resize(n);
   vignette_.resize(n);
-  const double half_diag2 = 0.25 * (static_cast<double>(rig.width) * rig.width + static_cast<double>(rig.height) * rig.height);
+  const double half_diag2 =
+      0.25 * (static_cast<double>(rig.width) * rig.width + static_cast<double>(rig.height) * rig.height);
   for (int j = 0; j < rig.height; ++j) {
     for (int i = 0; i < rig.width; ++i) {
       const size_t k = static_cast<size_t>(j) * rig.width + i;
@@ -84,10 +85,11 @@ Eigen::Vector3f CameraRenderer::shade(const Scene& scene, const Ray& ray, const 
   const double cos_view = std::max(std::abs(sp.normal.dot(ray.direction)), 0.15);
   const double footprint = hit.t / rig_.fx / cos_view;  // pixel size on the surface
   const Material& m = scene.material(hit.object);
-  const double light = scene.lighting.ambient +
-                       scene.lighting.diffuse * std::max(0.0, -sp.normal.dot(scene.lighting.direction));
+  const double light =
+      scene.lighting.ambient + scene.lighting.diffuse * std::max(0.0, -sp.normal.dot(scene.lighting.direction));
   const Texture& texture = scene.texture(m.texture);
-  if (!rig_.color) return Eigen::Vector3f::Constant(texture.sampleLuminance(sp.u, sp.v, footprint) * static_cast<float>(light));
+  if (!rig_.color)
+    return Eigen::Vector3f::Constant(texture.sampleLuminance(sp.u, sp.v, footprint) * static_cast<float>(light));
   return texture.sample(sp.u, sp.v, footprint) * static_cast<float>(light);
 }
 

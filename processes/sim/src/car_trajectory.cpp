@@ -60,14 +60,11 @@ Jet cosOf(const Jet& a) {
   return {c, -s * a.d1, -c * a.d1 * a.d1 - s * a.d2};
 }
 /// The jet in time through the warp.
-Jet inTime(const Jet& f, const PathTimeWarp& w) {
-  return {f.f, f.d1 * w.d1, f.d2 * w.d1 * w.d1 + f.d1 * w.d2};
-}
+Jet inTime(const Jet& f, const PathTimeWarp& w) { return {f.f, f.d1 * w.d1, f.d2 * w.d1 * w.d1 + f.d1 * w.d2}; }
 
 /// The ground's height under the point `ahead` metres forward and `left` metres to the left of the
 /// path point, on the horizontal axes of the path's heading.
-Jet groundUnder(const Terrain& ground, const PathSample& base, const double heading[3], double ahead,
-                double left) {
+Jet groundUnder(const Terrain& ground, const PathSample& base, const double heading[3], double ahead, double left) {
   const double c = std::cos(heading[0]), s = std::sin(heading[0]), h1 = heading[1], h2 = heading[2];
   const Vec2 u(c, s), l(-s, c);
   const Vec2 u1 = h1 * l, l1 = -h1 * u;
@@ -168,8 +165,7 @@ CarFrame CarTrajectory::gradedFrame(double t) const {
   CarFrame f;
   f.p = g + R_g.R.col(2) * r.f;
   f.v = g1 * w.d1 + R_g.dR.col(2) * r.f + R_g.R.col(2) * r.d1;
-  f.a = g2 * w.d1 * w.d1 + g1 * w.d2 + R_g.ddR.col(2) * r.f + 2.0 * R_g.dR.col(2) * r.d1 +
-        R_g.R.col(2) * r.d2;
+  f.a = g2 * w.d1 * w.d1 + g1 * w.d2 + R_g.ddR.col(2) * r.f + 2.0 * R_g.dR.col(2) * r.d1 + R_g.R.col(2) * r.d2;
   f.R = R_WB.R, f.dR = R_WB.dR, f.ddR = R_WB.ddR;
   return f;
 }

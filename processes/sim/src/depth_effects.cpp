@@ -41,7 +41,8 @@ void dilate(std::vector<uint8_t>* mask, int width, int height, int r) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       if (!rows[static_cast<size_t>(y) * width + x]) continue;
-      for (int j = std::max(0, y - r); j <= std::min(height - 1, y + r); ++j) (*mask)[static_cast<size_t>(j) * width + x] = 1;
+      for (int j = std::max(0, y - r); j <= std::min(height - 1, y + r); ++j)
+        (*mask)[static_cast<size_t>(j) * width + x] = 1;
     }
   }
 }
@@ -61,12 +62,15 @@ std::vector<uint16_t> measureDepth(const std::vector<float>& z_exact, int width,
   // area), so this many give hole_fraction, borders aside)
   if (e.hole_fraction > 0.0) {
     const double mean_area = M_PI * e.hole_radius_px * e.hole_radius_px * (13.0 / 12.0);  // E[r^2] of U[0.5, 1.5] r
-    const int blobs = static_cast<int>(std::lround(-std::log(1.0 - e.hole_fraction) * static_cast<double>(n) / mean_area));
+    const int blobs =
+        static_cast<int>(std::lround(-std::log(1.0 - e.hole_fraction) * static_cast<double>(n) / mean_area));
     for (int b = 0; b < blobs; ++b) {
       const double cx = rng.uniform(0.0, width), cy = rng.uniform(0.0, height);
       const double r = e.hole_radius_px * rng.uniform(0.5, 1.5);
-      const int y0 = std::max(0, static_cast<int>(std::floor(cy - r))), y1 = std::min(height - 1, static_cast<int>(std::ceil(cy + r)));
-      const int x0 = std::max(0, static_cast<int>(std::floor(cx - r))), x1 = std::min(width - 1, static_cast<int>(std::ceil(cx + r)));
+      const int y0 = std::max(0, static_cast<int>(std::floor(cy - r))),
+                y1 = std::min(height - 1, static_cast<int>(std::ceil(cy + r)));
+      const int x0 = std::max(0, static_cast<int>(std::floor(cx - r))),
+                x1 = std::min(width - 1, static_cast<int>(std::ceil(cx + r)));
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x)
           if ((x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r)

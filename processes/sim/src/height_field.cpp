@@ -43,8 +43,8 @@ HeightField::HeightField(const HeightFieldOptions& o, const std::function<double
   // blocks of cells: a ray crosses a block whose heights it stays clear of without visiting its cells
   nbx_ = (nx_ + kBlock - 1) / kBlock;
   nby_ = (ny_ + kBlock - 1) / kBlock;
-  block_range_.assign(static_cast<size_t>(nbx_) * nby_, {std::numeric_limits<float>::max(),
-                                                         std::numeric_limits<float>::lowest()});
+  block_range_.assign(static_cast<size_t>(nbx_) * nby_,
+                      {std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()});
   for (int j = 0; j < ny_; ++j) {
     for (int i = 0; i < nx_; ++i) {
       auto& b = block_range_[static_cast<size_t>(j / kBlock) * nbx_ + i / kBlock];

@@ -79,8 +79,8 @@ LidarSweep LidarScanner::scan(const Scene& scene, const BodyTrajectory& trajecto
       const double drop = rng.uniform();
       const double detect = effects_.detection() ? rng.uniform() : 0.0;
       const CastContext context = CastContext::lidar(t0 + time_offset, rng.key());
-      const Echo echo = sub_rays_.empty() ? axisEcho(scene, ray, context)
-                                          : footprintEcho(scene, ray, R_WL.col(2), context, &hits);
+      const Echo echo =
+          sub_rays_.empty() ? axisEcho(scene, ray, context) : footprintEcho(scene, ray, R_WL.col(2), context, &hits);
       if (!echo.valid() || echo.range < rig_.min_range) continue;
       if (drop < rig_.dropout_probability) continue;
       const double apparent = echo.apparentReflectivity();

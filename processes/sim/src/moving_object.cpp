@@ -23,8 +23,9 @@ Vec3 MovingObject::groundPointAt(double t, double* heading) const {
   double s = std::fmod(path_.phase * length + path_.speed * t, length);
   if (s < 0.0) s += length;
   // segment i runs from cumulative_[i] to cumulative_[i + 1]
-  const size_t i = std::min<size_t>(std::upper_bound(cumulative_.begin(), cumulative_.end(), s) - cumulative_.begin() - 1,
-                                    path_.waypoints.size() - 1);
+  const size_t i =
+      std::min<size_t>(std::upper_bound(cumulative_.begin(), cumulative_.end(), s) - cumulative_.begin() - 1,
+                       path_.waypoints.size() - 1);
   const Vec3& a = path_.waypoints[i];
   const Vec3& b = path_.waypoints[(i + 1) % path_.waypoints.size()];
   const double f = (s - cumulative_[i]) / (cumulative_[i + 1] - cumulative_[i]);

@@ -18,13 +18,15 @@ inline int wrap(int64_t i, int period) {
 struct GradientTable {
   double x[32], y[32];
   GradientTable() {
-    for (int i = 0; i < 32; ++i) x[i] = std::cos(2.0 * M_PI * (i + 0.5) / 32.0), y[i] = std::sin(2.0 * M_PI * (i + 0.5) / 32.0);
+    for (int i = 0; i < 32; ++i)
+      x[i] = std::cos(2.0 * M_PI * (i + 0.5) / 32.0), y[i] = std::sin(2.0 * M_PI * (i + 0.5) / 32.0);
   }
 };
 const GradientTable kGradients;
 
 inline double gradientDot(int ix, int iy, double dx, double dy, uint64_t seed) {
-  const uint64_t h = mix64(seed ^ ((static_cast<uint64_t>(static_cast<uint32_t>(ix)) << 32) | static_cast<uint32_t>(iy)));
+  const uint64_t h =
+      mix64(seed ^ ((static_cast<uint64_t>(static_cast<uint32_t>(ix)) << 32) | static_cast<uint32_t>(iy)));
   const int k = static_cast<int>(h >> 59);
   return kGradients.x[k] * dx + kGradients.y[k] * dy;
 }

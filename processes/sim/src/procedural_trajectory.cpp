@@ -138,8 +138,9 @@ BodyState ProceduralTrajectory::at(double t) const {
   sumOfSinusoids(options_.shake.attitude[2], w.s, yc);
   const Mat3 Rx = rotX(ra[0]), Ry = rotY(pb[0]), Rz = rotZ(yc[0]);
   const Mat3 R_pert = Rz * Ry * Rx;
-  const Vec3 omega_pert = (Rx.transpose() * Ry.transpose() * Vec3(0.0, 0.0, yc[1]) + Rx.transpose() * Vec3(0.0, pb[1], 0.0) +
-                           Vec3(ra[1], 0.0, 0.0)) * w.d1;
+  const Vec3 omega_pert = (Rx.transpose() * Ry.transpose() * Vec3(0.0, 0.0, yc[1]) +
+                           Rx.transpose() * Vec3(0.0, pb[1], 0.0) + Vec3(ra[1], 0.0, 0.0)) *
+                          w.d1;
 
   st.T_W_I.linear() = R_base * R_pert;
   st.T_W_I.translation() = p;

@@ -34,8 +34,10 @@ std::vector<SampledCurve::Value> RecordedTrajectory::values(const livo::Trajecto
 
 RecordedTrajectory::RecordedTrajectory(const livo::Trajectory& recorded, const RecordedMotionOptions& options) {
   const livo::Trajectory poses = placeRecording(recorded, options.placement, options.body_in_recorded);
-  if (options.smoothing_s > 0.0) curve_ = std::make_unique<SmoothingCubicBSpline>(times(poses), values(poses), options.smoothing_s);
-  else curve_ = std::make_unique<NaturalCubicSpline>(times(poses), values(poses));
+  if (options.smoothing_s > 0.0)
+    curve_ = std::make_unique<SmoothingCubicBSpline>(times(poses), values(poses), options.smoothing_s);
+  else
+    curve_ = std::make_unique<NaturalCubicSpline>(times(poses), values(poses));
   start_stamp_ = poses.front().stamp;
   duration_ = poses.back().stamp - poses.front().stamp;
 }

@@ -25,8 +25,7 @@ int Scene::addHeightField(const std::string& name, const HeightFieldOptions& opt
   return addHeightField(name, std::make_unique<HeightField>(options), material);
 }
 
-int Scene::addHeightField(const std::string& name, std::unique_ptr<HeightField> field,
-                          const Material& material) {
+int Scene::addHeightField(const std::string& name, std::unique_ptr<HeightField> field, const Material& material) {
   height_fields_.push_back(std::move(field));
   objects_.push_back({name, -1, static_cast<int>(height_fields_.size()) - 1, -1, material});
   built_ = false;
@@ -154,8 +153,8 @@ bool glassReturns(uint64_t key, int object, double probability) {
 }
 }  // namespace
 
-bool Scene::intersectObject(int object, const PreparedRay& ray, const CastContext& context, double t_min,
-                            double t_max, double* t, int* face) const {
+bool Scene::intersectObject(int object, const PreparedRay& ray, const CastContext& context, double t_min, double t_max,
+                            double* t, int* face) const {
   const Object& o = objects_[object];
   if (o.material.kind == MaterialKind::kVegetation) {
     *face = 0;
@@ -192,7 +191,8 @@ void Scene::castMovers(const Ray& ray, const CastContext& context, double t_min,
     if (o.material.kind == MaterialKind::kGlass && context.sample_glass &&
         !glassReturns(context.key, object, o.material.glass_return_probability))
       continue;
-    if (intersectShape(movers_[o.mover].shapeAt(context.time), ray, t_min, std::min(t_max, hit->t), &t, &face)) *hit = {t, object, face};
+    if (intersectShape(movers_[o.mover].shapeAt(context.time), ray, t_min, std::min(t_max, hit->t), &t, &face))
+      *hit = {t, object, face};
   }
   hit->time = context.time;
 }
@@ -243,10 +243,14 @@ SurfacePoint leafSurface(const Ray& ray, double t, int object) {
 SurfacePoint Scene::surface(const Ray& ray, const RayHit& hit) const {
   const Object& o = objects_[hit.object];
   SurfacePoint sp;
-  if (o.material.kind == MaterialKind::kVegetation) sp = leafSurface(ray, hit.t, hit.object);
-  else if (o.height_field >= 0) sp = height_fields_[o.height_field]->surface(ray, hit.t, hit.face);
-  else if (o.mover >= 0) sp = shapeSurface(movers_[o.mover].shapeAt(hit.time), ray, hit.t, hit.face);
-  else sp = shapeSurface(shapes_[o.shape], ray, hit.t, hit.face);
+  if (o.material.kind == MaterialKind::kVegetation)
+    sp = leafSurface(ray, hit.t, hit.object);
+  else if (o.height_field >= 0)
+    sp = height_fields_[o.height_field]->surface(ray, hit.t, hit.face);
+  else if (o.mover >= 0)
+    sp = shapeSurface(movers_[o.mover].shapeAt(hit.time), ray, hit.t, hit.face);
+  else
+    sp = shapeSurface(shapes_[o.shape], ray, hit.t, hit.face);
   sp.u += o.material.u_offset;
   sp.v += o.material.v_offset;
   return sp;

@@ -51,8 +51,10 @@ TextureOptions readTexture(const Config& c, uint64_t seed) {
     throw ConfigError(c.where("pattern") + ": unknown pattern '" + pattern +
                       "' (known: uniform, noise, bricks, checker, stripes)");
   t.color_a = colour(c, "color");
-  if (c.has("color2")) t.color_b = colour(c, "color2");
-  else t.color_b = 0.5 * t.color_a;
+  if (c.has("color2"))
+    t.color_b = colour(c, "color2");
+  else
+    t.color_b = 0.5 * t.color_a;
   if (t.pattern != TexturePattern::kUniform) t.scale = positive(c, "scale");
   if (t.pattern == TexturePattern::kBricks) {
     t.brick_height = positive(c, "brick_height");
@@ -302,8 +304,7 @@ GradeProfile readGradeProfile(const Config& c) {
   c.readOptional("curve_length", g.curve_length);
   c.checkAllUsed();
   if (g.stations.size() < 2) throw ConfigError(c.where("stations") + ": needs at least 2 stations");
-  if (g.heights.size() != g.stations.size())
-    throw ConfigError(c.where("heights") + ": needs one height per station");
+  if (g.heights.size() != g.stations.size()) throw ConfigError(c.where("heights") + ": needs one height per station");
   if (!(g.curve_length > 0.0)) throw ConfigError(c.where("curve_length") + ": must be > 0");
   for (size_t i = 1; i < g.stations.size(); ++i)
     if (!(g.stations[i] - g.stations[i - 1] >= g.curve_length))
@@ -330,15 +331,13 @@ void readTerrain(Scene& scene, const Config& c, const std::map<std::string, int>
   c.readOptional("base", o.base);
   const Config profiles = c.optionalSection("profiles");
   if (!profiles.isNull())
-    for (const std::string& name : profiles.keys())
-      o.profiles.push_back(readGradeProfile(profiles.section(name)));
+    for (const std::string& name : profiles.keys()) o.profiles.push_back(readGradeProfile(profiles.section(name)));
   const Config relief = c.optionalSection("relief");
   if (!relief.isNull())
     for (const std::string& name : relief.keys()) o.relief.push_back(readReliefWave(relief.section(name)));
   const Config surface = c.section("surface");
   const Material m = readMaterial(surface, textures);
-  if (m.kind != MaterialKind::kOpaque)
-    throw ConfigError(surface.where("material") + ": the terrain is opaque");
+  if (m.kind != MaterialKind::kOpaque) throw ConfigError(surface.where("material") + ": the terrain is opaque");
   HeightFieldOptions grid;
   grid.center.head<2>() = pair(surface, "center", "[x, y]");
   const Vec2 size = pair(surface, "size", "[size_x, size_y] > 0");
@@ -357,8 +356,7 @@ void readTerrain(Scene& scene, const Config& c, const std::map<std::string, int>
   // (M: the largest curvature; the triangle's smallest enclosing circle has radius r / sqrt 2)
   const double departure = terrain->maxCurvature() * grid.resolution * grid.resolution / 4.0;
   if (departure > 1e-3)
-    throw ConfigError(surface.where("resolution") +
-                      ": the triangles would depart from the terrain by up to " +
+    throw ConfigError(surface.where("resolution") + ": the triangles would depart from the terrain by up to " +
                       std::to_string(departure * 1e3) + " mm (curvature up to " +
                       std::to_string(terrain->maxCurvature()) + " /m); take at most " +
                       std::to_string(std::sqrt(4e-3 / terrain->maxCurvature())) + " m");

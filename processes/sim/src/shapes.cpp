@@ -42,7 +42,7 @@ bool intersectBox(const Shape& s, const LocalRay& r, double t_min, double t_max,
   if (near > t_min) {
     tt = near, axis = near_axis;  // from outside
   } else if (far > t_min) {
-    tt = far, axis = far_axis;    // from inside (a room seen from within)
+    tt = far, axis = far_axis;  // from inside (a room seen from within)
   } else {
     return false;
   }
@@ -199,12 +199,11 @@ bool shapeInterval(const Shape& s, const Ray& ray, double* t_in, double* t_out) 
 SurfacePoint shapeSurface(const Shape& s, const Ray& ray, double t, int face) {
   SurfacePoint sp;
   sp.position = ray.origin + t * ray.direction;
-  const Vec3 p = s.axis_aligned ? Vec3(sp.position - s.center) : Vec3(s.rotation.transpose() * (sp.position - s.center));
+  const Vec3 p =
+      s.axis_aligned ? Vec3(sp.position - s.center) : Vec3(s.rotation.transpose() * (sp.position - s.center));
   Vec3 n_local = Vec3::UnitZ();
   switch (s.type) {
-    case ShapeType::kPlane:
-      sp.u = p.x(), sp.v = p.y();
-      break;
+    case ShapeType::kPlane: sp.u = p.x(), sp.v = p.y(); break;
     case ShapeType::kBox: {
       const int axis = face / 2;
       n_local = Vec3::Zero();

@@ -51,7 +51,8 @@ void readErrorWithin(const Config& c, const std::string& key, double limit, bool
 void readErrorWithin(const Config& c, const std::string& key, double limit, bool sigma, Vec3* v) {
   if (!c.readOptional(key, *v)) return;
   for (int i = 0; i < 3; ++i) {
-    if (!(std::abs((*v)[i]) <= limit)) throw ConfigError(c.where(key) + ": components must be within +-" + number(limit));
+    if (!(std::abs((*v)[i]) <= limit))
+      throw ConfigError(c.where(key) + ": components must be within +-" + number(limit));
     if (sigma && (*v)[i] < 0.0) throw ConfigError(c.where(key) + ": a 1-sigma (calibration_errors.draw) must be >= 0");
   }
 }
@@ -85,9 +86,9 @@ void readCalibrationErrors(const Config& c, const SensorRig& rig, CalibrationErr
 }
 
 // The sim.imu keys of the IMU error model.
-const std::vector<std::string> kImuErrorKeys = {"gyro_scale_ppm",     "accel_scale_ppm",  "gyro_misalignment_mrad",
-                                                "accel_misalignment_mrad", "gyro_g_sensitivity", "gyro_bias_per_c",
-                                                "accel_bias_per_c",   "temperature"};
+const std::vector<std::string> kImuErrorKeys = {
+    "gyro_scale_ppm",     "accel_scale_ppm", "gyro_misalignment_mrad", "accel_misalignment_mrad",
+    "gyro_g_sensitivity", "gyro_bias_per_c", "accel_bias_per_c",       "temperature"};
 
 void readImuErrors(const Config& imu, bool sigma, ImuErrors* e) {
   readErrorWithin(imu, "gyro_scale_ppm", 1e5, sigma, &e->gyro_scale_ppm);
@@ -103,7 +104,8 @@ void readImuErrors(const Config& imu, bool sigma, ImuErrors* e) {
   T.end_c = T.start_c;
   temp.readOptional("end_c", T.end_c);
   temp.readOptional("ramp_s", T.ramp_s);
-  if (!(T.start_c >= -60.0 && T.start_c <= 150.0)) throw ConfigError(temp.where("start_c") + ": must be in -60..150 deg C");
+  if (!(T.start_c >= -60.0 && T.start_c <= 150.0))
+    throw ConfigError(temp.where("start_c") + ": must be in -60..150 deg C");
   if (!(T.end_c >= -60.0 && T.end_c <= 150.0)) throw ConfigError(temp.where("end_c") + ": must be in -60..150 deg C");
   if (!(T.ramp_s > 0.0)) throw ConfigError(temp.where("ramp_s") + ": must be > 0");
   temp.checkAllUsed();
@@ -116,7 +118,8 @@ void refuseImuModelOnARealImu(const Config& imu) {
   keys.insert(keys.end(), {"initial_gyro_bias", "initial_accel_bias"});
   for (const std::string& key : keys)
     if (imu.has(key))
-      throw ConfigError(imu.where(key) + ": a recorded trajectory publishes its real IMU samples unchanged; "
+      throw ConfigError(imu.where(key) +
+                        ": a recorded trajectory publishes its real IMU samples unchanged; "
                         "the IMU model cannot be applied to them (remove the key, or drop sim.trajectory.imu to "
                         "synthesise the IMU from the recorded motion)");
 }
@@ -165,7 +168,8 @@ void readAutoExposure(const Config& cam, CameraEffects* e) {
   ae.readOptional("min_gain", a.min_gain);
   ae.readOptional("max_gain", a.max_gain);
   ae.readOptional("rate", a.rate);
-  if (!(a.target_mean > 0.0 && a.target_mean < 255.0)) throw ConfigError(ae.where("target_mean") + ": must be in (0, 255)");
+  if (!(a.target_mean > 0.0 && a.target_mean < 255.0))
+    throw ConfigError(ae.where("target_mean") + ": must be in (0, 255)");
   if (!(a.min_exposure > 0.0)) throw ConfigError(ae.where("min_exposure") + ": must be > 0");
   if (!(a.max_exposure >= a.min_exposure)) throw ConfigError(ae.where("max_exposure") + ": must be >= min_exposure");
   if (!(a.min_gain >= 1.0)) throw ConfigError(ae.where("min_gain") + ": must be >= 1");
@@ -220,8 +224,10 @@ void readDepthEffects(const Config& sim, const SensorRig& rig, DepthEffects* d) 
   if (!(d->max_range > d->min_range && d->max_range <= 65.0))
     throw ConfigError(depth.where("max_range") + ": must be greater than min_range and at most 65 m (DEPTH16 in mm)");
   if (!(d->edge_jump > 0.0)) throw ConfigError(depth.where("edge_jump") + ": must be > 0");
-  if (d->edge_hole_px < 0 || d->edge_hole_px > 50) throw ConfigError(depth.where("edge_hole_px") + ": must be in 0..50");
-  if (!(d->hole_fraction >= 0.0 && d->hole_fraction < 0.9)) throw ConfigError(depth.where("hole_fraction") + ": must be in [0, 0.9)");
+  if (d->edge_hole_px < 0 || d->edge_hole_px > 50)
+    throw ConfigError(depth.where("edge_hole_px") + ": must be in 0..50");
+  if (!(d->hole_fraction >= 0.0 && d->hole_fraction < 0.9))
+    throw ConfigError(depth.where("hole_fraction") + ": must be in [0, 0.9)");
   if (!(d->hole_radius_px >= 0.5 && d->hole_radius_px <= 200.0))
     throw ConfigError(depth.where("hole_radius_px") + ": must be in [0.5, 200]");
   depth.checkAllUsed();
@@ -253,7 +259,8 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
   if (!lidar.isNull() && !rig.lidar) throw ConfigError(sim.where("lidar") + ": the rig has no lidar");
   lidar.readOptional("columns", o->lidar.columns);
   lidar.readOptional("start_azimuth_deg", o->lidar.start_azimuth_deg);
-  if (o->lidar.columns < 0 || o->lidar.columns > 100000) throw ConfigError(lidar.where("columns") + ": must be in 0..100000");
+  if (o->lidar.columns < 0 || o->lidar.columns > 100000)
+    throw ConfigError(lidar.where("columns") + ": must be in 0..100000");
   readLidarEffects(lidar, &o->lidar_effects);
   lidar.checkAllUsed();
 
@@ -308,10 +315,10 @@ void readSimOptions(const Config& sim, const SensorRig& rig, SimOptions* o) {
 }
 
 void printDepthEffects(const DepthEffects& d, std::ostream& os) {
-  os << "  depth: noise " << d.noise_floor * 1e3 << " mm + " << d.noise_per_m2 * 1e3 << " mm/m^2 z^2 (" << d.sigmaAt(1.0) * 1e3
-     << " mm at 1 m, " << d.sigmaAt(3.0) * 1e3 << " mm at 3 m), range " << d.min_range << ".." << d.max_range
-     << " m, holes: " << d.edge_hole_px << " px at jumps over " << d.edge_jump * 100 << " %, blobs of " << d.hole_radius_px
-     << " px over " << d.hole_fraction * 100 << " % of the image\n";
+  os << "  depth: noise " << d.noise_floor * 1e3 << " mm + " << d.noise_per_m2 * 1e3 << " mm/m^2 z^2 ("
+     << d.sigmaAt(1.0) * 1e3 << " mm at 1 m, " << d.sigmaAt(3.0) * 1e3 << " mm at 3 m), range " << d.min_range << ".."
+     << d.max_range << " m, holes: " << d.edge_hole_px << " px at jumps over " << d.edge_jump * 100 << " %, blobs of "
+     << d.hole_radius_px << " px over " << d.hole_fraction * 100 << " % of the image\n";
 }
 
 void printLidarEffects(const LidarEffects& e, std::ostream& os) {
@@ -376,8 +383,8 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
   const SensorRig mounted = trueRig(s.rig, s.calibration_errors);
   const Pose3 T_I_rear_axle = mounted.wheel ? mounted.wheel->T_I_B : Pose3::Identity();
   const double track_width = mounted.wheel ? mounted.wheel->track_width : CarTrajectoryOptions().track_width;
-  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir,
-                                               T_I_rear_axle, s.scene->terrain, track_width);
+  TrajectoryConfig traj = readTrajectoryConfig(sim.section("trajectory"), s.rig.imu.gravity, base_dir, T_I_rear_axle,
+                                               s.scene->terrain, track_width);
   s.trajectory = std::move(traj.trajectory);
   s.trajectory_description = traj.description;
   s.recorded = traj.recorded;
@@ -393,11 +400,13 @@ SimulationSetup loadSimulation(const Config& root, const std::string& base_dir, 
     if (s.replaysRecordedImu()) {
       t0 = std::max(gt0, s.recorded_imu.front().stamp_ns * 1e-9);
       t1 = std::min(gt1, s.recorded_imu.back().stamp_ns * 1e-9);
-      if (!(t1 > t0)) throw ConfigError(sim.where("trajectory") + ": the ground truth and the IMU do not overlap in time");
+      if (!(t1 > t0))
+        throw ConfigError(sim.where("trajectory") + ": the ground truth and the IMU do not overlap in time");
     }
     t0 += traj.recorded_start_offset_s;
     if (!(t1 > t0))
-      throw ConfigError(sim.section("trajectory").where("start_offset_s") + ": starts at or after the end of the recording (" +
+      throw ConfigError(sim.section("trajectory").where("start_offset_s") +
+                        ": starts at or after the end of the recording (" +
                         number(t1 - t0 + traj.recorded_start_offset_s) + " s available)");
     s.start_utime = static_cast<int64_t>(std::ceil(t0 * 1e6));
     s.trajectory_time_offset = static_cast<double>(s.start_utime) * 1e-6 - gt0;
@@ -422,7 +431,8 @@ void printCalibrationErrors(const SimulationSetup& s, std::ostream& os) {
   const CalibrationErrors& e = s.calibration_errors;
   os << "  calibration errors (the TRUTH, never in rig:; T_I_X_true = T_I_X_rig * T_err, a message stamped t was "
         "measured at t + offset), "
-     << (e.draw ? "drawn with seed " + std::to_string(s.options.seed) + " from the configured 1-sigmas" : "as configured")
+     << (e.draw ? "drawn with seed " + std::to_string(s.options.seed) + " from the configured 1-sigmas"
+                : "as configured")
      << ":\n";
   if (s.rig.lidar) printExtrinsicError("lidar", e.lidar, e.lidar_time_offset_s, os);
   if (s.rig.camera) printExtrinsicError("camera", e.camera, e.camera_time_offset_s, os);
@@ -464,7 +474,8 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
        << " /m\n";
   }
   os << "  trajectory: " << s.trajectory_description << "\n";
-  if (s.replaysRecordedImu()) os << "  IMU: the recording's own samples, unchanged\n";
+  if (s.replaysRecordedImu())
+    os << "  IMU: the recording's own samples, unchanged\n";
   else
     os << "  IMU initial bias: gyro [" << o.initial_gyro_bias.transpose() << "] rad/s, accel ["
        << o.initial_accel_bias.transpose() << "] m/s^2\n";
@@ -478,7 +489,7 @@ void printSimulation(const SimulationSetup& s, std::ostream& os) {
        << "% over " << o.camera.exposure_period_s << " s, motion blur samples " << o.camera.motion_blur_samples
        << ", noise " << o.camera.noise_std << " DN, brightness " << o.camera.brightness << ", vignetting "
        << o.camera.vignetting << ", "
-       << (o.camera_trigger == CameraTrigger::kFree ? "free-running"
+       << (o.camera_trigger == CameraTrigger::kFree         ? "free-running"
            : o.camera_trigger == CameraTrigger::kSweepStart ? "triggered at each sweep's start"
                                                             : "triggered at each sweep's end");
   if (s.rig.camera && o.camera.rolling_shutter_s > 0.0)

@@ -109,7 +109,8 @@ class SimulationRun {
       if (o_.camera.auto_exposure.enabled) auto_exposure_.emplace(o_.camera.auto_exposure, o_.camera.exposure_time);
     }
     if (s_.replaysRecordedImu()) {
-      while (recorded_k_ < s_.recorded_imu.size() && s_.recorded_imu[recorded_k_].stamp_ns < start_ * 1000) ++recorded_k_;
+      while (recorded_k_ < s_.recorded_imu.size() && s_.recorded_imu[recorded_k_].stamp_ns < start_ * 1000)
+        ++recorded_k_;
     }
   }
 
@@ -167,7 +168,8 @@ class SimulationRun {
   /// Reserves the chunk's sweeps; a job per sweep computes it.
   void planSweeps(Chunk* c) {
     if (!scanner_) return;
-    for (int64_t u; (u = stampOf(start_, sweep_k_, rig_.lidar->rate_hz)) < c->end && u + sweep_us_ <= end_; ++sweep_k_) {
+    for (int64_t u; (u = stampOf(start_, sweep_k_, rig_.lidar->rate_hz)) < c->end && u + sweep_us_ <= end_;
+         ++sweep_k_) {
       c->pending.push_back({u, kLidarRank, c->sweeps.size()});
       c->sweeps.emplace_back();
       const size_t slot = c->sweeps.size() - 1;
@@ -220,8 +222,12 @@ class SimulationRun {
         }
       });
     }
-    if (auto_exposure_) c->jobs.push_back([frames] { for (const auto& f : frames) f(); });
-    else c->jobs.insert(c->jobs.end(), frames.begin(), frames.end());
+    if (auto_exposure_)
+      c->jobs.push_back([frames] {
+        for (const auto& f : frames) f();
+      });
+    else
+      c->jobs.insert(c->jobs.end(), frames.begin(), frames.end());
   }
 
   /// Hands the chunk's messages to the sink in time order (ties by rank).
@@ -231,16 +237,31 @@ class SimulationRun {
     });
     for (const Pending& p : c->pending) {
       switch (p.rank) {
-        case kImuRank: sink.write(c->imus[p.index]); ++stats_.messages[rig_.channels.imu]; break;
-        case kWheelRank: sink.write(c->wheels[p.index]); ++stats_.messages[rig_.channels.wheel]; break;
-        case kGroundTruthRank: sink.write(c->poses[p.index]); ++stats_.messages[rig_.channels.ground_truth]; break;
+        case kImuRank:
+          sink.write(c->imus[p.index]);
+          ++stats_.messages[rig_.channels.imu];
+          break;
+        case kWheelRank:
+          sink.write(c->wheels[p.index]);
+          ++stats_.messages[rig_.channels.wheel];
+          break;
+        case kGroundTruthRank:
+          sink.write(c->poses[p.index]);
+          ++stats_.messages[rig_.channels.ground_truth];
+          break;
         case kLidarRank:
           sink.write(c->sweeps[p.index]);
           ++stats_.messages[rig_.channels.lidar];
           stats_.lidar_points += static_cast<int64_t>(c->sweeps[p.index].size());
           break;
-        case kCameraRank: sink.write(c->images[p.index]); ++stats_.messages[rig_.channels.camera]; break;
-        case kDepthRank: sink.write(c->depths[p.index]); ++stats_.messages[rig_.channels.depth]; break;
+        case kCameraRank:
+          sink.write(c->images[p.index]);
+          ++stats_.messages[rig_.channels.camera];
+          break;
+        case kDepthRank:
+          sink.write(c->depths[p.index]);
+          ++stats_.messages[rig_.channels.depth];
+          break;
       }
     }
   }

@@ -33,8 +33,8 @@ Terrain::Terrain(const TerrainOptions& options) : options_(options) {
     for (size_t i = 1; i < n; ++i)
       if (!(g.stations[i] > g.stations[i - 1]))
         throw std::invalid_argument(name + "stations must increase (station " + std::to_string(i) + " at " +
-                                    std::to_string(g.stations[i]) + " m follows " +
-                                    std::to_string(g.stations[i - 1]) + " m)");
+                                    std::to_string(g.stations[i]) + " m follows " + std::to_string(g.stations[i - 1]) +
+                                    " m)");
     Profile p;
     p.direction = unitDirection(g.direction_deg);
     p.origin = g.origin;
@@ -78,8 +78,7 @@ Terrain::Terrain(const TerrainOptions& options) : options_(options) {
 void Terrain::profileAt(const Profile& p, double s, double out[3]) {
   const std::vector<double>& st = p.stations;
   const double half = 0.5 * p.curve_length;
-  const size_t k =
-      static_cast<size_t>(std::upper_bound(st.begin(), st.end(), s) - st.begin());  // stations <= s
+  const size_t k = static_cast<size_t>(std::upper_bound(st.begin(), st.end(), s) - st.begin());  // stations <= s
   for (size_t j : {k - 1, k}) {
     if (j >= st.size() || std::abs(s - st[j]) > half) continue;
     // the vertical curve at station j: from grade grades[j] to grades[j + 1], centred on the station

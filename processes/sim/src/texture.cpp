@@ -10,8 +10,8 @@ namespace livo::sim {
 
 namespace {
 constexpr int kTileTexels = 256;
-constexpr int kNoiseCells = 8;    // lattice cells of the first noise octave per tile
-constexpr int kGrainCells = 64;   // lattice cells of the grain per tile
+constexpr int kNoiseCells = 8;   // lattice cells of the first noise octave per tile
+constexpr int kGrainCells = 64;  // lattice cells of the grain per tile
 
 double cellVariation(uint64_t seed, int64_t a, int64_t b, double amount) {
   Random r(seed, static_cast<uint64_t>(a) * 7919 + 13, static_cast<uint64_t>(b));
@@ -28,12 +28,18 @@ double roughLog2(double x) {
 }  // namespace
 
 bool parseTexturePattern(const std::string& name, TexturePattern* p) {
-  if (name == "uniform") *p = TexturePattern::kUniform;
-  else if (name == "noise") *p = TexturePattern::kNoise;
-  else if (name == "bricks") *p = TexturePattern::kBricks;
-  else if (name == "checker") *p = TexturePattern::kChecker;
-  else if (name == "stripes") *p = TexturePattern::kStripes;
-  else return false;
+  if (name == "uniform")
+    *p = TexturePattern::kUniform;
+  else if (name == "noise")
+    *p = TexturePattern::kNoise;
+  else if (name == "bricks")
+    *p = TexturePattern::kBricks;
+  else if (name == "checker")
+    *p = TexturePattern::kChecker;
+  else if (name == "stripes")
+    *p = TexturePattern::kStripes;
+  else
+    return false;
   return true;
 }
 
@@ -83,11 +89,11 @@ Texture::Texture(const TextureOptions& o) : options_(o) {
   }
   for (const auto& level : levels_) {
     std::vector<float> y(level.size() / 3);
-    for (size_t i = 0; i < y.size(); ++i) y[i] = 0.299f * level[3 * i] + 0.587f * level[3 * i + 1] + 0.114f * level[3 * i + 2];
+    for (size_t i = 0; i < y.size(); ++i)
+      y[i] = 0.299f * level[3 * i] + 0.587f * level[3 * i + 1] + 0.114f * level[3 * i + 2];
     luminance_.push_back(std::move(y));
   }
 }
-
 
 Eigen::Vector3d Texture::bakeTexel(double u, double v, double lo, double hi) const {
   const TextureOptions& o = options_;
@@ -116,7 +122,8 @@ Eigen::Vector3d Texture::bakeTexel(double u, double v, double lo, double hi) con
       break;
     }
     case TexturePattern::kChecker: {
-      const int64_t a = static_cast<int64_t>(std::floor(u / o.scale)), b = static_cast<int64_t>(std::floor(v / o.scale));
+      const int64_t a = static_cast<int64_t>(std::floor(u / o.scale)),
+                    b = static_cast<int64_t>(std::floor(v / o.scale));
       c = (((a + b) % 2 + 2) % 2 == 0 ? o.color_a : o.color_b) * cellVariation(o.seed, a & 7, b & 7, o.variation);
       break;
     }
@@ -127,7 +134,8 @@ Eigen::Vector3d Texture::bakeTexel(double u, double v, double lo, double hi) con
     }
   }
   if (o.grain > 0.0) {
-    const double g = fractalNoise(u / period_u_ * kGrainCells, v / period_v_ * kGrainCells, 2, kGrainCells, o.seed + 101);
+    const double g =
+        fractalNoise(u / period_u_ * kGrainCells, v / period_v_ * kGrainCells, 2, kGrainCells, o.seed + 101);
     c *= 1.0 + o.grain * g;
   }
   return c;
@@ -138,7 +146,8 @@ void Texture::bilinear(const std::vector<float>& t, int n, double x, double y, f
   const double fx = std::floor(x), fy = std::floor(y);
   const float ax = static_cast<float>(x - fx), ay = static_cast<float>(y - fy);
   const int64_t mask = n - 1;  // n is a power of two; & wraps negative indices too
-  const int x0 = static_cast<int>(static_cast<int64_t>(fx) & mask), y0 = static_cast<int>(static_cast<int64_t>(fy) & mask);
+  const int x0 = static_cast<int>(static_cast<int64_t>(fx) & mask),
+            y0 = static_cast<int>(static_cast<int64_t>(fy) & mask);
   const int x1 = static_cast<int>((x0 + 1) & mask), y1 = static_cast<int>((y0 + 1) & mask);
   const float* p00 = &t[(static_cast<size_t>(y0) * n + x0) * C];
   const float* p10 = &t[(static_cast<size_t>(y0) * n + x1) * C];

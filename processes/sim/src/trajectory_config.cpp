@@ -3,9 +3,9 @@
 #include <sstream>
 
 #include "livo/sim/car_trajectory.hpp"
-#include "livo/trajectory_io.hpp"
 #include "livo/sim/procedural_trajectory.hpp"
 #include "livo/sim/recorded_trajectory.hpp"
+#include "livo/trajectory_io.hpp"
 
 namespace livo::sim {
 
@@ -62,20 +62,24 @@ TrajectoryConfig readRecorded(const Config& c, const std::string& base_dir) {
   const bool smoothing = motion.smoothing_s > 0.0;
   for (size_t i = 1; i < poses.size(); ++i)
     if (poses[i].stamp < poses[i - 1].stamp || (!smoothing && poses[i].stamp == poses[i - 1].stamp))
-      throw ConfigError(c.where("ground_truth") + ": " + gt_path + ": stamps do not increase at pose " + std::to_string(i) +
-                        (smoothing ? "" : " (smoothing_s > 0 accepts repeated stamps)"));
+      throw ConfigError(c.where("ground_truth") + ": " + gt_path + ": stamps do not increase at pose " +
+                        std::to_string(i) + (smoothing ? "" : " (smoothing_s > 0 accepts repeated stamps)"));
   if (smoothing && !(motion.smoothing_s < poses.back().stamp - poses.front().stamp))
     throw ConfigError(c.where("smoothing_s") + ": must be shorter than the recording");
   auto rec = std::make_unique<RecordedTrajectory>(poses, motion);
   out.recorded_start_stamp = rec->startStamp();
   std::ostringstream os;
   os << "recorded: " << poses.size() << " poses from " << gt_path << " (" << rec->duration() << " s), ";
-  if (smoothing) os << "least-squares cubic B-spline, knots every " << motion.smoothing_s << " s";
-  else os << "natural cubic splines through the poses";
+  if (smoothing)
+    os << "least-squares cubic B-spline, knots every " << motion.smoothing_s << " s";
+  else
+    os << "natural cubic splines through the poses";
   if (!motion.placement.matrix().isIdentity(0.0) || !motion.body_in_recorded.matrix().isIdentity(0.0))
     os << ", T_W_I = placement * T_recorded * body_in_recorded";
-  if (out.recorded_imu.empty()) os << "; IMU synthesised from the motion";
-  else os << "; " << out.recorded_imu.size() << " IMU samples from " << imu_path;
+  if (out.recorded_imu.empty())
+    os << "; IMU synthesised from the motion";
+  else
+    os << "; " << out.recorded_imu.size() << " IMU samples from " << imu_path;
   out.description = os.str();
   out.trajectory = std::move(rec);
   out.recorded = true;
@@ -145,7 +149,8 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
     os << "uav: Lissajous flight around [" << center.transpose() << "], amplitude [" << amplitude.transpose()
        << "] m, frequencies [" << frequency.transpose() << "] Hz, thrust-aligned attitude";
   } else {
-    throw ConfigError(c.where("type") + ": unknown trajectory type '" + type + "' (known: handheld, car, uav, recorded)");
+    throw ConfigError(c.where("type") + ": unknown trajectory type '" + type +
+                      "' (known: handheld, car, uav, recorded)");
   }
   c.checkAllUsed();
   os << ", still for " << o.start_still_s << " s then a " << o.ramp_s << " s ramp, shake x" << shake;
@@ -154,12 +159,11 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
     const Vec3 p_BI = T_I_rear_axle.inverse().translation();
     os << "; rear axle " << p_BI.x() << " m behind and " << p_BI.z() << " m below the body origin";
     if (ground)
-      os << "; on the scene's terrain (grades at most " << ground->maxGrade() * 100.0 << " %, wheelbase "
-         << wheelbase << " m, track " << track_width << " m)";
+      os << "; on the scene's terrain (grades at most " << ground->maxGrade() * 100.0 << " %, wheelbase " << wheelbase
+         << " m, track " << track_width << " m)";
     out.trajectory = std::make_unique<CarTrajectory>(
         std::move(path),
-        CarTrajectoryOptions{o.start_still_s, o.ramp_s, o.shake, T_I_rear_axle, ground, wheelbase,
-                             track_width});
+        CarTrajectoryOptions{o.start_still_s, o.ramp_s, o.shake, T_I_rear_axle, ground, wheelbase, track_width});
   } else {
     out.trajectory = std::make_unique<ProceduralTrajectory>(std::move(path), o);
   }

@@ -38,8 +38,10 @@ void WheelSlip::drawNext() {
   const double after = episodes_.empty() ? 0.0 : episodes_.back().end_s;
   e.start_s = after - std::log1p(-u_gap) * 60.0 / o_.rate_per_min;
   e.end_s = e.start_s + o_.min_duration_s + (o_.max_duration_s - o_.min_duration_s) * u_duration;
-  if (u_wheels < o_.both_probability) e.left = e.right = true;
-  else (u_side < 0.5 ? e.left : e.right) = true;
+  if (u_wheels < o_.both_probability)
+    e.left = e.right = true;
+  else
+    (u_side < 0.5 ? e.left : e.right) = true;
   e.lock = u_lock < o_.lock_probability;
   const double spin_l = o_.min_spin + (o_.max_spin - o_.min_spin) * u_left;
   const double spin_r = o_.min_spin + (o_.max_spin - o_.min_spin) * u_right;

@@ -149,12 +149,14 @@ DirectUpdateResult directUpdate(const FilterState& prior, const StateCovariance&
     Measurement first;
     first.info.calibration_block = FilterState::kCamera;
     for (size_t i = 0; i < patches.size(); ++i) {
-      active[i] = evaluatePatch(pyramid, level, camera, x, patches[i], po, &e, shutter) && (!gate || e.ncc >= po.min_ncc);
+      active[i] =
+          evaluatePatch(pyramid, level, camera, x, patches[i], po, &e, shutter) && (!gate || e.ncc >= po.min_ncc);
       if (active[i]) add(e, po, &first);
     }
     if (first.used < uo.min_patches) {
       if (level > 0) continue;  // a finer level may still have enough
-      res.why = "too few patches correlate (" + std::to_string(first.used) + " < " + std::to_string(uo.min_patches) + ")";
+      res.why =
+          "too few patches correlate (" + std::to_string(first.used) + " < " + std::to_string(uo.min_patches) + ")";
       return res;
     }
     for (int it = 0; it < uo.max_iterations; ++it) {
@@ -187,8 +189,8 @@ DirectUpdateResult directUpdate(const FilterState& prior, const StateCovariance&
     MeasurementInformation gated = aligned.info;
     scaleCalibrationInformation(uo.calibration_information_scale, P_measured, &gated);
     if (floored) applyMeasurementFloor(floor, &gated.HtRinvH, &gated.HtRinvz);
-    res.consistency = consistencyTest(measuredDifference(x, prior), gated.HtRinvH, gated.HtRinvz,
-                                      P_measured, uo.gate_probability);
+    res.consistency =
+        consistencyTest(measuredDifference(x, prior), gated.HtRinvH, gated.HtRinvz, P_measured, uo.gate_probability);
   }
   // the pose the image aligned to, with the prior's calibration: the cost test's (below)
   FilterState aligned_pose = x;
@@ -233,8 +235,9 @@ DirectUpdateResult directUpdate(const FilterState& prior, const StateCovariance&
   // photometric cost that grows by a few per cent there is the texture's sub-pixel noise, not a
   // failed alignment)
   if (pose_step_d2 > 1.0 && !(res.cost_post <= 1.05 * res.cost_prior + 1e-9)) {
-    res.why = "photometric cost grew (" + formatSignificant(res.cost_prior) + " -> " + formatSignificant(res.cost_post) +
-              ", pose step " + formatSignificant(std::sqrt(pose_step_d2)) + " sigma)";
+    res.why = "photometric cost grew (" + formatSignificant(res.cost_prior) + " -> " +
+              formatSignificant(res.cost_post) + ", pose step " + formatSignificant(std::sqrt(pose_step_d2)) +
+              " sigma)";
   } else if (!res.consistency.passed) {
     res.why = "image inconsistent with the prior (chi-square " + formatSignificant(res.consistency.nis) + " > " +
               formatSignificant(res.consistency.threshold) + ", " + std::to_string(res.consistency.dof) + " dof)";

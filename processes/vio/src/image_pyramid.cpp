@@ -36,8 +36,7 @@ inline void bilinearRow(const uint8_t* r0, const uint8_t* r1, float w00, float w
 // vectoriser evaluates them four at a time: per lane the same expression,
 // ((w00 a + w10 b) + w01 c) + w11 d, on the same values, so bit for bit the scalar result.
 template <int N>
-void sampleRows(const cv::Mat& img, int ix, int iy, float w00, float w10, float w01, float w11,
-                float* __restrict out) {
+void sampleRows(const cv::Mat& img, int ix, int iy, float w00, float w10, float w01, float w11, float* __restrict out) {
   constexpr int kStride = (N + 1 + 3) / 4 * 4;
   float px[(N + 1) * kStride];
   for (int j = 0; j <= N; ++j) {
@@ -65,7 +64,8 @@ void ImagePyramid::build(const cv::Mat& grey, int levels) {
     const int w = src.cols / 2, h = src.rows / 2;
     cv::Mat& dst = levels_[l];
     dst.create(h, w, CV_8UC1);  // keeps the last image's buffer (same size)
-    for (int y = 0; y < h; ++y) averageRow(src.ptr<uint8_t>(2 * y), src.ptr<uint8_t>(2 * y + 1), dst.ptr<uint8_t>(y), w);
+    for (int y = 0; y < h; ++y)
+      averageRow(src.ptr<uint8_t>(2 * y), src.ptr<uint8_t>(2 * y + 1), dst.ptr<uint8_t>(y), w);
   }
 }
 

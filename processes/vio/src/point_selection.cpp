@@ -167,8 +167,8 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
     }
   }
   std::vector<TrackedPatch> out;
-  out.reserve(static_cast<size_t>(
-      std::count_if(grid.begin(), grid.end(), [](const Candidate& c) { return c.point >= 0; })));
+  out.reserve(
+      static_cast<size_t>(std::count_if(grid.begin(), grid.end(), [](const Candidate& c) { return c.point >= 0; })));
   for (const Candidate& c : grid) {
     if (c.point < 0) continue;
     const MapPoint& m = map.point(c.point);

@@ -138,11 +138,12 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
   const VioOptions& o = n.vio;
   const CameraRig& c = n.camera;
   os << "[" << n.name << "] inputs " << n.camera_channel << ", " << n.state_prior_channel << ", "
-     << n.registered_scan_channel << ", " << n.loop_correction_channel << "; output " << n.state_posterior_channel << "\n"
+     << n.registered_scan_channel << ", " << n.loop_correction_channel << "; output " << n.state_posterior_channel
+     << "\n"
      << "  camera " << c.width << "x" << c.height << " f " << c.fx << "/" << c.fy << " c " << c.cx << "/" << c.cy
      << ", " << distortionModelName(c.distortion_model) << " distortion [" << c.distortion[0] << ", " << c.distortion[1]
-     << ", " << c.distortion[2] << ", " << c.distortion[3] << "], time offset " << n.camera_time_offset_s << " s (match within " << n.time_tolerance_s
-     << " s)\n"
+     << ", " << c.distortion[2] << ", " << c.distortion[3] << "], time offset " << n.camera_time_offset_s
+     << " s (match within " << n.time_tolerance_s << " s)\n"
      << "  map: voxel " << o.map.voxel_size << " m, radius " << o.map.radius << " m, max " << o.map.max_points
      << " points x " << o.map.max_observations << " patches, " << o.map.recent_scans << " recent scans, plane snap "
      << o.map.plane_snap_max_rms << " m RMS from " << o.map.plane_snap_min_points << " points, normals "
@@ -150,19 +151,19 @@ void printOptions(const VioNodeOptions& n, std::ostream& os) {
      << "  selection: grid " << o.selection.grid_cell_px << " px, depth " << o.selection.min_depth << ".."
      << o.selection.max_depth << " m, occlusion cell " << o.selection.depth_cell_px << " px, max view angle "
      << o.selection.max_view_angle_deg << " deg\n"
-     << "  photometric: " << o.photometric.pyramid_levels << " levels, noise " << o.photometric.noise_std
-     << ", Huber " << o.photometric.huber_threshold << ", "
-     << (o.photometric.affine_brightness ? "gain + offset" : "offset") << " per patch, min NCC "
-     << o.photometric.min_ncc << ", map points known to " << o.photometric.point_std << " m\n"
+     << "  photometric: " << o.photometric.pyramid_levels << " levels, noise " << o.photometric.noise_std << ", Huber "
+     << o.photometric.huber_threshold << ", " << (o.photometric.affine_brightness ? "gain + offset" : "offset")
+     << " per patch, min NCC " << o.photometric.min_ncc << ", map points known to " << o.photometric.point_std << " m\n"
      << "  update: " << o.update.max_iterations << " iterations per level, min " << o.update.min_patches
-     << " patches, consistency gate at " << o.update.gate_probability << ", step <= " << o.update.max_step_pos << " m / "
-     << o.update.max_step_rot_deg << " deg, covariance counts "
+     << " patches, consistency gate at " << o.update.gate_probability << ", step <= " << o.update.max_step_pos
+     << " m / " << o.update.max_step_rot_deg << " deg, covariance counts "
      << (o.update.covariance == CovarianceUpdate::kFull ? "all the information" : "the information beyond the prior")
      << ", reference floor x" << o.update.reference_floor << ", gyro bias updated while its 1-sigma > "
      << o.update.gyro_bias_std_to_update << " rad/s\n"
-     << "  maintenance: new points on a " << o.maintenance.new_point_cell_px << " px grid (gradient >= "
-     << o.maintenance.min_gradient << "), new patch after " << o.maintenance.refresh_angle_deg << " deg / x"
-     << o.maintenance.refresh_distance_ratio << " distance / RMS " << o.maintenance.refresh_error << "\n";
+     << "  maintenance: new points on a " << o.maintenance.new_point_cell_px
+     << " px grid (gradient >= " << o.maintenance.min_gradient << "), new patch after "
+     << o.maintenance.refresh_angle_deg << " deg / x" << o.maintenance.refresh_distance_ratio << " distance / RMS "
+     << o.maintenance.refresh_error << "\n";
   os << std::flush;
 }
 

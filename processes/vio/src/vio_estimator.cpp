@@ -151,16 +151,17 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   // the camera when the image was really taken: the stamp plus the camera's time shift
   const Pose3 T_W_C = advanced(prior, body_rate, prior.camera.dt).pose() * prior.camera.pose();
   fillDepth(T_W_C);
-  std::vector<TrackedPatch> tracked = selectPatches(map_, camera_, T_W_C, prior.camera, image.utime, image.exposure_time,
-                                                    depth_, levels, options_.selection, &r.selection);
+  std::vector<TrackedPatch> tracked =
+      selectPatches(map_, camera_, T_W_C, prior.camera, image.utime, image.exposure_time, depth_, levels,
+                    options_.selection, &r.selection);
   bool updated = false;
   if (static_cast<int>(tracked.size()) < options_.update.min_patches) {
     r.why = map_.size() == 0 ? std::string("the point-patch map is empty")
                              : "too few map points in view (" + std::to_string(tracked.size()) + " < " +
                                    std::to_string(options_.update.min_patches) + ")";
   } else {
-    const DirectUpdateResult u = directUpdate(prior, P, pyramid_, camera_, options_.photometric, options_.update,
-                                              &tracked, shutter);
+    const DirectUpdateResult u =
+        directUpdate(prior, P, pyramid_, camera_, options_.photometric, options_.update, &tracked, shutter);
     r.iterations = u.iterations;
     r.num_measurements = u.num_measurements;
     r.patches = u.patches;
@@ -271,7 +272,8 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
       if (occupied[c] || b.evaluated >= kMaxCandidatesPerCell || map_.find(p) >= 0) continue;
       ++r->candidates;
       if (depth_.occluded(px, p_C.z(), so.occlusion_tolerance, so.occlusion_tolerance_rel) ||
-          depth_.depthEdge(px, p_C.z(), so.depth_edge_radius_px, so.depth_edge_tolerance, so.depth_edge_tolerance_rel)) {
+          depth_.depthEdge(px, p_C.z(), so.depth_edge_radius_px, so.depth_edge_tolerance,
+                           so.depth_edge_tolerance_rel)) {
         ++r->candidates_hidden;
         continue;
       }

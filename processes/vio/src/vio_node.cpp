@@ -8,8 +8,8 @@
 
 #include "livo/correction_frames.hpp"
 #include "livo/message_checks.hpp"
-#include "livo/time.hpp"
 #include "livo/messages.hpp"
+#include "livo/time.hpp"
 #include "livo/vio/vio_messages.hpp"
 
 namespace livo::vio {
@@ -57,8 +57,8 @@ void VioNode::onImage(const image_t& m) {
     ++counts_.images;
   }
   b.image.utime = b.t;
-  const auto it = std::upper_bound(images_.begin(), images_.end(), b.t,
-                                   [](int64_t t, const BufferedImage& e) { return t < e.t; });
+  const auto it =
+      std::upper_bound(images_.begin(), images_.end(), b.t, [](int64_t t, const BufferedImage& e) { return t < e.t; });
   images_.insert(it, std::move(b));
   resolve();
 }
@@ -87,7 +87,8 @@ void VioNode::onPrior(const filter_state_t& m) {
     return;
   }
   if (std::find(answered_ids_.begin(), answered_ids_.end(), m.request_id) != answered_ids_.end() ||
-      std::any_of(pending_.begin(), pending_.end(), [&](const filter_state_t& p) { return p.request_id == m.request_id; })) {
+      std::any_of(pending_.begin(), pending_.end(),
+                  [&](const filter_state_t& p) { return p.request_id == m.request_id; })) {
     node_.reject(opts_.state_prior_channel, "duplicate prior (request id already seen): not answered again");
     return;
   }
@@ -118,8 +119,10 @@ void VioNode::resolve() {
       const BufferedImage image = std::move(*best);
       for (auto it = images_.begin(); it != best; ++it) counts_.unused_images += it->problem.empty();
       images_.erase(images_.begin(), best + 1);  // it and everything older are used up
-      if (!image.problem.empty()) keep(prior, "bad image at the prior's time: " + image.problem);
-      else process(prior, image);
+      if (!image.problem.empty())
+        keep(prior, "bad image at the prior's time: " + image.problem);
+      else
+        process(prior, image);
       // older priors cannot get an image any more (pending_ is sorted; they were answered above)
       continue;
     }

@@ -40,7 +40,8 @@ void validate(const VioOptions& o) {
   require(o.update.min_patches >= 1, "update.min_patches must be >= 1");
   require(o.update.calibration_information_scale > 0.0 && o.update.calibration_information_scale <= 1.0,
           "update.calibration_information_scale must be in (0, 1]");
-  require(o.update.gate_probability > 0.0 && o.update.gate_probability < 1.0, "update.gate_probability must be in (0, 1)");
+  require(o.update.gate_probability > 0.0 && o.update.gate_probability < 1.0,
+          "update.gate_probability must be in (0, 1)");
   require(o.update.max_step_pos > 0.0 && o.update.max_step_rot_deg > 0.0, "update: step bounds must be > 0");
   require(o.update.reference_floor >= 0.0, "update.reference_floor must be >= 0");
   require(o.update.gyro_bias_std_to_update >= 0.0, "update.gyro_bias_std_to_update must be >= 0");

@@ -53,9 +53,12 @@ TrackedFrame FeatureTracker::track(int64_t utime, const cv::Mat& image, const Ma
                                 std::to_string(image.rows) + ", the camera " + std::to_string(rig.width) + "x" +
                                 std::to_string(rig.height));
   cv::Mat grey;
-  if (image.type() == CV_8UC1) grey = image;
-  else if (image.type() == CV_8UC3) cv::cvtColor(image, grey, cv::COLOR_RGB2GRAY);
-  else throw std::invalid_argument("FeatureTracker: image type must be CV_8UC1 or CV_8UC3");
+  if (image.type() == CV_8UC1)
+    grey = image;
+  else if (image.type() == CV_8UC3)
+    cv::cvtColor(image, grey, cv::COLOR_RGB2GRAY);
+  else
+    throw std::invalid_argument("FeatureTracker: image type must be CV_8UC1 or CV_8UC3");
 
   std::vector<cv::Mat> pyramid;  // with the gradients, which KLT needs of the image it tracks from
   cv::buildOpticalFlowPyramid(grey, pyramid, cv::Size(options_.window_px, options_.window_px), options_.pyramid_levels,
@@ -67,15 +70,17 @@ TrackedFrame FeatureTracker::track(int64_t utime, const cv::Mat& image, const Ma
   if (!first) followTracks(pyramid, R_cur_prev, &frame);
 
   cv::Mat half;  // the pyramid holds (image, gradient) per level: [2] is the half-resolution image
-  if (pyramid.size() > 2) half = pyramid[2];
-  else cv::pyrDown(grey, half);
+  if (pyramid.size() > 2)
+    half = pyramid[2];
+  else
+    cv::pyrDown(grey, half);
   frame.new_features = detect(half, &tracks_);
   frame.tracked = static_cast<int>(tracks_.size()) - frame.new_features;
 
   if (R_cur_prev) R_cur_keyframe_ = *R_cur_prev * R_cur_keyframe_;
   frame.parallax_px = parallaxSinceKeyframe(tracks_);
-  frame.keyframe = first || frame.tracked < options_.keyframe_min_tracked ||
-                   frame.parallax_px >= options_.keyframe_parallax_px;
+  frame.keyframe =
+      first || frame.tracked < options_.keyframe_min_tracked || frame.parallax_px >= options_.keyframe_parallax_px;
 
   const double dt = first ? 0.0 : 1e-6 * static_cast<double>(utime - prev_utime_);
   frame.features.reserve(tracks_.size());
@@ -108,7 +113,8 @@ void FeatureTracker::followTracks(const std::vector<cv::Mat>& pyramid, const Mat
   for (const Track& t : tracks_) {
     prev_pts.push_back(t.pixel);
     Eigen::Vector2d predicted;
-    if (R_cur_prev && camera_.project(*R_cur_prev * camera_.pixelRay(Eigen::Vector2d(t.pixel.x, t.pixel.y)), &predicted))
+    if (R_cur_prev &&
+        camera_.project(*R_cur_prev * camera_.pixelRay(Eigen::Vector2d(t.pixel.x, t.pixel.y)), &predicted))
       cur_pts.emplace_back(static_cast<float>(predicted.x()), static_cast<float>(predicted.y()));
     else
       cur_pts.push_back(t.pixel);
@@ -168,7 +174,8 @@ std::vector<uint8_t> FeatureTracker::epipolarInliers(const std::vector<Eigen::Ve
   for (size_t i = 0; i < from.size(); ++i) a.push_back(onPinhole(from[i])), b.push_back(onPinhole(to[i]));
   // OpenCV's RANSAC draws from a fixed seed: the same input gives the same inliers.
   std::vector<uint8_t> mask;
-  const cv::Mat F = cv::findFundamentalMat(a, b, cv::FM_RANSAC, options_.ransac_threshold_px, options_.ransac_confidence, mask);
+  const cv::Mat F =
+      cv::findFundamentalMat(a, b, cv::FM_RANSAC, options_.ransac_threshold_px, options_.ransac_confidence, mask);
   if (!F.empty() && mask.size() == from.size()) inlier = mask;
   return inlier;
 }

@@ -17,7 +17,10 @@ namespace {
 class ReprojectionCost : public ceres::SizedCostFunction<2, 4, 3, 4, 3, 1> {
  public:
   ReprojectionCost(const Vec2& xy_a, const Vec2& xy_j, const Pose3& T_I_C, double weight)
-      : ray_a_(xy_a.x(), xy_a.y(), 1.0), xy_j_(xy_j), R_IC_(T_I_C.linear()), t_IC_(T_I_C.translation()),
+      : ray_a_(xy_a.x(), xy_a.y(), 1.0),
+        xy_j_(xy_j),
+        R_IC_(T_I_C.linear()),
+        t_IC_(T_I_C.translation()),
         weight_(weight) {}
 
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override {
@@ -51,8 +54,7 @@ class ReprojectionCost : public ceres::SizedCostFunction<2, 4, 3, 4, 3, 1> {
       Eigen::Map<RowJ4>{jacobians[2]} = J * tangentToAmbient(x[2]);
     }
     if (jacobians[3]) Eigen::Map<RowJ3>{jacobians[3]} = -J_proj * R_CI_R_jW;
-    if (jacobians[4])
-      Eigen::Map<Eigen::Vector2d>{jacobians[4]} = J_proj * (R_CI_R_jW * R_a * R_IC_ * (-P_Ca / rho));
+    if (jacobians[4]) Eigen::Map<Eigen::Vector2d>{jacobians[4]} = J_proj * (R_CI_R_jW * R_a * R_IC_ * (-P_Ca / rho));
     return true;
   }
 

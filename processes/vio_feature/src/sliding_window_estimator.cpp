@@ -56,13 +56,13 @@ struct SlidingWindowEstimator::Feature {
   struct Observation {
     Frame* frame;
     Vec2 xy;
-    double depth;  // measured, 0: none
+    double depth;                               // measured, 0: none
     std::unique_ptr<ceres::CostFunction> cost;  // reprojection from the anchor (null for the anchor)
   };
   std::vector<Observation> obs;
   double rho[1] = {0.0};
   bool has_rho = false;
-  bool in_graph = false;   // was in the last optimisation (its factors then go into a marginal prior)
+  bool in_graph = false;  // was in the last optimisation (its factors then go into a marginal prior)
   std::unique_ptr<ceres::CostFunction> depth_prior;  // the anchor's measured depth
 
   Frame* anchor() const { return obs.front().frame; }
@@ -74,7 +74,9 @@ constexpr double kStillWheelSpeed = 0.02;  // m/s: a wheel turning slower than t
 
 double depthSigma(const SlidingWindowOptions& o, double d) { return o.depth_sigma_base + o.depth_sigma_relative * d; }
 
-bool validDepth(const SlidingWindowOptions& o, double d) { return std::isfinite(d) && d >= o.min_depth && d <= o.max_depth; }
+bool validDepth(const SlidingWindowOptions& o, double d) {
+  return std::isfinite(d) && d >= o.min_depth && d <= o.max_depth;
+}
 
 template <class Sample>
 bool pushSample(std::deque<Sample>* buf, const Sample& s, bool finite, const char* what, std::string* why) {
@@ -102,8 +104,9 @@ SlidingWindowEstimator::~SlidingWindowEstimator() = default;
 bool SlidingWindowEstimator::addImu(const ImuSample& s, std::string* why) {
   if (!pushSample(&imu_, s, s.gyro.allFinite() && s.accel.allFinite(), "IMU sample", why)) return false;
   // keep what the oldest state and the initialisation windows may still need
-  const int64_t keep = window_.empty() ? s.utime - toUtime(std::max(opts_.init.window_s, opts_.moving_init_window_s) + 1.0)
-                                       : window_.back()->utime - toUtime(1.0);
+  const int64_t keep = window_.empty()
+                           ? s.utime - toUtime(std::max(opts_.init.window_s, opts_.moving_init_window_s) + 1.0)
+                           : window_.back()->utime - toUtime(1.0);
   while (imu_.size() > 2 && imu_[1].utime <= keep) imu_.pop_front();
   return true;
 }
@@ -111,8 +114,8 @@ bool SlidingWindowEstimator::addImu(const ImuSample& s, std::string* why) {
 bool SlidingWindowEstimator::addWheel(const WheelSample& s, std::string* why) {
   if (!pushSample(&wheel_, s, std::isfinite(s.left_speed) && std::isfinite(s.right_speed), "wheel reading", why))
     return false;
-  const int64_t keep = window_.empty() ? s.utime - toUtime(opts_.moving_init_window_s + 1.0)
-                                       : window_.back()->utime - toUtime(1.0);
+  const int64_t keep =
+      window_.empty() ? s.utime - toUtime(opts_.moving_init_window_s + 1.0) : window_.back()->utime - toUtime(1.0);
   while (wheel_.size() > 2 && wheel_[1].utime <= keep) wheel_.pop_front();
   return true;
 }
@@ -218,7 +221,8 @@ bool SlidingWindowEstimator::initialize(int64_t t, const FrameFeatures& frame, F
   if (wheels_turn) return initializeMoving(t, res);
   if (initializeAtRest(t, camera_still, res)) return true;
   if (opts_.use_wheel && initializeMoving(t, res)) return true;
-  if (res->note.empty()) res->note = opts_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
+  if (res->note.empty())
+    res->note = opts_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
   return false;
 }
 
@@ -246,7 +250,8 @@ bool SlidingWindowEstimator::initializeAtRest(int64_t t, bool camera_still, Fram
               init.static_vel_std, 0.002 + gyro_mean_std);
   res->static_start = true;
   res->note = "initialised at rest";
-  if (camera_still && !isStill(window, opts_.init)) res->note = "initialised at rest (the images still, the IMU shaking)";
+  if (camera_still && !isStill(window, opts_.init))
+    res->note = "initialised at rest (the images still, the IMU shaking)";
   return true;
 }
 
@@ -372,8 +377,8 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
     std::copy(from.ba, from.ba + 3, to.ba);
   }
   to.imu.reset(makeImuFactor(pre, gravity_W_));
-  to.bias_walk.reset(makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk,
-                                        pre.duration()));
+  to.bias_walk.reset(
+      makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk, pre.duration()));
   to.wheel.reset();
   to.wheel_loss.reset();
   if (opts_.use_wheel) {
@@ -384,8 +389,10 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
     WheelPreintegration wp(opts_.wheel_rig, opts_.wheel_noise);
     for (size_t k = 0; ok && k + 1 < w.size(); ++k) {
       const double dt = toSeconds(w[k + 1].utime - w[k].utime);
-      if (dt > opts_.max_wheel_gap_s) ok = false;
-      else wp.integrate(w[k].left_speed, w[k].right_speed, w[k + 1].left_speed, w[k + 1].right_speed, dt);
+      if (dt > opts_.max_wheel_gap_s)
+        ok = false;
+      else
+        wp.integrate(w[k].left_speed, w[k].right_speed, w[k + 1].left_speed, w[k + 1].right_speed, dt);
     }
     if (ok && wp.duration() > 0.0) {
       to.wheel.reset(makeWheelFactor(wp, {estimatesWheelScale(), estimatesWheelMounting()}));
@@ -417,8 +424,8 @@ void SlidingWindowEstimator::addObservations(Frame& frame, const FrameFeatures& 
     Feature& ft = *it->second;
     if (ft.obs.back().frame == &frame) continue;  // the same id twice in one image
     ft.obs.push_back({&frame, m.xy, depth,
-                      std::unique_ptr<ceres::CostFunction>(makeReprojectionFactor(
-                          ft.obs.front().xy, m.xy, opts_.T_I_C, focal, opts_.pixel_sigma))});
+                      std::unique_ptr<ceres::CostFunction>(
+                          makeReprojectionFactor(ft.obs.front().xy, m.xy, opts_.T_I_C, focal, opts_.pixel_sigma))});
   }
 }
 
@@ -461,7 +468,8 @@ std::vector<SlidingWindowEstimator::Feature*> SlidingWindowEstimator::graphFeatu
     if (ft->has_rho && ft->obs.size() >= 2) out.push_back(ft.get());
   }
   // longest tracks first (ties by id: deterministic), at most max_features
-  std::stable_sort(out.begin(), out.end(), [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
   if (static_cast<int>(out.size()) > opts_.max_features) out.resize(opts_.max_features);
   for (Feature* ft : out) ft->in_graph = true;
   return out;
@@ -580,7 +588,8 @@ void SlidingWindowEstimator::dropSecondNewest() {
   // its observations go; features anchored there move to their next observation
   std::vector<uint64_t> gone;
   for (auto& [id, ft] : features_) {
-    auto it = std::find_if(ft->obs.begin(), ft->obs.end(), [&](const Feature::Observation& o) { return o.frame == &s; });
+    auto it =
+        std::find_if(ft->obs.begin(), ft->obs.end(), [&](const Feature::Observation& o) { return o.frame == &s; });
     if (it == ft->obs.end()) continue;
     if (it != ft->obs.begin()) {
       ft->obs.erase(it);
@@ -607,8 +616,8 @@ void SlidingWindowEstimator::dropSecondNewest() {
                               ? makeInverseDepthPrior(ft->obs.front().depth, depthSigma(opts_, ft->obs.front().depth))
                               : nullptr);
     for (size_t k = 1; k < ft->obs.size(); ++k)
-      ft->obs[k].cost.reset(makeReprojectionFactor(ft->obs.front().xy, ft->obs[k].xy, opts_.T_I_C, opts_.focal,
-                                                   opts_.pixel_sigma));
+      ft->obs[k].cost.reset(
+          makeReprojectionFactor(ft->obs.front().xy, ft->obs[k].xy, opts_.T_I_C, opts_.focal, opts_.pixel_sigma));
   }
   for (uint64_t id : gone) features_.erase(id);
   // the IMU and wheel intervals merge: [e, s] + [s, c] becomes [e, c]

@@ -95,20 +95,19 @@ void printOptions(const VioFeatureNodeOptions& n, std::ostream& os) {
   os << "[" << n.name << "] inputs " << n.imu_channel << ", " << n.camera_channel
      << (core.use_depth_image ? ", " + n.depth_channel : std::string())
      << (w.use_wheel ? ", " + n.wheel_channel : std::string())
-     << (core.use_lidar_depth ? ", " + n.registered_scan_channel : std::string()) << "; outputs " << n.visual_state_channel
-     << ", " << n.odometry_channel << "\n"
+     << (core.use_lidar_depth ? ", " + n.registered_scan_channel : std::string()) << "; outputs "
+     << n.visual_state_channel << ", " << n.odometry_channel << "\n"
      << "  camera " << core.camera.width << "x" << core.camera.height << " ("
      << distortionModelName(core.camera.distortion_model) << "); KLT " << core.tracker.max_features << " corners "
      << core.tracker.min_distance_px << " px apart, keyframes at " << core.tracker.keyframe_parallax_px
      << " px parallax\n"
      << "  window " << w.window_frames << " states, " << w.max_features << " features, " << w.solver_iterations
      << " solver iterations; factors: reprojection (sigma " << w.pixel_sigma << " px), IMU preintegration, bias walk"
-     << (w.use_wheel ? ", " + wheelFactorText(w.wheel_rig, w.wheel_scale_std) : std::string())
-     << "; depth from "
+     << (w.use_wheel ? ", " + wheelFactorText(w.wheel_rig, w.wheel_scale_std) : std::string()) << "; depth from "
      << (core.use_depth_image && core.use_lidar_depth ? "the depth image and the LiDAR"
-         : core.use_depth_image                          ? "the depth image"
-         : core.use_lidar_depth                          ? "the LiDAR"
-                                                         : "triangulation only")
+         : core.use_depth_image                       ? "the depth image"
+         : core.use_lidar_depth                       ? "the LiDAR"
+                                                      : "triangulation only")
      << "\n";
 }
 

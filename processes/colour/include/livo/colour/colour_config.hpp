@@ -20,7 +20,7 @@ struct ColourNodeOptions {
   std::string loop_correction_channel = "LOOP_CORRECTION";
   std::string colored_cloud_channel = "COLORED_CLOUD";
   std::string colour_save_channel = "COLOUR_SAVE";  // any message here writes the map files now
-  std::string map_name = "colour_map";       // files <output_dir>/<map_name>.ply / .pcd
+  std::string map_name = "colour_map";              // files <output_dir>/<map_name>.ply / .pcd
   // COLORED_CLOUD is split into messages of at most this many points (~15 bytes each): a loop
   // correction that moves the whole map must not become one message of tens of MB, which a UDP
   // bus loses (design.md, pitfalls).

@@ -30,9 +30,9 @@ namespace livo::colour {
 struct MapPoint {
   Eigen::Vector3f position = Eigen::Vector3f::Zero();  // world frame
   Eigen::Vector3f colour = Eigen::Vector3f::Zero();    // running mean, 0..255 (exposure-normalised)
-  int32_t count = 0;           // accepted observations
-  int32_t rejected = 0;        // observations refused as outliers (-1: a free slot)
-  int64_t anchor = -1;         // keyframe id it moves with (-1: none)
+  int32_t count = 0;                                   // accepted observations
+  int32_t rejected = 0;                                // observations refused as outliers (-1: a free slot)
+  int64_t anchor = -1;                                 // keyframe id it moves with (-1: none)
   bool coloured() const { return count > 0; }
   bool live() const { return rejected >= 0; }
 };
@@ -44,8 +44,8 @@ struct AccumulationOptions {
 };
 
 struct TileOptions {
-  double tile_size = 16.0;  // m, rounded to whole voxels
-  double idle_s = 10.0;     // sensor time without a new point before a tile goes to disk (0: never)
+  double tile_size = 16.0;      // m, rounded to whole voxels
+  double idle_s = 10.0;         // sensor time without a new point before a tile goes to disk (0: never)
   std::string spill_directory;  // "" : the temp directory
   /// Resident points above which the least recently used tiles go to disk before they are idle_s
   /// idle (0: no limit), but none used within the last `min_idle_s` (the scans an image may still
@@ -163,7 +163,7 @@ class ColourMap {
     // voxels may repeat: merged when it comes back)
     std::vector<SpillFile::Record> records;
     size_t spilled_coloured = 0;
-    uint64_t epoch = 0;             // transform()s before its first record was written (behind epoch_: stale)
+    uint64_t epoch = 0;  // transform()s before its first record was written (behind epoch_: stale)
   };
 
   struct Voxel {
@@ -211,7 +211,7 @@ class ColourMap {
   std::vector<uint32_t> remap_;
   std::vector<uint64_t> batch_keys_, batch_tiles_;  // addPoints' working set, kept between scans
   std::vector<uint32_t> moved_on_reload_;
-  uint64_t epoch_ = 0;                          // transform()s so far
+  uint64_t epoch_ = 0;  // transform()s so far
   size_t evicted_for_memory_ = 0;
 };
 

@@ -22,13 +22,13 @@
 #include <vector>
 
 #include "livo/camera_projection.hpp"
-#include "livo/map_inputs.hpp"
 #include "livo/colour/colour_image.hpp"
 #include "livo/colour/colour_map.hpp"
 #include "livo/colour/colour_options.hpp"
 #include "livo/colour/depth_buffer.hpp"
 #include "livo/colour/pose_history.hpp"
 #include "livo/colour/view_cone.hpp"
+#include "livo/map_inputs.hpp"
 
 namespace livo::colour {
 
@@ -45,7 +45,7 @@ struct ColouringStats {
   int64_t scans = 0, points_in = 0, points_rejected = 0;
   int64_t points_out_of_reach = 0;  // beyond max_depth + map_margin from the body: not mapped
   int64_t points_out_of_view = 0;   // outside the widened view cone (map_only_in_view): not mapped
-  int64_t points_pruned = 0;  // left the map uncoloured once no image could colour them any more
+  int64_t points_pruned = 0;        // left the map uncoloured once no image could colour them any more
   int64_t images = 0, images_without_pose = 0, images_dropped = 0;  // dropped: waited beyond max_pending_images
   int64_t projected = 0, occluded = 0, accepted = 0, outliers = 0;
   int64_t gain_estimates = 0;
@@ -114,7 +114,7 @@ class ColouringPipeline {
   ColourMap map_;
   PoseHistory poses_;
   std::deque<ActiveScan> active_;
-  std::deque<ColourImage> images_;  // time order
+  std::deque<ColourImage> images_;                          // time order
   std::map<int64_t, std::pair<int64_t, Pose3>> keyframes_;  // id -> (utime, pose the map is in)
   int64_t last_scan_utime_ = INT64_MIN, last_image_utime_ = INT64_MIN;
   int64_t newest_scan_end_ = INT64_MIN;
@@ -144,9 +144,9 @@ class ColouringPipeline {
   std::vector<uint32_t> sampled_ids_;
   std::vector<Eigen::Vector3f> observed_, gain_observed_, gain_mapped_;
   std::vector<std::pair<uint32_t, int64_t>> spare_points_;  // a dropped scan's buffer, for the next
-  std::vector<int> accepted_;  // the scan's points the map takes: their indices, ...
-  std::vector<Eigen::Vector3f> accepted_points_;  // ... positions ...
-  std::vector<uint32_t> accepted_ids_;            // ... and map ids
+  std::vector<int> accepted_;                               // the scan's points the map takes: their indices, ...
+  std::vector<Eigen::Vector3f> accepted_points_;            // ... positions ...
+  std::vector<uint32_t> accepted_ids_;                      // ... and map ids
   // map reads are started this many points ahead of their use (the map and its index are far
   // larger than the cache)
   static constexpr size_t kReadAhead = 8;

@@ -14,7 +14,7 @@ struct DepthBufferOptions {
   int cell_px = 4;
   double occluder_radius = 0.06;  // m
   int max_splat_cells = 6;
-  double tolerance = 0.05;        // m
+  double tolerance = 0.05;  // m
   double tolerance_rel = 0.02;
 };
 

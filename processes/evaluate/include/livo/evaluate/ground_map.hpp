@@ -45,9 +45,9 @@ using GroundScanVisitor = std::function<void(const GroundScan&)>;
 using GroundScanSource = std::function<void(const GroundScanVisitor&)>;
 
 struct GroundMapOptions {
-  double cell_m = 0.5;      // side of the square cells (true x, y)
-  double band_m = 0.2;      // height of the ground layer above a cell's 5th percentile
-  double max_dt = 0.05;     // s: the ground-truth poses on either side of a scan's stamp at most this far
+  double cell_m = 0.5;            // side of the square cells (true x, y)
+  double band_m = 0.2;            // height of the ground layer above a cell's 5th percentile
+  double max_dt = 0.05;           // s: the ground-truth poses on either side of a scan's stamp at most this far
   Vec3 gt_offset = Vec3::Zero();  // body frame: the point the ground truth tracks (--gt-offset)
 
   /// Throws std::invalid_argument naming the offending option.

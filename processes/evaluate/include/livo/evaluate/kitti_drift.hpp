@@ -24,7 +24,7 @@ struct SegmentLengthDrift {
 };
 
 struct KittiDrift {
-  size_t segments = 0;  // 0: the path is shorter than the shortest segment
+  size_t segments = 0;         // 0: the path is shorter than the shortest segment
   double path_length_m = 0.0;  // ground-truth path over the associated poses
   double translation_percent = 0.0;
   double rotation_deg_per_m = 0.0;

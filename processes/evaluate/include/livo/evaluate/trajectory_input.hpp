@@ -15,7 +15,7 @@ class InputError : public std::runtime_error {
 };
 
 struct TrajectoryInput {
-  std::string spec;    // as given
+  std::string spec;  // as given
   std::string path;
   std::string format;  // "tum", "kitti", "euroc-csv", or "lcmlog CHANNEL (livo.pose_t)"
   Trajectory poses;

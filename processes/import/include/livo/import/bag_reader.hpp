@@ -21,7 +21,7 @@ class BagError : public std::runtime_error {
 struct BagConnection {
   uint32_t id = 0;
   std::string topic;
-  std::string type;                // e.g. "sensor_msgs/Imu"
+  std::string type;  // e.g. "sensor_msgs/Imu"
   std::string md5sum;
   std::string message_definition;
   std::string callerid;
@@ -29,11 +29,11 @@ struct BagConnection {
 
 struct BagMessage {
   const BagConnection* connection = nullptr;
-  int64_t record_time_ns = 0;      // the bag's receive time of the message
-  const uint8_t* data = nullptr;   // serialised ROS message
+  int64_t record_time_ns = 0;     // the bag's receive time of the message
+  const uint8_t* data = nullptr;  // serialised ROS message
   size_t size = 0;
-  int64_t record_number = 0;       // 1-based count of message records in the file
-  uint64_t chunk_offset = 0;       // file offset of the chunk (or record) holding the message
+  int64_t record_number = 0;  // 1-based count of message records in the file
+  uint64_t chunk_offset = 0;  // file offset of the chunk (or record) holding the message
 };
 
 class BagReader {

@@ -15,7 +15,6 @@ struct DecompressedChunk {
 };
 
 /// `expected_size` is the chunk record's uncompressed size.
-DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size,
-                                  size_t expected_size);
+DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size, size_t expected_size);
 
 }  // namespace livo::import

@@ -30,7 +30,7 @@ struct ImportJob {
   EurocImportOptions euroc;
   OusterImportOptions ouster;
   int64_t max_buffer_mb = 512;
-  bool quiet = false;  // no progress, no warnings on stderr
+  bool quiet = false;   // no progress, no warnings on stderr
   std::string rig_out;  // write a starter rig config here ("" = none)
   /// A rig to check the log against (its file name for messages; `rig` is read by the caller,
   /// who also takes its channel names for the job's).
@@ -43,8 +43,8 @@ struct ImportOutcome {
   std::map<std::string, int64_t> channel_counts;
   std::map<std::string, std::string> channel_types;
   bool wrote_log = false;
-  SensorSurvey survey;                    // what the messages showed of the sensors
-  std::vector<RigFinding> rig_findings;   // job.rig against the log, errors first
+  SensorSurvey survey;                   // what the messages showed of the sensors
+  std::vector<RigFinding> rig_findings;  // job.rig against the log, errors first
   bool ok() const { return wrote_log && report.errors().empty(); }
   bool rigFits() const { return rig_findings.empty() || !rig_findings.front().error; }
 };

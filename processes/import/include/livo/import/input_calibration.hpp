@@ -15,7 +15,7 @@ namespace livo::import {
 
 /// A pinhole camera's calibration in the rig's terms (livo::CameraRig).
 struct CameraIntrinsics {
-  int width = 0, height = 0;                 // the size the calibration is for
+  int width = 0, height = 0;  // the size the calibration is for
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
   DistortionModel distortion_model = DistortionModel::kRadtan;
   std::array<double, 4> distortion{{0.0, 0.0, 0.0, 0.0}};
@@ -42,9 +42,9 @@ struct InputCalibration {
   std::optional<CameraIntrinsics> camera;
   std::optional<ImuNoise> imu_noise;
   std::optional<KnownExtrinsic> T_I_L, T_I_C;
-  std::string lidar_model;         // a model the input names (Ouster prod_line), one of livo::kLidarModels; "" if none
+  std::string lidar_model;  // a model the input names (Ouster prod_line), one of livo::kLidarModels; "" if none
   std::string lidar_model_source;
-  std::string calibrated_rig;      // the project's calibrated rig for this dataset (a preset's), "" if none
+  std::string calibrated_rig;  // the project's calibrated rig for this dataset (a preset's), "" if none
 };
 
 /// The calibration of a CameraInfo message, nullopt for an uncalibrated camera (K[0] == 0, as

@@ -12,8 +12,8 @@ namespace livo::import {
 enum class LidarFamily { kVelodyne, kOuster, kHesai, kLivox };
 
 struct LidarModelFacts {
-  std::string model;        // as livo::kLidarModels names it
-  int rings = 0;            // beams (Livox: scan lines)
+  std::string model;  // as livo::kLidarModels names it
+  int rings = 0;      // beams (Livox: scan lines)
   bool solid_state = false;
   LidarFamily family = LidarFamily::kVelodyne;
   double max_range = 100.0;       // m

@@ -25,7 +25,7 @@ namespace livo::import {
 
 struct OusterImportOptions {
   ChannelNames channels;
-  std::string metadata_file;     // "" = <pcap without extension>.json, else the only .json beside it
+  std::string metadata_file;        // "" = <pcap without extension>.json, else the only .json beside it
   bool keep_partial_sweeps = true;  // sweeps missing packets (e.g. the capture's first and last)
   bool progress = true;
 };

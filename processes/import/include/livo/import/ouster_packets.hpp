@@ -26,7 +26,7 @@ struct OusterColumn {
   int64_t timestamp_ns = 0;
   int measurement_id = 0;
   bool valid = false;
-  std::vector<uint32_t> range_mm;      // per beam, 0 = no return
+  std::vector<uint32_t> range_mm;  // per beam, 0 = no return
   std::vector<uint16_t> reflectivity;
   std::vector<uint16_t> signal;
 };

@@ -24,16 +24,16 @@ struct UdpDatagram {
   uint32_t src_ip = 0, dst_ip = 0;
   uint16_t src_port = 0, dst_port = 0;
   std::vector<uint8_t> payload;
-  int64_t record_number = 0;    // 1-based pcap record of the last fragment
+  int64_t record_number = 0;  // 1-based pcap record of the last fragment
 };
 
 struct PcapStats {
   int64_t records = 0;
-  int64_t non_ipv4 = 0;            // frames that are not IPv4 (ARP, IPv6, ...)
-  int64_t non_udp = 0;             // IPv4 but not UDP
-  int64_t fragments = 0;           // IPv4 fragments seen
+  int64_t non_ipv4 = 0;              // frames that are not IPv4 (ARP, IPv6, ...)
+  int64_t non_udp = 0;               // IPv4 but not UDP
+  int64_t fragments = 0;             // IPv4 fragments seen
   int64_t incomplete_datagrams = 0;  // fragment sets never completed
-  int64_t truncated_records = 0;   // captured shorter than on the wire (snaplen)
+  int64_t truncated_records = 0;     // captured shorter than on the wire (snaplen)
 };
 
 class PcapReader {
@@ -59,7 +59,8 @@ class PcapReader {
     uint32_t total = 0;                              // known once the last fragment arrived
     int64_t first_record = 0;
   };
-  void handleFrame(const uint8_t* data, size_t size, int64_t time_ns, const std::function<void(const UdpDatagram&)>& fn);
+  void handleFrame(const uint8_t* data, size_t size, int64_t time_ns,
+                   const std::function<void(const UdpDatagram&)>& fn);
   void handleIpv4(const uint8_t* data, size_t size, int64_t time_ns, const std::function<void(const UdpDatagram&)>& fn);
   void deliverUdp(uint32_t src, uint32_t dst, const uint8_t* data, size_t size, int64_t time_ns,
                   const std::function<void(const UdpDatagram&)>& fn);

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "livo/point_cloud_t.hpp"
 #include "livo/import/ros_messages.hpp"
+#include "livo/point_cloud_t.hpp"
 
 namespace livo::import {
 
@@ -57,7 +57,7 @@ struct PointCloudConversion {
   point_cloud_t cloud;
   int64_t non_finite_points = 0;
   int64_t zero_points = 0;
-  std::string layout;      // e.g. "x y z intensity t(uint32 ns, relative) ring"
+  std::string layout;  // e.g. "x y z intensity t(uint32 ns, relative) ring"
 };
 
 /// Throws DecodeError naming `where` and the field for a missing coordinate field, a field

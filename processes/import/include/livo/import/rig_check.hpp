@@ -22,7 +22,8 @@ struct RigFinding {
 };
 
 /// Findings, errors first. `rig_file` names the rig in the messages.
-std::vector<RigFinding> checkRigAgainstLog(const SensorRig& rig, const std::string& rig_file, const SensorSurvey& survey,
-                                           const InputCalibration& calibration, const ChannelNames& written);
+std::vector<RigFinding> checkRigAgainstLog(const SensorRig& rig, const std::string& rig_file,
+                                           const SensorSurvey& survey, const InputCalibration& calibration,
+                                           const ChannelNames& written);
 
 }  // namespace livo::import

@@ -32,19 +32,19 @@ struct ImuSurvey {
 
 struct LidarSurvey {
   MeasuredRate rate;
-  int rings = 0;                 // the largest num_rings of a sweep (else the largest ring + 1)
-  bool solid_state = false;      // any sweep marked PATTERN_SOLID_STATE
-  double sweep_duration_s = 0.0; // median sweep_duration
-  bool point_times = false;      // some point has a time offset > 0
+  int rings = 0;                  // the largest num_rings of a sweep (else the largest ring + 1)
+  bool solid_state = false;       // any sweep marked PATTERN_SOLID_STATE
+  double sweep_duration_s = 0.0;  // median sweep_duration
+  bool point_times = false;       // some point has a time offset > 0
   int64_t median_points = 0;
 };
 
 struct CameraSurvey {
   MeasuredRate rate;
-  int width = 0, height = 0;     // of the first image
-  int other_sizes = 0;           // images of another size than the first
-  std::string encoding;          // GRAY8, RGB8, BGR8, JPEG, PNG
-  int channels = 0;              // 1 grey, 3 colour, 0 unknown (a compressed header cut short)
+  int width = 0, height = 0;  // of the first image
+  int other_sizes = 0;        // images of another size than the first
+  std::string encoding;       // GRAY8, RGB8, BGR8, JPEG, PNG
+  int channels = 0;           // 1 grey, 3 colour, 0 unknown (a compressed header cut short)
 };
 
 struct SensorSurvey {

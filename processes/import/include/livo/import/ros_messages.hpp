@@ -81,7 +81,7 @@ struct RosCameraInfo {
   uint32_t height = 0, width = 0;
   std::string distortion_model;  // plumb_bob, rational_polynomial, equidistant, ...
   std::vector<double> D;
-  std::array<double, 9> K{};     // row-major [fx 0 cx; 0 fy cy; 0 0 1]
+  std::array<double, 9> K{};  // row-major [fx 0 cx; 0 fy cy; 0 0 1]
   uint32_t binning_x = 0, binning_y = 0;
   uint32_t roi_x_offset = 0, roi_y_offset = 0, roi_height = 0, roi_width = 0;
 };

@@ -26,12 +26,12 @@ struct RosbagImportOptions {
   // the one in the camera topic's namespace (/a/b/image_raw -> /a/b/camera_info).
   std::string camera_info_topic;
   bool auto_map = true;
-  std::string ground_truth_file;              // TUM / EuRoC csv instead of a topic
+  std::string ground_truth_file;  // TUM / EuRoC csv instead of a topic
   std::string ground_truth_child_frame = "I";
   ChannelNames channels;
   PointCloudConversionOptions lidar;
   ImuUnitOptions imu_units;
-  bool use_bag_time = false;                  // stamp by the bag's receive time, not header.stamp
+  bool use_bag_time = false;  // stamp by the bag's receive time, not header.stamp
   bool progress = true;
 };
 

@@ -19,9 +19,9 @@
 // measures jointly with the axis as if the position along it were known: in a featureless
 // corridor (tests/lio, CorridorFlagsDegeneracyWithoutDiverging) the two or three rows a sweep has
 // along it then tilt the attitude, the tilt leaks gravity into the acceleration along the axis,
-// and a bias-free IMU ended 0.19 of the distance off where it now ends 0.04. Removing the eigenvector of the full 6x6 G is not
-// enough: noisy normals couple the corridor's axis to a small rotation, and through the large
-// rotational information of far points that leaves the axis centimetre-level "information".
+// and a bias-free IMU ended 0.19 of the distance off where it now ends 0.04. Removing the eigenvector of the full 6x6 G
+// is not enough: noisy normals couple the corridor's axis to a small rotation, and through the large rotational
+// information of far points that leaves the axis centimetre-level "information".
 #pragma once
 
 #include "livo/so3.hpp"
@@ -29,11 +29,11 @@
 namespace livo::lio {
 
 struct DegeneracyReport {
-  Vec3 rotation_eigenvalues = Vec3::Zero();     // ascending, of G's rotation block
-  Vec3 translation_eigenvalues = Vec3::Zero();  // ascending, of G's translation block
-  Mat3 rotation_directions = Mat3::Identity();  // columns: body-frame axes (right perturbation)
+  Vec3 rotation_eigenvalues = Vec3::Zero();        // ascending, of G's rotation block
+  Vec3 translation_eigenvalues = Vec3::Zero();     // ascending, of G's translation block
+  Mat3 rotation_directions = Mat3::Identity();     // columns: body-frame axes (right perturbation)
   Mat3 translation_directions = Mat3::Identity();  // columns: world-frame directions
-  int degenerate_rotations = 0;     // eigenvalues below the threshold, per block
+  int degenerate_rotations = 0;                    // eigenvalues below the threshold, per block
   int degenerate_translations = 0;
   bool degenerate = false;
   Vec6 weakest_direction = Vec6::Zero();  // [rotation; translation] of the smallest eigenvalue

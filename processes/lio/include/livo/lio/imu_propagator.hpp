@@ -30,9 +30,9 @@ struct ImuNoise {
   // diagonal of gyro_scale_std and its off-diagonal of gyro_misalignment_std. Between two updates that
   // correct the attitude (the LiDAR sweeps, systematic_error_window_s apart) it adds up to M w T, so the
   // propagation adds a rate noise of density^2 = var(M w) T: the attitude spread grows by the turn.
-  double gyro_scale_std = 0.0;            // relative
-  double gyro_misalignment_std = 0.0;     // rad
-  double systematic_error_window_s = 0.1; // s, the LiDAR sweep period
+  double gyro_scale_std = 0.0;             // relative
+  double gyro_misalignment_std = 0.0;      // rad
+  double systematic_error_window_s = 0.1;  // s, the LiDAR sweep period
   // The accelerometer's (rig.imu.accel_scale_std, accel_misalignment_std): used only where the
   // axes are modelled as states (ImuIntrinsics); the noise budget above is the gyro's alone.
   double accel_scale_std = 0.0;
@@ -51,8 +51,8 @@ FilterState propagateState(const FilterState& x, const Vec3& gyro, const Vec3& a
 
 /// F_x = ∂δx_{i+1}/∂δx_i and F_w = ∂δx_{i+1}/∂w_i (eq. 8), w = [n_w n_a n_bw n_ba]; with `Fm`,
 /// also ∂δx_{i+1}/∂(intrinsics) (the navigation rows; the intrinsics are constant).
-void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx,
-                          Mat18x12* Fw, const ImuIntrinsics& intrinsics = {}, IntrinsicsJacobian* Fm = nullptr);
+void propagationJacobians(const FilterState& x, const Vec3& gyro, const Vec3& accel, double dt, Mat18* Fx, Mat18x12* Fw,
+                          const ImuIntrinsics& intrinsics = {}, IntrinsicsJacobian* Fm = nullptr);
 
 /// Covariance of the discrete noise w_i over a step of dt: density^2 / dt per axis; the gyro's part
 /// grows with the bias-corrected rate `omega` when the scale or misalignment error is modelled.
@@ -140,8 +140,8 @@ class ImuPropagator {
   FilterState x_;
   StateCovariance P_ = StateCovariance::Identity();
   CloneCrossCovariance clone_cross_ = CloneCrossCovariance::Zero();
-  bool model_intrinsics_ = false;  // modelled (considered or estimated)
-  bool update_intrinsics_ = false;    // estimated
+  bool model_intrinsics_ = false;   // modelled (considered or estimated)
+  bool update_intrinsics_ = false;  // estimated
   ImuIntrinsics intrinsics_;
   ImuIntrinsics::Covariance intrinsics_cov_ = ImuIntrinsics::Covariance::Zero();
   Eigen::Matrix<double, FilterState::kDim, ImuIntrinsics::kDim> intrinsics_cross_ =

@@ -27,8 +27,7 @@ struct KeyframeClone {
 /// relative pose = (R Exp(phi), t + R tau) to first order, livo-loop's convention for its edges),
 /// from the filter's errors of the two poses ([rotation, right; position, world] each): their
 /// covariances and Cov(δb, δa).
-Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb,
-                            const Mat6& P_ba);
+Mat6 relativePoseCovariance(const Pose3& T_a, const Pose3& T_b, const Mat6& P_aa, const Mat6& P_bb, const Mat6& P_ba);
 
 /// What the filter's covariance cannot contain: calibration it holds at the rig's values (the
 /// parts of rig.lidar.calibration_std that livo-lio does not estimate; the gyro's scale and axis

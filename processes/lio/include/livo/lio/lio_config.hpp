@@ -44,22 +44,22 @@ struct LioNodeOptions {
   // Where calibration.csv and calibration.yaml go at exit (LioNode::writeCalibrationFiles; "" none)
   std::string output_dir;
 
-  double clock_reset_s = 1.0;          // an IMU stamp this far before the last one resets the node
-  double clock_jump_s = 1.0;           // an IMU stamp this far after the newest is a clock jump
+  double clock_reset_s = 1.0;  // an IMU stamp this far before the last one resets the node
+  double clock_jump_s = 1.0;   // an IMU stamp this far after the newest is a clock jump
   // (either way a jumping stamp is used only once the next sample confirms the new clock: a
   // single corrupted stamp is dropped instead of resetting or stalling the filter)
   // IMU samples beyond a MEMS IMU's range are corrupted, not motion (finite garbage would otherwise
   // be integrated): refused. Defaults: 2000 deg/s and 16 g, the widest common full-scale settings.
   double imu_max_angular_velocity = 35.0;  // rad/s
   double imu_max_acceleration = 160.0;     // m/s^2
-  int max_pending_scans = 50;          // sweeps waiting for IMU; older ones are dropped beyond this
+  int max_pending_scans = 50;              // sweeps waiting for IMU; older ones are dropped beyond this
 
   // Camera hand-off (design.md): at each image time publish STATE_PRIOR and adopt the
   // STATE_POSTERIOR that answers it; nothing later than the image is processed meanwhile.
   bool camera_handoff = false;
-  double camera_time_offset_s = 0.0;   // rig.camera.time_offset_s: image utime + offset = IMU time
-  double camera_rate_hz = 20.0;        // rig.camera.rate_hz: when the next image is due
-  double posterior_max_wait_s = 0.1;   // IMU time past an image after which lio goes on without its posterior
+  double camera_time_offset_s = 0.0;  // rig.camera.time_offset_s: image utime + offset = IMU time
+  double camera_rate_hz = 20.0;       // rig.camera.rate_hz: when the next image is due
+  double posterior_max_wait_s = 0.1;  // IMU time past an image after which lio goes on without its posterior
   // An image is handed off once a sweep ending at or after it has arrived (so every sweep ending
   // before it is registered first), or once the IMU has run this far past it (the LiDAR is late or
   // gone). At least a sweep period plus the LiDAR driver's latency: a sweep arrives when it ends.

@@ -23,9 +23,9 @@ namespace livo::lio {
 
 struct Keyframe {
   int64_t id = 0;
-  int64_t utime = 0;                  // IMU clock
-  Pose3 pose = Pose3::Identity();     // W_T_I
-  Mat6 pose_covariance = Mat6::Zero();// [rotation; position]
+  int64_t utime = 0;                    // IMU clock
+  Pose3 pose = Pose3::Identity();       // W_T_I
+  Mat6 pose_covariance = Mat6::Zero();  // [rotation; position]
   /// The odometry increment from keyframe relative_to_id (the previous one of the epoch; -1: none,
   /// the first keyframe or the first after an IMU re-initialisation) to this one: covariance of
   /// the right perturbation of T_prev^-1 T_this ([rotation; translation in this frame]), from the
@@ -34,8 +34,8 @@ struct Keyframe {
   int64_t relative_to_id = -1;
   Mat6 relative_covariance = Mat6::Zero();
   Mat6 relative_covariance_held_calibration = Mat6::Zero();
-  std::vector<Vec3> cloud;            // body frame I, downsampled
-  std::vector<float> intensity;       // one per cloud point, from the input sweep (0 if it had none)
+  std::vector<Vec3> cloud;       // body frame I, downsampled
+  std::vector<float> intensity;  // one per cloud point, from the input sweep (0 if it had none)
 };
 
 struct ScanResult {
@@ -49,15 +49,15 @@ struct ScanResult {
   Status status = Status::kRejected;
   std::string message;  // what went wrong or was worked around (empty if nothing)
 
-  int64_t utime = 0;  // end of the sweep, IMU clock: the time of state and points
+  int64_t utime = 0;              // end of the sweep, IMU clock: the time of state and points
   int64_t sweep_start_utime = 0;  // start of the sweep, IMU clock (input utime + extrinsic time offset)
   FilterState state;
   StateCovariance covariance = StateCovariance::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
 
-  int num_points = 0;       // valid points of the sweep
-  int num_registered = 0;   // after downsampling
-  int num_residuals = 0;    // point-to-plane residuals of the last iterate
+  int num_points = 0;                  // valid points of the sweep
+  int num_registered = 0;              // after downsampling
+  int num_residuals = 0;               // point-to-plane residuals of the last iterate
   size_t map_points_seen_through = 0;  // map points this sweep's beams removed (SeenThroughOptions)
   int iterations = 0;
   bool converged = false;
@@ -129,9 +129,7 @@ class LioEstimator {
   size_t undistortionSegments() const { return prop_.segments().size(); }
   /// The stamp of the oldest IMU sample waiting for a sweep (INT64_MAX: none): once a sample
   /// max_imu_backlog_s after it is added, the filter propagates the backlog on its own.
-  int64_t oldestQueuedImu() const {
-    return imu_.empty() ? std::numeric_limits<int64_t>::max() : imu_.front().utime;
-  }
+  int64_t oldestQueuedImu() const { return imu_.empty() ? std::numeric_limits<int64_t>::max() : imu_.front().utime; }
 
   /// Camera hand-off: propagates the filter with the added IMU samples to `utime` (STATE_PRIOR).
   bool propagateTo(int64_t utime, std::string* why = nullptr);
@@ -193,8 +191,9 @@ class LioEstimator {
   void reseedAfterOutage(int64_t t_end, FilterState* x, StateCovariance* P, std::string* note);
   /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis. `reg` was
   /// undistorted through `undistorted_with` (the LiDAR's calibration before any update of this sweep).
-  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid, const SensorCalibration& undistorted_with,
-                                FilterState* x, StateCovariance* P, ScanResult* res);
+  ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid,
+                                const SensorCalibration& undistorted_with, FilterState* x, StateCovariance* P,
+                                ScanResult* res);
   /// The iterated point-to-plane update (and the no-time-passed hypothesis after a bridged gap).
   ScanResult::Status registerSweep(const std::vector<Vec3>& reg, const SensorCalibration& undistorted_with,
                                    FilterState* x, StateCovariance* P, ScanResult* res);
@@ -248,7 +247,7 @@ class LioEstimator {
   bool has_wheel_ = false;
   WheelScaleEstimator wheel_scale_;
   WheelCounts wheel_counts_;
-  bool has_scale_anchor_ = false;       // the last sweep starts a wheel-scale interval
+  bool has_scale_anchor_ = false;  // the last sweep starts a wheel-scale interval
   Pose3 scale_anchor_pose_ = Pose3::Identity();
   int64_t scale_anchor_utime_ = 0;
   Vec3 last_prune_position_ = Vec3::Zero();
@@ -258,9 +257,9 @@ class LioEstimator {
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
   // addScan's per-sweep buffers (kept for their capacity: a 64-beam sweep's are megabytes)
-  std::vector<size_t> valid_;  // indices of the valid input points
-  std::vector<Vec3> body_;     // those points undistorted, body frame at the sweep end
-  std::vector<Vec3> reg_;      // the registration subset of body_
+  std::vector<size_t> valid_;      // indices of the valid input points
+  std::vector<Vec3> body_;         // those points undistorted, body frame at the sweep end
+  std::vector<Vec3> reg_;          // the registration subset of body_
   Vec3 body_rate_ = Vec3::Zero();  // bias-corrected angular rate at the sweep end
   // the calibration an odometry reset carries into the next epoch (it belongs to the rig)
   bool has_kept_calibration_ = false;

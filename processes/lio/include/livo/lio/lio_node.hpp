@@ -134,26 +134,26 @@ class LioNode {
   int64_t newest_imu_ = 0;
   bool has_imu_ = false;
   std::optional<ImuSample> held_jump_;  // first sample after a clock jump, until the next confirms it
-  int64_t fed_imu_ = 0;       // newest IMU stamp handed to the filter
+  int64_t fed_imu_ = 0;                 // newest IMU stamp handed to the filter
   bool fed_any_imu_ = false;
   int64_t fed_wheel_ = 0;
   bool fed_any_wheel_ = false;
   int64_t sweeps_ = 0;
   SweepCounts sweep_counts_;
-  int64_t last_wheel_log_ = 0;  // IMU time of the last periodic wheel summary
+  int64_t last_wheel_log_ = 0;        // IMU time of the last periodic wheel summary
   int64_t last_calibration_log_ = 0;  // ... and of the last calibration.csv row
   int64_t calibration_t0_ = 0;        // the first row's time (its t_s is 0)
   int64_t calibration_rows_ = 0;
-  std::string calibration_csv_;       // calibration.csv so far (output_dir)
+  std::string calibration_csv_;  // calibration.csv so far (output_dir)
 
   struct PendingPrior {
     int64_t request_id;
     int64_t utime;
   };
-  TimeBuffer<bool> images_;             // image times (IMU clock) not yet handed off
-  int64_t newest_sweep_end_ = -1;       // the LiDAR's watermark: latest end of a sweep received (IMU clock)
-  int64_t last_image_ = -1;             // latest image time handed off or skipped (IMU clock)
-  int64_t newest_image_ = -1;           // the camera's watermark: latest image time received (IMU clock)
+  TimeBuffer<bool> images_;              // image times (IMU clock) not yet handed off
+  int64_t newest_sweep_end_ = -1;        // the LiDAR's watermark: latest end of a sweep received (IMU clock)
+  int64_t last_image_ = -1;              // latest image time handed off or skipped (IMU clock)
+  int64_t newest_image_ = -1;            // the camera's watermark: latest image time received (IMU clock)
   std::optional<PendingPrior> pending_;  // prior waiting for its posterior
   int64_t next_request_id_ = 1;
   HandoffCounts handoff_;

@@ -7,12 +7,12 @@
 #include "livo/imu_initializer.hpp"
 #include "livo/keyframe_selector.hpp"
 #include "livo/lio/imu_propagator.hpp"
-#include "livo/sensor_samples.hpp"
 #include "livo/lio/scan_to_map.hpp"
 #include "livo/lio/voxel_map.hpp"
 #include "livo/lio/voxel_planes.hpp"
 #include "livo/lio/wheel_scale.hpp"
 #include "livo/lio/wheel_update.hpp"
+#include "livo/sensor_samples.hpp"
 
 namespace livo::lio {
 
@@ -49,10 +49,10 @@ struct LioOptions {
   // The sensors' calibration (FilterState::lidar / camera): the rig's values are the filter's prior
   // and its stated uncertainty (rig.*.calibration_std) the prior's 1-sigmas; `calibration` says
   // which parts are estimated (the others are held at the rig's values).
-  LidarExtrinsics extrinsics;             // rig.lidar.T_I_L and lidar_time_offset_s
-  CalibrationStd lidar_calibration_std;   // rig.lidar.calibration_std
-  Pose3 camera_T_I_C = Pose3::Identity(); // rig.camera.T_I_C (carried for livo-vio's image updates)
-  CalibrationStd camera_calibration_std;  // rig.camera.calibration_std
+  LidarExtrinsics extrinsics;              // rig.lidar.T_I_L and lidar_time_offset_s
+  CalibrationStd lidar_calibration_std;    // rig.lidar.calibration_std
+  Pose3 camera_T_I_C = Pose3::Identity();  // rig.camera.T_I_C (carried for livo-vio's image updates)
+  CalibrationStd camera_calibration_std;   // rig.camera.calibration_std
   CalibrationEstimation calibration;
 
   // scan preprocessing
@@ -64,10 +64,10 @@ struct LioOptions {
 
   // map and registration
   VoxelMapOptions map;
-  VoxelPlanesOptions planes;           // planes that average the range noise (lio.map.planes)
-  SeenThroughOptions seen_through;     // points later beams pass through leave the map
-  double map_radius = 100.0;           // m, local window kept around the body
-  double map_prune_distance = 10.0;    // m travelled between window prunings
+  VoxelPlanesOptions planes;         // planes that average the range noise (lio.map.planes)
+  SeenThroughOptions seen_through;   // points later beams pass through leave the map
+  double map_radius = 100.0;         // m, local window kept around the body
+  double map_prune_distance = 10.0;  // m travelled between window prunings
   /// What a loop correction does to the local map: rebuild it from the stored keyframes' clouds at
   /// their corrected poses (kRebuild: the odometry registers against the corrected map of a place
   /// it passes again), or move it with the frame (kMove: the map stays the odometry's own and its
@@ -76,24 +76,24 @@ struct LioOptions {
   enum class OnLoopCorrection { kMove, kRebuild };
   OnLoopCorrection map_on_loop_correction = OnLoopCorrection::kRebuild;
   ScanToMapOptions matching;
-  int search_threads = 1;              // threads sharing the neighbour searches of a registration
-                                       // (the same result for any number; livo-lio's default: 2)
+  int search_threads = 1;  // threads sharing the neighbour searches of a registration
+                           // (the same result for any number; livo-lio's default: 2)
   EsikfOptions esikf;
-  int min_residuals = 30;              // fewer: the update is skipped and flagged degenerate
+  int min_residuals = 30;  // fewer: the update is skipped and flagged degenerate
 
   // robustness
-  double max_imu_gap_s = 0.05;         // larger gaps are bridged and reported
-  double reset_imu_gap_s = 1.0;        // larger gaps reset the velocity (soft re-initialisation)
-  double gap_rate_std = 1.0;           // rad/s: rotation uncertainty added per second of such a gap
-                                       // (the position gets init.moving_vel_std per second)
-  double max_position_jump = 5.0;      // m per scan: a larger update step is rejected (the sweep is only predicted)
-  double max_imu_backlog_s = 1.0;      // IMU waiting for a sweep beyond this is propagated at once
-                                       // (a LiDAR outage must not grow the buffer)
-  double reseed_after_s = 1.0;         // no registration for this long (LiDAR outage, lost
-                                       // track): the map is re-seeded at the predicted pose
+  double max_imu_gap_s = 0.05;     // larger gaps are bridged and reported
+  double reset_imu_gap_s = 1.0;    // larger gaps reset the velocity (soft re-initialisation)
+  double gap_rate_std = 1.0;       // rad/s: rotation uncertainty added per second of such a gap
+                                   // (the position gets init.moving_vel_std per second)
+  double max_position_jump = 5.0;  // m per scan: a larger update step is rejected (the sweep is only predicted)
+  double max_imu_backlog_s = 1.0;  // IMU waiting for a sweep beyond this is propagated at once
+                                   // (a LiDAR outage must not grow the buffer)
+  double reseed_after_s = 1.0;     // no registration for this long (LiDAR outage, lost
+                                   // track): the map is re-seeded at the predicted pose
 
   KeyframeOptions keyframe;
-  size_t max_stored_keyframes = 300;   // keyframe clouds kept for map rebuilds (bounded memory)
+  size_t max_stored_keyframes = 300;  // keyframe clouds kept for map rebuilds (bounded memory)
 
   WheelOptions wheel;
   WheelScaleOptions wheel_scale;  // online scale calibration (used only with wheel.enabled)

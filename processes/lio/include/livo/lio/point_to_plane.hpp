@@ -21,11 +21,11 @@ using Row6 = Eigen::Matrix<double, 1, 6>;
 using Row13 = Eigen::Matrix<double, 1, kMeasuredDim>;
 
 struct PlaneFitOptions {
-  int num_neighbors = 5;              // k of the kNN search
-  double max_neighbor_distance = 1.5; // m, all k neighbours within this radius
-  double max_plane_thickness = 0.03;  // m, every neighbour within this distance of the plane
-  double min_planarity = 0.02;        // second over largest scatter eigenvalue: rejects the
-                                      // nearly collinear neighbours of one far ring
+  int num_neighbors = 5;               // k of the kNN search
+  double max_neighbor_distance = 1.5;  // m, all k neighbours within this radius
+  double max_plane_thickness = 0.03;   // m, every neighbour within this distance of the plane
+  double min_planarity = 0.02;         // second over largest scatter eigenvalue: rejects the
+                                       // nearly collinear neighbours of one far ring
 };
 
 /// The body pose of the sweep's true end, R Exp(ω (dt - dt0)) and p + v (dt - dt0) (ω: the body

@@ -12,8 +12,8 @@
 #include <limits>
 #include <vector>
 
-#include "livo/lio/degeneracy.hpp"
 #include "livo/esikf_update.hpp"
+#include "livo/lio/degeneracy.hpp"
 #include "livo/lio/point_to_plane.hpp"
 #include "livo/lio/voxel_map.hpp"
 #include "livo/lio/voxel_planes.hpp"
@@ -56,14 +56,12 @@ class ScanToMap {
  public:
   /// `map` must outlive this object and stay unchanged while it is used; `body_points` were
   /// undistorted through the LiDAR calibration `undistorted_with` (its extrinsic and time shift) and
-  /// `body_rate` is the bias-corrected angular rate at the sweep end (frame I). With `threads`, the neighbour searches of an iterate
-  /// are shared among them; the result is the same bit for bit.
-  /// `planes` (may be null) answer first where they have a plane; the map's k nearest points
-  /// elsewhere.
+  /// `body_rate` is the bias-corrected angular rate at the sweep end (frame I). With `threads`, the neighbour searches
+  /// of an iterate are shared among them; the result is the same bit for bit. `planes` (may be null) answer first where
+  /// they have a plane; the map's k nearest points elsewhere.
   ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::vector<Vec3>& body_points,
-            const ScanToMapOptions& options,
-            WorkerThreads* threads = nullptr, const SensorCalibration& undistorted_with = {},
-            const Vec3& body_rate = Vec3::Zero());
+            const ScanToMapOptions& options, WorkerThreads* threads = nullptr,
+            const SensorCalibration& undistorted_with = {}, const Vec3& body_rate = Vec3::Zero());
 
   /// Measurement for iteratedUpdate.
   bool evaluate(const FilterState& x, int iteration, MeasurementInformation* info);
@@ -91,17 +89,17 @@ class ScanToMap {
   };
   const VoxelMap& map_;
   const VoxelPlanes* planes_;
-  std::vector<Vec3> points_;          // the points in the LiDAR frame (q above)
+  std::vector<Vec3> points_;  // the points in the LiDAR frame (q above)
   Vec3 body_rate_;
-  double undistorted_dt_;             // the time shift the points were undistorted with
+  double undistorted_dt_;  // the time shift the points were undistorted with
   ScanToMapOptions opts_;
   WorkerThreads* threads_;
   std::vector<Match> matches_;
-  std::vector<double> gate_;  // per point: max |r|
-  std::vector<Vec3> world_;           // per point: its image at the current iterate
-  std::vector<uint32_t> to_search_;   // the points whose planes are fitted anew at this iterate
-  Mat13 floor_ = Mat13::Zero();       // the registration floor over the measured states
-  std::vector<Row> rows_;     // accepted residuals of the current iterate
+  std::vector<double> gate_;         // per point: max |r|
+  std::vector<Vec3> world_;          // per point: its image at the current iterate
+  std::vector<uint32_t> to_search_;  // the points whose planes are fitted anew at this iterate
+  Mat13 floor_ = Mat13::Zero();      // the registration floor over the measured states
+  std::vector<Row> rows_;            // accepted residuals of the current iterate
   std::vector<double> abs_r_;
   DegeneracyReport degeneracy_;
   double min_information_eigenvalue_ = 0.0;

@@ -28,18 +28,18 @@ class Undistorter {
   /// Undistorts a whole scan; `first_utime_imu` is scan.utime in the IMU clock, and every point was
   /// taken `time_shift` seconds after its stamp (the LiDAR's estimated time shift): it is moved
   /// along the motion from that instant to the end.
-  void undistort(const LidarScan& scan, int64_t first_utime_imu, double time_shift,
-                 const std::vector<size_t>& indices, std::vector<Vec3>* out_body) const;
+  void undistort(const LidarScan& scan, int64_t first_utime_imu, double time_shift, const std::vector<size_t>& indices,
+                 std::vector<Vec3>* out_body) const;
 
  private:
   struct Seg {
-    double t0;       // start, s relative to the end
-    Mat3 R_L;        // R_k R_IL, with R_k = R_end^T R_k(world)
-    Vec3 t_L;        // R_k t_IL
-    Vec3 p;          // R_end^T (p_k - p_end)
-    Vec3 v;          // R_end^T v_k
-    Vec3 a;          // R_end^T acc_world_k
-    Vec3 omega;      // R_k times the body rate over the step
+    double t0;   // start, s relative to the end
+    Mat3 R_L;    // R_k R_IL, with R_k = R_end^T R_k(world)
+    Vec3 t_L;    // R_k t_IL
+    Vec3 p;      // R_end^T (p_k - p_end)
+    Vec3 v;      // R_end^T v_k
+    Vec3 a;      // R_end^T acc_world_k
+    Vec3 omega;  // R_k times the body rate over the step
   };
   /// Index of the segment holding time t (relative to the end).
   size_t segmentAt(double t) const;

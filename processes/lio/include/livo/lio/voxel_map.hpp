@@ -14,11 +14,11 @@
 namespace livo::lio {
 
 struct VoxelMapOptions {
-  double voxel_size = 1.0;         // m, edge of a hash voxel
-  int max_points_per_voxel = 20;   // a full voxel takes no more points
-  double min_point_distance = 0.4; // m, a new point this close to one in its voxel is dropped
-  double seen_again_distance = 0.1; // m, a new point this close to a stored one is a new sighting
-                                    // of it (SeenThroughOptions)
+  double voxel_size = 1.0;           // m, edge of a hash voxel
+  int max_points_per_voxel = 20;     // a full voxel takes no more points
+  double min_point_distance = 0.4;   // m, a new point this close to one in its voxel is dropped
+  double seen_again_distance = 0.1;  // m, a new point this close to a stored one is a new sighting
+                                     // of it (SeenThroughOptions)
   // Refresh: a point seen from a range below this fraction of the range a stored point was seen
   // from replaces it (the stored point within min_point_distance of it or, in a full voxel, the one
   // seen from farthest): range noise, beam footprint and grazing smear all grow with range, so the
@@ -35,14 +35,14 @@ struct VoxelMapOptions {
 /// the surface the beam hits, and the floor a beam grazes on its way there, out of the test.
 struct SeenThroughOptions {
   bool enabled = true;
-  double beam_radius = 0.03;          // m at the sensor
-  double beam_divergence = 0.003;     // rad (VLP-16: 3 mrad horizontal)
-  double end_margin = 1.0;            // m
-  double end_margin_fraction = 0.2;   // of the beam's range
-  double min_range = 1.0;             // m, points nearer the sensor are not tested
-  double max_range = 40.0;            // m, longer beams are not cast
-  int misses_to_remove = 3;           // sweeps seeing through a point before it goes
-  int ray_stride = 4;                 // every n-th beam of a sweep is cast
+  double beam_radius = 0.03;         // m at the sensor
+  double beam_divergence = 0.003;    // rad (VLP-16: 3 mrad horizontal)
+  double end_margin = 1.0;           // m
+  double end_margin_fraction = 0.2;  // of the beam's range
+  double min_range = 1.0;            // m, points nearer the sensor are not tested
+  double max_range = 40.0;           // m, longer beams are not cast
+  int misses_to_remove = 3;          // sweeps seeing through a point before it goes
+  int ray_stride = 4;                // every n-th beam of a sweep is cast
 };
 
 class VoxelMap {
@@ -117,9 +117,9 @@ class VoxelMap {
 
   VoxelMapOptions opts_;
   double inv_size_;
-  size_t stride_;            // floats per voxel: 3 * max_points_per_voxel
+  size_t stride_;  // floats per voxel: 3 * max_points_per_voxel
   std::vector<Voxel> voxels_;
-  std::vector<float> pool_;  // voxel v's points at [v * stride_, v * stride_ + 3 * count)
+  std::vector<float> pool_;      // voxel v's points at [v * stride_, v * stride_ + 3 * count)
   std::vector<uint8_t> misses_;  // per point slot: sweeps that saw through it since it was last seen;
                                  // the high bit marks "seen through in the current sweep"
   std::vector<float> ranges_;    // per point slot: the range it was seen from (refresh)

@@ -21,16 +21,16 @@ namespace livo::lio {
 
 struct VoxelPlanesOptions {
   bool enabled = false;
-  double cell_size = 0.5;     // m, edge of a cell
-  int max_points = 2000;      // a cell's scatter takes no more points (then its plane stays)
-  int min_points = 50;        // fewer points make no plane
-  int point_stride = 2;       // every n-th point of a sweep is added
-  double max_std = 0.03;      // m, largest root-mean-square distance of a cell's points to its plane
+  double cell_size = 0.5;  // m, edge of a cell
+  int max_points = 2000;   // a cell's scatter takes no more points (then its plane stays)
+  int min_points = 50;     // fewer points make no plane
+  int point_stride = 2;    // every n-th point of a sweep is added
+  double max_std = 0.03;   // m, largest root-mean-square distance of a cell's points to its plane
   // A cell is a plane only where its points scatter off the plane no more than the range noise
   // explains: sigma^2 times the mean squared cosine between the beams and the normal, times
   // max_variance_ratio, plus model_std^2 (curvature, the poses' own error). A cell holding an
   // edge, a step or returns mixed across a depth jump scatters more.
-  double range_noise_std = 0.01;   // m, the LiDAR's (the rig states it)
+  double range_noise_std = 0.01;  // m, the LiDAR's (the rig states it)
   double max_variance_ratio = 1.5;
   double model_std = 0.005;        // m
   double max_normal_angle = 0.02;  // rad, the normal's spread: sqrt(off-plane / (n * weaker in-plane))
@@ -39,7 +39,7 @@ struct VoxelPlanesOptions {
   // that range starts the cell again (beam footprint and grazing smear grow with range: a street
   // first seen far ahead is re-measured when the sensor passes it). 0: every range.
   double refresh_range_ratio = 0.5;
-  double max_range = 0.0;   // m, farther points are not added (0: no limit)
+  double max_range = 0.0;  // m, farther points are not added (0: no limit)
 };
 
 class VoxelPlanes {
@@ -63,8 +63,8 @@ class VoxelPlanes {
   /// The upper triangle of a sum of outer products v v^T: xx, xy, xz, yy, yz, zz.
   using SymmetricSum = Eigen::Matrix<double, 6, 1>;
   static void addOuter(const Vec3& v, SymmetricSum* sum) {
-    *sum += (SymmetricSum() << v.x() * v.x(), v.x() * v.y(), v.x() * v.z(), v.y() * v.y(), v.y() * v.z(),
-             v.z() * v.z()).finished();
+    *sum += (SymmetricSum() << v.x() * v.x(), v.x() * v.y(), v.x() * v.z(), v.y() * v.y(), v.y() * v.z(), v.z() * v.z())
+                .finished();
   }
   static Mat3 toMatrix(const SymmetricSum& s) {
     return (Mat3() << s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5]).finished();
@@ -75,8 +75,8 @@ class VoxelPlanes {
     int32_t count = 0;
     bool planar = false;
     bool dirty = false;
-    float nearest_range = 0.0f;  // of the points in the scatter
-    Vec3 sum = Vec3::Zero();            // of the points relative to the cell's corner
+    float nearest_range = 0.0f;                 // of the points in the scatter
+    Vec3 sum = Vec3::Zero();                    // of the points relative to the cell's corner
     SymmetricSum outer = SymmetricSum::Zero();  // of their outer products
     SymmetricSum beams = SymmetricSum::Zero();  // of the unit beam directions' outer products
     Plane plane;

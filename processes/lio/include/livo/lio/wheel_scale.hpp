@@ -31,9 +31,9 @@ struct WheelScaleOptions {
 /// What the two contact points travelled between two registered sweeps.
 struct WheelTravel {
   double duration_s = 0.0;
-  double forward_distance = 0.0;   // m, of B along its own x axis (from the poses)
-  Vec2 predicted = Vec2::Zero();   // m, left and right, from the poses
-  Vec2 measured = Vec2::Zero();    // m, left and right, integrated encoder speeds
+  double forward_distance = 0.0;     // m, of B along its own x axis (from the poses)
+  Vec2 predicted = Vec2::Zero();     // m, left and right, from the poses
+  Vec2 measured = Vec2::Zero();      // m, left and right, integrated encoder speeds
   double measured_noise_gain = 0.0;  // variance of a measured distance / speed_noise_std^2
 };
 
@@ -69,7 +69,7 @@ class WheelScaleEstimator {
   /// Variance of the corrected mean speed 0.5 (l / s_l + r / s_r) due to the scales' uncertainty.
   double meanSpeedVariance(const WheelSample& raw) const;
 
-  const Vec2& scales() const { return scale_; }   // left, right
+  const Vec2& scales() const { return scale_; }  // left, right
   Vec2 stds() const { return covariance_.diagonal().cwiseSqrt(); }
   const Mat2& covariance() const { return covariance_; }
   const Counts& counts() const { return counts_; }

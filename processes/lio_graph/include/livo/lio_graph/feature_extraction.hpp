@@ -15,24 +15,24 @@
 namespace livo::lio_graph {
 
 struct FeatureOptions {
-  int neighbours = 5;               // k each side
-  int sectors = 6;                  // per ring
+  int neighbours = 5;  // k each side
+  int sectors = 6;     // per ring
   int max_edges_per_sector = 20;
-  double edge_threshold = 1.0;      // roughness (m^2) above which a point may be an edge
-  double surface_threshold = 0.1;   // roughness below which a point is planar
-  double occlusion_gap = 0.3;       // m: range jump between neighbours that marks an occlusion
-  double parallel_ratio = 0.02;     // |range jump| / range to both neighbours: beam grazing a surface
-  double surface_voxel = 0.2;       // m: surface points downsampled (first point per voxel; 0.4 with
-                                    // LIO-SAM's plane test: README, "Against livo-lio")
-  double min_range = 1.0;           // m (the vehicle itself, rain, the mount)
+  double edge_threshold = 1.0;     // roughness (m^2) above which a point may be an edge
+  double surface_threshold = 0.1;  // roughness below which a point is planar
+  double occlusion_gap = 0.3;      // m: range jump between neighbours that marks an occlusion
+  double parallel_ratio = 0.02;    // |range jump| / range to both neighbours: beam grazing a surface
+  double surface_voxel = 0.2;      // m: surface points downsampled (first point per voxel; 0.4 with
+                                   // LIO-SAM's plane test: README, "Against livo-lio")
+  double min_range = 1.0;          // m (the vehicle itself, rain, the mount)
 };
 
 /// A sweep's points in sensor order: `ring[i]` (negative or absent: no ring) and the time offset
 /// order points along a ring.
 struct RingCloud {
-  std::vector<Vec3> points;         // sensor frame (deskewed)
-  std::vector<int16_t> ring;        // one per point, or empty
-  std::vector<float> time_offset;   // one per point
+  std::vector<Vec3> points;        // sensor frame (deskewed)
+  std::vector<int16_t> ring;       // one per point, or empty
+  std::vector<float> time_offset;  // one per point
 };
 
 struct ScanFeatures {

@@ -36,19 +36,19 @@ namespace livo::lio_graph {
 struct GraphKeyframe {
   int64_t id = 0;
   int64_t utime = 0;
-  Pose3 pose = Pose3::Identity();       // W_T_I
+  Pose3 pose = Pose3::Identity();                  // W_T_I
   Mat6 pose_covariance = Mat6::Identity() * 1e-4;  // [rotation, position]
-  std::vector<Vec3> cloud;              // the deskewed sweep, body frame, downsampled
-  std::vector<float> intensity;         // one per cloud point
+  std::vector<Vec3> cloud;                         // the deskewed sweep, body frame, downsampled
+  std::vector<float> intensity;                    // one per cloud point
 };
 
 struct GraphScanResult {
   enum class Status { kInitializing, kRejected, kMapInitialized, kTracked, kPredicted };
   Status status = Status::kRejected;
   std::string message;
-  int64_t utime = 0;              // sweep end, IMU clock
-  int64_t sweep_start_utime = 0;  // IMU clock
-  Pose3 pose = Pose3::Identity(); // W_T_I at utime (after the window's optimisation)
+  int64_t utime = 0;               // sweep end, IMU clock
+  int64_t sweep_start_utime = 0;   // IMU clock
+  Pose3 pose = Pose3::Identity();  // W_T_I at utime (after the window's optimisation)
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // bias-corrected, frame I
   Vec3 gyro_bias = Vec3::Zero(), accel_bias = Vec3::Zero();
@@ -56,11 +56,11 @@ struct GraphScanResult {
   Vec3 wheel_mounting = Vec3::Zero();       // the wheel frame's mounting correction δ (rad; wheelMounting())
   Mat6 pose_covariance = Mat6::Identity();  // [rotation (right), position]
   bool degenerate = false;
-  bool visual_motion = false;   // the deskew and the guess took the visual subsystem's motion
-  bool visual_factor = false;   // and its motion since the previous state joined the graph
-  Vec6 weakest_direction = Vec6::Zero();    // of the scan matching, [rotation, translation]
+  bool visual_motion = false;             // the deskew and the guess took the visual subsystem's motion
+  bool visual_factor = false;             // and its motion since the previous state joined the graph
+  Vec6 weakest_direction = Vec6::Zero();  // of the scan matching, [rotation, translation]
   int edge_residuals = 0, surface_residuals = 0;
-  int planes = 0;                 // planes observed in the sweep (planar factors)
+  int planes = 0;  // planes observed in the sweep (planar factors)
   int ground_planes = 0;
   int num_points = 0;
   // the sweep's valid points deskewed to utime, world frame, and their indices in the input
@@ -197,9 +197,9 @@ class LioGraphEstimator {
   KeyframeSelector keyframe_selector_;
   int64_t next_keyframe_id_ = 0;
   int64_t last_sweep_end_ = -1;
-  double wheel_scale_[2] = {1.0, 1.0};  // a block of the graph for as long as it runs (never marginalised)
+  double wheel_scale_[2] = {1.0, 1.0};          // a block of the graph for as long as it runs (never marginalised)
   double wheel_mounting_[3] = {0.0, 0.0, 0.0};  // likewise, the wheel frame's mounting correction δ
-  double visual_scale_[1] = {1.0};      // the truth over the visual motion's scale, likewise
+  double visual_scale_[1] = {1.0};              // the truth over the visual motion's scale, likewise
   OdometryFrame frame_;
   Vec3 gravity_W_;  // what the IMU factors, the prediction and the plane extraction's "up" use
 };

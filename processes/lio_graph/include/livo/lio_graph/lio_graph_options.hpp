@@ -2,8 +2,8 @@
 #pragma once
 
 #include "livo/imu_initializer.hpp"
-#include "livo/keyframe_selector.hpp"
 #include "livo/imu_preintegration.hpp"
+#include "livo/keyframe_selector.hpp"
 #include "livo/lio_graph/feature_extraction.hpp"
 #include "livo/lio_graph/plane_extraction.hpp"
 #include "livo/lio_graph/scan_matching.hpp"
@@ -14,22 +14,22 @@
 namespace livo::lio_graph {
 
 struct LioGraphOptions {
-  LidarExtrinsics extrinsics;           // rig.lidar
-  double min_range = 1.0;               // m (rig.lidar.min_range, at least features.min_range)
-  double max_range = 100.0;             // m
-  ImuPreintegrationNoise imu_noise;     // rig.imu
-  double gravity = 9.81;                // m/s^2 (rig.imu.gravity)
+  LidarExtrinsics extrinsics;        // rig.lidar
+  double min_range = 1.0;            // m (rig.lidar.min_range, at least features.min_range)
+  double max_range = 100.0;          // m
+  ImuPreintegrationNoise imu_noise;  // rig.imu
+  double gravity = 9.81;             // m/s^2 (rig.imu.gravity)
   ImuInitOptions init;
   FeatureOptions features;
   ScanMatchingOptions matching;
 
-  bool use_wheel = false;               // rig.wheel present and lio_graph.wheel not false
+  bool use_wheel = false;  // rig.wheel present and lio_graph.wheel not false
   WheelRig wheel_rig;
   WheelPreintegrationNoise wheel_noise;
   // Cauchy loss on the whitened wheel residual: a slipping wheel (tens of sigmas off the IMU) loses
   // its influence instead of pulling with a bounded one, as a Huber loss would.
   double wheel_cauchy = 3.0;
-  double max_wheel_gap_s = 0.2;         // a longer gap between readings: no wheel factor there
+  double max_wheel_gap_s = 0.2;  // a longer gap between readings: no wheel factor there
   // The tyres' radii over the nominal ([s_l, s_r], wheel_preintegration.hpp) as a parameter of the
   // graph with this prior sigma around 1; 0 keeps them at the nominal.
   double wheel_scale_std = 0.02;
@@ -67,23 +67,23 @@ struct LioGraphOptions {
   // as it is): a wheeled visual subsystem inherits the tyres' nominal radii, which the LiDAR sees.
   double visual_scale_std = 0.02;
 
-  int window_states = 10;               // sweeps in the fixed-lag smoother
+  int window_states = 10;  // sweeps in the fixed-lag smoother
   int solver_iterations = 10;
-  KeyframeOptions keyframe;             // a new keyframe (local map, KEYFRAME) after 1 m or 10 deg
+  KeyframeOptions keyframe;  // a new keyframe (local map, KEYFRAME) after 1 m or 10 deg
   // The local map (LIO-SAM's surrounding keyframes): the newest local_map_keyframes, and of every
   // stored keyframe within local_map_radius the oldest in each local_map_spacing cell, so a place
   // seen before is matched against what was mapped there first, not only against the last metres.
   int local_map_keyframes = 10;
-  double local_map_radius = 50.0;       // m
-  double local_map_spacing = 2.0;       // m
-  double map_edge_voxel = 0.2;          // m
-  double map_surface_voxel = 0.4;       // m
+  double local_map_radius = 50.0;  // m
+  double local_map_spacing = 2.0;  // m
+  double map_edge_voxel = 0.2;     // m
+  double map_surface_voxel = 0.4;  // m
   // The scan-matching result as a pose measurement: information = scale * J^T J / sigma^2. The
   // residuals of neighbouring points are far from independent (the map's own noise is shared),
   // so the scale is well below one.
-  double lidar_point_sigma = 0.05;      // m
+  double lidar_point_sigma = 0.05;  // m
   double lidar_information_scale = 0.05;
-  double max_imu_gap_s = 0.5;           // s without IMU: the state is re-initialised
+  double max_imu_gap_s = 0.5;  // s without IMU: the state is re-initialised
   // Keyframes kept for the local map: the newest local_map_keyframes and the oldest per
   // local_map_spacing cell (so the store grows with the area covered, not the distance); beyond
   // this many the one farthest from the newest goes (a 64-beam sweep's features are about 0.25 MB:

@@ -22,30 +22,30 @@ namespace livo::lio_graph {
 
 struct PlaneExtractionOptions {
   // threshold = clamp(threshold_base + threshold_per_metre * |centroid|, threshold_min, threshold_max)
-  double threshold_base = 0.03;         // m
-  double threshold_per_metre = 0.004;   // m per metre of the centroid's range
-  double threshold_min = 0.03;          // m
-  double threshold_max = 0.20;          // m
-  int min_inliers = 30;                 // points a plane needs (after the normal check)
-  int max_planes = 8;                   // planes per cloud
+  double threshold_base = 0.03;        // m
+  double threshold_per_metre = 0.004;  // m per metre of the centroid's range
+  double threshold_min = 0.03;         // m
+  double threshold_max = 0.20;         // m
+  int min_inliers = 30;                // points a plane needs (after the normal check)
+  int max_planes = 8;                  // planes per cloud
   int ransac_iterations = 150;
-  int score_sample = 1500;              // RANSAC scores hypotheses on at most this many points
-  int normal_neighbours = 8;            // points of each local normal
-  double normal_max_angle_deg = 20.0;   // a consistent inlier's local normal is this close
-  double min_consistent_fraction = 0.6; // of the distance inliers, else the plane is refused
-  Vec3 up = Vec3::UnitZ();              // in the cloud's frame (the filter's gravity direction)
-  double ground_below = 0.5;            // m: a plane whose centroid is this far below the sensor ...
-  double ground_candidate_deg = 30.0;   // ... with a normal this close to up is a ground candidate,
-  double ground_max_tilt_deg = 8.0;     // accepted as the ground only within this tilt
-  double max_quality_ratio = 0.5;       // accepted when mean |distance| <= ratio * threshold
-  uint32_t seed = 1;                    // RANSAC's sampling (deterministic)
+  int score_sample = 1500;               // RANSAC scores hypotheses on at most this many points
+  int normal_neighbours = 8;             // points of each local normal
+  double normal_max_angle_deg = 20.0;    // a consistent inlier's local normal is this close
+  double min_consistent_fraction = 0.6;  // of the distance inliers, else the plane is refused
+  Vec3 up = Vec3::UnitZ();               // in the cloud's frame (the filter's gravity direction)
+  double ground_below = 0.5;             // m: a plane whose centroid is this far below the sensor ...
+  double ground_candidate_deg = 30.0;    // ... with a normal this close to up is a ground candidate,
+  double ground_max_tilt_deg = 8.0;      // accepted as the ground only within this tilt
+  double max_quality_ratio = 0.5;        // accepted when mean |distance| <= ratio * threshold
+  uint32_t seed = 1;                     // RANSAC's sampling (deterministic)
 };
 
 struct ExtractedPlane {
-  Plane plane;               // in the cloud's frame; normal towards the sensor (offset >= 0)
+  Plane plane;  // in the cloud's frame; normal towards the sensor (offset >= 0)
   Vec3 centroid = Vec3::Zero();
-  double threshold = 0.0;    // the adaptive distance threshold it was found with
-  double quality = 0.0;      // mean absolute distance of its inliers, m
+  double threshold = 0.0;  // the adaptive distance threshold it was found with
+  double quality = 0.0;    // mean absolute distance of its inliers, m
   bool ground = false;
   std::vector<int> inliers;  // indices into the cloud
 };

@@ -23,15 +23,15 @@ struct ScanMatchingOptions {
   // plane whose normal nothing fixed: with them the held-out bridge_deck and campus_loop runs had
   // 2.7x and 1.9x the ATE (README, "Against livo-lio"). The price: in a map of one sweep the floor
   // is single-ring arcs, which are refused, and the height rests on fewer points.
-  int neighbours = 5;                  // per line and per plane
-  double max_neighbour_distance = 1.5; // m, the farthest of them
-  double max_plane_distance = 0.03;    // m
+  int neighbours = 5;                   // per line and per plane
+  double max_neighbour_distance = 1.5;  // m, the farthest of them
+  double max_plane_distance = 0.03;     // m
   double min_planarity = 0.02;
-  double min_line_ratio = 3.0;         // largest / second eigenvalue of the neighbours for a line
+  double min_line_ratio = 3.0;  // largest / second eigenvalue of the neighbours for a line
   int max_iterations = 30;
-  double converged_rotation = 1e-3;    // rad, update norm
-  double converged_translation = 1e-3; // m
-  double degenerate_eigenvalue = 50.0; // of the weighted J^T J (one residual per point)
+  double converged_rotation = 1e-3;     // rad, update norm
+  double converged_translation = 1e-3;  // m
+  double degenerate_eigenvalue = 50.0;  // of the weighted J^T J (one residual per point)
   int min_residuals = 50;
 };
 
@@ -56,15 +56,15 @@ class LocalMap {
 };
 
 struct ScanMatchResult {
-  bool valid = false;                 // enough residuals and a finite pose
+  bool valid = false;  // enough residuals and a finite pose
   Pose3 T_W_I = Pose3::Identity();
   /// J^T J of the last iterate in the coordinates [dtheta (right, body), dt (world)] of
   /// T = (R Exp(dtheta), t + dt), one unit-weight residual per point: the information of the pose
   /// up to the point noise (the graph scales it).
   Mat6 hessian = Mat6::Zero();
-  Vec6 eigenvalues = Vec6::Zero();    // of `hessian`, ascending
-  Vec6 weakest = Vec6::Zero();        // the eigenvector of the smallest
-  bool degenerate = false;            // some eigenvalue below degenerate_eigenvalue
+  Vec6 eigenvalues = Vec6::Zero();  // of `hessian`, ascending
+  Vec6 weakest = Vec6::Zero();      // the eigenvector of the smallest
+  bool degenerate = false;          // some eigenvalue below degenerate_eigenvalue
   int edge_residuals = 0;
   int surface_residuals = 0;
   int iterations = 0;

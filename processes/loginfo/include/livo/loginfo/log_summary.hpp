@@ -9,13 +9,13 @@
 namespace livo::loginfo {
 
 struct ChannelSummary {
-  std::string type;            // project type name, "unknown (0x…)" or "mixed"
+  std::string type;  // project type name, "unknown (0x…)" or "mixed"
   int64_t count = 0;
   int64_t bytes = 0;
-  int64_t first_utime = 0;     // event timestamps (log time)
+  int64_t first_utime = 0;  // event timestamps (log time)
   int64_t last_utime = 0;
-  int64_t out_of_order = 0;    // events stamped earlier than the previous one on this channel
-  uint64_t digest = 0;         // FNV-1a over the payloads in log order (determinism checks)
+  int64_t out_of_order = 0;         // events stamped earlier than the previous one on this channel
+  uint64_t digest = 0;              // FNV-1a over the payloads in log order (determinism checks)
   int64_t non_finite_messages = 0;  // messages holding a NaN or an infinity (countNonFinite)
   int64_t non_finite_values = 0;
   double rateHz() const;

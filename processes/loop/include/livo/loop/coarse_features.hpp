@@ -21,11 +21,11 @@
 namespace livo::loop {
 
 struct CoarseFeatureOptions {
-  double voxel_size = 0.6;          // m
-  double normal_radius = 1.0;       // m, normals and ISS saliency
-  double feature_radius = 2.5;      // m, FPFH
-  double max_normal_z = 0.9;        // points with |n_z| above this are not keypoints
-  int max_keypoints = 1500;         // the most salient are kept (bounds the matching time)
+  double voxel_size = 0.6;      // m
+  double normal_radius = 1.0;   // m, normals and ISS saliency
+  double feature_radius = 2.5;  // m, FPFH
+  double max_normal_z = 0.9;    // points with |n_z| above this are not keypoints
+  int max_keypoints = 1500;     // the most salient are kept (bounds the matching time)
   IssOptions keypoints;
 };
 
@@ -38,10 +38,10 @@ struct CoarseFeatures {
 /// The first stage: the voxel centroids with their normals and kd-tree, and the keypoints among
 /// them. The points live on the heap so the tree's reference survives moves and copies.
 struct CoarseKeypoints {
-  std::shared_ptr<const Points> points;    // voxel centroids (null if there are none)
-  Points normals;                          // per point (zero: fewer than 3 neighbours)
-  std::shared_ptr<const PointTree> tree;   // over *points (null if there are none)
-  std::vector<int> keys;                   // indices into *points, most salient first, at most max_keypoints
+  std::shared_ptr<const Points> points;   // voxel centroids (null if there are none)
+  Points normals;                         // per point (zero: fewer than 3 neighbours)
+  std::shared_ptr<const PointTree> tree;  // over *points (null if there are none)
+  std::vector<int> keys;                  // indices into *points, most salient first, at most max_keypoints
 };
 
 /// From a gravity-aligned cloud (z up), so that "horizontal" means ground-like; the sensor at the

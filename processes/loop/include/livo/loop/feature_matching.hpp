@@ -29,8 +29,8 @@ Descriptors quantise(const Features& features);
 int descriptorDistance(const Descriptor& a, const Descriptor& b);
 
 struct FeatureMatchingOptions {
-  bool mutual = true;               // keep i <-> j only if each is the other's nearest
-  int max_correspondences = 2000;   // keep the best (smallest feature distance) if more
+  bool mutual = true;              // keep i <-> j only if each is the other's nearest
+  int max_correspondences = 2000;  // keep the best (smallest feature distance) if more
 };
 
 /// Nearest neighbours by L1 distance (the lowest index on ties); zero descriptors are skipped.

@@ -37,19 +37,19 @@ struct GicpCloud {
 struct GicpOptions {
   double max_correspondence_distance = 1.0;  // m
   int max_iterations = 30;
-  double rotation_epsilon = 2e-4;            // rad: converged when the update is smaller
-  double translation_epsilon = 1e-4;         // m
-  double overlap_distance = 0.5;             // m, a source point "overlaps" within this
-  int max_source_points = 6000;              // source thinned evenly to at most this many (0: all);
-                                             // the target keeps every point
+  double rotation_epsilon = 2e-4;     // rad: converged when the update is smaller
+  double translation_epsilon = 1e-4;  // m
+  double overlap_distance = 0.5;      // m, a source point "overlaps" within this
+  int max_source_points = 6000;       // source thinned evenly to at most this many (0: all);
+                                      // the target keeps every point
 };
 
 struct GicpResult {
   Pose3 T_target_source = Pose3::Identity();
   bool converged = false;
   int iterations = 0;
-  double fitness = 0.0;        // mean squared distance of correspondences within max distance, m^2
-  double overlap = 0.0;        // fraction of (used) source points with a target point within overlap_distance
+  double fitness = 0.0;  // mean squared distance of correspondences within max distance, m^2
+  double overlap = 0.0;  // fraction of (used) source points with a target point within overlap_distance
   int num_correspondences = 0;
   /// Gauss-Newton Hessian of the GICP cost at the solution, [rotation; translation], for a left
   /// perturbation in the target frame (T' = [Exp(dr), dt] T). Its scale is that of the regularised

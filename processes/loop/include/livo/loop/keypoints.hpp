@@ -12,11 +12,11 @@
 namespace livo::loop {
 
 struct IssOptions {
-  double gamma21 = 0.975;       // keep lambda2 / lambda1 below this (lambda1 >= lambda2 >= lambda3)
-  double gamma32 = 0.975;       // keep lambda3 / lambda2 below this
-  double min_variation = 0.0;   // lambda3 / (lambda1 + lambda2 + lambda3): 0 keeps noise on planes
+  double gamma21 = 0.975;      // keep lambda2 / lambda1 below this (lambda1 >= lambda2 >= lambda3)
+  double gamma32 = 0.975;      // keep lambda3 / lambda2 below this
+  double min_variation = 0.0;  // lambda3 / (lambda1 + lambda2 + lambda3): 0 keeps noise on planes
   int min_neighbours = 6;
-  double nms_radius = 0.6;      // m: a keypoint has the largest saliency within this radius
+  double nms_radius = 0.6;  // m: a keypoint has the largest saliency within this radius
 };
 
 /// Indices of the keypoints among `points` (with their neighbourhoods from analyseNeighbourhoods),

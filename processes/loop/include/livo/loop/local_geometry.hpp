@@ -23,7 +23,6 @@ std::vector<Neighbourhood> analyseNeighbourhoods(const Points& points, const Poi
 
 /// GICP covariances from the k nearest neighbours, regularised plane-like: the eigenvectors of
 /// the sample covariance with eigenvalues replaced by (1, 1, epsilon).
-Covariances estimateCovariances(const Points& points, const PointTree& tree, int num_neighbors,
-                                double plane_epsilon);
+Covariances estimateCovariances(const Points& points, const PointTree& tree, int num_neighbors, double plane_epsilon);
 
 }  // namespace livo::loop

@@ -13,35 +13,35 @@
 #include <string>
 #include <vector>
 
-#include "livo/reason_counts.hpp"
-#include "livo/loop/coarse_features.hpp"
 #include "livo/correction_frames.hpp"
+#include "livo/loop/coarse_features.hpp"
 #include "livo/loop/gicp.hpp"
-#include "livo/spill_file.hpp"
 #include "livo/loop/loop_consistency.hpp"
 #include "livo/loop/loop_information.hpp"
 #include "livo/loop/loop_registration.hpp"
 #include "livo/loop/pose_graph.hpp"
+#include "livo/reason_counts.hpp"
+#include "livo/spill_file.hpp"
 
 namespace livo::loop {
 
 struct CandidateOptions {
-  double search_radius = 12.0;      // m, around the current (corrected) keyframe position
-  double exclude_recent_s = 30.0;   // keyframes this recent are not loop candidates
-  int max_candidates = 2;           // nearest first
-  int cooldown_keyframes = 3;       // after an accepted loop, skip this many keyframes
+  double search_radius = 12.0;     // m, around the current (corrected) keyframe position
+  double exclude_recent_s = 30.0;  // keyframes this recent are not loop candidates
+  int max_candidates = 2;          // nearest first
+  int cooldown_keyframes = 3;      // after an accepted loop, skip this many keyframes
 };
 
 struct LoopCloserOptions {
   CoarseFeatureOptions coarse;
-  double fine_voxel_size = 0.4;     // m
+  double fine_voxel_size = 0.4;  // m
   int covariance_neighbors = 10;
-  double map_voxel_size = 0.2;      // m, clouds kept for the global map
+  double map_voxel_size = 0.2;  // m, clouds kept for the global map
   /// Keyframes whose coarse features and GICP clouds (as far as derived) stay in memory (the newest
   /// ones near an older node and the recent loop candidates); the others are derived again from the
   /// stored cloud when needed.
   int feature_cache_keyframes = 32;
-  std::string spill_directory;      // where the keyframe clouds go ("" : the temp directory)
+  std::string spill_directory;  // where the keyframe clouds go ("" : the temp directory)
   CandidateOptions candidates;
   LoopRegistrationOptions registration;
   PoseGraphOptions graph;
@@ -66,17 +66,17 @@ struct LoopCloserOptions {
   // of LiDAR odometry (0.5 % and 0.01 deg/m; the old 2 cm / 2 mrad per edge made 1,450 edges of a
   // 300 s drive worth 0.8 m of random walk and let every loop's noise through). The consistency
   // check below always uses it (a loose model, to refuse only what no drift explains).
-  double odometry_rotation_floor = 2e-4;       // rad
-  double odometry_translation_floor = 2e-3;    // m
-  double odometry_rotation_per_m = 2e-4;       // rad per metre travelled
-  double odometry_translation_per_m = 5e-3;    // m per metre travelled
+  double odometry_rotation_floor = 2e-4;     // rad
+  double odometry_translation_floor = 2e-3;  // m
+  double odometry_rotation_per_m = 2e-4;     // rad per metre travelled
+  double odometry_translation_per_m = 5e-3;  // m per metre travelled
   /// A loop edge's covariance: from its fine registration (GICP's point-to-plane information,
   /// floored and capped per `loop_information`: loop_information.hpp), or (false) the fixed
   /// diagonal below, as before.
   bool registration_information = true;
   LoopInformationOptions loop_information;
-  double loop_rotation_sigma = 5e-3;         // rad (registration_information false)
-  double loop_translation_sigma = 5e-2;      // m (registration_information false)
+  double loop_rotation_sigma = 5e-3;     // rad (registration_information false)
+  double loop_translation_sigma = 5e-2;  // m (registration_information false)
   /// A verified loop enters the graph only if it agrees, within the chi-square bound, with the
   /// graph's relative pose of its two keyframes (covariance: the odometry's drift model above over
   /// the odometry's path between them) and with the cycle through the earlier loop nearest to it
@@ -131,10 +131,10 @@ struct LoopCloserOptions {
 struct KeyframeInput {
   int64_t id = 0;
   int64_t utime = 0;
-  int32_t epoch = 0;                 // odometry epoch (keyframe_t.epoch)
-  int64_t correction_id = 0;         // the correction of this closer the pose includes (0: none)
-  Pose3 pose = Pose3::Identity();    // odometry W_T_I, as published (in correction correction_id)
-  Mat6 covariance = Mat6::Zero();    // [rotation; position]
+  int32_t epoch = 0;               // odometry epoch (keyframe_t.epoch)
+  int64_t correction_id = 0;       // the correction of this closer the pose includes (0: none)
+  Pose3 pose = Pose3::Identity();  // odometry W_T_I, as published (in correction correction_id)
+  Mat6 covariance = Mat6::Zero();  // [rotation; position]
   /// The odometry increment from keyframe relative_to_id (keyframe_t): covariance of the right
   /// perturbation of T_prev^-1 T_this. Used for the odometry edges when it is from the previous
   /// keyframe of the epoch and positive definite; otherwise the drift model stands in.
@@ -143,12 +143,12 @@ struct KeyframeInput {
   /// The part of relative_covariance the odometry's held calibration adds (keyframe_t; zero where
   /// nothing is held).
   Mat6 relative_covariance_held_calibration = Mat6::Zero();
-  Points cloud;                      // body frame I
+  Points cloud;  // body frame I
 };
 
 struct AcceptedLoop {
-  int64_t from_id = 0;   // the new keyframe (source)
-  int64_t to_id = 0;     // the earlier keyframe (target)
+  int64_t from_id = 0;  // the new keyframe (source)
+  int64_t to_id = 0;    // the earlier keyframe (target)
   int64_t from_utime = 0, to_utime = 0;
   Pose3 T_to_from = Pose3::Identity();  // I_to <- I_from
   int coarse_inliers = 0;
@@ -177,13 +177,13 @@ struct AcceptedLoop {
 /// A verified loop the consistency check kept out of the graph.
 struct RefusedLoop {
   int64_t from_id = 0, to_id = 0;
-  bool merged = false;       // it would have joined keyframe from_id to node to_id
+  bool merged = false;  // it would have joined keyframe from_id to node to_id
   Pose3 T_to_from = Pose3::Identity();
-  std::string against;       // "odometry" (the graph's relative pose) or "loop" (a cycle with an earlier one)
+  std::string against;  // "odometry" (the graph's relative pose) or "loop" (a cycle with an earlier one)
   int64_t against_from_id = -1, against_to_id = -1;  // the earlier loop (against "loop")
-  double chi2 = 0.0;         // of the check that failed (bound: consistency_chi2)
-  double path = 0.0;         // m of odometry in the prediction it was checked against
-  std::string reason;        // the above in words
+  double chi2 = 0.0;                                 // of the check that failed (bound: consistency_chi2)
+  double path = 0.0;                                 // m of odometry in the prediction it was checked against
+  std::string reason;                                // the above in words
 };
 
 /// What a LIO adopts after an accepted loop (loop_correction_t): correction `id` of `epoch`.
@@ -197,7 +197,7 @@ struct Correction {
 
 struct AddResult {
   std::vector<LoopRegistrationResult> attempts;
-  std::optional<AcceptedLoop> loop;  // set if a loop was accepted (added to the graph)
+  std::optional<AcceptedLoop> loop;      // set if a loop was accepted (added to the graph)
   std::optional<Correction> correction;  // if the loop changed the estimate: the correction to publish
   std::vector<RefusedLoop> refused;      // verified loops the consistency check refused
 };
@@ -262,10 +262,10 @@ class LoopCloser {
     int64_t id = -1;
     int64_t utime = 0;
     int32_t epoch = 0;
-    Pose3 odometry = Pose3::Identity();   // in the raw odometry frame of its epoch (no correction)
+    Pose3 odometry = Pose3::Identity();  // in the raw odometry frame of its epoch (no correction)
     Mat6 covariance = Mat6::Zero();
-    Mat3 G_R_I = Mat3::Identity();      // roll and pitch: the gravity-aligned frame G of the keyframe
-    double path = 0.0;                  // m of odometry from the first keyframe of its epoch
+    Mat3 G_R_I = Mat3::Identity();  // roll and pitch: the gravity-aligned frame G of the keyframe
+    double path = 0.0;              // m of odometry from the first keyframe of its epoch
     /// Covariance of `odometry` given the epoch's first keyframe, as a left perturbation in the
     /// odometry frame: the increments' covariances carried there (Ad(T_k) cov_k Ad(T_k)^T) and
     /// summed, so the odometry's covariance between two keyframes is a difference of two of these.
@@ -284,7 +284,7 @@ class LoopCloser {
     int32_t epoch = 0;
     int64_t node = 0;                     // the graph node it belongs to (its own id if it is one)
     Pose3 T_node_kf = Pose3::Identity();  // its pose in that node's frame (identity for a node)
-    Vec3 up_in_body = Vec3::UnitZ();       // the odometry's world up axis in its frame (kept)
+    Vec3 up_in_body = Vec3::UnitZ();      // the odometry's world up axis in its frame (kept)
   };
   /// The odometry's world up axis seen in a keyframe's frame: what its corrected pose keeps.
   static Vec3 upInBody(const Keyframe& kf) { return kf.odometry.linear().transpose() * Vec3::UnitZ(); }
@@ -298,8 +298,8 @@ class LoopCloser {
     int64_t start = -1;
     Keyframe start_keyframe;  // the odometry's reference (a node's, or a keyframe that joined one)
     Pose3 T_node_start = Pose3::Identity();
-    bool via_loop = false;  // T_node_start is a loop measurement (else start == node)
-    double path = 0.0;      // m of odometry from start
+    bool via_loop = false;                // T_node_start is a loop measurement (else start == node)
+    double path = 0.0;                    // m of odometry from start
     Mat6 loop_covariance = Mat6::Zero();  // of T_node_start (right perturbation), if via_loop
     /// The raw odometry from start: covariance of the right perturbation of T_start^-1 T_newest,
     /// composed from the increments' own (valid while every increment had one).
@@ -390,11 +390,12 @@ class LoopCloser {
   std::vector<Placement> placements_;  // every keyframe, in id order
   std::map<int64_t, Keyframe> nodes_;  // the graph nodes' keyframes
   Keyframe newest_;
-  size_t loops_since_optimization_ = 0;  // loop edges added to the graph since it was last optimised                    // the newest keyframe (valid if placements_ is not empty)
-  KeyframeCloudStore clouds_;  // the nodes' clouds, body frame I, float as received (lossless)
+  size_t loops_since_optimization_ = 0;  // loop edges added to the graph since it was last optimised // the newest
+                                         // keyframe (valid if placements_ is not empty)
+  KeyframeCloudStore clouds_;            // the nodes' clouds, body frame I, float as received (lossless)
   std::list<std::pair<int64_t, std::shared_ptr<const Features>>> cache_;  // most recently used first
   std::vector<AcceptedLoop> loops_;
-  std::vector<LoopAnchor> anchors_;    // parallel to loops_
+  std::vector<LoopAnchor> anchors_;  // parallel to loops_
   std::vector<RefusedLoop> refused_;
   int64_t registrations_ = 0;
   int64_t unusable_held_parts_ = 0;

@@ -13,8 +13,8 @@ namespace livo::loop {
 struct LoopNodeOptions {
   std::string keyframe_channel = "KEYFRAME";
   std::string loop_correction_channel = "LOOP_CORRECTION";
-  std::string output_dir;            // empty: no files
-  double global_map_voxel = 0.2;     // m
+  std::string output_dir;         // empty: no files
+  double global_map_voxel = 0.2;  // m
   LoopCloserOptions closer;
 };
 

@@ -32,8 +32,8 @@ struct LoopInformationOptions {
   double fitness_rotation_sigma = 0.0;
   /// Caps on the standard deviation in any direction: a direction the surfaces do not constrain
   /// (a corridor's axis) keeps this small information instead of none.
-  double max_rotation_sigma = 0.1;      // rad (5.7 deg)
-  double max_translation_sigma = 1.0;   // m
+  double max_rotation_sigma = 0.1;     // rad (5.7 deg)
+  double max_translation_sigma = 1.0;  // m
   /// A translation direction that less than this share of the correspondences' normals constrain
   /// is treated as unconstrained (the cap applies): noise tilts the normals of a 0.4 m voxel's
   /// neighbourhood by 1-4 deg (1 to 3 cm of range noise), which gives a corridor's axis 0.1-0.5 %
@@ -47,7 +47,8 @@ struct LoopInformationOptions {
 /// (a left perturbation in the target frame): the directions the normals barely constrain are
 /// dropped, the information is carried to the source frame, its directions weaker than the caps
 /// raised to them, and the floors added per axis.
-Mat6 registrationCovariance(const GicpResult& fine, const Pose3& T_target_source, const LoopInformationOptions& options);
+Mat6 registrationCovariance(const GicpResult& fine, const Pose3& T_target_source,
+                            const LoopInformationOptions& options);
 
 /// A right-perturbation covariance of T_a_b ([rotation; translation in b]) in the pose graph's
 /// edge convention ([rotation on the right; translation added in a], PoseEdge T_from_to).

@@ -8,9 +8,9 @@
 
 #include "livo/config.hpp"
 #include "livo/keyframe_t.hpp"
-#include "livo/node.hpp"
 #include "livo/loop/loop_closer.hpp"
 #include "livo/loop/loop_config.hpp"
+#include "livo/node.hpp"
 
 namespace livo::loop {
 

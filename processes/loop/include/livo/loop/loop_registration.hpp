@@ -14,10 +14,10 @@
 namespace livo::loop {
 
 struct AcceptanceOptions {
-  int min_coarse_inliers = 10;          // max-clique inliers consistent with the coarse result (6 let a
-                                        // 90°-rotated match of a symmetric room through)
-  double max_fitness = 0.15;            // m^2, fine mean squared residual
-  double min_overlap = 0.5;             // fraction of source points near the target
+  int min_coarse_inliers = 10;  // max-clique inliers consistent with the coarse result (6 let a
+                                // 90°-rotated match of a symmetric room through)
+  double max_fitness = 0.15;    // m^2, fine mean squared residual
+  double min_overlap = 0.5;     // fraction of source points near the target
   double max_coarse_fine_rotation_deg = 5.0;
   double max_coarse_fine_translation = 1.0;  // m
   double min_translation_eigenvalue = 0.05;  // of the per-correspondence GICP Hessian (degeneracy)

@@ -26,7 +26,6 @@ struct MaxCliqueOptions {
 std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& options = {}, bool* exact = nullptr);
 
 /// Consistency graph: i ~ j if | |s_i - s_j| - |t_i - t_j| | <= 2 * noise_bound.
-Graph consistencyGraph(const Points& source, const Points& target, const Correspondences& matches,
-                       double noise_bound);
+Graph consistencyGraph(const Points& source, const Points& target, const Correspondences& matches, double noise_bound);
 
 }  // namespace livo::loop

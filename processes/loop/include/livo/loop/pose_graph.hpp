@@ -25,13 +25,13 @@ class Problem;
 namespace livo::loop {
 
 struct PoseGraphOptions {
-  int max_iterations = 20;            // per optimisation (a warm-started one needs 2-5)
-  double function_tolerance = 1e-9;   // relative cost decrease at which a solve stops
-  double parameter_tolerance = 1e-9;  // relative step size at which a solve stops
+  int max_iterations = 20;                    // per optimisation (a warm-started one needs 2-5)
+  double function_tolerance = 1e-9;           // relative cost decrease at which a solve stops
+  double parameter_tolerance = 1e-9;          // relative step size at which a solve stops
   double initial_trust_region_radius = 1e12;  // large: the first steps are Gauss-Newton steps
-  bool robust_loops = false;      // Cauchy loss on loop edges (off: loops are verified, and a
-                                  // large first correction would be down-weighted away)
-  double loop_loss_scale = 1.0;   // in units of the whitened residual
+  bool robust_loops = false;                  // Cauchy loss on loop edges (off: loops are verified, and a
+                                              // large first correction would be down-weighted away)
+  double loop_loss_scale = 1.0;               // in units of the whitened residual
   /// A loop edge between the same two nodes, in the same direction, as an earlier loop edge is
   /// fused into it (information-weighted, to first order: the same optimum) instead of added:
   /// passes over a mapped route then add no edges once their node pairs are in the graph.
@@ -104,7 +104,7 @@ class PoseGraph {
   std::map<std::pair<int64_t, int64_t>, size_t> loop_edges_;  // (from, to) -> index in edges_
   std::unique_ptr<ceres::Problem> problem_;
   size_t edges_in_problem_ = 0;
-  int64_t fixed_id_ = 0;  // the node held constant in problem_
+  int64_t fixed_id_ = 0;          // the node held constant in problem_
   std::set<int64_t> held_fixed_;  // first nodes of later segments (holdFixed)
   struct GravityPrior {
     int64_t id = 0;
@@ -117,6 +117,7 @@ class PoseGraph {
 
 /// The information of a relative edge from two absolute covariances (cov_to - cov_from,
 /// eigenvalues clamped below at the floors), [rotation; translation].
-Mat6 relativeInformation(const Mat6& cov_from, const Mat6& cov_to, double rotation_floor_rad, double translation_floor_m);
+Mat6 relativeInformation(const Mat6& cov_from, const Mat6& cov_to, double rotation_floor_rad,
+                         double translation_floor_m);
 
 }  // namespace livo::loop

@@ -14,10 +14,10 @@
 namespace livo::loop {
 
 struct QuatroOptions {
-  double noise_bound = 0.3;         // m, the inlier bound of a correspondence
-  bool quasi_so3 = true;            // yaw only (clouds in gravity-aligned frames)
-  int max_tims = 20000;             // translation-invariant measurements used for the rotation
-  double gnc_factor = 1.4;          // GNC: mu *= factor each iteration
+  double noise_bound = 0.3;  // m, the inlier bound of a correspondence
+  bool quasi_so3 = true;     // yaw only (clouds in gravity-aligned frames)
+  int max_tims = 20000;      // translation-invariant measurements used for the rotation
+  double gnc_factor = 1.4;   // GNC: mu *= factor each iteration
   int gnc_max_iterations = 100;
   double gnc_cost_threshold = 1e-6;
   MaxCliqueOptions clique;
@@ -26,10 +26,10 @@ struct QuatroOptions {
 struct QuatroResult {
   Pose3 T_target_source = Pose3::Identity();
   int num_correspondences = 0;
-  int num_clique = 0;         // max-clique size
-  int num_inliers = 0;        // clique members consistent with the final transform
+  int num_clique = 0;   // max-clique size
+  int num_inliers = 0;  // clique members consistent with the final transform
   bool clique_exact = true;
-  bool valid = false;         // at least 3 inliers and the estimation converged
+  bool valid = false;  // at least 3 inliers and the estimation converged
 };
 
 /// Registers matched source/target points (matches index into them).

@@ -94,7 +94,8 @@ class OccupancyMap {
   Tile& residentTile(uint64_t tile_index);
   void spill(Tile* tile);
   /// A tile's tree: the resident one, or (for a tile on disk) one read back into `holder`.
-  ::octomap::AbstractOccupancyOcTree& treeOf(const Tile& tile, std::unique_ptr<::octomap::AbstractOccupancyOcTree>* holder) const;
+  ::octomap::AbstractOccupancyOcTree& treeOf(const Tile& tile,
+                                             std::unique_ptr<::octomap::AbstractOccupancyOcTree>* holder) const;
   std::unique_ptr<::octomap::AbstractOccupancyOcTree> newTree() const;
   void refreshResident() const;
   /// What the file needs of a tile: its root's data and subtree size, and (payload) its part of
@@ -103,9 +104,9 @@ class OccupancyMap {
   bool writeTree(std::ostream& out, Format format, bool resident_only) const;
 
   OctomapOptions options_;
-  int tile_bits_ = 16;  // a tile spans 2^tile_bits_ keys per axis
-  std::unique_ptr<::octomap::OcTree> keys_;  // empty: the key arithmetic (same resolution)
-  std::unique_ptr<Scratch> scratch_;       // key sets reused across sweeps
+  int tile_bits_ = 16;                               // a tile spans 2^tile_bits_ keys per axis
+  std::unique_ptr<::octomap::OcTree> keys_;          // empty: the key arithmetic (same resolution)
+  std::unique_ptr<Scratch> scratch_;                 // key sets reused across sweeps
   std::map<uint64_t, std::unique_ptr<Tile>> tiles_;  // by tile index
   std::unique_ptr<SpillFile> spill_;
   int64_t now_ = INT64_MIN;

@@ -19,15 +19,15 @@
 #include <vector>
 
 #include "livo/map_inputs.hpp"
+#include "livo/octomap/occupancy_map.hpp"
 #include "livo/so3.hpp"
 #include "livo/spill_file.hpp"
-#include "livo/octomap/occupancy_map.hpp"
 
 namespace livo::octomap {
 
 struct Keyframe {
   int64_t utime = 0;
-  Pose3 T_W_I = Pose3::Identity();     // current (corrected) pose
+  Pose3 T_W_I = Pose3::Identity();      // current (corrected) pose
   std::vector<Eigen::Vector3f> points;  // body frame I
 };
 

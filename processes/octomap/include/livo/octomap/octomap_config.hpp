@@ -16,8 +16,8 @@ struct OctomapNodeOptions {
   std::string keyframe_channel = "KEYFRAME";
   std::string loop_correction_channel = "LOOP_CORRECTION";
   std::string octomap_channel = "OCTOMAP";
-  double publish_period_s = 2.0;  // sensor time between OCTOMAP messages (0: never)
-  double write_period_s = 10.0;   // sensor time between file writes (0: only on exit)
+  double publish_period_s = 2.0;     // sensor time between OCTOMAP messages (0: never)
+  double write_period_s = 10.0;      // sensor time between file writes (0: only on exit)
   std::string map_name = "octomap";  // files <output_dir>/<map_name>.bt / .ot
 };
 

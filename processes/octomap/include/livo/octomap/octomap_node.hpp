@@ -7,9 +7,9 @@
 
 #include "livo/correction_frames.hpp"
 #include "livo/node.hpp"
-#include "livo/sensor_rig.hpp"
 #include "livo/octomap/octomap_builder.hpp"
 #include "livo/octomap/octomap_config.hpp"
+#include "livo/sensor_rig.hpp"
 
 namespace livo::octomap {
 

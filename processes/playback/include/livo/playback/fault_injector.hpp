@@ -18,11 +18,11 @@ namespace livo::playback {
 struct Fault {
   enum class Kind { kDrop, kDuplicate, kDelay, kReorder, kCorrupt, kNanPoints, kTimeJump, kCut };
   Kind kind = Kind::kDrop;
-  std::string channel;      // exact channel name
-  double fraction = 0.0;    // of messages on the channel (drop, duplicate, delay, reorder, corrupt, nan)
-  double seconds = 0.0;     // delay: how late; time-jump: size of the jump
-  double from_s = 0.0;      // time-jump: from this log time on; cut: window start (s from log start)
-  double to_s = 0.0;        // cut: window end
+  std::string channel;    // exact channel name
+  double fraction = 0.0;  // of messages on the channel (drop, duplicate, delay, reorder, corrupt, nan)
+  double seconds = 0.0;   // delay: how late; time-jump: size of the jump
+  double from_s = 0.0;    // time-jump: from this log time on; cut: window start (s from log start)
+  double to_s = 0.0;      // cut: window end
 };
 
 /// Parses "drop:CH:FRAC", "duplicate:CH:FRAC", "delay:CH:FRAC:SECONDS", "reorder:CH:FRAC",
@@ -32,8 +32,8 @@ Fault parseFault(const std::string& text);
 std::string describe(const Fault& f);
 
 struct FaultCounts {
-  int64_t dropped = 0, duplicated = 0, delayed = 0, reordered = 0, corrupted = 0, nan_clouds = 0,
-          time_shifted = 0, cut = 0;
+  int64_t dropped = 0, duplicated = 0, delayed = 0, reordered = 0, corrupted = 0, nan_clouds = 0, time_shifted = 0,
+          cut = 0;
 };
 
 class FaultInjector {

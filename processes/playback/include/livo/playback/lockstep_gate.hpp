@@ -43,16 +43,16 @@
 namespace livo::playback {
 
 struct LockstepGateOptions {
-  double loss_grace_s = 3.0;        // an idle consumer still lacking a message this old lost it
-  bool tolerate_restarts = false;   // consumers may exit and come back (supervised runs)
-  double silent_after_s = 5.0;      // tolerate_restarts: a consumer not heard for this long is away
-  double restart_wait_s = 30.0;     // tolerate_restarts: how long a consumer away is waited for
-  bool honour_quiet_promises = true; // false: wait for every consumer after every message
-  std::vector<std::string> may_lag; // consumers that may fall behind (see above)
-  int max_lag_messages = 16;        // how far (messages not yet handled, all channels) they may,
-  int64_t max_lag_bytes = 16 << 20; // and in bytes (estimated from each channel's mean size): what
-                                    // a sink's LCM receive thread queues for it (a 64-beam cloud
-                                    // is ~3 MB, an RGB image ~1 MB)
+  double loss_grace_s = 3.0;          // an idle consumer still lacking a message this old lost it
+  bool tolerate_restarts = false;     // consumers may exit and come back (supervised runs)
+  double silent_after_s = 5.0;        // tolerate_restarts: a consumer not heard for this long is away
+  double restart_wait_s = 30.0;       // tolerate_restarts: how long a consumer away is waited for
+  bool honour_quiet_promises = true;  // false: wait for every consumer after every message
+  std::vector<std::string> may_lag;   // consumers that may fall behind (see above)
+  int max_lag_messages = 16;          // how far (messages not yet handled, all channels) they may,
+  int64_t max_lag_bytes = 16 << 20;   // and in bytes (estimated from each channel's mean size): what
+                                      // a sink's LCM receive thread queues for it (a 64-beam cloud
+                                      // is ~3 MB, an RGB image ~1 MB)
 };
 
 class LockstepGate {
@@ -121,7 +121,7 @@ class LockstepGate {
     int64_t instance = 0;
     int64_t sequence = -1;
     bool finished = false;
-    bool away = false;                      // exited or silent, waiting for a new instance
+    bool away = false;  // exited or silent, waiting for a new instance
     double away_since_s = 0.0;
     double last_heard_s = 0.0;
     std::map<std::string, int64_t> handled;
@@ -129,7 +129,7 @@ class LockstepGate {
     std::map<std::string, int64_t> published_bytes;
     std::map<std::string, int64_t> published_before;  // by earlier instances of this node
     std::map<std::string, int64_t> published_bytes_before;
-    std::map<std::string, int64_t> offset;  // counted as handled: lost, or published while away
+    std::map<std::string, int64_t> offset;                     // counted as handled: lost, or published while away
     std::map<std::string, std::pair<int64_t, int64_t>> quiet;  // the newest PROGRESS's promises
   };
   struct Waiting {
@@ -147,7 +147,7 @@ class LockstepGate {
   bool isConsumer(const std::string& node) const;
   /// Why a consumer listed in may_lag is kept in step ("" if it may lag).
   std::string keptInStepBecause(const std::string& node) const;
-  int64_t behind(const NodeState& n) const;  // messages not yet handled, all channels
+  int64_t behind(const NodeState& n) const;       // messages not yet handled, all channels
   int64_t behindBytes(const NodeState& n) const;  // their bytes, at each channel's mean size
   /// The consumer's unhandled messages on `channel` are all playback's and inside its promise.
   bool promisedQuiet(const NodeState& n, const std::string& channel) const;
@@ -168,12 +168,12 @@ class LockstepGate {
   std::map<std::string, int64_t> playback_published_;
   std::map<std::string, int64_t> playback_bytes_;
   std::map<std::string, std::deque<std::pair<int64_t, int64_t>>> playback_utimes_;  // channel -> (index, utime), newest
-  std::map<std::string, int64_t> known_total_;                       // channel -> total seen so far
-  std::map<std::string, std::deque<std::pair<int64_t, double>>> reached_at_;  // channel -> (total, time)
-  std::map<std::pair<std::string, std::string>, Waiting> waiting_;   // (consumer, channel)
+  std::map<std::string, int64_t> known_total_;                                      // channel -> total seen so far
+  std::map<std::string, std::deque<std::pair<int64_t, double>>> reached_at_;        // channel -> (total, time)
+  std::map<std::pair<std::string, std::string>, Waiting> waiting_;                  // (consumer, channel)
   std::map<std::string, int64_t> lost_total_;
   std::vector<std::string> events_;
-  std::vector<std::string> lagging_;                  // lagging(), worked out when the topology changes
+  std::vector<std::string> lagging_;                 // lagging(), worked out when the topology changes
   std::map<std::string, std::string> lag_decision_;  // may_lag consumer -> "" or why in step (last told)
   int restarts_ = 0;
 };

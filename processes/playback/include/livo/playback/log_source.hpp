@@ -16,7 +16,7 @@ class LogFile;
 namespace livo::playback {
 
 struct LogEvent {
-  int64_t utime = 0;          // the log event's timestamp (sensor time for logs made here)
+  int64_t utime = 0;  // the log event's timestamp (sensor time for logs made here)
   std::string channel;
   std::vector<uint8_t> data;
 };

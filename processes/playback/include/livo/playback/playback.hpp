@@ -19,26 +19,26 @@ namespace livo::playback {
 struct PlaybackOptions {
   std::string log;
   LogSourceOptions source;
-  double speed = 1.0;                   // real-time factor; 0 = as fast as possible
+  double speed = 1.0;  // real-time factor; 0 = as fast as possible
   bool lockstep = false;
-  std::vector<std::string> consumers;   // nodes to wait for at the start (and, lockstep, always)
+  std::vector<std::string> consumers;  // nodes to wait for at the start (and, lockstep, always)
   std::string progress_channel = "PROGRESS";
-  double stall_timeout_s = 30.0;        // lockstep: a consumer behind on a channel whose count has
-                                        // not moved for this long = a stall (heartbeats do not count)
-  double loss_grace_s = 3.0;            // lockstep: an idle consumer lacking a message published this
-                                        // long ago lost it on the bus (reported, then not waited for)
-  bool respawn = false;                 // lockstep: consumers may exit and be restarted (supervised
-                                        // runs); not waited for while away
-  double startup_timeout_s = 30.0;      // lockstep: time for every consumer to report once
-  bool serial = false;                  // lockstep: wait for every consumer after every message (no
-                                        // quiet promises, nothing lags): the reference order
-  std::vector<std::string> may_lag;     // lockstep: consumers that may fall behind by up to max_lag
-  int max_lag_messages = 16;            // messages, while the rest handle the next ones (lockstep_gate.hpp)
-  int64_t max_lag_bytes = 16 << 20;      // and bytes (at each channel's mean message size)
+  double stall_timeout_s = 30.0;     // lockstep: a consumer behind on a channel whose count has
+                                     // not moved for this long = a stall (heartbeats do not count)
+  double loss_grace_s = 3.0;         // lockstep: an idle consumer lacking a message published this
+                                     // long ago lost it on the bus (reported, then not waited for)
+  bool respawn = false;              // lockstep: consumers may exit and be restarted (supervised
+                                     // runs); not waited for while away
+  double startup_timeout_s = 30.0;   // lockstep: time for every consumer to report once
+  bool serial = false;               // lockstep: wait for every consumer after every message (no
+                                     // quiet promises, nothing lags): the reference order
+  std::vector<std::string> may_lag;  // lockstep: consumers that may fall behind by up to max_lag
+  int max_lag_messages = 16;         // messages, while the rest handle the next ones (lockstep_gate.hpp)
+  int64_t max_lag_bytes = 16 << 20;  // and bytes (at each channel's mean message size)
   std::vector<Fault> faults;
   uint64_t seed = 1;
-  std::string out_log;                  // write the (faulted) stream here instead of publishing
-  std::string clock_file;               // keep the log seconds replayed so far in this file (supervisors)
+  std::string out_log;     // write the (faulted) stream here instead of publishing
+  std::string clock_file;  // keep the log seconds replayed so far in this file (supervisors)
   bool quiet = false;
 };
 
@@ -46,8 +46,8 @@ struct PlaybackOptions {
 /// consumer's PROGRESS ended each wait (the one the replay was waiting for last): where the
 /// critical path of a lockstep replay runs.
 struct LockstepWaits {
-  int64_t messages = 0;                 // published on the channel
-  int64_t waited = 0;                   // after which playback had to wait
+  int64_t messages = 0;  // published on the channel
+  int64_t waited = 0;    // after which playback had to wait
   double seconds = 0.0;
   std::map<std::string, double> seconds_by_last;  // consumer whose report ended the wait -> seconds
 };
@@ -56,12 +56,12 @@ struct PlaybackResult {
   int64_t published = 0;
   double log_seconds = 0.0;
   double wall_seconds = 0.0;
-  std::string error;                    // empty on success
-  int64_t lost = 0;                     // lockstep: messages consumers never received (bus losses)
-  int restarts = 0;                     // lockstep with respawn: consumers that came back
-  int64_t not_waited = 0;               // lockstep: messages after which the next went out at once
-                                        // (quiet promises, lagging consumers), not after the whole
-                                        // pipeline had handled them
+  std::string error;                           // empty on success
+  int64_t lost = 0;                            // lockstep: messages consumers never received (bus losses)
+  int restarts = 0;                            // lockstep with respawn: consumers that came back
+  int64_t not_waited = 0;                      // lockstep: messages after which the next went out at once
+                                               // (quiet promises, lagging consumers), not after the whole
+                                               // pipeline had handled them
   std::map<std::string, LockstepWaits> waits;  // lockstep: per channel
 };
 

@@ -18,21 +18,21 @@ struct ViewerOptions {
 };
 
 struct ViewerScene {
-  Vec3 origin = Vec3::Zero();      // subtracted from every position (float32 keeps mm only near it)
-  std::vector<float> positions;    // x y z of each point, relative to origin
-  std::vector<uint8_t> colours;    // r g b of each point
-  size_t map_points = 0;           // in the map file
-  double voxel_m = 0.0;            // the thinning grid (0: every point)
-  double point_size_m = 0.05;      // of the points drawn (the grid when thinned)
-  std::vector<float> path;         // x y z of the trajectory's positions, relative to origin
+  Vec3 origin = Vec3::Zero();         // subtracted from every position (float32 keeps mm only near it)
+  std::vector<float> positions;       // x y z of each point, relative to origin
+  std::vector<uint8_t> colours;       // r g b of each point
+  size_t map_points = 0;              // in the map file
+  double voxel_m = 0.0;               // the thinning grid (0: every point)
+  double point_size_m = 0.05;         // of the points drawn (the grid when thinned)
+  std::vector<float> path;            // x y z of the trajectory's positions, relative to origin
   std::vector<uint32_t> path_pieces;  // positions per piece (pathPieces: split at resets and gaps)
-  Vec3 camera = Vec3::Zero();      // the start view (obliqueView), relative to origin; the page
-  Vec3 target = Vec3::Zero();      // keeps its direction and moves it to fit the box in the canvas
-  Vec3 box_min = Vec3::Zero();     // what the start view frames (relative to origin)
+  Vec3 camera = Vec3::Zero();         // the start view (obliqueView), relative to origin; the page
+  Vec3 target = Vec3::Zero();         // keeps its direction and moves it to fit the box in the canvas
+  Vec3 box_min = Vec3::Zero();        // what the start view frames (relative to origin)
   Vec3 box_max = Vec3::Zero();
-  double fov_deg = 50.0;           // vertical
-  double z_min = 0.0, z_max = 0.0; // height range of the points and the path, relative to origin
-  double cut_z = 0.0;              // the height cut at start, relative to origin
+  double fov_deg = 50.0;            // vertical
+  double z_min = 0.0, z_max = 0.0;  // height range of the points and the path, relative to origin
+  double cut_z = 0.0;               // the height cut at start, relative to origin
   size_t size() const { return colours.size() / 3; }
 };
 

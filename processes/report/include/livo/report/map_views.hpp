@@ -38,7 +38,9 @@ struct TopViewFrame {
   int width = 0;
   int height = 0;
   /// Continuous pixel coordinates of a world point (the pixel is their floor).
-  cv::Point2d pixel(double x, double y) const { return {(x - x_min) / metres_per_pixel, (y_max - y) / metres_per_pixel}; }
+  cv::Point2d pixel(double x, double y) const {
+    return {(x - x_min) / metres_per_pixel, (y_max - y) / metres_per_pixel};
+  }
 };
 
 /// A frame over the box's horizontal extent, widened by `margin` (a fraction of its larger side) on
@@ -76,8 +78,8 @@ PerspectiveView obliqueView(const Box3& box, const Eigen::Vector2d& major_axis, 
 cv::Mat cropToContent(const cv::Mat& image, const cv::Vec3b& background, int margin_px);
 
 struct SplatStyle {
-  double point_size_m = 0.05;  // the map's point spacing (livo-colour's voxel): a splat's width
-  int max_px = 12;             // splats no wider than this
+  double point_size_m = 0.05;           // the map's point spacing (livo-colour's voxel): a splat's width
+  int max_px = 12;                      // splats no wider than this
   cv::Vec3b background{255, 255, 255};  // BGR
   /// Eye-dome lighting: a pixel nearer than its neighbours stays bright, one farther (behind an
   /// edge) is darkened by exp(-strength * the sum of its log-depth steps); 0: the points' colours.
@@ -86,8 +88,7 @@ struct SplatStyle {
 
 /// The points no higher than the trajectory's height there plus `cut_above_m` (the ceiling of a
 /// room, the canopy over a road would hide the map from above).
-ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height,
-                                      double cut_above_m);
+ColouredPoints pointsBelowCut(const ColouredPoints& points, const TrajectoryHeight& height, double cut_above_m);
 
 /// The points from straight above: the highest point of a pixel wins it. `top_z` (if given) gets
 /// the z of each pixel's point (NaN where none).

@@ -50,7 +50,7 @@ struct OdometryQuality {
 struct LoopEvent {
   int64_t correction_id = 0;
   int32_t epoch = 0;
-  double stamp = 0.0;  // the newest keyframe in the graph
+  double stamp = 0.0;              // the newest keyframe in the graph
   int64_t from_id = 0, to_id = 0;  // the loop edge's keyframes
   double fitness = 0.0;            // m^2
   double shift_m = 0.0;            // the newest corrected keyframe moved by it (T_Ck_Cj)
@@ -66,26 +66,26 @@ struct VisualAnswer {
 
 /// An LIO reset seen in the outputs: the first odometry of a new epoch.
 struct OdometryReset {
-  double stamp = 0.0;   // first odometry of the new epoch
-  int32_t epoch = 0;    // the new epoch
-  std::string reason;   // from lio's HEALTH ("odometry reset to epoch N: ..."), empty if not logged
+  double stamp = 0.0;  // first odometry of the new epoch
+  int32_t epoch = 0;   // the new epoch
+  std::string reason;  // from lio's HEALTH ("odometry reset to epoch N: ..."), empty if not logged
 };
 
 struct PipelineOutputs {
-  Trajectory odometry;                          // body pose at every scan, in stamp order
-  std::vector<PublishedFrame> odometry_frames;  // the frame of each odometry pose (same order)
-  std::vector<OdometryQuality> odometry_quality;  // and what it says of itself (same order)
-  std::vector<KeyframePose> keyframes;          // in id order
-  std::map<int32_t, loop_correction_t> last_loop;  // the newest LOOP_CORRECTION of each epoch
+  Trajectory odometry;                                       // body pose at every scan, in stamp order
+  std::vector<PublishedFrame> odometry_frames;               // the frame of each odometry pose (same order)
+  std::vector<OdometryQuality> odometry_quality;             // and what it says of itself (same order)
+  std::vector<KeyframePose> keyframes;                       // in id order
+  std::map<int32_t, loop_correction_t> last_loop;            // the newest LOOP_CORRECTION of each epoch
   std::map<int64_t, std::pair<int32_t, Pose3>> corrections;  // every correction: id -> (epoch, T_Ck_O)
   int64_t loop_corrections = 0;
-  std::vector<LoopEvent> loops;                 // every LOOP_CORRECTION, in log order
-  int64_t state_priors = 0;                     // STATE_PRIOR: images handed to a VIO
-  std::vector<VisualAnswer> visual_answers;     // STATE_POSTERIOR, in stamp order
-  std::vector<OdometryReset> resets;            // in stamp order
-  std::map<std::string, health_t> final_health; // newest HEALTH per node
-  int64_t undecodable = 0;                      // messages on these channels that did not decode
-  int64_t non_finite = 0;                       // odometry poses dropped for NaN/Inf
+  std::vector<LoopEvent> loops;                  // every LOOP_CORRECTION, in log order
+  int64_t state_priors = 0;                      // STATE_PRIOR: images handed to a VIO
+  std::vector<VisualAnswer> visual_answers;      // STATE_POSTERIOR, in stamp order
+  std::vector<OdometryReset> resets;             // in stamp order
+  std::map<std::string, health_t> final_health;  // newest HEALTH per node
+  int64_t undecodable = 0;                       // messages on these channels that did not decode
+  int64_t non_finite = 0;                        // odometry poses dropped for NaN/Inf
 };
 
 /// Reads the log; throws std::runtime_error naming the file if it cannot be opened.

@@ -15,7 +15,7 @@ namespace livo::report {
 struct TrajectoryFigureInputs {
   Trajectory final_estimate;         // trajectory.tum (loop-corrected); empty: the odometry is drawn as the estimate
   Trajectory odometry;               // odometry.tum; drawn in grey beneath when it differs from the final
-  PlotMarks marks;         // none: nothing marked
+  PlotMarks marks;                   // none: nothing marked
   std::vector<double> reset_stamps;  // odometry resets: the path is broken there (resets.json)
   std::string title;
 };

@@ -62,9 +62,9 @@ struct DegenerateStretch {
 /// kept) and the counts by reason its final HEALTH carries (livo/reason_counts.hpp).
 struct VisualRefusals {
   std::string node;
-  std::string what;       // how the node names them: "priors kept", "images refused"
+  std::string what;  // how the node names them: "priors kept", "images refused"
   int64_t refused = 0;
-  int64_t of = 0;         // images answered or handled; 0: unknown
+  int64_t of = 0;                          // images answered or handled; 0: unknown
   std::map<std::string, int64_t> reasons;  // empty: the node did not say
   std::vector<TimeSpan> spans;             // runs of kept priors, in time order
 };
@@ -77,15 +77,15 @@ struct LoopMark {
 };
 
 struct WeakSpots {
-  double start = 0.0;   // stamp (s) of the first odometry pose: report.md counts time from it
-  int64_t sweeps = 0;   // odometry poses
+  double start = 0.0;  // stamp (s) of the first odometry pose: report.md counts time from it
+  int64_t sweeps = 0;  // odometry poses
   int64_t degenerate = 0;
   std::vector<DegenerateStretch> degenerate_stretches;  // in time order
-  std::string direction;        // the most frequent description over every degenerate sweep
-  double direction_share = 0.0; // of the degenerate sweeps it describes
-  int64_t predicted = 0;        // sweeps without a LiDAR update (after each epoch's first)
+  std::string direction;                                // the most frequent description over every degenerate sweep
+  double direction_share = 0.0;                         // of the degenerate sweeps it describes
+  int64_t predicted = 0;                                // sweeps without a LiDAR update (after each epoch's first)
   std::vector<TimeSpan> predicted_spans;
-  int64_t state_priors = 0;     // images lio handed to a VIO (STATE_PRIOR)
+  int64_t state_priors = 0;  // images lio handed to a VIO (STATE_PRIOR)
   std::vector<VisualRefusals> visual;
   std::vector<LoopMark> loops;  // in log order
 };

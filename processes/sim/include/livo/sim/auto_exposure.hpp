@@ -11,12 +11,12 @@ namespace livo::sim {
 
 struct AutoExposureOptions {
   bool enabled = false;
-  double target_mean = 110.0;   // grey levels (0..255) of the mean image brightness
-  double min_exposure = 2e-5;   // s
-  double max_exposure = 0.02;   // s
-  double min_gain = 1.0;        // linear analogue gain
+  double target_mean = 110.0;  // grey levels (0..255) of the mean image brightness
+  double min_exposure = 2e-5;  // s
+  double max_exposure = 0.02;  // s
+  double min_gain = 1.0;       // linear analogue gain
   double max_gain = 16.0;
-  double rate = 0.5;            // fraction of the log-brightness error corrected per frame, (0, 1]
+  double rate = 0.5;  // fraction of the log-brightness error corrected per frame, (0, 1]
 };
 
 struct ExposureSetting {

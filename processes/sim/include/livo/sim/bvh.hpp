@@ -63,9 +63,9 @@ class Bvh {
  private:
   struct Node {
     Aabb box;
-    int first = 0;   // leaf: first index into items_; inner: index of the left child (right = +1)
-    int count = 0;   // > 0 for leaves
-    int axis = 0;    // split axis of an inner node
+    int first = 0;  // leaf: first index into items_; inner: index of the left child (right = +1)
+    int count = 0;  // > 0 for leaves
+    int axis = 0;   // split axis of an inner node
   };
   int buildNode(std::vector<int>& items, int begin, int end, const std::vector<Aabb>& bounds, int max_leaf, int node);
 

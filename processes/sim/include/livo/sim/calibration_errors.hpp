@@ -23,7 +23,7 @@ struct ExtrinsicError {
 };
 
 struct CalibrationErrors {
-  bool draw = false;                 // values are 1-sigmas of per-component draws
+  bool draw = false;  // values are 1-sigmas of per-component draws
   ExtrinsicError lidar, camera, wheel;
   double lidar_time_offset_s = 0.0;  // stamp t was measured at IMU time t + offset
   double camera_time_offset_s = 0.0;

@@ -22,15 +22,15 @@
 namespace livo::sim {
 
 struct CameraEffects {
-  double exposure_time = 0.005;      // s, nominal
-  double exposure_variation = 0.25;  // relative amplitude of the exposure drift (0 = constant)
-  double exposure_period_s = 8.0;    // time scale of the drift
-  int motion_blur_samples = 1;       // sub-frames averaged over the exposure (1 = no blur)
-  double noise_std = 1.5;            // sensor noise, grey levels
-  double brightness = 1.0;           // overall gain
-  double vignetting = 0.25;          // brightness loss at the image corners (0..1)
-  double rolling_shutter_s = 0.0;    // readout time, top row to bottom row (0 = global shutter)
-  AutoExposureOptions auto_exposure; // when enabled, exposure_variation drifts the scene light instead
+  double exposure_time = 0.005;       // s, nominal
+  double exposure_variation = 0.25;   // relative amplitude of the exposure drift (0 = constant)
+  double exposure_period_s = 8.0;     // time scale of the drift
+  int motion_blur_samples = 1;        // sub-frames averaged over the exposure (1 = no blur)
+  double noise_std = 1.5;             // sensor noise, grey levels
+  double brightness = 1.0;            // overall gain
+  double vignetting = 0.25;           // brightness loss at the image corners (0..1)
+  double rolling_shutter_s = 0.0;     // readout time, top row to bottom row (0 = global shutter)
+  AutoExposureOptions auto_exposure;  // when enabled, exposure_variation drifts the scene light instead
 };
 
 class CameraRenderer {
@@ -38,7 +38,8 @@ class CameraRenderer {
   CameraRenderer(const CameraRig& rig, const CameraEffects& effects);
 
   /// The image whose exposure is centred on trajectory time `t_mid` (stamped `utime`).
-  CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime, Random rng) const;
+  CameraImage render(const Scene& scene, const BodyTrajectory& trajectory, double t_mid, int64_t utime,
+                     Random rng) const;
   /// The same with the exposure and gain an auto-exposure controller chose; with `z_depth`, also
   /// the exact depth along the optical axis per pixel (m, row-major; 0 where the ray meets nothing
   /// or glass first), from the rays of the sub-frame at t_mid (rows at their own times under a
@@ -67,9 +68,9 @@ class CameraRenderer {
   /// A block of pixels whose rays all lie inside a pyramid (camera frame), used to cull the scene
   /// once per block instead of traversing it once per pixel.
   struct Tile {
-    int x0, y0, x1, y1;   // pixel range [x0, x1) x [y0, y1)
-    Vec3 normals[4];      // inward normals of the pyramid's planes through the optical centre
-    bool culled = true;   // false if the tile is too wide for a pyramid
+    int x0, y0, x1, y1;  // pixel range [x0, x1) x [y0, y1)
+    Vec3 normals[4];     // inward normals of the pyramid's planes through the optical centre
+    bool culled = true;  // false if the tile is too wide for a pyramid
   };
   void buildTiles();
 

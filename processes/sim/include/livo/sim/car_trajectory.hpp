@@ -19,18 +19,18 @@
 namespace livo::sim {
 
 struct CarTrajectoryOptions {
-  double start_still_s = 2.0;          // stand still this long
-  double ramp_s = 2.0;                 // then reach full speed over this long
-  MotionShake shake;                   // position: of the rear axle (world); attitude: of the car about it
-  Pose3 T_I_B = Pose3::Identity();     // the rear-axle frame in the body frame: the TRUE wheel base mounting
+  double start_still_s = 2.0;             // stand still this long
+  double ramp_s = 2.0;                    // then reach full speed over this long
+  MotionShake shake;                      // position: of the rear axle (world); attitude: of the car about it
+  Pose3 T_I_B = Pose3::Identity();        // the rear-axle frame in the body frame: the TRUE wheel base mounting
   std::shared_ptr<const Terrain> ground;  // null: the plane z = 0 (the path's z is absolute)
-  double wheelbase = 2.7;              // m, rear to front axle (on a ground)
-  double track_width = 1.6;            // m, left to right wheel (on a ground)
+  double wheelbase = 2.7;                 // m, rear to front axle (on a ground)
+  double track_width = 1.6;               // m, left to right wheel (on a ground)
 };
 
 /// The car frame B in the world and its first two time derivatives (without the body mounting).
 struct CarFrame {
-  Vec3 p = Vec3::Zero(), v = Vec3::Zero(), a = Vec3::Zero();  // the rear-axle centre
+  Vec3 p = Vec3::Zero(), v = Vec3::Zero(), a = Vec3::Zero();         // the rear-axle centre
   Mat3 R = Mat3::Identity(), dR = Mat3::Zero(), ddR = Mat3::Zero();  // R_WB
 };
 

@@ -22,15 +22,15 @@ namespace livo::sim {
 ///    each depth discontinuity, the occlusion shadow) and on surfaces its projector and texture do
 ///    not reach (blobs: dark, shiny or transparent patches); a few per cent of a typical indoor view.
 struct DepthEffects {
-  double noise_floor = 0.001;       // m, sigma at z = 0
-  double noise_per_m2 = 0.0036;     // 1/m: sigma(z) = noise_floor + noise_per_m2 z^2
-  double min_range = 0.2;           // m: nearer is no depth
-  double max_range = 10.0;          // m: farther is no depth
-  double edge_jump = 0.05;          // relative depth step between 4-neighbours that is a discontinuity
-                                    // (also a pixel beside one without depth, e.g. sky)
-  int edge_hole_px = 2;             // width of the band without depth on each side of a discontinuity (0: none)
-  double hole_fraction = 0.02;      // expected share of pixels inside random blobs without depth
-  double hole_radius_px = 6.0;      // mean radius of a blob (radii uniform in [0.5, 1.5] x this)
+  double noise_floor = 0.001;    // m, sigma at z = 0
+  double noise_per_m2 = 0.0036;  // 1/m: sigma(z) = noise_floor + noise_per_m2 z^2
+  double min_range = 0.2;        // m: nearer is no depth
+  double max_range = 10.0;       // m: farther is no depth
+  double edge_jump = 0.05;       // relative depth step between 4-neighbours that is a discontinuity
+                                 // (also a pixel beside one without depth, e.g. sky)
+  int edge_hole_px = 2;          // width of the band without depth on each side of a discontinuity (0: none)
+  double hole_fraction = 0.02;   // expected share of pixels inside random blobs without depth
+  double hole_radius_px = 6.0;   // mean radius of a blob (radii uniform in [0.5, 1.5] x this)
 
   double sigmaAt(double z) const { return noise_floor + noise_per_m2 * z * z; }
 };

@@ -73,8 +73,8 @@ struct RayHit {
 /// What a renderer or LiDAR needs to know about a hit point.
 struct SurfacePoint {
   Vec3 position = Vec3::Zero();
-  Vec3 normal = Vec3::UnitZ();      // unit, facing the ray origin
-  double u = 0.0, v = 0.0;          // texture coordinates on the surface, metres
+  Vec3 normal = Vec3::UnitZ();  // unit, facing the ray origin
+  double u = 0.0, v = 0.0;      // texture coordinates on the surface, metres
 };
 
 }  // namespace livo::sim

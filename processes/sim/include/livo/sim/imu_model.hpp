@@ -33,11 +33,11 @@ struct ImuTemperature {
 struct ImuErrors {
   Vec3 gyro_scale_ppm = Vec3::Zero();
   Vec3 accel_scale_ppm = Vec3::Zero();
-  Vec3 gyro_misalignment_mrad = Vec3::Zero();   // [m0, m1, m2]
+  Vec3 gyro_misalignment_mrad = Vec3::Zero();  // [m0, m1, m2]
   Vec3 accel_misalignment_mrad = Vec3::Zero();
-  Vec3 gyro_g_sensitivity = Vec3::Zero();       // rad/s per m/s^2, per axis
-  Vec3 gyro_bias_per_c = Vec3::Zero();          // rad/s per deg C
-  Vec3 accel_bias_per_c = Vec3::Zero();         // m/s^2 per deg C
+  Vec3 gyro_g_sensitivity = Vec3::Zero();  // rad/s per m/s^2, per axis
+  Vec3 gyro_bias_per_c = Vec3::Zero();     // rad/s per deg C
+  Vec3 accel_bias_per_c = Vec3::Zero();    // m/s^2 per deg C
   ImuTemperature temperature;
   bool any() const;
 };

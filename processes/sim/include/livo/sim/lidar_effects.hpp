@@ -21,11 +21,11 @@ struct LidarEffects {
   double noise_reflectivity_exponent = 0.5;  // 0.5: shot-noise limited receiver; 0: no reflectivity penalty
   // detection probability = Phi(ln(p / p10) / detection_softness + z90), p10 = 0.1 / max_range_at_10pct^2:
   // 90 % for a 10 % target at normal incidence at max_range_at_10pct
-  double max_range_at_10pct = 0.0;           // m; 0: every return is detected
-  double detection_softness = 0.2;           // std of ln(power) at the threshold (width of the edge)
+  double max_range_at_10pct = 0.0;  // m; 0: every return is detected
+  double detection_softness = 0.2;  // std of ln(power) at the threshold (width of the edge)
   // Gaussian beam of these full widths at half maximum, sampled by 7 sub-rays
   std::array<double, 2> beam_divergence_mrad{{0.0, 0.0}};  // horizontal (along the scan), vertical
-  double echo_separation_m = 1.0;            // echoes closer than this merge into one (mixed pixel)
+  double echo_separation_m = 1.0;                          // echoes closer than this merge into one (mixed pixel)
 
   bool detection() const { return max_range_at_10pct > 0.0; }
   bool footprint() const { return beam_divergence_mrad[0] > 0.0 || beam_divergence_mrad[1] > 0.0; }
@@ -69,10 +69,10 @@ struct SubRayHit {
 /// The return the receiver reports, as a range along the beam axis. Intensity is
 /// 255 * reflectivity * cos_incidence * share.
 struct Echo {
-  double range = -1.0;          // < 0: no return
-  double reflectivity = 0.0;    // a merged echo carries its apparent reflectivity / share here
-  double cos_incidence = 1.0;   //   and 1 here
-  double share = 1.0;           // part of the beam energy in this echo
+  double range = -1.0;         // < 0: no return
+  double reflectivity = 0.0;   // a merged echo carries its apparent reflectivity / share here
+  double cos_incidence = 1.0;  //   and 1 here
+  double share = 1.0;          // part of the beam energy in this echo
   bool valid() const { return range >= 0.0; }
   double apparentReflectivity() const { return reflectivity * cos_incidence * share; }
 };

@@ -13,8 +13,8 @@
 namespace livo::sim {
 
 struct LidarPatternOptions {
-  int columns = 0;                  // firings per sweep; 0: the model's own
-  double start_azimuth_deg = 180.0; // spinning: azimuth (from +x, counter-clockwise) at the sweep start
+  int columns = 0;                   // firings per sweep; 0: the model's own
+  double start_azimuth_deg = 180.0;  // spinning: azimuth (from +x, counter-clockwise) at the sweep start
 };
 
 class LidarPattern {

@@ -5,9 +5,9 @@
 // footprint with mixed pixels).
 #pragma once
 
+#include "livo/sensor_rig.hpp"
 #include "livo/sim/lidar_effects.hpp"
 #include "livo/sim/lidar_pattern.hpp"
-#include "livo/sensor_rig.hpp"
 #include "livo/sim/random.hpp"
 #include "livo/sim/scene.hpp"
 #include "livo/sim/sensor_data.hpp"

@@ -34,9 +34,9 @@ struct ProceduralTrajectoryOptions {
   double start_still_s = 2.0;  // stand still this long
   double ramp_s = 2.0;         // then reach full speed over this long
   MotionShake shake;
-  double gravity = 9.81;       // for kThrustAligned
-  double yaw_rate = 0.0;       // rad per second of path time (kThrustAligned)
-  Sinusoid yaw_wave;           // added to the yaw (kThrustAligned)
+  double gravity = 9.81;  // for kThrustAligned
+  double yaw_rate = 0.0;  // rad per second of path time (kThrustAligned)
+  Sinusoid yaw_wave;      // added to the yaw (kThrustAligned)
 };
 
 /// Built-in shake of a handheld walk, a car and a multirotor, times `scale`.

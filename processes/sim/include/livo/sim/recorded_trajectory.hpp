@@ -8,9 +8,9 @@
 #include <memory>
 #include <vector>
 
-#include "livo/trajectory_io.hpp"
 #include "livo/sim/sample_curves.hpp"
 #include "livo/sim/trajectory.hpp"
+#include "livo/trajectory_io.hpp"
 
 namespace livo::sim {
 

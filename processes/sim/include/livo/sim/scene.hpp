@@ -27,9 +27,9 @@ enum class MaterialKind {
 };
 
 struct Material {
-  int texture = 0;             // index into the scene's textures
-  double reflectivity = 0.5;   // LiDAR reflectivity in [0, 1]
-  double u_offset = 0.0;       // texture shift (m) so equal textures on different objects differ
+  int texture = 0;            // index into the scene's textures
+  double reflectivity = 0.5;  // LiDAR reflectivity in [0, 1]
+  double u_offset = 0.0;      // texture shift (m) so equal textures on different objects differ
   double v_offset = 0.0;
   MaterialKind kind = MaterialKind::kOpaque;
   double glass_return_probability = 0.05;  // glass: chance a LiDAR beam returns from this object
@@ -65,8 +65,7 @@ class Scene {
   int addTexture(const TextureOptions& options);
   int addShape(const std::string& name, const Shape& shape, const Material& material);
   int addHeightField(const std::string& name, const HeightFieldOptions& options, const Material& material);
-  int addHeightField(const std::string& name, std::unique_ptr<HeightField> field,
-                     const Material& material);
+  int addHeightField(const std::string& name, std::unique_ptr<HeightField> field, const Material& material);
   /// A moving object (opaque or glass); it is not in the BVH but tested at each cast's time.
   int addMover(const std::string& name, const MovingObject& mover, const Material& material);
   /// Builds the acceleration structure; call after the last add*() and before casting.
@@ -130,7 +129,7 @@ class Scene {
   std::vector<Shape> shapes_;
   std::vector<std::unique_ptr<HeightField>> height_fields_;
   std::vector<MovingObject> movers_;
-  std::vector<int> mover_objects_;        // object index of each mover
+  std::vector<int> mover_objects_;  // object index of each mover
   std::vector<std::unique_ptr<Texture>> textures_;
   std::vector<int> bounded_, unbounded_;  // object indices
   Bvh bvh_;

@@ -27,8 +27,8 @@ struct WheelReading {
 
 /// One LiDAR sweep in the sensor frame L at each point's own firing time.
 struct LidarSweep {
-  int64_t utime = 0;            // sweep start
-  double duration = 0.1;        // s
+  int64_t utime = 0;      // sweep start
+  double duration = 0.1;  // s
   bool solid_state = false;
   int num_rings = 0;
   std::vector<float> x, y, z, intensity, time_offset;
@@ -37,17 +37,17 @@ struct LidarSweep {
 };
 
 struct CameraImage {
-  int64_t utime = 0;            // mid-exposure, on the camera's clock
-  int64_t log_utime = 0;        // the same instant on the IMU clock: the log event's time
+  int64_t utime = 0;      // mid-exposure, on the camera's clock
+  int64_t log_utime = 0;  // the same instant on the IMU clock: the log event's time
   int width = 0, height = 0;
-  bool color = false;           // RGB8 if true, GRAY8 otherwise
-  float exposure_time = 0.0f;   // s
+  bool color = false;          // RGB8 if true, GRAY8 otherwise
+  float exposure_time = 0.0f;  // s
   std::vector<uint8_t> data;
 };
 
 /// The depth image registered to a CameraImage (rig.camera.depth): the same size and stamps.
 struct DepthImage {
-  int64_t utime = 0;             // the colour image's
+  int64_t utime = 0;  // the colour image's
   int64_t log_utime = 0;
   int width = 0, height = 0;
   std::vector<uint16_t> millimetres;  // z along the optical axis per pixel, row-major; 0: no depth

@@ -8,15 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "livo/asl_dataset.hpp"
+#include "livo/config.hpp"
+#include "livo/sensor_rig.hpp"
 #include "livo/sim/calibration_errors.hpp"
 #include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/depth_effects.hpp"
 #include "livo/sim/imu_model.hpp"
 #include "livo/sim/lidar_effects.hpp"
 #include "livo/sim/lidar_pattern.hpp"
-#include "livo/asl_dataset.hpp"
-#include "livo/config.hpp"
-#include "livo/sensor_rig.hpp"
 #include "livo/sim/scene.hpp"
 #include "livo/sim/trajectory.hpp"
 #include "livo/sim/wheel_model.hpp"
@@ -29,25 +29,25 @@ namespace livo::sim {
 enum class CameraTrigger { kFree, kSweepStart, kSweepEnd };
 
 struct SimOptions {
-  double start_time_s = 1.7e9;        // stamp of t = 0 (procedural trajectories)
+  double start_time_s = 1.7e9;  // stamp of t = 0 (procedural trajectories)
   double duration_s = 30.0;
   double ground_truth_rate_hz = 100.0;
   uint64_t seed = 1;
-  int threads = 2;                    // worker threads; the output does not depend on it
-  bool images = true;                 // false: no camera or depth images (livo-sim --no-images); every
-                                      // other channel is as it is with them (each sensor draws its own noise)
+  int threads = 2;                         // worker threads; the output does not depend on it
+  bool images = true;                      // false: no camera or depth images (livo-sim --no-images); every
+                                           // other channel is as it is with them (each sensor draws its own noise)
   Vec3 initial_gyro_bias = Vec3::Zero();   // rad/s
   Vec3 initial_accel_bias = Vec3::Zero();  // m/s^2
   LidarPatternOptions lidar;
-  LidarEffects lidar_effects;         // sim.lidar receiver effects, all off by default
+  LidarEffects lidar_effects;  // sim.lidar receiver effects, all off by default
   CameraEffects camera;
   CameraTrigger camera_trigger = CameraTrigger::kFree;
-  DepthEffects depth;                 // sim.depth, for a camera with rig.camera.depth
-  double wheel_left_scale = 1.0;      // multiplicative scale errors of the wheel speeds
+  DepthEffects depth;             // sim.depth, for a camera with rig.camera.depth
+  double wheel_left_scale = 1.0;  // multiplicative scale errors of the wheel speeds
   double wheel_right_scale = 1.0;
-  WheelSlipOptions wheel_slip;        // sim.wheel.slip, off by default
-  ImuErrors imu_errors;                 // sim.imu error model, as configured (1-sigmas if drawn)
-  CalibrationErrors calibration_errors; // sim.calibration_errors, as configured (1-sigmas if drawn)
+  WheelSlipOptions wheel_slip;           // sim.wheel.slip, off by default
+  ImuErrors imu_errors;                  // sim.imu error model, as configured (1-sigmas if drawn)
+  CalibrationErrors calibration_errors;  // sim.calibration_errors, as configured (1-sigmas if drawn)
 };
 
 /// Command-line values that take precedence over the file.
@@ -63,12 +63,12 @@ struct SimulationSetup {
   SensorRig rig;
   SimOptions options;
   std::unique_ptr<Scene> scene;
-  std::string scene_source;           // file or "inline"
+  std::string scene_source;  // file or "inline"
   std::unique_ptr<BodyTrajectory> trajectory;
   std::string trajectory_description;
   int64_t start_utime = 0;
-  double trajectory_time_offset = 0.0;  // trajectory time at start_utime
-  bool recorded = false;                // re-simulation along a recording:
+  double trajectory_time_offset = 0.0;     // trajectory time at start_utime
+  bool recorded = false;                   // re-simulation along a recording:
   std::vector<AslImuSample> recorded_imu;  //   its real IMU stream, published untouched (none: synthesised)
   // The truth of this run (drawn from the seed when calibration_errors.draw is on): never in `rig`.
   CalibrationErrors calibration_errors;

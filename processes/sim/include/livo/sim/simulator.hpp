@@ -17,7 +17,7 @@ namespace livo::sim {
 struct SimulationStats {
   std::map<std::string, int64_t> messages;  // per channel
   int64_t lidar_points = 0;
-  int64_t wheel_slip_episodes = 0;           // sim.wheel.slip episodes begun among the wheel samples so far
+  int64_t wheel_slip_episodes = 0;  // sim.wheel.slip episodes begun among the wheel samples so far
   double sim_seconds = 0.0;
   double wall_seconds = 0.0;
 };

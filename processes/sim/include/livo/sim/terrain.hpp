@@ -66,9 +66,9 @@ class Terrain {
     double curve_length = 0.0;
   };
   struct Wave {
-    Vec2 direction;                            // unit
-    double wavenumber = 0.0, phase = 0.0;      // rad/m, rad
-    double amplitude = 0.0;                    // m
+    Vec2 direction;                        // unit
+    double wavenumber = 0.0, phase = 0.0;  // rad/m, rad
+    double amplitude = 0.0;                // m
   };
   /// Height, slope and second derivative of a profile at station s.
   static void profileAt(const Profile& p, double s, double out[3]);

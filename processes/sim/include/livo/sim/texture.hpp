@@ -20,12 +20,12 @@ struct TextureOptions {
   TexturePattern pattern = TexturePattern::kNoise;
   Eigen::Vector3d color_a{0.7, 0.7, 0.7};  // linear RGB in [0, 1]: base / brick / first square
   Eigen::Vector3d color_b{0.3, 0.3, 0.3};  // second colour / mortar
-  double scale = 0.5;         // m: noise feature size, brick length, checker square, stripe width
-  double brick_height = 0.1;  // m (bricks)
-  double mortar = 0.012;      // m (bricks)
-  int octaves = 4;            // noise
-  double grain = 0.15;        // relative amplitude of fine noise over any pattern (0 = none)
-  double variation = 0.15;    // relative brightness variation between bricks, squares, stripes
+  double scale = 0.5;                      // m: noise feature size, brick length, checker square, stripe width
+  double brick_height = 0.1;               // m (bricks)
+  double mortar = 0.012;                   // m (bricks)
+  int octaves = 4;                         // noise
+  double grain = 0.15;                     // relative amplitude of fine noise over any pattern (0 = none)
+  double variation = 0.15;                 // relative brightness variation between bricks, squares, stripes
   uint64_t seed = 1;
 };
 

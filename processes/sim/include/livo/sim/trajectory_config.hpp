@@ -16,9 +16,9 @@ struct TrajectoryConfig {
   std::unique_ptr<BodyTrajectory> trajectory;
   std::string description;
   bool recorded = false;
-  double recorded_start_stamp = 0.0;      // s, first ground-truth stamp
-  double recorded_start_offset_s = 0.0;   // recorded: the run starts this long after the default start
-  std::vector<AslImuSample> recorded_imu;    // recorded: the real IMU samples (none: synthesised from the motion)
+  double recorded_start_stamp = 0.0;       // s, first ground-truth stamp
+  double recorded_start_offset_s = 0.0;    // recorded: the run starts this long after the default start
+  std::vector<AslImuSample> recorded_imu;  // recorded: the real IMU samples (none: synthesised from the motion)
 };
 
 /// `gravity` is used by the thrust-aligned (uav) attitude; `base_dir` resolves relative paths;
@@ -27,7 +27,6 @@ struct TrajectoryConfig {
 /// terrain), its wheels `track_width` apart unless the trajectory says otherwise.
 TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
                                       const Pose3& T_I_rear_axle = Pose3::Identity(),
-                                      std::shared_ptr<const Terrain> ground = nullptr,
-                                      double track_width = 1.6);
+                                      std::shared_ptr<const Terrain> ground = nullptr, double track_width = 1.6);
 
 }  // namespace livo::sim

@@ -33,21 +33,21 @@ class WheelNoise {
 
 /// sim.wheel.slip: occasional slip episodes. Off (rate 0) by default.
 struct WheelSlipOptions {
-  double rate_per_min = 0.0;      // episodes per minute of time without slip; 0 = off
-  double min_duration_s = 0.2;    // each episode lasts uniform [min, max] seconds
+  double rate_per_min = 0.0;    // episodes per minute of time without slip; 0 = off
+  double min_duration_s = 0.2;  // each episode lasts uniform [min, max] seconds
   double max_duration_s = 1.5;
-  double min_spin = 0.10;         // a spinning wheel reads (1 + uniform [min, max]) x its true speed
+  double min_spin = 0.10;  // a spinning wheel reads (1 + uniform [min, max]) x its true speed
   double max_spin = 0.40;
-  double lock_probability = 0.25; // share of episodes whose wheel(s) lock instead: they read 0
-  double both_probability = 0.3;  // share of episodes on both wheels (else the left or the right alike)
+  double lock_probability = 0.25;  // share of episodes whose wheel(s) lock instead: they read 0
+  double both_probability = 0.3;   // share of episodes on both wheels (else the left or the right alike)
   bool enabled() const { return rate_per_min > 0.0; }
 };
 
 /// One slip episode, in seconds of sensor time since the run's start.
 struct WheelSlipEpisode {
-  double start_s = 0.0, end_s = 0.0;   // [start, end)
-  bool left = false, right = false;    // the wheels it affects
-  bool lock = false;                   // locked (factor 0) rather than spinning
+  double start_s = 0.0, end_s = 0.0;             // [start, end)
+  bool left = false, right = false;              // the wheels it affects
+  bool lock = false;                             // locked (factor 0) rather than spinning
   double left_factor = 1.0, right_factor = 1.0;  // measured / true speed while it lasts (1: unaffected)
 };
 

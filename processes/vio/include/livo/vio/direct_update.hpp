@@ -23,15 +23,15 @@ namespace livo::vio {
 
 struct DirectUpdateResult {
   bool valid = false;
-  std::string why;                    // when not valid
-  FilterState state;                  // posterior (the prior when not valid)
+  std::string why;    // when not valid
+  FilterState state;  // posterior (the prior when not valid)
   StateCovariance covariance = StateCovariance::Zero();
-  int iterations = 0;                 // Gauss-Newton steps over all levels
-  int num_measurements = 0;           // scalar residuals of the last step
-  int patches = 0;                    // patches of the last step
-  double cost_prior = 0.0;            // Huber cost per residual at level 0 over the final patches:
-  double cost_post = 0.0;             //   at the prior and at the aligned pose (the posterior without floors)
-  ConsistencyTest consistency;        // of the image's measurement against the prior
+  int iterations = 0;           // Gauss-Newton steps over all levels
+  int num_measurements = 0;     // scalar residuals of the last step
+  int patches = 0;              // patches of the last step
+  double cost_prior = 0.0;      // Huber cost per residual at level 0 over the final patches:
+  double cost_post = 0.0;       //   at the prior and at the aligned pose (the posterior without floors)
+  ConsistencyTest consistency;  // of the image's measurement against the prior
 };
 
 /// The reference floor of an image at body attitude R_W_I: the mean of its patches' reference pose

@@ -22,10 +22,10 @@
 
 namespace livo::vio {
 
-constexpr int kPatch = 8;                        // residual patch side (pixels of a level)
+constexpr int kPatch = 8;  // residual patch side (pixels of a level)
 constexpr int kPatchArea = kPatch * kPatch;
-constexpr int kWindow = kPatch + 2;              // with a one-pixel margin for gradients
-constexpr int kStored = 16;                      // stored reference patch side
+constexpr int kWindow = kPatch + 2;  // with a one-pixel margin for gradients
+constexpr int kStored = 16;          // stored reference patch side
 constexpr int kStoredArea = kStored * kStored;
 constexpr int kMaxLevels = 4;
 

@@ -38,13 +38,13 @@ namespace livo::vio {
 
 /// A map point tracked in the current image: its reference patch warped into this view.
 struct TrackedPatch {
-  int point = -1;             // index into the map
-  int observation = -1;       // the reference observation
+  int point = -1;        // index into the map
+  int observation = -1;  // the reference observation
   Vec3 p_W = Vec3::Zero();
-  float gain0 = 1.0f;         // expected gain: exposure ratio current / reference, 1 if unknown
-  float gradient = 0.0f;      // texture strength of the reference
-  ReferenceView view;         // the view the reference was cut in
-  Mat6 reference_cov_W = Mat6::Zero();   // its pose covariance [rotation (world frame), position]
+  float gain0 = 1.0f;                   // expected gain: exposure ratio current / reference, 1 if unknown
+  float gradient = 0.0f;                // texture strength of the reference
+  ReferenceView view;                   // the view the reference was cut in
+  Mat6 reference_cov_W = Mat6::Zero();  // its pose covariance [rotation (world frame), position]
   // the reference warped into this view at the level-0 shift `shift0` (the reference's projection
   // through the prior's calibration, relative to the stored patch's centre), per level row-major
   // 8x8, and the derivatives of each sample with respect to the shift (level pixels)
@@ -56,7 +56,7 @@ struct TrackedPatch {
   // filled by the update (level 0, at the posterior)
   bool active = false;
   float ncc = 0.0f;
-  float rms = 0.0f;           // residual RMS after the brightness fit, grey levels
+  float rms = 0.0f;  // residual RMS after the brightness fit, grey levels
 
   /// The camera centre the reference was captured from.
   Vec3 referenceCentre() const { return view.cameraPose().translation(); }
@@ -67,7 +67,8 @@ using Mat4x13 = Eigen::Matrix<double, 4, kMeasuredDim>;
 
 /// d pixel / d [δrot δpos] for the body pose (R_W_I, right perturbation; p_W_I) of a world point
 /// whose body-frame coordinates are p_I, given d pixel / d p_C (J_proj).
-Mat26 pixelPoseJacobian(const Eigen::Matrix<double, 2, 3>& J_proj, const Mat3& R_W_I, const Pose3& T_I_C, const Vec3& p_I);
+Mat26 pixelPoseJacobian(const Eigen::Matrix<double, 2, 3>& J_proj, const Mat3& R_W_I, const Pose3& T_I_C,
+                        const Vec3& p_I);
 
 /// d pixel / d [δrot δpos] of the stamp's body pose for a point seen through a rolling shutter
 /// at row time s.dt (the row's time held fixed: its change with the pose is second order).
@@ -83,11 +84,11 @@ struct PatchResidual {
   Eigen::Matrix<double, kPatchArea, 1> r;  // residuals, grey levels
   // d r / d [current pixel; reference pixel] (level pixels), the brightness fit projected out
   Eigen::Matrix<double, kPatchArea, 4> G;
-  Mat4x13 B;                               // d [current pixel; reference pixel] (level) / d [δθ δp δφ δρ δdt]
-  Eigen::Matrix<double, 4, 3> Bp;          // d [current pixel; reference pixel] (level) / d p_W (the map point)
-  Mat26 Bref;                              // d reference pixel (level) / d [δθ δp] of the reference's body pose
-  double baseline = 0.0;                   // m between the two camera centres
-  Eigen::Vector2d pixel;                   // level-0 projection
+  Mat4x13 B;                       // d [current pixel; reference pixel] (level) / d [δθ δp δφ δρ δdt]
+  Eigen::Matrix<double, 4, 3> Bp;  // d [current pixel; reference pixel] (level) / d p_W (the map point)
+  Mat26 Bref;                      // d reference pixel (level) / d [δθ δp] of the reference's body pose
+  double baseline = 0.0;           // m between the two camera centres
+  Eigen::Vector2d pixel;           // level-0 projection
   double gain = 1.0, offset = 0.0, ncc = 0.0;
 
   /// d r / d [δθ δp δφ δρ δdt] (64 x 13).

@@ -11,30 +11,30 @@
 #include "livo/so3.hpp"
 #include "livo/vio/patch.hpp"
 #include "livo/vio/reference_view.hpp"
-#include "livo/voxel_key.hpp"
 #include "livo/vio/vio_options.hpp"
+#include "livo/voxel_key.hpp"
 
 namespace livo::vio {
 
 struct PatchObservation {
-  int64_t utime = 0;               // image time (IMU clock)
-  ReferenceView view;              // the body pose, motion and calibration it was cut in
+  int64_t utime = 0;   // image time (IMU clock)
+  ReferenceView view;  // the body pose, motion and calibration it was cut in
   // covariance of that pose's error [rotation (world frame), position] as the filter had it
   Eigen::Matrix<float, 6, 6> pose_cov_W = Eigen::Matrix<float, 6, 6>::Zero();
-  float exposure_time = 0.0f;      // s, 0 if unknown
-  float gradient = 0.0f;           // texture strength at capture (patchGradient, level 1)
-  float error = 0.0f;              // residual RMS (grey levels) when last used as the reference
-  std::vector<uint8_t> pixels;     // levels x kStored x kStored
+  float exposure_time = 0.0f;   // s, 0 if unknown
+  float gradient = 0.0f;        // texture strength at capture (patchGradient, level 1)
+  float error = 0.0f;           // residual RMS (grey levels) when last used as the reference
+  std::vector<uint8_t> pixels;  // levels x kStored x kStored
 
   const uint8_t* level(int l) const { return pixels.data() + static_cast<size_t>(l) * kStoredArea; }
   Vec3 cameraCentre() const { return view.T_W_I * view.T_I_C.translation(); }
 };
 
 struct MapPoint {
-  int64_t id = 0;                  // unique, increasing: a deterministic tie-breaker
-  Vec3 position = Vec3::Zero();    // W
-  Vec3 normal = Vec3::Zero();      // W, unit: the surface's, from the LiDAR; zero if not known
-  int64_t last_seen = 0;           // utime of the last image it was tracked in (or created)
+  int64_t id = 0;                // unique, increasing: a deterministic tie-breaker
+  Vec3 position = Vec3::Zero();  // W
+  Vec3 normal = Vec3::Zero();    // W, unit: the surface's, from the LiDAR; zero if not known
+  int64_t last_seen = 0;         // utime of the last image it was tracked in (or created)
   std::vector<PatchObservation> observations;
 };
 

@@ -37,14 +37,15 @@ class DepthGrid {
   /// squares plane in (u, v, 1/z) is fitted and any deviation beyond tolerance + tolerance_rel z
   /// (in depth) marks a depth edge or a strongly curved surface, where a patch changes with the
   /// viewpoint. Slanted planes (a floor at a grazing angle) pass.
-  bool depthEdge(const Eigen::Vector2d& pixel, double z, double radius_px, double tolerance, double tolerance_rel) const;
+  bool depthEdge(const Eigen::Vector2d& pixel, double z, double radius_px, double tolerance,
+                 double tolerance_rel) const;
 
  private:
   struct Cell {
     float near_z, near_u, near_v;
     float far_z, far_u, far_v;
   };
-  static constexpr Cell kEmpty{std::numeric_limits<float>::infinity(), 0.0f, 0.0f,
+  static constexpr Cell kEmpty{std::numeric_limits<float>::infinity(),  0.0f, 0.0f,
                                -std::numeric_limits<float>::infinity(), 0.0f, 0.0f};
   int index(const Eigen::Vector2d& pixel) const;
   int cell_, cols_, rows_;
@@ -53,10 +54,10 @@ class DepthGrid {
 };
 
 struct SelectionStats {
-  int in_view = 0;        // project inside the image with the patch border, in the depth range
+  int in_view = 0;  // project inside the image with the patch border, in the depth range
   int occluded = 0;
-  int depth_edge = 0;     // next to a depth discontinuity
-  int no_reference = 0;   // no patch seen from close enough a direction, or the warp leaves it
+  int depth_edge = 0;    // next to a depth discontinuity
+  int no_reference = 0;  // no patch seen from close enough a direction, or the warp leaves it
   int selected = 0;
 };
 

@@ -17,11 +17,11 @@ namespace livo::vio {
 
 /// The view a reference patch was cut in.
 struct ReferenceView {
-  Pose3 T_W_I = Pose3::Identity();   // body pose at the patch's row (with the time shift then)
-  Vec3 omega_I = Vec3::Zero();       // body rate then (frame I)
-  Vec3 vel_W = Vec3::Zero();         // body velocity then
-  Pose3 T_I_C = Pose3::Identity();   // the extrinsic the patch was cut through
-  double time_shift = 0.0;           // the camera's time shift then (s)
+  Pose3 T_W_I = Pose3::Identity();                  // body pose at the patch's row (with the time shift then)
+  Vec3 omega_I = Vec3::Zero();                      // body rate then (frame I)
+  Vec3 vel_W = Vec3::Zero();                        // body velocity then
+  Pose3 T_I_C = Pose3::Identity();                  // the extrinsic the patch was cut through
+  double time_shift = 0.0;                          // the camera's time shift then (s)
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // level-0 pixel the stored patch is centred on
 
   /// The camera pose the patch was cut from.

@@ -18,9 +18,9 @@
 namespace livo::vio {
 
 struct RollingShutter {
-  double line_time = 0.0;          // s per row (0: global shutter)
-  double centre_row = 0.0;         // (rows − 1) / 2, the row the stamp refers to
-  Vec3 omega_I = Vec3::Zero();     // body angular rate, rad/s (frame I)
+  double line_time = 0.0;       // s per row (0: global shutter)
+  double centre_row = 0.0;      // (rows − 1) / 2, the row the stamp refers to
+  Vec3 omega_I = Vec3::Zero();  // body angular rate, rad/s (frame I)
 
   /// From the rig's readout time (first to last row) and image height; no motion yet.
   static RollingShutter fromReadout(double readout_s, int rows);
@@ -35,19 +35,19 @@ struct RollingShutter {
 struct ShutterProjection {
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   Eigen::Matrix<double, 2, 3> J_proj = Eigen::Matrix<double, 2, 3>::Zero();  // d pixel / d p_C
-  double dt = 0.0;                 // row time relative to the stamp
-  Mat3 R_W_I = Mat3::Identity();   // body pose at the row's time
+  double dt = 0.0;                                                           // row time relative to the stamp
+  Mat3 R_W_I = Mat3::Identity();                                             // body pose at the row's time
   Vec3 p_W_I = Vec3::Zero();
-  Vec3 p_I = Vec3::Zero();         // the point in that body frame
-  Vec3 p_C = Vec3::Zero();         // ... and in the camera frame
+  Vec3 p_I = Vec3::Zero();  // the point in that body frame
+  Vec3 p_C = Vec3::Zero();  // ... and in the camera frame
 };
 
 /// Projects p_W from the body state x (at the stamp) through a rolling shutter; false if it does
 /// not project (`border` as in CameraProjection::project). Without `with_jacobian` J_proj is left
 /// as it was (the map maintenance only needs where points are seen).
 bool projectThroughShutter(const CameraProjection& camera, const Pose3& T_I_C, const FilterState& x,
-                           const RollingShutter& shutter, const Vec3& p_W, ShutterProjection* out,
-                           double border = 0.0, bool with_jacobian = true);
+                           const RollingShutter& shutter, const Vec3& p_W, ShutterProjection* out, double border = 0.0,
+                           bool with_jacobian = true);
 
 /// The camera pose W_T_C at which a point seen at row time dt was captured.
 /// The state moved forward by dt at the body rate omega_I and its velocity (dt of a few ms:

@@ -41,22 +41,22 @@ std::vector<Vec3> voxelPoints(const float* x, const float* y, const float* z, si
                               std::vector<Vec3>* normals = nullptr);
 
 struct ImageResult {
-  bool valid = false;                // an update to adopt
-  std::string why;                   // why not
-  FilterState state;                 // posterior (the prior if not valid)
+  bool valid = false;  // an update to adopt
+  std::string why;     // why not
+  FilterState state;   // posterior (the prior if not valid)
   StateCovariance covariance = StateCovariance::Zero();
   int iterations = 0;
-  int num_measurements = 0;          // scalar photometric residuals of the last step
-  int patches = 0;                   // patches of the last step
-  ConsistencyTest consistency;       // of the image's measurement against the prior
+  int num_measurements = 0;     // scalar photometric residuals of the last step
+  int patches = 0;              // patches of the last step
+  ConsistencyTest consistency;  // of the image's measurement against the prior
   double cost_prior = 0.0, cost_post = 0.0;
   SelectionStats selection;
-  int new_points = 0;                // added to the map from the recent scans
-  int candidates = 0;                //   recent scan points in free cells of the image
-  int candidates_hidden = 0;         //   ... refused as occluded or on a depth edge
-  int candidates_weak = 0;           //   ... cells whose best candidate had too little texture
-  int new_patches = 0;               // observations added to tracked points
-  size_t map_points = 0;             // after maintenance
+  int new_points = 0;         // added to the map from the recent scans
+  int candidates = 0;         //   recent scan points in free cells of the image
+  int candidates_hidden = 0;  //   ... refused as occluded or on a depth edge
+  int candidates_weak = 0;    //   ... cells whose best candidate had too little texture
+  int new_patches = 0;        // observations added to tracked points
+  size_t map_points = 0;      // after maintenance
 };
 
 class VioEstimator {
@@ -83,6 +83,7 @@ class VioEstimator {
   const CameraProjection& camera() const { return camera_; }
   const ImagePyramid& pyramid() const { return pyramid_; }  // of the last image
   size_t recentScanPoints() const;
+
  private:
   struct Scan {
     int64_t utime = 0;
@@ -99,10 +100,10 @@ class VioEstimator {
   VioOptions options_;
   CameraProjection camera_;
   PointPatchMap map_;
-  std::deque<Scan> scans_;   // newest last
+  std::deque<Scan> scans_;  // newest last
   ImagePyramid pyramid_;
   DepthGrid depth_;
-  RollingShutter shutter_;       // line time of the rig; no motion
+  RollingShutter shutter_;  // line time of the rig; no motion
 };
 
 }  // namespace livo::vio

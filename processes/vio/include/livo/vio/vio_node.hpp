@@ -38,14 +38,14 @@ class VioNode {
   const VioEstimator& estimator() const { return vio_; }
 
   struct Counts {
-    int64_t priors = 0;        // STATE_PRIORs answered (each exactly once)
-    int64_t updated = 0;       // ... with valid = 1
-    int64_t kept = 0;          // ... with valid = 0
-    int64_t images = 0;        // usable images received
-    int64_t bad_images = 0;    // refused (size, decoding, black, blown out)
-    int64_t unused_images = 0; // dropped from the buffer without a prior
-    int64_t scans = 0;         // registered scans taken into the map source
-    int64_t epochs_started = 0;// odometry epochs after the first (LIO resets): the map was dropped
+    int64_t priors = 0;          // STATE_PRIORs answered (each exactly once)
+    int64_t updated = 0;         // ... with valid = 1
+    int64_t kept = 0;            // ... with valid = 0
+    int64_t images = 0;          // usable images received
+    int64_t bad_images = 0;      // refused (size, decoding, black, blown out)
+    int64_t unused_images = 0;   // dropped from the buffer without a prior
+    int64_t scans = 0;           // registered scans taken into the map source
+    int64_t epochs_started = 0;  // odometry epochs after the first (LIO resets): the map was dropped
   };
   const Counts& counts() const { return counts_; }
   /// Why priors were answered valid = 0, and how often.
@@ -56,9 +56,9 @@ class VioNode {
 
  private:
   struct BufferedImage {
-    int64_t t = 0;             // IMU clock
+    int64_t t = 0;  // IMU clock
     GreyImage image;
-    std::string problem;       // non-empty: a bad image (kept so its prior gets the reason)
+    std::string problem;  // non-empty: a bad image (kept so its prior gets the reason)
   };
   void onImage(const image_t& m);
   void onPrior(const filter_state_t& m);
@@ -78,9 +78,9 @@ class VioNode {
   VioEstimator vio_;
   int64_t offset_us_ = 0;
   int64_t tolerance_us_ = 0;
-  std::deque<BufferedImage> images_;   // by t
-  std::deque<filter_state_t> pending_; // priors waiting for their image, by utime
-  std::deque<int64_t> answered_ids_;   // recent request ids, to answer each only once
+  std::deque<BufferedImage> images_;    // by t
+  std::deque<filter_state_t> pending_;  // priors waiting for their image, by utime
+  std::deque<int64_t> answered_ids_;    // recent request ids, to answer each only once
   Counts counts_;
   MapFrame frame_;  // the map's odometry epoch and loop correction
   ReasonCounts kept_reasons_;

@@ -15,15 +15,15 @@
 namespace livo::vio_feature {
 
 struct DepthImageOptions {
-  int window_radius_px = 2;           // the window is (2 r + 1)^2 pixels around the feature
-  double min_valid_fraction = 0.5;    // of the window's pixels with a depth
-  double agreement = 0.03;            // every valid depth within this fraction of their median
-  double min_depth = 0.1;             // m; depths outside [min, max] count as none
+  int window_radius_px = 2;         // the window is (2 r + 1)^2 pixels around the feature
+  double min_valid_fraction = 0.5;  // of the window's pixels with a depth
+  double agreement = 0.03;          // every valid depth within this fraction of their median
+  double min_depth = 0.1;           // m; depths outside [min, max] count as none
   double max_depth = 20.0;
 };
 
 struct LidarDepthOptions {
-  double min_depth = 0.3;             // m along z; points outside [min, max] are not used
+  double min_depth = 0.3;  // m along z; points outside [min, max] are not used
   double max_depth = 60.0;
   int cell_px = 4;                    // occlusion cells: the nearest point per cell is kept
   double occlusion_ratio = 1.3;       // a kept point this many times farther than one in a

@@ -27,26 +27,26 @@
 namespace livo::vio_feature {
 
 struct FeatureTrackerOptions {
-  int max_features = 150;             // corners kept per image
-  double min_distance_px = 30.0;      // no new corner closer than this to a track, no track this
-                                      // close to a longer one (the even spread)
-  double quality_level = 0.01;        // Shi-Tomasi, relative to the image's strongest corner (new
-                                      // corners are found on the half-resolution image)
-  int border_px = 8;                  // tracks and corners stay this far inside the image
-  int pyramid_levels = 3;             // KLT levels above the full image
-  int window_px = 21;                 // KLT window side
-  int max_iterations = 30;            // KLT iterations per level
-  double klt_epsilon = 0.01;          // KLT convergence, px
-  bool backward_check = true;         // track back and compare with where the track came from
-  double backward_threshold_px = 0.5; // largest forward-backward distance kept
-  bool ransac = true;                 // fundamental-matrix RANSAC on the virtual pinhole
-  double ransac_threshold_px = 0.5;   // epipolar distance on the virtual pinhole (VINS: 1 px at f 460)
+  int max_features = 150;              // corners kept per image
+  double min_distance_px = 30.0;       // no new corner closer than this to a track, no track this
+                                       // close to a longer one (the even spread)
+  double quality_level = 0.01;         // Shi-Tomasi, relative to the image's strongest corner (new
+                                       // corners are found on the half-resolution image)
+  int border_px = 8;                   // tracks and corners stay this far inside the image
+  int pyramid_levels = 3;              // KLT levels above the full image
+  int window_px = 21;                  // KLT window side
+  int max_iterations = 30;             // KLT iterations per level
+  double klt_epsilon = 0.01;           // KLT convergence, px
+  bool backward_check = true;          // track back and compare with where the track came from
+  double backward_threshold_px = 0.5;  // largest forward-backward distance kept
+  bool ransac = true;                  // fundamental-matrix RANSAC on the virtual pinhole
+  double ransac_threshold_px = 0.5;    // epipolar distance on the virtual pinhole (VINS: 1 px at f 460)
   double ransac_confidence = 0.99;
-  bool keyframe_ransac = true;        // a second RANSAC from the last keyframe (the drift of a track
-                                      // builds up over images; a longer baseline shows it)
-  double keyframe_parallax_px = 10.0; // mean parallax since the last keyframe (rotation taken out
-                                      // with the hints, virtual pinhole px) that makes a keyframe
-  int keyframe_min_tracked = 50;      // fewer tracks from the previous image make a keyframe
+  bool keyframe_ransac = true;         // a second RANSAC from the last keyframe (the drift of a track
+                                       // builds up over images; a longer baseline shows it)
+  double keyframe_parallax_px = 10.0;  // mean parallax since the last keyframe (rotation taken out
+                                       // with the hints, virtual pinhole px) that makes a keyframe
+  int keyframe_min_tracked = 50;       // fewer tracks from the previous image make a keyframe
 };
 
 struct FeatureObservation {
@@ -99,7 +99,8 @@ class FeatureTracker {
   /// border, forward-backward and RANSAC checks; counts the rejections in `frame`.
   void followTracks(const std::vector<cv::Mat>& pyramid, const Mat3* R_cur_prev, TrackedFrame* frame);
   /// Inlier flags of a fundamental-matrix RANSAC from `from` to `to` (xy; all set if too few).
-  std::vector<uint8_t> epipolarInliers(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to) const;
+  std::vector<uint8_t> epipolarInliers(const std::vector<Eigen::Vector2d>& from,
+                                       const std::vector<Eigen::Vector2d>& to) const;
   /// Drops the tracks that fail the RANSAC from the previous image (and from the last keyframe,
   /// if keyframe_ransac); the count.
   int rejectByRansac(std::vector<Track>* tracks) const;
@@ -117,7 +118,7 @@ class FeatureTracker {
   std::vector<cv::Mat> prev_pyramid_;
   std::vector<Track> tracks_;
   std::unordered_map<uint64_t, Eigen::Vector2d> keyframe_xy_;  // track id -> xy at the last keyframe
-  Mat3 R_cur_keyframe_ = Mat3::Identity();                    // hinted rotation since that keyframe
+  Mat3 R_cur_keyframe_ = Mat3::Identity();                     // hinted rotation since that keyframe
 };
 
 }  // namespace livo::vio_feature

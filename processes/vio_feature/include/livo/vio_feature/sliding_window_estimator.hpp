@@ -49,15 +49,15 @@ struct FeatureMeasurement {
 /// The features of one image, stamped on the camera clock.
 struct FrameFeatures {
   int64_t utime = 0;
-  bool keyframe = true;   // the front end's decision (parallax, tracked count)
+  bool keyframe = true;  // the front end's decision (parallax, tracked count)
   std::vector<FeatureMeasurement> features;
 };
 
 /// The estimate at an image's time (IMU clock).
 struct VisualState {
   int64_t utime = 0;
-  Pose3 pose = Pose3::Identity();   // W_T_I
-  Vec3 velocity = Vec3::Zero();     // W
+  Pose3 pose = Pose3::Identity();  // W_T_I
+  Vec3 velocity = Vec3::Zero();    // W
   Vec3 gyro_bias = Vec3::Zero();
   Vec3 accel_bias = Vec3::Zero();
   Mat6 pose_covariance = Mat6::Identity();  // [dtheta (right), dp]
@@ -67,12 +67,12 @@ struct FrameResult {
   enum class Status { kRejected, kInitializing, kInitialized, kTracked };
   Status status = Status::kRejected;
   std::string note;
-  VisualState state;          // kInitialized, kTracked
-  int features_in_graph = 0;  // with an inverse depth and two observations or more
-  int features_with_depth = 0;// of those, with a measured depth
-  int outliers = 0;           // dropped after this optimisation
-  bool static_start = false;  // kInitialized: at rest, else in motion (wheels)
-  Vec2 wheel_scale = Vec2::Ones();  // kInitialized, kTracked: [left, right] tyre radius over the nominal
+  VisualState state;                   // kInitialized, kTracked
+  int features_in_graph = 0;           // with an inverse depth and two observations or more
+  int features_with_depth = 0;         // of those, with a measured depth
+  int outliers = 0;                    // dropped after this optimisation
+  bool static_start = false;           // kInitialized: at rest, else in motion (wheels)
+  Vec2 wheel_scale = Vec2::Ones();     // kInitialized, kTracked: [left, right] tyre radius over the nominal
   Vec3 wheel_mounting = Vec3::Zero();  // kInitialized, kTracked: the wheel frame's mounting correction (rad)
 };
 
@@ -163,7 +163,8 @@ class SlidingWindowEstimator {
   std::deque<std::unique_ptr<Frame>> window_;
   std::map<uint64_t, std::unique_ptr<Feature>> features_;
   std::set<uint64_t> rejected_;
-  std::deque<std::pair<int64_t, std::map<uint64_t, Vec2>>> recent_;  // before initialisation: t, features  // outlier tracks: their later observations are ignored
+  std::deque<std::pair<int64_t, std::map<uint64_t, Vec2>>>
+      recent_;  // before initialisation: t, features  // outlier tracks: their later observations are ignored
   std::shared_ptr<MarginalPrior> prior_;
   std::unique_ptr<ceres::CostFunction> prior_factor_;
   std::unique_ptr<ceres::LossFunction> reprojection_loss_;

@@ -21,7 +21,7 @@ struct VioFeatureNodeOptions {
   // vio_feature.channels
   std::string registered_scan_channel = "REGISTERED_SCAN";  // in: LiDAR depth (livo-lio / livo-lio-graph)
   std::string visual_state_channel = "VISUAL_STATE";        // out: visual_state_t (livo-lio-graph reads it)
-  std::string odometry_channel = "VISUAL_ODOMETRY";          // out: the same as odometry_t, for the tools
+  std::string odometry_channel = "VISUAL_ODOMETRY";         // out: the same as odometry_t, for the tools
   // An image waits for what it may use: the IMU past its time, a wheel reading past it, its depth
   // image, a REGISTERED_SCAN ending after (its time - core.lidar_lag_s); each of the last three at
   // most this much IMU beyond its time (a dead sensor or process must not stall the visual subsystem).

@@ -30,15 +30,15 @@ namespace livo::vio_feature {
 /// A registered LiDAR scan for feature depth: the points in the body frame at the sweep's end,
 /// those in front of the camera.
 struct BodyScan {
-  int64_t t = 0;               // end of sweep (IMU clock)
+  int64_t t = 0;  // end of sweep (IMU clock)
   std::vector<Vec3> points_I;
 };
 
 /// One image's input: the image (the camera's size) and what depth there is for it.
 struct ImageInput {
-  int64_t utime = 0;                 // camera clock (the image's stamp)
-  cv::Mat grey;                      // CV_8UC1 (CV_8UC3 R, G, B is converted: FeatureTracker::track)
-  const cv::Mat* depth = nullptr;    // its registered depth image (CV_32F metres along z), if any
+  int64_t utime = 0;                            // camera clock (the image's stamp)
+  cv::Mat grey;                                 // CV_8UC1 (CV_8UC3 R, G, B is converted: FeatureTracker::track)
+  const cv::Mat* depth = nullptr;               // its registered depth image (CV_32F metres along z), if any
   const std::deque<BodyScan>* scans = nullptr;  // the recent registered scans, oldest first, if any
 };
 

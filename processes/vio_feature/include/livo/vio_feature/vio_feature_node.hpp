@@ -39,12 +39,12 @@ class VioFeatureNode {
   int32_t epoch() const { return estimator_.epoch(); }
 
   struct Counts {
-    int64_t images = 0;        // processed
-    int64_t tracked = 0;       // ... giving a state
-    int64_t bad_images = 0;    // refused (size, decoding)
-    int64_t dropped = 0;       // dropped from a full queue (no IMU)
+    int64_t images = 0;            // processed
+    int64_t tracked = 0;           // ... giving a state
+    int64_t bad_images = 0;        // refused (size, decoding)
+    int64_t dropped = 0;           // dropped from a full queue (no IMU)
     int64_t with_depth_image = 0;  // processed with their depth image
-    int64_t with_lidar = 0;    // processed with LiDAR points
+    int64_t with_lidar = 0;        // processed with LiDAR points
   };
   Counts counts() const;
   std::string summary() const;
@@ -79,10 +79,10 @@ class VioFeatureNode {
   int64_t imu_watermark_ = INT64_MIN;
   int64_t wheel_watermark_ = INT64_MIN;
   int64_t scan_watermark_ = INT64_MIN;
-  std::string init_note_;  // the last reason the estimator gave for not initialising yet
+  std::string init_note_;   // the last reason the estimator gave for not initialising yet
   int64_t bad_images_ = 0;  // Counts::bad_images
   int64_t dropped_ = 0;     // Counts::dropped
-  ReasonCounts refused_;  // why images gave no state
+  ReasonCounts refused_;    // why images gave no state
 };
 
 }  // namespace livo::vio_feature
