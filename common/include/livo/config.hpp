@@ -24,11 +24,12 @@ class Node;  // yaml-cpp stays inside config.cpp
 namespace livo {
 
 // The value types Config reads (see the end of this file), as an X-macro: X(T) for each.
-#define LIVO_CONFIG_VALUE_TYPES(X)                                                                                    \
-  X(bool)                                                                                                             \
-  X(int)                                                                                                              \
-  X(int64_t) X(double) X(float) X(std::string) X(std::vector<double>) X(std::vector<int>) X(std::vector<std::string>) \
-      X(Eigen::Vector3d) X(Eigen::Matrix3d) X(Eigen::Matrix4d) X(Eigen::Quaterniond) X(Eigen::Isometry3d)
+// clang-format off
+#define LIVO_CONFIG_VALUE_TYPES(X)                                                                          \
+  X(bool) X(int) X(int64_t) X(double) X(float) X(std::string) X(std::vector<double>) X(std::vector<int>) \
+  X(std::vector<std::string>) X(Eigen::Vector3d) X(Eigen::Matrix3d) X(Eigen::Matrix4d)                  \
+  X(Eigen::Quaterniond) X(Eigen::Isometry3d)
+// clang-format on
 
 class ConfigError : public std::runtime_error {
  public:
