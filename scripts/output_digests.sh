@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
 # The pipeline's outputs as fingerprints, to show that a restructuring changed nothing (issue 45):
 # the room and campus demos (scripts/demo.sh's sequences, seed 1) run in lockstep through every
-# process, then per run each recorded channel's digest (livo-loginfo --digest; HEALTH and PROGRESS
-# left out: they carry wall-clock timings) and the md5 of every map and trajectory file.
+# process, and 20 s of bridge_deck through the second paper's pair (livo-lio-graph swapped in for
+# lio, coupled to livo-vio-feature: wheels, depth, visual_state); then per run each recorded
+# channel's digest (livo-loginfo --digest; HEALTH and PROGRESS left out: they carry wall-clock
+# timings) and the md5 of every map and trajectory file.
 #
-#   scripts/output_digests.sh --out DIR [--logs DIR] [--runs room:30,campus_loop:60] [--against FILE]
+#   scripts/output_digests.sh --out DIR [--logs DIR] [--runs room:30,campus_loop:60,bridge_deck:20:paper2]
+#                             [--against FILE]
+#
+# A run is NAME:SECONDS (every process of config/sim/NAME.yaml) or NAME:SECONDS:paper2 (the pair).
 #
 # Writes DIR/digests.txt ("RUN channel NAME DIGEST" and "RUN file NAME MD5" lines, sorted) and
 # prints it. --against FILE compares with an earlier digests.txt: prints the lines that differ and
@@ -17,10 +22,10 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${LIVO_BUILD_DIR:-$root/build}"
 
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "output_digests.sh: $*" >&2; exit 1; }
 
-out="" logs="" runs="room:30,campus_loop:60" against=""
+out="" logs="" runs="room:30,campus_loop:60,bridge_deck:20:paper2" against=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out="$2"; shift 2 ;;
@@ -45,8 +50,9 @@ lines="$out/digests.txt.part"
 : >"$lines"
 IFS=',' read -ra list <<<"$runs"
 for r in "${list[@]}"; do
-  name="${r%%:*}" duration="${r#*:}"
-  [[ "$duration" =~ ^[0-9]+$ ]] || die "--runs: want NAME:SECONDS, got '$r'"
+  IFS=':' read -r name duration kind <<<"$r"
+  [[ "$duration" =~ ^[0-9]+$ ]] && [[ "${kind:-}" =~ ^(|paper2)$ ]] ||
+    die "--runs: want NAME:SECONDS or NAME:SECONDS:paper2, got '$r'"
   config="$root/config/sim/$name.yaml"
   [ -f "$config" ] || die "--runs: no config $config"
   log="$logs/${name}_${duration}s.lcmlog"
@@ -55,15 +61,21 @@ for r in "${list[@]}"; do
     "$build/bin/livo-sim" --config "$config" --out "$log" --duration "$duration" --seed 1 >"$log.sim.txt" 2>&1 ||
       { tail -n 20 "$log.sim.txt" >&2; die "livo-sim failed on $name"; }
   fi
-  run="$out/${name}_${duration}s"
-  echo "== $name ($duration s): the pipeline -> $run" >&2
-  "$root/scripts/run_pipeline.sh" --log "$log" --config "$config" --out "$run" >"$run.log" 2>&1 ||
+  tag="${name}_${duration}s${kind:+_$kind}"
+  run="$out/$tag"
+  pipeline=(--log "$log" --config "$config" --out "$run")
+  if [ "${kind:-}" = paper2 ]; then
+    echo "lio_graph: {visual_state: true}" >"$out/paper2.overlay.yaml"
+    pipeline+=(--processes lio,vio_feature --swap "lio=$build/bin/livo-lio-graph" --overlay "$out/paper2.overlay.yaml")
+  fi
+  echo "== $tag ($duration s): the pipeline -> $run" >&2
+  "$root/scripts/run_pipeline.sh" "${pipeline[@]}" >"$run.log" 2>&1 ||
     { tail -n 20 "$run.log" >&2; die "run_pipeline.sh failed on $name (log: $run.log)"; }
   "$build/bin/livo-loginfo" --digest "$run/outputs.lcmlog" |
-    awk -v run="${name}_${duration}s" '$1 != "HEALTH" && $1 != "PROGRESS" {
+    awk -v run="$tag" '$1 != "HEALTH" && $1 != "PROGRESS" {
       for (i = 3; i <= NF; ++i) if (length($i) == 16 && $i ~ /^[0-9a-f]+$/) { print run, "channel", $1, $i; break } }' >>"$lines"
   for f in "${files[@]}"; do
-    [ -f "$run/$f" ] && echo "${name}_${duration}s file $f $(md5sum <"$run/$f" | cut -d' ' -f1)" >>"$lines"
+    [ -f "$run/$f" ] && echo "$tag file $f $(md5sum <"$run/$f" | cut -d' ' -f1)" >>"$lines"
   done
 done
 sort "$lines" >"$out/digests.txt"
