@@ -85,8 +85,8 @@ void runDriftedLoop(Adoption adoption) {
   lo.output_dir = livo_test::tempPath("loop-out");
   // The graph's odometry noise model says how bad this odometry is (2 % of the distance, 0.006 rad
   // per 2.4 m step), else the graph would trust it over the loop.
-  lo.closer.odometry_translation_per_m = 0.02;
-  lo.closer.odometry_rotation_per_m = 2.5e-3;
+  lo.core.odometry_translation_per_m = 0.02;
+  lo.core.odometry_rotation_per_m = 2.5e-3;
   LoopNode node(lcm, no, lo);
   std::optional<loop_correction_t> last;
   int corrections = 0;

@@ -13,7 +13,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
   ch.readOptional("loop_correction", o.loop_correction_channel);
   s.readOptional("output_dir", o.output_dir);
   s.readOptional("global_map_voxel", o.global_map_voxel);
-  LoopCloserOptions& c = o.closer;
+  LoopCloserOptions& c = o.core;
   s.readOptional("coarse_voxel", c.coarse.voxel_size);
   s.readOptional("fpfh_normal_radius", c.coarse.normal_radius);
   s.readOptional("fpfh_radius", c.coarse.feature_radius);
@@ -82,7 +82,7 @@ LoopNodeOptions readLoopNodeOptions(const Config& root) {
 }
 
 void printOptions(const LoopNodeOptions& o, std::ostream& os) {
-  const LoopCloserOptions& c = o.closer;
+  const LoopCloserOptions& c = o.core;
   const AcceptanceOptions& a = c.registration.acceptance;
   os << "loop: input " << o.keyframe_channel << "; output " << o.loop_correction_channel << "; files "
      << (o.output_dir.empty() ? std::string("none") : o.output_dir + "/{keyframes.tum,loops.json,global_map.ply}")

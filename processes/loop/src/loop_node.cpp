@@ -10,7 +10,7 @@
 namespace livo::loop {
 
 LoopNode::LoopNode(lcm::LCM& lcm, NodeOptions node_options, LoopNodeOptions options)
-    : node_(lcm, std::move(node_options)), options_(std::move(options)), closer_(options_.closer) {
+    : node_(lcm, std::move(node_options)), options_(std::move(options)), closer_(options_.core) {
   node_.declareOutput(options_.loop_correction_channel);
   node_.subscribe<keyframe_t>(options_.keyframe_channel, [this](const keyframe_t& m) { onKeyframe(m); });
 }
@@ -141,7 +141,7 @@ void LoopNode::writeOutputs() {
     node_.info(summary());
     return;
   }
-  if (options_.closer.optimize_at_exit && closer_.optimizePendingLoops())
+  if (options_.core.optimize_at_exit && closer_.optimizePendingLoops())
     node_.info("optimised the graph once more with the loops accepted since the last correction");
   writeLoopOutputs(options_.output_dir, closer_, options_.global_map_voxel);
   node_.info("wrote " + options_.output_dir + "/keyframes.tum, loops.json, global_map.ply (" + summary() + "; " +

@@ -15,7 +15,7 @@ struct LoopNodeOptions {
   std::string loop_correction_channel = "LOOP_CORRECTION";
   std::string output_dir;         // empty: no files
   double global_map_voxel = 0.2;  // m
-  LoopCloserOptions closer;
+  LoopCloserOptions core;
 };
 
 /// Reads the optional `loop:` section of a project config (absent keys keep the defaults) and
