@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -139,6 +140,111 @@ const char* const kViewerScript = R"JS(
 })();
 )JS";
 
+// The map's points kept for the page and the grid that kept them.
+struct KeptPoints {
+  std::vector<size_t> indices;
+  double voxel_m = 0.0;  // 0: every finite point
+  double point_size_m = 0.0;
+};
+
+// The first point of each voxel of the finest grid that keeps at most max_points, or every
+// finite point when there are no more than that.
+KeptPoints keptPoints(const std::vector<Vec3>& xyz, const std::vector<size_t>& finite, const ViewerOptions& options) {
+  KeptPoints out;
+  out.indices = finite;
+  out.point_size_m = options.point_size_m;
+  std::vector<size_t>& kept = out.indices;
+  if (kept.size() <= options.max_points) return out;
+  // grids point_size_m x 1.25^k; the search starts where a surface sampled at point_size_m
+  // would fit and walks to the smallest k that fits
+  const auto grid = [&](int k) { return options.point_size_m * std::pow(1.25, k); };
+  const double ratio = static_cast<double>(kept.size()) / static_cast<double>(std::max<size_t>(options.max_points, 1));
+  int k = static_cast<int>(std::lround(std::log(std::max(1.0, 0.8 * std::sqrt(ratio))) / std::log(1.25)));
+  kept = firstPointPerVoxel(xyz, finite, grid(k));
+  if (kept.size() <= options.max_points) {
+    while (k > 0) {
+      std::vector<size_t> finer = firstPointPerVoxel(xyz, finite, grid(k - 1));
+      if (finer.size() > options.max_points) break;
+      kept.swap(finer);
+      --k;
+    }
+  } else {
+    while (kept.size() > options.max_points) kept = firstPointPerVoxel(xyz, finite, grid(++k));
+  }
+  out.voxel_m = grid(k);
+  out.point_size_m = std::max(options.point_size_m, out.voxel_m);
+  return out;
+}
+
+// The median height of the trajectory's positions (at least one).
+double medianHeight(const std::vector<Vec3>& path_xyz) {
+  std::vector<double> z;
+  for (const Vec3& p : path_xyz) z.push_back(p.z());
+  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
+  return z[z.size() / 2];
+}
+
+// The trajectory as the page draws it.
+struct ScenePath {
+  std::vector<float> path;            // x y z, relative to the scene's origin
+  std::vector<uint32_t> path_pieces;  // positions per piece
+};
+
+// The trajectory's positions relative to `origin`, thinned to 5 cm apart, in pieces.
+ScenePath scenePath(const Trajectory& trajectory, const std::vector<double>& reset_stamps, const Vec3& origin) {
+  ScenePath out;
+  for (const auto& [begin, end] : pathPieces(trajectory, reset_stamps)) {
+    uint32_t n = 0;
+    Vec3 last = Vec3::Constant(INFINITY);
+    for (size_t i = begin; i < end; ++i) {
+      const Vec3 p = trajectory[i].pose.translation();
+      if (i + 1 < end && (p - last).norm() < kPathSpacing_m) continue;
+      last = p;
+      for (int a = 0; a < 3; ++a) out.path.push_back(static_cast<float>(p[a] - origin[a]));
+      ++n;
+    }
+    out.path_pieces.push_back(n);
+  }
+  return out;
+}
+
+// A very long run: every k-th position of each piece (and its last), at most kMaxPathPositions.
+ScenePath thinnedLongPath(ScenePath in) {
+  if (in.path.size() / 3 <= kMaxPathPositions) return in;
+  const size_t k = (in.path.size() / 3 + kMaxPathPositions - 1) / kMaxPathPositions;
+  ScenePath out;
+  size_t start = 0;
+  for (uint32_t n : in.path_pieces) {
+    uint32_t m = 0;
+    for (size_t j = 0; j < n; ++j)
+      if (j % k == 0 || j + 1 == n) {
+        for (int a = 0; a < 3; ++a) out.path.push_back(in.path[3 * (start + j) + a]);
+        ++m;
+      }
+    out.path_pieces.push_back(m);
+    start += n;
+  }
+  return out;
+}
+
+// The scene's start view (obliqueView of what is framed, with the trajectory), its height range
+// (of everything) and its height cut, relative to its origin.
+ViewerScene withStartView(ViewerScene s, const std::vector<Vec3>& framed, const Box3& points_box,
+                          const Trajectory& trajectory, double cut_z) {
+  const Box3 box = withTrajectory(percentileBox(framed, 0.005, 0.995), trajectory);
+  const PerspectiveView view = obliqueView(box, majorHorizontalAxis(framed));
+  s.camera = view.position - s.origin;
+  s.target = box.centre() - s.origin;
+  s.box_min = box.min - s.origin;
+  s.box_max = box.max - s.origin;
+  s.fov_deg = 55.0;
+  const Box3 everything = withTrajectory(points_box, trajectory);
+  s.z_min = everything.min.z() - s.origin.z();
+  s.z_max = everything.max.z() - s.origin.z();
+  s.cut_z = std::min(cut_z - s.origin.z(), s.z_max);
+  return s;
+}
+
 }  // namespace
 
 ViewerScene viewerScene(const ColouredPoints& map, const Trajectory& trajectory,
@@ -157,100 +263,31 @@ ViewerScene viewerScene(const ColouredPoints& map, const Trajectory& trajectory,
     if (p.pose.translation().allFinite()) path_xyz.push_back(p.pose.translation());
   if (finite.empty() && path_xyz.empty()) return s;
 
-  // the points kept: the first of each voxel of the finest grid that keeps few enough
-  std::vector<size_t> kept = finite;
-  s.point_size_m = options.point_size_m;
-  if (kept.size() > options.max_points) {
-    // grids point_size_m x 1.25^k; the search starts where a surface sampled at point_size_m
-    // would fit and walks to the smallest k that fits
-    const auto grid = [&](int k) { return options.point_size_m * std::pow(1.25, k); };
-    const double ratio =
-        static_cast<double>(kept.size()) / static_cast<double>(std::max<size_t>(options.max_points, 1));
-    int k = static_cast<int>(std::lround(std::log(std::max(1.0, 0.8 * std::sqrt(ratio))) / std::log(1.25)));
-    kept = firstPointPerVoxel(xyz, finite, grid(k));
-    if (kept.size() <= options.max_points) {
-      while (k > 0) {
-        std::vector<size_t> finer = firstPointPerVoxel(xyz, finite, grid(k - 1));
-        if (finer.size() > options.max_points) break;
-        kept.swap(finer);
-        --k;
-      }
-    } else {
-      while (kept.size() > options.max_points) kept = firstPointPerVoxel(xyz, finite, grid(++k));
-    }
-    s.voxel_m = grid(k);
-    s.point_size_m = std::max(options.point_size_m, s.voxel_m);
-  }
-
+  const KeptPoints kept = keptPoints(xyz, finite, options);
+  s.voxel_m = kept.voxel_m;
+  s.point_size_m = kept.point_size_m;
   std::vector<Vec3> box_points;
-  for (size_t i : kept) box_points.push_back(xyz[i]);
+  for (size_t i : kept.indices) box_points.push_back(xyz[i]);
   const Box3 all = percentileBox(box_points.empty() ? path_xyz : box_points, 0.0, 1.0);
   s.origin = all.centre().array().round().matrix();
-  double path_median = all.centre().z();
-  if (!path_xyz.empty()) {
-    std::vector<double> z;
-    for (const Vec3& p : path_xyz) z.push_back(p.z());
-    std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
-    path_median = z[z.size() / 2];
-  }
   // no trajectory to cut above: nothing cut at the start
-  const double cut_z = path_xyz.empty() ? INFINITY : path_median + options.cut_above_m;
+  const double cut_z = path_xyz.empty() ? INFINITY : medianHeight(path_xyz) + options.cut_above_m;
 
-  s.positions.reserve(3 * kept.size());
-  s.colours.reserve(3 * kept.size());
+  s.positions.reserve(3 * kept.indices.size());
+  s.colours.reserve(3 * kept.indices.size());
   std::vector<Vec3> below;  // what the start view frames: the points under the cut
-  for (size_t i : kept) {
+  for (size_t i : kept.indices) {
     const Vec3 p = xyz[i] - s.origin;
     for (int a = 0; a < 3; ++a) s.positions.push_back(static_cast<float>(p[a]));
     for (int c = 0; c < 3; ++c) s.colours.push_back(map.rgb[i][c]);
     if (xyz[i].z() <= cut_z) below.push_back(xyz[i]);
   }
 
-  // the trajectory, thinned to positions 5 cm apart, in pieces
-  for (const auto& [begin, end] : pathPieces(trajectory, reset_stamps)) {
-    uint32_t n = 0;
-    Vec3 last = Vec3::Constant(INFINITY);
-    for (size_t i = begin; i < end; ++i) {
-      const Vec3 p = trajectory[i].pose.translation();
-      if (i + 1 < end && (p - last).norm() < kPathSpacing_m) continue;
-      last = p;
-      for (int a = 0; a < 3; ++a) s.path.push_back(static_cast<float>(p[a] - s.origin[a]));
-      ++n;
-    }
-    s.path_pieces.push_back(n);
-  }
-  if (s.path.size() / 3 > kMaxPathPositions) {  // a very long run: every k-th position
-    const size_t k = (s.path.size() / 3 + kMaxPathPositions - 1) / kMaxPathPositions;
-    std::vector<float> thinned;
-    std::vector<uint32_t> pieces;
-    size_t start = 0;
-    for (uint32_t n : s.path_pieces) {
-      uint32_t m = 0;
-      for (size_t j = 0; j < n; ++j)
-        if (j % k == 0 || j + 1 == n) {
-          for (int a = 0; a < 3; ++a) thinned.push_back(s.path[3 * (start + j) + a]);
-          ++m;
-        }
-      pieces.push_back(m);
-      start += n;
-    }
-    s.path.swap(thinned);
-    s.path_pieces.swap(pieces);
-  }
-
+  ScenePath path = thinnedLongPath(scenePath(trajectory, reset_stamps, s.origin));
+  s.path = std::move(path.path);
+  s.path_pieces = std::move(path.path_pieces);
   const std::vector<Vec3>& framed = below.empty() ? (box_points.empty() ? path_xyz : box_points) : below;
-  const Box3 box = withTrajectory(percentileBox(framed, 0.005, 0.995), trajectory);
-  const PerspectiveView view = obliqueView(box, majorHorizontalAxis(framed));
-  s.camera = view.position - s.origin;
-  s.target = box.centre() - s.origin;
-  s.box_min = box.min - s.origin;
-  s.box_max = box.max - s.origin;
-  s.fov_deg = 55.0;
-  const Box3 everything = withTrajectory(all, trajectory);
-  s.z_min = everything.min.z() - s.origin.z();
-  s.z_max = everything.max.z() - s.origin.z();
-  s.cut_z = std::min(cut_z - s.origin.z(), s.z_max);
-  return s;
+  return withStartView(std::move(s), framed, all, trajectory, cut_z);
 }
 
 std::string viewerSection(const ViewerScene& scene, const std::string& description) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include <lcm/lcm-cpp.hpp>
@@ -19,11 +20,6 @@
 namespace livo::report {
 
 namespace {
-template <class T>
-bool decodeInto(const lcm::LogEvent* ev, T& msg) {
-  return msg.decode(ev->data, 0, ev->datalen) == ev->datalen;
-}
-
 OdometryQuality qualityOf(const odometry_t& m) {
   OdometryQuality q;
   q.degenerate = m.degenerate != 0;
@@ -62,6 +58,71 @@ std::vector<T> permuted(const std::vector<T>& v, const std::vector<size_t>& orde
   for (size_t i : order) out.push_back(v[i]);
   return out;
 }
+// The message `ev` holds, or none (counted in `undecodable`) when it does not decode.
+template <class T>
+std::optional<T> decoded(const lcm::LogEvent* ev, int64_t* undecodable) {
+  T msg;
+  if (msg.decode(ev->data, 0, ev->datalen) == ev->datalen) return msg;
+  ++*undecodable;
+  return std::nullopt;
+}
+
+void addOdometry(const odometry_t& m, PipelineOutputs* out) {
+  if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
+    ++out->non_finite;
+    return;
+  }
+  out->odometry.push_back({toSeconds(m.utime), poseFrom(m.position, m.orientation)});
+  out->odometry_frames.push_back({m.epoch, m.correction_id});
+  out->odometry_quality.push_back(qualityOf(m));
+}
+
+void addLoopCorrection(const loop_correction_t& m, PipelineOutputs* out) {
+  Pose3 T_Ck_O;
+  if (!correctionTransform(m, &T_Ck_O).empty()) {
+    ++out->undecodable;
+    return;
+  }
+  out->corrections[m.correction_id] = {m.epoch, T_Ck_O};
+  auto last = out->last_loop.find(m.epoch);
+  if (last == out->last_loop.end() || last->second.correction_id < m.correction_id) out->last_loop[m.epoch] = m;
+  ++out->loop_corrections;
+  out->loops.push_back(loopEventOf(m));
+}
+
+// lio's HEALTH "odometry reset to epoch N: why": N and why into `reasons`.
+void addResetReason(const std::string& message, std::map<int32_t, std::string>* reasons) {
+  const std::string tag = "odometry reset to epoch ";
+  if (message.rfind(tag, 0) != 0) return;
+  const size_t colon = message.find(": ", tag.size());
+  if (colon != std::string::npos) (*reasons)[std::atoi(message.c_str() + tag.size())] = message.substr(colon + 2);
+}
+
+// The odometry in stamp order with its frames and qualities.
+void sortOdometryByStamp(PipelineOutputs* out) {
+  std::vector<size_t> order(out->odometry.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return out->odometry[a].stamp < out->odometry[b].stamp; });
+  out->odometry = permuted(out->odometry, order);
+  out->odometry_frames = permuted(out->odometry_frames, order);
+  out->odometry_quality = permuted(out->odometry_quality, order);
+}
+
+// The first odometry of each new epoch, in stamp order (in log order, a new epoch's stamps may be
+// earlier), with why lio was reset when its HEALTH said.
+std::vector<OdometryReset> odometryResets(const Trajectory& odometry, const std::vector<PublishedFrame>& frames,
+                                          const std::map<int32_t, std::string>& reasons) {
+  std::vector<OdometryReset> resets;
+  int32_t epoch = 0;
+  for (size_t i = 0; i < odometry.size(); ++i) {
+    if (frames[i].epoch <= epoch) continue;
+    epoch = frames[i].epoch;
+    auto r = reasons.find(epoch);
+    resets.push_back({odometry[i].stamp, epoch, r == reasons.end() ? std::string() : r->second});
+  }
+  return resets;
+}
 }  // namespace
 
 PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineChannels& ch) {
@@ -71,84 +132,29 @@ PipelineOutputs readPipelineOutputs(const std::string& log_path, const PipelineC
   std::map<int32_t, std::string> reasons;  // epoch -> why lio was reset
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     if (ev->channel == ch.odometry) {
-      odometry_t m;
-      if (!decodeInto(ev, m)) {
-        ++out.undecodable;
-        continue;
-      }
-      if (!allFinite(m.position, 3) || !allFinite(m.orientation, 4)) {
-        ++out.non_finite;
-        continue;
-      }
-      out.odometry.push_back({toSeconds(m.utime), poseFrom(m.position, m.orientation)});
-      out.odometry_frames.push_back({m.epoch, m.correction_id});
-      out.odometry_quality.push_back(qualityOf(m));
+      if (auto m = decoded<odometry_t>(ev, &out.undecodable)) addOdometry(*m, &out);
     } else if (ev->channel == ch.keyframe) {
-      keyframe_t m;
-      if (!decodeInto(ev, m)) {
-        ++out.undecodable;
-        continue;
-      }
-      out.keyframes.push_back(
-          {m.id, toSeconds(m.utime), poseFrom(m.position, m.orientation), {m.epoch, m.correction_id}});
+      if (auto m = decoded<keyframe_t>(ev, &out.undecodable))
+        out.keyframes.push_back(
+            {m->id, toSeconds(m->utime), poseFrom(m->position, m->orientation), {m->epoch, m->correction_id}});
     } else if (ev->channel == ch.loop_correction) {
-      loop_correction_t m;
-      if (!decodeInto(ev, m)) {
-        ++out.undecodable;
-        continue;
-      }
-      Pose3 T_Ck_O;
-      if (!correctionTransform(m, &T_Ck_O).empty()) {
-        ++out.undecodable;
-        continue;
-      }
-      out.corrections[m.correction_id] = {m.epoch, T_Ck_O};
-      auto last = out.last_loop.find(m.epoch);
-      if (last == out.last_loop.end() || last->second.correction_id < m.correction_id) out.last_loop[m.epoch] = m;
-      ++out.loop_corrections;
-      out.loops.push_back(loopEventOf(m));
+      if (auto m = decoded<loop_correction_t>(ev, &out.undecodable)) addLoopCorrection(*m, &out);
     } else if (ev->channel == ch.state_prior) {
       ++out.state_priors;
     } else if (ev->channel == ch.state_posterior) {
-      filter_state_t m;
-      if (!decodeInto(ev, m)) {
-        ++out.undecodable;
-        continue;
-      }
-      out.visual_answers.push_back({toSeconds(m.utime), m.source, m.valid != 0});
+      if (auto m = decoded<filter_state_t>(ev, &out.undecodable))
+        out.visual_answers.push_back({toSeconds(m->utime), m->source, m->valid != 0});
     } else if (ev->channel == ch.health) {
-      health_t m;
-      if (!decodeInto(ev, m)) {
-        ++out.undecodable;
-        continue;
-      }
-      out.final_health[m.node] = m;
-      const std::string tag = "odometry reset to epoch ";
-      if (m.message.rfind(tag, 0) == 0) {
-        const size_t colon = m.message.find(": ", tag.size());
-        if (colon != std::string::npos)
-          reasons[std::atoi(m.message.c_str() + tag.size())] = m.message.substr(colon + 2);
+      if (auto m = decoded<health_t>(ev, &out.undecodable)) {
+        out.final_health[m->node] = *m;
+        addResetReason(m->message, &reasons);
       }
     }
   }
-  // odometry in stamp order with its frames and qualities
-  std::vector<size_t> order(out.odometry.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return out.odometry[a].stamp < out.odometry[b].stamp; });
-  out.odometry = permuted(out.odometry, order);
-  out.odometry_frames = permuted(out.odometry_frames, order);
-  out.odometry_quality = permuted(out.odometry_quality, order);
+  sortOdometryByStamp(&out);
   std::stable_sort(out.visual_answers.begin(), out.visual_answers.end(),
                    [](const VisualAnswer& a, const VisualAnswer& b) { return a.stamp < b.stamp; });
-  // the stamp order of a reset's first odometry (in log order, a new epoch's stamps may be earlier)
-  int32_t epoch = 0;
-  for (size_t i = 0; i < out.odometry.size(); ++i) {
-    if (out.odometry_frames[i].epoch <= epoch) continue;
-    epoch = out.odometry_frames[i].epoch;
-    auto r = reasons.find(epoch);
-    out.resets.push_back({out.odometry[i].stamp, epoch, r == reasons.end() ? std::string() : r->second});
-  }
+  out.resets = odometryResets(out.odometry, out.odometry_frames, reasons);
   std::stable_sort(out.keyframes.begin(), out.keyframes.end(),
                    [](const KeyframePose& a, const KeyframePose& b) { return a.id < b.id; });
   return out;

@@ -50,6 +50,115 @@ double num(const nlohmann::json& j, std::initializer_list<const char*> path) {
   }
   return node->is_number() ? node->get<double>() : std::nan("");
 }
+
+// The table at the top: what was run, how, and what it produced.
+std::string runTableMarkdown(const RunSummary& run, const PipelineOutputs* outputs, size_t resets) {
+  std::ostringstream md;
+  md << "# Pipeline run\n\n";
+  md << "| | |\n| --- | --- |\n";
+  md << "| log | `" << run.log << "` |\n";
+  md << "| config | `" << run.config << "` |\n";
+  md << "| processes | ";
+  for (size_t i = 0; i < run.processes.size(); ++i) md << (i ? ", " : "") << run.processes[i];
+  md << " |\n";
+  md << "| replay | " << run.mode << ": " << fixed(run.log_seconds, 1) << " s of log in " << fixed(run.wall_seconds, 1)
+     << " s wall";
+  if (run.wall_seconds > 0) md << " (" << fixed(run.log_seconds / run.wall_seconds, 2) << "x real time)";
+  md << " |\n";
+  if (outputs) {
+    md << "| odometry poses | " << outputs->odometry.size() << " |\n";
+    md << "| keyframes | " << outputs->keyframes.size() << " |\n";
+    md << "| loop corrections | " << outputs->loop_corrections << " |\n";
+  }
+  md << "| odometry resets | " << resets << " (epochs 0.." << resets << ") |\n";
+  md << "\n";
+  return md.str();
+}
+
+std::string resetsMarkdown(const nlohmann::json& resets) {
+  if (resets.empty()) return "";
+  std::ostringstream md;
+  md << "## Odometry resets\n\n";
+  md << "livo-lio re-initialised: the odometry restarted at the origin in a new epoch, and every consumer "
+        "started over in it (loop: a new graph segment; vio, colour, octomap: a new map; the old maps are "
+        "written as `*_epoch<N>.*`). Trajectories of different epochs are in unrelated frames.\n\n";
+  md << "| time s | new epoch | reason |\n| --- | --- | --- |\n";
+  for (const auto& r : resets) {
+    const std::string reason = r.value("reason", std::string());
+    md << "| " << fixed(r.value("time", 0.0), 3) << " | " << r.value("epoch", 0) << " | "
+       << (reason.empty() ? "(not in HEALTH; see logs/lio.log)" : reason) << " |\n";
+  }
+  md << "\n";
+  return md.str();
+}
+
+// A row per livo-evaluate JSON, and the alignment the first one used.
+std::string accuracyMarkdown(const std::vector<std::pair<std::string, nlohmann::json>>& evaluations) {
+  if (evaluations.empty()) return "## Accuracy\n\nNo ground truth in the log: no accuracy figures.\n\n";
+  std::ostringstream md;
+  md << "## Accuracy\n\n";
+  md << "| trajectory | ATE RMSE m | mean m | median m | max m | coverage | RPE trans RMSE m | RPE rot RMSE deg |\n";
+  md << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& [title, j] : evaluations) {
+    md << "| " << title << " | " << fixed(num(j, {"ate", "rmse"}), 4) << " | " << fixed(num(j, {"ate", "mean"}), 4)
+       << " | " << fixed(num(j, {"ate", "median"}), 4) << " | " << fixed(num(j, {"ate", "max"}), 4) << " | "
+       << fixed(100.0 * num(j, {"ate", "coverage"}), 1) << " % | " << fixed(num(j, {"rpe", "translation", "rmse"}), 4)
+       << " | " << fixed(num(j, {"rpe", "rotation", "rmse"}), 3) << " |\n";
+  }
+  const nlohmann::json& first = evaluations.front().second;
+  const std::string mode =
+      first.contains("alignment") && first["alignment"].contains("mode") && first["alignment"]["mode"].is_string()
+          ? first["alignment"]["mode"].get<std::string>()
+          : std::string("?");
+  md << "\nATE: translation error after `" << mode << "` Umeyama alignment (`livo-evaluate`, as evo's `evo_ape`); "
+     << "RPE between consecutive poses.\n\n";
+  return md.str();
+}
+
+// Per process, its busiest input (timingJson()).
+std::string processingTimeMarkdown(const nlohmann::json& timing) {
+  std::ostringstream md;
+  md << "## Processing time\n\n";
+  md << "Per process, its busiest input (median x messages); `timing.json` lists every channel.\n\n";
+  md << "| process | input | messages | median ms | p90 ms | max ms | peak RSS MB |\n";
+  md << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& [node, p] : timing.items()) {
+    md << "| " << node << " | " << p.value("busiest_channel", std::string()) << " | " << p.value("messages", 0) << " | "
+       << fixed(p.value("median_ms", 0.0), 2) << " | " << fixed(p.value("p90_ms", 0.0), 2) << " | "
+       << fixed(p.value("max_ms", 0.0), 2) << " | " << fixed(p.value("peak_rss_mb", 0.0), 1) << " |\n";
+  }
+  md << "\n";
+  return md.str();
+}
+
+// A section of one bullet per line; none when there are no lines.
+std::string listSection(const std::string& heading, const std::string& intro, const std::vector<std::string>& lines) {
+  if (lines.empty()) return "";
+  std::string md = "## " + heading + "\n\n" + intro + "\n\n";
+  for (const auto& line : lines) md += "- " + line + "\n";
+  return md + "\n";
+}
+
+std::string restartsMarkdown(const std::vector<ProcessRestart>& restarts) {
+  if (restarts.empty()) return "## Restarts\n\nNone: no process exited during the run.\n\n";
+  std::ostringstream md;
+  md << "## Restarts\n\n";
+  md << "| process | ended at (wall s) | log s | how | restart | down s | lost |\n";
+  md << "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& r : restarts)
+    md << "| " << r.process << " | " << r.wall_s << " | " << (r.log_s.empty() ? "?" : r.log_s) << " | " << r.ended
+       << " | " << r.restart << " | " << r.down_s << " | " << r.lost << " |\n";
+  md << "\n";
+  return md.str();
+}
+
+std::string warningsMarkdown(const std::vector<std::string>& warnings) {
+  std::string md = "## Warnings\n\n";
+  if (warnings.empty()) md += "None.\n";
+  for (const auto& w : warnings) md += "- " + w + "\n";
+  return md;
+}
+
 }  // namespace
 
 std::vector<ProcessRestart> readRestarts(const std::string& path) {
@@ -75,109 +184,20 @@ std::vector<ProcessRestart> readRestarts(const std::string& path) {
 
 std::string reportMarkdown(const ReportInputs& in) {
   std::ostringstream md;
-  md << "# Pipeline run\n\n";
-  md << "| | |\n| --- | --- |\n";
-  md << "| log | `" << in.run.log << "` |\n";
-  md << "| config | `" << in.run.config << "` |\n";
-  md << "| processes | ";
-  for (size_t i = 0; i < in.run.processes.size(); ++i) md << (i ? ", " : "") << in.run.processes[i];
-  md << " |\n";
-  md << "| replay | " << in.run.mode << ": " << fixed(in.run.log_seconds, 1) << " s of log in "
-     << fixed(in.run.wall_seconds, 1) << " s wall";
-  if (in.run.wall_seconds > 0) md << " (" << fixed(in.run.log_seconds / in.run.wall_seconds, 2) << "x real time)";
-  md << " |\n";
-  if (in.outputs) {
-    md << "| odometry poses | " << in.outputs->odometry.size() << " |\n";
-    md << "| keyframes | " << in.outputs->keyframes.size() << " |\n";
-    md << "| loop corrections | " << in.outputs->loop_corrections << " |\n";
-  }
-  md << "| odometry resets | " << in.resets.size() << " (epochs 0.." << in.resets.size() << ") |\n";
-  md << "\n";
-
-  if (!in.resets.empty()) {
-    md << "## Odometry resets\n\n";
-    md << "livo-lio re-initialised: the odometry restarted at the origin in a new epoch, and every consumer "
-          "started over in it (loop: a new graph segment; vio, colour, octomap: a new map; the old maps are "
-          "written as `*_epoch<N>.*`). Trajectories of different epochs are in unrelated frames.\n\n";
-    md << "| time s | new epoch | reason |\n| --- | --- | --- |\n";
-    for (const auto& r : in.resets) {
-      const std::string reason = r.value("reason", std::string());
-      md << "| " << fixed(r.value("time", 0.0), 3) << " | " << r.value("epoch", 0) << " | "
-         << (reason.empty() ? "(not in HEALTH; see logs/lio.log)" : reason) << " |\n";
-    }
-    md << "\n";
-  }
-
-  if (!in.evaluations.empty()) {
-    md << "## Accuracy\n\n";
-    md << "| trajectory | ATE RMSE m | mean m | median m | max m | coverage | RPE trans RMSE m | RPE rot RMSE deg |\n";
-    md << "| --- | --- | --- | --- | --- | --- | --- | --- |\n";
-    for (const auto& [title, j] : in.evaluations) {
-      md << "| " << title << " | " << fixed(num(j, {"ate", "rmse"}), 4) << " | " << fixed(num(j, {"ate", "mean"}), 4)
-         << " | " << fixed(num(j, {"ate", "median"}), 4) << " | " << fixed(num(j, {"ate", "max"}), 4) << " | "
-         << fixed(100.0 * num(j, {"ate", "coverage"}), 1) << " % | " << fixed(num(j, {"rpe", "translation", "rmse"}), 4)
-         << " | " << fixed(num(j, {"rpe", "rotation", "rmse"}), 3) << " |\n";
-    }
-    const nlohmann::json& first = in.evaluations.front().second;
-    const std::string mode =
-        first.contains("alignment") && first["alignment"].contains("mode") && first["alignment"]["mode"].is_string()
-            ? first["alignment"]["mode"].get<std::string>()
-            : std::string("?");
-    md << "\nATE: translation error after `" << mode << "` Umeyama alignment (`livo-evaluate`, as evo's `evo_ape`); "
-       << "RPE between consecutive poses.\n\n";
-  } else {
-    md << "## Accuracy\n\nNo ground truth in the log: no accuracy figures.\n\n";
-  }
-
+  md << runTableMarkdown(in.run, in.outputs, in.resets.size());
+  md << resetsMarkdown(in.resets);
+  md << accuracyMarkdown(in.evaluations);
   for (const auto& [caption, path] : in.figures) md << "![" << caption << "](" << path << ")\n\n";
-
   if (in.weak_spots) md << weakSpotsMarkdown(*in.weak_spots);
   if (in.pictures) md << mapsMarkdown(*in.pictures);
-
-  md << "## Processing time\n\n";
-  md << "Per process, its busiest input (median x messages); `timing.json` lists every channel.\n\n";
-  md << "| process | input | messages | median ms | p90 ms | max ms | peak RSS MB |\n";
-  md << "| --- | --- | --- | --- | --- | --- | --- |\n";
-  for (const auto& [node, p] : in.timing.items()) {
-    md << "| " << node << " | " << p.value("busiest_channel", std::string()) << " | " << p.value("messages", 0) << " | "
-       << fixed(p.value("median_ms", 0.0), 2) << " | " << fixed(p.value("p90_ms", 0.0), 2) << " | "
-       << fixed(p.value("max_ms", 0.0), 2) << " | " << fixed(p.value("peak_rss_mb", 0.0), 1) << " |\n";
-  }
-  md << "\n";
-
+  md << processingTimeMarkdown(in.timing);
   if (!in.calibration.empty()) md << calibrationMarkdown(in.calibration);
-
-  if (!in.sensor_use.empty()) {
-    md << "## Sensor use\n\n";
-    md << "What the estimators did with their inputs, from their summaries at exit:\n\n";
-    for (const auto& f : in.sensor_use) md << "- " << f << "\n";
-    md << "\n";
-  }
-
-  if (!in.injected_faults.empty()) {
-    md << "## Injected faults\n\n";
-    md << "Faults injected by `livo-playback --faults` (seeded), per channel:\n\n";
-    for (const auto& f : in.injected_faults) md << "- " << f << "\n";
-    md << "\n";
-  }
-
-  if (in.supervised || !in.restarts.empty()) {
-    md << "## Restarts\n\n";
-    if (in.restarts.empty()) {
-      md << "None: no process exited during the run.\n\n";
-    } else {
-      md << "| process | ended at (wall s) | log s | how | restart | down s | lost |\n";
-      md << "| --- | --- | --- | --- | --- | --- | --- |\n";
-      for (const auto& r : in.restarts)
-        md << "| " << r.process << " | " << r.wall_s << " | " << (r.log_s.empty() ? "?" : r.log_s) << " | " << r.ended
-           << " | " << r.restart << " | " << r.down_s << " | " << r.lost << " |\n";
-      md << "\n";
-    }
-  }
-
-  md << "## Warnings\n\n";
-  if (in.warnings.empty()) md << "None.\n";
-  for (const auto& w : in.warnings) md << "- " << w << "\n";
+  md << listSection("Sensor use",
+                    "What the estimators did with their inputs, from their summaries at exit:", in.sensor_use);
+  md << listSection("Injected faults",
+                    "Faults injected by `livo-playback --faults` (seeded), per channel:", in.injected_faults);
+  if (in.supervised || !in.restarts.empty()) md << restartsMarkdown(in.restarts);
+  md << warningsMarkdown(in.warnings);
   return md.str();
 }
 

@@ -88,40 +88,53 @@ long nearestPose(const Trajectory& t, double stamp, double slack) {
   return best;
 }
 
-}  // namespace
+// The layout: title and legend above the plot, axis labels left and below.
+constexpr double kLeft = 70, kRight = 24, kTop = 78, kBottom = 52;
 
-std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
-  const bool has_final = !in.final_estimate.empty();
-  const Trajectory& est = has_final ? in.final_estimate : in.odometry;
-  const bool draw_odometry = has_final && !in.odometry.empty() && !sameTrajectory(in.final_estimate, in.odometry);
+// The figure's size and where the plot sits in it.
+struct Layout {
+  Canvas c;
+  double width = 0, height = 0, plot_w = 0, plot_h = 0;
+};
+
+// The finite positions of the estimate and, when drawn, the odometry beneath it.
+std::vector<Vec3> finitePositions(const Trajectory& est, const Trajectory* odometry) {
   std::vector<Vec3> all;
-  for (const Trajectory* t : {&est, draw_odometry ? &in.odometry : nullptr})
+  for (const Trajectory* t : {&est, odometry})
     if (t)
       for (const StampedPose& p : *t)
         if (p.pose.translation().allFinite()) all.push_back(p.pose.translation());
-  if (all.empty()) throw std::invalid_argument("trajectoryTopSvg: no finite pose");
-  const Box3 box = percentileBox(all, 0.0, 1.0);
+  return all;
+}
 
-  // layout: title and legend above the plot, axis labels left and below
-  constexpr double kLeft = 70, kRight = 24, kTop = 78, kBottom = 52;
-  const double plot_w = width - kLeft - kRight;
+// `width` px wide, equal scales on both axes, the box in the middle with 3 % margins.
+Layout figureLayout(const Box3& box, double width) {
+  Layout l;
+  l.width = width;
+  l.plot_w = width - kLeft - kRight;
   const double dx = std::max(box.size().x(), 1.0), dy = std::max(box.size().y(), 1.0);
-  const double plot_h = std::clamp(plot_w * dy / dx, 0.35 * plot_w, 1.1 * plot_w);
-  const double s = std::min(plot_w / (dx * 1.06), plot_h / (dy * 1.06));  // px per m, 3 % margins
-  Canvas c;
-  c.s = s, c.x0 = kLeft, c.y0 = kTop;
-  c.xmin = box.centre().x() - 0.5 * plot_w / s;
-  c.ymax = box.centre().y() + 0.5 * plot_h / s;
-  const double height = kTop + plot_h + kBottom;
+  l.plot_h = std::clamp(l.plot_w * dy / dx, 0.35 * l.plot_w, 1.1 * l.plot_w);
+  const double s = std::min(l.plot_w / (dx * 1.06), l.plot_h / (dy * 1.06));  // px per m, 3 % margins
+  l.c.s = s, l.c.x0 = kLeft, l.c.y0 = kTop;
+  l.c.xmin = box.centre().x() - 0.5 * l.plot_w / s;
+  l.c.ymax = box.centre().y() + 0.5 * l.plot_h / s;
+  l.height = kTop + l.plot_h + kBottom;
+  return l;
+}
 
-  std::ostringstream os;
-  os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fixed1(width) << "\" height=\"" << fixed1(height)
-     << "\" viewBox=\"0 0 " << fixed1(width) << " " << fixed1(height) << "\">\n";
+// The svg element, the background and the title.
+void writeHeader(std::ostringstream& os, const Layout& l, const std::string& title) {
+  os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fixed1(l.width) << "\" height=\"" << fixed1(l.height)
+     << "\" viewBox=\"0 0 " << fixed1(l.width) << " " << fixed1(l.height) << "\">\n";
   os << "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
-  os << "<text x=\"" << fixed1(kLeft) << "\" y=\"24\" font-size=\"16\" " << kFont << ">" << escapeMarkup(in.title)
+  os << "<text x=\"" << fixed1(kLeft) << "\" y=\"24\" font-size=\"16\" " << kFont << ">" << escapeMarkup(title)
      << "</text>\n";
+}
 
-  // axes: ticks and a light grid, equal scales
+// Axes: ticks and a light grid, equal scales.
+void writeAxes(std::ostringstream& os, const Layout& l) {
+  const Canvas& c = l.c;
+  const double plot_w = l.plot_w, plot_h = l.plot_h, s = c.s;
   const double x_lo = c.xmin, x_hi = c.xmin + plot_w / s, y_lo = c.ymax - plot_h / s, y_hi = c.ymax;
   const auto xt = niceTicks(x_lo, x_hi, 8), yt = niceTicks(y_lo, y_hi, 6);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
@@ -141,33 +154,43 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
     os << "<text x=\"" << fixed1(kLeft - 8) << "\" y=\"" << fixed1(py + 4) << "\" font-size=\"12\" text-anchor=\"end\" "
        << kFont << ">" << tickLabel(y, ystep) << "</text>\n";
   }
-  os << "<text x=\"" << fixed1(kLeft + 0.5 * plot_w) << "\" y=\"" << fixed1(height - 12) << "\" font-size=\"13\" "
+  os << "<text x=\"" << fixed1(kLeft + 0.5 * plot_w) << "\" y=\"" << fixed1(l.height - 12) << "\" font-size=\"13\" "
      << "text-anchor=\"middle\" " << kFont << ">x (m)</text>\n";
   os << "<text x=\"18\" y=\"" << fixed1(kTop + 0.5 * plot_h) << "\" font-size=\"13\" text-anchor=\"middle\" "
      << "transform=\"rotate(-90 18 " << fixed1(kTop + 0.5 * plot_h) << ")\" " << kFont << ">y (m)</text>\n";
+}
 
-  auto pixels = [&](const Trajectory& t, const std::vector<size_t>& idx) {
-    std::vector<std::pair<double, double>> px;
-    for (size_t i : idx) px.push_back(c(t[i].pose.translation()));
-    return px;
-  };
-  auto range = [](size_t a, size_t b) {
-    std::vector<size_t> v;
-    for (size_t i = a; i < b; ++i) v.push_back(i);
-    return v;
-  };
-  const auto pieces = pathPieces(est, in.reset_stamps);
-  if (pieces.empty()) throw std::invalid_argument("trajectoryTopSvg: no finite pose in the estimate");
-  const auto degenerate = runsInSpans(est, pieces, in.marks.degenerate);
-  const auto predicted = runsInSpans(est, pieces, in.marks.predicted);
-  for (const auto& run : predicted) polyline(os, pixels(est, run), kPredictedColour, 9, "stroke-opacity=\"0.45\"");
-  for (const auto& run : degenerate) polyline(os, pixels(est, run), kDegenerateColour, 9, "stroke-opacity=\"0.45\"");
-  if (draw_odometry)
-    for (const auto& [a, b] : pathPieces(in.odometry, in.reset_stamps))
-      polyline(os, pixels(in.odometry, range(a, b)), kOdometryColour, 1.2);
-  for (const auto& [a, b] : pieces) polyline(os, pixels(est, range(a, b)), kEstimateColour, 1.8);
-  size_t loops_drawn = 0;
-  for (const auto& l : in.marks.loops) {
+// The pixels of the poses `idx` of `t`.
+std::vector<std::pair<double, double>> pixels(const Canvas& c, const Trajectory& t, const std::vector<size_t>& idx) {
+  std::vector<std::pair<double, double>> px;
+  for (size_t i : idx) px.push_back(c(t[i].pose.translation()));
+  return px;
+}
+
+std::vector<size_t> indexRange(size_t a, size_t b) {
+  std::vector<size_t> v;
+  for (size_t i = a; i < b; ++i) v.push_back(i);
+  return v;
+}
+
+// Each piece of `t` as one line.
+void drawPieces(std::ostringstream& os, const Canvas& c, const Trajectory& t,
+                const std::vector<std::pair<size_t, size_t>>& pieces, const char* colour, double width) {
+  for (const auto& [a, b] : pieces) polyline(os, pixels(c, t, indexRange(a, b)), colour, width);
+}
+
+// Each run as a wide translucent stroke beneath the path.
+void drawRuns(std::ostringstream& os, const Canvas& c, const Trajectory& t,
+              const std::vector<std::vector<size_t>>& runs, const char* colour) {
+  for (const auto& run : runs) polyline(os, pixels(c, t, run), colour, 9, "stroke-opacity=\"0.45\"");
+}
+
+// Each loop closure as a dashed line between the poses nearest its keyframes' stamps, a dot at
+// each end; returns how many could be placed.
+size_t drawLoops(std::ostringstream& os, const Canvas& c, const Trajectory& est,
+                 const std::vector<PlotMarks::Loop>& loops) {
+  size_t drawn = 0;
+  for (const auto& l : loops) {
     const long a = nearestPose(est, l.from_stamp, 0.25), b = nearestPose(est, l.to_stamp, 0.25);
     if (a < 0 || b < 0) continue;
     const auto pa = c(est[a].pose.translation()), pb = c(est[b].pose.translation());
@@ -177,34 +200,45 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
     for (const auto& p : {pa, pb})
       os << "<circle cx=\"" << fixed1(p.first) << "\" cy=\"" << fixed1(p.second) << "\" r=\"3.5\" fill=\""
          << kLoopColour << "\"/>\n";
-    ++loops_drawn;
+    ++drawn;
   }
-  const auto start = c(est[pieces.front().first].pose.translation());
-  const auto end = c(est[pieces.back().second - 1].pose.translation());
+  return drawn;
+}
+
+// A green dot at the start, a red square at the end.
+void drawStartEnd(std::ostringstream& os, std::pair<double, double> start, std::pair<double, double> end) {
   os << "<circle cx=\"" << fixed1(start.first) << "\" cy=\"" << fixed1(start.second) << "\" r=\"5\" fill=\"#3cb43c\" "
      << "stroke=\"#282828\"/>\n";
   os << "<rect x=\"" << fixed1(end.first - 4.5) << "\" y=\"" << fixed1(end.second - 4.5)
      << "\" width=\"9\" height=\"9\" "
      << "fill=\"#dc2828\" stroke=\"#282828\"/>\n";
+}
 
-  // legend: one row above the plot, only what is drawn
-  struct Item {
-    std::string swatch, label;
-  };
-  std::vector<Item> items;
-  auto stroke = [](const char* colour, double w, const char* extra) {
-    return std::string("<line x1=\"0\" y1=\"0\" x2=\"26\" y2=\"0\" stroke=\"") + colour + "\" stroke-width=\"" +
-           fixed1(w) + "\" " + extra + "/>";
-  };
-  items.push_back(
-      {stroke(kEstimateColour, 1.8, ""), has_final ? "trajectory (trajectory.tum)" : "odometry (odometry.tum)"});
-  if (draw_odometry) items.push_back({stroke(kOdometryColour, 1.2, ""), "online odometry"});
-  if (!degenerate.empty())
-    items.push_back({stroke(kDegenerateColour, 9, "stroke-opacity=\"0.45\""), "degenerate sweeps"});
-  if (!predicted.empty())
-    items.push_back({stroke(kPredictedColour, 9, "stroke-opacity=\"0.45\""), "predicted, no LiDAR update"});
-  if (loops_drawn > 0)
-    items.push_back({stroke(kLoopColour, 1.8, "stroke-dasharray=\"6,3\"") +
+struct LegendItem {
+  std::string swatch, label;
+};
+
+// What the figure drew, for its legend.
+struct DrawnMarks {
+  bool odometry = false, degenerate = false, predicted = false, loops = false;
+};
+
+std::string legendStroke(const char* colour, double w, const char* extra) {
+  return std::string("<line x1=\"0\" y1=\"0\" x2=\"26\" y2=\"0\" stroke=\"") + colour + "\" stroke-width=\"" +
+         fixed1(w) + "\" " + extra + "/>";
+}
+
+// The legend's entries: only what is drawn.
+std::vector<LegendItem> legendItems(const std::string& estimate_label, const DrawnMarks& drawn) {
+  std::vector<LegendItem> items;
+  items.push_back({legendStroke(kEstimateColour, 1.8, ""), estimate_label});
+  if (drawn.odometry) items.push_back({legendStroke(kOdometryColour, 1.2, ""), "online odometry"});
+  if (drawn.degenerate)
+    items.push_back({legendStroke(kDegenerateColour, 9, "stroke-opacity=\"0.45\""), "degenerate sweeps"});
+  if (drawn.predicted)
+    items.push_back({legendStroke(kPredictedColour, 9, "stroke-opacity=\"0.45\""), "predicted, no LiDAR update"});
+  if (drawn.loops)
+    items.push_back({legendStroke(kLoopColour, 1.8, "stroke-dasharray=\"6,3\"") +
                          "<circle cx=\"0\" cy=\"0\" r=\"3.5\" fill=\"" + kLoopColour +
                          "\"/><circle cx=\"26\" cy=\"0\" "
                          "r=\"3.5\" fill=\"" +
@@ -214,12 +248,46 @@ std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
       {"<circle cx=\"8\" cy=\"0\" r=\"5\" fill=\"#3cb43c\" stroke=\"#282828\"/><rect x=\"17\" y=\"-4.5\" "
        "width=\"9\" height=\"9\" fill=\"#dc2828\" stroke=\"#282828\"/>",
        "start, end"});
+  return items;
+}
+
+// The legend: one row above the plot.
+void writeLegend(std::ostringstream& os, const std::vector<LegendItem>& items) {
   double x = kLeft;
-  for (const Item& item : items) {
+  for (const LegendItem& item : items) {
     os << "<g transform=\"translate(" << fixed1(x) << " 52)\">" << item.swatch
        << "<text x=\"34\" y=\"4\" font-size=\"12\" " << kFont << ">" << escapeMarkup(item.label) << "</text></g>\n";
     x += 46 + 7.0 * static_cast<double>(item.label.size());
   }
+}
+
+}  // namespace
+
+std::string trajectoryTopSvg(const TrajectoryFigureInputs& in, double width) {
+  const bool has_final = !in.final_estimate.empty();
+  const Trajectory& est = has_final ? in.final_estimate : in.odometry;
+  const bool draw_odometry = has_final && !in.odometry.empty() && !sameTrajectory(in.final_estimate, in.odometry);
+  const std::vector<Vec3> all = finitePositions(est, draw_odometry ? &in.odometry : nullptr);
+  if (all.empty()) throw std::invalid_argument("trajectoryTopSvg: no finite pose");
+  const Layout layout = figureLayout(percentileBox(all, 0.0, 1.0), width);
+  const Canvas& c = layout.c;
+  const auto pieces = pathPieces(est, in.reset_stamps);
+  if (pieces.empty()) throw std::invalid_argument("trajectoryTopSvg: no finite pose in the estimate");
+  const auto degenerate = runsInSpans(est, pieces, in.marks.degenerate);
+  const auto predicted = runsInSpans(est, pieces, in.marks.predicted);
+
+  std::ostringstream os;
+  writeHeader(os, layout, in.title);
+  writeAxes(os, layout);
+  drawRuns(os, c, est, predicted, kPredictedColour);
+  drawRuns(os, c, est, degenerate, kDegenerateColour);
+  if (draw_odometry) drawPieces(os, c, in.odometry, pathPieces(in.odometry, in.reset_stamps), kOdometryColour, 1.2);
+  drawPieces(os, c, est, pieces, kEstimateColour, 1.8);
+  const size_t loops_drawn = drawLoops(os, c, est, in.marks.loops);
+  drawStartEnd(os, c(est[pieces.front().first].pose.translation()),
+               c(est[pieces.back().second - 1].pose.translation()));
+  const DrawnMarks drawn{draw_odometry, !degenerate.empty(), !predicted.empty(), loops_drawn > 0};
+  writeLegend(os, legendItems(has_final ? "trajectory (trajectory.tum)" : "odometry (odometry.tum)", drawn));
   os << "</svg>\n";
   return os.str();
 }
