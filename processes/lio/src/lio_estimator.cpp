@@ -20,6 +20,32 @@ void appendNote(std::string* note, const std::string& what) {
   if (!note->empty()) *note += "; ";
   *note += what;
 }
+
+/// The points registered against the map: every point_stride-th, then one per scan voxel.
+std::vector<Vec3> registrationSubset(const std::vector<Vec3>& body, int point_stride, double scan_voxel_size) {
+  const size_t stride = static_cast<size_t>(std::max(1, point_stride));
+  std::vector<size_t> subset;
+  if (stride == 1) {
+    subset = firstPointPerVoxel(body, scan_voxel_size);
+  } else {
+    for (size_t i = 0; i < body.size(); i += stride) subset.push_back(i);
+    subset = firstPointPerVoxel(body, subset, scan_voxel_size);
+  }
+  std::vector<Vec3> reg;
+  for (size_t i : subset) reg.push_back(body[i]);
+  return reg;
+}
+
+/// The sweep's points in the world at the posterior x, with their indices in the input sweep.
+void worldPoints(const std::vector<Vec3>& body, const std::vector<size_t>& valid, const FilterState& x,
+                 ScanResult* res) {
+  res->world_points.resize(body.size());
+  res->input_index.resize(body.size());
+  for (size_t i = 0; i < body.size(); ++i) {
+    res->input_index[i] = static_cast<uint32_t>(valid[i]);
+    res->world_points[i] = x.rot * body[i] + x.pos;
+  }
+}
 }  // namespace
 
 const char* toString(ScanResult::Status s) {
@@ -354,22 +380,26 @@ void LioEstimator::pruneMap(const Vec3& position) {
   last_prune_position_ = position;
 }
 
+bool LioEstimator::refusesSweep(int64_t t_end, ScanResult* res) const {
+  if (!initialized_) {
+    res->status = ScanResult::Status::kInitializing;
+    res->message = "waiting for the IMU initialisation";
+    return true;
+  }
+  if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
+    // before the first output this is a sweep recorded during the IMU initialisation window
+    res->status = map_.empty() ? ScanResult::Status::kInitializing : ScanResult::Status::kRejected;
+    res->message = map_.empty() ? "sweep ends before the IMU initialisation" : "sweep ends before the filter time";
+    return true;
+  }
+  return false;
+}
+
 ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timing) {
   ScanResult res;
   std::string* note = &res.message;
-  if (!initialized_) {
-    res.status = ScanResult::Status::kInitializing;
-    res.message = "waiting for the IMU initialisation";
-    return res;
-  }
-  const double end_offset = timing.end_offset_s;
   const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
-  if (!acceptsSweepEnding(t_end) || (map_.empty() && t_end <= prop_.utime())) {
-    // before the first output this is a sweep recorded during the IMU initialisation window
-    res.status = map_.empty() ? ScanResult::Status::kInitializing : ScanResult::Status::kRejected;
-    res.message = map_.empty() ? "sweep ends before the IMU initialisation" : "sweep ends before the filter time";
-    return res;
-  }
+  if (refusesSweep(t_end, &res)) return res;
   last_sweep_end_utime_ = t_end;
 
   // 1. propagation to the sweep end (eqs. 5-6)
@@ -383,16 +413,13 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
   StateCovariance P = prop_.covariance();
 
   // 2. valid points, undistorted into the body frame at the end
-  validPoints(scan, end_offset, note);
-  const std::vector<size_t>& valid = valid_;
+  const std::vector<size_t> valid = validPoints(scan, timing.end_offset_s, note);
   res.num_points = static_cast<int>(valid.size());
-  undistortToSweepEnd(scan, x, t_first, t_end);
+  std::vector<Vec3> body = undistortToSweepEnd(scan, valid, x, t_first, t_end);
   const SensorCalibration undistorted_with = x.lidar;  // the wheel update below may move it
-  const std::vector<Vec3>& body = body_;
 
   // 3. registration subset: stride, then voxel downsampling
-  registrationSubset();
-  const std::vector<Vec3>& reg = reg_;
+  std::vector<Vec3> reg = registrationSubset(body, opts_.point_stride, opts_.scan_voxel_size);
   res.num_registered = static_cast<int>(reg.size());
 
   // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
@@ -402,9 +429,9 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
 
   // 5. LiDAR update or map seeding
   reseedAfterOutage(t_end, &x, &P, note);
-  body_rate_ = prop_.angularVelocity(prop_.lastSample().gyro, x);
-  res.status = lidarStage(reg, valid.size(), undistorted_with, &x, &P, &res);
-  toBodyAtSweepEnd(undistorted_with, x);
+  const Vec3 body_rate = prop_.angularVelocity(prop_.lastSample().gyro, x);
+  res.status = lidarStage(reg, valid.size(), undistorted_with, body_rate, &x, &P, &res);
+  toBodyAtSweepEnd(undistorted_with, x, body_rate, &body, &reg);
   noteRegistration(res.status, x, t_end);
   prop_.applyUpdate(x, P);
   res.utime = t_end;
@@ -412,18 +439,8 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
 
   // 6. the sweep in the world (an output, and what the voxel planes take), map insertion and the
   // local window
-  res.world_points.resize(body.size());
-  res.input_index.resize(body.size());
-  for (size_t i = 0; i < body.size(); ++i) {
-    res.input_index[i] = static_cast<uint32_t>(valid[i]);
-    res.world_points[i] = x.rot * body[i] + x.pos;
-  }
-  if (res.status != ScanResult::Status::kPredicted) {
-    res.map_points_seen_through = insertIntoMap(reg, x);
-    if (opts_.planes.enabled) planes_.add(res.world_points, x.rot * x.lidar.pos + x.pos);
-    last_registered_body_ = reg;
-    pruneMap(x.pos);
-  }
+  worldPoints(body, valid, x, &res);
+  if (res.status != ScanResult::Status::kPredicted) addToMap(reg, x, res.world_points, &res);
 
   // 7. outputs
   res.sweep_start_utime = t_first;
@@ -437,9 +454,16 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
   return res;
 }
 
-void LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::string* note) {
-  std::vector<size_t>& valid = valid_;
-  valid.clear();
+void LioEstimator::addToMap(const std::vector<Vec3>& reg, const FilterState& x, const std::vector<Vec3>& world,
+                            ScanResult* res) {
+  res->map_points_seen_through = insertIntoMap(reg, x);
+  if (opts_.planes.enabled) planes_.add(world, x.rot * x.lidar.pos + x.pos);
+  last_registered_body_ = reg;
+  pruneMap(x.pos);
+}
+
+std::vector<size_t> LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::string* note) const {
+  std::vector<size_t> valid;
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
   const double min_r2 = opts_.min_range * opts_.min_range, max_r2 = opts_.max_range * opts_.max_range;
   const bool has_intensity = scan.intensity.size() == scan.points.size();
@@ -453,46 +477,36 @@ void LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::st
     valid.push_back(j);
   }
   if (scan.points.size() != scan.time_offset.size()) appendNote(note, "points and time offsets differ in number");
+  return valid;
 }
 
-void LioEstimator::undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first,
-                                       int64_t t_end) {
+std::vector<Vec3> LioEstimator::undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
+                                                    const FilterState& at_end, int64_t t_first, int64_t t_end) {
   const Pose3 T_I_L = at_end.lidar.pose();
+  std::vector<Vec3> body;
   if (!prop_.segments().empty()) {
     const Undistorter und(prop_.segments(), at_end.rot, at_end.pos, t_end, T_I_L);
     // each point at its stamp plus the LiDAR's time shift in use (the rate changes within a sweep)
-    und.undistort(scan, t_first, at_end.lidar.dt, valid_, &body_);
+    und.undistort(scan, t_first, at_end.lidar.dt, valid, &body);
   } else {
-    body_.clear();
-    for (size_t j : valid_) body_.push_back(T_I_L * scan.points[j]);
+    for (size_t j : valid) body.push_back(T_I_L * scan.points[j]);
   }
   prop_.clearSegments();
+  return body;
 }
 
-void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x) {
-  // body_ and reg_ hold the points through the calibration of the undistortion, as if taken at the
+void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x,
+                                    const Vec3& body_rate, std::vector<Vec3>* body, std::vector<Vec3>* reg) {
+  // body and reg hold the points through the calibration of the undistortion, as if taken at the
   // filter's time; the sweep was seen through x's extrinsic at the state's time plus what the time
   // shift moved beyond the undistortion's (ScanToMap): A = T_W_I^-1 T_W_I(end) T_I_L(x) T_I_L(undistortion)^-1
   const bool same =
       x.lidar.dt == undistorted_with.dt && x.lidar.rot == undistorted_with.rot && x.lidar.pos == undistorted_with.pos;
   if (same) return;
-  const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate_, undistorted_with.dt) * x.lidar.pose() *
+  const Pose3 A = x.pose().inverse() * sweepEndPose(x, body_rate, undistorted_with.dt) * x.lidar.pose() *
                   undistorted_with.pose().inverse();
-  for (Vec3& p : body_) p = A * p;
-  for (Vec3& p : reg_) p = A * p;
-}
-
-void LioEstimator::registrationSubset() {
-  const size_t stride = static_cast<size_t>(std::max(1, opts_.point_stride));
-  std::vector<size_t> subset;
-  if (stride == 1) {
-    subset = firstPointPerVoxel(body_, opts_.scan_voxel_size);
-  } else {
-    for (size_t i = 0; i < body_.size(); i += stride) subset.push_back(i);
-    subset = firstPointPerVoxel(body_, subset, opts_.scan_voxel_size);
-  }
-  reg_.clear();
-  for (size_t i : subset) reg_.push_back(body_[i]);
+  for (Vec3& p : *body) p = A * p;
+  for (Vec3& p : *reg) p = A * p;
 }
 
 bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel,
@@ -536,8 +550,8 @@ void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, StateCovaria
 }
 
 ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t num_valid,
-                                            const SensorCalibration& undistorted_with, FilterState* x,
-                                            StateCovariance* P, ScanResult* res) {
+                                            const SensorCalibration& undistorted_with, const Vec3& body_rate,
+                                            FilterState* x, StateCovariance* P, ScanResult* res) {
   std::string* note = &res->message;
   ScanResult::Status status;
   if (map_.empty()) {
@@ -551,7 +565,7 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
     status = ScanResult::Status::kPredicted;
     appendNote(note, "too few valid points (" + std::to_string(num_valid) + "): prediction only");
   } else {
-    status = registerSweep(reg, undistorted_with, x, P, res);
+    status = registerSweep(reg, undistorted_with, body_rate, x, P, res);
   }
   gap_bridged_ = false;
   gap_undo_rot_.setIdentity();
@@ -561,10 +575,10 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
 }
 
 ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, const SensorCalibration& undistorted_with,
-                                               FilterState* x, StateCovariance* P, ScanResult* res) {
+                                               const Vec3& body_rate, FilterState* x, StateCovariance* P,
+                                               ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with,
-                body_rate_);
+  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate);
   FilterState post;
   StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
@@ -581,7 +595,7 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, con
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
     s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with,
-                      body_rate_);
+                      body_rate);
     FilterState post_still;
     StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(

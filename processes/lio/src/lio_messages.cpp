@@ -32,10 +32,31 @@ registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in,
                                OutputFrame{frame.epoch, frame.correction_id});
 }
 
+registered_scan_t toRegisteredScan(const ScanResult& r, const LidarScan& input, const SweepFormat& format,
+                                   const OdometryFrame& frame) {
+  // the fields registeredScanMessage reads (fromMessage kept the input's arrays as they came)
+  point_cloud_t in;
+  in.pattern = format.pattern;
+  in.num_rings = format.num_rings;
+  in.sweep_duration = static_cast<float>(input.sweep_duration);
+  in.num_points = static_cast<int32_t>(input.time_offset.size());
+  in.intensity = input.intensity;
+  in.time_offset = input.time_offset;
+  in.ring = input.ring;
+  return toRegisteredScan(r, in, frame);
+}
+
 keyframe_t toKeyframe(const Keyframe& k, int16_t num_rings, const OdometryFrame& frame) {
   const KeyframeIncrement increment{k.relative_to_id, k.relative_covariance, k.relative_covariance_held_calibration};
   return keyframeMessage(k.id, k.utime, k.pose, k.pose_covariance, increment, k.cloud, k.intensity, num_rings,
                          OutputFrame{frame.epoch, frame.correction_id});
+}
+
+filter_state_t toStatePrior(const LioEstimator& lio, int64_t utime, int64_t request_id, const std::string& sender) {
+  filter_state_t prior = toFilterState(utime, lio.state(), lio.covariance(), request_id, sender, lio.bodyRate());
+  prior.epoch = lio.frame().epoch;
+  prior.correction_id = lio.frame().correction_id;
+  return prior;
 }
 
 }  // namespace livo::lio

@@ -157,7 +157,7 @@ void LioNode::onLidar(const point_cloud_t& m) {
     node_.reject(opts_.lidar_channel, why);
     return;
   }
-  p->msg = m;
+  p->format = sweepFormat(m);
   p->timing = lio_.sweepTiming(p->scan);
   const int64_t t_end = p->timing.end_utime;
   // Refused on arrival if the filter is already past its end. addScan asks again when its turn
@@ -423,12 +423,12 @@ void LioNode::process(const PendingScan& p) {
   sweep_counts_.predicted += r.status == ScanResult::Status::kPredicted;
   sweep_counts_.degenerate += odo.degenerate != 0;
   if (opts_.publish_registered_scan)
-    node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.msg, lio_.frame()));
+    node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.scan, p.format, lio_.frame()));
   if (r.is_keyframe) {
     // the numbering on disk first: a process killed between the two then skips an id on restart
     // instead of repeating the one it published (livo-loop refuses a repeated id)
     saveNumbering();
-    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.msg.num_rings, lio_.frame()));
+    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.format.num_rings, lio_.frame()));
   }
 }
 
@@ -519,10 +519,7 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
-  filter_state_t prior = toFilterState(utime, lio_.state(), lio_.covariance(), id, opts_.name, lio_.bodyRate());
-  prior.epoch = lio_.frame().epoch;
-  prior.correction_id = lio_.frame().correction_id;
-  node_.publish(opts_.state_prior_channel, prior);
+  node_.publish(opts_.state_prior_channel, toStatePrior(lio_, utime, id, opts_.name));
   ++handoff_.priors;
   pending_ = PendingPrior{id, utime};
 }

@@ -167,23 +167,26 @@ class LioEstimator {
   void reset();
 
  private:
-  // The stages of addScan, in order.
-  // The per-sweep point buffers are members (valid_, body_, reg_), reused from sweep to sweep.
+  // The stages of addScan, in order: each takes its inputs as arguments and returns its results.
+  /// Why a sweep ending at t_end is not processed (kRejected, or kInitializing for a sweep of the
+  /// IMU start-up window), in `res`; false if it is processed.
+  bool refusesSweep(int64_t t_end, ScanResult* res) const;
   /// Indices of the sweep's usable points (finite, inside the sweep [0, end_offset] and the range
-  /// limits) into valid_.
-  void validPoints(const LidarScan& scan, double end_offset, std::string* note);
+  /// limits).
+  std::vector<size_t> validPoints(const LidarScan& scan, double end_offset, std::string* note) const;
   /// The valid points in the body frame at t_end (IMU-propagated motion undistortion through the
-  /// state's LiDAR calibration) into body_; consumes the propagation segments.
-  void undistortToSweepEnd(const LidarScan& scan, const FilterState& at_end, int64_t t_first, int64_t t_end);
-  /// After the update: body_ and reg_ re-expressed through the posterior's LiDAR calibration
-  /// (extrinsic and time shift), so that x's pose maps them where the registration put them.
-  void toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x);
+  /// state's LiDAR calibration); consumes the propagation segments.
+  std::vector<Vec3> undistortToSweepEnd(const LidarScan& scan, const std::vector<size_t>& valid,
+                                        const FilterState& at_end, int64_t t_first, int64_t t_end);
+  /// After the update: the body points and their registration subset re-expressed through the
+  /// posterior's LiDAR calibration (extrinsic and time shift), so that x's pose maps them where the
+  /// registration put them; `body_rate` is the bias-corrected rate at the sweep end.
+  static void toBodyAtSweepEnd(const SensorCalibration& undistorted_with, const FilterState& x, const Vec3& body_rate,
+                               std::vector<Vec3>* body, std::vector<Vec3>* reg);
   /// The first state and covariance of an epoch: the IMU's, with the calibration the last epoch
   /// ended with (or the rig's, with its stated uncertainty).
   FilterState initialState(const ImuInitResult& r) const;
   StateCovariance initialCovariance(const ImuInitResult& r) const;
-  /// The points registered against the map into reg_: every point_stride-th, then one per scan voxel.
-  void registrationSubset();
   /// Wheel speed update at the sweep end; returns whether `travel` holds the wheels' travel since
   /// the wheel-scale anchor.
   bool wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel, std::string* note);
@@ -192,11 +195,11 @@ class LioEstimator {
   /// Map seeding, registration or prediction only; ends a bridged IMU gap's hypothesis. `reg` was
   /// undistorted through `undistorted_with` (the LiDAR's calibration before any update of this sweep).
   ScanResult::Status lidarStage(const std::vector<Vec3>& reg, size_t num_valid,
-                                const SensorCalibration& undistorted_with, FilterState* x, StateCovariance* P,
-                                ScanResult* res);
+                                const SensorCalibration& undistorted_with, const Vec3& body_rate, FilterState* x,
+                                StateCovariance* P, ScanResult* res);
   /// The iterated point-to-plane update (and the no-time-passed hypothesis after a bridged gap).
   ScanResult::Status registerSweep(const std::vector<Vec3>& reg, const SensorCalibration& undistorted_with,
-                                   FilterState* x, StateCovariance* P, ScanResult* res);
+                                   const Vec3& body_rate, FilterState* x, StateCovariance* P, ScanResult* res);
   /// Remembers the last registration (re-seeding, velocity after IMU gaps).
   void noteRegistration(ScanResult::Status status, const FilterState& x, int64_t t_end);
   /// The calibration the filter holds at the rig's values, with the rig's stated uncertainty.
@@ -223,6 +226,9 @@ class LioEstimator {
   /// After the LiDAR update: learns the wheel scales from the travel since the last anchor (a
   /// registered, non-degenerate sweep) and makes this sweep the next anchor if it is one.
   void learnWheelScales(const ScanResult& res, const FilterState& x, const WheelTravel* travel);
+  /// A sweep that seeded the map or registered: its registration subset `reg` into the map (and
+  /// res->map_points_seen_through), its world points into the voxel planes, the local window pruned.
+  void addToMap(const std::vector<Vec3>& reg, const FilterState& x, const std::vector<Vec3>& world, ScanResult* res);
   /// Removes the map points the sweep's beams pass through, then adds the sweep; returns how many
   /// map points were removed.
   size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
@@ -256,11 +262,6 @@ class LioEstimator {
   OdometryFrame frame_;
   int64_t next_keyframe_id_ = 0;
   std::vector<Vec3> last_registered_body_;  // last sweep's downsampled body points (map rebuilds)
-  // addScan's per-sweep buffers (kept for their capacity: a 64-beam sweep's are megabytes)
-  std::vector<size_t> valid_;      // indices of the valid input points
-  std::vector<Vec3> body_;         // those points undistorted, body frame at the sweep end
-  std::vector<Vec3> reg_;          // the registration subset of body_
-  Vec3 body_rate_ = Vec3::Zero();  // bias-corrected angular rate at the sweep end
   // the calibration an odometry reset carries into the next epoch (it belongs to the rig)
   bool has_kept_calibration_ = false;
   FilterState kept_calibration_;

@@ -84,9 +84,10 @@ class LioNode {
   const OdometryFrame& frame() const { return lio_.frame(); }
 
  private:
+  /// A sweep waiting for the IMU: decoded on arrival, with what its outputs need of the message.
   struct PendingScan {
-    point_cloud_t msg;
     LidarScan scan;
+    SweepFormat format;
     SweepTiming timing;  // lio_.sweepTiming(scan), once on arrival
   };
   void onImu(const imu_t& m);
