@@ -33,6 +33,7 @@
 #include "livo/lio/lio_estimator.hpp"
 #include "livo/lio/lio_messages.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "livo/sim/log_writer.hpp"
 #include "livo/sim/simulation_setup.hpp"
 #include "livo/sim/simulator.hpp"
 
@@ -69,24 +70,6 @@ inline livo::sim::SimulationSetup loadLongRun(const std::string& config, double 
   if (!std::isinf(setup.trajectory->duration()) && setup.trajectory->duration() < setup.options.duration_s)
     throw std::invalid_argument(config + ": the trajectory ends before --duration");
   return setup;
-}
-
-/// The point_cloud_t the sim's LogWriter would have written for a sweep (what livo-lio reads).
-inline livo::point_cloud_t toPointCloud(const livo::sim::LidarSweep& m) {
-  livo::point_cloud_t msg;
-  msg.utime = m.utime;
-  msg.frame = "L";
-  msg.pattern = m.solid_state ? livo::point_cloud_t::PATTERN_SOLID_STATE : livo::point_cloud_t::PATTERN_SPINNING;
-  msg.num_rings = static_cast<int16_t>(m.num_rings);
-  msg.sweep_duration = static_cast<float>(m.duration);
-  msg.num_points = static_cast<int32_t>(m.size());
-  msg.x = m.x;
-  msg.y = m.y;
-  msg.z = m.z;
-  msg.intensity = m.intensity;
-  msg.time_offset = m.time_offset;
-  msg.ring = m.ring;
-  return msg;
 }
 
 /// Feeds the simulator's IMU, wheel and LiDAR data (and, if enabled, image times) to a LioEstimator
@@ -149,7 +132,7 @@ class SimLioDriver : public livo::sim::SensorDataSink {
   void write(const livo::sim::LidarSweep& m) override {
     if (m.utime >= outage_begin_ && m.utime < outage_end_) return;
     Pending p;
-    p.msg = toPointCloud(m);  // the node's own conversion
+    p.msg = livo::sim::toPointCloud(m);  // what the sim's log holds for the sweep
     std::string why;
     if (!livo::fromMessage(p.msg, &p.scan, &why)) throw std::runtime_error("sweep conversion: " + why);
     p.t_end = lio_.scanEndUtime(p.scan);

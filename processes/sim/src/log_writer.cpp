@@ -14,6 +14,23 @@
 
 namespace livo::sim {
 
+point_cloud_t toPointCloud(const LidarSweep& m) {
+  point_cloud_t msg;
+  msg.utime = m.utime;
+  msg.frame = "L";
+  msg.pattern = m.solid_state ? point_cloud_t::PATTERN_SOLID_STATE : point_cloud_t::PATTERN_SPINNING;
+  msg.num_rings = static_cast<int16_t>(m.num_rings);
+  msg.sweep_duration = static_cast<float>(m.duration);
+  msg.num_points = static_cast<int32_t>(m.size());
+  msg.x = m.x;
+  msg.y = m.y;
+  msg.z = m.z;
+  msg.intensity = m.intensity;
+  msg.time_offset = m.time_offset;
+  msg.ring = m.ring;
+  return msg;
+}
+
 LogWriter::LogWriter(const std::string& path, const RigChannels& channels) : channels_(channels), path_(path) {
   log_ = std::make_unique<lcm::LogFile>(path, "w");
   if (!log_->good()) throw std::runtime_error(path + ": cannot create the log file");
@@ -61,22 +78,7 @@ void LogWriter::write(const WheelReading& m) {
   writeEvent(channels_.wheel, m.utime, msg);
 }
 
-void LogWriter::write(const LidarSweep& m) {
-  point_cloud_t msg;
-  msg.utime = m.utime;
-  msg.frame = "L";
-  msg.pattern = m.solid_state ? point_cloud_t::PATTERN_SOLID_STATE : point_cloud_t::PATTERN_SPINNING;
-  msg.num_rings = static_cast<int16_t>(m.num_rings);
-  msg.sweep_duration = static_cast<float>(m.duration);
-  msg.num_points = static_cast<int32_t>(m.size());
-  msg.x = m.x;
-  msg.y = m.y;
-  msg.z = m.z;
-  msg.intensity = m.intensity;
-  msg.time_offset = m.time_offset;
-  msg.ring = m.ring;
-  writeEvent(channels_.lidar, m.utime, msg);
-}
+void LogWriter::write(const LidarSweep& m) { writeEvent(channels_.lidar, m.utime, toPointCloud(m)); }
 
 void LogWriter::write(const CameraImage& m) {
   image_t msg;

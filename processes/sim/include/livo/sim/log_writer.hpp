@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "livo/point_cloud_t.hpp"
 #include "livo/sensor_rig.hpp"
 #include "livo/sim/sensor_data.hpp"
 
@@ -13,6 +14,9 @@ class LogFile;
 }
 
 namespace livo::sim {
+
+/// The point_cloud_t the log holds for a sweep (what livo-lio reads), in the LiDAR frame "L".
+point_cloud_t toPointCloud(const LidarSweep& m);
 
 class LogWriter : public SensorDataSink {
  public:
