@@ -1,10 +1,11 @@
 // Shared pieces of the simulator tests: fixed and constant-velocity trajectories, a sink that
-// keeps what it is given, and a minimal config.
+// keeps what it is given, camera effects that leave a render as it is, and a minimal config.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "livo/sim/camera_renderer.hpp"
 #include "livo/sim/sensor_data.hpp"
 #include "livo/sim/trajectory.hpp"
 
@@ -45,6 +46,15 @@ class CollectingSink : public SensorDataSink {
   std::vector<CameraImage> images;
   std::vector<int64_t> order;  // stamps in the order written
 };
+
+/// No exposure variation, no noise, no vignetting: the render as the scene and its lighting make it.
+inline CameraEffects plainEffects() {
+  CameraEffects e;
+  e.exposure_variation = 0.0;
+  e.noise_std = 0.0;
+  e.vignetting = 0.0;
+  return e;
+}
 
 /// A rig with a noise-free 200 Hz IMU only, and a sim section placeholder `SIM` to fill in.
 inline std::string noiseFreeImuRig() {

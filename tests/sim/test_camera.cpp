@@ -31,14 +31,6 @@ CameraRig testCamera() {
   return c;
 }
 
-CameraEffects plainEffects() {
-  CameraEffects e;
-  e.exposure_variation = 0.0;
-  e.noise_std = 0.0;
-  e.vignetting = 0.0;
-  return e;
-}
-
 // Checkerboard plane z = 4 (normal towards the camera), squares of 0.25 m, lit uniformly.
 constexpr double kPlaneZ = 4.0, kSquare = 0.25;
 const Vec3 kPlaneCenter(0.2, -0.1, kPlaneZ);
@@ -107,7 +99,7 @@ TEST(CameraRenderer, EquidistantRigPutsKnownPointsWhereTheModelProjectsThem) {
       scene.addShape("ball" + std::to_string(centres.size()), ball, Material{});
     }
   scene.build();
-  CameraRenderer renderer(rig, plainEffects());
+  CameraRenderer renderer(rig, test::plainEffects());
   test::ConstantMotion still(Pose3::Identity());  // T_W_C = identity: camera frame = world frame
   const CameraImage img = renderer.render(scene, still, 0.0, 1, Random(1, 4));
   const CameraProjection model(rig);
@@ -135,7 +127,7 @@ TEST(CameraRenderer, EquidistantRigPutsKnownPointsWhereTheModelProjectsThem) {
 TEST(CameraRenderer, CheckerboardLandsOnThePredictedPixels) {
   const CameraRig rig = testCamera();
   const Scene scene = checkerScene();
-  CameraRenderer renderer(rig, plainEffects());
+  CameraRenderer renderer(rig, test::plainEffects());
   test::ConstantMotion still(bodyPose());
   const CameraImage img = renderer.render(scene, still, 0.0, 42, Random(1, 4));
   ASSERT_EQ(img.width, 320);
@@ -171,7 +163,7 @@ TEST(CameraRenderer, ExposureChangesScaleTheImage) {
   CameraRig rig = testCamera();
   rig.color = true;
   const Scene scene = checkerScene();
-  CameraEffects e = plainEffects();
+  CameraEffects e = test::plainEffects();
   e.exposure_variation = 0.3;
   e.brightness = 0.8;
   CameraRenderer renderer(rig, e);
@@ -196,7 +188,7 @@ TEST(CameraRenderer, ExposureChangesScaleTheImage) {
 TEST(CameraRenderer, MotionBlurSmoothsAMovingView) {
   const CameraRig rig = testCamera();
   const Scene scene = checkerScene();
-  CameraEffects sharp = plainEffects(), blurred = plainEffects();
+  CameraEffects sharp = test::plainEffects(), blurred = test::plainEffects();
   sharp.exposure_time = blurred.exposure_time = 0.02;
   blurred.motion_blur_samples = 8;
   test::ConstantMotion pan(bodyPose(), Vec3(2.0, 0, 0), Vec3(0, 1.5, 0));

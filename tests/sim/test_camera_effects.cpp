@@ -24,14 +24,6 @@ CameraRig smallCamera() {
   return c;
 }
 
-CameraEffects plainEffects() {
-  CameraEffects e;
-  e.exposure_variation = 0.0;
-  e.noise_std = 0.0;
-  e.vignetting = 0.0;
-  return e;
-}
-
 /// A wall at distance 4 m in front of a camera looking along world +x (camera z = world x, camera
 /// y down); `split_y` > 0 makes its left half (world y > 0) white and its right half black,
 /// otherwise it is a checkerboard of `level` and level / 4.
@@ -88,9 +80,9 @@ test::ConstantMotion yawing(double yaw_rate) {
 TEST(RollingShutter, RowsAreTheGlobalShutterRowsAtTheRowTimes) {
   const CameraRig rig = smallCamera();
   const Scene scene = wallScene(0.8, false);
-  CameraEffects rolling = plainEffects();
+  CameraEffects rolling = test::plainEffects();
   rolling.rolling_shutter_s = 0.03;
-  const CameraRenderer rs(rig, rolling), gs(rig, plainEffects());
+  const CameraRenderer rs(rig, rolling), gs(rig, test::plainEffects());
   const test::ConstantMotion view = yawing(1.5);
   const double t_mid = 0.2;
   const CameraImage img = rs.render(scene, view, t_mid, 0, Random(1, 4));
@@ -112,7 +104,7 @@ TEST(RollingShutter, RowsAreTheGlobalShutterRowsAtTheRowTimes) {
 TEST(RollingShutter, AVerticalEdgeSeenWhileYawingIsShearedByTheAnalyticAmount) {
   const CameraRig rig = smallCamera();
   const Scene scene = wallScene(0.8, true);
-  CameraEffects rolling = plainEffects();
+  CameraEffects rolling = test::plainEffects();
   rolling.rolling_shutter_s = 0.05;
   const CameraRenderer rs(rig, rolling);
   const double yaw_rate = 1.0;  // rad/s, the edge moves right in the image while the camera turns left
@@ -136,7 +128,7 @@ TEST(RollingShutter, AVerticalEdgeSeenWhileYawingIsShearedByTheAnalyticAmount) {
 TEST(AutoExposure, ConvergesToTheTargetAfterABrightToDarkChangeWithinSevenFrames) {
   const CameraRig rig = smallCamera();
   const Scene bright = wallScene(0.8, false), dark = wallScene(0.08, false);
-  CameraEffects e = plainEffects();
+  CameraEffects e = test::plainEffects();
   e.exposure_time = 0.005;
   e.auto_exposure.enabled = true;
   e.auto_exposure.target_mean = 100.0;
@@ -210,7 +202,7 @@ TEST(Vignetting, CornersLoseTheConfiguredShareQuadraticallyWithRadius) {
   wall.half_size = Vec3(50.0, 50.0, 0.0);
   scene.addShape("wall", wall, Material{});
   scene.build();
-  CameraEffects e = plainEffects();
+  CameraEffects e = test::plainEffects();
   e.vignetting = 0.3;
   const CameraImage img = CameraRenderer(rig, e).render(scene, yawing(0.0), 0.0, 0, Random(1, 4));
   const double half_diag2 = 0.25 * (rig.width * rig.width + rig.height * rig.height);

@@ -41,14 +41,6 @@ CameraRig depthCamera() {
   return c;
 }
 
-CameraEffects plainEffects() {
-  CameraEffects e;
-  e.exposure_variation = 0.0;
-  e.noise_std = 0.0;
-  e.vignetting = 0.0;
-  return e;
-}
-
 /// Planes facing the camera (which looks along world z from the origin) at the given depths, each
 /// `half` wide, centred at `x`.
 struct Wall {
@@ -72,7 +64,7 @@ Scene wallScene(const std::vector<Wall>& walls) {
 
 /// The exact z-depth the renderer gives for a camera at the world origin looking along world z.
 std::vector<float> exactDepth(const Scene& scene, const CameraRig& rig, int motion_blur_samples = 1) {
-  CameraEffects e = plainEffects();
+  CameraEffects e = test::plainEffects();
   e.motion_blur_samples = motion_blur_samples;
   CameraRenderer renderer(rig, e);
   test::ConstantMotion still(Pose3::Identity());

@@ -208,26 +208,20 @@ TEST(ImuIntegration, AggressiveFlightReproducesGroundTruth) {
 )");
 }
 
-TEST(ImuIntegration, CarLoopReproducesGroundTruth) {
-  expectImuIntegratesToGroundTruth(R"(
+/// A car driving a 60 x 40 m loop at 8 m/s, as YAML under sim.trajectory.
+const char* const kCarLoop = R"(
     type: car
     waypoints: [0, 0, 1.8,  60, 0, 1.8,  60, 40, 1.8,  0, 40, 1.8]
     speed: 8
     control_spacing: 6
     start_still_s: 0.5
     ramp_s: 2.0
-)");
-}
+)";
+
+TEST(ImuIntegration, CarLoopReproducesGroundTruth) { expectImuIntegratesToGroundTruth(kCarLoop); }
 
 TEST(ImuIntegration, CarWithRearAxleBehindTheImuReproducesGroundTruth) {
-  expectImuIntegratesToGroundTruth(R"(
-    type: car
-    waypoints: [0, 0, 1.8,  60, 0, 1.8,  60, 40, 1.8,  0, 40, 1.8]
-    speed: 8
-    control_spacing: 6
-    start_still_s: 0.5
-    ramp_s: 2.0
-)",
+  expectImuIntegratesToGroundTruth(kCarLoop,
                                    "  wheel: {rate_hz: 50, track_width: 1.6, speed_noise_std: 0, T_I_B: {translation: "
                                    "[-1.2, 0.1, -1.5], rpy_deg: [1, -2, 3]}}\n");
 }
