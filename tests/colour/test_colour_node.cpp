@@ -30,6 +30,15 @@ void drain(lcm::LCM& lcm) {
   }
 }
 
+/// num_points and the per-point fields of a cloud whose x, y, z are set: no intensity, every point
+/// stamped mid-sweep, no ring.
+void fillPerPointFields(point_cloud_t* c) {
+  c->num_points = static_cast<int32_t>(c->x.size());
+  c->intensity.assign(c->x.size(), 0.f);
+  c->time_offset.assign(c->x.size(), 0.05f);
+  c->ring.assign(c->x.size(), -1);
+}
+
 registered_scan_t makeScan(int64_t utime) {
   registered_scan_t s{};
   s.utime = utime;
@@ -39,10 +48,7 @@ registered_scan_t makeScan(int64_t utime) {
   c.frame = "W";
   c.sweep_duration = 0.1f;
   WallAndBox::points(0.05, 0.1, &c.x, &c.y, &c.z);
-  c.num_points = static_cast<int32_t>(c.x.size());
-  c.intensity.assign(c.x.size(), 0.f);
-  c.time_offset.assign(c.x.size(), 0.05f);
-  c.ring.assign(c.x.size(), -1);
+  fillPerPointFields(&c);
   return s;
 }
 
@@ -124,6 +130,21 @@ void colourTheRoomAtKeyframe0(lcm::LCM& lcm, const CameraRig& camera) {
   drain(lcm);
 }
 
+/// Correction 1 at 1.3 s (the identity but for keyframe 0): keyframe 0 at 0.5 m along x with
+/// `orientation` (w, x, y, z).
+loop_correction_t keyframe0Moved(const std::vector<double>& orientation) {
+  loop_correction_t c{};
+  c.utime = 1300000;
+  c.correction_id = 1;
+  c.correction_orientation[0] = 1.0;
+  c.odometry_to_corrected_orientation[0] = 1.0;
+  c.num_keyframes = 1;
+  c.keyframe_id = {0};
+  c.position = {{0.5, 0.0, 0.0}};
+  c.orientation = {orientation};
+  return c;
+}
+
 }  // namespace
 
 TEST(ColourNode, ColoursScansPublishesAndWritesFiles) {
@@ -200,22 +221,13 @@ TEST(ColourNode, LoopCorrectionMovesAndRepublishesTheKeyframesPoints) {
   for (const auto& p : node.pipeline().map().points()) before.push_back(p.position);
   const size_t messages = received.size();
 
-  loop_correction_t bad{};
-  bad.utime = 1300000;
-  bad.correction_id = 1;
-  bad.correction_orientation[0] = 1.0;
-  bad.odometry_to_corrected_orientation[0] = 1.0;
-  bad.num_keyframes = 1;
-  bad.keyframe_id = {0};
-  bad.position = {{0.5, 0.0, 0.0}};
-  bad.orientation = {{NAN, 0.0, 0.0, 0.0}};
+  const loop_correction_t bad = keyframe0Moved({NAN, 0.0, 0.0, 0.0});
   lcm.publish("LOOP_CORRECTION", &bad);
   drain(lcm);
   EXPECT_EQ(received.size(), messages);
   EXPECT_EQ(node.pipeline().map().points()[0].position, before[0]);
 
-  loop_correction_t good = bad;
-  good.orientation = {{1.0, 0.0, 0.0, 0.0}};  // keyframe 0 was 0.5 m further along x
+  const loop_correction_t good = keyframe0Moved({1.0, 0.0, 0.0, 0.0});  // keyframe 0 was 0.5 m further along x
   lcm.publish("LOOP_CORRECTION", &good);
   drain(lcm);
   ASSERT_EQ(received.size(), messages + 1);
@@ -249,15 +261,7 @@ TEST(ColourNode, SplitsLargeUpdatesIntoBoundedMessages) {
   for (const colored_cloud_t& m : received) EXPECT_LE(m.num_points, kMaxPoints);
   received.clear();
 
-  loop_correction_t move{};
-  move.utime = 1300000;
-  move.correction_id = 1;
-  move.correction_orientation[0] = 1.0;
-  move.odometry_to_corrected_orientation[0] = 1.0;
-  move.num_keyframes = 1;
-  move.keyframe_id = {0};
-  move.position = {{0.5, 0.0, 0.0}};
-  move.orientation = {{1.0, 0.0, 0.0, 0.0}};
+  const loop_correction_t move = keyframe0Moved({1.0, 0.0, 0.0, 0.0});
   lcm.publish("LOOP_CORRECTION", &move);
   drain(lcm);
   const size_t moved = t.node.pipeline().map().colouredCount();  // a few merge into shared voxels
@@ -292,10 +296,7 @@ registered_scan_t markerScan(int64_t utime, const Eigen::Vector3f& at, const Vec
     c.y.push_back(at.y());
     c.z.push_back(at.z());
   }
-  c.num_points = static_cast<int32_t>(c.x.size());
-  c.intensity.assign(c.x.size(), 0.f);
-  c.time_offset.assign(c.x.size(), 0.05f);
-  c.ring.assign(c.x.size(), -1);
+  fillPerPointFields(&c);
   return s;
 }
 
@@ -326,20 +327,7 @@ TEST(ColourNode, LateScansJoinTheCorrectedMapAndANewEpochStartsANewMap) {
   std::vector<colored_cloud_t> received;
   collect(lcm, &received);
 
-  keyframe_t kf{};
-  kf.id = 0;
-  kf.utime = 1000000;
-  kf.orientation[0] = 1.0;
-  kf.cloud.frame = "I";
-  lcm.publish("KEYFRAME", &kf);
-  publishStillOdometry(lcm);
-  const image_t img = makeImage(*t.rig.camera, 1050000);
-  lcm.publish("CAMERA", &img);
-  for (int64_t utime : {1100000, 1200000}) {
-    const registered_scan_t scan = makeScan(utime);
-    lcm.publish("REGISTERED_SCAN", &scan);
-  }
-  drain(lcm);
+  colourTheRoomAtKeyframe0(lcm, *t.rig.camera);
   ASSERT_GT(node.pipeline().map().colouredCount(), 1000u);
 
   // correction 1: the odometry frame moves 0.5 m along x

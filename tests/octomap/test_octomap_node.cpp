@@ -13,6 +13,7 @@
 #include "livo/octomap/octomap_node.hpp"
 #include "livo/octomap_t.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "loop_correction_fixtures.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -117,14 +118,7 @@ loop_correction_t correction(int64_t utime, const std::vector<std::pair<int64_t,
   m.correction_id = next_id++;
   m.correction_orientation[0] = 1.0;
   m.odometry_to_corrected_orientation[0] = 1.0;
-  m.num_keyframes = static_cast<int32_t>(poses.size());
-  for (const auto& [id, T] : poses) {
-    m.keyframe_id.push_back(id);
-    std::vector<double> p(3), q(4);
-    poseTo(T, p.data(), q.data());
-    m.position.push_back(p);
-    m.orientation.push_back(q);
-  }
+  livo_test::setKeyframePoses(poses, &m);
   return m;
 }
 

@@ -11,6 +11,7 @@
 #include "livo/messages.hpp"
 #include "livo/node.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "loop_correction_fixtures.hpp"
 
 using namespace livo;
 
@@ -25,14 +26,7 @@ Pose3 pose(double x, double yaw) {
 loop_correction_t correction(const std::vector<std::pair<int64_t, Pose3>>& poses) {
   loop_correction_t m{};
   m.correction_orientation[0] = 1.0;
-  m.num_keyframes = static_cast<int32_t>(poses.size());
-  for (const auto& [id, T] : poses) {
-    m.keyframe_id.push_back(id);
-    std::vector<double> p(3), q(4);
-    poseTo(T, p.data(), q.data());
-    m.position.push_back(p);
-    m.orientation.push_back(q);
-  }
+  livo_test::setKeyframePoses(poses, &m);
   return m;
 }
 }  // namespace
