@@ -16,27 +16,19 @@
 #include "livo/report/picture_annotations.hpp"
 #include "livo/report/run_pictures.hpp"
 #include "livo/report/trajectory_figure.hpp"
+#include "report_fixtures.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
 using namespace livo::report;
 namespace fs = std::filesystem;
+using livo_test::addPlane;
 
 namespace {
 
 const std::array<uint8_t, 3> kRed{220, 30, 30}, kGreen{30, 200, 40}, kBlue{20, 40, 230};
 
 cv::Vec3b bgr(const std::array<uint8_t, 3>& rgb) { return {rgb[2], rgb[1], rgb[0]}; }
-
-/// Points on a grid `step` apart (at cell centres) over [x0, x1) x [y0, y1) at height z.
-void addPlane(ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
-              const std::array<uint8_t, 3>& rgb) {
-  for (double x = x0 + step / 2; x < x1; x += step)
-    for (double y = y0 + step / 2; y < y1; y += step) {
-      p->position.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-      p->rgb.push_back(rgb);
-    }
-}
 
 size_t countColour(const cv::Mat& image, const cv::Vec3b& c) {
   size_t n = 0;

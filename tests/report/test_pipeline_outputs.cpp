@@ -3,6 +3,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "evaluate/lcm_log_writer.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/messages.hpp"
 #include "livo/odometry_t.hpp"
@@ -14,18 +15,6 @@ using namespace livo;
 using namespace livo::report;
 
 namespace {
-
-template <class T>
-void write(lcm::LogFile& log, const std::string& ch, int64_t t, const T& m) {
-  std::vector<uint8_t> buf(m.getEncodedSize());
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  lcm::LogEvent ev;
-  ev.timestamp = t;
-  ev.channel = ch;
-  ev.datalen = static_cast<int32_t>(buf.size());
-  ev.data = buf.data();
-  log.writeEvent(&ev);
-}
 
 Pose3 poseAt(int i) {
   Vec6 xi;
@@ -48,14 +37,14 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
     o.utime = t;
     poseTo(poseAt(i), o.position, o.orientation);
     if (with_nan && i == 7) o.position[1] = std::nan("");
-    write(log, "ODOMETRY", t, o);
+    fixtures::writeMessage(log, "ODOMETRY", t, o);
     if (with_keyframes && i % 5 == 0) {
       keyframe_t k{};
       k.id = i / 5;
       k.utime = t;
       poseTo(poseAt(i), k.position, k.orientation);
       k.cloud.frame = "I";
-      write(log, "KEYFRAME", t, k);
+      fixtures::writeMessage(log, "KEYFRAME", t, k);
     }
   }
   if (with_loop) {
@@ -74,14 +63,14 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
     lc.correction_id = 1;
     poseTo(correction_kf2, lc.correction_position, lc.correction_orientation);
     poseTo(correction_kf2, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
-    write(log, "LOOP_CORRECTION", 2000000, lc);
+    fixtures::writeMessage(log, "LOOP_CORRECTION", 2000000, lc);
     for (int i = 20; i < 20 + adopted_tail; ++i) {
       const int64_t t = 1000000 + i * 100000;
       odometry_t o{};
       o.utime = t;
       o.correction_id = 1;  // lio adopted correction 1
       poseTo(correction_kf2 * poseAt(i), o.position, o.orientation);
-      write(log, "ODOMETRY", t, o);
+      fixtures::writeMessage(log, "ODOMETRY", t, o);
       if (with_keyframes && i == 20) {
         keyframe_t k{};
         k.id = 4;
@@ -89,7 +78,7 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
         k.correction_id = 1;
         poseTo(correction_kf2 * poseAt(i), k.position, k.orientation);
         k.cloud.frame = "I";
-        write(log, "KEYFRAME", t, k);
+        fixtures::writeMessage(log, "KEYFRAME", t, k);
       }
     }
   }
@@ -110,7 +99,7 @@ std::string makeOutputs(const Pose3& correction_kf1, const Pose3& correction_kf2
   lidar.rejected = 1;
   h.channels = {imu, lidar};
   h.num_channels = 2;
-  write(log, "HEALTH", 3000000, h);
+  fixtures::writeMessage(log, "HEALTH", 3000000, h);
   return path;
 }
 
@@ -201,13 +190,13 @@ TEST(PipelineOutputs, ExplicitCorrectionIdsAndResets) {
       o.epoch = epoch;
       o.correction_id = correction_id;
       poseTo(pose, o.position, o.orientation);
-      write(log, "ODOMETRY", o.utime, o);
+      fixtures::writeMessage(log, "ODOMETRY", o.utime, o);
     };
     keyframe_t k{};
     k.utime = 1000000;
     poseTo(poseAt(0), k.position, k.orientation);
     k.cloud.frame = "I";
-    write(log, "KEYFRAME", k.utime, k);
+    fixtures::writeMessage(log, "KEYFRAME", k.utime, k);
     for (int i = 0; i < 10; ++i) odometry(i, 0, 0, poseAt(i));
     loop_correction_t lc{};
     lc.utime = 1900000;
@@ -221,14 +210,14 @@ TEST(PipelineOutputs, ExplicitCorrectionIdsAndResets) {
     lc.orientation = {{q[0], q[1], q[2], q[3]}};
     poseTo(c, lc.correction_position, lc.correction_orientation);
     poseTo(c, lc.odometry_to_corrected_position, lc.odometry_to_corrected_orientation);
-    write(log, "LOOP_CORRECTION", lc.utime, lc);
+    fixtures::writeMessage(log, "LOOP_CORRECTION", lc.utime, lc);
     odometry(10, 0, 0, poseAt(10));      // published before lio adopted correction 1
     odometry(11, 0, 1, c * poseAt(11));  // after
     health_t h{};
     h.node = "lio";
     h.level = health_t::LEVEL_WARN;
     h.message = "odometry reset to epoch 1: IMU time jumped back by 5.000000 s: re-initialising";
-    write(log, "HEALTH", 2150000, h);
+    fixtures::writeMessage(log, "HEALTH", 2150000, h);
     odometry(12, 1, 0, poseAt(1));
   }
   const PipelineOutputs out = readPipelineOutputs(path);

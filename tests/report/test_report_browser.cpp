@@ -17,11 +17,13 @@
 #include "livo/report/html_report.hpp"
 #include "livo/report/run_pictures.hpp"
 #include "livo/report/run_report.hpp"
+#include "report_fixtures.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
 using namespace livo::report;
 namespace fs = std::filesystem;
+using livo_test::addPlane;
 
 namespace {
 
@@ -49,16 +51,6 @@ int run(const std::string& command) {
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-/// Points on a grid (cell centres) over [x0, x1) x [y0, y1) at height z, or a wall when z1 > z.
-void addPlane(ColouredPoints* p, double x0, double x1, double y0, double y1, double z, double step,
-              const std::array<uint8_t, 3>& rgb) {
-  for (double x = x0 + step / 2; x < x1; x += step)
-    for (double y = y0 + step / 2; y < y1; y += step) {
-      p->position.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-      p->rgb.push_back(rgb);
-    }
 }
 
 /// A run folder as run_pipeline.sh leaves it: a 6 x 4 m room (red floor, green walls), the path

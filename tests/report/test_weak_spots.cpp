@@ -5,6 +5,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "evaluate/lcm_log_writer.hpp"
 #include "livo/filter_state_t.hpp"
 #include "livo/keyframe_t.hpp"
 #include "livo/messages.hpp"
@@ -253,20 +254,6 @@ TEST(WeakSpots, AFeatureVioCountsItsImagesFromHealth) {
                        "visual state was initialised, 1 × image not later than the previous one."));
 }
 
-namespace {
-template <class T>
-void write(lcm::LogFile& log, const std::string& ch, int64_t t, const T& m) {
-  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  lcm::LogEvent ev;
-  ev.timestamp = t;
-  ev.channel = ch;
-  ev.datalen = static_cast<int32_t>(buf.size());
-  ev.data = buf.data();
-  log.writeEvent(&ev);
-}
-}  // namespace
-
 TEST(WeakSpots, ReadFromARecordedOutputsLog) {
   const std::string path = livo_test::tempPath("weak_outputs.lcmlog");
   {
@@ -280,14 +267,14 @@ TEST(WeakSpots, ReadFromARecordedOutputsLog) {
       o.degenerate = i >= 10 && i < 20;
       o.num_residuals = i == 25 ? 0 : 300;
       matrixTo<6>(Mat6(Vec6(1e-4, 1e-4, 1e-4, 1e-4, o.degenerate ? 0.09 : 1e-4, 1e-4).asDiagonal()), o.pose_covariance);
-      write(log, "ODOMETRY", t, o);
+      fixtures::writeMessage(log, "ODOMETRY", t, o);
       if (i % 5 == 0) {
         filter_state_t s{};
         s.utime = t;
         s.source = "vio";
         s.valid = i != 15;
-        write(log, "STATE_PRIOR", t, s);
-        write(log, "STATE_POSTERIOR", t, s);
+        fixtures::writeMessage(log, "STATE_PRIOR", t, s);
+        fixtures::writeMessage(log, "STATE_POSTERIOR", t, s);
       }
     }
     for (int id : {0, 1}) {
@@ -296,7 +283,7 @@ TEST(WeakSpots, ReadFromARecordedOutputsLog) {
       k.utime = id == 0 ? 5000000 : 7900000;
       poseTo(Pose3::Identity(), k.position, k.orientation);
       k.cloud.frame = "I";
-      write(log, "KEYFRAME", k.utime, k);
+      fixtures::writeMessage(log, "KEYFRAME", k.utime, k);
     }
     loop_correction_t lc{};
     lc.utime = 7900000;
@@ -311,7 +298,7 @@ TEST(WeakSpots, ReadFromARecordedOutputsLog) {
     lc.keyframe_id = {0, 1};
     lc.position = {{0.0, 0.0, 0.0}, {0.3, 0.0, 0.0}};
     lc.orientation = {{1.0, 0.0, 0.0, 0.0}, {1.0, 0.0, 0.0, 0.0}};
-    write(log, "LOOP_CORRECTION", 7900000, lc);
+    fixtures::writeMessage(log, "LOOP_CORRECTION", 7900000, lc);
   }
   const PipelineOutputs out = readPipelineOutputs(path);
   ASSERT_EQ(out.odometry_quality.size(), 30u);
