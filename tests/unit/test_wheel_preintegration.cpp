@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <sstream>
+#include <string>
 #include <type_traits>
 
 #include <Eigen/Eigenvalues>
@@ -368,6 +370,34 @@ TEST(WheelPreintegration, ZeroAndNegativeIntervals) {
 }
 
 #ifdef LIVO_HAVE_CERES_JET
+namespace {
+/// The 6 residuals of `residual` (callable on double and on Jet parameters) at `x` as Jets, in
+/// `rj`, their derivatives checked against central differences: each finite (fatal otherwise) and
+/// within 1e-7; `what` names the case in a failure. The step h = 1e-6: truncation ~ h² |f'''| / 6
+/// < 1e-10, rounding ~ 1e-16 * 10 / h = 1e-9, both below 1e-8 at |terms| ~ 10.
+template <int kParams, class Residual>
+void expectJetMatchesCentralDifferences(const Residual& residual, const Eigen::Matrix<double, kParams, 1>& x,
+                                        const std::string& what,
+                                        Eigen::Matrix<ceres::Jet<double, kParams>, 6, 1>* rj_out) {
+  using J = ceres::Jet<double, kParams>;
+  std::array<J, kParams> xj;
+  for (int i = 0; i < kParams; ++i) xj[i] = J(x[i], i);
+  Eigen::Matrix<J, 6, 1>& rj = *rj_out;
+  rj = residual(xj.data());
+  const double h = 1e-6;
+  for (int i = 0; i < kParams; ++i) {
+    Eigen::Matrix<double, kParams, 1> xp = x, xm = x;
+    xp[i] += h;
+    xm[i] -= h;
+    const Vec6 numeric = (residual(xp.data()) - residual(xm.data())) / (2 * h);
+    for (int k = 0; k < 6; ++k) {
+      ASSERT_TRUE(std::isfinite(rj[k].v[i]));
+      EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7) << what << " residual " << k << " parameter " << i;
+    }
+  }
+}
+}  // namespace
+
 // The derivatives Ceres' AutoDiff would take against central differences of the double residual,
 // at a perturbed state and at the truth of a straight line (zero rotation residual).
 TEST(WheelPreintegrationJet, DerivativesMatchCentralDifferences) {
@@ -386,20 +416,10 @@ TEST(WheelPreintegrationJet, DerivativesMatchCentralDifferences) {
       pre.residual(p, p + 4, p + 7, p + 11, r.data());
       return r;
     };
-    std::array<J, kParams> xj;
-    for (int i = 0; i < kParams; ++i) xj[i] = J(x[i], i);
-    const Eigen::Matrix<J, 6, 1> rj = residual(xj.data());
-    const double h = 1e-6;  // truncation ~ h² |f'''| / 6 < 1e-10, rounding ~ 1e-16 * 10 / h = 1e-9
-    for (int i = 0; i < kParams; ++i) {
-      Eigen::Matrix<double, kParams, 1> xp = x, xm = x;
-      xp[i] += h;
-      xm[i] -= h;
-      const Vec6 numeric = (residual(xp.data()) - residual(xm.data())) / (2 * h);
-      for (int k = 0; k < 6; ++k) {
-        ASSERT_TRUE(std::isfinite(rj[k].v[i]));
-        EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7) << "w " << w << " residual " << k << " parameter " << i;
-      }
-    }
+    std::ostringstream what;
+    what << "w " << w;
+    Eigen::Matrix<J, 6, 1> rj;
+    ASSERT_NO_FATAL_FAILURE(expectJetMatchesCentralDifferences<kParams>(residual, x, what.str(), &rj));
   }
 }
 
@@ -422,21 +442,10 @@ TEST(WheelPreintegrationJet, MountingDerivativesMatchCentralDifferences) {
       pre.residual(p, p + 4, p + 7, p + 11, p + 14, p + 16, r.data());
       return r;
     };
-    std::array<J, kParams> xj;
-    for (int i = 0; i < kParams; ++i) xj[i] = J(x[i], i);
-    const Eigen::Matrix<J, 6, 1> rj = residual(xj.data());
-    const double h = 1e-6;  // as above: truncation and rounding both below 1e-8 at |terms| ~ 10
-    for (int i = 0; i < kParams; ++i) {
-      Eigen::Matrix<double, kParams, 1> xp = x, xm = x;
-      xp[i] += h;
-      xm[i] -= h;
-      const Vec6 numeric = (residual(xp.data()) - residual(xm.data())) / (2 * h);
-      for (int k = 0; k < 6; ++k) {
-        ASSERT_TRUE(std::isfinite(rj[k].v[i]));
-        EXPECT_NEAR(rj[k].v[i], numeric[k], 1e-7)
-            << "delta " << delta.transpose() << " residual " << k << " parameter " << i;
-      }
-    }
+    std::ostringstream what;
+    what << "delta " << delta.transpose();
+    Eigen::Matrix<J, 6, 1> rj;
+    ASSERT_NO_FATAL_FAILURE(expectJetMatchesCentralDifferences<kParams>(residual, x, what.str(), &rj));
     // the mounting moves the translation residual by about the distance driven (5 m) per radian
     double mounting_gain = 0.0;
     for (int i = 16; i < kParams; ++i)
