@@ -5,6 +5,7 @@ livo-lio's ATE?
     scripts/lio_graph_gap_table.py --out DIR [--configs room,campus_loop,bridge_deck] [--seeds 2,3,4,5,6]
                                    [--duration S] [--duration-of NAME=S,...] [--logs DIR] [--keep-logs]
                                    [--resume] [--variants graph-loop,lio-loop,graph,lio] [--ratio 1.5]
+                                   [--sim-overlay config/sim/controls/FILE.yaml]
 
 For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log (without images: neither
 subsystem reads them), then scripts/run_pipeline.sh runs (sim_variants.py):
@@ -69,10 +70,10 @@ def main():
     rows, failures = sv.sweep('lio_graph_gap_table.py', a.configs.split(','), a.seeds.split(','), a.duration,
                               variants, a.out, ('livo-lio', 'livo-lio-graph', 'livo-loop'), a.logs, a.keep_logs,
                               sv.parse_durations('lio_graph_gap_table.py', a.duration_of), a.resume,
-                              images=False)  # neither subsystem reads the camera
+                              images=False, sim_overlay=a.sim_overlay)  # neither subsystem reads the camera
     check_bars(rows, chosen, a.ratio, failures)
     shown = [v.name for v in variants]
-    lines = ['Per run:', '']
+    lines = sv.sim_overlay_line(a) + ['Per run:', '']
     lines += sv.markdown(rows, shown)
     lines += ['', 'Per config, mean ± standard deviation over the seeds (vertical errors as magnitudes):', '']
     lines += sv.summary(rows, shown)

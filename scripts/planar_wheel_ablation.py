@@ -4,6 +4,7 @@
     scripts/planar_wheel_ablation.py --out DIR [--configs bridge_deck_graded,tree_campus_graded,long_slope]
                                      [--seeds 2,3,4,5,6] [--duration S] [--duration-of NAME=S,...]
                                      [--keep-logs] [--logs DIR] [--resume] [--variants graph,...]
+                                     [--sim-overlay config/sim/controls/FILE.yaml]
 
 For every config (config/sim/NAME.yaml) and seed, livo-sim writes the log (without the camera's
 images: no variant reads them), then scripts/run_pipeline.sh
@@ -98,14 +99,14 @@ def main():
     rows, failures = sv.sweep('planar_wheel_ablation.py', a.configs.split(','), a.seeds.split(','), a.duration,
                               variants, a.out, ('livo-lio', 'livo-lio-graph'), a.logs, a.keep_logs,
                               sv.parse_durations('planar_wheel_ablation.py', a.duration_of), a.resume,
-                              images=False)  # no variant reads the camera
+                              images=False, sim_overlay=a.sim_overlay)  # no variant reads the camera
     check_bars(rows, chosen, failures)
 
     def best(row, v):
         return v in GRAPH and all(row[v]['ate'] <= row[w]['ate'] for w in GRAPH if w in row)
 
     shown = [v.name for v in variants]
-    lines = ['Per run:', '']
+    lines = sv.sim_overlay_line(a) + ['Per run:', '']
     lines += sv.markdown(rows, shown, best)
     lines += ['', 'Per config, mean ± standard deviation over the seeds (vertical errors as magnitudes):', '']
     lines += sv.summary(rows, shown)

@@ -157,6 +157,8 @@ METRICS = (
     ('roll', 'roll RMSE deg', lambda e: e.get('attitude', {}).get('roll_rmse_deg')),
     ('pitch', 'pitch RMSE deg', lambda e: e.get('attitude', {}).get('pitch_rmse_deg')),
     ('end', 'end-point drift m', lambda e: e['end_point']['translation_m']),
+    # the heading a run ends with, against the truth's: on a ground vehicle mostly the yaw drift
+    ('end_rotation', 'end-point rotation deg', lambda e: e['end_point'].get('rotation_deg')),
     # None unless the variant asked for it (Variant.ground_map)
     ('ground_thickness', 'ground-map thickness m', lambda e: (e.get('ground_map') or {}).get('thickness_rms_m')),
 )
@@ -170,8 +172,23 @@ def metrics_of(e):
     return {name: get(e) for name, _, get in METRICS} | {'coverage': e['ate']['coverage']}
 
 
+def sim_overlay_of(script, path):
+    """--sim-overlay's file and bytes ((None, b'') without one); exits unless the file exists and holds
+    only a sim: section. The overlay changes what the simulator renders, never the rig the estimators
+    read (rig:) nor their options: that is what makes it a control."""
+    if not path:
+        return None, b''
+    if not os.path.exists(path):
+        raise SystemExit('%s: --sim-overlay: no file %s' % (script, path))
+    sections = [line.split(':', 1)[0] for line in open(path) if line[:1].isalpha()]
+    if sections != ['sim']:
+        raise SystemExit('%s: --sim-overlay %s: wants one top-level section, sim: (has %s)' % (
+            script, path, ', '.join(sections) or 'none'))
+    return os.path.abspath(path), open(path, 'rb').read()
+
+
 def sweep(script, configs, seeds, duration, variants, out, executables, logs=None, keep_logs=False,
-          durations=None, resume=False, images=True):
+          durations=None, resume=False, images=True, sim_overlay=None):
     """Runs every variant on every config x seed. Returns (rows, failures): a row is {'config', 'seed',
     'duration', 'length', variant name: metrics_of(its evaluation)}; a variant that did not run or
     wrote no trajectory is a failure and has no entry, one with odometry over less than 90 % of the
@@ -179,7 +196,9 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
     a config to its own duration; a config without one runs for `duration`, or when that is None for
     its own sim.duration_s. images=False simulates without the camera's images (livo-sim --no-images:
     a fraction of the time) when no variant reads them. `executables` (build/bin names) are what the variants run besides
-    the pipeline's tools; exits naming a missing one.
+    the pipeline's tools; exits naming a missing one. sim_overlay: a file merged over every config by
+    livo-sim only (livo-sim --overlay; a sim: section, sim_overlay_of), e.g. a control with some of the
+    simulator's sensor errors off; its bytes are in the log's key and its name in the log's.
 
     Logs go to logs/NAME_sSEED_DURs[_noimages].lcmlog when `logs` is given (kept), else beside the runs (removed
     unless keep_logs); a log is reused only when its key (the config's bytes, seed, duration and
@@ -193,6 +212,8 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
     sim, sim_hash, run_hash = keyed_executables(script, build, tools,
                                                 [os.path.join(ROOT, 'scripts', 'run_pipeline.sh')])
     env = dict(os.environ, LIVO_BUILD_DIR=build)
+    overlay_path, overlay_bytes = sim_overlay_of(script, sim_overlay)
+    overlay_tag = '_' + os.path.basename(overlay_path).rsplit('.', 1)[0] if overlay_path else ''
     os.makedirs(out, exist_ok=True)
     rows, failures = [], []
     for name in configs:
@@ -209,9 +230,10 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
             os.makedirs(base, exist_ok=True)
             if logs:
                 os.makedirs(logs, exist_ok=True)
-            suffix = '' if images else '_noimages'
+            suffix = ('' if images else '_noimages') + overlay_tag
             log = os.path.join(logs, '%s_%gs%s.lcmlog' % (tag, dur, suffix)) if logs else base + '.lcmlog'
-            log_key = key_of(config_bytes, seed, dur, sim_hash, *([] if images else ['no-images']))
+            log_key = key_of(config_bytes, seed, dur, sim_hash, *([] if images else ['no-images']),
+                             *([overlay_bytes] if overlay_path else []))
             run_keys = {v.name: key_of(config_bytes, v.processes, sorted(v.swaps.items()), v.overlay, v.record,
                                        seed, dur, log_key, run_hash, *(['ground-map'] if v.ground_map else []))
                         for v in variants}
@@ -222,7 +244,8 @@ def sweep(script, configs, seeds, duration, variants, out, executables, logs=Non
                 print('%s: simulating %g s' % (tag, dur), file=sys.stderr, flush=True)
                 part = '%s.%d.part' % (log, os.getpid())  # a concurrent run simulating the same log keeps its own
                 if not run([sim, '--config', config, '--out', part, '--seed', seed, '--duration', str(dur),
-                            '--quiet'] + ([] if images else ['--no-images']), base + '.sim.txt'):
+                            '--quiet'] + ([] if images else ['--no-images']) +
+                           (['--overlay', overlay_path] if overlay_path else []), base + '.sim.txt'):
                     failures.append('%s: livo-sim failed (%s.sim.txt)' % (tag, base))
                     continue
                 os.replace(part, log)
@@ -270,6 +293,16 @@ def add_arguments(ap, configs, variants, images=True):
     ap.add_argument('--logs', help='a directory for the logs (NAME_sSEED_DURs%s.lcmlog): kept, reused when their '
                                    'key matches' % ('' if images else '_noimages'))
     ap.add_argument('--variants', default=variants)
+    ap.add_argument('--sim-overlay', default='',
+                    help='a YAML file with a sim: section merged over every config by the simulator only (e.g. '
+                         'config/sim/controls/exact_imu.yaml: a control with sensor errors off); the estimators '
+                         'read the configs as they are')
+
+
+def sim_overlay_line(a):
+    """A table's line naming --sim-overlay (empty list without one)."""
+    return ['Simulated with `%s` merged over each config (livo-sim --overlay; the estimators read the '
+            'configs unchanged).' % a.sim_overlay, ''] if a.sim_overlay else []
 
 
 def chosen_variants(script, a, variants):

@@ -4,6 +4,7 @@
     scripts/visual_coupling_table.py --out DIR [--configs NAME,...] [--seeds 2,3,4,5,6] [--duration S]
                                      [--duration-of NAME=S,...] [--logs DIR] [--keep-logs]
                                      [--variants graph,vio,coupled,coupled-factor] [--resume]
+                                     [--sim-overlay config/sim/controls/FILE.yaml]
 
 For every config (config/sim/NAME.yaml; by default every one with a camera but the long soak scenes) and
 seed, livo-sim writes the log, then scripts/run_pipeline.sh runs (sim_variants.py):
@@ -77,14 +78,15 @@ def main():
     configs = a.configs.split(',')
     variants = [v for v in VARIANTS if v.name in chosen]
     rows, failures = sv.sweep('visual_coupling_table.py', configs, a.seeds.split(','), a.duration, variants, a.out,
-                              ('livo-lio-graph', 'livo-vio-feature'), a.logs, a.keep_logs, durations, a.resume)
+                              ('livo-lio-graph', 'livo-vio-feature'), a.logs, a.keep_logs, durations, a.resume,
+                              sim_overlay=a.sim_overlay)
     check_bars(rows, chosen, failures)
 
     def lowest(row, v):
         return all(row[v]['ate'] <= row[w.name]['ate'] for w in variants if w.name in row)
 
     shown = [v.name for v in variants]
-    lines = ['Per run:', '']
+    lines = sv.sim_overlay_line(a) + ['Per run:', '']
     lines += sv.markdown(rows, shown, lowest)
     lines += ['', 'Per config, mean ± standard deviation over the seeds (vertical errors as magnitudes):', '']
     lines += sv.summary(rows, shown)

@@ -5,6 +5,7 @@
 
 #include "livo/command_line.hpp"
 #include "livo/config/merged_config.hpp"
+#include "livo/config_overlays.hpp"
 #include "livo/file_output.hpp"
 
 int main(int argc, char** argv) {
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
   }
   try {
     const std::string text = livo::config::mergedConfig(
-        cli.get("BASE"), livo::config::overlayList(cli.has("--overlay") ? cli.get("--overlay") : std::string()));
+        cli.get("BASE"), livo::overlayFiles(cli.has("--overlay") ? cli.get("--overlay") : std::string()));
     if (!cli.has("--out")) {
       std::cout << text;
       return 0;

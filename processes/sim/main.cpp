@@ -1,9 +1,11 @@
-// livo-sim --config config/sim/NAME.yaml --out LOG [--duration S] [--seed N] [--threads N] [--no-images]
+// livo-sim --config config/sim/NAME.yaml --out LOG [--overlay FILE,...] [--duration S] [--seed N] [--threads N]
+//          [--no-images]
 #include <cmath>
 #include <iomanip>
 #include <iostream>
 
 #include "livo/command_line.hpp"
+#include "livo/config_overlays.hpp"
 #include "livo/file_output.hpp"
 #include "livo/sim/log_writer.hpp"
 #include "livo/sim/simulation_setup.hpp"
@@ -14,6 +16,9 @@ int main(int argc, char** argv) {
       "livo-sim", "Simulates IMU, LiDAR, camera, wheel encoder and ground truth in a scene and writes an LCM log.");
   cli.option("--config", "FILE", "sim config (rig: and sim: sections), e.g. config/sim/room.yaml")
       .option("--out", "LOG", "LCM log file to write")
+      .option("--overlay", "FILE[,FILE]",
+              "YAML merged over the config in order (maps key by key, other values replaced), e.g. "
+              "config/sim/controls/exact_imu.yaml: the same scene and seed with some sensor errors off")
       .option("--duration", "S", "seconds to simulate (default: sim.duration_s)")
       .option("--seed", "N", "random seed (default: sim.seed)")
       .option("--threads", "N", "worker threads (default: sim.threads; the log does not depend on it)")
@@ -43,6 +48,7 @@ int main(int argc, char** argv) {
       overrides.threads = static_cast<int>(t);
     }
     overrides.no_images = cli.has("--no-images");
+    if (cli.has("--overlay")) overrides.overlays = livo::overlayFiles(cli.get("--overlay"));
     const bool quiet = cli.has("--quiet");
     livo::sim::SimulationSetup setup = livo::sim::loadSimulation(cli.get("--config"), overrides);
     if (!quiet) livo::sim::printSimulation(setup, std::cerr);

@@ -6,6 +6,7 @@
 
 #include "livo/config.hpp"
 #include "livo/config/merged_config.hpp"
+#include "livo/config_overlays.hpp"
 #include "temp_path.hpp"
 
 using namespace livo;
@@ -43,6 +44,6 @@ TEST(ConfigMerge, RefusesAnUnknownSectionAndAMissingFile) {
 }
 
 TEST(ConfigMerge, SplitsTheOverlayList) {
-  EXPECT_EQ(overlayList("a.yaml,,b.yaml"), (std::vector<std::string>{"a.yaml", "b.yaml"}));
-  EXPECT_TRUE(overlayList("").empty());
+  EXPECT_EQ(overlayFiles("a.yaml,,b.yaml"), (std::vector<std::string>{"a.yaml", "b.yaml"}));
+  EXPECT_TRUE(overlayFiles("").empty());
 }

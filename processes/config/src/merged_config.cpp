@@ -1,7 +1,5 @@
 #include "livo/config/merged_config.hpp"
 
-#include <sstream>
-
 #include "livo/config.hpp"
 
 namespace livo::config {
@@ -12,14 +10,6 @@ std::string mergedConfig(const std::string& base, const std::vector<std::string>
   std::string header = "# livo-config merge: " + base;
   for (const std::string& o : overlays) header += " + " + o;
   return header + "\n" + Config::mergedText(base, overlays);
-}
-
-std::vector<std::string> overlayList(const std::string& comma_separated) {
-  std::vector<std::string> files;
-  std::stringstream list(comma_separated);
-  for (std::string f; std::getline(list, f, ',');)
-    if (!f.empty()) files.push_back(f);
-  return files;
 }
 
 }  // namespace livo::config

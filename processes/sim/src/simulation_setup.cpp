@@ -338,8 +338,9 @@ void printLidarEffects(const LidarEffects& e, std::ostream& os) {
 }  // namespace
 
 SimulationSetup loadSimulation(const std::string& file, const SimOverrides& overrides) {
-  SimulationSetup s = loadSimulation(Config::load(file), dirOf(file), overrides);
+  SimulationSetup s = loadSimulation(Config::load(file, overrides.overlays), dirOf(file), overrides);
   s.config_file = file;
+  for (const std::string& overlay : overrides.overlays) s.config_file += " + " + overlay;
   return s;
 }
 

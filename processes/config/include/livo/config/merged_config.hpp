@@ -12,7 +12,4 @@ namespace livo::config {
 /// error or a top-level section no process reads.
 std::string mergedConfig(const std::string& base, const std::vector<std::string>& overlays);
 
-/// "A.yaml,B.yaml" as a list (empty entries skipped).
-std::vector<std::string> overlayList(const std::string& comma_separated);
-
 }  // namespace livo::config

@@ -56,10 +56,13 @@ struct SimOverrides {
   std::optional<uint64_t> seed;
   std::optional<int> threads;
   bool no_images = false;  // leave the camera's and depth images out
+  // Files merged over the config file in order (livo::Config::load's overlays), e.g. a control
+  // run with some of the simulator's sensor errors switched off (config/sim/controls/).
+  std::vector<std::string> overlays;
 };
 
 struct SimulationSetup {
-  std::string config_file;
+  std::string config_file;  // "FILE + OVERLAY + ..."
   SensorRig rig;
   SimOptions options;
   std::unique_ptr<Scene> scene;
@@ -83,7 +86,8 @@ struct SimulationSetup {
   int64_t endUtime() const { return start_utime + static_cast<int64_t>(std::llround(options.duration_s * 1e6)); }
 };
 
-/// Reads `file`; relative paths inside it are taken from the file's folder. Throws ConfigError
+/// Reads `file` with overrides.overlays merged over it; relative paths inside it are taken from the
+/// file's folder. Throws ConfigError
 /// (or std::runtime_error for unreadable data files) naming the file and key.
 SimulationSetup loadSimulation(const std::string& file, const SimOverrides& overrides = {});
 /// Same from a parsed config; `base_dir` resolves relative paths.
