@@ -4,6 +4,7 @@
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <variant>
 
 #include "livo/sim/random.hpp"
 
@@ -120,6 +121,27 @@ Material readMaterial(const Config& c, const std::map<std::string, int>& texture
   return m;
 }
 
+/// A box (`size`), cylinder (`radius`, `height`) or sphere (`radius`) named by `form` into *shape;
+/// false for another form.
+bool readSolid(const Config& c, const std::string& form, Shape* shape) {
+  if (form == "box") {
+    shape->type = ShapeType::kBox;
+    const Vec3 size = c.get<Vec3>("size");
+    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
+    shape->half_size = 0.5 * size;
+  } else if (form == "cylinder") {
+    shape->type = ShapeType::kCylinder;
+    const double radius = positive(c, "radius"), height = positive(c, "height");
+    shape->half_size = Vec3(radius, radius, 0.5 * height);
+  } else if (form == "sphere") {
+    shape->type = ShapeType::kSphere;
+    shape->half_size = Vec3::Constant(positive(c, "radius"));
+  } else {
+    return false;
+  }
+  return true;
+}
+
 /// A box, cylinder or sphere crown of leaves (`shape`, its size keys, `leaf_density` in 1/m).
 Shape readVegetation(const Config& c, Material* m) {
   if (m->kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": vegetation has no material key");
@@ -128,96 +150,69 @@ Shape readVegetation(const Config& c, Material* m) {
   std::string form = "cylinder";
   c.readOptional("shape", form);
   Shape shape;
-  if (form == "box") {
-    shape.type = ShapeType::kBox;
-    const Vec3 size = c.get<Vec3>("size");
-    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
-    shape.half_size = 0.5 * size;
-  } else if (form == "cylinder") {
-    shape.type = ShapeType::kCylinder;
-    const double radius = positive(c, "radius"), height = positive(c, "height");
-    shape.half_size = Vec3(radius, radius, 0.5 * height);
-  } else if (form == "sphere") {
-    shape.type = ShapeType::kSphere;
-    shape.half_size = Vec3::Constant(positive(c, "radius"));
-  } else {
+  if (!readSolid(c, form, &shape))
     throw ConfigError(c.where("shape") + ": unknown vegetation shape '" + form + "' (known: box, cylinder, sphere)");
+  return shape;
+}
+
+/// A plane turned by `rotation` (from rpy_deg) or by its `normal` (not both), infinite unless `size`
+/// [size_x, size_y] bounds it.
+Shape readPlane(const Config& c, bool has_rpy, const Mat3& rotation) {
+  Shape shape;
+  shape.type = ShapeType::kPlane;
+  shape.rotation = rotation;
+  if (c.has("normal")) {
+    if (has_rpy) throw ConfigError(c.where("normal") + ": give normal or rpy_deg, not both");
+    shape.rotation = rotationFromNormal(c.get<Vec3>("normal"));
+  }
+  shape.half_size = Vec3(kInfinity, kInfinity, 0.0);
+  std::vector<double> size;
+  if (c.readOptional("size", size)) {
+    if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+      throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0 (omit for an infinite plane)");
+    shape.half_size = Vec3(0.5 * size[0], 0.5 * size[1], 0.0);
   }
   return shape;
 }
 
-void readObject(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
-  const std::string type = c.get<std::string>("type");
-  Material m = readMaterial(c, textures);
-  const Vec3 center = c.get<Vec3>("center");
-  const Placement placement = readRepeat(c);
-
-  Shape shape;
+/// A height field (`size`, `resolution`, `relief` waves, `seed`): opaque and axis-aligned.
+HeightFieldOptions readHeightField(const Config& c, const Material& m, bool has_rpy) {
+  if (m.kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": a height field is opaque");
+  if (has_rpy) throw ConfigError(c.where("rpy_deg") + ": a height field is axis-aligned");
   HeightFieldOptions hf;
-  bool is_height_field = false;
-  Vec3 rpy = Vec3::Zero();
-  const bool has_rpy = c.readOptional("rpy_deg", rpy);
-  shape.rotation = rotationFromRpyDeg(rpy);
-  if (type == "vegetation") {
-    shape = readVegetation(c, &m);
-    shape.rotation = rotationFromRpyDeg(rpy);
-  } else if (type == "plane") {
-    shape.type = ShapeType::kPlane;
-    if (c.has("normal")) {
-      if (has_rpy) throw ConfigError(c.where("normal") + ": give normal or rpy_deg, not both");
-      shape.rotation = rotationFromNormal(c.get<Vec3>("normal"));
-    }
-    shape.half_size = Vec3(kInfinity, kInfinity, 0.0);
-    std::vector<double> size;
-    if (c.readOptional("size", size)) {
-      if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
-        throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0 (omit for an infinite plane)");
-      shape.half_size = Vec3(0.5 * size[0], 0.5 * size[1], 0.0);
-    }
-  } else if (type == "box") {
-    shape.type = ShapeType::kBox;
-    const Vec3 size = c.get<Vec3>("size");
-    if ((size.array() <= 0.0).any()) throw ConfigError(c.where("size") + ": must be > 0");
-    shape.half_size = 0.5 * size;
-  } else if (type == "cylinder") {
-    shape.type = ShapeType::kCylinder;
-    const double radius = positive(c, "radius"), height = positive(c, "height");
-    shape.half_size = Vec3(radius, radius, 0.5 * height);
-  } else if (type == "sphere") {
-    shape.type = ShapeType::kSphere;
-    shape.half_size = Vec3::Constant(positive(c, "radius"));
-  } else if (type == "heightfield") {
-    if (m.kind != MaterialKind::kOpaque) throw ConfigError(c.where("material") + ": a height field is opaque");
-    if (has_rpy) throw ConfigError(c.where("rpy_deg") + ": a height field is axis-aligned");
-    is_height_field = true;
-    const std::vector<double> size = c.get<std::vector<double>>("size");
-    if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
-      throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0");
-    hf.size_x = size[0];
-    hf.size_y = size[1];
-    hf.resolution = positive(c, "resolution");
-    if (hf.size_x / hf.resolution * hf.size_y / hf.resolution > 2e7)
-      throw ConfigError(c.where("resolution") + ": too fine for this size (more than 2e7 cells)");
-    const Config relief = c.section("relief");
-    const auto amplitude = relief.get<std::vector<double>>("amplitude");
-    const auto wavelength = relief.get<std::vector<double>>("wavelength");
-    if (amplitude.size() != wavelength.size())
-      throw ConfigError(relief.where("wavelength") + ": needs as many entries as amplitude");
-    hf.relief.clear();
-    for (size_t i = 0; i < amplitude.size(); ++i) {
-      if (!(wavelength[i] > 0.0)) throw ConfigError(relief.where("wavelength") + ": must be > 0");
-      hf.relief.emplace_back(amplitude[i], wavelength[i]);
-    }
-    relief.checkAllUsed();
-    int seed = 1;
-    c.readOptional("seed", seed);
-    hf.seed = static_cast<uint64_t>(seed);
-  } else {
-    throw ConfigError(c.where("type") + ": unknown object type '" + type +
-                      "' (known: plane, box, cylinder, sphere, heightfield, vegetation)");
+  const std::vector<double> size = c.get<std::vector<double>>("size");
+  if (size.size() != 2 || !(size[0] > 0.0) || !(size[1] > 0.0))
+    throw ConfigError(c.where("size") + ": expected [size_x, size_y] > 0");
+  hf.size_x = size[0];
+  hf.size_y = size[1];
+  hf.resolution = positive(c, "resolution");
+  if (hf.size_x / hf.resolution * hf.size_y / hf.resolution > 2e7)
+    throw ConfigError(c.where("resolution") + ": too fine for this size (more than 2e7 cells)");
+  const Config relief = c.section("relief");
+  const auto amplitude = relief.get<std::vector<double>>("amplitude");
+  const auto wavelength = relief.get<std::vector<double>>("wavelength");
+  if (amplitude.size() != wavelength.size())
+    throw ConfigError(relief.where("wavelength") + ": needs as many entries as amplitude");
+  hf.relief.clear();
+  for (size_t i = 0; i < amplitude.size(); ++i) {
+    if (!(wavelength[i] > 0.0)) throw ConfigError(relief.where("wavelength") + ": must be > 0");
+    hf.relief.emplace_back(amplitude[i], wavelength[i]);
   }
-  c.checkAllUsed();
+  relief.checkAllUsed();
+  int seed = 1;
+  c.readOptional("seed", seed);
+  hf.seed = static_cast<uint64_t>(seed);
+  return hf;
+}
 
+/// What an object entry describes: a shape, or a height field.
+using ObjectGeometry = std::variant<Shape, HeightFieldOptions>;
+
+/// The object's copies (`repeat`) added to the scene at `center` + their offsets, each named
+/// name[i] (name alone for one copy), jittered by the placement's seed and with its own texture
+/// offset.
+void addCopies(Scene& scene, const std::string& name, const Vec3& center, const Placement& placement, const Material& m,
+               const ObjectGeometry& geometry) {
   const Texture& texture = scene.texture(m.texture);
   int index = 0;
   for (int row = 0; row < placement.rows; ++row) {
@@ -230,17 +225,47 @@ void readObject(Scene& scene, const Config& c, const std::string& name, const st
       Material mi = m;
       mi.u_offset = shift.uniform() * texture.periodU();
       mi.v_offset = shift.uniform() * texture.periodV();
-      if (is_height_field) {
-        HeightFieldOptions h = hf;
+      if (const auto* hf = std::get_if<HeightFieldOptions>(&geometry)) {
+        HeightFieldOptions h = *hf;
         h.center = center + offset;
         scene.addHeightField(full, h, mi);
       } else {
-        Shape s = shape;
+        Shape s = std::get<Shape>(geometry);
         s.center = center + offset;
         scene.addShape(full, s, mi);
       }
     }
   }
+}
+
+void readObject(Scene& scene, const Config& c, const std::string& name, const std::map<std::string, int>& textures) {
+  const std::string type = c.get<std::string>("type");
+  Material m = readMaterial(c, textures);
+  const Vec3 center = c.get<Vec3>("center");
+  const Placement placement = readRepeat(c);
+
+  Vec3 rpy = Vec3::Zero();
+  const bool has_rpy = c.readOptional("rpy_deg", rpy);
+  const Mat3 rotation = rotationFromRpyDeg(rpy);
+  ObjectGeometry geometry;
+  Shape solid;
+  solid.rotation = rotation;
+  if (type == "vegetation") {
+    Shape shape = readVegetation(c, &m);
+    shape.rotation = rotation;
+    geometry = shape;
+  } else if (type == "plane") {
+    geometry = readPlane(c, has_rpy, rotation);
+  } else if (readSolid(c, type, &solid)) {
+    geometry = solid;
+  } else if (type == "heightfield") {
+    geometry = readHeightField(c, m, has_rpy);
+  } else {
+    throw ConfigError(c.where("type") + ": unknown object type '" + type +
+                      "' (known: plane, box, cylinder, sphere, heightfield, vegetation)");
+  }
+  c.checkAllUsed();
+  addCopies(scene, name, center, placement, m, geometry);
 }
 
 std::vector<Vec3> readPath(const Config& c) {

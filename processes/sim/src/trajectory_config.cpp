@@ -86,6 +86,64 @@ TrajectoryConfig readRecorded(const Config& c, const std::string& base_dir) {
   return out;
 }
 
+/// A path and the words that describe it (livo-sim's print-out).
+struct DescribedPath {
+  std::unique_ptr<Path> path;
+  std::string description;
+};
+
+/// handheld / car: a closed loop through `waypoints` at about `speed`, heading along the path; the
+/// shake of a walker or a car; a car's `wheelbase` and `track_width` (kept as given when absent).
+DescribedPath readLoop(const Config& c, const std::string& type, double shake, ProceduralTrajectoryOptions* o,
+                       double* wheelbase, double* track_width) {
+  const bool car = type == "car";
+  const std::vector<Vec3> waypoints = readWaypoints(c);
+  const double speed = positive(c, "speed", car ? 6.0 : 1.2);
+  const double spacing = positive(c, "control_spacing", car ? 4.0 : 1.0);
+  DescribedPath out;
+  std::ostringstream os;
+  try {
+    auto loop = std::make_unique<BSplineLoopPath>(waypoints, speed, spacing);
+    os << type << ": closed loop through " << waypoints.size() << " waypoints, about " << speed << " m/s, "
+       << loop->period() << " s per lap";
+    out.path = std::move(loop);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(c.where("waypoints") + ": " + e.what());
+  }
+  o->attitude = AttitudeMode::kFollowHeading;
+  o->shake = car ? carShake(shake) : handheldShake(shake);
+  if (car) {
+    *wheelbase = positive(c, "wheelbase", *wheelbase);
+    *track_width = positive(c, "track_width", *track_width);
+  }
+  out.description = os.str();
+  return out;
+}
+
+/// uav: a Lissajous flight around `center` with a thrust-aligned attitude and its own yaw motion.
+DescribedPath readLissajous(const Config& c, double shake, ProceduralTrajectoryOptions* o) {
+  const Vec3 center = c.get<Vec3>("center");
+  const Vec3 amplitude = c.get<Vec3>("amplitude");
+  const Vec3 frequency = c.get<Vec3>("frequency_hz");
+  Vec3 phase_deg = Vec3::Zero();
+  c.readOptional("phase_deg", phase_deg);
+  double yaw_rate_deg = 20.0, yaw_amplitude_deg = 0.0, yaw_frequency = 0.1;
+  c.readOptional("yaw_rate_deg", yaw_rate_deg);
+  c.readOptional("yaw_amplitude_deg", yaw_amplitude_deg);
+  c.readOptional("yaw_frequency_hz", yaw_frequency);
+  DescribedPath out;
+  out.path = std::make_unique<LissajousPath>(center, amplitude, frequency, phase_deg * M_PI / 180.0);
+  o->attitude = AttitudeMode::kThrustAligned;
+  o->yaw_rate = yaw_rate_deg * M_PI / 180.0;
+  o->yaw_wave = {yaw_amplitude_deg * M_PI / 180.0, yaw_frequency, 0.0};
+  o->shake = flightShake(shake);
+  std::ostringstream os;
+  os << "uav: Lissajous flight around [" << center.transpose() << "], amplitude [" << amplitude.transpose()
+     << "] m, frequencies [" << frequency.transpose() << "] Hz, thrust-aligned attitude";
+  out.description = os.str();
+  return out;
+}
+
 }  // namespace
 
 TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std::string& base_dir,
@@ -109,49 +167,19 @@ TrajectoryConfig readTrajectoryConfig(const Config& c, double gravity, const std
   c.readOptional("shake", shake);
   if (shake < 0.0) throw ConfigError(c.where("shake") + ": must be >= 0");
 
-  std::unique_ptr<Path> path;
-  std::ostringstream os;
   double wheelbase = CarTrajectoryOptions().wheelbase;
+  DescribedPath described;
   if (type == "handheld" || type == "car") {
-    const bool car = type == "car";
-    const std::vector<Vec3> waypoints = readWaypoints(c);
-    const double speed = positive(c, "speed", car ? 6.0 : 1.2);
-    const double spacing = positive(c, "control_spacing", car ? 4.0 : 1.0);
-    try {
-      auto loop = std::make_unique<BSplineLoopPath>(waypoints, speed, spacing);
-      os << type << ": closed loop through " << waypoints.size() << " waypoints, about " << speed << " m/s, "
-         << loop->period() << " s per lap";
-      path = std::move(loop);
-    } catch (const std::invalid_argument& e) {
-      throw ConfigError(c.where("waypoints") + ": " + e.what());
-    }
-    o.attitude = AttitudeMode::kFollowHeading;
-    o.shake = car ? carShake(shake) : handheldShake(shake);
-    if (car) {
-      wheelbase = positive(c, "wheelbase", wheelbase);
-      track_width = positive(c, "track_width", track_width);
-    }
+    described = readLoop(c, type, shake, &o, &wheelbase, &track_width);
   } else if (type == "uav") {
-    const Vec3 center = c.get<Vec3>("center");
-    const Vec3 amplitude = c.get<Vec3>("amplitude");
-    const Vec3 frequency = c.get<Vec3>("frequency_hz");
-    Vec3 phase_deg = Vec3::Zero();
-    c.readOptional("phase_deg", phase_deg);
-    double yaw_rate_deg = 20.0, yaw_amplitude_deg = 0.0, yaw_frequency = 0.1;
-    c.readOptional("yaw_rate_deg", yaw_rate_deg);
-    c.readOptional("yaw_amplitude_deg", yaw_amplitude_deg);
-    c.readOptional("yaw_frequency_hz", yaw_frequency);
-    path = std::make_unique<LissajousPath>(center, amplitude, frequency, phase_deg * M_PI / 180.0);
-    o.attitude = AttitudeMode::kThrustAligned;
-    o.yaw_rate = yaw_rate_deg * M_PI / 180.0;
-    o.yaw_wave = {yaw_amplitude_deg * M_PI / 180.0, yaw_frequency, 0.0};
-    o.shake = flightShake(shake);
-    os << "uav: Lissajous flight around [" << center.transpose() << "], amplitude [" << amplitude.transpose()
-       << "] m, frequencies [" << frequency.transpose() << "] Hz, thrust-aligned attitude";
+    described = readLissajous(c, shake, &o);
   } else {
     throw ConfigError(c.where("type") + ": unknown trajectory type '" + type +
                       "' (known: handheld, car, uav, recorded)");
   }
+  std::unique_ptr<Path> path = std::move(described.path);
+  std::ostringstream os;
+  os << described.description;
   c.checkAllUsed();
   os << ", still for " << o.start_still_s << " s then a " << o.ramp_s << " s ramp, shake x" << shake;
   TrajectoryConfig out;
