@@ -173,42 +173,42 @@ std::pair<LinearScale, LinearScale> axes(Svg& svg, const Rect& r, double xlo, do
   return {sx, sy};
 }
 
-void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, double err_hi, double max_step,
-             const PlotMarks& marks) {
-  // The two axes along which the ground truth spreads most.
+/// The two axes (a < b) along which the ground truth and the estimate spread most, and their extents.
+struct PlanView {
+  int a = 0, b = 1;
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
+};
+
+PlanView planView(const Evaluation& ev) {
+  PlanView v;
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
   for (const auto& p : ev.gt_path) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
   for (const auto& T : ev.est) lo = lo.cwiseMin(Vec3(T.translation())), hi = hi.cwiseMax(Vec3(T.translation()));
   const Vec3 extent = hi - lo;
   int order[3] = {0, 1, 2};
   std::stable_sort(order, order + 3, [&](int i, int j) { return extent[i] > extent[j]; });
-  const int a = std::min(order[0], order[1]), b = std::max(order[0], order[1]);
-  const char* names[3] = {"x", "y", "z"};
+  v.a = std::min(order[0], order[1]), v.b = std::max(order[0], order[1]);
+  v.lo = lo, v.hi = hi;
+  return v;
+}
 
-  // Equal scale on both axes, centred in the area.
-  double xlo = lo[a], xhi = hi[a], ylo = lo[b], yhi = hi[b];
+/// The panel's axes: equal scale on both, the path centred in the area.
+std::pair<LinearScale, LinearScale> planAxes(Svg& svg, const Rect& area, const PlanView& v) {
+  const char* names[3] = {"x", "y", "z"};
+  double xlo = v.lo[v.a], xhi = v.hi[v.a], ylo = v.lo[v.b], yhi = v.hi[v.b];
   niceRange(xlo, xhi, 7);
   niceRange(ylo, yhi, 7);
   const double m_per_px = std::max((xhi - xlo) / area.w, (yhi - ylo) / area.h);
   const double cx = 0.5 * (xlo + xhi), cy = 0.5 * (ylo + yhi);
   xlo = cx - 0.5 * area.w * m_per_px, xhi = cx + 0.5 * area.w * m_per_px;
   ylo = cy - 0.5 * area.h * m_per_px, yhi = cy + 0.5 * area.h * m_per_px;
-  const auto [sx, sy] =
-      axes(svg, area, xlo, xhi, ylo, yhi, std::string(names[a]) + " (m)", std::string(names[b]) + " (m)", 7, 7);
+  return axes(svg, area, xlo, xhi, ylo, yhi, std::string(names[v.a]) + " (m)", std::string(names[v.b]) + " (m)", 7, 7);
+}
 
-  std::vector<std::pair<double, double>> gt_px;
-  for (const auto& p : ev.gt_path) gt_px.emplace_back(sx(p[a]), sy(p[b]));
-  svg.polyline(thin(gt_px, 0.7), "#555555", 1.6, "stroke-dasharray=\"5,3\"");
-
-  // Under the estimate, where the estimator was weak.
-  std::vector<std::pair<double, double>> est_px;
-  for (const auto& T : ev.est) est_px.emplace_back(sx(T.translation()[a]), sy(T.translation()[b]));
-  const bool degenerate_drawn =
-      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.degenerate), max_step, kDegenerateColour);
-  const bool predicted_drawn =
-      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.predicted), max_step, kPredictedColour);
-
-  // Estimate: runs of segments in one colour level become one polyline.
+/// The estimate coloured by its ATE: runs of segments in one colour level become one polyline; no
+/// line where it was not tracked (pairs more than max_step apart).
+void errorColouredPath(Svg& svg, const std::vector<std::pair<double, double>>& est_px, const Evaluation& ev,
+                       double err_lo, double err_hi, double max_step) {
   const double span = err_hi > err_lo ? err_hi - err_lo : 1.0;
   auto level = [&](double e) {
     return std::min(kColourLevels - 1, std::max(0, static_cast<int>((e - err_lo) / span * kColourLevels)));
@@ -223,26 +223,26 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
       continue;
     }
     const int l = level(0.5 * (ev.ate_m[k] + ev.ate_m[k + 1]));
-    const auto p0 = std::make_pair(sx(ev.est[k].translation()[a]), sy(ev.est[k].translation()[b]));
-    const auto p1 = std::make_pair(sx(ev.est[k + 1].translation()[a]), sy(ev.est[k + 1].translation()[b]));
     if (l != run_level) {
       svg.polyline(thin(run, 0.7), errorColour((run_level + 0.5) / kColourLevels), 2.6);
-      run = {p0};
+      run = {est_px[k]};
       run_level = l;
     }
-    run.push_back(p1);
+    run.push_back(est_px[k + 1]);
   }
   svg.polyline(thin(run, 0.7), errorColour((run_level + 0.5) / kColourLevels), 2.6);
-  const bool loops_drawn = loopLines(svg, est_px, ev.est_stamps, marks.loops);
-  if (!ev.est.empty()) {
-    const auto& s = ev.est.front().translation();
-    const auto& e = ev.est.back().translation();
-    svg.os << "<circle cx=\"" << fixed1(sx(s[a])) << "\" cy=\"" << fixed1(sy(s[b]))
-           << "\" r=\"6\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
-    svg.os << "<rect x=\"" << fixed1(sx(e[a]) - 5) << "\" y=\"" << fixed1(sy(e[b]) - 5)
-           << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
-  }
-  // Legend: a row per thing drawn.
+}
+
+/// A circle at the start, a square at the end.
+void startAndEnd(Svg& svg, std::pair<double, double> s, std::pair<double, double> e) {
+  svg.os << "<circle cx=\"" << fixed1(s.first) << "\" cy=\"" << fixed1(s.second)
+         << "\" r=\"6\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
+  svg.os << "<rect x=\"" << fixed1(e.first - 5) << "\" y=\"" << fixed1(e.second - 5)
+         << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000000\" stroke-width=\"2\"/>\n";
+}
+
+/// Legend of the top view: a row per thing drawn, then start and end.
+void topViewLegend(Svg& svg, const Rect& area, bool degenerate_drawn, bool predicted_drawn, bool loops_drawn) {
   std::vector<std::pair<std::function<void(double, double)>, std::string>> rows;
   rows.push_back({[&](double x, double y) { svg.line(x, y, x + 30, y, "#555555", 1.6, "stroke-dasharray=\"5,3\""); },
                   "ground truth"});
@@ -279,6 +279,29 @@ void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, do
   svg.os << "<rect x=\"" << fixed1(lx + 64) << "\" y=\"" << fixed1(ey - 5)
          << "\" width=\"10\" height=\"10\" fill=\"none\" stroke=\"#000\" stroke-width=\"2\"/>\n";
   svg.text(lx + 80, ey + 5, "end", 13);
+}
+
+/// The paths from above, in the plane they spread most in: the ground truth dashed, the estimate
+/// coloured by its ATE over where the estimator was weak, the loop closures, start and end.
+void topView(Svg& svg, const Rect& area, const Evaluation& ev, double err_lo, double err_hi, double max_step,
+             const PlotMarks& marks) {
+  const PlanView v = planView(ev);
+  const auto [sx, sy] = planAxes(svg, area, v);
+  std::vector<std::pair<double, double>> gt_px;
+  for (const auto& p : ev.gt_path) gt_px.emplace_back(sx(p[v.a]), sy(p[v.b]));
+  svg.polyline(thin(gt_px, 0.7), "#555555", 1.6, "stroke-dasharray=\"5,3\"");
+
+  // Under the estimate, where the estimator was weak.
+  std::vector<std::pair<double, double>> est_px;
+  for (const auto& T : ev.est) est_px.emplace_back(sx(T.translation()[v.a]), sy(T.translation()[v.b]));
+  const bool degenerate_drawn =
+      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.degenerate), max_step, kDegenerateColour);
+  const bool predicted_drawn =
+      overlayRuns(svg, est_px, ev.est_stamps, inSpans(ev.est_stamps, marks.predicted), max_step, kPredictedColour);
+  errorColouredPath(svg, est_px, ev, err_lo, err_hi, max_step);
+  const bool loops_drawn = loopLines(svg, est_px, ev.est_stamps, marks.loops);
+  if (!ev.est.empty()) startAndEnd(svg, est_px.front(), est_px.back());
+  topViewLegend(svg, area, degenerate_drawn, predicted_drawn, loops_drawn);
 }
 
 void colourBar(Svg& svg, const Rect& r, double err_lo, double err_hi) {
