@@ -9,6 +9,7 @@ root="$1"; bin="$2"
 dir=$(mktemp -d /tmp/livo-lio-graph-pipeline.XXXXXX)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/input_faults.sh"
 export LIVO_BUILD_DIR="$(dirname "$bin")"
 "$bin/livo-sim" --config "$root/config/sim/room.yaml" --out "$dir/room.lcmlog" --duration 10 --seed 3 --quiet \
   || fail "livo-sim failed"
@@ -47,20 +48,7 @@ for ch in ODOMETRY KEYFRAME; do
 done
 echo "two runs: identical ODOMETRY and KEYFRAME"
 
-"$root/scripts/run_pipeline.sh" --log "$dir/room.lcmlog" --config "$root/config/sim/room.yaml" --processes lio \
-  --swap lio="$bin/livo-lio-graph" --out "$dir/faults" --seed 5 \
-  --faults "nan:LIDAR:0.3,corrupt:LIDAR:0.05,drop:IMU:0.05,duplicate:IMU:0.05,reorder:IMU:0.05,cut:LIDAR:3:4" \
-  >/dev/null 2>"$dir/faults.err" || { cat "$dir/faults.err"; fail "the run with faults failed"; }
-/usr/bin/python3 - "$dir/faults" <<'PY' || exit 1
-import json, math, sys
-d = sys.argv[1]
-rows = [[float(x) for x in l.split()] for l in open(d + '/odometry.tum') if l.strip() and not l.startswith('#')]
-assert all(math.isfinite(v) for r in rows for v in r), 'NaN in the odometry'
-assert len(rows) >= 70, len(rows)
-e = json.load(open(d + '/evaluation_odometry.json'))
-assert e['ate']['rmse'] < 0.05, e['ate']
-print('with faults: %d poses, ATE rmse %.4f m' % (len(rows), e['ate']['rmse']))
-PY
+check_input_faults 70 --swap lio="$bin/livo-lio-graph"
 
 # The ablation script end to end on 4 s (too short for its bars: the table, the honesty about
 # variants left out and the keyed reuse are checked)

@@ -8,6 +8,7 @@ root="$1"; bin="$2"
 dir=$(mktemp -d /tmp/livo-sim-pipeline.XXXXXX)
 trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/input_faults.sh"
 export LIVO_BUILD_DIR="$(dirname "$bin")"
 "$bin/livo-sim" --config "$root/config/sim/room.yaml" --out "$dir/room.lcmlog" --duration 8 --seed 3 --quiet \
   || fail "livo-sim failed"
@@ -35,17 +36,4 @@ b=$("$bin/livo-loginfo" --digest "$dir/b/outputs.lcmlog" | grep '^ODOMETRY' | gr
 [ -n "$a" ] && [ "$a" = "$b" ] || fail "two lockstep runs gave different ODOMETRY ($a vs $b)"
 echo "two runs: identical ODOMETRY ($a)"
 
-"$root/scripts/run_pipeline.sh" --log "$dir/room.lcmlog" --config "$root/config/sim/room.yaml" --processes lio \
-  --out "$dir/faults" --seed 5 \
-  --faults "nan:LIDAR:0.3,corrupt:LIDAR:0.05,drop:IMU:0.05,duplicate:IMU:0.05,reorder:IMU:0.05,cut:LIDAR:3:4" \
-  >/dev/null 2>"$dir/faults.err" || { cat "$dir/faults.err"; fail "the run with faults failed"; }
-/usr/bin/python3 - "$dir/faults" <<'PY' || exit 1
-import json, math, sys
-d = sys.argv[1]
-rows = [[float(x) for x in l.split()] for l in open(d + '/odometry.tum') if l.strip() and not l.startswith('#')]
-assert all(math.isfinite(v) for r in rows for v in r), 'NaN in the odometry'
-assert len(rows) >= 55, len(rows)
-e = json.load(open(d + '/evaluation_odometry.json'))
-assert e['ate']['rmse'] < 0.05, e['ate']
-print('with faults: %d poses, ATE rmse %.4f m' % (len(rows), e['ate']['rmse']))
-PY
+check_input_faults 55
