@@ -58,38 +58,43 @@ CompressedImageInfo sniffCompressedImage(const uint8_t* d, size_t n) {
   return info;
 }
 
-image_t convertRosImage(const RosImage& m, const std::string& frame, const std::string& where) {
+namespace {
+
+/// A raw (or depth) image's pixels, `bytes_per_pixel` each, with its stamp, frame and size; throws
+/// unless a row of `step` bytes holds the width and the data holds every row.
+image_t rawImage(const RosImage& m, int8_t encoding, uint64_t bytes_per_pixel, const std::string& frame,
+                 const std::string& where) {
+  if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * bytes_per_pixel)
+    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " +
+                      std::to_string(bytes_per_pixel));
+  const uint64_t size = static_cast<uint64_t>(m.step) * m.height;
+  if (size > m.data_size)
+    throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
+                      std::to_string(size));
   image_t img;
   img.utime = nsToUtime(m.header.stampNs());
   img.frame = frame;
   img.width = static_cast<int32_t>(m.width);
   img.height = static_cast<int32_t>(m.height);
   img.row_stride = static_cast<int32_t>(m.step);
+  img.encoding = encoding;
   img.exposure_time = 0.0f;
-  int channels = 0;
-  if (m.encoding == "mono8" || m.encoding == "8UC1") {
-    img.encoding = image_t::ENCODING_GRAY8, channels = 1;
-  } else if (m.encoding == "rgb8") {
-    img.encoding = image_t::ENCODING_RGB8, channels = 3;
-  } else if (m.encoding == "bgr8" || m.encoding == "8UC3") {
-    img.encoding = image_t::ENCODING_BGR8, channels = 3;
-  } else if (isRosDepthEncoding(m.encoding)) {
-    throw DecodeError(where + ": field 'encoding': '" + m.encoding +
-                      "' is depth, not a camera image (map the topic with --depth)");
-  } else {
-    throw DecodeError(where + ": field 'encoding': '" + m.encoding +
-                      "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
-  }
-  if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * channels)
-    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " +
-                      std::to_string(channels));
-  if (static_cast<uint64_t>(m.step) * m.height > m.data_size)
-    throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
-                      std::to_string(static_cast<uint64_t>(m.step) * m.height));
-  const size_t size = static_cast<size_t>(m.step) * m.height;
   img.size = static_cast<int32_t>(size);
   img.data.assign(m.data, m.data + size);
   return img;
+}
+
+}  // namespace
+
+image_t convertRosImage(const RosImage& m, const std::string& frame, const std::string& where) {
+  if (m.encoding == "mono8" || m.encoding == "8UC1") return rawImage(m, image_t::ENCODING_GRAY8, 1, frame, where);
+  if (m.encoding == "rgb8") return rawImage(m, image_t::ENCODING_RGB8, 3, frame, where);
+  if (m.encoding == "bgr8" || m.encoding == "8UC3") return rawImage(m, image_t::ENCODING_BGR8, 3, frame, where);
+  if (isRosDepthEncoding(m.encoding))
+    throw DecodeError(where + ": field 'encoding': '" + m.encoding +
+                      "' is depth, not a camera image (map the topic with --depth)");
+  throw DecodeError(where + ": field 'encoding': '" + m.encoding +
+                    "' is not supported (mono8, rgb8, bgr8, 8UC1, 8UC3)");
 }
 
 bool isRosDepthEncoding(const std::string& encoding) {
@@ -101,23 +106,7 @@ image_t convertRosDepthImage(const RosImage& m, const std::string& frame, const 
     throw DecodeError(where + ": field 'encoding': '" + m.encoding + "' is not depth (16UC1 in mm, 32FC1 in m)");
   const bool metres = m.encoding == "32FC1";
   const uint64_t bytes = metres ? 4 : 2;
-  if (static_cast<uint64_t>(m.step) < static_cast<uint64_t>(m.width) * bytes)
-    throw DecodeError(where + ": field 'step': " + std::to_string(m.step) + " is less than width * " +
-                      std::to_string(bytes));
-  const uint64_t size = static_cast<uint64_t>(m.step) * m.height;
-  if (size > m.data_size)
-    throw DecodeError(where + ": field 'data': " + std::to_string(m.data_size) + " bytes, step * height needs " +
-                      std::to_string(size));
-  image_t img;
-  img.utime = nsToUtime(m.header.stampNs());
-  img.frame = frame;
-  img.width = static_cast<int32_t>(m.width);
-  img.height = static_cast<int32_t>(m.height);
-  img.row_stride = static_cast<int32_t>(m.step);
-  img.encoding = metres ? image_t::ENCODING_DEPTH32F : image_t::ENCODING_DEPTH16;
-  img.exposure_time = 0.0f;
-  img.size = static_cast<int32_t>(size);
-  img.data.assign(m.data, m.data + size);
+  image_t img = rawImage(m, metres ? image_t::ENCODING_DEPTH32F : image_t::ENCODING_DEPTH16, bytes, frame, where);
   if (m.is_bigendian) {
     for (uint32_t y = 0; y < m.height; ++y) {
       uint8_t* row = img.data.data() + static_cast<size_t>(y) * m.step;
