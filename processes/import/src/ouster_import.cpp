@@ -57,7 +57,7 @@ class OusterGeometry {
 class SweepAssembler {
  public:
   SweepAssembler(const OusterMetadata& m, const OusterImportOptions& o, SortedLogWriter& w, ImportReport& r)
-      : meta_(m), geometry_(m), o_(o), writer_(w), report_(r) {
+      : meta_(m), geometry_(m), options_(o), writer_(w), report_(r) {
     expected_columns_ = m.column_window_last >= m.column_window_first
                             ? m.column_window_last - m.column_window_first + 1
                             : m.columns_per_frame - m.column_window_first + m.column_window_last + 1;
@@ -87,13 +87,13 @@ class SweepAssembler {
     const int received = static_cast<int>(columns_.size());
     const bool partial = received < expected_columns_;
     if (partial) {
-      report_.skip("partial sweep (" + std::string(o_.keep_partial_sweeps ? "kept" : "dropped") +
+      report_.skip("partial sweep (" + std::string(options_.keep_partial_sweeps ? "kept" : "dropped") +
                        "): fewer columns than the column window",
                    where_ + ": frame " + std::to_string(*current_frame_) + " has " + std::to_string(received) + " of " +
                        std::to_string(expected_columns_) + " columns",
                    1, false);
     }
-    if (received > 0 && (!partial || o_.keep_partial_sweeps)) write();
+    if (received > 0 && (!partial || options_.keep_partial_sweeps)) write();
     columns_.clear();
     current_frame_.reset();
   }
@@ -128,12 +128,12 @@ class SweepAssembler {
     }
     if (max_offset >= cloud.sweep_duration) cloud.sweep_duration = std::nextafter(max_offset, 1e9f);
     cloud.num_points = static_cast<int32_t>(cloud.x.size());
-    writer_.add(o_.channels.lidar, cloud);
+    writer_.add(options_.channels.lidar, cloud);
   }
 
   const OusterMetadata& meta_;
   OusterGeometry geometry_;
-  const OusterImportOptions& o_;
+  const OusterImportOptions& options_;
   SortedLogWriter& writer_;
   ImportReport& report_;
   int expected_columns_ = 0;
@@ -150,6 +150,83 @@ std::string matrixYaml(const Eigen::Matrix4d& T_mm) {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) v.push_back(T(r, c));
   return yamlList(v);
+}
+
+/// The sensor's metadata, frames and extrinsics into the sidecar, and for the starter rig
+/// (--rig-out) T_I_L in metres and the model from the product line ("OS-1-128" -> OS1-128).
+void reportOusterSensor(const OusterMetadata& meta, const std::string& meta_path, ImportReport& report) {
+  report.metadataString("ouster_metadata", meta_path);
+  report.metadataString("ouster_product", meta.prod_line + " " + meta.lidar_mode + " firmware " + meta.firmware);
+  report.metadataString("ouster_udp_profile_lidar", meta.udp_profile_lidar);
+  report.metadataString("lidar_frame", "L = Ouster sensor frame (os_sensor)");
+  report.metadataString("imu_frame", "I = Ouster IMU frame (os_imu)");
+  report.metadata("T_sensor_imu", matrixYaml(meta.imu_to_sensor));
+  report.metadata("T_sensor_lidar", matrixYaml(meta.lidar_to_sensor));
+  // Points are in the sensor frame, so the body(IMU)-from-LiDAR extrinsic is inv(T_sensor_imu).
+  report.metadata("extrinsic_imu_lidar", matrixYaml(Eigen::Matrix4d(meta.imu_to_sensor.inverse())));
+  Pose3 T_I_L;
+  T_I_L.matrix() = meta.imu_to_sensor.inverse();
+  T_I_L.translation() *= 1e-3;
+  report.calibration().T_I_L = KnownExtrinsic{T_I_L, "", "the metadata's imu_to_sensor_transform, inverted (mm -> m)"};
+  std::string model = meta.prod_line;
+  if (model.rfind("OS-", 0) == 0 && model.size() > 4 && model[4] == '-')
+    model = "OS" + model.substr(3, 1) + model.substr(4);
+  report.calibration().lidar_model = model;
+  report.calibration().lidar_model_source = "Ouster metadata prod_line " + meta.prod_line;
+}
+
+/// An IMU packet as imu_t (g -> m/s^2, deg/s -> rad/s), stamped by its gyro timestamp.
+imu_t imuSampleOf(const OusterImuPacket& p) {
+  imu_t m;
+  m.utime = nsToUtime(p.gyro_ts_ns);
+  for (int i = 0; i < 3; ++i) {
+    m.linear_acceleration[i] = p.accel_g[i] * kStandardGravity;
+    m.angular_velocity[i] = p.gyro_deg_s[i] * M_PI / 180.0;
+  }
+  return m;
+}
+
+struct OusterPacketCounts {
+  int64_t lidar = 0, imu = 0;
+};
+
+/// Reads the capture: LiDAR packets into `sweeps`, IMU packets into the log; other datagrams and
+/// undecodable packets are skipped, a capture that cannot be read to its end is an error.
+OusterPacketCounts readCapture(const std::string& pcap, const OusterMetadata& meta, const OusterPacketFormat& format,
+                               const OusterImportOptions& o, SweepAssembler& sweeps, SortedLogWriter& writer,
+                               ImportReport& report) {
+  OusterPacketCounts packets;
+  try {
+    PcapReader reader(pcap);
+    ProgressLine progress("livo-import " + pcap, static_cast<double>(reader.fileSize()) / 1e6, "MB", o.progress);
+    reader.readAll([&](const UdpDatagram& u) {
+      progress.update(static_cast<double>(reader.position()) / 1e6);
+      const std::string where = pcap + ": record " + std::to_string(u.record_number);
+      try {
+        if (u.dst_port == meta.udp_port_lidar) {
+          ++packets.lidar;
+          sweeps.add(format.decodeLidar(u.payload.data(), u.payload.size()), where);
+        } else if (u.dst_port == meta.udp_port_imu) {
+          ++packets.imu;
+          writer.add(o.channels.imu, imuSampleOf(decodeOusterImu(u.payload.data(), u.payload.size())));
+        } else {
+          report.skip("UDP datagram to port " + std::to_string(u.dst_port) + " (neither LiDAR nor IMU port)", where, 1,
+                      false);
+        }
+      } catch (const std::exception& e) {
+        report.skip("undecodable Ouster packet", where + ": " + e.what());
+      }
+    });
+    progress.finish();
+    const PcapStats& s = reader.stats();
+    report.metadata("pcap_records", std::to_string(s.records));
+    report.metadata("pcap_ipv4_fragments", std::to_string(s.fragments));
+    if (s.non_ipv4 + s.non_udp) report.skip("pcap frames that are not IPv4/UDP", pcap, s.non_ipv4 + s.non_udp, false);
+    if (s.incomplete_datagrams) report.skip("IPv4 datagrams with missing fragments", pcap, s.incomplete_datagrams);
+  } catch (const std::exception& e) {
+    report.error(e.what());
+  }
+  return packets;
 }
 
 }  // namespace
@@ -191,71 +268,14 @@ void importOuster(const std::string& pcap, const OusterImportOptions& o, SortedL
     report.error(meta_path + ": " + e.what());
     return;
   }
-  report.metadataString("ouster_metadata", meta_path);
-  report.metadataString("ouster_product", meta.prod_line + " " + meta.lidar_mode + " firmware " + meta.firmware);
-  report.metadataString("ouster_udp_profile_lidar", meta.udp_profile_lidar);
-  report.metadataString("lidar_frame", "L = Ouster sensor frame (os_sensor)");
-  report.metadataString("imu_frame", "I = Ouster IMU frame (os_imu)");
-  report.metadata("T_sensor_imu", matrixYaml(meta.imu_to_sensor));
-  report.metadata("T_sensor_lidar", matrixYaml(meta.lidar_to_sensor));
-  // Points are in the sensor frame, so the body(IMU)-from-LiDAR extrinsic is inv(T_sensor_imu).
-  report.metadata("extrinsic_imu_lidar", matrixYaml(Eigen::Matrix4d(meta.imu_to_sensor.inverse())));
-  // The starter rig's (--rig-out): T_I_L in metres, and the model from the product line
-  // ("OS-1-128" -> OS1-128) when it is one the rig knows.
-  Pose3 T_I_L;
-  T_I_L.matrix() = meta.imu_to_sensor.inverse();
-  T_I_L.translation() *= 1e-3;
-  report.calibration().T_I_L = KnownExtrinsic{T_I_L, "", "the metadata's imu_to_sensor_transform, inverted (mm -> m)"};
-  std::string model = meta.prod_line;
-  if (model.rfind("OS-", 0) == 0 && model.size() > 4 && model[4] == '-')
-    model = "OS" + model.substr(3, 1) + model.substr(4);
-  report.calibration().lidar_model = model;
-  report.calibration().lidar_model_source = "Ouster metadata prod_line " + meta.prod_line;
-
+  reportOusterSensor(meta, meta_path, report);
   SweepAssembler sweeps(meta, o, writer, report);
-  int64_t lidar_packets = 0, imu_packets = 0;
-  try {
-    PcapReader reader(pcap);
-    ProgressLine progress("livo-import " + pcap, static_cast<double>(reader.fileSize()) / 1e6, "MB", o.progress);
-    reader.readAll([&](const UdpDatagram& u) {
-      progress.update(static_cast<double>(reader.position()) / 1e6);
-      const std::string where = pcap + ": record " + std::to_string(u.record_number);
-      try {
-        if (u.dst_port == meta.udp_port_lidar) {
-          ++lidar_packets;
-          sweeps.add(format->decodeLidar(u.payload.data(), u.payload.size()), where);
-        } else if (u.dst_port == meta.udp_port_imu) {
-          ++imu_packets;
-          const OusterImuPacket p = decodeOusterImu(u.payload.data(), u.payload.size());
-          imu_t m;
-          m.utime = nsToUtime(p.gyro_ts_ns);
-          for (int i = 0; i < 3; ++i) {
-            m.linear_acceleration[i] = p.accel_g[i] * kStandardGravity;
-            m.angular_velocity[i] = p.gyro_deg_s[i] * M_PI / 180.0;
-          }
-          writer.add(o.channels.imu, m);
-        } else {
-          report.skip("UDP datagram to port " + std::to_string(u.dst_port) + " (neither LiDAR nor IMU port)", where, 1,
-                      false);
-        }
-      } catch (const std::exception& e) {
-        report.skip("undecodable Ouster packet", where + ": " + e.what());
-      }
-    });
-    progress.finish();
-    const PcapStats& s = reader.stats();
-    report.metadata("pcap_records", std::to_string(s.records));
-    report.metadata("pcap_ipv4_fragments", std::to_string(s.fragments));
-    if (s.non_ipv4 + s.non_udp) report.skip("pcap frames that are not IPv4/UDP", pcap, s.non_ipv4 + s.non_udp, false);
-    if (s.incomplete_datagrams) report.skip("IPv4 datagrams with missing fragments", pcap, s.incomplete_datagrams);
-  } catch (const std::exception& e) {
-    report.error(e.what());
-  }
+  const OusterPacketCounts packets = readCapture(pcap, meta, *format, o, sweeps, writer, report);
   sweeps.flush();
   if (sweeps.invalidColumns())
     report.skip("LiDAR columns flagged invalid by the sensor", pcap, sweeps.invalidColumns(), false);
-  report.metadata("ouster_lidar_packets", std::to_string(lidar_packets));
-  report.metadata("ouster_imu_packets", std::to_string(imu_packets));
+  report.metadata("ouster_lidar_packets", std::to_string(packets.lidar));
+  report.metadata("ouster_imu_packets", std::to_string(packets.imu));
 }
 
 }  // namespace livo::import

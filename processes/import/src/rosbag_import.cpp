@@ -81,7 +81,8 @@ std::map<std::string, std::string> firstImageEncodings(const std::string& bag,
 
 class BagConverter {
  public:
-  BagConverter(const RosbagImportOptions& o, SortedLogWriter& w, ImportReport& r) : o_(o), writer_(w), report_(r) {
+  BagConverter(const RosbagImportOptions& o, SortedLogWriter& w, ImportReport& r)
+      : options_(o), writer_(w), report_(r) {
     topics_[Role::kImu] = o.imu_topic;
     topics_[Role::kLidar] = o.lidar_topic;
     topics_[Role::kCamera] = o.camera_topic;
@@ -95,7 +96,7 @@ class BagConverter {
   /// (firstImageEncodings) tells depth Image topics, which fit only the depth role, from cameras.
   void autoMap(const std::map<uint32_t, BagConnection>& connections,
                const std::map<std::string, std::string>& image_encodings) {
-    if (!o_.auto_map) return;
+    if (!options_.auto_map) return;
     auto isDepth = [&](const std::string& topic) {
       const auto it = image_encodings.find(topic);
       return it != image_encodings.end() && isRosDepthEncoding(it->second);
@@ -218,7 +219,7 @@ class BagConverter {
   static std::string frameOf(Role role) { return role == Role::kCameraRight ? "C1" : "C"; }
 
   int64_t stampOf(const RosHeader& h, const BagMessage& m, const std::string& where) {
-    if (o_.use_bag_time) return nsToUtime(m.record_time_ns);
+    if (options_.use_bag_time) return nsToUtime(m.record_time_ns);
     if (h.sec == 0 && h.nsec == 0) {
       report_.skip("header.stamp is zero: stamped with the bag's receive time instead", where, 1, false);
       return nsToUtime(m.record_time_ns);
@@ -239,15 +240,15 @@ class BagConverter {
     }
     auto& norm = imu_units_[m.connection->topic];
     if (!norm) {
-      const std::string channel = o_.channels.imu;
-      norm = std::make_unique<ImuUnitNormaliser>(o_.imu_units, m.connection->topic, report_,
+      const std::string channel = options_.channels.imu;
+      norm = std::make_unique<ImuUnitNormaliser>(options_.imu_units, m.connection->topic, report_,
                                                  [this, channel](const imu_t& x) { writer_.add(channel, x); });
     }
     norm->add(s);
   }
 
   void cloud(RosPointCloud2 msg, const BagMessage& m, const std::string& where) {
-    if (o_.use_bag_time) {
+    if (options_.use_bag_time) {
       msg.header.sec = static_cast<uint32_t>(m.record_time_ns / 1000000000LL);
       msg.header.nsec = static_cast<uint32_t>(m.record_time_ns % 1000000000LL);
     } else if (msg.header.sec == 0 && msg.header.nsec == 0) {
@@ -255,21 +256,21 @@ class BagConverter {
       msg.header.sec = static_cast<uint32_t>(m.record_time_ns / 1000000000LL);
       msg.header.nsec = static_cast<uint32_t>(m.record_time_ns % 1000000000LL);
     }
-    PointCloudConversion c = convertPointCloud2(msg, o_.lidar, where);
+    PointCloudConversion c = convertPointCloud2(msg, options_.lidar, where);
     if (c.non_finite_points) report_.skip("LiDAR points with a NaN/inf coordinate", where, c.non_finite_points, false);
     if (c.zero_points) report_.skip("LiDAR points at (0, 0, 0) (no return)", where, c.zero_points, false);
     if (report_.metadataValue("lidar_point_layout").empty()) {
       report_.metadataString("lidar_point_layout", c.layout);
       report_.metadataString("lidar_topic", m.connection->topic);
     }
-    writer_.add(o_.channels.lidar, c.cloud);
+    writer_.add(options_.channels.lidar, c.cloud);
   }
 
   void image(Role role, image_t img, const BagMessage& m) {
-    if (o_.use_bag_time) img.utime = nsToUtime(m.record_time_ns);
-    writer_.add(role == Role::kCameraRight ? o_.channels.camera_right
-                : role == Role::kDepth     ? o_.channels.depth
-                                           : o_.channels.camera,
+    if (options_.use_bag_time) img.utime = nsToUtime(m.record_time_ns);
+    writer_.add(role == Role::kCameraRight ? options_.channels.camera_right
+                : role == Role::kDepth     ? options_.channels.depth
+                                           : options_.channels.camera,
                 img);
   }
 
@@ -302,7 +303,7 @@ class BagConverter {
     pose_t out;
     out.utime = stampOf(p.header, m, where);
     out.parent_frame = "W";
-    out.child_frame = o_.ground_truth_child_frame;
+    out.child_frame = options_.ground_truth_child_frame;
     for (int i = 0; i < 3; ++i) out.position[i] = p.position[i];
     out.orientation[0] = p.orientation_xyzw[3];
     out.orientation[1] = p.orientation_xyzw[0];
@@ -310,10 +311,10 @@ class BagConverter {
     out.orientation[3] = p.orientation_xyzw[2];
     if (!p.has_orientation && report_.metadataValue("ground_truth_orientation").empty())
       report_.metadataString("ground_truth_orientation", "none (position only; identity written)");
-    writer_.add(o_.channels.ground_truth, out);
+    writer_.add(options_.channels.ground_truth, out);
   }
 
-  const RosbagImportOptions& o_;
+  const RosbagImportOptions& options_;
   SortedLogWriter& writer_;
   ImportReport& report_;
   std::map<Role, std::string> topics_;
