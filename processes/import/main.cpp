@@ -3,29 +3,11 @@
 #include <iostream>
 
 #include "livo/command_line.hpp"
-#include "livo/config.hpp"
-#include "livo/import/file_utils.hpp"
-#include "livo/import/import_job.hpp"
-#include "livo/import/rosbag_presets.hpp"
+#include "livo/import/import_command_line.hpp"
 
 namespace {
 
-livo::import::LidarStampConvention stampConvention(const std::string& s) {
-  if (s == "start") return livo::import::LidarStampConvention::kStart;
-  if (s == "end") return livo::import::LidarStampConvention::kEnd;
-  throw std::invalid_argument("--lidar-stamp: expected start or end, got '" + s + "'");
-}
-
-livo::import::KittiPointFields pointFields(const std::string& s) {
-  if (s == "auto") return livo::import::KittiPointFields::kAuto;
-  if (s == "xyzi") return livo::import::KittiPointFields::kXyzi;
-  if (s == "xyz") return livo::import::KittiPointFields::kXyz;
-  throw std::invalid_argument("--point-fields: expected auto, xyzi or xyz, got '" + s + "'");
-}
-
-}  // namespace
-
-int main(int argc, char** argv) {
+livo::CommandLine importCommandLine() {
   livo::CommandLine cli(
       "livo-import",
       "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
@@ -86,81 +68,25 @@ int main(int argc, char** argv) {
       .option("--point-fields", "auto|xyzi|xyz", "kitti: floats per point in .bin scans", "auto")
       .option("--max-buffer-mb", "MB", "memory for sorting before spilling to temporary files", "512")
       .flag("--quiet", "no progress line and no warnings on stderr (the summary still prints)");
-  if (!cli.parse(argc, argv)) return cli.exitCode();
+  return cli;
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  livo::CommandLine cli = importCommandLine();
+  if (!cli.parse(argc, argv)) return cli.exitCode();
   if (cli.has("--list-presets")) {
-    for (const livo::import::RosbagPreset& p : livo::import::rosbagPresets())
-      std::cout << p.name << ": " << p.description << "\n";
+    livo::import::printRosbagPresets(std::cout);
     return 0;
   }
   livo::import::ImportJob job;
   try {
-    job.format = cli.get("FORMAT");
-    job.input = cli.get("INPUT");
     if (cli.has("--list-topics")) {
-      if (job.format != "rosbag") throw std::invalid_argument("--list-topics is for the rosbag format");
-      for (const livo::import::BagTopic& t : livo::import::listBagTopics(job.input))
-        std::cout << t.topic << "  " << t.type << "  " << t.messages << "\n";
+      livo::import::printBagTopics(cli.get("FORMAT"), cli.get("INPUT"), std::cout);
       return 0;
     }
-    if (!cli.has("--out")) throw std::invalid_argument("--out LOG is required");
-    job.out = cli.get("--out");
-    job.preset = cli.get("--preset");
-    if (cli.has("--rig")) {
-      job.rig_file = cli.get("--rig");
-      job.rig = livo::readSensorRig(livo::Config::load(job.rig_file).section("rig"));
-      job.channels = livo::import::channelNamesOf(*job.rig, job.channels);
-    }
-    job.rig_out = cli.get("--rig-out");
-    auto channel = [&](const char* flag, std::string& name) {
-      if (cli.has(flag)) name = cli.get(flag);
-    };
-    channel("--imu-channel", job.channels.imu);
-    channel("--lidar-channel", job.channels.lidar);
-    channel("--camera-channel", job.channels.camera);
-    channel("--camera-right-channel", job.channels.camera_right);
-    channel("--depth-channel", job.channels.depth);
-    channel("--ground-truth-channel", job.channels.ground_truth);
-    job.max_buffer_mb = cli.getInt("--max-buffer-mb");
-    job.quiet = cli.has("--quiet");
-
-    livo::import::RosbagImportOptions& r = job.rosbag;
-    r.imu_topic = cli.get("--imu");
-    r.lidar_topic = cli.get("--lidar");
-    r.camera_topic = cli.get("--camera");
-    r.camera_right_topic = cli.get("--camera-right");
-    r.depth_topic = cli.get("--depth");
-    r.camera_info_topic = cli.get("--camera-info");
-    if (cli.has("--ground-truth")) {
-      const std::string gt = cli.get("--ground-truth");
-      if (job.format == "rosbag" && !gt.empty() && gt[0] == '/' && !livo::import::isFile(gt))
-        r.ground_truth_topic = gt;
-      else
-        r.ground_truth_file = gt;
-      job.euroc.ground_truth_file = gt;
-    }
-    r.auto_map = !cli.has("--no-auto-topics");
-    r.use_bag_time = cli.has("--use-bag-time");
-    r.imu_units.accel = cli.get("--imu-accel-unit");
-    r.imu_units.gyro = cli.get("--imu-gyro-unit");
-    applyPreset(job);  // fills what the flags left empty
-    if (cli.has("--lidar-stamp")) r.lidar.stamp = stampConvention(cli.get("--lidar-stamp"));
-    if (cli.has("--sweep-duration")) {
-      r.lidar.sweep_duration = cli.getDouble("--sweep-duration");
-      job.kitti.sweep_duration = r.lidar.sweep_duration;
-    }
-    if (cli.has("--lidar-rings")) r.lidar.num_rings = static_cast<int>(cli.getInt("--lidar-rings"));
-    r.lidar.time_field = cli.get("--lidar-time-field");
-    r.lidar.time_unit = cli.get("--lidar-time-unit");
-    r.lidar.azimuth_times = !cli.has("--no-azimuth-times");
-
-    job.euroc.decode_png = cli.has("--decode-png");
-    job.ouster.metadata_file = cli.get("--metadata");
-    job.ouster.keep_partial_sweeps = !cli.has("--drop-partial-sweeps");
-    job.kitti.poses_file = cli.get("--poses");
-    job.kitti.times_file = cli.get("--times");
-    job.kitti.lidar_rate_hz = cli.getDouble("--lidar-rate");
-    job.kitti.point_fields = pointFields(cli.get("--point-fields"));
+    job = livo::import::importJobFromCommandLine(cli);
   } catch (const std::exception& e) {
     std::cerr << "livo-import: " << e.what() << "\n";
     return 2;

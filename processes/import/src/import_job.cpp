@@ -72,47 +72,44 @@ void printRigFindings(const std::vector<RigFinding>& findings, const std::string
   }
 }
 
-}  // namespace
+/// The LCM type written on each channel.
+std::map<std::string, std::string> channelTypes(const ChannelNames& ch) {
+  return {{ch.imu, "livo.imu_t"},      {ch.lidar, "livo.point_cloud_t"},
+          {ch.camera, "livo.image_t"}, {ch.camera_right, "livo.image_t"},
+          {ch.depth, "livo.image_t"},  {ch.ground_truth, "livo.pose_t"}};
+}
 
-ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
-  ImportOutcome out;
-  ImportReport& report = out.report;
-  report.setQuiet(job.quiet);
-  const ChannelNames& ch = job.channels;
-  out.channel_types = {{ch.imu, "livo.imu_t"},      {ch.lidar, "livo.point_cloud_t"},
-                       {ch.camera, "livo.image_t"}, {ch.camera_right, "livo.image_t"},
-                       {ch.depth, "livo.image_t"},  {ch.ground_truth, "livo.pose_t"}};
-  SortedLogWriterOptions wo;
-  wo.max_buffer_bytes = job.max_buffer_mb << 20;
-  SortedLogWriter writer(job.out, wo);
-  RigSurvey survey(ch);
-  writer.setObserver(&survey);
-  if (!job.preset.empty()) {
-    report.metadataString("preset", job.preset);
-    if (const RosbagPreset* p = findRosbagPreset(job.preset)) {
-      for (const auto& [k, v] : p->metadata) report.metadata(k, v);
-      presetCalibration(*p, job.rosbag, report);
-    }
+/// The preset's name, metadata and extrinsics into the report.
+void reportPreset(const std::string& preset, const RosbagImportOptions& r, ImportReport& report) {
+  report.metadataString("preset", preset);
+  if (const RosbagPreset* p = findRosbagPreset(preset)) {
+    for (const auto& [k, v] : p->metadata) report.metadata(k, v);
+    presetCalibration(*p, r, report);
   }
+}
+
+/// The format's importer, writing to `writer` (an unknown format or an importer's exception is an
+/// error in the report).
+void runImporter(const ImportJob& job, SortedLogWriter& writer, ImportReport& report) {
   try {
     if (job.format == "rosbag") {
       RosbagImportOptions o = job.rosbag;
-      o.channels = ch;
+      o.channels = job.channels;
       o.progress = !job.quiet;
       importRosbag({job.input}, o, writer, report);
     } else if (job.format == "kitti") {
       KittiImportOptions o = job.kitti;
-      o.channels = ch;
+      o.channels = job.channels;
       o.progress = !job.quiet;
       importKitti(job.input, o, writer, report);
     } else if (job.format == "euroc") {
       EurocImportOptions o = job.euroc;
-      o.channels = ch;
+      o.channels = job.channels;
       o.progress = !job.quiet;
       importEuroc(job.input, o, writer, report);
     } else if (job.format == "ouster") {
       OusterImportOptions o = job.ouster;
-      o.channels = ch;
+      o.channels = job.channels;
       o.progress = !job.quiet;
       importOuster(job.input, o, writer, report);
     } else {
@@ -121,6 +118,49 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
   } catch (const std::exception& e) {
     report.error(e.what());
   }
+}
+
+/// What the starter rig config is written from: the job, the log's counts and survey, the
+/// report's calibration and LiDAR layout.
+StarterRigInputs starterRigInputs(const ImportJob& job, const ImportOutcome& out) {
+  StarterRigInputs in;
+  in.format = job.format;
+  in.input = job.input;
+  in.log = job.out;
+  in.preset = job.preset;
+  in.channels = job.channels;
+  in.channel_counts = out.channel_counts;
+  in.survey = out.survey;
+  in.calibration = out.report.calibration();
+  const std::string layout = out.report.metadataValue("lidar_point_layout");
+  in.lidar_layout = layout.size() >= 2 && layout.front() == '"' ? layout.substr(1, layout.size() - 2) : layout;
+  return in;
+}
+
+void writeStarterRig(const ImportJob& job, const StarterRigInputs& in, ImportReport& report, std::ostream* summary) {
+  try {
+    writeStarterRigConfig(job.rig_out, in);
+    if (summary) *summary << "starter rig: " << job.rig_out << "\n";
+  } catch (const std::exception& e) {
+    report.error(e.what());
+  }
+}
+
+}  // namespace
+
+ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
+  ImportOutcome out;
+  ImportReport& report = out.report;
+  report.setQuiet(job.quiet);
+  const ChannelNames& ch = job.channels;
+  out.channel_types = channelTypes(ch);
+  SortedLogWriterOptions wo;
+  wo.max_buffer_bytes = job.max_buffer_mb << 20;
+  SortedLogWriter writer(job.out, wo);
+  RigSurvey survey(ch);
+  writer.setObserver(&survey);
+  if (!job.preset.empty()) reportPreset(job.preset, job.rosbag, report);
+  runImporter(job, writer, report);
   try {
     writer.finish();
     out.wrote_log = true;
@@ -137,25 +177,7 @@ ImportOutcome runImport(const ImportJob& job, std::ostream* summary) {
     if (out.wrote_log) *summary << "sidecar: " << job.out << ".meta.yaml\n";
   }
   if (!out.wrote_log) return out;
-  if (!job.rig_out.empty()) {
-    StarterRigInputs in;
-    in.format = job.format;
-    in.input = job.input;
-    in.log = job.out;
-    in.preset = job.preset;
-    in.channels = ch;
-    in.channel_counts = out.channel_counts;
-    in.survey = out.survey;
-    in.calibration = report.calibration();
-    const std::string layout = report.metadataValue("lidar_point_layout");
-    in.lidar_layout = layout.size() >= 2 && layout.front() == '"' ? layout.substr(1, layout.size() - 2) : layout;
-    try {
-      writeStarterRigConfig(job.rig_out, in);
-      if (summary) *summary << "starter rig: " << job.rig_out << "\n";
-    } catch (const std::exception& e) {
-      report.error(e.what());
-    }
-  }
+  if (!job.rig_out.empty()) writeStarterRig(job, starterRigInputs(job, out), report, summary);
   if (job.rig) {
     out.rig_findings = checkRigAgainstLog(*job.rig, job.rig_file, out.survey, report.calibration(), ch);
     printRigFindings(out.rig_findings, job.rig_file, summary, job.quiet);
