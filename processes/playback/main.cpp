@@ -1,25 +1,16 @@
 // livo-playback LOG: real-time or lockstep replay with optional fault injection.
 #include <iostream>
-#include <sstream>
 
 #include <lcm/lcm-cpp.hpp>
 
 #include "livo/command_line.hpp"
 #include "livo/node.hpp"
 #include "livo/playback/playback.hpp"
+#include "livo/playback/playback_command_line.hpp"
 
 namespace {
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-}  // namespace
 
-int main(int argc, char** argv) {
+livo::CommandLine playbackCommandLine() {
   livo::CommandLine cli("livo-playback",
                         "Replays an LCM log onto the bus: real time, faster, or in lockstep with the pipeline.");
   cli.positional("LOG", "LCM log to replay")
@@ -57,58 +48,41 @@ int main(int argc, char** argv) {
       .option("--startup-timeout", "S", "lockstep: give up when a consumer has not reported within S seconds", "30")
       .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
       .flag("--quiet", "no progress output");
-  if (!cli.parse(argc, argv)) return cli.exitCode();
+  return cli;
+}
 
+void printSummary(const livo::playback::PlaybackResult& r) {
+  std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
+            << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())
+            << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string())
+            << (r.not_waited > 0
+                    ? "; " + std::to_string(r.not_waited) +
+                          " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
+                    : std::string())
+            << std::endl;
+  std::cerr << "[playback] CPU " << livo::cpuSeconds() << " s (user + system)" << std::endl;
+  if (!r.waits.empty()) {
+    const auto lines = livo::playback::describeWaits(r.waits);
+    if (!lines.empty()) std::cerr << "[playback] lockstep waits, longest first (whose report ended them):\n";
+    for (const auto& l : lines) std::cerr << "[playback]   " << l << "\n";
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  livo::CommandLine cli = playbackCommandLine();
+  if (!cli.parse(argc, argv)) return cli.exitCode();
   try {
-    livo::playback::PlaybackOptions o;
-    o.log = cli.get("LOG");
-    o.speed = cli.getDouble("--speed");
-    o.lockstep = cli.has("--lockstep");
-    o.consumers = splitList(cli.get("--consumers"));
-    o.source.channels = cli.get("--channels");
-    o.source.start_s = cli.getDouble("--start");
-    o.source.duration_s = cli.getDouble("--duration");
-    for (const auto& f : splitList(cli.get("--faults"))) o.faults.push_back(livo::playback::parseFault(f));
-    o.seed = static_cast<uint64_t>(cli.getInt("--seed"));
-    o.out_log = cli.get("--out");
-    o.progress_channel = cli.get("--progress-channel");
-    o.clock_file = cli.get("--clock-file");
-    o.stall_timeout_s = cli.getDouble("--stall-timeout");
-    o.startup_timeout_s = cli.getDouble("--startup-timeout");
-    o.loss_grace_s = cli.getDouble("--loss-grace");
-    o.respawn = cli.has("--respawn");
-    o.serial = cli.has("--serial");
-    o.may_lag = splitList(cli.get("--lag"));
-    o.max_lag_messages = static_cast<int>(cli.getInt("--max-lag"));
-    if (o.max_lag_messages < 0) throw std::invalid_argument("--max-lag must be >= 0");
-    const double max_lag_mb = cli.getDouble("--max-lag-mb");
-    if (!(max_lag_mb >= 0.0)) throw std::invalid_argument("--max-lag-mb must be >= 0");
-    o.max_lag_bytes = static_cast<int64_t>(max_lag_mb * 1048576.0);
-    o.quiet = cli.has("--quiet");
-    if (o.speed < 0) throw std::invalid_argument("--speed must be >= 0");
+    const livo::playback::PlaybackOptions o = livo::playback::playbackOptionsFromCommandLine(cli);
     if (!o.quiet)
       for (const auto& f : o.faults) std::cerr << "[playback] fault: " << livo::playback::describe(f) << "\n";
-
     livo::keepLargeBlocksOnHeap();
     std::unique_ptr<lcm::LCM> lcm;
     if (o.out_log.empty()) lcm = livo::makeLcm(cli.get("--lcm-url"));
     livo::installSignalHandlers();
     const livo::playback::PlaybackResult r = livo::playback::runPlayback(o, lcm.get());
-    if (!o.quiet)
-      std::cerr << "[playback] " << r.published << " messages, " << r.log_seconds << " s of log in " << r.wall_seconds
-                << " s" << (r.lost > 0 ? ", " + std::to_string(r.lost) + " lost on the bus" : std::string())
-                << (r.restarts > 0 ? ", " + std::to_string(r.restarts) + " consumer restarts" : std::string())
-                << (r.not_waited > 0
-                        ? "; " + std::to_string(r.not_waited) +
-                              " went on before the whole pipeline had handled them (quiet promises, lagging consumers)"
-                        : std::string())
-                << std::endl;
-    if (!o.quiet) std::cerr << "[playback] CPU " << livo::cpuSeconds() << " s (user + system)" << std::endl;
-    if (!o.quiet && !r.waits.empty()) {
-      const auto lines = livo::playback::describeWaits(r.waits);
-      if (!lines.empty()) std::cerr << "[playback] lockstep waits, longest first (whose report ended them):\n";
-      for (const auto& l : lines) std::cerr << "[playback]   " << l << "\n";
-    }
+    if (!o.quiet) printSummary(r);
     if (!r.error.empty()) {
       std::cerr << "livo-playback: " << r.error << std::endl;
       return 1;

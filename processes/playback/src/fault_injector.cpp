@@ -138,33 +138,54 @@ bool FaultInjector::makeNanPoints(LogEvent& e) {
 }
 
 std::vector<LogEvent> FaultInjector::push(LogEvent event, int64_t t0) {
-  std::vector<LogEvent> out;
   // Release delayed events whose time has come (before this one, by stamp).
-  while (!delayed_.empty() && delayed_.top().release_utime <= event.utime) {
+  std::vector<LogEvent> out = releaseDelayed(event.utime);
+  FaultCounts& counts = counts_[event.channel];
+  const double t = (event.utime - t0) * 1e-6;
+  const FaultDecision decision = applyFaults(event, t, counts);
+  if (!decision.emit) {
+    // A dropped or cut message is gone; count it once under the reason that applied first.
+    (inCut(event.channel, t) ? counts.cut : counts.dropped)++;
+    return out;
+  }
+  std::vector<LogEvent> now;
+  now.push_back(event);
+  if (decision.duplicate) {
+    now.push_back(event);
+    ++counts.duplicated;
+  }
+  for (LogEvent& e : route(std::move(now), decision, counts)) out.push_back(std::move(e));
+  return out;
+}
+
+std::vector<LogEvent> FaultInjector::releaseDelayed(int64_t utime) {
+  std::vector<LogEvent> out;
+  while (!delayed_.empty() && delayed_.top().release_utime <= utime) {
     out.push_back(delayed_.top().event);
     delayed_.pop();
   }
-  FaultCounts& counts = counts_[event.channel];
-  const double t = (event.utime - t0) * 1e-6;
-  bool emit = true, duplicate = false, hold = false;
-  int64_t delay_us = 0;
+  return out;
+}
+
+FaultInjector::FaultDecision FaultInjector::applyFaults(LogEvent& event, double t, FaultCounts& counts) {
+  FaultDecision d;
   for (const Fault& f : faults_) {
     if (f.channel != event.channel) continue;
     switch (f.kind) {
       case Fault::Kind::kCut:
-        if (t >= f.from_s && t < f.to_s) emit = false;
+        if (t >= f.from_s && t < f.to_s) d.emit = false;
         break;
       case Fault::Kind::kDrop:
-        if (draw(f.fraction)) emit = false;
+        if (draw(f.fraction)) d.emit = false;
         break;
       case Fault::Kind::kDuplicate:
-        if (draw(f.fraction)) duplicate = true;
+        if (draw(f.fraction)) d.duplicate = true;
         break;
       case Fault::Kind::kDelay:
-        if (draw(f.fraction)) delay_us = static_cast<int64_t>(std::llround(f.seconds * 1e6));
+        if (draw(f.fraction)) d.delay_us = static_cast<int64_t>(std::llround(f.seconds * 1e6));
         break;
       case Fault::Kind::kReorder:
-        if (draw(f.fraction)) hold = true;
+        if (draw(f.fraction)) d.hold = true;
         break;
       case Fault::Kind::kCorrupt:
         if (draw(f.fraction)) {
@@ -182,24 +203,24 @@ std::vector<LogEvent> FaultInjector::push(LogEvent event, int64_t t0) {
         break;
     }
   }
-  if (!emit) {
-    // A dropped or cut message is gone; count it once under the reason that applied first.
-    bool in_cut = false;
-    for (const Fault& f : faults_)
-      if (f.channel == event.channel && f.kind == Fault::Kind::kCut && t >= f.from_s && t < f.to_s) in_cut = true;
-    (in_cut ? counts.cut : counts.dropped)++;
-    return out;
-  }
-  std::vector<LogEvent> now;
-  now.push_back(event);
-  if (duplicate) {
-    now.push_back(event);
-    ++counts.duplicated;
-  }
+  return d;
+}
+
+bool FaultInjector::inCut(const std::string& channel, double t) const {
+  bool in_cut = false;
+  for (const Fault& f : faults_)
+    if (f.channel == channel && f.kind == Fault::Kind::kCut && t >= f.from_s && t < f.to_s) in_cut = true;
+  return in_cut;
+}
+
+std::vector<LogEvent> FaultInjector::route(std::vector<LogEvent> now, const FaultDecision& decision,
+                                           FaultCounts& counts) {
+  std::vector<LogEvent> out;
+  bool hold = decision.hold;
   for (LogEvent& e : now) {
-    if (delay_us > 0) {
+    if (decision.delay_us > 0) {
       ++counts.delayed;
-      const int64_t release = e.utime + delay_us;
+      const int64_t release = e.utime + decision.delay_us;
       delayed_.push(Delayed{release, order_++, std::move(e)});
       continue;
     }

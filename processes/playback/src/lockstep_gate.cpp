@@ -29,36 +29,8 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
   if (is_new) {
     n.instance = p.instance;
   } else if (p.instance != n.instance) {
-    // A new process under the same name: its counts start again from zero. What the old instance
-    // published stays published; what was published before the new one reported is lost to it.
-    for (const auto& [channel, count] : n.published) n.published_before[channel] += count;
-    for (const auto& [channel, bytes] : n.published_bytes) n.published_bytes_before[channel] += bytes;
-    n.published.clear();
-    n.published_bytes.clear();
-    std::ostringstream lost;
-    int64_t lost_total = 0;
-    for (int i = 0; i < p.num_inputs; ++i) {
-      const std::string& channel = p.input_channel[i];
-      const int64_t missed = totalPublished(channel) - n.handled[channel] - n.offset[channel];
-      if (missed > 0) {
-        lost << (lost_total ? ", " : "") << missed << " " << channel;
-        lost_total += missed;
-      }
-    }
-    n.handled.clear();
-    n.offset.clear();
-    for (int i = 0; i < p.num_inputs; ++i)
-      n.offset[p.input_channel[i]] = totalPublished(p.input_channel[i]) - p.handled[i];
-    n.instance = p.instance;
-    n.sequence = -1;
-    n.finished = false;
-    n.away = false;
+    startNewInstance(p, n);
     changed = true;
-    if (isConsumer(p.node)) {
-      ++restarts_;
-      events_.push_back("consumer " + p.node + " restarted" +
-                        (lost_total ? "; missed while it was away: " + lost.str() : std::string()));
-    }
   }
   if (p.sequence <= n.sequence && !p.finished) return false;  // stale or reordered
   n.last_heard_s = now_s;
@@ -67,6 +39,55 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
     events_.push_back("consumer " + p.node + " is heard again");
   }
   n.sequence = p.sequence;
+  const bool counts_changed = recordCounts(p, n, now_s);
+  changed = changed || counts_changed;
+  if (p.finished && !n.finished) {
+    noteFinished(p.node, n, now_s);
+    changed = true;
+  }
+  if (p.idle && !p.finished && isConsumer(p.node))
+    detectLosses(p.node, n, std::isfinite(idle_checked_s) ? std::min(idle_checked_s, now_s) : now_s);
+  updateWaiting(now_s);
+  // who may lag depends on who takes what (and who is away): worked out again when that changes
+  if (is_new || n.handled.size() != inputs_before || n.published.size() != outputs_before || n.away != away_before)
+    noteLagDecisions();
+  return changed;
+}
+
+void LockstepGate::startNewInstance(const progress_t& p, NodeState& n) {
+  // A new process under the same name: its counts start again from zero. What the old instance
+  // published stays published; what was published before the new one reported is lost to it.
+  for (const auto& [channel, count] : n.published) n.published_before[channel] += count;
+  for (const auto& [channel, bytes] : n.published_bytes) n.published_bytes_before[channel] += bytes;
+  n.published.clear();
+  n.published_bytes.clear();
+  std::ostringstream lost;
+  int64_t lost_total = 0;
+  for (int i = 0; i < p.num_inputs; ++i) {
+    const std::string& channel = p.input_channel[i];
+    const int64_t missed = totalPublished(channel) - n.handled[channel] - n.offset[channel];
+    if (missed > 0) {
+      lost << (lost_total ? ", " : "") << missed << " " << channel;
+      lost_total += missed;
+    }
+  }
+  n.handled.clear();
+  n.offset.clear();
+  for (int i = 0; i < p.num_inputs; ++i)
+    n.offset[p.input_channel[i]] = totalPublished(p.input_channel[i]) - p.handled[i];
+  n.instance = p.instance;
+  n.sequence = -1;
+  n.finished = false;
+  n.away = false;
+  if (isConsumer(p.node)) {
+    ++restarts_;
+    events_.push_back("consumer " + p.node + " restarted" +
+                      (lost_total ? "; missed while it was away: " + lost.str() : std::string()));
+  }
+}
+
+bool LockstepGate::recordCounts(const progress_t& p, NodeState& n, double now_s) {
+  bool changed = false;
   n.quiet.clear();
   for (int i = 0; i < p.num_quiet; ++i)
     if (p.quiet_before[i] > p.quiet_from[i]) n.quiet[p.quiet_channel[i]] = {p.quiet_from[i], p.quiet_before[i]};
@@ -85,22 +106,16 @@ bool LockstepGate::onProgress(const progress_t& p, double now_s, double idle_che
       notePublished(p.output_channel[i], now_s);
     }
   }
-  if (p.finished && !n.finished) {
-    n.finished = true;
-    changed = true;
-    if (options_.tolerate_restarts && isConsumer(p.node)) {
-      n.away = true;
-      n.away_since_s = now_s;
-      events_.push_back("consumer " + p.node + " exited; not waited for until it restarts");
-    }
-  }
-  if (p.idle && !p.finished && isConsumer(p.node))
-    detectLosses(p.node, n, std::isfinite(idle_checked_s) ? std::min(idle_checked_s, now_s) : now_s);
-  updateWaiting(now_s);
-  // who may lag depends on who takes what (and who is away): worked out again when that changes
-  if (is_new || n.handled.size() != inputs_before || n.published.size() != outputs_before || n.away != away_before)
-    noteLagDecisions();
   return changed;
+}
+
+void LockstepGate::noteFinished(const std::string& node, NodeState& n, double now_s) {
+  n.finished = true;
+  if (options_.tolerate_restarts && isConsumer(node)) {
+    n.away = true;
+    n.away_since_s = now_s;
+    events_.push_back("consumer " + node + " exited; not waited for until it restarts");
+  }
 }
 
 void LockstepGate::onPublished(const std::string& channel, double now_s, int64_t utime, int64_t bytes) {

@@ -57,6 +57,23 @@ class FaultInjector {
       return release_utime != o.release_utime ? release_utime > o.release_utime : order > o.order;
     }
   };
+  /// What the faults on a message's channel decided (corrupt, NaN points and time jumps are
+  /// applied to the message itself).
+  struct FaultDecision {
+    bool emit = true;  // false: dropped or cut
+    bool duplicate = false;
+    bool hold = false;  // reorder: held until the channel's next message
+    int64_t delay_us = 0;
+  };
+  /// Delayed events due at or before `utime`, in release order (taken off the queue).
+  std::vector<LogEvent> releaseDelayed(int64_t utime);
+  /// Draws every fault of the event's channel (`t`: seconds since the log's start) in order.
+  FaultDecision applyFaults(LogEvent& event, double t, FaultCounts& counts);
+  /// A cut of `channel` covers log time `t`.
+  bool inCut(const std::string& channel, double t) const;
+  /// Sends the message (and its duplicate) to the delay queue or the held place of a reorder, or
+  /// returns it (with a held one it releases) to be emitted now.
+  std::vector<LogEvent> route(std::vector<LogEvent> now, const FaultDecision& decision, FaultCounts& counts);
   bool draw(double fraction);
   void corrupt(LogEvent& e);
   bool makeNanPoints(LogEvent& e);

@@ -136,6 +136,13 @@ class LockstepGate {
     int64_t handled = 0;
     double since_s = 0.0;
   };
+  /// A new instance of a known node (it restarted): its counts start again, what was published
+  /// while it was away is counted as lost to it.
+  void startNewInstance(const progress_t& p, NodeState& n);
+  /// Takes the report's quiet promises and counts; true if a count changed.
+  bool recordCounts(const progress_t& p, NodeState& n, double now_s);
+  /// The node exited (tolerate_restarts: a consumer is away until a new instance reports).
+  void noteFinished(const std::string& node, NodeState& n, double now_s);
   int64_t totalPublished(const std::string& channel) const;  // known_total_: kept up to date
   int64_t countPublished(const std::string& channel) const;  // summed over playback and the nodes
   /// Messages on `channel` published at or before `t_s`.
