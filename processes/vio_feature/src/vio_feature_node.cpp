@@ -21,38 +21,30 @@ constexpr size_t kMaxDepthImages = 30;
 }  // namespace
 
 VioFeatureNode::VioFeatureNode(lcm::LCM& lcm, NodeOptions node_options, VioFeatureNodeOptions options)
-    : node_(lcm, std::move(node_options)), opts_(std::move(options)), estimator_(opts_.core) {
-  node_.declareOutput(opts_.visual_state_channel);
-  node_.declareOutput(opts_.odometry_channel);
-  node_.subscribe<imu_t>(opts_.imu_channel, [this](const imu_t& m) { onImu(m); });
-  node_.subscribe<image_t>(opts_.camera_channel, [this](const image_t& m) { onImage(m); });
-  if (opts_.core.use_depth_image)
-    node_.subscribe<image_t>(opts_.depth_channel, [this](const image_t& m) { onDepth(m); });
-  if (opts_.core.window.use_wheel)
-    node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
-  if (opts_.core.use_lidar_depth)
-    node_.subscribe<registered_scan_t>(opts_.registered_scan_channel,
+    : node_(lcm, std::move(node_options)), options_(std::move(options)), estimator_(options_.core) {
+  node_.declareOutput(options_.visual_state_channel);
+  node_.declareOutput(options_.odometry_channel);
+  node_.subscribe<imu_t>(options_.imu_channel, [this](const imu_t& m) { onImu(m); });
+  node_.subscribe<image_t>(options_.camera_channel, [this](const image_t& m) { onImage(m); });
+  if (options_.core.use_depth_image)
+    node_.subscribe<image_t>(options_.depth_channel, [this](const image_t& m) { onDepth(m); });
+  if (options_.core.window.use_wheel)
+    node_.subscribe<wheel_odometry_t>(options_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
+  if (options_.core.use_lidar_depth)
+    node_.subscribe<registered_scan_t>(options_.registered_scan_channel,
                                        [this](const registered_scan_t& m) { onScan(m); });
 }
 
 void VioFeatureNode::onImu(const imu_t& m) {
   std::string why;
-  if (!estimator_.addImu(fromMessage(m), &why)) {
-    node_.reject(opts_.imu_channel, why);
-    return;
-  }
-  imu_watermark_ = m.utime;
-  processReady();
+  const auto add = [&](std::string* w) { return estimator_.addImu(fromMessage(m), w); };
+  if (imu_.take(node_, options_.imu_channel, m.utime, add, &why)) processReady();
 }
 
 void VioFeatureNode::onWheel(const wheel_odometry_t& m) {
   std::string why;
-  if (!estimator_.addWheel(fromMessage(m), &why)) {
-    node_.reject(opts_.wheel_channel, why);
-    return;
-  }
-  wheel_watermark_ = m.utime;
-  processReady();
+  const auto add = [&](std::string* w) { return estimator_.addWheel(fromMessage(m), w); };
+  if (wheel_.take(node_, options_.wheel_channel, m.utime, add, &why)) processReady();
 }
 
 void VioFeatureNode::onImage(const image_t& m) {
@@ -60,32 +52,33 @@ void VioFeatureNode::onImage(const image_t& m) {
   p.utime = m.utime;
   p.t = estimator_.imuTime(m.utime);
   std::string why;
-  if (!decodeGrey(rawImage(m), opts_.core.camera.width, opts_.core.camera.height, &p.grey, &why)) {
-    node_.reject(opts_.camera_channel, why);
+  if (!decodeGrey(rawImage(m), options_.core.camera.width, options_.core.camera.height, &p.grey, &why)) {
+    node_.reject(options_.camera_channel, why);
     refused_.add(why);
     ++bad_images_;
     return;
   }
-  if ((!pending_.empty() && p.t <= pending_.back().t) || p.t <= estimator_.lastImageTime()) {
-    node_.reject(opts_.camera_channel, "image not later than the previous one");
+  if (!pending_.takes(p.t) || p.t <= estimator_.lastImageTime()) {
+    node_.reject(options_.camera_channel, "image not later than the previous one");
     refused_.add("image not later than the previous one");
     return;
   }
   if (pending_.size() >= kMaxPendingImages) {
     node_.warn("no IMU up to " + std::to_string(pending_.front().t) + ": image dropped");
     refused_.add("dropped waiting for the IMU");
-    pending_.pop_front();
+    pending_.popFront();
     ++dropped_;
   }
-  pending_.push_back(std::move(p));
+  const int64_t t = p.t;
+  pending_.pushLater(t, std::move(p));
   processReady();
 }
 
 void VioFeatureNode::onDepth(const image_t& m) {
   cv::Mat depth;
   std::string why;
-  if (!decodeDepth(rawImage(m), opts_.core.camera.width, opts_.core.camera.height, &depth, &why)) {
-    node_.reject(opts_.depth_channel, why);
+  if (!decodeDepth(rawImage(m), options_.core.camera.width, options_.core.camera.height, &depth, &why)) {
+    node_.reject(options_.depth_channel, why);
     return;
   }
   depth_images_[m.utime] = depth;
@@ -95,38 +88,36 @@ void VioFeatureNode::onDepth(const image_t& m) {
 
 void VioFeatureNode::onScan(const registered_scan_t& m) {
   if (const std::string why = registeredScanProblem(m); !why.empty()) {
-    node_.reject(opts_.registered_scan_channel, why);
+    node_.reject(options_.registered_scan_channel, why);
     return;
   }
   // into the body frame at the sweep's end, keeping what lies in front of the camera
-  BodyScan s = toBodyScan(m, opts_.core.window.T_I_C, opts_.core.lidar_depth.min_depth);
-  if (!scans_.empty() && s.t <= scans_.back().t) {
-    node_.reject(opts_.registered_scan_channel, "scan not later than the previous one");
+  BodyScan s = toBodyScan(m, options_.core.window.T_I_C, options_.core.lidar_depth.min_depth);
+  const int64_t t = s.t;
+  if (!scans_.pushLater(t, std::move(s))) {
+    node_.reject(options_.registered_scan_channel, "scan not later than the previous one");
     return;
   }
-  scans_.push_back(std::move(s));
-  scan_watermark_ = m.utime;
-  const int64_t keep = scan_watermark_ - toUtime(opts_.core.lidar_depth_window_s + opts_.lidar_max_wait_s + 0.2);
-  while (scans_.size() > 1 && scans_.front().t < keep) scans_.pop_front();
+  const int64_t keep =
+      scans_.watermark() - toUtime(options_.core.lidar_depth_window_s + options_.lidar_max_wait_s + 0.2);
+  while (scans_.size() > 1 && scans_.front().t < keep) scans_.popFront();
   processReady();
 }
 
 bool VioFeatureNode::ready(const PendingImage& p) const {
-  if (imu_watermark_ < p.t) return false;
-  auto waited = [&](double max_wait_s) { return imu_watermark_ >= p.t + toUtime(max_wait_s); };
-  if (opts_.core.window.use_wheel && wheel_watermark_ < p.t && !waited(opts_.wheel_max_wait_s)) return false;
-  if (opts_.core.use_depth_image && !depth_images_.count(p.utime) && !waited(opts_.depth_max_wait_s)) return false;
-  if (opts_.core.use_lidar_depth && scan_watermark_ < p.t - toUtime(opts_.core.lidar_lag_s) &&
-      !waited(opts_.lidar_max_wait_s))
+  if (imu_.watermark() < p.t) return false;
+  auto waited = [&](double max_wait_s) { return imu_.watermark() >= p.t + toUtime(max_wait_s); };
+  if (options_.core.window.use_wheel && wheel_.watermark() < p.t && !waited(options_.wheel_max_wait_s)) return false;
+  if (options_.core.use_depth_image && !depth_images_.count(p.utime) && !waited(options_.depth_max_wait_s))
+    return false;
+  if (options_.core.use_lidar_depth && scans_.watermark() < p.t - toUtime(options_.core.lidar_lag_s) &&
+      !waited(options_.lidar_max_wait_s))
     return false;
   return true;
 }
 
 void VioFeatureNode::processReady() {
-  while (!pending_.empty() && ready(pending_.front())) {
-    process(pending_.front());
-    pending_.pop_front();
-  }
+  pending_.popWhile([this](const PendingImage& p) { return ready(p); }, [this](const PendingImage& p) { process(p); });
 }
 
 void VioFeatureNode::process(const PendingImage& p) {
@@ -134,9 +125,9 @@ void VioFeatureNode::process(const PendingImage& p) {
   ImageInput in;
   in.utime = p.utime;
   in.grey = p.grey;
-  const auto depth = opts_.core.use_depth_image ? depth_images_.find(p.utime) : depth_images_.end();
+  const auto depth = options_.core.use_depth_image ? depth_images_.find(p.utime) : depth_images_.end();
   if (depth != depth_images_.end()) in.depth = &depth->second;
-  if (opts_.core.use_lidar_depth) in.scans = &scans_;
+  if (options_.core.use_lidar_depth) in.scans = &scans_.samples();
   const ImageOutcome out = estimator_.addImage(in);
   if (depth != depth_images_.end()) depth_images_.erase(depth_images_.begin(), std::next(depth));
   node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -148,7 +139,7 @@ void VioFeatureNode::process(const PendingImage& p) {
     return;
   }
   if (r.status == FrameResult::Status::kRejected) {
-    node_.reject(opts_.camera_channel, r.note);
+    node_.reject(options_.camera_channel, r.note);
     refused_.add(r.note);
     return;
   }
@@ -160,8 +151,8 @@ void VioFeatureNode::process(const PendingImage& p) {
   }
   init_note_.clear();
   if (r.status == FrameResult::Status::kInitialized) node_.info(r.note);
-  node_.publish(opts_.visual_state_channel, toVisualState(r, out.epoch));
-  node_.publish(opts_.odometry_channel, toOdometry(r, out.epoch));
+  node_.publish(options_.visual_state_channel, toVisualState(r, out.epoch));
+  node_.publish(options_.odometry_channel, toOdometry(r, out.epoch));
 }
 
 void VioFeatureNode::reportRefusals() {
@@ -184,8 +175,8 @@ std::string VioFeatureNode::summary() const {
   const Counts c = counts();
   std::ostringstream s;
   s << c.images << " images: " << c.tracked << " with a state";
-  if (opts_.core.use_depth_image) s << ", " << c.with_depth_image << " with their depth image";
-  if (opts_.core.use_lidar_depth) s << ", " << c.with_lidar << " with LiDAR depth";
+  if (options_.core.use_depth_image) s << ", " << c.with_depth_image << " with their depth image";
+  if (options_.core.use_lidar_depth) s << ", " << c.with_lidar << " with LiDAR depth";
   if (c.bad_images) s << ", " << c.bad_images << " refused";
   if (c.dropped) s << ", " << c.dropped << " dropped waiting for the IMU";
   if (estimator_.epoch()) s << "; " << estimator_.epoch() << " restarts";

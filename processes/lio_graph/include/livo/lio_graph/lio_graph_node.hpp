@@ -11,8 +11,6 @@
 // only on the messages' contents and stamps, not on how the channels interleave.
 #pragma once
 
-#include <deque>
-
 #include <lcm/lcm-cpp.hpp>
 
 #include "livo/imu_t.hpp"
@@ -21,6 +19,8 @@
 #include "livo/loop_correction_t.hpp"
 #include "livo/node.hpp"
 #include "livo/point_cloud_t.hpp"
+#include "livo/sample_queue.hpp"
+#include "livo/sensor_feed.hpp"
 #include "livo/sweep_timing.hpp"
 #include "livo/visual_state_t.hpp"
 #include "livo/wheel_odometry_t.hpp"
@@ -52,15 +52,18 @@ class LioGraphNode {
   /// Warns (HEALTH, stderr) "odometry reset to epoch N: why: re-initialising" after the estimator
   /// was reset.
   void announceReset(const std::string& why);
+  /// Whether a sweep ending at t_end may be processed: the IMU has passed its end and, with wheels
+  /// or the visual subsystem, their watermark has too, or the IMU has gone their max wait beyond it.
+  bool ready(int64_t t_end) const;
+  /// Processes the waiting sweeps, oldest first, as long as they are ready.
   void processReady();
   void process(const PendingSweep& p);
 
   Node node_;
-  LioGraphNodeOptions opts_;
+  LioGraphNodeOptions options_;
   LioGraphEstimator estimator_;
-  std::deque<PendingSweep> pending_;
-  int64_t imu_watermark_ = INT64_MIN;
-  int64_t wheel_watermark_ = INT64_MIN;
+  SampleQueue<PendingSweep> pending_;  // by sweep end, in arrival order
+  SensorFeed imu_, wheel_;             // into the estimator; their watermarks
   int64_t processed_ = 0, tracked_ = 0, predicted_ = 0, degenerate_ = 0, visual_ = 0, visual_factors_ = 0;
   int64_t resets_ = 0;
 };

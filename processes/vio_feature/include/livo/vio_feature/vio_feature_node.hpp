@@ -12,7 +12,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <string>
 
@@ -24,6 +23,8 @@
 #include "livo/node.hpp"
 #include "livo/reason_counts.hpp"
 #include "livo/registered_scan_t.hpp"
+#include "livo/sample_queue.hpp"
+#include "livo/sensor_feed.hpp"
 #include "livo/vio_feature/vio_feature_config.hpp"
 #include "livo/vio_feature/vio_feature_estimator.hpp"
 #include "livo/wheel_odometry_t.hpp"
@@ -66,23 +67,23 @@ class VioFeatureNode {
   void onImage(const image_t& m);
   void onDepth(const image_t& m);
   void onScan(const registered_scan_t& m);
+  /// Whether an image may be processed: what it waits for has come (vio_feature_node.hpp's top).
   bool ready(const PendingImage& p) const;
+  /// Processes the waiting images, oldest first, as long as they are ready.
   void processReady();
   void process(const PendingImage& p);
 
   Node node_;
-  VioFeatureNodeOptions opts_;
+  VioFeatureNodeOptions options_;
   VioFeatureEstimator estimator_;
-  std::deque<PendingImage> pending_;
+  SampleQueue<PendingImage> pending_;        // by IMU-clock time, in arrival order
   std::map<int64_t, cv::Mat> depth_images_;  // by camera utime
-  std::deque<BodyScan> scans_;
-  int64_t imu_watermark_ = INT64_MIN;
-  int64_t wheel_watermark_ = INT64_MIN;
-  int64_t scan_watermark_ = INT64_MIN;
-  std::string init_note_;   // the last reason the estimator gave for not initialising yet
-  int64_t bad_images_ = 0;  // Counts::bad_images
-  int64_t dropped_ = 0;     // Counts::dropped
-  ReasonCounts refused_;    // why images gave no state
+  SampleQueue<BodyScan> scans_;              // by sweep end; watermark(): the REGISTERED_SCAN one
+  SensorFeed imu_, wheel_;                   // into the estimator; their watermarks
+  std::string init_note_;                    // the last reason the estimator gave for not initialising yet
+  int64_t bad_images_ = 0;                   // Counts::bad_images
+  int64_t dropped_ = 0;                      // Counts::dropped
+  ReasonCounts refused_;                     // why images gave no state
 };
 
 }  // namespace livo::vio_feature
