@@ -1,6 +1,7 @@
 #include "livo/lio_graph/lio_graph_messages.hpp"
 
 #include "livo/messages.hpp"
+#include "livo/odometry_message.hpp"
 #include "livo/output_messages.hpp"
 
 namespace livo::lio_graph {
@@ -14,22 +15,17 @@ VisualSample toVisualSample(const visual_state_t& m) {
 }
 
 odometry_t toOdometry(const GraphScanResult& r, const OdometryFrame& frame) {
-  odometry_t o;
+  OdometryOutput o;
   o.utime = r.utime;
-  o.parent_frame = "W";
-  o.child_frame = "I";
-  poseTo(r.pose, o.position, o.orientation);
-  vec3To(r.velocity, o.velocity);
-  vec3To(r.angular_velocity, o.angular_velocity);
-  matrixTo<6>(r.pose_covariance, o.pose_covariance);
-  matrixTo<3>(Mat3(Mat3::Identity() * 1e-2), o.velocity_covariance);
+  o.pose = r.pose;
+  o.velocity = r.velocity;
+  o.angular_velocity = r.angular_velocity;
+  o.pose_covariance = r.pose_covariance;
+  o.velocity_covariance = Mat3::Identity() * 1e-2;
   // a predicted sweep used none: its matching, if any, was not taken
   o.num_residuals = r.status == GraphScanResult::Status::kPredicted ? 0 : r.edge_residuals + r.surface_residuals;
-  o.degenerate = r.degenerate ? 1 : 0;
-  o.min_information_eigenvalue = 0.0;
-  o.epoch = frame.epoch;
-  o.correction_id = frame.correction_id;
-  return o;
+  o.degenerate = r.degenerate;
+  return odometryMessage(o, OutputFrame{frame.epoch, frame.correction_id});
 }
 
 registered_scan_t toRegisteredScan(const GraphScanResult& r, const point_cloud_t& input, const OdometryFrame& frame) {

@@ -1,6 +1,7 @@
 #include "livo/vio_feature/vio_feature_messages.hpp"
 
 #include "livo/messages.hpp"
+#include "livo/odometry_message.hpp"
 
 namespace livo::vio_feature {
 
@@ -37,21 +38,16 @@ visual_state_t toVisualState(const FrameResult& r, int32_t epoch) {
 
 odometry_t toOdometry(const FrameResult& r, int32_t epoch) {
   const VisualState& s = r.state;
-  odometry_t o;
+  OdometryOutput o;
   o.utime = s.utime;
   o.parent_frame = "V";
-  o.child_frame = "I";
-  poseTo(s.pose, o.position, o.orientation);
-  vec3To(s.velocity, o.velocity);
-  vec3To(Vec3::Zero(), o.angular_velocity);
-  matrixTo<6>(s.pose_covariance, o.pose_covariance);
-  matrixTo<3>(Mat3(Mat3::Identity() * 1e-2), o.velocity_covariance);
+  o.pose = s.pose;
+  o.velocity = s.velocity;
+  o.pose_covariance = s.pose_covariance;
+  o.velocity_covariance = Mat3::Identity() * 1e-2;
   o.num_residuals = 2 * r.features_in_graph;
-  o.degenerate = r.features_in_graph < 20 ? 1 : 0;
-  o.min_information_eigenvalue = 0.0;
-  o.epoch = epoch;
-  o.correction_id = 0;
-  return o;
+  o.degenerate = r.features_in_graph < 20;
+  return odometryMessage(o, OutputFrame{epoch, 0});
 }
 
 }  // namespace livo::vio_feature
