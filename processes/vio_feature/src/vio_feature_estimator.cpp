@@ -8,22 +8,22 @@
 namespace livo::vio_feature {
 
 VioFeatureEstimator::VioFeatureEstimator(VioFeatureOptions options)
-    : opts_(std::move(options)),
-      window_(opts_.window),
-      tracker_(CameraProjection(opts_.camera), opts_.tracker),
-      lidar_map_(CameraProjection(opts_.camera), opts_.lidar_depth),
-      offset_us_(toUtime(opts_.window.camera_time_offset_s)) {}
+    : options_(std::move(options)),
+      window_(options_.window),
+      tracker_(CameraProjection(options_.camera), options_.tracker),
+      lidar_map_(CameraProjection(options_.camera), options_.lidar_depth),
+      offset_us_(toUtime(options_.window.camera_time_offset_s)) {}
 
 int VioFeatureEstimator::lidarDepth(int64_t t, const std::deque<BodyScan>& scans,
                                     std::vector<FeatureObservation>* features) {
   Pose3 T_W_It;
   if (!window_.poseAt(t, &T_W_It)) return 0;
-  const Pose3 T_C_W = (T_W_It * opts_.window.T_I_C).inverse();
+  const Pose3 T_C_W = (T_W_It * options_.window.T_I_C).inverse();
   std::vector<Vec3> points_C;
   for (const BodyScan& s : scans) {
     // the scans that ended lidar_lag_s before the image at the latest: the same set however the
     // channels interleave (a later one may or may not have arrived)
-    if (s.t < t - toUtime(opts_.lidar_depth_window_s) || s.t > t - toUtime(opts_.lidar_lag_s)) continue;
+    if (s.t < t - toUtime(options_.lidar_depth_window_s) || s.t > t - toUtime(options_.lidar_lag_s)) continue;
     Pose3 T_W_Is;
     if (!window_.poseAt(s.t, &T_W_Is)) continue;  // older than the window, or past the IMU
     const Pose3 T_C_Is = T_C_W * T_W_Is;
@@ -40,16 +40,16 @@ ImageOutcome VioFeatureEstimator::addImage(const ImageInput& in) {
   // the gyro's rotation since the previous image predicts where the features move
   Mat3 R_I;
   const bool hint = last_image_t_ != INT64_MIN && window_.gyroRotation(last_image_t_, t, &R_I);
-  const Mat3 R_IC = opts_.window.T_I_C.linear();
+  const Mat3 R_IC = options_.window.T_I_C.linear();
   const Mat3 R_cur_prev = R_IC.transpose() * R_I.transpose() * R_IC;
   last_image_t_ = t;
   TrackedFrame tracked = tracker_.track(in.utime, in.grey, hint ? &R_cur_prev : nullptr);
-  if (opts_.use_depth_image && in.depth) {
-    depthFromImage(*in.depth, opts_.depth_image, &tracked.features);
+  if (options_.use_depth_image && in.depth) {
+    depthFromImage(*in.depth, options_.depth_image, &tracked.features);
     out.with_depth_image = true;
     ++stats_.with_depth_image;
   }
-  if (opts_.use_lidar_depth && in.scans && lidarDepth(t, *in.scans, &tracked.features) > 0) {
+  if (options_.use_lidar_depth && in.scans && lidarDepth(t, *in.scans, &tracked.features) > 0) {
     out.with_lidar = true;
     ++stats_.with_lidar;
   }

@@ -82,13 +82,13 @@ class VioFeatureEstimator {
   /// Restarts so far (= the current epoch).
   int32_t epoch() const { return epoch_; }
   const Stats& stats() const { return stats_; }
-  const VioFeatureOptions& options() const { return opts_; }
+  const VioFeatureOptions& options() const { return options_; }
 
  private:
   /// Depth from the scans moved into the camera at t (the window's poses); how many features got one.
   int lidarDepth(int64_t t, const std::deque<BodyScan>& scans, std::vector<FeatureObservation>* features);
 
-  VioFeatureOptions opts_;
+  VioFeatureOptions options_;
   SlidingWindowEstimator window_;
   FeatureTracker tracker_;
   LidarDepthMap lidar_map_;
