@@ -54,9 +54,8 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-}  // namespace
-
-int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& err) {
+// The command line: its options and what each means.
+CommandLine evaluateCommandLine() {
   CommandLine cli("livo-evaluate",
                   "Absolute trajectory error, relative pose error and KITTI drift of an estimated trajectory against\n"
                   "ground truth. Inputs: TUM files, KITTI pose files (paired by index), EuRoC csv, or LCM logs\n"
@@ -91,27 +90,39 @@ int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& e
       .option("--report", "F", "write a Markdown report with the tables, embedding the --plot figure")
       .option("--title", "T", "title of the figure and report (default: estimate vs ground truth)")
       .flag("--quiet", "print nothing on success");
+  return cli;
+}
+
+// The evaluation's options from the command line, validated.
+EvaluationOptions evaluationOptions(const CommandLine& cli) {
+  EvaluationOptions options;
+  options.alignment = parseAlignment(cli.get("--align"));
+  options.max_dt = cli.getDouble("--max-dt");
+  if (cli.has("--gt-offset")) {
+    const auto v = parseNumberList("--gt-offset", cli.get("--gt-offset"));
+    if (v.size() != 3) throw std::invalid_argument("--gt-offset: expected x,y,z, got '" + cli.get("--gt-offset") + "'");
+    options.gt_offset = Vec3(v[0], v[1], v[2]);
+  }
+  options.rpe.delta = static_cast<int>(cli.getInt("--rpe-delta"));
+  options.rpe.all_pairs = cli.has("--rpe-all-pairs");
+  options.drift.segment_lengths = parseNumberList("--drift-lengths", cli.get("--drift-lengths"));
+  options.drift.step = static_cast<int>(cli.getInt("--drift-step"));
+  if (cli.has("--coverage-gap")) options.coverage_gap = cli.getDouble("--coverage-gap");
+  options.validate();
+  return options;
+}
+
+}  // namespace
+
+int runEvaluateCommand(int argc, char** argv, std::ostream& out, std::ostream& err) {
+  CommandLine cli = evaluateCommandLine();
   if (!cli.parse(argc, argv)) return cli.exitCode();
 
   try {
     if (!cli.has("--est") || !cli.has("--gt")) throw std::invalid_argument("--est and --gt are both required");
     if (cli.has("--marks") && !cli.has("--plot"))
       throw std::invalid_argument("--marks draws on the figure: give --plot F too");
-    EvaluationOptions options;
-    options.alignment = parseAlignment(cli.get("--align"));
-    options.max_dt = cli.getDouble("--max-dt");
-    if (cli.has("--gt-offset")) {
-      const auto v = parseNumberList("--gt-offset", cli.get("--gt-offset"));
-      if (v.size() != 3)
-        throw std::invalid_argument("--gt-offset: expected x,y,z, got '" + cli.get("--gt-offset") + "'");
-      options.gt_offset = Vec3(v[0], v[1], v[2]);
-    }
-    options.rpe.delta = static_cast<int>(cli.getInt("--rpe-delta"));
-    options.rpe.all_pairs = cli.has("--rpe-all-pairs");
-    options.drift.segment_lengths = parseNumberList("--drift-lengths", cli.get("--drift-lengths"));
-    options.drift.step = static_cast<int>(cli.getInt("--drift-step"));
-    if (cli.has("--coverage-gap")) options.coverage_gap = cli.getDouble("--coverage-gap");
-    options.validate();
+    const EvaluationOptions options = evaluationOptions(cli);
     const TrajectoryInput est = readTrajectoryInput(cli.get("--est"), "ODOMETRY");
     const TrajectoryInput gt = readTrajectoryInput(cli.get("--gt"), "GROUND_TRUTH");
     Evaluation ev = evaluateTrajectory(est, gt, options);

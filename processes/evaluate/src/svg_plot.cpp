@@ -342,6 +342,29 @@ void shadeTimeMarks(Svg& svg, const Rect& r, const LinearScale& sx, const TimeMa
       svg.line(sx(t), r.y, sx(t), r.y + r.h, kLoopColour, 1.0, "stroke-dasharray=\"4,3\" stroke-opacity=\"0.7\"");
 }
 
+/// The key of a series panel: line samples with the RMSE and median, and the max (and how many
+/// values were clipped), laid out right to left from the panel's corner.
+void seriesKey(Svg& svg, const Rect& r, const ErrorStatistics& stats, size_t clipped) {
+  const std::string rmse_label = "rmse " + number(stats.rmse), median_label = "median " + number(stats.median);
+  std::string max_label = "max " + number(stats.max);
+  if (clipped) max_label += " (" + std::to_string(clipped) + " above the axis)";
+  auto width = [](const std::string& text) { return 7.4 * static_cast<double>(text.size()); };  // 13 px sans
+  const double sample = 26, pad = 8, space = 16;
+  const double kw =
+      pad + sample + 6 + width(rmse_label) + space + sample + 6 + width(median_label) + space + width(max_label) + pad;
+  const double kx = r.x + r.w - kw - 6, ky = r.y + 6;
+  svg.os << "<rect x=\"" << fixed1(kx) << "\" y=\"" << fixed1(ky) << "\" width=\"" << fixed1(kw) << "\" height=\"22\" "
+         << "fill=\"#ffffff\" fill-opacity=\"0.9\" stroke=\"#bbbbbb\"/>\n";
+  double x = kx + pad;
+  svg.line(x, ky + 11, x + sample, ky + 11, "#222222", 1.4, "stroke-dasharray=\"7,4\"");
+  svg.text(x + sample + 6, ky + 16, rmse_label, 13);
+  x += sample + 6 + width(rmse_label) + space;
+  svg.line(x, ky + 11, x + sample, ky + 11, "#1a9641", 1.6, "stroke-dasharray=\"2,3\"");
+  svg.text(x + sample + 6, ky + 16, median_label, 13);
+  x += sample + 6 + width(median_label) + space;
+  svg.text(x, ky + 16, max_label, 13);
+}
+
 /// One error series over time, with dashed RMSE and dotted median lines, over the marks; the line
 /// breaks where consecutive samples are more than `max_step` apart. When a few spikes
 /// dwarf the rest, the axis stops above the 99th percentile and the clipped values sit on the
@@ -400,25 +423,7 @@ void seriesPanel(Svg& svg, const Rect& r, const std::vector<double>& t, const st
   }
   svg.line(r.x, sy(stats.rmse), r.x + r.w, sy(stats.rmse), "#222222", 1.4, "stroke-dasharray=\"7,4\"");
   svg.line(r.x, sy(stats.median), r.x + r.w, sy(stats.median), "#1a9641", 1.6, "stroke-dasharray=\"2,3\"");
-  // Key: line samples with their values, laid out right to left from the panel's corner.
-  const std::string rmse_label = "rmse " + number(stats.rmse), median_label = "median " + number(stats.median);
-  std::string max_label = "max " + number(stats.max);
-  if (clipped) max_label += " (" + std::to_string(clipped) + " above the axis)";
-  auto width = [](const std::string& text) { return 7.4 * static_cast<double>(text.size()); };  // 13 px sans
-  const double sample = 26, pad = 8, space = 16;
-  const double kw =
-      pad + sample + 6 + width(rmse_label) + space + sample + 6 + width(median_label) + space + width(max_label) + pad;
-  const double kx = r.x + r.w - kw - 6, ky = r.y + 6;
-  svg.os << "<rect x=\"" << fixed1(kx) << "\" y=\"" << fixed1(ky) << "\" width=\"" << fixed1(kw) << "\" height=\"22\" "
-         << "fill=\"#ffffff\" fill-opacity=\"0.9\" stroke=\"#bbbbbb\"/>\n";
-  double x = kx + pad;
-  svg.line(x, ky + 11, x + sample, ky + 11, "#222222", 1.4, "stroke-dasharray=\"7,4\"");
-  svg.text(x + sample + 6, ky + 16, rmse_label, 13);
-  x += sample + 6 + width(rmse_label) + space;
-  svg.line(x, ky + 11, x + sample, ky + 11, "#1a9641", 1.6, "stroke-dasharray=\"2,3\"");
-  svg.text(x + sample + 6, ky + 16, median_label, 13);
-  x += sample + 6 + width(median_label) + space;
-  svg.text(x, ky + 16, max_label, 13);
+  seriesKey(svg, r, stats, clipped);
 }
 
 }  // namespace
