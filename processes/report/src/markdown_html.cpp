@@ -61,7 +61,7 @@ bool safeUrl(const std::string& url) {
 
 class InlineRenderer {
  public:
-  explicit InlineRenderer(const MarkdownHtmlOptions& o) : o_(o) {}
+  explicit InlineRenderer(const MarkdownHtmlOptions& options) : options_(options) {}
 
   std::string render(const std::string& s) const {
     std::string out;
@@ -102,7 +102,7 @@ class InlineRenderer {
   }
 
  private:
-  const MarkdownHtmlOptions& o_;
+  const MarkdownHtmlOptions& options_;
 
   static size_t runLength(const std::string& s, size_t i) {
     size_t j = i;
@@ -192,7 +192,7 @@ class InlineRenderer {
     const std::string text = s.substr(open + 1, close - open - 1);
     const std::string title_attr = title.empty() ? "" : " title=\"" + escapeMarkup(title) + "\"";
     if (image) {
-      const std::string src = o_.image_source ? o_.image_source(dest) : dest;
+      const std::string src = options_.image_source ? options_.image_source(dest) : dest;
       if (src.empty() || !safeUrl(src))
         *out += "<span class=\"missing-image\">[" + escapeMarkup(plain(text)) + ": " + escapeMarkup(dest) + "]</span>";
       else
