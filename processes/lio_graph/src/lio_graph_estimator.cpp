@@ -9,8 +9,10 @@
 #include <Eigen/Eigenvalues>
 
 #include "livo/graph_factors.hpp"
+#include "livo/inertial_window.hpp"
 #include "livo/lio_graph/plane_factor.hpp"
 #include "livo/plane.hpp"
+#include "livo/result_note.hpp"
 #include "livo/sample_interval.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
@@ -19,11 +21,6 @@
 namespace livo::lio_graph {
 
 namespace {
-
-void appendNote(std::string* note, const std::string& what) {
-  if (!note->empty()) *note += "; ";
-  *note += what;
-}
 
 /// A pose's information [dtheta (right), dp] in a world turned by R: the rotation error is
 /// body-frame and stays, the position error turns with the world.
@@ -118,15 +115,16 @@ struct LioGraphEstimator::Node {
     std::copy(t.data(), t.data() + 3, p);
   }
   std::vector<double*> blocks() { return {q, p, v, bg, ba}; }
+  InertialBlocks inertial() { return {q, p, v, bg, ba}; }
 };
 
 LioGraphEstimator::LioGraphEstimator(LioGraphOptions options)
-    : opts_(std::move(options)), keyframe_selector_(opts_.keyframe), gravity_W_(0.0, 0.0, -opts_.gravity) {}
+    : options_(std::move(options)), keyframe_selector_(options_.keyframe), gravity_W_(0.0, 0.0, -options_.gravity) {}
 LioGraphEstimator::~LioGraphEstimator() = default;
 
 void LioGraphEstimator::reset() {
   frame_ = OdometryFrame{frame_.epoch + 1, 0, Pose3::Identity()};
-  gravity_W_ = Vec3(0.0, 0.0, -opts_.gravity);
+  gravity_W_ = Vec3(0.0, 0.0, -options_.gravity);
   window_.clear();
   landmarks_.clear();
   prior_.reset();
@@ -146,14 +144,14 @@ bool LioGraphEstimator::addImu(const ImuSample& s, std::string* why) {
     if (why) *why = "IMU sample not later than the previous one";
     return false;
   }
-  if (!imu_.empty() && toSeconds(s.utime - imu_.back().utime) > opts_.max_imu_gap_s && initialized()) {
+  if (!imu_.empty() && toSeconds(s.utime - imu_.back().utime) > options_.max_imu_gap_s && initialized()) {
     const double gap = toSeconds(s.utime - imu_.back().utime);
     reset();  // the propagation across such a gap is worthless: a new epoch
     if (why) *why = "IMU gap of " + formatSignificant(gap) + " s";
   }
   imu_.push_back(s);
   // keep what the newest state and the initialisation window need
-  const int64_t keep_from = initialized() ? window_.back()->utime : s.utime - toUtime(opts_.init.window_s + 1.0);
+  const int64_t keep_from = initialized() ? window_.back()->utime : s.utime - toUtime(options_.init.window_s + 1.0);
   dropImuBefore(keep_from);
   return true;
 }
@@ -180,36 +178,35 @@ void LioGraphEstimator::dropImuBefore(int64_t utime) {
 bool LioGraphEstimator::addVisualState(const VisualSample& s, std::string* why) { return visual_.add(s, why); }
 
 bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
-  std::vector<ImuSample> window;
-  for (const ImuSample& s : imu_)
-    if (s.utime <= t_end && s.utime >= t_end - toUtime(opts_.init.window_s)) window.push_back(s);
-  if (window.size() < 2 || toSeconds(window.back().utime - window.front().utime) < 0.8 * opts_.init.window_s) {
-    *note = "waiting for the IMU initialisation window";
+  const std::vector<ImuSample> window = imuStartWindow(imu_, t_end, options_.init.window_s);
+  if (!startWindowFilled(window, options_.init.window_s)) {
+    *note = kWaitingForImuStartWindow;
     return false;
   }
-  ImuInitOptions init = opts_.init;
-  init.gravity = opts_.gravity;
+  ImuInitOptions init = options_.init;
+  init.gravity = options_.gravity;
   const ImuInitResult r = initializeImu(window, init);
   if (!r.ok) {
     *note = "IMU initialisation failed: " + r.message;
     return false;
   }
+  const StartStateSigmas sigma = r.static_start ? restStartSigmas(init) : movingStartSigmas(init);
+  window_.push_back(startNode(t_end, r.state, window.back().gyro, sigma));
+  *note = r.static_start ? "initialised at rest" : "initialised in motion";
+  return true;
+}
+
+std::unique_ptr<LioGraphEstimator::Node> LioGraphEstimator::startNode(int64_t t_end, const FilterState& state,
+                                                                      const Vec3& last_gyro,
+                                                                      const StartStateSigmas& sigma) {
   auto n = std::make_unique<Node>();
   n->utime = t_end;
-  n->setPose(se3::fromRotationTranslation(r.state.rot, Vec3::Zero()));
-  Eigen::Map<Vec3>(n->bg) = r.state.gyro_bias;
-  Eigen::Map<Vec3>(n->ba) = r.state.accel_bias;
-  n->last_gyro = window.back().gyro;
+  n->setPose(se3::fromRotationTranslation(state.rot, Vec3::Zero()));
+  Eigen::Map<Vec3>(n->bg) = state.gyro_bias;
+  Eigen::Map<Vec3>(n->ba) = state.accel_bias;
+  n->last_gyro = last_gyro;
   // the gauge (yaw, position) held firmly, roll and pitch, velocity and biases as initialised
-  Mat6 info = Mat6::Zero();
-  const double rot_std = r.static_start ? init.static_rot_std : init.moving_rot_std;
-  info(0, 0) = info(1, 1) = 1.0 / (rot_std * rot_std);
-  info(2, 2) = 1.0 / (init.yaw_std * init.yaw_std);
-  info.bottomRightCorner<3, 3>() = Mat3::Identity() / (init.pos_std * init.pos_std);
-  // information on the body-frame rotation: roll/pitch/yaw are world-frame angles; for a level
-  // start they coincide, otherwise this is the usual approximation
-  const double vel_std = r.static_start ? init.static_vel_std : init.moving_vel_std;
-  const double bg_std = r.static_start ? 0.002 : init.moving_gyro_bias_std;
+  const Mat6 info = startPoseInformation(sigma.rotation, options_.init.yaw_std, options_.init.pos_std);
   using Unary = Node::Unary;
   n->priors.resize(4);
   n->priors[0].kind = Unary::Kind::kPose;
@@ -219,15 +216,22 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
   // isotropic: a loop correction turns the mean only
   n->priors[1].kind = Unary::Kind::kVelocity;
   n->priors[1].blocks = {n->v};
-  n->priors[1].sigma = Vec3::Constant(vel_std);
+  n->priors[1].sigma = Vec3::Constant(sigma.velocity);
   n->priors[2].kind = Unary::Kind::kBias;
   n->priors[2].blocks = {n->bg};
-  n->priors[2].mean = r.state.gyro_bias;
-  n->priors[2].sigma = Vec3::Constant(bg_std);
+  n->priors[2].mean = state.gyro_bias;
+  n->priors[2].sigma = Vec3::Constant(sigma.gyro_bias);
   n->priors[3].kind = Unary::Kind::kBias;
   n->priors[3].blocks = {n->ba};
-  n->priors[3].mean = r.state.accel_bias;
-  n->priors[3].sigma = Vec3::Constant(init.accel_bias_std);
+  n->priors[3].mean = state.accel_bias;
+  n->priors[3].sigma = Vec3::Constant(sigma.accel_bias);
+  addCalibrationPriors(n.get());
+  for (Unary& u : n->priors) u.remake();
+  return n;
+}
+
+void LioGraphEstimator::addCalibrationPriors(Node* n) {
+  using Unary = Node::Unary;
   // the wheel scales keep what an earlier epoch learned, held with the prior's sigma
   if (estimatesWheelScale()) {
     n->priors.emplace_back();
@@ -235,7 +239,7 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.kind = Unary::Kind::kWheelScale;
     u.blocks = {wheel_scale_};
     u.mean.head<2>() = wheelScale();
-    u.sigma.setConstant(opts_.wheel_scale_std);
+    u.sigma.setConstant(options_.wheel_scale_std);
   }
   // the wheel frame's mounting likewise, around what an earlier epoch learned, with the rig's sigma
   if (estimatesWheelMounting()) {
@@ -244,7 +248,7 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.kind = Unary::Kind::kWheelMounting;
     u.blocks = {wheel_mounting_};
     u.mean = wheelMounting();
-    u.sigma.setConstant(opts_.wheel_rig.mountingStdRad());
+    u.sigma.setConstant(options_.wheel_rig.mountingStdRad());
   }
   // the visual motion's scale likewise
   if (estimatesVisualScale()) {
@@ -253,12 +257,8 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     u.kind = Unary::Kind::kVisualScale;
     u.blocks = {visual_scale_};
     u.mean(0) = visual_scale_[0];
-    u.sigma.setConstant(opts_.visual_scale_std);
+    u.sigma.setConstant(options_.visual_scale_std);
   }
-  for (Unary& u : n->priors) u.remake();
-  window_.push_back(std::move(n));
-  *note = r.static_start ? "initialised at rest" : "initialised in motion";
-  return true;
 }
 
 bool LioGraphEstimator::preintegrate(int64_t t_end, ImuPreintegration* pre, std::vector<ImuStep>* steps,
@@ -270,7 +270,7 @@ bool LioGraphEstimator::preintegrate(int64_t t_end, ImuPreintegration* pre, std:
   const Vec3 p0(n.p[0], n.p[1], n.p[2]), v0(n.v[0], n.v[1], n.v[2]);
   const Vec3 bg(n.bg[0], n.bg[1], n.bg[2]), ba(n.ba[0], n.ba[1], n.ba[2]);
   const Vec3& g = gravity_W_;
-  *pre = ImuPreintegration(bg, ba, opts_.imu_noise);
+  *pre = ImuPreintegration(bg, ba, options_.imu_noise);
   steps->clear();
   steps->push_back({n.utime, n.pose()});
   for (size_t k = 0; k + 1 < s.size(); ++k) {
@@ -290,10 +290,10 @@ std::unique_ptr<WheelPreintegration> LioGraphEstimator::wheelBetween(int64_t t0,
   std::vector<WheelSample> s;
   if (!samplesOver(wheel_, t0, t1, &s)) return nullptr;
   if (wheel_.front().utime > t0) return nullptr;  // the readings do not reach back to t0
-  auto pre = std::make_unique<WheelPreintegration>(opts_.wheel_rig, opts_.wheel_noise);
+  auto pre = std::make_unique<WheelPreintegration>(options_.wheel_rig, options_.wheel_noise);
   for (size_t k = 0; k + 1 < s.size(); ++k) {
     const double dt = toSeconds(s[k + 1].utime - s[k].utime);
-    if (dt > opts_.max_wheel_gap_s) return nullptr;
+    if (dt > options_.max_wheel_gap_s) return nullptr;
     pre->integrate(s[k].left_speed, s[k].right_speed, s[k + 1].left_speed, s[k + 1].right_speed, dt);
   }
   return pre->duration() > 0.0 ? std::move(pre) : nullptr;
@@ -303,11 +303,11 @@ void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std
                                std::vector<Vec3>* body, std::vector<uint32_t>* index, std::vector<int16_t>* ring,
                                std::vector<float>* time) const {
   const Pose3 T_end_inv = steps.back().pose.inverse();
-  const Pose3& T_I_L = opts_.extrinsics.T_I_L;
+  const Pose3& T_I_L = options_.extrinsics.T_I_L;
   const double end_offset = toSeconds(steps.back().utime - t_first);
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
   const bool has_ring = scan.ring.size() == scan.points.size();
-  const double min2 = opts_.min_range * opts_.min_range, max2 = opts_.max_range * opts_.max_range;
+  const double min2 = options_.min_range * options_.min_range, max2 = options_.max_range * options_.max_range;
   size_t seg = 0;
   for (size_t j = 0; j < n; ++j) {
     const Vec3& pl = scan.points[j];
@@ -338,49 +338,37 @@ void LioGraphEstimator::deskew(const LidarScan& scan, int64_t t_first, const std
 
 GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTiming& timing) {
   GraphScanResult res;
-  std::string* note = &res.message;
   const int64_t t_end = timing.end_utime, t_first = timing.start_utime;
   res.utime = t_end;
   res.sweep_start_utime = t_first;
   if (t_end <= last_sweep_end_) {
     res.status = GraphScanResult::Status::kRejected;
-    *note = "sweep ends before the previous one";
+    res.message = "sweep ends before the previous one";
     return res;
   }
   const bool seeding = !initialized();
-  if (seeding) {
-    if (!initialize(t_end, note)) {
-      res.status = GraphScanResult::Status::kInitializing;
-      return res;
-    }
+  if (seeding && !initialize(t_end, &res.message)) {
+    res.status = GraphScanResult::Status::kInitializing;
+    return res;
   }
   last_sweep_end_ = t_end;
 
   // 1. preintegration to the sweep end and the predicted poses (deskewing)
-  ImuPreintegration pre(Vec3::Zero(), Vec3::Zero(), opts_.imu_noise);
+  ImuPreintegration pre(Vec3::Zero(), Vec3::Zero(), options_.imu_noise);
   std::vector<ImuStep> steps;
   Vec3 last_gyro = window_.back()->last_gyro;
   if (seeding) {
     steps = {{t_end, window_.back()->pose()}};
   } else if (!preintegrate(t_end, &pre, &steps, &last_gyro)) {
     res.status = GraphScanResult::Status::kRejected;
-    *note = "the IMU does not reach the sweep end";
+    res.message = "the IMU does not reach the sweep end";
     return res;
   }
-
   // The visual subsystem's motion over the sweep, where it covers it, replaces the IMU's
   // translation (which rests on the graph's velocity); the rotation stays the gyro's.
-  if (!seeding && opts_.use_visual_motion) {
-    const Pose3 T_prev = window_.back()->pose();
-    std::vector<Vec3> p_visual(steps.size());
-    bool covered = true;
-    for (size_t k = 0; k < steps.size() && covered; ++k) {
-      Pose3 rel;
-      covered = visual_.relative(window_.back()->utime, steps[k].utime, &rel);
-      p_visual[k] = T_prev * rel.translation();
-    }
-    if (covered) {
-      for (size_t k = 0; k < steps.size(); ++k) steps[k].pose.translation() = p_visual[k];
+  if (!seeding && options_.use_visual_motion) {
+    if (const auto p_visual = visualPositions(steps)) {
+      for (size_t k = 0; k < steps.size(); ++k) steps[k].pose.translation() = (*p_visual)[k];
       res.visual_motion = true;
     }
   }
@@ -390,12 +378,7 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTim
   RingCloud cloud;
   deskew(scan, t_first, steps, &body, &res.input_index, &cloud.ring, &cloud.time_offset);
   res.num_points = static_cast<int>(body.size());
-  const Pose3 T_L_I = opts_.extrinsics.T_I_L.inverse();
-  cloud.points.reserve(body.size());
-  for (const Vec3& b : body) cloud.points.push_back(T_L_I * b);
-  ScanFeatures features = extractFeatures(cloud, opts_.features);
-  for (Vec3& e : features.edges) e = opts_.extrinsics.T_I_L * e;
-  for (Vec3& s : features.surfaces) s = opts_.extrinsics.T_I_L * s;
+  ScanFeatures features = bodyFrameFeatures(body, std::move(cloud));
 
   Node* newest = nullptr;
   if (seeding) {
@@ -403,125 +386,180 @@ GraphScanResult LioGraphEstimator::addScan(const LidarScan& scan, const SweepTim
     res.status = GraphScanResult::Status::kMapInitialized;
     observePlanes(body, newest, &res);
   } else {
-    // 3. scan-to-map matching from the prediction
-    const Node& prev = *window_.back();
-    auto n = std::make_unique<Node>();
-    n->utime = t_end;
-    Mat3 R;
-    Vec3 p, v;
-    pre.predict(prev.pose().linear(), Vec3(prev.p[0], prev.p[1], prev.p[2]), Vec3(prev.v[0], prev.v[1], prev.v[2]),
-                pre.gyroBias(), pre.accelBias(), gravity_W_, &R, &p, &v);
-    n->setPose(res.visual_motion ? steps.back().pose : se3::fromRotationTranslation(R, p));
-    Eigen::Map<Vec3>(n->v) = v;
-    std::copy(prev.bg, prev.bg + 3, n->bg);
-    std::copy(prev.ba, prev.ba + 3, n->ba);
-    n->last_gyro = last_gyro;
-    const ScanMatchResult match = matchScan(map_, features, n->pose(), opts_.matching);
-    res.edge_residuals = match.edge_residuals;
-    res.surface_residuals = match.surface_residuals;
-    res.degenerate = match.degenerate;
-    res.weakest_direction = match.weakest;
-    if (match.valid) {
-      n->setPose(match.T_W_I);
-      n->lidar_pose = match.T_W_I;
-      n->lidar_information =
-          match.hessian * (opts_.lidar_information_scale / (opts_.lidar_point_sigma * opts_.lidar_point_sigma));
-      n->lidar.reset(makePoseFactor(n->lidar_pose, n->lidar_information));
-      res.status = GraphScanResult::Status::kTracked;
-    } else {
-      res.status = GraphScanResult::Status::kPredicted;
-      res.degenerate = true;
-      appendNote(note, "too few matches with the local map (" + std::to_string(match.edge_residuals) + " edge, " +
-                           std::to_string(match.surface_residuals) + " surface): IMU prediction");
-    }
-    // 4. the new state's factors, the window optimised, the oldest state marginalised
-    n->imu_preintegration = pre;
-    n->imu.reset(makeImuFactor(pre, gravity_W_));
-    n->bias_walk.reset(
-        makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk, pre.duration()));
-    if (opts_.use_wheel) {
-      if (auto w = wheelBetween(prev.utime, t_end)) {
-        n->wheel.reset(makeWheelFactor(*w, {estimatesWheelScale(), estimatesWheelMounting()}));
-        n->wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
-      } else {
-        appendNote(note, "no wheel readings over the sweep");
-      }
-    }
-    if (res.visual_motion && opts_.visual_factor) {
-      // the visual subsystem's motion from the previous state to this one (the deskew's last step)
-      Pose3 rel;
-      visual_.relative(prev.utime, t_end, &rel);
-      n->visual.reset(estimatesVisualScale() ? makeScaledRelativePoseFactor(rel, visualInformation(rel))
-                                             : makeRelativePoseFactor(rel, visualInformation(rel)));
-      n->visual_loss = std::make_unique<ceres::CauchyLoss>(opts_.visual_cauchy);
-      res.visual_factor = true;
-    }
-    observePlanes(body, n.get(), &res);
-    window_.push_back(std::move(n));
-    newest = window_.back().get();
-    optimize();
-    while (static_cast<int>(window_.size()) > std::max(2, opts_.window_states)) marginalizeOldest();
-    updateKeyframePoses();
-    dropImuBefore(newest->utime);
+    // 3. and 4.
+    newest = addState(t_end, pre, res.visual_motion ? &steps.back().pose : nullptr, last_gyro, features, body, &res);
   }
-
-  res.pose = newest->pose();
-  res.velocity = Vec3(newest->v[0], newest->v[1], newest->v[2]);
-  res.gyro_bias = Vec3(newest->bg[0], newest->bg[1], newest->bg[2]);
-  res.accel_bias = Vec3(newest->ba[0], newest->ba[1], newest->ba[2]);
-  res.angular_velocity = newest->last_gyro - res.gyro_bias;
-  res.wheel_scale = wheelScale();
-  res.wheel_mounting = wheelMounting();
-  res.pose_covariance = newestPoseCovariance();
-  res.world_points.reserve(body.size());
-  for (const Vec3& b : body) res.world_points.push_back(res.pose * b);
+  reportState(*newest, body, &res);
 
   // 5. keyframes: the local map grows where the body has moved
-  if (res.status != GraphScanResult::Status::kPredicted && keyframe_selector_.check(res.pose)) {
-    StoredKeyframe s;
-    s.kf.id = next_keyframe_id_++;
-    s.kf.utime = t_end;
-    s.kf.pose = res.pose;
-    s.kf.pose_covariance = res.pose_covariance;
-    const bool has_intensity = scan.intensity.size() == scan.points.size();
-    for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
-      s.kf.cloud.push_back(body[i]);
-      s.kf.intensity.push_back(has_intensity ? scan.intensity[res.input_index[i]] : 0.0f);
-    }
-    s.edges = std::move(features.edges);
-    s.surfaces = std::move(features.surfaces);
-    s.node = newest;
-    res.is_keyframe = true;
-    res.keyframe = s.kf;
-    s.kf.cloud = {};  // the map needs the features only
-    s.kf.intensity = {};
-    keyframes_.push_back(std::move(s));
-    pruneStoredKeyframes();
-    rebuildLocalMap(keyframes_.back().kf.pose.translation());
-  }
+  if (res.status != GraphScanResult::Status::kPredicted && keyframe_selector_.check(res.pose))
+    addKeyframe(scan, body, std::move(features), newest, &res);
   return res;
 }
 
+std::optional<std::vector<Vec3>> LioGraphEstimator::visualPositions(const std::vector<ImuStep>& steps) const {
+  const Pose3 T_prev = window_.back()->pose();
+  std::vector<Vec3> p_visual(steps.size());
+  bool covered = true;
+  for (size_t k = 0; k < steps.size() && covered; ++k) {
+    Pose3 rel;
+    covered = visual_.relative(window_.back()->utime, steps[k].utime, &rel);
+    p_visual[k] = T_prev * rel.translation();
+  }
+  if (!covered) return std::nullopt;
+  return p_visual;
+}
+
+ScanFeatures LioGraphEstimator::bodyFrameFeatures(const std::vector<Vec3>& body, RingCloud cloud) const {
+  const Pose3 T_L_I = options_.extrinsics.T_I_L.inverse();
+  cloud.points.reserve(body.size());
+  for (const Vec3& b : body) cloud.points.push_back(T_L_I * b);
+  ScanFeatures features = extractFeatures(cloud, options_.features);
+  for (Vec3& e : features.edges) e = options_.extrinsics.T_I_L * e;
+  for (Vec3& s : features.surfaces) s = options_.extrinsics.T_I_L * s;
+  return features;
+}
+
+LioGraphEstimator::Node* LioGraphEstimator::addState(int64_t t_end, const ImuPreintegration& pre,
+                                                     const Pose3* visual_guess, const Vec3& last_gyro,
+                                                     const ScanFeatures& features, const std::vector<Vec3>& body,
+                                                     GraphScanResult* res) {
+  // 3. scan-to-map matching from the prediction
+  const Node& prev = *window_.back();
+  std::unique_ptr<Node> n = predictedState(prev, t_end, pre, visual_guess, last_gyro);
+  addLidarFactor(matchScan(map_, features, n->pose(), options_.matching), n.get(), res);
+  // 4. the new state's factors, the window optimised, the oldest state marginalised
+  addMotionFactors(prev, pre, n.get(), res);
+  observePlanes(body, n.get(), res);
+  window_.push_back(std::move(n));
+  Node* newest = window_.back().get();
+  optimize();
+  while (static_cast<int>(window_.size()) > std::max(2, options_.window_states)) marginalizeOldest();
+  updateKeyframePoses();
+  dropImuBefore(newest->utime);
+  return newest;
+}
+
+std::unique_ptr<LioGraphEstimator::Node> LioGraphEstimator::predictedState(const Node& prev, int64_t t_end,
+                                                                           const ImuPreintegration& pre,
+                                                                           const Pose3* visual_guess,
+                                                                           const Vec3& last_gyro) const {
+  auto n = std::make_unique<Node>();
+  n->utime = t_end;
+  Mat3 R;
+  Vec3 p, v;
+  pre.predict(prev.pose().linear(), Vec3(prev.p[0], prev.p[1], prev.p[2]), Vec3(prev.v[0], prev.v[1], prev.v[2]),
+              pre.gyroBias(), pre.accelBias(), gravity_W_, &R, &p, &v);
+  n->setPose(visual_guess ? *visual_guess : se3::fromRotationTranslation(R, p));
+  Eigen::Map<Vec3>(n->v) = v;
+  std::copy(prev.bg, prev.bg + 3, n->bg);
+  std::copy(prev.ba, prev.ba + 3, n->ba);
+  n->last_gyro = last_gyro;
+  return n;
+}
+
+void LioGraphEstimator::addLidarFactor(const ScanMatchResult& match, Node* n, GraphScanResult* res) const {
+  res->edge_residuals = match.edge_residuals;
+  res->surface_residuals = match.surface_residuals;
+  res->degenerate = match.degenerate;
+  res->weakest_direction = match.weakest;
+  if (match.valid) {
+    n->setPose(match.T_W_I);
+    n->lidar_pose = match.T_W_I;
+    n->lidar_information =
+        match.hessian * (options_.lidar_information_scale / (options_.lidar_point_sigma * options_.lidar_point_sigma));
+    n->lidar.reset(makePoseFactor(n->lidar_pose, n->lidar_information));
+    res->status = GraphScanResult::Status::kTracked;
+  } else {
+    res->status = GraphScanResult::Status::kPredicted;
+    res->degenerate = true;
+    appendNote(&res->message, "too few matches with the local map (" + std::to_string(match.edge_residuals) +
+                                  " edge, " + std::to_string(match.surface_residuals) + " surface): IMU prediction");
+  }
+}
+
+void LioGraphEstimator::addMotionFactors(const Node& prev, const ImuPreintegration& pre, Node* n,
+                                         GraphScanResult* res) const {
+  n->imu_preintegration = pre;
+  n->imu.reset(makeImuFactor(pre, gravity_W_));
+  n->bias_walk.reset(
+      makeBiasWalkFactor(options_.imu_noise.gyro_random_walk, options_.imu_noise.accel_random_walk, pre.duration()));
+  if (options_.use_wheel) {
+    if (auto w = wheelBetween(prev.utime, n->utime)) {
+      n->wheel.reset(makeWheelFactor(*w, {estimatesWheelScale(), estimatesWheelMounting()}));
+      n->wheel_loss = std::make_unique<ceres::CauchyLoss>(options_.wheel_cauchy);
+    } else {
+      appendNote(&res->message, "no wheel readings over the sweep");
+    }
+  }
+  if (res->visual_motion && options_.visual_factor) {
+    // the visual subsystem's motion from the previous state to this one (the deskew's last step)
+    Pose3 rel;
+    visual_.relative(prev.utime, n->utime, &rel);
+    n->visual.reset(estimatesVisualScale() ? makeScaledRelativePoseFactor(rel, visualInformation(rel))
+                                           : makeRelativePoseFactor(rel, visualInformation(rel)));
+    n->visual_loss = std::make_unique<ceres::CauchyLoss>(options_.visual_cauchy);
+    res->visual_factor = true;
+  }
+}
+
+void LioGraphEstimator::reportState(const Node& newest, const std::vector<Vec3>& body, GraphScanResult* res) {
+  res->pose = newest.pose();
+  res->velocity = Vec3(newest.v[0], newest.v[1], newest.v[2]);
+  res->gyro_bias = Vec3(newest.bg[0], newest.bg[1], newest.bg[2]);
+  res->accel_bias = Vec3(newest.ba[0], newest.ba[1], newest.ba[2]);
+  res->angular_velocity = newest.last_gyro - res->gyro_bias;
+  res->wheel_scale = wheelScale();
+  res->wheel_mounting = wheelMounting();
+  res->pose_covariance = newestPoseCovariance();
+  res->world_points.reserve(body.size());
+  for (const Vec3& b : body) res->world_points.push_back(res->pose * b);
+}
+
+void LioGraphEstimator::addKeyframe(const LidarScan& scan, const std::vector<Vec3>& body, ScanFeatures features,
+                                    const Node* newest, GraphScanResult* res) {
+  StoredKeyframe s;
+  s.kf.id = next_keyframe_id_++;
+  s.kf.utime = res->utime;
+  s.kf.pose = res->pose;
+  s.kf.pose_covariance = res->pose_covariance;
+  const bool has_intensity = scan.intensity.size() == scan.points.size();
+  for (size_t i : firstPointPerVoxel(body, options_.keyframe.cloud_voxel)) {
+    s.kf.cloud.push_back(body[i]);
+    s.kf.intensity.push_back(has_intensity ? scan.intensity[res->input_index[i]] : 0.0f);
+  }
+  s.edges = std::move(features.edges);
+  s.surfaces = std::move(features.surfaces);
+  s.node = newest;
+  res->is_keyframe = true;
+  res->keyframe = s.kf;
+  s.kf.cloud = {};  // the map needs the features only
+  s.kf.intensity = {};
+  keyframes_.push_back(std::move(s));
+  pruneStoredKeyframes();
+  rebuildLocalMap(keyframes_.back().kf.pose.translation());
+}
+
 void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node, GraphScanResult* res) {
-  if (!opts_.planar_factors) return;
+  if (!options_.planar_factors) return;
   std::vector<Vec3> cloud;
-  for (size_t i : firstPointPerVoxel(body, opts_.plane_cloud_voxel)) cloud.push_back(body[i]);
+  for (size_t i : firstPointPerVoxel(body, options_.plane_cloud_voxel)) cloud.push_back(body[i]);
   const Pose3 T = node->pose();
   const Mat3 R = T.linear();
   const Vec3 p = T.translation();
-  PlaneExtractionOptions po = opts_.planes;
+  PlaneExtractionOptions po = options_.planes;
   po.up = R.transpose() * (-gravity_W_).normalized();  // a loop correction may have tilted the world
-  const double cos_match = std::cos(opts_.plane_match_angle_deg * M_PI / 180.0);
+  const double cos_match = std::cos(options_.plane_match_angle_deg * M_PI / 180.0);
   std::vector<const PlaneLandmark*> used;
   for (const ExtractedPlane& e : extractPlanes(cloud, po)) {
-    if (opts_.planar_ground_only && !e.ground) continue;
+    if (options_.planar_ground_only && !e.ground) continue;
     // the observation in the world, the sensor on its positive side
     Plane w;
     w.normal = R * e.plane.normal;
     w.offset = e.plane.offset - w.normal.dot(p);
     const Vec3 centroid = T * e.centroid;
     PlaneLandmark* best = nullptr;
-    double best_distance = opts_.plane_match_distance;
+    double best_distance = options_.plane_match_distance;
     for (auto& l : landmarks_) {
       if (std::find(used.begin(), used.end(), l.get()) != used.end()) continue;
       const Plane lp = l->seenFrom();
@@ -542,8 +580,8 @@ void LioGraphEstimator::observePlanes(const std::vector<Vec3>& body, Node* node,
     Node::PlaneObservation o{best,
                              e.plane.normal,
                              e.plane.offset,
-                             opts_.plane_sigma_angle_deg * M_PI / 180.0,
-                             std::max(opts_.plane_sigma_distance, e.quality),
+                             options_.plane_sigma_angle_deg * M_PI / 180.0,
+                             std::max(options_.plane_sigma_distance, e.quality),
                              nullptr};
     o.remake();
     node->planes.push_back(std::move(o));
@@ -568,12 +606,12 @@ void LioGraphEstimator::optimize() {
     for (auto& o : n.planes) problem.AddResidualBlock(o.cost.get(), nullptr, n.q, n.p, o.landmark->c);
     if (k == 0) continue;
     Node& m = *window_[k - 1];
-    if (n.imu) problem.AddResidualBlock(n.imu.get(), nullptr, {m.q, m.p, m.v, m.bg, m.ba, n.q, n.p, n.v});
-    if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, m.bg, m.ba, n.bg, n.ba);
+    if (n.imu) problem.AddResidualBlock(n.imu.get(), nullptr, imuFactorBlocks(m.inertial(), n.inertial()));
+    if (n.bias_walk) problem.AddResidualBlock(n.bias_walk.get(), nullptr, biasWalkBlocks(m.inertial(), n.inertial()));
     if (n.wheel) problem.AddResidualBlock(n.wheel.get(), n.wheel_loss.get(), wheelBlocks(m, n));
     if (n.visual) problem.AddResidualBlock(n.visual.get(), n.visual_loss.get(), visualBlocks(m, n));
   }
-  solveWindow(&problem, opts_.solver_iterations);
+  solveWindow(&problem, options_.solver_iterations);
 }
 
 void LioGraphEstimator::marginalizeOldest() {
@@ -584,11 +622,10 @@ void LioGraphEstimator::marginalizeOldest() {
   if (prior_factor_) m.addFactor(prior_factor_.get(), prior_->blocks);
   for (auto& u : a.priors) m.addFactor(u.cost.get(), u.blocks);
   if (a.lidar) m.addFactor(a.lidar.get(), {a.q, a.p});
-  if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
-  if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
+  std::set<const double*> drop =
+      addOldestInertialFactors(&m, a.inertial(), b.inertial(), b.imu.get(), b.bias_walk.get());
   if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
   if (b.visual) m.addFactor(b.visual.get(), visualBlocks(a, b), b.visual_loss.get());
-  std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   for (auto& o : a.planes) {
     m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
     if (--o.landmark->observers == 0) drop.insert(o.landmark->c);  // seen by no state that stays
@@ -611,8 +648,9 @@ void LioGraphEstimator::marginalizeOldest() {
 }
 
 Mat6 LioGraphEstimator::visualInformation(const Pose3& T_i_j) const {
-  const double sr = opts_.visual_sigma_rotation_deg * M_PI / 180.0;
-  const double st = opts_.visual_sigma_translation + opts_.visual_sigma_translation_ratio * T_i_j.translation().norm();
+  const double sr = options_.visual_sigma_rotation_deg * M_PI / 180.0;
+  const double st =
+      options_.visual_sigma_translation + options_.visual_sigma_translation_ratio * T_i_j.translation().norm();
   Vec6 d;
   d << Vec3::Constant(1.0 / (sr * sr)), Vec3::Constant(1.0 / (st * st));
   return d.asDiagonal();
@@ -638,18 +676,18 @@ void LioGraphEstimator::updateKeyframePoses() {
 }
 
 std::vector<size_t> LioGraphEstimator::firstKeyframePerCell(const std::vector<size_t>& candidates) const {
-  if (!(opts_.local_map_spacing > 0.0)) return {};
+  if (!(options_.local_map_spacing > 0.0)) return {};
   std::vector<Vec3> positions;
   for (size_t i : candidates) positions.push_back(keyframes_[i].kf.pose.translation());
   std::vector<size_t> first;
-  for (size_t j : firstPointPerVoxel(positions, opts_.local_map_spacing)) first.push_back(candidates[j]);
+  for (size_t j : firstPointPerVoxel(positions, options_.local_map_spacing)) first.push_back(candidates[j]);
   return first;
 }
 
 std::vector<const LioGraphEstimator::StoredKeyframe*> LioGraphEstimator::localMapKeyframes(const Vec3& here) const {
   const size_t first_newest =
-      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(opts_.local_map_keyframes));
-  const double r2 = opts_.local_map_radius * opts_.local_map_radius;
+      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(options_.local_map_keyframes));
+  const double r2 = options_.local_map_radius * options_.local_map_radius;
   std::vector<size_t> older, newest;
   for (size_t i = 0; i < keyframes_.size(); ++i)
     if ((keyframes_[i].kf.pose.translation() - here).squaredNorm() <= r2)
@@ -663,7 +701,7 @@ std::vector<const LioGraphEstimator::StoredKeyframe*> LioGraphEstimator::localMa
 void LioGraphEstimator::pruneStoredKeyframes() {
   // keep what localMapKeyframes() can still choose: the newest, and the oldest of each cell
   const size_t first_newest =
-      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(opts_.local_map_keyframes));
+      keyframes_.size() - std::min(keyframes_.size(), static_cast<size_t>(options_.local_map_keyframes));
   std::vector<size_t> older(first_newest);
   for (size_t i = 0; i < first_newest; ++i) older[i] = i;
   std::vector<size_t> keep = firstKeyframePerCell(older);
@@ -672,12 +710,12 @@ void LioGraphEstimator::pruneStoredKeyframes() {
   for (size_t i : keep) kept.push_back(std::move(keyframes_[i]));
   keyframes_ = std::move(kept);
   // beyond the bound, the older keyframe farthest from the newest (first of equals) goes
-  const size_t bound = std::max(opts_.max_stored_keyframes, static_cast<size_t>(opts_.local_map_keyframes));
+  const size_t bound = std::max(options_.max_stored_keyframes, static_cast<size_t>(options_.local_map_keyframes));
   while (keyframes_.size() > bound) {
     const Vec3 here = keyframes_.back().kf.pose.translation();
     size_t farthest = 0;
     double far2 = -1.0;
-    for (size_t i = 0; i + static_cast<size_t>(opts_.local_map_keyframes) < keyframes_.size(); ++i) {
+    for (size_t i = 0; i + static_cast<size_t>(options_.local_map_keyframes) < keyframes_.size(); ++i) {
       const double d2 = (keyframes_[i].kf.pose.translation() - here).squaredNorm();
       if (d2 > far2) far2 = d2, farthest = i;
     }
@@ -694,8 +732,8 @@ void LioGraphEstimator::rebuildLocalMap(const Vec3& here) {
     for (const Vec3& s : k->surfaces) surfaces.push_back(k->kf.pose * s);
   }
   std::vector<Vec3> e_ds, s_ds;
-  for (size_t i : firstPointPerVoxel(edges, opts_.map_edge_voxel)) e_ds.push_back(edges[i]);
-  for (size_t i : firstPointPerVoxel(surfaces, opts_.map_surface_voxel)) s_ds.push_back(surfaces[i]);
+  for (size_t i : firstPointPerVoxel(edges, options_.map_edge_voxel)) e_ds.push_back(edges[i]);
+  for (size_t i : firstPointPerVoxel(surfaces, options_.map_surface_voxel)) s_ds.push_back(surfaces[i]);
   map_.rebuild(std::move(e_ds), std::move(s_ds));
 }
 
@@ -788,8 +826,8 @@ Mat6 LioGraphEstimator::newestPoseCovariance() {
     for (auto& o : a.planes) m.addFactor(o.cost.get(), {a.q, a.p, o.landmark->c});
     if (k == 0) continue;
     Node& b = *window_[k - 1];
-    if (a.imu) m.addFactor(a.imu.get(), {b.q, b.p, b.v, b.bg, b.ba, a.q, a.p, a.v});
-    if (a.bias_walk) m.addFactor(a.bias_walk.get(), {b.bg, b.ba, a.bg, a.ba});
+    if (a.imu) m.addFactor(a.imu.get(), imuFactorBlocks(b.inertial(), a.inertial()));
+    if (a.bias_walk) m.addFactor(a.bias_walk.get(), biasWalkBlocks(b.inertial(), a.inertial()));
     if (a.wheel) m.addFactor(a.wheel.get(), wheelBlocks(b, a), a.wheel_loss.get());
     if (a.visual) m.addFactor(a.visual.get(), visualBlocks(b, a), a.visual_loss.get());
   }

@@ -8,7 +8,9 @@
 #include <ceres/ceres.h>
 
 #include "livo/graph_factors.hpp"
+#include "livo/inertial_window.hpp"
 #include "livo/sample_interval.hpp"
+#include "livo/start_state_prior.hpp"
 #include "livo/time.hpp"
 #include "livo/vio_feature/reprojection_factor.hpp"
 
@@ -48,6 +50,7 @@ struct SlidingWindowEstimator::Frame {
   Vec3 gyroBias() const { return Vec3(bg[0], bg[1], bg[2]); }
   Vec3 accelBias() const { return Vec3(ba[0], ba[1], ba[2]); }
   Vec3 velocity() const { return Vec3(v[0], v[1], v[2]); }
+  InertialBlocks inertial() { return {q, p, v, bg, ba}; }
 };
 
 /// A tracked feature: its inverse depth along the ray of its first observation in the window (the
@@ -95,7 +98,7 @@ bool pushSample(std::deque<Sample>* buf, const Sample& s, bool finite, const cha
 }  // namespace
 
 SlidingWindowEstimator::SlidingWindowEstimator(const SlidingWindowOptions& options)
-    : opts_(options),
+    : options_(options),
       gravity_W_(0.0, 0.0, -options.gravity),
       reprojection_loss_(std::make_unique<ceres::CauchyLoss>(options.reprojection_cauchy)) {}
 
@@ -105,7 +108,7 @@ bool SlidingWindowEstimator::addImu(const ImuSample& s, std::string* why) {
   if (!pushSample(&imu_, s, s.gyro.allFinite() && s.accel.allFinite(), "IMU sample", why)) return false;
   // keep what the oldest state and the initialisation windows may still need
   const int64_t keep = window_.empty()
-                           ? s.utime - toUtime(std::max(opts_.init.window_s, opts_.moving_init_window_s) + 1.0)
+                           ? s.utime - toUtime(std::max(options_.init.window_s, options_.moving_init_window_s) + 1.0)
                            : window_.back()->utime - toUtime(1.0);
   while (imu_.size() > 2 && imu_[1].utime <= keep) imu_.pop_front();
   return true;
@@ -115,7 +118,7 @@ bool SlidingWindowEstimator::addWheel(const WheelSample& s, std::string* why) {
   if (!pushSample(&wheel_, s, std::isfinite(s.left_speed) && std::isfinite(s.right_speed), "wheel reading", why))
     return false;
   const int64_t keep =
-      window_.empty() ? s.utime - toUtime(opts_.moving_init_window_s + 1.0) : window_.back()->utime - toUtime(1.0);
+      window_.empty() ? s.utime - toUtime(options_.moving_init_window_s + 1.0) : window_.back()->utime - toUtime(1.0);
   while (wheel_.size() > 2 && wheel_[1].utime <= keep) wheel_.pop_front();
   return true;
 }
@@ -133,7 +136,7 @@ void SlidingWindowEstimator::reset() {
 
 FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   FrameResult res;
-  const int64_t t = in.utime + toUtime(opts_.camera_time_offset_s);
+  const int64_t t = in.utime + toUtime(options_.camera_time_offset_s);
   if (imu_.empty() || imu_.back().utime < t) {
     res.note = "no IMU up to the image's time";
     return res;
@@ -158,7 +161,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   Frame& prev = *window_.back();
   // a keyframe at least every max_keyframe_interval_s, so that merged intervals stay bounded
   const Frame& last_key = **std::find_if(window_.rbegin(), window_.rend(), [](const auto& w) { return w->keyframe; });
-  f->keyframe = in.keyframe || toSeconds(t - last_key.utime) >= opts_.max_keyframe_interval_s;
+  f->keyframe = in.keyframe || toSeconds(t - last_key.utime) >= options_.max_keyframe_interval_s;
   std::string why;
   if (!connect(prev, *f, true, &why)) {
     reset();
@@ -182,7 +185,7 @@ FrameResult SlidingWindowEstimator::addFrame(const FrameFeatures& in) {
   res.wheel_mounting = wheelMounting();
 
   // The previous newest state stays if it is a keyframe (the oldest then leaves), else it goes.
-  if (static_cast<int>(window_.size()) > opts_.window_frames) {
+  if (static_cast<int>(window_.size()) > options_.window_frames) {
     if (window_[window_.size() - 2]->keyframe)
       marginalizeOldest();
     else
@@ -195,18 +198,18 @@ bool SlidingWindowEstimator::cameraStill(int64_t t, const FrameFeatures& frame) 
   std::map<uint64_t, Vec2> now;
   for (const FeatureMeasurement& m : frame.features) now[m.id] = m.xy;
   recent_.emplace_back(t, std::move(now));
-  const int64_t span = toUtime(opts_.init.window_s);
+  const int64_t span = toUtime(options_.init.window_s);
   while (recent_.size() > 2 && recent_[1].first <= t - span) recent_.pop_front();
   if (recent_.size() < 2 || recent_.front().first > t - span) return false;
   std::vector<double> moved;
   const auto& then = recent_.front().second;
   for (const auto& [id, xy] : recent_.back().second) {
     const auto it = then.find(id);
-    if (it != then.end()) moved.push_back((xy - it->second).norm() * opts_.focal);
+    if (it != then.end()) moved.push_back((xy - it->second).norm() * options_.focal);
   }
   if (moved.size() < 10) return false;
   std::nth_element(moved.begin(), moved.begin() + static_cast<long>(moved.size() / 2), moved.end());
-  return moved[moved.size() / 2] < opts_.still_parallax_px;
+  return moved[moved.size() / 2] < options_.still_parallax_px;
 }
 
 bool SlidingWindowEstimator::initialize(int64_t t, const FrameFeatures& frame, FrameResult* res) {
@@ -214,28 +217,26 @@ bool SlidingWindowEstimator::initialize(int64_t t, const FrameFeatures& frame, F
   const bool camera_still = cameraStill(t, frame);
   // A car cruising on a smooth road can look still to the IMU: where the wheels turn, it is not.
   bool wheels_turn = false;
-  if (opts_.use_wheel)
+  if (options_.use_wheel)
     for (const WheelSample& w : wheel_)
-      if (w.utime <= t && w.utime >= t - toUtime(opts_.init.window_s))
+      if (w.utime <= t && w.utime >= t - toUtime(options_.init.window_s))
         wheels_turn |= std::abs(w.left_speed) + std::abs(w.right_speed) > 2.0 * kStillWheelSpeed;
   if (wheels_turn) return initializeMoving(t, res);
   if (initializeAtRest(t, camera_still, res)) return true;
-  if (opts_.use_wheel && initializeMoving(t, res)) return true;
+  if (options_.use_wheel && initializeMoving(t, res)) return true;
   if (res->note.empty())
-    res->note = opts_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
+    res->note = options_.use_wheel ? "waiting for rest or for the wheels" : "waiting for the IMU at rest";
   return false;
 }
 
 bool SlidingWindowEstimator::initializeAtRest(int64_t t, bool camera_still, FrameResult* res) {
-  std::vector<ImuSample> window;
-  for (const ImuSample& s : imu_)
-    if (s.utime <= t && s.utime >= t - toUtime(opts_.init.window_s)) window.push_back(s);
-  if (window.size() < 2 || toSeconds(window.back().utime - window.front().utime) < 0.8 * opts_.init.window_s) {
-    res->note = "waiting for the IMU initialisation window";
+  const std::vector<ImuSample> window = imuStartWindow(imu_, t, options_.init.window_s);
+  if (!startWindowFilled(window, options_.init.window_s)) {
+    res->note = kWaitingForImuStartWindow;
     return false;
   }
-  ImuInitOptions init = opts_.init;
-  init.gravity = opts_.gravity;
+  ImuInitOptions init = options_.init;
+  init.gravity = options_.gravity;
   init.mode = ImuInitOptions::Mode::kStatic;
   if (camera_still) init.max_gyro_std = init.max_accel_std = std::numeric_limits<double>::infinity();
   const ImuInitResult r = initializeImu(window, init);
@@ -246,17 +247,18 @@ bool SlidingWindowEstimator::initializeAtRest(int64_t t, bool camera_still, Fram
   mean /= static_cast<double>(window.size());
   for (const ImuSample& s : window) var += (s.gyro - mean).cwiseAbs2();
   const double gyro_mean_std = std::sqrt(var.maxCoeff() / static_cast<double>(window.size() * window.size()));
-  startWindow(t, r.state.rot, Vec3::Zero(), r.state.gyro_bias, r.state.accel_bias, init.static_rot_std,
-              init.static_vel_std, 0.002 + gyro_mean_std);
+  StartStateSigmas sigma = restStartSigmas(init);
+  sigma.gyro_bias += gyro_mean_std;
+  startWindow(t, r.state.rot, Vec3::Zero(), r.state.gyro_bias, r.state.accel_bias, sigma);
   res->static_start = true;
   res->note = "initialised at rest";
-  if (camera_still && !isStill(window, opts_.init))
+  if (camera_still && !isStill(window, options_.init))
     res->note = "initialised at rest (the images still, the IMU shaking)";
   return true;
 }
 
 bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
-  const int64_t t0 = t - toUtime(opts_.moving_init_window_s);
+  const int64_t t0 = t - toUtime(options_.moving_init_window_s);
   std::vector<ImuSample> imu;
   std::vector<WheelSample> wheel;
   if (imu_.empty() || imu_.front().utime > t0 || !samplesOver(imu_, t0, t, &imu)) return false;
@@ -267,8 +269,8 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   // The body-frame velocity from the wheels: the wheel frame B moves forward at the mean speed
   // (through the tyre scales and the mounting as estimated so far: nominal unless an earlier epoch
   // learnt them); v_I = R_IB v_B - w x t_IB.
-  const Mat3 R_IB = opts_.wheel_rig.T_I_B.linear() * so3::Exp(wheelMounting());
-  const Vec3 t_IB = opts_.wheel_rig.T_I_B.translation();
+  const Mat3 R_IB = options_.wheel_rig.T_I_B.linear() * so3::Exp(wheelMounting());
+  const Vec3 t_IB = options_.wheel_rig.T_I_B.translation();
   auto bodyVelocity = [&](const WheelSample& w, const Vec3& gyro) {
     const double forward = 0.5 * (wheel_scale_[0] * w.left_speed + wheel_scale_[1] * w.right_speed);
     return Vec3(R_IB * Vec3(forward, 0.0, 0.0) - gyro.cross(t_IB));
@@ -290,7 +292,7 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   const Vec3 v0 = bodyVelocity(wheel.front(), imu.front().gyro);
   const Vec3 v1 = bodyVelocity(wheel.back(), imu.back().gyro);
   const Vec3 g0 = (R * v1 - v0 - sum_f) / T;
-  if (!g0.allFinite() || std::abs(g0.norm() - opts_.gravity) > 0.1 * opts_.gravity) {
+  if (!g0.allFinite() || std::abs(g0.norm() - options_.gravity) > 0.1 * options_.gravity) {
     res->note = "moving initialisation: gravity from the wheels is off (" + std::to_string(g0.norm()) + " m/s^2)";
     return false;
   }
@@ -301,19 +303,20 @@ bool SlidingWindowEstimator::initializeMoving(int64_t t, FrameResult* res) {
   // With the scales estimated, the velocity's prior carries their uncertainty too: through the
   // first wheel factors a velocity prior at the nominal radii is a prior on the scales (at 10 m/s
   // with the rig's 2 cm/s, sigma 0.11 m/s is 1.1 % of the speed: tighter than wheel_scale_std).
-  double vel_std = 3.0 * opts_.wheel_noise.speed_std + 0.05;
-  if (estimatesWheelScale()) vel_std = std::hypot(vel_std, opts_.wheel_scale_std * v_W.norm());
+  double vel_std = 3.0 * options_.wheel_noise.speed_std + 0.05;
+  if (estimatesWheelScale()) vel_std = std::hypot(vel_std, options_.wheel_scale_std * v_W.norm());
   // likewise the mounting's: its rotation turns the velocity's direction
-  if (estimatesWheelMounting()) vel_std = std::hypot(vel_std, opts_.wheel_rig.mountingStdRad() * v_W.norm());
-  startWindow(t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(), opts_.moving_init_rot_std, vel_std,
-              opts_.init.moving_gyro_bias_std);
+  if (estimatesWheelMounting()) vel_std = std::hypot(vel_std, options_.wheel_rig.mountingStdRad() * v_W.norm());
+  startWindow(
+      t, R_W_I, v_W, Vec3::Zero(), Vec3::Zero(),
+      {options_.moving_init_rot_std, vel_std, options_.init.moving_gyro_bias_std, options_.init.accel_bias_std});
   res->static_start = false;
   res->note = "initialised in motion from the wheels";
   return true;
 }
 
 void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v, const Vec3& bg, const Vec3& ba,
-                                         double rot_std, double vel_std, double bg_std) {
+                                         const StartStateSigmas& sigma) {
   auto f = std::make_unique<Frame>();
   f->utime = t;
   f->setPose(se3::fromRotationTranslation(R, Vec3::Zero()));
@@ -321,26 +324,23 @@ void SlidingWindowEstimator::startWindow(int64_t t, const Mat3& R, const Vec3& v
   Eigen::Map<Vec3>{f->bg} = bg;
   Eigen::Map<Vec3>{f->ba} = ba;
   // the gauge (yaw, position) held firmly; roll, pitch, velocity and biases as initialised
-  Mat6 info = Mat6::Zero();
-  info(0, 0) = info(1, 1) = 1.0 / (rot_std * rot_std);
-  info(2, 2) = 1.0 / (opts_.init.yaw_std * opts_.init.yaw_std);
-  info.bottomRightCorner<3, 3>() = Mat3::Identity() / (opts_.init.pos_std * opts_.init.pos_std);
+  const Mat6 info = startPoseInformation(sigma.rotation, options_.init.yaw_std, options_.init.pos_std);
   f->priors.emplace_back(makePoseFactor(f->pose(), info));
   f->prior_blocks.push_back({f->q, f->p});
-  f->priors.emplace_back(makeVectorPriorFactor(v, Vec3::Constant(vel_std)));
+  f->priors.emplace_back(makeVectorPriorFactor(v, Vec3::Constant(sigma.velocity)));
   f->prior_blocks.push_back({f->v});
-  f->priors.emplace_back(makeVectorPriorFactor(bg, Vec3::Constant(bg_std)));
+  f->priors.emplace_back(makeVectorPriorFactor(bg, Vec3::Constant(sigma.gyro_bias)));
   f->prior_blocks.push_back({f->bg});
-  f->priors.emplace_back(makeVectorPriorFactor(ba, Vec3::Constant(opts_.init.accel_bias_std)));
+  f->priors.emplace_back(makeVectorPriorFactor(ba, Vec3::Constant(sigma.accel_bias)));
   f->prior_blocks.push_back({f->ba});
   // the tyre scales, once per window (epoch): around what an earlier epoch learnt, [1, 1] at first
   if (estimatesWheelScale()) {
-    f->priors.emplace_back(makeWheelScalePrior(wheelScale(), opts_.wheel_scale_std));
+    f->priors.emplace_back(makeWheelScalePrior(wheelScale(), options_.wheel_scale_std));
     f->prior_blocks.push_back({wheel_scale_});
   }
   // the wheel mounting likewise, with the rig's sigma
   if (estimatesWheelMounting()) {
-    f->priors.emplace_back(makeWheelMountingPrior(wheelMounting(), opts_.wheel_rig.mountingStdRad()));
+    f->priors.emplace_back(makeWheelMountingPrior(wheelMounting(), options_.wheel_rig.mountingStdRad()));
     f->prior_blocks.push_back({wheel_mounting_});
   }
   window_.push_back(std::move(f));
@@ -357,10 +357,10 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
     *why = "IMU interval does not span the frames";
     return false;
   }
-  ImuPreintegration pre(from.gyroBias(), from.accelBias(), opts_.imu_noise);
+  ImuPreintegration pre(from.gyroBias(), from.accelBias(), options_.imu_noise);
   for (size_t k = 0; k + 1 < s.size(); ++k) {
     const double dt = toSeconds(s[k + 1].utime - s[k].utime);
-    if (dt > opts_.max_imu_gap_s) {
+    if (dt > options_.max_imu_gap_s) {
       *why = "IMU gap of " + std::to_string(dt) + " s";
       return false;
     }
@@ -378,25 +378,25 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
   }
   to.imu.reset(makeImuFactor(pre, gravity_W_));
   to.bias_walk.reset(
-      makeBiasWalkFactor(opts_.imu_noise.gyro_random_walk, opts_.imu_noise.accel_random_walk, pre.duration()));
+      makeBiasWalkFactor(options_.imu_noise.gyro_random_walk, options_.imu_noise.accel_random_walk, pre.duration()));
   to.wheel.reset();
   to.wheel_loss.reset();
-  if (opts_.use_wheel) {
+  if (options_.use_wheel) {
     if (to.wheel_samples.empty() && !(wheel_.empty() || wheel_.front().utime > from.utime))
       samplesOver(wheel_, from.utime, to.utime, &to.wheel_samples);
     const std::vector<WheelSample>& w = to.wheel_samples;
     bool ok = w.size() >= 2;
-    WheelPreintegration wp(opts_.wheel_rig, opts_.wheel_noise);
+    WheelPreintegration wp(options_.wheel_rig, options_.wheel_noise);
     for (size_t k = 0; ok && k + 1 < w.size(); ++k) {
       const double dt = toSeconds(w[k + 1].utime - w[k].utime);
-      if (dt > opts_.max_wheel_gap_s)
+      if (dt > options_.max_wheel_gap_s)
         ok = false;
       else
         wp.integrate(w[k].left_speed, w[k].right_speed, w[k + 1].left_speed, w[k + 1].right_speed, dt);
     }
     if (ok && wp.duration() > 0.0) {
       to.wheel.reset(makeWheelFactor(wp, {estimatesWheelScale(), estimatesWheelMounting()}));
-      to.wheel_loss = std::make_unique<ceres::CauchyLoss>(opts_.wheel_cauchy);
+      to.wheel_loss = std::make_unique<ceres::CauchyLoss>(options_.wheel_cauchy);
     } else {
       to.wheel_samples.clear();
     }
@@ -405,10 +405,10 @@ bool SlidingWindowEstimator::connect(Frame& from, Frame& to, bool predict, std::
 }
 
 void SlidingWindowEstimator::addObservations(Frame& frame, const FrameFeatures& in) {
-  const double focal = opts_.focal;
+  const double focal = options_.focal;
   for (const FeatureMeasurement& m : in.features) {
     if (!m.xy.allFinite() || rejected_.count(m.id)) continue;
-    const double depth = validDepth(opts_, m.depth) ? m.depth : 0.0;
+    const double depth = validDepth(options_, m.depth) ? m.depth : 0.0;
     auto it = features_.find(m.id);
     if (it == features_.end()) {
       auto ft = std::make_unique<Feature>();
@@ -416,7 +416,7 @@ void SlidingWindowEstimator::addObservations(Frame& frame, const FrameFeatures& 
       if (depth > 0.0) {
         ft->rho[0] = 1.0 / depth;
         ft->has_rho = true;
-        ft->depth_prior.reset(makeInverseDepthPrior(depth, depthSigma(opts_, depth)));
+        ft->depth_prior.reset(makeInverseDepthPrior(depth, depthSigma(options_, depth)));
       }
       features_.emplace(m.id, std::move(ft));
       continue;
@@ -424,28 +424,28 @@ void SlidingWindowEstimator::addObservations(Frame& frame, const FrameFeatures& 
     Feature& ft = *it->second;
     if (ft.obs.back().frame == &frame) continue;  // the same id twice in one image
     ft.obs.push_back({&frame, m.xy, depth,
-                      std::unique_ptr<ceres::CostFunction>(
-                          makeReprojectionFactor(ft.obs.front().xy, m.xy, opts_.T_I_C, focal, opts_.pixel_sigma))});
+                      std::unique_ptr<ceres::CostFunction>(makeReprojectionFactor(
+                          ft.obs.front().xy, m.xy, options_.T_I_C, focal, options_.pixel_sigma))});
   }
 }
 
 void SlidingWindowEstimator::triangulate() {
-  const double min_cos = std::cos(opts_.min_triangulation_angle_deg * M_PI / 180.0);
+  const double min_cos = std::cos(options_.min_triangulation_angle_deg * M_PI / 180.0);
   for (auto& [id, ft] : features_) {
     if (ft->has_rho || ft->obs.size() < 2) continue;
     // the anchor against the observation with the widest angle between the two rays
-    const Pose3 T_W_Ca = ft->anchor()->pose() * opts_.T_I_C;
+    const Pose3 T_W_Ca = ft->anchor()->pose() * options_.T_I_C;
     const Vec3 ray_a = T_W_Ca.linear() * Vec3(ft->obs[0].xy.x(), ft->obs[0].xy.y(), 1.0).normalized();
     double best_cos = 1.0;
     size_t best = 0;
     for (size_t k = 1; k < ft->obs.size(); ++k) {
-      const Mat3 R_W_Ck = (ft->obs[k].frame->pose() * opts_.T_I_C).linear();
+      const Mat3 R_W_Ck = (ft->obs[k].frame->pose() * options_.T_I_C).linear();
       const double c = ray_a.dot(R_W_Ck * Vec3(ft->obs[k].xy.x(), ft->obs[k].xy.y(), 1.0).normalized());
       if (c < best_cos) best_cos = c, best = k;
     }
     if (best == 0 || best_cos > min_cos) continue;
     // the point on ray a closest to ray b (midpoint method in the anchor camera's frame)
-    const Pose3 T_Ca_Cb = T_W_Ca.inverse() * ft->obs[best].frame->pose() * opts_.T_I_C;
+    const Pose3 T_Ca_Cb = T_W_Ca.inverse() * ft->obs[best].frame->pose() * options_.T_I_C;
     const Vec3 da(ft->obs[0].xy.x(), ft->obs[0].xy.y(), 1.0);
     const Vec3 db = T_Ca_Cb.linear() * Vec3(ft->obs[best].xy.x(), ft->obs[best].xy.y(), 1.0);
     const Vec3 ob = T_Ca_Cb.translation();
@@ -455,7 +455,7 @@ void SlidingWindowEstimator::triangulate() {
     const Vec2 b(da.dot(ob), db.dot(ob));
     const Vec2 su = A.colPivHouseholderQr().solve(b);
     const double z = su.x();  // depth along the anchor's z (da has z = 1)
-    if (!std::isfinite(z) || su.y() <= 0.0 || !validDepth(opts_, z)) continue;
+    if (!std::isfinite(z) || su.y() <= 0.0 || !validDepth(options_, z)) continue;
     ft->rho[0] = 1.0 / z;
     ft->has_rho = true;
   }
@@ -470,7 +470,7 @@ std::vector<SlidingWindowEstimator::Feature*> SlidingWindowEstimator::graphFeatu
   // longest tracks first (ties by id: deterministic), at most max_features
   std::stable_sort(out.begin(), out.end(),
                    [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
-  if (static_cast<int>(out.size()) > opts_.max_features) out.resize(opts_.max_features);
+  if (static_cast<int>(out.size()) > options_.max_features) out.resize(options_.max_features);
   for (Feature* ft : out) ft->in_graph = true;
   return out;
 }
@@ -483,8 +483,8 @@ void SlidingWindowEstimator::forEachFactor(const std::vector<Feature*>& features
     for (size_t i = 0; i < f.priors.size(); ++i) add(f.priors[i].get(), nullptr, f.prior_blocks[i]);
     if (k == 0) continue;
     Frame& e = *window_[k - 1];
-    if (f.imu) add(f.imu.get(), nullptr, {e.q, e.p, e.v, e.bg, e.ba, f.q, f.p, f.v});
-    if (f.bias_walk) add(f.bias_walk.get(), nullptr, {e.bg, e.ba, f.bg, f.ba});
+    if (f.imu) add(f.imu.get(), nullptr, imuFactorBlocks(e.inertial(), f.inertial()));
+    if (f.bias_walk) add(f.bias_walk.get(), nullptr, biasWalkBlocks(e.inertial(), f.inertial()));
     if (f.wheel) add(f.wheel.get(), f.wheel_loss.get(), wheelBlocks(e, f));
   }
   for (Feature* ft : features) {
@@ -507,20 +507,20 @@ void SlidingWindowEstimator::optimize(const std::vector<Feature*>& features) {
     problem.AddResidualBlock(cost, loss, blocks);
   });
   for (Feature* ft : features) {
-    problem.SetParameterLowerBound(ft->rho, 0, 1.0 / opts_.max_depth);
-    problem.SetParameterUpperBound(ft->rho, 0, 1.0 / opts_.min_depth);
+    problem.SetParameterLowerBound(ft->rho, 0, 1.0 / options_.max_depth);
+    problem.SetParameterUpperBound(ft->rho, 0, 1.0 / options_.min_depth);
   }
-  solveWindow(&problem, opts_.solver_iterations);
+  solveWindow(&problem, options_.solver_iterations);
 }
 
 int SlidingWindowEstimator::rejectOutliers() {
-  const double limit = opts_.outlier_px / opts_.focal;
+  const double limit = options_.outlier_px / options_.focal;
   std::vector<uint64_t> drop;
   for (auto& [id, ft] : features_) {
     if (!ft->in_graph) continue;
     const Pose3 T_a = ft->anchor()->pose();
     for (size_t k = 1; k < ft->obs.size(); ++k) {
-      const Vec3 p = predictInCamera(ft->obs[0].xy, ft->rho[0], T_a, ft->obs[k].frame->pose(), opts_.T_I_C);
+      const Vec3 p = predictInCamera(ft->obs[0].xy, ft->rho[0], T_a, ft->obs[k].frame->pose(), options_.T_I_C);
       if (!(p.z() > 1e-6) || (p.head<2>() / p.z() - ft->obs[k].xy).norm() > limit) {
         drop.push_back(id);
         break;
@@ -543,11 +543,10 @@ void SlidingWindowEstimator::marginalizeOldest() {
   for (auto& f : window_) m.setQuaternion(f->q);
   if (prior_factor_) m.addFactor(prior_factor_.get(), prior_->blocks);
   for (size_t i = 0; i < a.priors.size(); ++i) m.addFactor(a.priors[i].get(), a.prior_blocks[i]);
-  if (b.imu) m.addFactor(b.imu.get(), {a.q, a.p, a.v, a.bg, a.ba, b.q, b.p, b.v});
-  if (b.bias_walk) m.addFactor(b.bias_walk.get(), {a.bg, a.ba, b.bg, b.ba});
+  std::set<const double*> drop =
+      addOldestInertialFactors(&m, a.inertial(), b.inertial(), b.imu.get(), b.bias_walk.get());
   if (b.wheel) m.addFactor(b.wheel.get(), wheelBlocks(a, b), b.wheel_loss.get());
   // the scales and the mounting are not dropped: what these factors said about them stays in the prior
-  std::set<const double*> drop = {a.q, a.p, a.v, a.bg, a.ba};
   // The features anchored here leave with it: what they said about the states that stay goes into
   // the prior (those in the last optimisation); a later observation of the same track starts anew.
   std::vector<uint64_t> leaving;
@@ -605,19 +604,20 @@ void SlidingWindowEstimator::dropSecondNewest() {
     if (next.depth > 0.0) {
       rho = 1.0 / next.depth;
     } else if (ft->has_rho) {
-      const Vec3 p = predictInCamera(ft->obs[0].xy, ft->rho[0], s.pose(), next.frame->pose(), opts_.T_I_C);
-      if (p.z() > 0.0 && validDepth(opts_, p.z())) rho = 1.0 / p.z();
+      const Vec3 p = predictInCamera(ft->obs[0].xy, ft->rho[0], s.pose(), next.frame->pose(), options_.T_I_C);
+      if (p.z() > 0.0 && validDepth(options_, p.z())) rho = 1.0 / p.z();
     }
     ft->obs.erase(ft->obs.begin());
     ft->obs.front().cost.reset();
     ft->has_rho = rho > 0.0;
     ft->rho[0] = rho;
-    ft->depth_prior.reset(ft->obs.front().depth > 0.0
-                              ? makeInverseDepthPrior(ft->obs.front().depth, depthSigma(opts_, ft->obs.front().depth))
-                              : nullptr);
+    ft->depth_prior.reset(
+        ft->obs.front().depth > 0.0
+            ? makeInverseDepthPrior(ft->obs.front().depth, depthSigma(options_, ft->obs.front().depth))
+            : nullptr);
     for (size_t k = 1; k < ft->obs.size(); ++k)
-      ft->obs[k].cost.reset(
-          makeReprojectionFactor(ft->obs.front().xy, ft->obs[k].xy, opts_.T_I_C, opts_.focal, opts_.pixel_sigma));
+      ft->obs[k].cost.reset(makeReprojectionFactor(ft->obs.front().xy, ft->obs[k].xy, options_.T_I_C, options_.focal,
+                                                   options_.pixel_sigma));
   }
   for (uint64_t id : gone) features_.erase(id);
   // the IMU and wheel intervals merge: [e, s] + [s, c] becomes [e, c]
@@ -671,7 +671,7 @@ bool SlidingWindowEstimator::poseAt(int64_t t, Pose3* pose) const {
   }
   std::vector<ImuSample> samples;
   if (!samplesOver(imu_, last.utime, t, &samples)) return false;
-  ImuPreintegration pre(last.gyroBias(), last.accelBias(), opts_.imu_noise);
+  ImuPreintegration pre(last.gyroBias(), last.accelBias(), options_.imu_noise);
   for (size_t k = 0; k + 1 < samples.size(); ++k)
     pre.integrate(0.5 * (samples[k].gyro + samples[k + 1].gyro), 0.5 * (samples[k].accel + samples[k + 1].accel),
                   toSeconds(samples[k + 1].utime - samples[k].utime));

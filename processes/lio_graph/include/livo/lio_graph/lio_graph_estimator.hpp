@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include "livo/lio_graph/visual_motion.hpp"
 #include "livo/marginalization.hpp"
 #include "livo/odometry_frame.hpp"
+#include "livo/start_state_prior.hpp"
 #include "livo/sweep_timing.hpp"
 
 namespace livo::lio_graph {
@@ -92,7 +94,7 @@ class LioGraphEstimator {
   /// The sweep's start and end in the IMU clock (livo/sweep_timing.hpp, through the rig's LiDAR
   /// time offset: the same as livo-lio's); the IMU must have passed the end before addScan.
   SweepTiming sweepTiming(const LidarScan& scan) const {
-    return livo::sweepTiming(scan, opts_.extrinsics.time_offset_s);
+    return livo::sweepTiming(scan, options_.extrinsics.time_offset_s);
   }
   /// sweepTiming(scan).end_utime.
   int64_t scanEndUtime(const LidarScan& scan) const { return sweepTiming(scan).end_utime; }
@@ -109,12 +111,12 @@ class LioGraphEstimator {
   /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
   /// estimated when estimatesWheelMounting(), else zero (the rig's nominal).
   Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
-  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.estimatesMounting(); }
+  bool estimatesWheelMounting() const { return options_.use_wheel && options_.wheel_rig.estimatesMounting(); }
   /// What the visual subsystem's translations are multiplied by to be true (estimated).
   double visualScale() const { return visual_scale_[0]; }
   /// Stored keyframe i, oldest first (i < storedKeyframes()).
   const GraphKeyframe& storedKeyframe(size_t i) const { return keyframes_.at(i).kf; }
-  const LioGraphOptions& options() const { return opts_; }
+  const LioGraphOptions& options() const { return options_; }
   const LocalMap& localMap() const { return map_; }
   /// Gravity in the world frame: (0, 0, -gravity) until a loop correction tilts the frame.
   const Vec3& gravity() const { return gravity_W_; }
@@ -141,13 +143,43 @@ class LioGraphEstimator {
     Pose3 pose;  // predicted W_T_I
   };
 
+  /// The first state from the IMU's start-up window ending at t_end; false (with the reason) while it
+  /// cannot start.
   bool initialize(int64_t t_end, std::string* note);
+  /// The first state (at rest at the origin, or as the initialisation found it) and its priors.
+  std::unique_ptr<Node> startNode(int64_t t_end, const FilterState& state, const Vec3& last_gyro,
+                                  const StartStateSigmas& sigma);
+  /// The priors of the calibration blocks the window estimates (tyre scales, wheel mounting, visual
+  /// scale), around what an earlier epoch learned, added to the first state's.
+  void addCalibrationPriors(Node* n);
   /// The IMU preintegration from the newest state to t_end and the predicted poses at every sample.
   bool preintegrate(int64_t t_end, ImuPreintegration* pre, std::vector<ImuStep>* steps, Vec3* last_gyro) const;
   std::unique_ptr<WheelPreintegration> wheelBetween(int64_t t0, int64_t t1) const;
   /// Valid points deskewed to the sweep end, body frame (and their indices).
   void deskew(const LidarScan& scan, int64_t t_first, const std::vector<ImuStep>& steps, std::vector<Vec3>* body,
               std::vector<uint32_t>* index, std::vector<int16_t>* ring, std::vector<float>* time) const;
+  /// The visual subsystem's positions at the steps (its motion from the newest state), if it
+  /// covers them all.
+  std::optional<std::vector<Vec3>> visualPositions(const std::vector<ImuStep>& steps) const;
+  /// The roughness features of the deskewed sweep `body` (its rings and times in `cloud`), body frame.
+  ScanFeatures bodyFrameFeatures(const std::vector<Vec3>& body, RingCloud cloud) const;
+  /// A tracked sweep's state joins the window (matched to the local map from the prediction, or
+  /// the visual guess, with its factors), the window is optimised and its oldest states
+  /// marginalised; returns the new state.
+  Node* addState(int64_t t_end, const ImuPreintegration& pre, const Pose3* visual_guess, const Vec3& last_gyro,
+                 const ScanFeatures& features, const std::vector<Vec3>& body, GraphScanResult* res);
+  /// The state at t_end the IMU predicts from prev (its pose the visual guess where given).
+  std::unique_ptr<Node> predictedState(const Node& prev, int64_t t_end, const ImuPreintegration& pre,
+                                       const Pose3* visual_guess, const Vec3& last_gyro) const;
+  /// The LiDAR pose factor from a scan match (tracked), or the prediction kept (too few matches).
+  void addLidarFactor(const ScanMatchResult& match, Node* n, GraphScanResult* res) const;
+  /// The IMU, bias-walk, wheel and visual factors from prev to n.
+  void addMotionFactors(const Node& prev, const ImuPreintegration& pre, Node* n, GraphScanResult* res) const;
+  /// The newest state, its covariance and the sweep in the world into the result.
+  void reportState(const Node& newest, const std::vector<Vec3>& body, GraphScanResult* res);
+  /// The sweep as a keyframe: its features join the local map.
+  void addKeyframe(const LidarScan& scan, const std::vector<Vec3>& body, ScanFeatures features, const Node* newest,
+                   GraphScanResult* res);
   /// Planes of the sweep (body frame) associated with the window's landmarks or new ones; their
   /// factors go to the node.
   void observePlanes(const std::vector<Vec3>& body, Node* node, GraphScanResult* res);
@@ -168,18 +200,18 @@ class LioGraphEstimator {
   WorldMotion motionOf(const double* block) const;
   Mat6 newestPoseCovariance();
   void dropImuBefore(int64_t utime);
-  bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
+  bool estimatesWheelScale() const { return options_.use_wheel && options_.wheel_scale_std > 0.0; }
   /// The visual relative-pose factor's information for a measured motion T_i_j.
   Mat6 visualInformation(const Pose3& T_i_j) const;
   bool estimatesVisualScale() const {
-    return opts_.use_visual_motion && opts_.visual_factor && opts_.visual_scale_std > 0.0;
+    return options_.use_visual_motion && options_.visual_factor && options_.visual_scale_std > 0.0;
   }
   /// The parameter blocks of the visual factor that ends at state b.
   std::vector<double*> visualBlocks(Node& a, Node& b);
   /// The parameter blocks of the wheel factor that ends at state b.
   std::vector<double*> wheelBlocks(Node& a, Node& b);
 
-  LioGraphOptions opts_;
+  LioGraphOptions options_;
   VisualMotion visual_;
   std::deque<ImuSample> imu_;
   std::deque<WheelSample> wheel_;

@@ -34,6 +34,7 @@
 
 #include "livo/marginalization.hpp"
 #include "livo/sensor_samples.hpp"
+#include "livo/start_state_prior.hpp"
 #include "livo/vio_feature/vio_feature_options.hpp"
 
 namespace livo::vio_feature {
@@ -108,15 +109,15 @@ class SlidingWindowEstimator {
   /// The tyres' scales [left, right] (true radius over the nominal): estimated when
   /// estimatesWheelScale(), else [1, 1].
   Vec2 wheelScale() const { return Vec2(wheel_scale_[0], wheel_scale_[1]); }
-  bool estimatesWheelScale() const { return opts_.use_wheel && opts_.wheel_scale_std > 0.0; }
+  bool estimatesWheelScale() const { return options_.use_wheel && options_.wheel_scale_std > 0.0; }
   /// The wheel frame's mounting correction δ (rad): R_IO = R_IB Exp(δ) (wheel_preintegration.hpp),
   /// estimated when estimatesWheelMounting() (the rig states its rotation's uncertainty), else zero.
   Vec3 wheelMounting() const { return Vec3(wheel_mounting_[0], wheel_mounting_[1], wheel_mounting_[2]); }
-  bool estimatesWheelMounting() const { return opts_.use_wheel && opts_.wheel_rig.estimatesMounting(); }
+  bool estimatesWheelMounting() const { return options_.use_wheel && options_.wheel_rig.estimatesMounting(); }
   /// The newest IMU sample's time (0 before any).
   int64_t imuWatermark() const { return imu_.empty() ? 0 : imu_.back().utime; }
   int64_t wheelWatermark() const { return wheel_.empty() ? 0 : wheel_.back().utime; }
-  const SlidingWindowOptions& options() const { return opts_; }
+  const SlidingWindowOptions& options() const { return options_; }
 
  private:
   struct Frame;
@@ -130,8 +131,10 @@ class SlidingWindowEstimator {
   /// init.window_s older; keeps the images of that span.
   bool cameraStill(int64_t t, const FrameFeatures& frame);
   bool initializeMoving(int64_t t, FrameResult* res);
-  void startWindow(int64_t t, const Mat3& R, const Vec3& v, const Vec3& bg, const Vec3& ba, double rot_std,
-                   double vel_std, double bg_std);
+  /// The first state and its priors (the gauge held, the rest with `sigma`), the calibration
+  /// blocks' priors around what an earlier epoch learnt.
+  void startWindow(int64_t t, const Mat3& R, const Vec3& v, const Vec3& bg, const Vec3& ba,
+                   const StartStateSigmas& sigma);
   /// The IMU (and wheel) factors of `to` from `from`'s time, linearised at from's biases; false if
   /// the IMU does not cover the interval or has a gap.
   /// `predict`: the new state's first guess is the IMU's prediction (else it keeps its estimate).
@@ -156,7 +159,7 @@ class SlidingWindowEstimator {
   /// if estimated.
   std::vector<double*> wheelBlocks(Frame& a, Frame& b) const;
 
-  SlidingWindowOptions opts_;
+  SlidingWindowOptions options_;
   Vec3 gravity_W_;
   std::deque<ImuSample> imu_;
   std::deque<WheelSample> wheel_;
