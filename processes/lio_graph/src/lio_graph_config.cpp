@@ -7,10 +7,13 @@
 
 namespace livo::lio_graph {
 
-LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
+namespace {
+
+/// What the rig decides: the sensors' channels, the IMU's noise and gravity, the LiDAR's extrinsic
+/// and range limits, the wheels.
+LioGraphNodeOptions fromRig(const SensorRig& rig, const Config& root) {
   LioGraphNodeOptions n;
   LioGraphOptions& o = n.core;
-  const SensorRig rig = readSensorRig(root.section("rig"));
   n.imu_channel = rig.channels.imu;
   n.lidar_channel = rig.channels.lidar;
   n.wheel_channel = rig.channels.wheel;
@@ -26,63 +29,88 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
     o.wheel_rig = *rig.wheel;
     o.wheel_noise = WheelPreintegrationNoise::fromRig(*rig.wheel);
   }
+  return n;
+}
 
-  const Config c = root.optionalSection("lio_graph");
-  if (!c.isNull()) {
-    c.readOptional("name", n.name);
-    const Config ch = c.optionalSection("channels");
-    ch.readOptional("odometry", n.odometry_channel);
-    ch.readOptional("registered_scan", n.registered_scan_channel);
-    ch.readOptional("keyframe", n.keyframe_channel);
-    ch.readOptional("loop_correction", n.loop_correction_channel);
-    ch.readOptional("visual_state", n.visual_state_channel);
-    c.readOptional("visual_state", o.use_visual_motion);
-    c.readOptional("visual_max_wait_s", n.visual_max_wait_s);
-    c.readOptional("visual_factor", o.visual_factor);
-    c.readOptional("visual_sigma_rotation_deg", o.visual_sigma_rotation_deg);
-    c.readOptional("visual_sigma_translation", o.visual_sigma_translation);
-    c.readOptional("visual_sigma_translation_ratio", o.visual_sigma_translation_ratio);
-    c.readOptional("visual_cauchy", o.visual_cauchy);
-    c.readOptional("visual_scale_std", o.visual_scale_std);
-    bool wheel = o.use_wheel;
-    if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig.wheel.has_value();
-    c.readOptional("wheel_cauchy", o.wheel_cauchy);
-    c.readOptional("wheel_scale_std", o.wheel_scale_std);
-    c.readOptional("wheel_max_wait_s", n.wheel_max_wait_s);
-    c.readOptional("window_states", o.window_states);
-    c.readOptional("solver_iterations", o.solver_iterations);
-    c.readOptional("keyframe_distance", o.keyframe.min_distance);
-    c.readOptional("keyframe_angle_deg", o.keyframe.min_angle_deg);
-    c.readOptional("local_map_keyframes", o.local_map_keyframes);
-    c.readOptional("local_map_radius", o.local_map_radius);
-    c.readOptional("local_map_spacing", o.local_map_spacing);
-    int max_stored = static_cast<int>(o.max_stored_keyframes);
-    if (c.readOptional("max_stored_keyframes", max_stored)) {
-      if (max_stored < 1) throw ConfigError(c.where("max_stored_keyframes") + ": must be >= 1");
-      o.max_stored_keyframes = static_cast<size_t>(max_stored);
-    }
-    c.readOptional("map_edge_voxel", o.map_edge_voxel);
-    c.readOptional("map_surface_voxel", o.map_surface_voxel);
-    c.readOptional("lidar_point_sigma", o.lidar_point_sigma);
-    c.readOptional("lidar_information_scale", o.lidar_information_scale);
-    c.readOptional("edge_threshold", o.features.edge_threshold);
-    c.readOptional("surface_threshold", o.features.surface_threshold);
-    c.readOptional("surface_voxel", o.features.surface_voxel);
-    c.readOptional("degenerate_eigenvalue", o.matching.degenerate_eigenvalue);
-    c.readOptional("max_neighbour_distance", o.matching.max_neighbour_distance);
-    c.readOptional("max_plane_distance", o.matching.max_plane_distance);
-    c.readOptional("min_planarity", o.matching.min_planarity);
-    c.readOptional("planar_factors", o.planar_factors);
-    c.readOptional("planar_ground_only", o.planar_ground_only);
-    c.readOptional("plane_sigma_angle_deg", o.plane_sigma_angle_deg);
-    c.readOptional("plane_sigma_distance", o.plane_sigma_distance);
-    c.readOptional("plane_match_angle_deg", o.plane_match_angle_deg);
-    c.readOptional("plane_match_distance", o.plane_match_distance);
-    c.readOptional("plane_threshold_base", o.planes.threshold_base);
-    c.readOptional("plane_threshold_per_metre", o.planes.threshold_per_metre);
-    c.readOptional("plane_max_quality_ratio", o.planes.max_quality_ratio);
-    c.checkAllUsed();
+/// lio_graph.channels.
+void readChannels(const Config& ch, LioGraphNodeOptions* n) {
+  ch.readOptional("odometry", n->odometry_channel);
+  ch.readOptional("registered_scan", n->registered_scan_channel);
+  ch.readOptional("keyframe", n->keyframe_channel);
+  ch.readOptional("loop_correction", n->loop_correction_channel);
+  ch.readOptional("visual_state", n->visual_state_channel);
+}
+
+/// The visual subsystem's keys (visual_*).
+void readVisualKeys(const Config& c, LioGraphNodeOptions* n) {
+  LioGraphOptions& o = n->core;
+  c.readOptional("visual_state", o.use_visual_motion);
+  c.readOptional("visual_max_wait_s", n->visual_max_wait_s);
+  c.readOptional("visual_factor", o.visual_factor);
+  c.readOptional("visual_sigma_rotation_deg", o.visual_sigma_rotation_deg);
+  c.readOptional("visual_sigma_translation", o.visual_sigma_translation);
+  c.readOptional("visual_sigma_translation_ratio", o.visual_sigma_translation_ratio);
+  c.readOptional("visual_cauchy", o.visual_cauchy);
+  c.readOptional("visual_scale_std", o.visual_scale_std);
+}
+
+/// The wheels' keys (wheel*): `wheel: false` turns a rig's wheels off, never on without them.
+void readWheelKeys(const Config& c, bool rig_has_wheel, LioGraphNodeOptions* n) {
+  LioGraphOptions& o = n->core;
+  bool wheel = o.use_wheel;
+  if (c.readOptional("wheel", wheel)) o.use_wheel = wheel && rig_has_wheel;
+  c.readOptional("wheel_cauchy", o.wheel_cauchy);
+  c.readOptional("wheel_scale_std", o.wheel_scale_std);
+  c.readOptional("wheel_max_wait_s", n->wheel_max_wait_s);
+}
+
+/// The window's, the keyframes' and the local map's keys.
+void readWindowKeys(const Config& c, LioGraphOptions* o) {
+  c.readOptional("window_states", o->window_states);
+  c.readOptional("solver_iterations", o->solver_iterations);
+  c.readOptional("keyframe_distance", o->keyframe.min_distance);
+  c.readOptional("keyframe_angle_deg", o->keyframe.min_angle_deg);
+  c.readOptional("local_map_keyframes", o->local_map_keyframes);
+  c.readOptional("local_map_radius", o->local_map_radius);
+  c.readOptional("local_map_spacing", o->local_map_spacing);
+  int max_stored = static_cast<int>(o->max_stored_keyframes);
+  if (c.readOptional("max_stored_keyframes", max_stored)) {
+    if (max_stored < 1) throw ConfigError(c.where("max_stored_keyframes") + ": must be >= 1");
+    o->max_stored_keyframes = static_cast<size_t>(max_stored);
   }
+  c.readOptional("map_edge_voxel", o->map_edge_voxel);
+  c.readOptional("map_surface_voxel", o->map_surface_voxel);
+}
+
+/// The LiDAR factor's, the features' and the scan matching's keys.
+void readMatchingKeys(const Config& c, LioGraphOptions* o) {
+  c.readOptional("lidar_point_sigma", o->lidar_point_sigma);
+  c.readOptional("lidar_information_scale", o->lidar_information_scale);
+  c.readOptional("edge_threshold", o->features.edge_threshold);
+  c.readOptional("surface_threshold", o->features.surface_threshold);
+  c.readOptional("surface_voxel", o->features.surface_voxel);
+  c.readOptional("degenerate_eigenvalue", o->matching.degenerate_eigenvalue);
+  c.readOptional("max_neighbour_distance", o->matching.max_neighbour_distance);
+  c.readOptional("max_plane_distance", o->matching.max_plane_distance);
+  c.readOptional("min_planarity", o->matching.min_planarity);
+}
+
+/// The planar factors' and the plane extraction's keys.
+void readPlaneKeys(const Config& c, LioGraphOptions* o) {
+  c.readOptional("planar_factors", o->planar_factors);
+  c.readOptional("planar_ground_only", o->planar_ground_only);
+  c.readOptional("plane_sigma_angle_deg", o->plane_sigma_angle_deg);
+  c.readOptional("plane_sigma_distance", o->plane_sigma_distance);
+  c.readOptional("plane_match_angle_deg", o->plane_match_angle_deg);
+  c.readOptional("plane_match_distance", o->plane_match_distance);
+  c.readOptional("plane_threshold_base", o->planes.threshold_base);
+  c.readOptional("plane_threshold_per_metre", o->planes.threshold_per_metre);
+  c.readOptional("plane_max_quality_ratio", o->planes.max_quality_ratio);
+}
+
+/// Out-of-range values are errors naming their key in the section `c`.
+void checkRanges(const LioGraphNodeOptions& n, const Config& c) {
+  const LioGraphOptions& o = n.core;
   auto fail = [&](const std::string& key, const std::string& what) { throw ConfigError(c.where(key) + ": " + what); };
   if (o.window_states < 2) fail("window_states", "must be >= 2");
   if (o.solver_iterations < 1) fail("solver_iterations", "must be >= 1");
@@ -115,6 +143,25 @@ LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
   if (!(o.visual_sigma_translation_ratio >= 0.0)) fail("visual_sigma_translation_ratio", "must be >= 0");
   if (!(o.visual_cauchy > 0.0)) fail("visual_cauchy", "must be > 0");
   if (!(o.visual_scale_std >= 0.0 && o.visual_scale_std <= 0.2)) fail("visual_scale_std", "must be in [0, 0.2]");
+}
+
+}  // namespace
+
+LioGraphNodeOptions readLioGraphNodeOptions(const Config& root) {
+  const SensorRig rig = readSensorRig(root.section("rig"));
+  LioGraphNodeOptions n = fromRig(rig, root);
+  const Config c = root.optionalSection("lio_graph");
+  if (!c.isNull()) {
+    c.readOptional("name", n.name);
+    readChannels(c.optionalSection("channels"), &n);
+    readVisualKeys(c, &n);
+    readWheelKeys(c, rig.wheel.has_value(), &n);
+    readWindowKeys(c, &n.core);
+    readMatchingKeys(c, &n.core);
+    readPlaneKeys(c, &n.core);
+    c.checkAllUsed();
+  }
+  checkRanges(n, c);
   return n;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include <Eigen/Core>
@@ -267,6 +268,110 @@ Vec3 centroidOf(const std::vector<Vec3>& points, const std::vector<int>& ids) {
   return ids.empty() ? c : Vec3(c / static_cast<double>(ids.size()));
 }
 
+std::vector<int> finiteIndices(const std::vector<Vec3>& points) {
+  std::vector<int> finite;
+  finite.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i)
+    if (points[i].allFinite()) finite.push_back(static_cast<int>(i));
+  return finite;
+}
+
+/// RANSAC's scoring sample: every stride-th remaining point (at most about `score_sample`),
+/// coordinate by coordinate.
+struct ScoringSample {
+  std::vector<double> x, y, z;
+};
+
+ScoringSample scoringSample(const std::vector<Vec3>& points, const std::vector<int>& remaining, int score_sample) {
+  const size_t stride = std::max<size_t>(1, remaining.size() / static_cast<size_t>(std::max(1, score_sample)));
+  const size_t samples = (remaining.size() + stride - 1) / stride;
+  ScoringSample s;
+  s.x.resize(samples), s.y.resize(samples), s.z.resize(samples);
+  for (size_t k = 0; k < samples; ++k) {
+    const Vec3& x = points[remaining[k * stride]];
+    s.x[k] = x.x(), s.y[k] = x.y(), s.z[k] = x.z();
+  }
+  return s;
+}
+
+struct ScoredPlane {
+  Plane plane;
+  int score = 0;  // sample points within the threshold
+};
+
+/// The best scoring of `iterations` planes through three random remaining points.
+ScoredPlane bestRandomPlane(const std::vector<Vec3>& points, const std::vector<int>& remaining,
+                            const ScoringSample& sample, double threshold, int iterations, std::mt19937* rng) {
+  std::uniform_int_distribution<size_t> pick(0, remaining.size() - 1);
+  ScoredPlane best;
+  for (int it = 0; it < iterations; ++it) {
+    Plane h;
+    if (!planeThrough(points[remaining[pick(*rng)]], points[remaining[pick(*rng)]], points[remaining[pick(*rng)]], &h))
+      continue;
+    const int score = scoreOf(h, sample.x, sample.y, sample.z, threshold, best.score);
+    if (score > best.score) best.score = score, best.plane = h;
+  }
+  return best;
+}
+
+/// The remaining points within `threshold` of p.
+std::vector<int> inliersOf(const std::vector<Vec3>& points, const std::vector<int>& remaining, const Plane& p,
+                           double threshold) {
+  std::vector<int> ids;
+  for (int i : remaining)
+    if (std::abs(p.distance(points[i])) < threshold) ids.push_back(i);
+  return ids;
+}
+
+/// The least-squares plane of the points `ids`; none for fewer than three or a degenerate fit.
+std::optional<Plane> refitPlane(const std::vector<Vec3>& points, const std::vector<int>& ids) {
+  std::vector<Vec3> buf;
+  for (int i : ids) buf.push_back(points[i]);
+  PlaneFit fit;
+  if (buf.size() < 3 || !fitPlane(buf.data(), static_cast<int>(buf.size()), &fit)) return std::nullopt;
+  return fit.plane;
+}
+
+/// The inliers whose local normal agrees with the plane's (within acos(cos_consistent)).
+std::vector<int> consistentInliers(const std::vector<int>& in, const Plane& plane, double cos_consistent,
+                                   LocalNormals* normals) {
+  std::vector<int> consistent;
+  for (int i : in)
+    if (std::abs((*normals)(i).dot(plane.normal)) >= cos_consistent) consistent.push_back(i);
+  return consistent;
+}
+
+void removeFromRemaining(const std::vector<int>& ids, std::vector<char>* gone, std::vector<int>* remaining) {
+  for (int i : ids) (*gone)[i] = 1;
+  remaining->erase(std::remove_if(remaining->begin(), remaining->end(), [&](int i) { return (*gone)[i] != 0; }),
+                   remaining->end());
+}
+
+/// The plane of the points `ids` turned towards the sensor, with their centroid and its quality.
+ExtractedPlane describePlane(const std::vector<Vec3>& points, std::vector<int> ids, Plane plane, double threshold) {
+  ExtractedPlane e;
+  if (plane.offset < 0.0) plane.normal = -plane.normal, plane.offset = -plane.offset;
+  e.plane = plane;
+  e.centroid = centroidOf(points, ids);
+  e.threshold = threshold;
+  double sum = 0.0;
+  for (int i : ids) sum += std::abs(plane.distance(points[i]));
+  e.quality = sum / static_cast<double>(ids.size());
+  e.inliers = std::move(ids);
+  return e;
+}
+
+enum class GroundTest { kNotGround, kGround, kTiltedGround };
+
+/// The ground-direction constraint: a nearly horizontal plane below the sensor must be level.
+GroundTest groundTest(const ExtractedPlane& e, const Vec3& up, const PlaneExtractionOptions& o) {
+  const double tilt_deg = std::acos(std::min(1.0, std::abs(e.plane.normal.dot(up)))) * 180.0 / M_PI;
+  const bool below = e.centroid.dot(up) < -o.ground_below;
+  if (below && tilt_deg <= o.ground_candidate_deg)
+    return tilt_deg > o.ground_max_tilt_deg ? GroundTest::kTiltedGround : GroundTest::kGround;
+  return GroundTest::kNotGround;
+}
+
 }  // namespace
 
 double adaptiveThreshold(const Vec3& centroid, const PlaneExtractionOptions& o) {
@@ -279,104 +384,50 @@ std::vector<ExtractedPlane> extractPlanes(const std::vector<Vec3>& points, const
   PlaneExtractionStats& st = stats ? *stats : local;
   st = PlaneExtractionStats{};
   std::vector<ExtractedPlane> planes;
-  std::vector<int> remaining;
-  remaining.reserve(points.size());
-  for (size_t i = 0; i < points.size(); ++i)
-    if (points[i].allFinite()) remaining.push_back(static_cast<int>(i));
+  std::vector<int> remaining = finiteIndices(points);
   if (static_cast<int>(remaining.size()) < std::max(3, o.min_inliers)) return planes;
 
   LocalNormals normals(points, o.normal_neighbours);
   const double cos_consistent = std::cos(o.normal_max_angle_deg * M_PI / 180.0);
   const Vec3 up = o.up.normalized();
   std::mt19937 rng(o.seed);
-  std::vector<double> sx, sy, sz;  // the scoring sample, coordinate by coordinate
   std::vector<char> gone(points.size(), 0);
-  std::vector<int> in, consistent;
-  std::vector<Vec3> buf;
-
   for (int attempt = 0; attempt < o.max_planes; ++attempt) {
     if (static_cast<int>(remaining.size()) < std::max(3, o.min_inliers)) break;
     const double threshold = adaptiveThreshold(centroidOf(points, remaining), o);
-
     // hypotheses from three random remaining points, scored on a strided sample
-    const size_t stride = std::max<size_t>(1, remaining.size() / static_cast<size_t>(std::max(1, o.score_sample)));
-    const size_t samples = (remaining.size() + stride - 1) / stride;
-    sx.resize(samples), sy.resize(samples), sz.resize(samples);
-    for (size_t s = 0; s < samples; ++s) {
-      const Vec3& x = points[remaining[s * stride]];
-      sx[s] = x.x(), sy[s] = x.y(), sz[s] = x.z();
-    }
-    std::uniform_int_distribution<size_t> pick(0, remaining.size() - 1);
-    Plane best;
-    int best_score = 0;
-    for (int it = 0; it < o.ransac_iterations; ++it) {
-      Plane h;
-      if (!planeThrough(points[remaining[pick(rng)]], points[remaining[pick(rng)]], points[remaining[pick(rng)]], &h))
-        continue;
-      const int score = scoreOf(h, sx, sy, sz, threshold, best_score);
-      if (score > best_score) best_score = score, best = h;
-    }
-    if (best_score < 3) break;
-
+    const ScoredPlane best = bestRandomPlane(points, remaining, scoringSample(points, remaining, o.score_sample),
+                                             threshold, o.ransac_iterations, &rng);
+    if (best.score < 3) break;
     // every remaining point within the threshold, refitted by least squares, then counted again
-    auto inliersOf = [&](const Plane& p, std::vector<int>* ids) {
-      ids->clear();
-      for (int i : remaining)
-        if (std::abs(p.distance(points[i])) < threshold) ids->push_back(i);
-    };
-    auto refit = [&](const std::vector<int>& ids, Plane* p) {
-      buf.clear();
-      for (int i : ids) buf.push_back(points[i]);
-      PlaneFit fit;
-      if (buf.size() < 3 || !fitPlane(buf.data(), static_cast<int>(buf.size()), &fit)) return false;
-      *p = fit.plane;
-      return true;
-    };
-    inliersOf(best, &in);
-    Plane plane = best;
-    if (refit(in, &plane)) inliersOf(plane, &in);
-
+    std::vector<int> in = inliersOf(points, remaining, best.plane, threshold);
+    Plane plane = best.plane;
+    if (const std::optional<Plane> refitted = refitPlane(points, in)) {
+      plane = *refitted;
+      in = inliersOf(points, remaining, plane, threshold);
+    }
     // normal consistency: inliers whose local normal agrees with the plane's
-    consistent.clear();
-    for (int i : in)
-      if (std::abs(normals(i).dot(plane.normal)) >= cos_consistent) consistent.push_back(i);
-    auto removeFromRemaining = [&](const std::vector<int>& ids) {
-      for (int i : ids) gone[i] = 1;
-      remaining.erase(std::remove_if(remaining.begin(), remaining.end(), [&](int i) { return gone[i] != 0; }),
-                      remaining.end());
-    };
+    const std::vector<int> consistent = consistentInliers(in, plane, cos_consistent, &normals);
     if (static_cast<int>(consistent.size()) < o.min_inliers ||
         static_cast<double>(consistent.size()) < o.min_consistent_fraction * static_cast<double>(in.size())) {
       ++st.refused_inconsistent;
-      removeFromRemaining(in);  // explained by no plane: not tried again
+      removeFromRemaining(in, &gone, &remaining);  // explained by no plane: not tried again
       continue;
     }
-    refit(consistent, &plane);
-    removeFromRemaining(consistent);
+    if (const std::optional<Plane> refitted = refitPlane(points, consistent)) plane = *refitted;
+    removeFromRemaining(consistent, &gone, &remaining);
 
-    ExtractedPlane e;
-    if (plane.offset < 0.0) plane.normal = -plane.normal, plane.offset = -plane.offset;
-    e.plane = plane;
-    e.centroid = centroidOf(points, consistent);
-    e.threshold = threshold;
-    double sum = 0.0;
-    for (int i : consistent) sum += std::abs(plane.distance(points[i]));
-    e.quality = sum / static_cast<double>(consistent.size());
+    ExtractedPlane e = describePlane(points, consistent, plane, threshold);
     if (e.quality > o.max_quality_ratio * threshold) {
       ++st.refused_quality;
       continue;
     }
-    // ground-direction constraint: a nearly horizontal plane below the sensor must be level
-    const double tilt_deg = std::acos(std::min(1.0, std::abs(plane.normal.dot(up)))) * 180.0 / M_PI;
-    const bool below = e.centroid.dot(up) < -o.ground_below;
-    if (below && tilt_deg <= o.ground_candidate_deg) {
-      if (tilt_deg > o.ground_max_tilt_deg) {
-        ++st.refused_ground_tilt;
-        continue;
-      }
-      e.ground = true;
+    const GroundTest ground = groundTest(e, up, o);
+    if (ground == GroundTest::kTiltedGround) {
+      ++st.refused_ground_tilt;
+      continue;
     }
-    e.inliers = consistent;
+    e.ground = ground == GroundTest::kGround;
     planes.push_back(std::move(e));
     ++st.accepted;
   }
