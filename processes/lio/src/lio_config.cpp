@@ -82,8 +82,9 @@ void readRig(const Config& rig, LioNodeOptions* o) {
   }
 }
 
-void readLio(const Config& c, LioNodeOptions* o) {
-  LioOptions& l = o->lio;
+// lio.*: a reader per section, in the order the keys were always read (the first malformed value
+// is the one reported), then the ranges.
+void readNodeKeys(const Config& c, LioNodeOptions* o) {
   c.readOptional("name", o->name);
   c.readOptional("publish_registered_scan", o->publish_registered_scan);
   c.readOptional("imu_reorder_window_s", o->imu_reorder_window_s);
@@ -98,163 +99,178 @@ void readLio(const Config& c, LioNodeOptions* o) {
   c.readOptional("posterior_max_wait_s", o->posterior_max_wait_s);
   c.readOptional("image_lidar_wait_s", o->image_lidar_wait_s);
   c.readOptional("image_max_wait_s", o->image_max_wait_s);
+}
 
-  const Config out = c.optionalSection("channels");
+void readOutputChannels(const Config& out, LioNodeOptions* o) {
   out.readOptional("state_posterior", o->state_posterior_channel);
   out.readOptional("loop_correction", o->loop_correction_channel);
   out.readOptional("odometry", o->odometry_channel);
   out.readOptional("registered_scan", o->registered_scan_channel);
   out.readOptional("keyframe", o->keyframe_channel);
   out.readOptional("state_prior", o->state_prior_channel);
+}
 
-  const Config init = c.optionalSection("init");
+void readInit(const Config& init, ImuInitOptions* i) {
   std::string mode;
   if (init.readOptional("mode", mode)) {
     if (mode == "auto")
-      l.init.mode = ImuInitOptions::Mode::kAuto;
+      i->mode = ImuInitOptions::Mode::kAuto;
     else if (mode == "static")
-      l.init.mode = ImuInitOptions::Mode::kStatic;
+      i->mode = ImuInitOptions::Mode::kStatic;
     else if (mode == "moving")
-      l.init.mode = ImuInitOptions::Mode::kMoving;
+      i->mode = ImuInitOptions::Mode::kMoving;
     else
       throw ConfigError(init.where("mode") + ": expected auto, static or moving, got '" + mode + "'");
   }
-  init.readOptional("window_s", l.init.window_s);
-  init.readOptional("max_gyro_std", l.init.max_gyro_std);
-  init.readOptional("max_accel_std", l.init.max_accel_std);
-  init.readOptional("moving_vel_std", l.init.moving_vel_std);
+  init.readOptional("window_s", i->window_s);
+  init.readOptional("max_gyro_std", i->max_gyro_std);
+  init.readOptional("max_accel_std", i->max_accel_std);
+  init.readOptional("moving_vel_std", i->moving_vel_std);
+}
 
-  c.readOptional("lidar_time_offset_s", l.extrinsics.time_offset_s);
-  const Config cal = c.optionalSection("calibration").optionalSection("estimate");
-  cal.readOptional("lidar_rotation", l.calibration.lidar_rotation);
-  cal.readOptional("lidar_translation", l.calibration.lidar_translation);
-  cal.readOptional("lidar_time", l.calibration.lidar_time);
-  cal.readOptional("camera_rotation", l.calibration.camera_rotation);
-  cal.readOptional("camera_translation", l.calibration.camera_translation);
-  cal.readOptional("camera_time", l.calibration.camera_time);
+void readCalibrationEstimate(const Config& cal, CalibrationEstimation* e) {
+  cal.readOptional("lidar_rotation", e->lidar_rotation);
+  cal.readOptional("lidar_translation", e->lidar_translation);
+  cal.readOptional("lidar_time", e->lidar_time);
+  cal.readOptional("camera_rotation", e->camera_rotation);
+  cal.readOptional("camera_translation", e->camera_translation);
+  cal.readOptional("camera_time", e->camera_time);
   std::string imu_axes;
   if (cal.readOptional("imu_axes", imu_axes)) {
     using A = CalibrationEstimation::ImuAxes;
     if (imu_axes == "budget")
-      l.calibration.imu_axes = A::kBudget;
+      e->imu_axes = A::kBudget;
     else if (imu_axes == "consider")
-      l.calibration.imu_axes = A::kConsider;
+      e->imu_axes = A::kConsider;
     else if (imu_axes == "estimate")
-      l.calibration.imu_axes = A::kEstimate;
+      e->imu_axes = A::kEstimate;
     else
       throw ConfigError(cal.where("imu_axes") + ": must be budget, consider or estimate (got '" + imu_axes + "')");
   }
-  c.readOptional("point_stride", l.point_stride);
-  c.readOptional("scan_voxel_size", l.scan_voxel_size);
-  c.readOptional("min_points", l.min_points);
-  c.readOptional("min_residuals", l.min_residuals);
-  c.readOptional("search_threads", l.search_threads);
-  c.readOptional("max_imu_gap_s", l.max_imu_gap_s);
-  c.readOptional("reset_imu_gap_s", l.reset_imu_gap_s);
-  c.readOptional("gap_rate_std", l.gap_rate_std);
-  c.readOptional("max_position_jump", l.max_position_jump);
-  c.readOptional("max_imu_backlog_s", l.max_imu_backlog_s);
-  c.readOptional("reseed_after_s", l.reseed_after_s);
+}
 
-  const Config map = c.optionalSection("map");
-  map.readOptional("voxel_size", l.map.voxel_size);
-  map.readOptional("max_points_per_voxel", l.map.max_points_per_voxel);
-  map.readOptional("min_point_distance", l.map.min_point_distance);
-  map.readOptional("seen_again_distance", l.map.seen_again_distance);
-  map.readOptional("refresh_range_ratio", l.map.refresh_range_ratio);
-  const Config planes = map.optionalSection("planes");
-  planes.readOptional("enabled", l.planes.enabled);
-  planes.readOptional("cell_size", l.planes.cell_size);
-  planes.readOptional("max_points", l.planes.max_points);
-  planes.readOptional("min_points", l.planes.min_points);
-  planes.readOptional("point_stride", l.planes.point_stride);
-  planes.readOptional("max_std", l.planes.max_std);
-  planes.readOptional("max_normal_angle", l.planes.max_normal_angle);
-  planes.readOptional("refresh_range_ratio", l.planes.refresh_range_ratio);
-  planes.readOptional("max_variance_ratio", l.planes.max_variance_ratio);
-  planes.readOptional("model_std", l.planes.model_std);
-  planes.readOptional("max_range", l.planes.max_range);
-  map.readOptional("radius", l.map_radius);
-  map.readOptional("prune_distance", l.map_prune_distance);
-  std::string on_correction = l.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "move" : "rebuild";
+void readCoreKeys(const Config& c, LioOptions* l) {
+  c.readOptional("point_stride", l->point_stride);
+  c.readOptional("scan_voxel_size", l->scan_voxel_size);
+  c.readOptional("min_points", l->min_points);
+  c.readOptional("min_residuals", l->min_residuals);
+  c.readOptional("search_threads", l->search_threads);
+  c.readOptional("max_imu_gap_s", l->max_imu_gap_s);
+  c.readOptional("reset_imu_gap_s", l->reset_imu_gap_s);
+  c.readOptional("gap_rate_std", l->gap_rate_std);
+  c.readOptional("max_position_jump", l->max_position_jump);
+  c.readOptional("max_imu_backlog_s", l->max_imu_backlog_s);
+  c.readOptional("reseed_after_s", l->reseed_after_s);
+}
+
+void readPlanes(const Config& planes, VoxelPlanesOptions* p) {
+  planes.readOptional("enabled", p->enabled);
+  planes.readOptional("cell_size", p->cell_size);
+  planes.readOptional("max_points", p->max_points);
+  planes.readOptional("min_points", p->min_points);
+  planes.readOptional("point_stride", p->point_stride);
+  planes.readOptional("max_std", p->max_std);
+  planes.readOptional("max_normal_angle", p->max_normal_angle);
+  planes.readOptional("refresh_range_ratio", p->refresh_range_ratio);
+  planes.readOptional("max_variance_ratio", p->max_variance_ratio);
+  planes.readOptional("model_std", p->model_std);
+  planes.readOptional("max_range", p->max_range);
+}
+
+void readSeenThrough(const Config& seen, SeenThroughOptions* s) {
+  seen.readOptional("enabled", s->enabled);
+  seen.readOptional("beam_radius", s->beam_radius);
+  seen.readOptional("beam_divergence", s->beam_divergence);
+  seen.readOptional("end_margin", s->end_margin);
+  seen.readOptional("end_margin_fraction", s->end_margin_fraction);
+  seen.readOptional("min_range", s->min_range);
+  seen.readOptional("max_range", s->max_range);
+  seen.readOptional("misses_to_remove", s->misses_to_remove);
+  seen.readOptional("ray_stride", s->ray_stride);
+}
+
+void readMap(const Config& map, LioOptions* l) {
+  map.readOptional("voxel_size", l->map.voxel_size);
+  map.readOptional("max_points_per_voxel", l->map.max_points_per_voxel);
+  map.readOptional("min_point_distance", l->map.min_point_distance);
+  map.readOptional("seen_again_distance", l->map.seen_again_distance);
+  map.readOptional("refresh_range_ratio", l->map.refresh_range_ratio);
+  readPlanes(map.optionalSection("planes"), &l->planes);
+  map.readOptional("radius", l->map_radius);
+  map.readOptional("prune_distance", l->map_prune_distance);
+  std::string on_correction = l->map_on_loop_correction == LioOptions::OnLoopCorrection::kMove ? "move" : "rebuild";
   map.readOptional("on_loop_correction", on_correction);
   if (on_correction != "move" && on_correction != "rebuild")
     throw ConfigError(map.where("on_loop_correction") + ": must be move or rebuild (not " + on_correction + ")");
-  l.map_on_loop_correction =
+  l->map_on_loop_correction =
       on_correction == "move" ? LioOptions::OnLoopCorrection::kMove : LioOptions::OnLoopCorrection::kRebuild;
-  const Config seen = map.optionalSection("seen_through");
-  seen.readOptional("enabled", l.seen_through.enabled);
-  seen.readOptional("beam_radius", l.seen_through.beam_radius);
-  seen.readOptional("beam_divergence", l.seen_through.beam_divergence);
-  seen.readOptional("end_margin", l.seen_through.end_margin);
-  seen.readOptional("end_margin_fraction", l.seen_through.end_margin_fraction);
-  seen.readOptional("min_range", l.seen_through.min_range);
-  seen.readOptional("max_range", l.seen_through.max_range);
-  seen.readOptional("misses_to_remove", l.seen_through.misses_to_remove);
-  seen.readOptional("ray_stride", l.seen_through.ray_stride);
+  readSeenThrough(map.optionalSection("seen_through"), &l->seen_through);
+}
 
-  const Config m = c.optionalSection("matching");
-  m.readOptional("num_neighbors", l.matching.plane.num_neighbors);
-  m.readOptional("max_neighbor_distance", l.matching.plane.max_neighbor_distance);
-  m.readOptional("max_plane_thickness", l.matching.plane.max_plane_thickness);
-  m.readOptional("min_planarity", l.matching.plane.min_planarity);
-  m.readOptional("point_noise_std", l.matching.point_noise_std);
-  m.readOptional("residual_range_factor", l.matching.residual_range_factor);
-  m.readOptional("research_distance", l.matching.research_distance);
-  m.readOptional("robust_scale", l.matching.robust_scale);
-  m.readOptional("degeneracy_threshold", l.matching.degeneracy_threshold);
-  m.readOptional("degeneracy_lever_arm", l.matching.degeneracy_lever_arm);
-  m.readOptional("remove_degenerate", l.matching.remove_degenerate);
+void readMatching(const Config& m, ScanToMapOptions* o) {
+  m.readOptional("num_neighbors", o->plane.num_neighbors);
+  m.readOptional("max_neighbor_distance", o->plane.max_neighbor_distance);
+  m.readOptional("max_plane_thickness", o->plane.max_plane_thickness);
+  m.readOptional("min_planarity", o->plane.min_planarity);
+  m.readOptional("point_noise_std", o->point_noise_std);
+  m.readOptional("residual_range_factor", o->residual_range_factor);
+  m.readOptional("research_distance", o->research_distance);
+  m.readOptional("robust_scale", o->robust_scale);
+  m.readOptional("degeneracy_threshold", o->degeneracy_threshold);
+  m.readOptional("degeneracy_lever_arm", o->degeneracy_lever_arm);
+  m.readOptional("remove_degenerate", o->remove_degenerate);
   const Config floor = m.optionalSection("registration_floor");
-  double floor_rotation_deg = l.matching.registration_floor_rotation * 180.0 / M_PI;
+  double floor_rotation_deg = o->registration_floor_rotation * 180.0 / M_PI;
   floor.readOptional("rotation_deg", floor_rotation_deg);
-  floor.readOptional("translation", l.matching.registration_floor_translation);
-  l.matching.registration_floor_rotation = floor_rotation_deg * M_PI / 180.0;
+  floor.readOptional("translation", o->registration_floor_translation);
+  o->registration_floor_rotation = floor_rotation_deg * M_PI / 180.0;
   if (!(floor_rotation_deg >= 0.0 && floor_rotation_deg <= 1.0))
     throw ConfigError(floor.where("rotation_deg") + ": must be in [0, 1] deg");
-  if (!(l.matching.registration_floor_translation >= 0.0 && l.matching.registration_floor_translation <= 0.1))
+  if (!(o->registration_floor_translation >= 0.0 && o->registration_floor_translation <= 0.1))
     throw ConfigError(floor.where("translation") + ": must be in [0, 0.1] m");
+}
 
-  const Config e = c.optionalSection("esikf");
-  e.readOptional("max_iterations", l.esikf.max_iterations);
-  e.readOptional("convergence_rot", l.esikf.convergence_rot);
-  e.readOptional("convergence_pos", l.esikf.convergence_pos);
-
-  const Config k = c.optionalSection("keyframe");
-  k.readOptional("min_distance", l.keyframe.min_distance);
-  k.readOptional("min_angle_deg", l.keyframe.min_angle_deg);
-  k.readOptional("cloud_voxel", l.keyframe.cloud_voxel);
-  int max_stored = static_cast<int>(l.max_stored_keyframes);
+void readKeyframe(const Config& k, LioOptions* l) {
+  k.readOptional("min_distance", l->keyframe.min_distance);
+  k.readOptional("min_angle_deg", l->keyframe.min_angle_deg);
+  k.readOptional("cloud_voxel", l->keyframe.cloud_voxel);
+  int max_stored = static_cast<int>(l->max_stored_keyframes);
   k.readOptional("max_stored", max_stored);
-  l.max_stored_keyframes = static_cast<size_t>(std::max(1, max_stored));
+  l->max_stored_keyframes = static_cast<size_t>(std::max(1, max_stored));
+}
 
-  const Config w = c.optionalSection("wheel");
-  w.readOptional("enabled", l.wheel.enabled);
-  w.readOptional("lateral_noise_std", l.wheel.lateral_noise_std);
-  w.readOptional("vertical_noise_std", l.wheel.vertical_noise_std);
-  w.readOptional("max_sample_gap_s", l.wheel.max_sample_gap_s);
-  w.readOptional("gate_chi2", l.wheel.gate_chi2);
-  const Config ws = w.optionalSection("scale");
-  WheelScaleOptions& s = l.wheel_scale;
-  ws.readOptional("enabled", s.enabled);
-  ws.readOptional("prior_std", s.prior_std);
-  ws.readOptional("random_walk", s.random_walk);
-  ws.readOptional("displacement_noise_std", s.displacement_noise_std);
-  ws.readOptional("min_speed", s.min_speed);
-  ws.readOptional("gate_chi2", s.gate_chi2);
-  ws.readOptional("max_interval_s", s.max_interval_s);
+void readWheelScale(const Config& ws, WheelScaleOptions* s) {
+  ws.readOptional("enabled", s->enabled);
+  ws.readOptional("prior_std", s->prior_std);
+  ws.readOptional("random_walk", s->random_walk);
+  ws.readOptional("displacement_noise_std", s->displacement_noise_std);
+  ws.readOptional("min_speed", s->min_speed);
+  ws.readOptional("gate_chi2", s->gate_chi2);
+  ws.readOptional("max_interval_s", s->max_interval_s);
   auto inRange = [&](bool ok, const char* key, const char* what) {
     if (!ok) throw ConfigError(ws.where(key) + ": " + what);
   };
-  inRange(s.prior_std >= 0.0 && s.prior_std <= 0.5, "prior_std", "must be in [0, 0.5]");
-  inRange(s.random_walk >= 0.0 && s.random_walk <= 0.01, "random_walk", "must be in [0, 0.01] 1/sqrt(s)");
-  inRange(s.displacement_noise_std > 0.0 && s.displacement_noise_std <= 1.0, "displacement_noise_std",
+  inRange(s->prior_std >= 0.0 && s->prior_std <= 0.5, "prior_std", "must be in [0, 0.5]");
+  inRange(s->random_walk >= 0.0 && s->random_walk <= 0.01, "random_walk", "must be in [0, 0.01] 1/sqrt(s)");
+  inRange(s->displacement_noise_std > 0.0 && s->displacement_noise_std <= 1.0, "displacement_noise_std",
           "must be in (0, 1] m");
-  inRange(s.min_speed > 0.0, "min_speed", "must be positive");
-  inRange(s.gate_chi2 > 0.0, "gate_chi2", "must be positive");
-  inRange(s.max_interval_s > 0.0 && s.max_interval_s <= 10.0, "max_interval_s", "must be in (0, 10] s");
+  inRange(s->min_speed > 0.0, "min_speed", "must be positive");
+  inRange(s->gate_chi2 > 0.0, "gate_chi2", "must be positive");
+  inRange(s->max_interval_s > 0.0 && s->max_interval_s <= 10.0, "max_interval_s", "must be in (0, 10] s");
+}
 
-  // every check names the key it is about (c.where: lio.KEY, with its section)
+void readWheel(const Config& w, LioOptions* l) {
+  w.readOptional("enabled", l->wheel.enabled);
+  w.readOptional("lateral_noise_std", l->wheel.lateral_noise_std);
+  w.readOptional("vertical_noise_std", l->wheel.vertical_noise_std);
+  w.readOptional("max_sample_gap_s", l->wheel.max_sample_gap_s);
+  w.readOptional("gate_chi2", l->wheel.gate_chi2);
+  readWheelScale(w.optionalSection("scale"), &l->wheel_scale);
+}
+
+/// The ranges of lio.* once read; every check names the key it is about (c.where: lio.KEY, with its section).
+void checkRanges(const Config& c, const LioNodeOptions& o) {
+  const LioOptions& l = o.lio;
   auto check = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
@@ -285,11 +301,30 @@ void readLio(const Config& c, LioNodeOptions* o) {
   check(l.matching.point_noise_std > 0, "matching.point_noise_std", "must be positive");
   check(l.esikf.max_iterations > 0, "esikf.max_iterations", "must be positive");
   check(l.init.window_s > 0, "init.window_s", "must be positive");
-  check(o->posterior_max_wait_s > 0, "posterior_max_wait_s", "must be positive");
-  check(o->image_lidar_wait_s > 0, "image_lidar_wait_s", "must be positive");
-  check(o->image_max_wait_s >= 0, "image_max_wait_s", "must be >= 0");
+  check(o.posterior_max_wait_s > 0, "posterior_max_wait_s", "must be positive");
+  check(o.image_lidar_wait_s > 0, "image_lidar_wait_s", "must be positive");
+  check(o.image_max_wait_s >= 0, "image_max_wait_s", "must be >= 0");
   check(l.max_imu_backlog_s > 0, "max_imu_backlog_s", "must be positive");
   check(l.reseed_after_s > 0, "reseed_after_s", "must be positive");
+}
+
+void readLio(const Config& c, LioNodeOptions* o) {
+  LioOptions& l = o->lio;
+  readNodeKeys(c, o);
+  readOutputChannels(c.optionalSection("channels"), o);
+  readInit(c.optionalSection("init"), &l.init);
+  c.readOptional("lidar_time_offset_s", l.extrinsics.time_offset_s);
+  readCalibrationEstimate(c.optionalSection("calibration").optionalSection("estimate"), &l.calibration);
+  readCoreKeys(c, &l);
+  readMap(c.optionalSection("map"), &l);
+  readMatching(c.optionalSection("matching"), &l.matching);
+  const Config e = c.optionalSection("esikf");
+  e.readOptional("max_iterations", l.esikf.max_iterations);
+  e.readOptional("convergence_rot", l.esikf.convergence_rot);
+  e.readOptional("convergence_pos", l.esikf.convergence_pos);
+  readKeyframe(c.optionalSection("keyframe"), &l);
+  readWheel(c.optionalSection("wheel"), &l);
+  checkRanges(c, *o);
 }
 }  // namespace
 

@@ -60,15 +60,15 @@ const char* toString(ScanResult::Status s) {
 }
 
 LioEstimator::LioEstimator(LioOptions options)
-    : opts_(options),
+    : options_(options),
       prop_(options.imu_noise),
       map_(options.map),
       planes_(options.planes),
       search_threads_(options.search_threads > 1 ? std::make_shared<WorkerThreads>(options.search_threads) : nullptr),
       keyframe_selector_(options.keyframe),
       wheel_scale_(options.wheel_scale, options.wheel.speed_noise_std) {
-  if (opts_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
-    prop_.setIntrinsics({}, intrinsicsPrior(opts_.imu_noise), estimatesImuAxes());
+  if (options_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
+    prop_.setIntrinsics({}, intrinsicsPrior(options_.imu_noise), estimatesImuAxes());
 }
 
 Vec3 LioEstimator::nominalGyro(const FilterState& x) const {
@@ -90,11 +90,11 @@ void LioEstimator::reset() {
   const ImuIntrinsics intrinsics = prop_.intrinsics();
   const ImuIntrinsics::Covariance intrinsics_cov = prop_.intrinsicsCovariance();
   const bool keep_intrinsics = prop_.modelsIntrinsics() && intrinsics.value.allFinite() && intrinsics_cov.allFinite();
-  prop_ = ImuPropagator(opts_.imu_noise);
+  prop_ = ImuPropagator(options_.imu_noise);
   if (keep_intrinsics)
     prop_.setIntrinsics(intrinsics, intrinsics_cov, estimatesImuAxes());
-  else if (opts_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
-    prop_.setIntrinsics({}, intrinsicsPrior(opts_.imu_noise), estimatesImuAxes());
+  else if (options_.calibration.imu_axes != CalibrationEstimation::ImuAxes::kBudget)
+    prop_.setIntrinsics({}, intrinsicsPrior(options_.imu_noise), estimatesImuAxes());
   map_.clear();
   planes_.clear();
   keyframe_selector_.reset();
@@ -127,7 +127,7 @@ bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
     imu_.push_back(s);
     // no sweep has come for a while: propagate the backlog now, keeping half of it for a late
     // sweep, and forget the undistortion segments no sweep can need any more
-    if (imu_.front().utime < s.utime - toUtime(opts_.max_imu_backlog_s)) drainBacklog(s.utime);
+    if (imu_.front().utime < s.utime - toUtime(options_.max_imu_backlog_s)) drainBacklog(s.utime);
   } else {
     init_window_.push_back(s);
     tryInitialize(nullptr);
@@ -136,7 +136,7 @@ bool LioEstimator::addImu(const ImuSample& s, std::string* why) {
 }
 
 bool LioEstimator::addWheel(const WheelSample& s, std::string* why) {
-  if (!opts_.wheel.enabled) {
+  if (!options_.wheel.enabled) {
     if (why) *why = "wheel fusion is disabled";
     return false;
   }
@@ -159,16 +159,16 @@ void LioEstimator::tryInitialize(std::string* note) {
   const int64_t span = init_window_.back().utime - init_window_.front().utime;
   // a gap inside the window restarts it
   const int64_t last_gap = init_window_.back().utime - init_window_[init_window_.size() - 2].utime;
-  if (static_cast<double>(last_gap) * 1e-6 > opts_.max_imu_gap_s) {
+  if (static_cast<double>(last_gap) * 1e-6 > options_.max_imu_gap_s) {
     init_window_.erase(init_window_.begin(), init_window_.end() - 1);
     return;
   }
-  if (static_cast<double>(span) * 1e-6 < opts_.init.window_s) return;
-  const ImuInitResult r = initializeImu(init_window_, opts_.init);
+  if (static_cast<double>(span) * 1e-6 < options_.init.window_s) return;
+  const ImuInitResult r = initializeImu(init_window_, options_.init);
   if (!r.ok) {
     appendNote(note, "IMU initialisation: " + r.message);
     // slide the window by half its length
-    const int64_t cut = init_window_.back().utime - toUtime(0.5 * opts_.init.window_s);
+    const int64_t cut = init_window_.back().utime - toUtime(0.5 * options_.init.window_s);
     init_window_.erase(init_window_.begin(), std::find_if(init_window_.begin(), init_window_.end(),
                                                           [&](const ImuSample& s) { return s.utime >= cut; }));
     return;
@@ -196,8 +196,8 @@ void calibrationPrior(const CalibrationStd& l, const CalibrationStd& c, const Ca
 
 FilterState LioEstimator::initialState(const ImuInitResult& r) const {
   FilterState x = r.state;
-  x.lidar = has_kept_calibration_ ? kept_calibration_.lidar : SensorCalibration::fromPose(opts_.extrinsics.T_I_L);
-  x.camera = has_kept_calibration_ ? kept_calibration_.camera : SensorCalibration::fromPose(opts_.camera_T_I_C);
+  x.lidar = has_kept_calibration_ ? kept_calibration_.lidar : SensorCalibration::fromPose(options_.extrinsics.T_I_L);
+  x.camera = has_kept_calibration_ ? kept_calibration_.camera : SensorCalibration::fromPose(options_.camera_T_I_C);
   return x;
 }
 
@@ -209,7 +209,8 @@ StateCovariance LioEstimator::initialCovariance(const ImuInitResult& r) const {
     P.bottomRightCorner<c, c>() = kept_calibration_cov_.bottomRightCorner<c, c>();
   } else {
     CalibrationStd lidar, camera;
-    calibrationPrior(opts_.lidar_calibration_std, opts_.camera_calibration_std, opts_.calibration, &lidar, &camera);
+    calibrationPrior(options_.lidar_calibration_std, options_.camera_calibration_std, options_.calibration, &lidar,
+                     &camera);
     setCalibrationPrior(FilterState::kLidar, lidar, &P);
     setCalibrationPrior(FilterState::kCamera, camera, &P);
   }
@@ -227,10 +228,10 @@ void LioEstimator::softReset(const ImuSample& s, double gap_s, std::string* note
   StateCovariance P = prop_.covariance();
   P.middleRows<3>(FilterState::kVel).setZero();
   P.middleCols<3>(FilterState::kVel).setZero();
-  const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
+  const double v2 = options_.init.moving_vel_std * options_.init.moving_vel_std;
   P.block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
   P.block<3, 3>(FilterState::kPos, FilterState::kPos) += Mat3::Identity() * v2 * skipped * skipped;
-  const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * skipped);
+  const double rot_std = std::min(M_PI / 2, options_.gap_rate_std * skipped);
   P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
   prop_.reset(x, P, s);
   clone_.valid = false;  // the velocity starts again: no increment from the last keyframe
@@ -241,8 +242,8 @@ void LioEstimator::widenForGap(double gap_s) {
   // a bridged gap: the interpolated IMU says little about the motion, so widen the pose and the
   // velocity by what the body may have done meanwhile
   StateCovariance P = prop_.covariance();
-  const double v = opts_.init.moving_vel_std;
-  const double rot_std = std::min(M_PI / 2, opts_.gap_rate_std * gap_s);
+  const double v = options_.init.moving_vel_std;
+  const double rot_std = std::min(M_PI / 2, options_.gap_rate_std * gap_s);
   P.block<3, 3>(FilterState::kPos, FilterState::kPos) += Mat3::Identity() * v * v * gap_s * gap_s;
   P.block<3, 3>(FilterState::kRot, FilterState::kRot) += Mat3::Identity() * rot_std * rot_std;
   P.block<3, 3>(FilterState::kVel, FilterState::kVel) += Mat3::Identity() * v * v * std::min(1.0, gap_s);
@@ -266,13 +267,13 @@ void LioEstimator::noteBridgedGap(const FilterState& before) {
 void LioEstimator::stepTo(const ImuSample& s, double* worst_gap, std::string* note) {
   if (s.utime <= prop_.utime()) return;
   const double gap = static_cast<double>(s.utime - prop_.utime()) * 1e-6;
-  if (gap > opts_.reset_imu_gap_s) {
+  if (gap > options_.reset_imu_gap_s) {
     softReset(s, gap, note);
     return;
   }
   const FilterState before = prop_.state();
   prop_.addSample(s);
-  if (gap > opts_.max_imu_gap_s) {
+  if (gap > options_.max_imu_gap_s) {
     noteBridgedGap(before);
     widenForGap(gap);
   }
@@ -280,12 +281,12 @@ void LioEstimator::stepTo(const ImuSample& s, double* worst_gap, std::string* no
 }
 
 void LioEstimator::drainBacklog(int64_t newest) {
-  const int64_t backlog = toUtime(opts_.max_imu_backlog_s);
+  const int64_t backlog = toUtime(options_.max_imu_backlog_s);
   double worst_gap = 0.0;
   while (!imu_.empty() && imu_.front().utime < newest - backlog / 2) {
     const ImuSample s = imu_.front();
     // a sweep may still come for an IMU gap that ended less than a backlog ago: leave it to addScan
-    if (static_cast<double>(s.utime - prop_.utime()) * 1e-6 > opts_.reset_imu_gap_s && newest - s.utime < backlog)
+    if (static_cast<double>(s.utime - prop_.utime()) * 1e-6 > options_.reset_imu_gap_s && newest - s.utime < backlog)
       break;
     imu_.pop_front();
     stepTo(s, &worst_gap, nullptr);
@@ -294,7 +295,7 @@ void LioEstimator::drainBacklog(int64_t newest) {
 }
 
 bool LioEstimator::propagateThrough(int64_t t_end, std::string* note) {
-  const double max_gap = opts_.max_imu_gap_s, reset_gap = opts_.reset_imu_gap_s;
+  const double max_gap = options_.max_imu_gap_s, reset_gap = options_.reset_imu_gap_s;
   double worst_gap = 0.0;
   while (!imu_.empty() && imu_.front().utime <= t_end) {
     const ImuSample s = imu_.front();
@@ -332,7 +333,7 @@ bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed, double* scale_vari
     const WheelSample& a = wheel_[i - 1];
     const WheelSample& b = wheel_[i];
     if (a.utime <= utime && utime <= b.utime) {
-      if (static_cast<double>(b.utime - a.utime) * 1e-6 > opts_.wheel.max_sample_gap_s) return false;
+      if (static_cast<double>(b.utime - a.utime) * 1e-6 > options_.wheel.max_sample_gap_s) return false;
       const double alpha =
           b.utime > a.utime ? static_cast<double>(utime - a.utime) / static_cast<double>(b.utime - a.utime) : 0.0;
       // scales of exactly 1 (calibration off) leave the speeds bit for bit as they came
@@ -340,7 +341,7 @@ bool LioEstimator::wheelSpeedAt(int64_t utime, double* speed, double* scale_vari
       *speed = 0.5 * ((1.0 - alpha) * (ca.left_speed + ca.right_speed) + alpha * (cb.left_speed + cb.right_speed));
       const WheelSample raw{utime, (1.0 - alpha) * a.left_speed + alpha * b.left_speed,
                             (1.0 - alpha) * a.right_speed + alpha * b.right_speed};
-      *scale_variance = opts_.wheel_scale.enabled ? wheel_scale_.meanSpeedVariance(raw) : 0.0;
+      *scale_variance = options_.wheel_scale.enabled ? wheel_scale_.meanSpeedVariance(raw) : 0.0;
       return true;
     }
   }
@@ -354,7 +355,7 @@ void LioEstimator::learnWheelScales(const ScanResult& res, const FilterState& x,
   if (anchor && travel) {
     WheelTravel t = *travel;
     t.duration_s = static_cast<double>(res.utime - scale_anchor_utime_) * 1e-6;
-    t.predicted = predictedWheelTravel(scale_anchor_pose_, x.pose(), opts_.wheel.T_I_B, opts_.wheel.track_width,
+    t.predicted = predictedWheelTravel(scale_anchor_pose_, x.pose(), options_.wheel.T_I_B, options_.wheel.track_width,
                                        &t.forward_distance);
     wheel_scale_.update(t, res.utime);
   }
@@ -368,15 +369,15 @@ size_t LioEstimator::insertIntoMap(const std::vector<Vec3>& body, const FilterSt
   for (size_t i = 0; i < body.size(); ++i) world[i] = x.rot * body[i] + x.pos;
   // the beams leave the LiDAR where it is at the sweep end (the frame the sweep is undistorted to)
   const Vec3 lidar = x.rot * x.lidar.pos + x.pos;
-  const size_t removed = map_.removeSeenThrough(lidar, world, opts_.seen_through, search_threads_.get());
+  const size_t removed = map_.removeSeenThrough(lidar, world, options_.seen_through, search_threads_.get());
   map_.insert(world, lidar);
   return removed;
 }
 
 void LioEstimator::pruneMap(const Vec3& position) {
-  if ((position - last_prune_position_).norm() < opts_.map_prune_distance) return;
-  map_.removeFarFrom(position, opts_.map_radius);
-  planes_.removeFarFrom(position, opts_.map_radius);
+  if ((position - last_prune_position_).norm() < options_.map_prune_distance) return;
+  map_.removeFarFrom(position, options_.map_radius);
+  planes_.removeFarFrom(position, options_.map_radius);
   last_prune_position_ = position;
 }
 
@@ -419,13 +420,13 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
   const SensorCalibration undistorted_with = x.lidar;  // the wheel update below may move it
 
   // 3. registration subset: stride, then voxel downsampling
-  std::vector<Vec3> reg = registrationSubset(body, opts_.point_stride, opts_.scan_voxel_size);
+  std::vector<Vec3> reg = registrationSubset(body, options_.point_stride, options_.scan_voxel_size);
   res.num_registered = static_cast<int>(reg.size());
 
   // 4. wheel velocity (before the LiDAR update), and what the wheels travelled since the last
   // wheel-scale anchor (learnt from after the LiDAR update)
   WheelTravel travel;
-  const bool has_travel = opts_.wheel.enabled && wheelVelocityStage(t_end, &x, &P, &travel, note);
+  const bool has_travel = options_.wheel.enabled && wheelVelocityStage(t_end, &x, &P, &travel, note);
 
   // 5. LiDAR update or map seeding
   reseedAfterOutage(t_end, &x, &P, note);
@@ -435,7 +436,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
   noteRegistration(res.status, x, t_end);
   prop_.applyUpdate(x, P);
   res.utime = t_end;
-  if (opts_.wheel.enabled && opts_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
+  if (options_.wheel.enabled && options_.wheel_scale.enabled) learnWheelScales(res, x, has_travel ? &travel : nullptr);
 
   // 6. the sweep in the world (an output, and what the voxel planes take), map insertion and the
   // local window
@@ -457,7 +458,7 @@ ScanResult LioEstimator::addScan(const LidarScan& scan, const SweepTiming& timin
 void LioEstimator::addToMap(const std::vector<Vec3>& reg, const FilterState& x, const std::vector<Vec3>& world,
                             ScanResult* res) {
   res->map_points_seen_through = insertIntoMap(reg, x);
-  if (opts_.planes.enabled) planes_.add(world, x.rot * x.lidar.pos + x.pos);
+  if (options_.planes.enabled) planes_.add(world, x.rot * x.lidar.pos + x.pos);
   last_registered_body_ = reg;
   pruneMap(x.pos);
 }
@@ -465,7 +466,7 @@ void LioEstimator::addToMap(const std::vector<Vec3>& reg, const FilterState& x, 
 std::vector<size_t> LioEstimator::validPoints(const LidarScan& scan, double end_offset, std::string* note) const {
   std::vector<size_t> valid;
   const size_t n = std::min(scan.points.size(), scan.time_offset.size());
-  const double min_r2 = opts_.min_range * opts_.min_range, max_r2 = opts_.max_range * opts_.max_range;
+  const double min_r2 = options_.min_range * options_.min_range, max_r2 = options_.max_range * options_.max_range;
   const bool has_intensity = scan.intensity.size() == scan.points.size();
   for (size_t j = 0; j < n; ++j) {
     const Vec3& p = scan.points[j];
@@ -512,12 +513,12 @@ void LioEstimator::toBodyAtSweepEnd(const SensorCalibration& undistorted_with, c
 bool LioEstimator::wheelVelocityStage(int64_t t_end, FilterState* x, StateCovariance* P, WheelTravel* travel,
                                       std::string* note) {
   bool has_travel = false;
-  if (opts_.wheel_scale.enabled && has_scale_anchor_)
-    has_travel = integrateWheelSpeeds(wheel_, scale_anchor_utime_, t_end, opts_.wheel.max_sample_gap_s,
+  if (options_.wheel_scale.enabled && has_scale_anchor_)
+    has_travel = integrateWheelSpeeds(wheel_, scale_anchor_utime_, t_end, options_.wheel.max_sample_gap_s,
                                       &travel->measured, &travel->measured_noise_gain);
   double speed = 0.0, scale_variance = 0.0;
   if (wheelSpeedAt(t_end, &speed, &scale_variance)) {
-    const WheelUpdateResult w = wheelVelocityUpdate(x, P, nominalGyro(*x), speed, opts_.wheel, scale_variance);
+    const WheelUpdateResult w = wheelVelocityUpdate(x, P, nominalGyro(*x), speed, options_.wheel, scale_variance);
     ++(w.applied ? wheel_counts_.accepted : wheel_counts_.rejected);
     if (!w.applied)
       appendNote(note, "wheel speed rejected (chi2 " + formatSignificant(w.chi2) + "; filter minus wheels forward " +
@@ -537,12 +538,12 @@ void LioEstimator::reseedAfterOutage(int64_t t_end, FilterState* x, StateCovaria
   // prediction instead of restarting at the origin.
   if (map_.empty() || !has_registered_) return;
   const double lost_s = static_cast<double>(t_end - last_registered_utime_) * 1e-6;
-  if (lost_s <= opts_.reseed_after_s) return;
+  if (lost_s <= options_.reseed_after_s) return;
   map_.clear();
   planes_.clear();
   // the IMU-only velocity of a long outage is worthless: keep it only after a short one
-  if (lost_s > 3.0 * opts_.reseed_after_s) x->vel.setZero();
-  const double v2 = opts_.init.moving_vel_std * opts_.init.moving_vel_std;
+  if (lost_s > 3.0 * options_.reseed_after_s) x->vel.setZero();
+  const double v2 = options_.init.moving_vel_std * options_.init.moving_vel_std;
   P->middleRows<3>(FilterState::kVel).setZero();
   P->middleCols<3>(FilterState::kVel).setZero();
   P->block<3, 3>(FilterState::kVel, FilterState::kVel) = Mat3::Identity() * v2;
@@ -555,13 +556,13 @@ ScanResult::Status LioEstimator::lidarStage(const std::vector<Vec3>& reg, size_t
   std::string* note = &res->message;
   ScanResult::Status status;
   if (map_.empty()) {
-    if (static_cast<int>(num_valid) < opts_.min_points) {
+    if (static_cast<int>(num_valid) < options_.min_points) {
       status = ScanResult::Status::kPredicted;
       appendNote(note, "too few valid points to seed the map (" + std::to_string(num_valid) + ")");
     } else {
       status = ScanResult::Status::kMapInitialized;
     }
-  } else if (static_cast<int>(num_valid) < opts_.min_points) {
+  } else if (static_cast<int>(num_valid) < options_.min_points) {
     status = ScanResult::Status::kPredicted;
     appendNote(note, "too few valid points (" + std::to_string(num_valid) + "): prediction only");
   } else {
@@ -578,12 +579,13 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, con
                                                const Vec3& body_rate, FilterState* x, StateCovariance* P,
                                                ScanResult* res) {
   std::string* note = &res->message;
-  ScanToMap s2m(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with, body_rate);
+  ScanToMap s2m(map_, planesForRegistration(), reg, options_.matching, search_threads_.get(), undistorted_with,
+                body_rate);
   FilterState post;
   StateCovariance P_post;
   EsikfResult er = iteratedUpdate(
       *x, *P, [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m.evaluate(xi, it, info); },
-      opts_.esikf, &post, &P_post);
+      options_.esikf, &post, &P_post);
   const ScanToMap* fitted = &s2m;
   std::optional<ScanToMap> s2m_still;
   if (gap_bridged_) {
@@ -594,14 +596,14 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, con
     still.rot = gap_undo_rot_ * x->rot;
     still.pos = x->pos + gap_undo_pos_;
     still.vel = x->vel + gap_undo_vel_;
-    s2m_still.emplace(map_, planesForRegistration(), reg, opts_.matching, search_threads_.get(), undistorted_with,
+    s2m_still.emplace(map_, planesForRegistration(), reg, options_.matching, search_threads_.get(), undistorted_with,
                       body_rate);
     FilterState post_still;
     StateCovariance P_still;
     const EsikfResult er_still = iteratedUpdate(
         still, *P,
         [&](const FilterState& xi, int it, MeasurementInformation* info) { return s2m_still->evaluate(xi, it, info); },
-        opts_.esikf, &post_still, &P_still);
+        options_.esikf, &post_still, &P_still);
     if (er_still.valid && er_still.info.count > (er.valid ? er.info.count : 0) * 11 / 10) {
       appendNote(note, "after the IMU gap the sweep fits the map better as if no time had passed (" +
                            std::to_string(er_still.info.count) + " against " + std::to_string(er.info.count) +
@@ -618,9 +620,9 @@ ScanResult::Status LioEstimator::registerSweep(const std::vector<Vec3>& reg, con
   res->converged = er.converged;
   res->degeneracy = fitted->degeneracy();
   res->min_information_eigenvalue = fitted->minInformationEigenvalue();
-  const bool enough = er.valid && er.info.count >= opts_.min_residuals;
+  const bool enough = er.valid && er.info.count >= options_.min_residuals;
   const bool sane = enough && post.rot.allFinite() && post.pos.allFinite() && P_post.allFinite() &&
-                    (post.pos - x->pos).norm() <= opts_.max_position_jump;
+                    (post.pos - x->pos).norm() <= options_.max_position_jump;
   if (!sane) {
     res->degeneracy.degenerate = true;
     appendNote(note, enough ? "update rejected (diverged)"
@@ -653,11 +655,12 @@ void LioEstimator::noteRegistration(ScanResult::Status status, const FilterState
 HeldCalibration LioEstimator::heldCalibration(const FilterState& x) const {
   HeldCalibration held;
   held.T_I_L = x.lidar.pose();
-  held.lidar_rotation_std = opts_.calibration.lidar_rotation ? 0.0 : opts_.lidar_calibration_std.rotation;
-  held.lidar_translation_std = opts_.calibration.lidar_translation ? 0.0 : opts_.lidar_calibration_std.translation;
+  held.lidar_rotation_std = options_.calibration.lidar_rotation ? 0.0 : options_.lidar_calibration_std.rotation;
+  held.lidar_translation_std =
+      options_.calibration.lidar_translation ? 0.0 : options_.lidar_calibration_std.translation;
   if (!prop_.modelsIntrinsics()) {  // modelled, they are in the filter's covariance
-    held.gyro_scale_std = opts_.imu_noise.gyro_scale_std;
-    held.gyro_misalignment_std = opts_.imu_noise.gyro_misalignment_std;
+    held.gyro_scale_std = options_.imu_noise.gyro_scale_std;
+    held.gyro_misalignment_std = options_.imu_noise.gyro_misalignment_std;
   }
   return held;
 }
@@ -682,12 +685,12 @@ Keyframe LioEstimator::makeKeyframe(const LidarScan& scan, const std::vector<siz
   clone_ = KeyframeClone{true, kf.id, kf.pose, kf.pose_covariance};
   prop_.clonePose();
   const bool has_intensity = scan.intensity.size() == scan.points.size();
-  for (size_t i : firstPointPerVoxel(body, opts_.keyframe.cloud_voxel)) {
+  for (size_t i : firstPointPerVoxel(body, options_.keyframe.cloud_voxel)) {
     kf.cloud.push_back(body[i]);
     kf.intensity.push_back(has_intensity ? scan.intensity[valid[i]] : 0.0f);
   }
   keyframes_.push_back(kf);
-  while (keyframes_.size() > opts_.max_stored_keyframes) keyframes_.pop_front();
+  while (keyframes_.size() > options_.max_stored_keyframes) keyframes_.pop_front();
   return kf;
 }
 
@@ -769,7 +772,7 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
       clone_.covariance = Tc * clone_.covariance * Tc.transpose();
     }
   }
-  if (opts_.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove) {
+  if (options_.map_on_loop_correction == LioOptions::OnLoopCorrection::kMove) {
     map_.transform(T);
     planes_.clear();  // the cells do not follow a rotation of the grid: they fill again
     last_prune_position_ = T * last_prune_position_;
@@ -778,10 +781,10 @@ void LioEstimator::applyLoopCorrection(const LoopCorrection& correction, const s
   // rebuild the local map from the corrected keyframes around the new position
   map_.clear();
   planes_.clear();
-  const Vec3 lidar_position = initialized_ ? prop_.state().lidar.pos : opts_.extrinsics.T_I_L.translation();
+  const Vec3 lidar_position = initialized_ ? prop_.state().lidar.pos : options_.extrinsics.T_I_L.translation();
   const Vec3 here = initialized_ ? prop_.state().pos : T.translation();
   for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
-    if ((it->pose.translation() - here).norm() > opts_.map_radius) continue;
+    if ((it->pose.translation() - here).norm() > options_.map_radius) continue;
     const Vec3 lidar = it->pose * lidar_position;
     for (const auto& p : it->cloud) {
       const Vec3 w = it->pose * p;

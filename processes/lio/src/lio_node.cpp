@@ -19,6 +19,7 @@ namespace {
 constexpr double kWheelLogPeriodS = 30.0;  // sensor time between wheel summaries in the log
 constexpr double kCalibrationRowS = 1.0;   // ... between calibration.csv rows
 constexpr int kCalibrationLogRows = 10;    // ... rows between calibration lines in the log
+constexpr int64_t kNever = std::numeric_limits<int64_t>::max();
 
 NodeOptions nodeOptions(const LioNodeOptions& o, bool quiet) {
   NodeOptions n;
@@ -35,25 +36,26 @@ bool finiteOdometry(const odometry_t& o) {
 }  // namespace
 
 LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
-    : opts_(std::move(options)), node_(lcm, nodeOptions(opts_, quiet)), lio_(opts_.lio) {
-  node_.declareOutput(opts_.odometry_channel);
-  if (opts_.publish_registered_scan) node_.declareOutput(opts_.registered_scan_channel);
-  node_.declareOutput(opts_.keyframe_channel);
-  node_.subscribe<imu_t>(opts_.imu_channel, [this](const imu_t& m) { onImu(m); });
-  node_.subscribe<point_cloud_t>(opts_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
-  if (opts_.lio.wheel.enabled)
-    node_.subscribe<wheel_odometry_t>(opts_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
-  if (opts_.camera_handoff) {
-    node_.declareOutput(opts_.state_prior_channel);
-    node_.watchConsumers(opts_.state_prior_channel);
-    node_.subscribeRaw(opts_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
+    : options_(std::move(options)), node_(lcm, nodeOptions(options_, quiet)), lio_(options_.lio) {
+  node_.declareOutput(options_.odometry_channel);
+  if (options_.publish_registered_scan) node_.declareOutput(options_.registered_scan_channel);
+  node_.declareOutput(options_.keyframe_channel);
+  node_.subscribe<imu_t>(options_.imu_channel, [this](const imu_t& m) { onImu(m); });
+  node_.subscribe<point_cloud_t>(options_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
+  if (options_.lio.wheel.enabled)
+    node_.subscribe<wheel_odometry_t>(options_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
+  if (options_.camera_handoff) {
+    node_.declareOutput(options_.state_prior_channel);
+    node_.watchConsumers(options_.state_prior_channel);
+    node_.subscribeRaw(options_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
   }
   node_.setQuietWindows([this] { return quietWindows(); });
-  node_.subscribe<filter_state_t>(opts_.state_posterior_channel, [this](const filter_state_t& m) { onPosterior(m); });
-  node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
+  node_.subscribe<filter_state_t>(options_.state_posterior_channel,
+                                  [this](const filter_state_t& m) { onPosterior(m); });
+  node_.subscribe<loop_correction_t>(options_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onLoopCorrection(m); });
-  if (opts_.continue_numbering && !opts_.numbering_file.empty()) {
-    std::ifstream f(opts_.numbering_file);
+  if (options_.continue_numbering && !options_.numbering_file.empty()) {
+    std::ifstream f(options_.numbering_file);
     std::string epoch_key, id_key;
     int32_t epoch = 0;
     int64_t next_id = 0;
@@ -63,18 +65,18 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
       node_.warn("restarted: odometry goes on in epoch " + std::to_string(epoch + 1) +
                  " (a new frame), keyframe ids from " + std::to_string(next_id));
     } else {
-      node_.warn("restarted, but " + opts_.numbering_file + " holds no numbering: starting at epoch 0");
+      node_.warn("restarted, but " + options_.numbering_file + " holds no numbering: starting at epoch 0");
     }
   }
   saveNumbering();
 }
 
 void LioNode::saveNumbering() {
-  if (opts_.numbering_file.empty()) return;
+  if (options_.numbering_file.empty()) return;
   const std::string text = "epoch " + std::to_string(lio_.frame().epoch) + "\nnext_keyframe_id " +
                            std::to_string(lio_.nextKeyframeId()) + "\n";
   std::string error;
-  if (!writeFileAtomically(opts_.numbering_file, {text}, &error)) node_.warn("cannot keep the numbering: " + error);
+  if (!writeFileAtomically(options_.numbering_file, {text}, &error)) node_.warn("cannot keep the numbering: " + error);
 }
 
 void LioNode::resetAll(const std::string& why) {
@@ -100,11 +102,11 @@ void LioNode::announceReset(const std::string& why) {
 void LioNode::onImu(const imu_t& m) {
   const ImuSample s = fromMessage(m);
   if (!s.gyro.allFinite() || !s.accel.allFinite()) {
-    node_.reject(opts_.imu_channel, "non-finite IMU sample");
+    node_.reject(options_.imu_channel, "non-finite IMU sample");
     return;
   }
-  if (s.gyro.norm() > opts_.imu_max_angular_velocity || s.accel.norm() > opts_.imu_max_acceleration) {
-    node_.reject(opts_.imu_channel,
+  if (s.gyro.norm() > options_.imu_max_angular_velocity || s.accel.norm() > options_.imu_max_acceleration) {
+    node_.reject(options_.imu_channel,
                  "IMU sample beyond the sensor's range (imu_max_angular_velocity, "
                  "imu_max_acceleration): corrupted");
     return;
@@ -112,16 +114,16 @@ void LioNode::onImu(const imu_t& m) {
   // A stamp that jumps (ahead by clock_jump_s or back by clock_reset_s) is held until the next
   // sample confirms the new clock by following it closely; otherwise it was one corrupted stamp.
   if (has_imu_) {
-    const bool jumps =
-        s.utime > newest_imu_ + toUtime(opts_.clock_jump_s) || s.utime < newest_imu_ - toUtime(opts_.clock_reset_s);
+    const bool jumps = s.utime > newest_imu_ + toUtime(options_.clock_jump_s) ||
+                       s.utime < newest_imu_ - toUtime(options_.clock_reset_s);
     const bool confirms =
-        held_jump_ && s.utime > held_jump_->utime && s.utime - held_jump_->utime <= toUtime(opts_.clock_jump_s);
+        held_jump_ && s.utime > held_jump_->utime && s.utime - held_jump_->utime <= toUtime(options_.clock_jump_s);
     if (jumps && !confirms) {
       if (held_jump_)
-        node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
+        node_.reject(options_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
       held_jump_ = s;
-      node_.reject(opts_.imu_channel, "IMU stamp jumps by " + std::to_string(toSeconds(s.utime - newest_imu_)) +
-                                          " s: held until the next sample confirms the new clock");
+      node_.reject(options_.imu_channel, "IMU stamp jumps by " + std::to_string(toSeconds(s.utime - newest_imu_)) +
+                                             " s: held until the next sample confirms the new clock");
       return;
     }
     if (held_jump_) {
@@ -130,7 +132,7 @@ void LioNode::onImu(const imu_t& m) {
       if (jumps) {
         acceptImu(first);
       } else {
-        node_.reject(opts_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
+        node_.reject(options_.imu_channel, "an IMU stamp that jumped was not confirmed: dropped as corrupted");
       }
     }
   }
@@ -138,11 +140,11 @@ void LioNode::onImu(const imu_t& m) {
 }
 
 void LioNode::acceptImu(const ImuSample& s) {
-  if (fed_any_imu_ && s.utime < fed_imu_ - toUtime(opts_.clock_reset_s)) {
+  if (fed_any_imu_ && s.utime < fed_imu_ - toUtime(options_.clock_reset_s)) {
     resetAll("IMU time jumped back by " + std::to_string(toSeconds(fed_imu_ - s.utime)) + " s");
   }
   if ((fed_any_imu_ && s.utime <= fed_imu_) || !imu_.insert(s.utime, s)) {
-    node_.reject(opts_.imu_channel, "IMU sample at or before one already used (late or duplicate)");
+    node_.reject(options_.imu_channel, "IMU sample at or before one already used (late or duplicate)");
     return;
   }
   if (!has_imu_ || s.utime > newest_imu_) newest_imu_ = s.utime;
@@ -154,7 +156,7 @@ void LioNode::onLidar(const point_cloud_t& m) {
   auto p = std::make_shared<PendingScan>();
   std::string why;
   if (!fromMessage(m, &p->scan, &why)) {
-    node_.reject(opts_.lidar_channel, why);
+    node_.reject(options_.lidar_channel, why);
     return;
   }
   p->format = sweepFormat(m);
@@ -164,15 +166,15 @@ void LioNode::onLidar(const point_cloud_t& m) {
   // comes: the filter may have moved meanwhile (a duplicate queued beside it ends where the first
   // left the filter), and before the map is seeded it refuses sweeps of the IMU start-up window.
   if (!lio_.acceptsSweepEnding(t_end)) {
-    node_.reject(opts_.lidar_channel, "sweep ends before the filter time (late or duplicate)");
+    node_.reject(options_.lidar_channel, "sweep ends before the filter time (late or duplicate)");
     return;
   }
   if (!scans_.insert(t_end, p)) {
-    node_.reject(opts_.lidar_channel, "sweep older than one already processed");
+    node_.reject(options_.lidar_channel, "sweep older than one already processed");
     return;
   }
   newest_sweep_end_ = std::max(newest_sweep_end_, t_end);
-  while (static_cast<int>(scans_.size()) > opts_.max_pending_scans) {
+  while (static_cast<int>(scans_.size()) > options_.max_pending_scans) {
     node_.warn("no IMU past pending sweeps: dropping the oldest");
     scans_.popUntil(scans_.front().utime, [](const auto&) {});
   }
@@ -184,18 +186,18 @@ void LioNode::onCamera(const void* data, int size) {
   const MessageType* type = identifyMessage(data, size);
   int64_t utime = 0;
   if (!type || type->name != "livo.image_t" || !messageUtime(data, size, &utime)) {
-    node_.reject(opts_.camera_channel, "not a livo.image_t message");
+    node_.reject(options_.camera_channel, "not a livo.image_t message");
     return;
   }
   node_.noteSensorTime(utime);
-  const int64_t t = utime + toUtime(opts_.camera_time_offset_s);
+  const int64_t t = utime + toUtime(options_.camera_time_offset_s);
   newest_image_ = std::max(newest_image_, t);
   if ((lio_.initialized() && t < lio_.utime()) || t <= last_image_ || (pending_ && t <= pending_->utime)) {
     ++handoff_.images_skipped;  // the filter is already past it
     return;
   }
   images_.insert(t, true);
-  while (static_cast<int>(images_.size()) > opts_.max_pending_scans) {
+  while (static_cast<int>(images_.size()) > options_.max_pending_scans) {
     ++handoff_.images_skipped;  // no IMU past them: the oldest are dropped like sweeps are
     images_.popUntil(images_.front().utime, [](const auto&) {});
   }
@@ -205,11 +207,11 @@ void LioNode::onCamera(const void* data, int size) {
 void LioNode::onWheel(const wheel_odometry_t& m) {
   const WheelSample w = fromMessage(m);
   if (!std::isfinite(w.left_speed) || !std::isfinite(w.right_speed)) {
-    node_.reject(opts_.wheel_channel, "non-finite wheel speed");
+    node_.reject(options_.wheel_channel, "non-finite wheel speed");
     return;
   }
   if ((fed_any_wheel_ && w.utime <= fed_wheel_) || !wheel_.insert(w.utime, w)) {
-    node_.reject(opts_.wheel_channel, "wheel reading at or before one already used");
+    node_.reject(options_.wheel_channel, "wheel reading at or before one already used");
     return;
   }
   advance();
@@ -218,7 +220,7 @@ void LioNode::onWheel(const wheel_odometry_t& m) {
 void LioNode::advance() {
   // IMU: hand over everything the reorder window has settled
   if (has_imu_) {
-    const int64_t settled = newest_imu_ - toUtime(opts_.imu_reorder_window_s);
+    const int64_t settled = newest_imu_ - toUtime(options_.imu_reorder_window_s);
     imu_.popUntil(settled, [&](const TimeBuffer<ImuSample>::Entry& e) {
       std::string why;
       if (!lio_.addImu(e.value, &why)) node_.warn("IMU sample refused by the filter: " + why);
@@ -227,12 +229,12 @@ void LioNode::advance() {
     });
   }
   // wheel readings no pending sweep can need (a LiDAR outage must not grow the buffer)
-  if (fed_any_imu_) wheel_.dropBefore(fed_imu_ - toUtime(opts_.wheel_max_wait_s + 1.0));
+  if (fed_any_imu_) wheel_.dropBefore(fed_imu_ - toUtime(options_.wheel_max_wait_s + 1.0));
   while (fed_any_imu_) {
     if (pending_) {
       // waiting for the posterior of an image: nothing later may be processed meanwhile
-      const bool vio_gone = !node_.hasConsumers(opts_.state_prior_channel);
-      if (!vio_gone && fed_imu_ <= pending_->utime + toUtime(opts_.posterior_max_wait_s)) break;
+      const bool vio_gone = !node_.hasConsumers(options_.state_prior_channel);
+      if (!vio_gone && fed_imu_ <= pending_->utime + toUtime(options_.posterior_max_wait_s)) break;
       ++handoff_.missing;
       node_.warn("no STATE_POSTERIOR for the image at " + std::to_string(pending_->utime) + ": going on LiDAR-only (" +
                  std::to_string(handoff_.missing) + " so far)");
@@ -246,7 +248,7 @@ void LioNode::advance() {
       continue;
     }
     const int64_t t_end = next.utime;
-    if (opts_.lio.wheel.enabled) {
+    if (options_.lio.wheel.enabled) {
       // wheel readings up to the first one past the end
       int64_t upto = t_end;
       for (const auto& e : wheel_.entries())
@@ -265,7 +267,7 @@ void LioNode::advance() {
       if (!p) {
         p = e.value;
       } else {
-        node_.reject(opts_.lidar_channel, "two sweeps end at the same time: the second is dropped");
+        node_.reject(options_.lidar_channel, "two sweeps end at the same time: the second is dropped");
       }
     });
     process(*p);
@@ -280,32 +282,27 @@ LioNode::NextEvent LioNode::nextEvent() const {
     e.utime = e.imu_after = images_.front().utime;
     // every sweep ending at or before the image must have been processed (the LiDAR watermark)
     const bool lidar_past = newest_sweep_end_ >= e.utime;
-    if (!lidar_past) e.imu_after += toUtime(opts_.image_lidar_wait_s);
+    if (!lidar_past) e.imu_after += toUtime(options_.image_lidar_wait_s);
     return e;
   }
   if (scans_.empty()) return e;
   e.kind = NextEvent::kSweep;
   e.utime = e.imu_after = scans_.front().utime;
-  if (opts_.lio.wheel.enabled) {
+  if (options_.lio.wheel.enabled) {
     const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
-    if (!wheel_past) e.wheel_wait = toUtime(opts_.wheel_max_wait_s);
+    if (!wheel_past) e.wheel_wait = toUtime(options_.wheel_max_wait_s);
   }
-  if (opts_.camera_handoff && newest_image_ >= 0 && e.utime - newest_image_ < toUtime(1.0) &&
-      node_.hasConsumers(opts_.state_prior_channel)) {
+  if (options_.camera_handoff && newest_image_ >= 0 && e.utime - newest_image_ < toUtime(1.0) &&
+      node_.hasConsumers(options_.state_prior_channel)) {
     // the images before the sweep end come first: wait until the next one is due after it
-    const bool images_past = newest_image_ + toUtime(0.75 / opts_.camera_rate_hz) > e.utime;
-    if (!images_past) e.image_wait = toUtime(opts_.image_max_wait_s);
+    const bool images_past = newest_image_ + toUtime(0.75 / options_.camera_rate_hz) > e.utime;
+    if (!images_past) e.image_wait = toUtime(options_.image_max_wait_s);
   }
   e.imu_after = e.utime + std::max(e.wheel_wait, e.image_wait);
   return e;
 }
 
-std::vector<Node::QuietWindow> LioNode::quietWindows() const {
-  // waiting for the next sample to confirm a jumped clock: no promise; nor while a posterior is
-  // out with no vio there to answer it (advance() then gives up on it at the next sample)
-  if (!has_imu_ || held_jump_ || (pending_ && !node_.hasConsumers(opts_.state_prior_channel))) return {};
-  constexpr int64_t kNever = std::numeric_limits<int64_t>::max();
-  const NextEvent next = nextEvent();
+LioNode::Promises LioNode::promises(const NextEvent& next) const {
   // advance() acts only once the filter's newest sample is past the next event's threshold, and
   // the filter gets samples imu_reorder_window_s behind the newest received. Images and sweeps
   // may be promised too: an image stamped at or after image_due, a sweep ending at or after the
@@ -321,75 +318,84 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   // camera that stopped must not hold the IMU promise back). Sweeps are promised where they
   // arrive before the IMU passes the newest sweep end (a driver that stamps and sends a sweep at
   // its start, or soon after its end).
-  const int64_t period = toUtime(1.0 / opts_.camera_rate_hz);
-  const int64_t image_due = newest_image_ + period;
-  const bool images_possible = opts_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= image_due + period;
+  Promises p;
+  p.period = toUtime(1.0 / options_.camera_rate_hz);
+  p.image_due = newest_image_ + p.period;
+  const bool images_possible = options_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= p.image_due + p.period;
   const bool sweeps_possible = newest_sweep_end_ >= 0;
-  const bool wheels_possible = opts_.lio.wheel.enabled;
+  const bool wheels_possible = options_.lio.wheel.enabled;
   const auto floor = [&](bool images, bool sweeps, bool wheels) {
     int64_t f = kNever;
     if (next.kind == NextEvent::kImage) f = sweeps ? next.utime : next.imu_after;
     if (next.kind == NextEvent::kSweep)
       f = next.utime + std::max(images ? 0 : next.image_wait, wheels ? 0 : next.wheel_wait);
-    if (images) f = std::min(f, image_due);
+    if (images) f = std::min(f, p.image_due);
     if (sweeps) f = std::min(f, newest_sweep_end_);
     return f;
   };
   // the most channels whose floor the filter is not past (a covered message could act at once)
-  bool images = false, sweeps = false, wheels = false;
   for (int mask = 7; mask > 0; --mask) {
     const bool i = mask & 4, s = mask & 2, w = mask & 1;
     if ((i && !images_possible) || (s && !sweeps_possible) || (w && !wheels_possible)) continue;
     if (fed_any_imu_ && floor(i, s, w) < fed_imu_) continue;
-    images = i;
-    sweeps = s;
-    wheels = w;
+    p.images = i;
+    p.sweeps = s;
+    p.wheels = w;
     break;
   }
-  int64_t threshold = floor(images, sweeps, wheels);
+  p.threshold = floor(p.images, p.sweeps, p.wheels);
   // Waiting for a posterior: advance() also acts once the filter is posterior_max_wait_s past the
   // image (it gives up on the answer), and the filter propagates on its own once its IMU queue
   // spans max_imu_backlog_s (the posterior could then not be adopted): the promises end before.
   if (pending_) {
-    threshold = std::min(threshold, pending_->utime + toUtime(opts_.posterior_max_wait_s));
+    p.threshold = std::min(p.threshold, pending_->utime + toUtime(options_.posterior_max_wait_s));
     if (const int64_t queued = lio_.oldestQueuedImu(); queued != kNever)
-      threshold = std::min(threshold, queued + toUtime(opts_.lio.max_imu_backlog_s));
+      p.threshold = std::min(p.threshold, queued + toUtime(options_.lio.max_imu_backlog_s));
   }
+  return p;
+}
+
+std::vector<Node::QuietWindow> LioNode::quietWindows() const {
+  // waiting for the next sample to confirm a jumped clock: no promise; nor while a posterior is
+  // out with no vio there to answer it (advance() then gives up on it at the next sample)
+  if (!has_imu_ || held_jump_ || (pending_ && !node_.hasConsumers(options_.state_prior_channel))) return {};
+  const NextEvent next = nextEvent();
+  const Promises p = promises(next);
 
   Node::QuietWindow w;
-  w.channel = opts_.imu_channel;
+  w.channel = options_.imu_channel;
   // a sample further back is a clock reset, one further ahead is held as a jump
-  w.from = newest_imu_ - toUtime(opts_.clock_reset_s);
-  w.before = newest_imu_ + toUtime(opts_.clock_jump_s);
-  if (threshold != kNever) w.before = std::min(w.before, threshold + toUtime(opts_.imu_reorder_window_s) + 1);
+  w.from = newest_imu_ - toUtime(options_.clock_reset_s);
+  w.before = newest_imu_ + toUtime(options_.clock_jump_s);
+  if (p.threshold != kNever) w.before = std::min(w.before, p.threshold + toUtime(options_.imu_reorder_window_s) + 1);
   std::vector<Node::QuietWindow> out{w};
   // The posterior being waited for: adopting it publishes nothing while the filter is not past the
   // next event's threshold (covered messages keep it there), and it commutes with the covered IMU
   // samples, which only join the filter's queue after the image time it sets the state at. So
   // lockstep playback may send them while vio is still working on the image.
-  if (pending_ && (!fed_any_imu_ || fed_imu_ <= threshold))
-    out.push_back(Node::QuietWindow::always(opts_.state_posterior_channel));
+  if (pending_ && (!fed_any_imu_ || fed_imu_ <= p.threshold))
+    out.push_back(Node::QuietWindow::always(options_.state_posterior_channel));
   // in the messages' own clocks; a period's worth of images (several in one window are as safe)
-  if (images) {
-    const int64_t offset = toUtime(opts_.camera_time_offset_s);
-    out.push_back({opts_.camera_channel, image_due - offset, image_due + period - offset});
+  if (p.images) {
+    const int64_t offset = toUtime(options_.camera_time_offset_s);
+    out.push_back({options_.camera_channel, p.image_due - offset, p.image_due + p.period - offset});
   }
-  if (sweeps) {
+  if (p.sweeps) {
     // a sweep ends at or after its stamp plus the LiDAR's time offset
-    const int64_t offset = toUtime(opts_.lio.extrinsics.time_offset_s);
-    out.push_back({opts_.lidar_channel, newest_sweep_end_ - offset, kNever});
+    const int64_t offset = toUtime(options_.lio.extrinsics.time_offset_s);
+    out.push_back({options_.lidar_channel, newest_sweep_end_ - offset, kNever});
   }
-  if (wheels) {
-    out.push_back(Node::QuietWindow::always(opts_.wheel_channel));
-  } else if (opts_.lio.wheel.enabled) {
+  if (p.wheels) {
+    out.push_back(Node::QuietWindow::always(options_.wheel_channel));
+  } else if (options_.lio.wheel.enabled) {
     // the filter is past the sweep's end and it waits for the wheels: a reading past its end would
     // let it go; readings up to its end cannot
     const bool sweep_waits_for_wheels =
         next.kind == NextEvent::kSweep && !(!wheel_.empty() && wheel_.back().utime > next.utime);
     if (sweep_waits_for_wheels)
-      out.push_back({opts_.wheel_channel, std::numeric_limits<int64_t>::min(), next.utime + 1});
+      out.push_back({options_.wheel_channel, std::numeric_limits<int64_t>::min(), next.utime + 1});
     else
-      out.push_back(Node::QuietWindow::always(opts_.wheel_channel));
+      out.push_back(Node::QuietWindow::always(options_.wheel_channel));
   }
   return out;
 }
@@ -404,7 +410,7 @@ void LioNode::process(const PendingScan& p) {
   ++sweeps_;
   if (!r.message.empty() && r.status != ScanResult::Status::kInitializing)
     node_.warn("sweep at " + std::to_string(p.scan.utime) + " (" + toString(r.status) + "): " + r.message);
-  if (opts_.lio.wheel.enabled && r.utime - last_wheel_log_ >= toUtime(kWheelLogPeriodS)) {
+  if (options_.lio.wheel.enabled && r.utime - last_wheel_log_ >= toUtime(kWheelLogPeriodS)) {
     if (last_wheel_log_ != 0) node_.info(wheelSummary());
     last_wheel_log_ = r.utime;
   }
@@ -417,18 +423,18 @@ void LioNode::process(const PendingScan& p) {
     announceReset("non-finite odometry");
     return;
   }
-  node_.publish(opts_.odometry_channel, odo);
+  node_.publish(options_.odometry_channel, odo);
   ++sweep_counts_.published;
   sweep_counts_.tracked += r.status == ScanResult::Status::kTracked;
   sweep_counts_.predicted += r.status == ScanResult::Status::kPredicted;
   sweep_counts_.degenerate += odo.degenerate != 0;
-  if (opts_.publish_registered_scan)
-    node_.publish(opts_.registered_scan_channel, toRegisteredScan(r, p.scan, p.format, lio_.frame()));
+  if (options_.publish_registered_scan)
+    node_.publish(options_.registered_scan_channel, toRegisteredScan(r, p.scan, p.format, lio_.frame()));
   if (r.is_keyframe) {
     // the numbering on disk first: a process killed between the two then skips an id on restart
     // instead of repeating the one it published (livo-loop refuses a repeated id)
     saveNumbering();
-    node_.publish(opts_.keyframe_channel, toKeyframe(r.keyframe, p.format.num_rings, lio_.frame()));
+    node_.publish(options_.keyframe_channel, toKeyframe(r.keyframe, p.format.num_rings, lio_.frame()));
   }
 }
 
@@ -441,18 +447,19 @@ std::string LioNode::sweepSummary() const {
 
 bool LioNode::estimatesCalibration() const {
   CalibrationStd lidar, camera;
-  calibrationPrior(opts_.lio.lidar_calibration_std, opts_.lio.camera_calibration_std, opts_.lio.calibration, &lidar,
-                   &camera);
-  return lidar.any() || (opts_.camera_handoff && camera.any());
+  calibrationPrior(options_.lio.lidar_calibration_std, options_.lio.camera_calibration_std, options_.lio.calibration,
+                   &lidar, &camera);
+  return lidar.any() || (options_.camera_handoff && camera.any());
 }
 
 CalibrationEstimate LioNode::calibrationEstimate() const {
-  return calibrationAgainstRig(lio_.state(), lio_.covariance(), opts_.lio.extrinsics.T_I_L, opts_.lio.camera_T_I_C);
+  return calibrationAgainstRig(lio_.state(), lio_.covariance(), options_.lio.extrinsics.T_I_L,
+                               options_.lio.camera_T_I_C);
 }
 
 std::string LioNode::calibrationSummary() const {
   if (!lio_.initialized()) return "";
-  std::string text = "calibration: " + describe(calibrationEstimate(), opts_.camera_handoff);
+  std::string text = "calibration: " + describe(calibrationEstimate(), options_.camera_handoff);
   if (lio_.modelsImuIntrinsics())
     text += "; " + describeImuIntrinsics(lio_.imuIntrinsics(), lio_.imuIntrinsicsCovariance());
   return text;
@@ -470,14 +477,14 @@ void LioNode::reportCalibration(int64_t utime) {
 }
 
 void LioNode::writeCalibrationFiles() {
-  if (opts_.output_dir.empty() || !estimatesCalibration() || !lio_.initialized()) return;
+  if (options_.output_dir.empty() || !estimatesCalibration() || !lio_.initialized()) return;
   const CalibrationEstimate e = calibrationEstimate();
   std::string error;
-  const std::string csv = opts_.output_dir + "/calibration.csv", yaml = opts_.output_dir + "/calibration.yaml";
+  const std::string csv = options_.output_dir + "/calibration.csv", yaml = options_.output_dir + "/calibration.yaml";
   if (!writeFileAtomically(csv, {calibration_csv_.empty() ? calibrationCsvHeader() : calibration_csv_}, &error) ||
       !writeFileAtomically(yaml,
-                           {calibrationOverlay(lio_.state(), opts_.lio.extrinsics.time_offset_s,
-                                               opts_.camera_time_offset_s, opts_.camera_handoff, e)},
+                           {calibrationOverlay(lio_.state(), options_.lio.extrinsics.time_offset_s,
+                                               options_.camera_time_offset_s, options_.camera_handoff, e)},
                            &error))
     node_.error("calibration files: " + error);
   else
@@ -489,7 +496,7 @@ std::string LioNode::wheelSummary() const {
   std::ostringstream os;
   os << "wheel updates: " << n.accepted << " accepted, " << n.rejected << " rejected (chi2 gate), " << n.no_reading
      << " without a reading; ";
-  if (!opts_.lio.wheel_scale.enabled) {
+  if (!options_.lio.wheel_scale.enabled) {
     os << "scale calibration off";
     return os.str();
   }
@@ -508,7 +515,7 @@ void LioNode::handOff(int64_t utime) {
     ++handoff_.images_skipped;
     return;
   }
-  if (!node_.hasConsumers(opts_.state_prior_channel)) {
+  if (!node_.hasConsumers(options_.state_prior_channel)) {
     ++handoff_.no_vio;  // nobody would answer: LiDAR-only, exactly as without the hand-off
     return;
   }
@@ -519,20 +526,20 @@ void LioNode::handOff(int64_t utime) {
   }
   if (!note.empty()) node_.warn("image at " + std::to_string(utime) + ": " + note);
   const int64_t id = next_request_id_++;
-  node_.publish(opts_.state_prior_channel, toStatePrior(lio_, utime, id, opts_.name));
+  node_.publish(options_.state_prior_channel, toStatePrior(lio_, utime, id, options_.name));
   ++handoff_.priors;
   pending_ = PendingPrior{id, utime};
 }
 
 void LioNode::onPosterior(const filter_state_t& m) {
   if (m.epoch != lio_.frame().epoch) {
-    node_.reject(opts_.state_posterior_channel, "posterior for odometry epoch " + std::to_string(m.epoch) +
-                                                    ", the filter is in epoch " + std::to_string(lio_.frame().epoch) +
-                                                    " (made before a reset): ignored");
+    node_.reject(options_.state_posterior_channel,
+                 "posterior for odometry epoch " + std::to_string(m.epoch) + ", the filter is in epoch " +
+                     std::to_string(lio_.frame().epoch) + " (made before a reset): ignored");
     return;
   }
   if (!pending_ || m.request_id != pending_->request_id || m.utime != pending_->utime) {
-    node_.reject(opts_.state_posterior_channel, "posterior answers no waiting prior (late, duplicate or foreign)");
+    node_.reject(options_.state_posterior_channel, "posterior answers no waiting prior (late, duplicate or foreign)");
     return;
   }
   pending_.reset();
@@ -543,10 +550,10 @@ void LioNode::onPosterior(const filter_state_t& m) {
     ++handoff_.kept_prior;  // the VIO kept the prior (it says why on its own HEALTH)
   } else if (!fromFilterState(m, &x, &P)) {
     ++handoff_.kept_prior;
-    node_.reject(opts_.state_posterior_channel, "non-finite or malformed posterior: prior kept");
+    node_.reject(options_.state_posterior_channel, "non-finite or malformed posterior: prior kept");
   } else if (!lio_.adoptPosterior(m.utime, x, P, &why)) {
     ++handoff_.kept_prior;
-    node_.reject(opts_.state_posterior_channel, why + ": prior kept");
+    node_.reject(options_.state_posterior_channel, why + ": prior kept");
   } else {
     ++handoff_.adopted;
   }
@@ -558,11 +565,11 @@ void LioNode::onLoopCorrection(const loop_correction_t& m) {
   std::vector<LioEstimator::KeyframePose> poses;
   std::string why;
   if (!fromMessage(m, &correction, &poses, &why)) {
-    node_.reject(opts_.loop_correction_channel, why);
+    node_.reject(options_.loop_correction_channel, why);
     return;
   }
   if (const std::string refusal = adoptionRefusal(m, lio_.frame()); !refusal.empty()) {
-    node_.reject(opts_.loop_correction_channel, refusal);
+    node_.reject(options_.loop_correction_channel, refusal);
     return;
   }
   if (pending_) {

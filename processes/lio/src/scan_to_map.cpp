@@ -38,7 +38,7 @@ ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::
       points_(body_points.size()),
       body_rate_(body_rate),
       undistorted_dt_(undistorted_with.dt),
-      opts_(options),
+      options_(options),
       threads_(threads),
       matches_(body_points.size()),
       gate_(body_points.size()),
@@ -46,11 +46,11 @@ ScanToMap::ScanToMap(const VoxelMap& map, const VoxelPlanes* planes, const std::
   const Mat3 R_LI = undistorted_with.rot.transpose();
   for (size_t i = 0; i < points_.size(); ++i) {
     points_[i] = R_LI * (body_points[i] - undistorted_with.pos);
-    gate_[i] = opts_.residual_range_factor * std::sqrt(body_points[i].norm());
+    gate_[i] = options_.residual_range_factor * std::sqrt(body_points[i].norm());
   }
-  floor_.diagonal().head<3>().setConstant(opts_.registration_floor_rotation * opts_.registration_floor_rotation);
-  floor_.diagonal().segment<3>(3).setConstant(opts_.registration_floor_translation *
-                                              opts_.registration_floor_translation);
+  floor_.diagonal().head<3>().setConstant(options_.registration_floor_rotation * options_.registration_floor_rotation);
+  floor_.diagonal().segment<3>(3).setConstant(options_.registration_floor_translation *
+                                              options_.registration_floor_translation);
 }
 
 int ScanToMap::numMatched() const {
@@ -59,28 +59,24 @@ int ScanToMap::numMatched() const {
   return n;
 }
 
-bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInformation* info) {
-  const int k = opts_.plane.num_neighbors;
-  const double research2 = opts_.research_distance * opts_.research_distance;
-  const double w = 1.0 / (opts_.point_noise_std * opts_.point_noise_std);
-  const double inv_lever = 1.0 / opts_.degeneracy_lever_arm;
-  // the body pose at the sweep's true end and the LiDAR's mounting at the iterate
-  const Pose3 sweep_end = sweepEndPose(x, body_rate_, undistorted_dt_);
-  const Mat3 R_WL = sweep_end.linear() * x.lidar.rot;
-  const Vec3 t_WL = sweep_end * x.lidar.pos;
-  // 1. the points' images, and which of them moved enough to search their neighbours anew
-  to_search_.clear();
+std::vector<uint32_t> ScanToMap::placePoints(const Mat3& R_WL, const Vec3& t_WL, int iteration) {
+  const double research2 = options_.research_distance * options_.research_distance;
+  std::vector<uint32_t> to_search;
   for (size_t i = 0; i < points_.size(); ++i) {
     world_[i] = R_WL * points_[i] + t_WL;
     if (iteration == 0 || !((world_[i] - matches_[i].searched_at).squaredNorm() <= research2))
-      to_search_.push_back(static_cast<uint32_t>(i));
+      to_search.push_back(static_cast<uint32_t>(i));
   }
-  // 2. the searches and plane fits: each point's own, so they may run on several threads
+  return to_search;
+}
+
+void ScanToMap::fitPlanes(const std::vector<uint32_t>& to_search) {
+  const int k = options_.plane.num_neighbors;
   auto search = [&](size_t begin, size_t end) {
     Vec3 nb[32];
     double d2[32];
     for (size_t j = begin; j < end; ++j) {
-      const uint32_t i = to_search_[j];
+      const uint32_t i = to_search[j];
       Match& m = matches_[i];
       m.searched_at = world_[i];
       if (const Plane* voxel_plane = planes_ ? planes_->planeAt(world_[i]) : nullptr) {
@@ -88,69 +84,99 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
         m.has_plane = m.observes_normal = true;
         continue;
       }
-      m.has_plane =
-          map_.knn(world_[i], k, opts_.plane.max_neighbor_distance, nb, d2) == k &&
-          fitPlane(nb, k, opts_.plane.max_plane_thickness, &m.plane, opts_.plane.min_planarity, &m.observes_normal);
+      m.has_plane = map_.knn(world_[i], k, options_.plane.max_neighbor_distance, nb, d2) == k &&
+                    fitPlane(nb, k, options_.plane.max_plane_thickness, &m.plane, options_.plane.min_planarity,
+                             &m.observes_normal);
     }
   };
   if (threads_)
-    threads_->forEachShare(to_search_.size(), search, kMinSearchesPerThread);
+    threads_->forEachShare(to_search.size(), search, kMinSearchesPerThread);
   else
-    search(0, to_search_.size());
-  // 3. the residuals, in the points' order (the sums below do not depend on the threads)
-  rows_.clear();
+    search(0, to_search.size());
+}
+
+std::vector<ScanToMap::Row> ScanToMap::residualRows(const FilterState& x, const Pose3& sweep_end) const {
+  std::vector<Row> rows;
   for (size_t i = 0; i < points_.size(); ++i) {
     const Match& m = matches_[i];
     if (!m.has_plane) continue;
     const double r = m.plane.distance(world_[i]);
     if (!(std::abs(r) <= gate_[i])) continue;
-    rows_.push_back(
+    rows.push_back(
         Row{PointToPlaneResidual{points_[i], m.plane}.jacobian(x, sweep_end, body_rate_), r, m.observes_normal});
   }
-  const int count = static_cast<int>(rows_.size());
-  last_count_ = count;
-  info->count = count;
-  if (count == 0) return false;
+  return rows;
+}
 
+double ScanToMap::robustScale2(const std::vector<Row>& rows) const {
   // Cauchy weights with a scale that follows the residuals while the iterate is still far off
   // (3 robust standard deviations) and settles at robust_scale near the optimum.
-  double c2 = 0.0;
-  if (opts_.robust_scale > 0.0) {
-    abs_r_.resize(rows_.size());
-    for (size_t i = 0; i < rows_.size(); ++i) abs_r_[i] = std::abs(rows_[i].r);
-    auto mid = abs_r_.begin() + static_cast<std::ptrdiff_t>(abs_r_.size() / 2);
-    std::nth_element(abs_r_.begin(), mid, abs_r_.end());
-    const double c = std::max(opts_.robust_scale, 3.0 * 1.4826 * *mid);
-    c2 = c * c;
-  }
+  if (!(options_.robust_scale > 0.0)) return 0.0;
+  std::vector<double> abs_r(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) abs_r[i] = std::abs(rows[i].r);
+  auto mid = abs_r.begin() + static_cast<std::ptrdiff_t>(abs_r.size() / 2);
+  std::nth_element(abs_r.begin(), mid, abs_r.end());
+  const double c = std::max(options_.robust_scale, 3.0 * 1.4826 * *mid);
+  return c * c;
+}
+
+Mat6 ScanToMap::degeneracyGeometry(const std::vector<Row>& rows) const {
   // The degeneracy test counts only the rows whose planes stay planes with any one neighbour left
   // out: a line of floor points plus the wall point beside it spans a plane that point chose, and
   // in a corridor such planes are the only rows along the axis, hiding its degeneracy.
+  const double inv_lever = 1.0 / options_.degeneracy_lever_arm;
   Mat6 G = Mat6::Zero();
   int observing = 0;
-  for (const Row& row : rows_) {
+  for (const Row& row : rows) {
     if (!row.observes_normal) continue;
     Row6 hs = row.h.head<6>();
     hs.head<3>() *= inv_lever;
     G.noalias() += hs.transpose() * hs;
     ++observing;
   }
-  info->geometry = G / static_cast<double>(std::max(observing, 1));
-  degeneracy_ = analyzeDegeneracy(info->geometry, opts_.degeneracy_threshold);
+  return G / static_cast<double>(std::max(observing, 1));
+}
+
+void ScanToMap::information(const std::vector<Row>& rows, double c2, bool degenerate, Mat13* S, Vec13* g) const {
+  const double w = 1.0 / (options_.point_noise_std * options_.point_noise_std);
+  *S = Mat13::Zero();
+  *g = Vec13::Zero();
+  for (const Row& row : rows) {
+    if (degenerate && !row.observes_normal) continue;
+    const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
+    S->noalias() += rw * row.h.transpose() * row.h;
+    g->noalias() += rw * row.h.transpose() * row.r;
+  }
+  *S *= w;
+  *g *= w;
+}
+
+bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInformation* info) {
+  // the body pose at the sweep's true end and the LiDAR's mounting at the iterate
+  const Pose3 sweep_end = sweepEndPose(x, body_rate_, undistorted_dt_);
+  const Mat3 R_WL = sweep_end.linear() * x.lidar.rot;
+  const Vec3 t_WL = sweep_end * x.lidar.pos;
+  // 1. the points' images, and which of them moved enough to search their neighbours anew
+  const std::vector<uint32_t> to_search = placePoints(R_WL, t_WL, iteration);
+  // 2. the searches and plane fits: each point's own, so they may run on several threads
+  fitPlanes(to_search);
+  // 3. the residuals, in the points' order (the sums below do not depend on the threads)
+  const std::vector<Row> rows = residualRows(x, sweep_end);
+  const int count = static_cast<int>(rows.size());
+  last_count_ = count;
+  info->count = count;
+  if (count == 0) return false;
+
+  const double c2 = robustScale2(rows);
+  info->geometry = degeneracyGeometry(rows);
+  degeneracy_ = analyzeDegeneracy(info->geometry, options_.degeneracy_threshold);
   // Where the other rows fix the whole pose, such a plane is mostly right (four points of one
   // ring on a wall and one of the next look the same) and a wrong one is outvoted; where they do
   // not, it would be the only say in a direction, and a wrong one tilts the attitude there.
-  const bool degenerate = opts_.remove_degenerate && degeneracy_.degenerate;
-  Mat13 S = Mat13::Zero();
-  Vec13 g = Vec13::Zero();
-  for (const Row& row : rows_) {
-    if (degenerate && !row.observes_normal) continue;
-    const double rw = c2 > 0.0 ? 1.0 / (1.0 + row.r * row.r / c2) : 1.0;
-    S.noalias() += rw * row.h.transpose() * row.h;
-    g.noalias() += rw * row.h.transpose() * row.r;
-  }
-  S *= w;
-  g *= w;
+  const bool degenerate = options_.remove_degenerate && degeneracy_.degenerate;
+  Mat13 S;
+  Vec13 g;
+  information(rows, c2, degenerate, &S, &g);
   info->calibration_block = FilterState::kLidar;
   min_information_eigenvalue_ =
       Eigen::SelfAdjointEigenSolver<Mat6>(Mat6(S.topLeftCorner<6, 6>()), Eigen::EigenvaluesOnly).eigenvalues()[0];
@@ -165,7 +191,7 @@ bool ScanToMap::evaluate(const FilterState& x, int iteration, MeasurementInforma
     S.topLeftCorner<6, 6>() = Sp;
     g.head<6>() = gp;
   }
-  if (opts_.registration_floor_rotation > 0.0 || opts_.registration_floor_translation > 0.0)
+  if (options_.registration_floor_rotation > 0.0 || options_.registration_floor_translation > 0.0)
     applyMeasurementFloor(floor_, &S, &g);
   info->HtRinvH = S;
   info->HtRinvz = g;

@@ -15,11 +15,11 @@ constexpr int64_t kSortedCandidates = 16;  // knn: up to this many voxels in a s
 int bitWidth(uint64_t v) { return v == 0 ? 0 : 64 - __builtin_clzll(v); }
 }  // namespace
 
-VoxelMap::VoxelMap(VoxelMapOptions options) : opts_(options) {
-  if (!(opts_.voxel_size > 0.0) || opts_.max_points_per_voxel < 1)
+VoxelMap::VoxelMap(VoxelMapOptions options) : options_(options) {
+  if (!(options_.voxel_size > 0.0) || options_.max_points_per_voxel < 1)
     throw std::invalid_argument("VoxelMap: voxel_size > 0 and max_points_per_voxel >= 1 required");
-  inv_size_ = 1.0 / opts_.voxel_size;
-  stride_ = 3 * static_cast<size_t>(opts_.max_points_per_voxel);
+  inv_size_ = 1.0 / options_.voxel_size;
+  stride_ = 3 * static_cast<size_t>(options_.max_points_per_voxel);
 }
 
 bool VoxelMap::insert(const Vec3& p) { return insert(p, 0.0); }
@@ -36,15 +36,15 @@ bool VoxelMap::insert(const Vec3& p, double range) {
     markOccupied(key);
     voxels_.push_back(Voxel{key, 0, static_cast<int32_t>(cx), static_cast<int32_t>(cy), static_cast<int32_t>(cz)});
     pool_.resize(pool_.size() + stride_);
-    misses_.resize(misses_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0);
-    ranges_.resize(ranges_.size() + static_cast<size_t>(opts_.max_points_per_voxel), 0.0f);
+    misses_.resize(misses_.size() + static_cast<size_t>(options_.max_points_per_voxel), 0);
+    ranges_.resize(ranges_.size() + static_cast<size_t>(options_.max_points_per_voxel), 0.0f);
   }
   Voxel& vox = voxels_[static_cast<size_t>(v)];
   float* pts = voxelPoints(v);
   uint8_t* misses = voxelMisses(v);
   float* ranges = voxelRanges(v);
-  const double min_d2 = opts_.min_point_distance * opts_.min_point_distance;
-  const double seen_d2 = opts_.seen_again_distance * opts_.seen_again_distance;
+  const double min_d2 = options_.min_point_distance * options_.min_point_distance;
+  const double seen_d2 = options_.seen_again_distance * options_.seen_again_distance;
   int nearest = -1;  // the nearest stored point closer than min_point_distance
   double nearest_d2 = min_d2;
   int farthest_seen = -1;  // the stored point seen from the longest range
@@ -56,9 +56,9 @@ bool VoxelMap::insert(const Vec3& p, double range) {
     if (farthest_seen < 0 || ranges[i] > ranges[farthest_seen]) farthest_seen = i;
   }
   int slot = vox.count;
-  if (nearest >= 0 || vox.count >= opts_.max_points_per_voxel) {
+  if (nearest >= 0 || vox.count >= options_.max_points_per_voxel) {
     slot = nearest >= 0 ? nearest : farthest_seen;
-    if (!(range < opts_.refresh_range_ratio * ranges[slot])) return false;
+    if (!(range < options_.refresh_range_ratio * ranges[slot])) return false;
   } else {
     ++vox.count;
   }
@@ -82,34 +82,171 @@ size_t VoxelMap::insert(const std::vector<Vec3>& points, const Vec3& origin) {
   return n;
 }
 
+// knn: the k nearest so far, sorted by squared distance (into the caller's arrays).
+struct VoxelMap::KnnResult {
+  int k;
+  Vec3* points;
+  double* sq_dist;
+  int found;
+  double worst;  // admit points with d2 <= worst
+};
+
+// knn: a box of voxels [lo, hi] per axis.
+struct VoxelMap::KnnBox {
+  int64_t lo[3] = {1, 1, 1}, hi[3] = {0, 0, 0};  // empty
+  bool contains(int64_t x, int64_t y, int64_t z) const {
+    return lo[0] <= x && x <= hi[0] && lo[1] <= y && y <= hi[1] && lo[2] <= z && z <= hi[2];
+  }
+};
+
+// knn: one stage's voxels meeting the ball. An entry of the heap is one integer, the voxel's
+// distance as float bits (non-negative floats order as their bits) above its place in the stage's
+// box, so a heap step moves 8 bytes; the stop test uses the double distance. The place packs the
+// voxel's offsets in the box into bit fields (x above y above z: the order of a linear index, for
+// equal distances), so that a visit decodes it with shifts, not divisions, and its key is the box
+// corner's plus the offsets (packVoxel's fields do not carry within its coordinate range).
+struct VoxelMap::KnnStage {
+  KnnBox box;
+  double r2 = 0.0;  // the stage's squared radius
+  int bits_z = 0, shift_x = 0;
+  uint32_t mask_y = 0, mask_z = 0;
+  VoxelKey corner = 0;
+  uint64_t* heap = heap_small;
+  double* cand_d2 = d2_small;  // by place in the box
+  int64_t nc = 0;              // entries of the heap
+  uint64_t heap_small[64];
+  double d2_small[64];
+  std::vector<uint64_t> heap_large;
+  std::vector<double> d2_large;
+
+  VoxelKey keyAt(uint64_t x, uint64_t y, uint64_t z) const { return corner + x + (y << 21) + (z << 42); }
+  VoxelKey keyOf(uint32_t index) const { return keyAt(index >> shift_x, (index >> bits_z) & mask_y, index & mask_z); }
+};
+
+inline __attribute__((always_inline)) void VoxelMap::scanVoxel(VoxelKey key, const Vec3& q, KnnResult* best) const {
+  const int32_t v = index_.find(key);
+  if (v < 0) return;
+  const int k = best->k;
+  double* out_sq_dist = best->sq_dist;
+  Vec3* out_points = best->points;
+  const float* pts = voxelPoints(v);
+  const int cnt = voxels_[static_cast<size_t>(v)].count;
+  for (int i = 0; i < cnt; ++i) {
+    const double dx = pts[3 * i] - q.x(), dy = pts[3 * i + 1] - q.y(), dz = pts[3 * i + 2] - q.z();
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 > best->worst) continue;
+    if (best->found == k && d2 >= out_sq_dist[k - 1]) continue;
+    int j = best->found < k ? best->found++ : k - 1;
+    while (j > 0 && out_sq_dist[j - 1] > d2) {
+      out_sq_dist[j] = out_sq_dist[j - 1];
+      out_points[j] = out_points[j - 1];
+      --j;
+    }
+    out_sq_dist[j] = d2;
+    out_points[j] = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+    if (best->found == k) best->worst = out_sq_dist[k - 1];
+  }
+}
+
+void VoxelMap::stageCandidates(const Vec3& q, double stage_r, const KnnBox& inner, double inner2,
+                               KnnStage* stage) const {
+  const double vs = options_.voxel_size;
+  const double stage_r2 = stage_r * stage_r;
+  stage->r2 = stage_r2;
+  KnnBox& box = stage->box;
+  double ax[3][8];  // per axis: the squared distance from q to each cell's slab (0 in q's own)
+  for (int a = 0; a < 3; ++a) {
+    box.lo[a] = floorToInt((q[a] - stage_r) * inv_size_);
+    box.hi[a] = floorToInt((q[a] + stage_r) * inv_size_);
+  }
+  const int64_t nx = box.hi[0] - box.lo[0] + 1, ny = box.hi[1] - box.lo[1] + 1, nz = box.hi[2] - box.lo[2] + 1;
+  const int64_t ncand = nx * ny * nz;
+  std::vector<double> ax_large;
+  double* axis[3] = {ax[0], ax[1], ax[2]};
+  if (std::max({nx, ny, nz}) > 8) {
+    ax_large.resize(static_cast<size_t>(nx + ny + nz));
+    axis[0] = ax_large.data(), axis[1] = axis[0] + nx, axis[2] = axis[1] + ny;
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int64_t c = box.lo[a]; c <= box.hi[a]; ++c) {
+      // the distance to the cell's slab: max(0, below, above) by branches (std::max of a list
+      // was a tenth of the search)
+      const double below = c * vs - q[a], above = q[a] - (c + 1) * vs;
+      const double d = below > 0.0 ? below : above > 0.0 ? above : 0.0;
+      axis[a][c - box.lo[a]] = d * d;
+    }
+  const int bits_y = bitWidth(static_cast<uint64_t>(ny - 1)), bits_z = bitWidth(static_cast<uint64_t>(nz - 1));
+  const int shift_x = bits_y + bits_z;
+  stage->bits_z = bits_z;
+  stage->shift_x = shift_x;
+  stage->mask_y = (uint32_t{1} << bits_y) - 1;
+  stage->mask_z = (uint32_t{1} << bits_z) - 1;
+  const size_t places = size_t{1} << (bitWidth(static_cast<uint64_t>(nx - 1)) + shift_x);
+  stage->corner = packVoxel(box.lo[0], box.lo[1], box.lo[2]);
+  if (places > 64) {
+    stage->heap_large.resize(static_cast<size_t>(ncand));
+    stage->d2_large.resize(places);
+    stage->heap = stage->heap_large.data();
+    stage->cand_d2 = stage->d2_large.data();
+  }
+  uint64_t* heap = stage->heap;
+  double* cand_d2 = stage->cand_d2;
+  int64_t nc = 0;
+  for (int64_t x = 0; x < nx; ++x)
+    for (int64_t y = 0; y < ny; ++y) {
+      const double dxy = axis[0][x] + axis[1][y];
+      if (dxy > stage_r2) continue;
+      for (int64_t z = 0; z < nz; ++z) {
+        const double d2 = dxy + axis[2][z];
+        if (d2 > stage_r2) continue;
+        if (d2 <= inner2 && inner.contains(box.lo[0] + x, box.lo[1] + y, box.lo[2] + z)) continue;  // visited
+        // a voxel the occupancy bits rule out holds nothing: it never enters the order (most of
+        // the ball is empty space outdoors, and each entry costs a heap step)
+        if (!mayHold(stage->keyAt(x, y, z))) continue;
+        const uint32_t index = static_cast<uint32_t>((x << shift_x) | (y << bits_z) | z);
+        const float f = static_cast<float>(d2);
+        uint32_t bits;
+        std::memcpy(&bits, &f, sizeof bits);
+        cand_d2[index] = d2;
+        heap[nc++] = (uint64_t{bits} << 32) | index;
+      }
+    }
+  stage->nc = nc;
+}
+
+void VoxelMap::visitNearestFirst(KnnStage* stage, const Vec3& q, KnnResult* best) const {
+  uint64_t* heap = stage->heap;
+  const double* cand_d2 = stage->cand_d2;
+  const int64_t nc = stage->nc;
+  if (nc <= kSortedCandidates) {
+    // a few candidates (the first stage's, usually): an insertion sort costs less than the heap
+    for (int64_t i = 1; i < nc; ++i) {
+      const uint64_t e = heap[i];
+      int64_t j = i;
+      for (; j > 0 && heap[j - 1] > e; --j) heap[j] = heap[j - 1];
+      heap[j] = e;
+    }
+    for (int64_t i = 0; i < nc; ++i) {
+      const uint32_t index = static_cast<uint32_t>(heap[i]);
+      if (cand_d2[index] > best->worst) break;  // this stage's others are farther still
+      scanVoxel(stage->keyOf(index), q, best);
+    }
+  } else {
+    const std::greater<uint64_t> farther;  // std::*_heap with greater: a min-heap
+    std::make_heap(heap, heap + nc, farther);
+    for (int64_t left = nc; left > 0; --left) {
+      const uint32_t index = static_cast<uint32_t>(heap[0]);
+      if (cand_d2[index] > best->worst) break;  // this stage's others are farther still
+      std::pop_heap(heap, heap + left, farther);
+      scanVoxel(stage->keyOf(index), q, best);
+    }
+  }
+}
+
 int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, double* out_sq_dist) const {
   if (k <= 0 || k > 32 || voxels_.empty() || !q.allFinite()) return 0;
-  const double r2 = max_distance * max_distance;
-  const double vs = opts_.voxel_size;
-  int found = 0;
-  double worst = r2;  // admit points with d2 <= worst
-  auto scanVoxel = [&](VoxelKey key) __attribute__((always_inline)) {
-    const int32_t v = index_.find(key);
-    if (v < 0) return;
-    const float* pts = voxelPoints(v);
-    const int cnt = voxels_[static_cast<size_t>(v)].count;
-    for (int i = 0; i < cnt; ++i) {
-      const double dx = pts[3 * i] - q.x(), dy = pts[3 * i + 1] - q.y(), dz = pts[3 * i + 2] - q.z();
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      if (d2 > worst) continue;
-      if (found == k && d2 >= out_sq_dist[k - 1]) continue;
-      int j = found < k ? found++ : k - 1;
-      while (j > 0 && out_sq_dist[j - 1] > d2) {
-        out_sq_dist[j] = out_sq_dist[j - 1];
-        out_points[j] = out_points[j - 1];
-        --j;
-      }
-      out_sq_dist[j] = d2;
-      out_points[j] = Vec3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
-      if (found == k) worst = out_sq_dist[k - 1];
-    }
-  };
-
+  const double vs = options_.voxel_size;
+  KnnResult best{k, out_points, out_sq_dist, 0, max_distance * max_distance};
   // The voxels meeting the ball (less those the occupancy bits rule out) are visited nearest
   // first and looked up in the index lazily, so the search stops after the few nearest (about 8 at
   // the defaults). It runs in two stages: the voxels within half the radius (a fifth of the ball's
@@ -117,123 +254,25 @@ int VoxelMap::knn(const Vec3& q, int k, double max_distance, Vec3* out_points, d
   // orders its voxels with a min-heap, which pays only for those visited (or, up to
   // kSortedCandidates of them, with an insertion sort). The order decides only which voxel is
   // looked up first: the result is exact.
-  // An entry of the heap is one integer, the voxel's distance as float bits (non-negative floats
-  // order as their bits) above its place in the stage's box, so a heap step moves 8 bytes; the stop
-  // test uses the double distance. The place packs the voxel's offsets in the box into bit fields
-  // (x above y above z: the order of a linear index, for equal distances), so that a visit decodes
-  // it with shifts, not divisions, and its key is the box corner's plus the offsets (packVoxel's
-  // fields do not carry within its coordinate range).
-  struct Box {
-    int64_t lo[3] = {1, 1, 1}, hi[3] = {0, 0, 0};  // empty
-    bool contains(int64_t x, int64_t y, int64_t z) const {
-      return lo[0] <= x && x <= hi[0] && lo[1] <= y && y <= hi[1] && lo[2] <= z && z <= hi[2];
-    }
-  };
-  Box inner;             // the previous stage's box ...
+  KnnBox inner;          // the previous stage's box ...
   double inner2 = -1.0;  // ... whose voxels with d2 <= inner2 were visited
-  uint64_t heap_small[64];
-  double d2_small[64];  // by place in the stage's box
-  std::vector<uint64_t> heap_large;
-  std::vector<double> d2_large;
   for (const double stage_r : {0.5 * max_distance, max_distance}) {
-    const double stage_r2 = stage_r * stage_r;
-    Box box;
-    double ax[3][8];  // per axis: the squared distance from q to each cell's slab (0 in q's own)
-    for (int a = 0; a < 3; ++a) {
-      box.lo[a] = floorToInt((q[a] - stage_r) * inv_size_);
-      box.hi[a] = floorToInt((q[a] + stage_r) * inv_size_);
-    }
-    const int64_t nx = box.hi[0] - box.lo[0] + 1, ny = box.hi[1] - box.lo[1] + 1, nz = box.hi[2] - box.lo[2] + 1;
-    const int64_t ncand = nx * ny * nz;
-    std::vector<double> ax_large;
-    double* axis[3] = {ax[0], ax[1], ax[2]};
-    if (std::max({nx, ny, nz}) > 8) {
-      ax_large.resize(static_cast<size_t>(nx + ny + nz));
-      axis[0] = ax_large.data(), axis[1] = axis[0] + nx, axis[2] = axis[1] + ny;
-    }
-    for (int a = 0; a < 3; ++a)
-      for (int64_t c = box.lo[a]; c <= box.hi[a]; ++c) {
-        // the distance to the cell's slab: max(0, below, above) by branches (std::max of a list
-        // was a tenth of the search)
-        const double below = c * vs - q[a], above = q[a] - (c + 1) * vs;
-        const double d = below > 0.0 ? below : above > 0.0 ? above : 0.0;
-        axis[a][c - box.lo[a]] = d * d;
-      }
-    const int bits_y = bitWidth(static_cast<uint64_t>(ny - 1)), bits_z = bitWidth(static_cast<uint64_t>(nz - 1));
-    const int shift_x = bits_y + bits_z;
-    const uint32_t mask_y = (uint32_t{1} << bits_y) - 1, mask_z = (uint32_t{1} << bits_z) - 1;
-    const size_t places = size_t{1} << (bitWidth(static_cast<uint64_t>(nx - 1)) + shift_x);
-    const VoxelKey corner = packVoxel(box.lo[0], box.lo[1], box.lo[2]);
-    auto keyAt = [corner](uint64_t x, uint64_t y, uint64_t z) __attribute__((always_inline)) {
-      return corner + x + (y << 21) + (z << 42);
-    };
-    uint64_t* heap = heap_small;
-    double* cand_d2 = d2_small;
-    if (places > 64) {
-      heap_large.resize(static_cast<size_t>(ncand));
-      d2_large.resize(places);
-      heap = heap_large.data();
-      cand_d2 = d2_large.data();
-    }
-    int64_t nc = 0;
-    for (int64_t x = 0; x < nx; ++x)
-      for (int64_t y = 0; y < ny; ++y) {
-        const double dxy = axis[0][x] + axis[1][y];
-        if (dxy > stage_r2) continue;
-        for (int64_t z = 0; z < nz; ++z) {
-          const double d2 = dxy + axis[2][z];
-          if (d2 > stage_r2) continue;
-          if (d2 <= inner2 && inner.contains(box.lo[0] + x, box.lo[1] + y, box.lo[2] + z)) continue;  // visited
-          // a voxel the occupancy bits rule out holds nothing: it never enters the order (most of
-          // the ball is empty space outdoors, and each entry costs a heap step)
-          if (!mayHold(keyAt(x, y, z))) continue;
-          const uint32_t index = static_cast<uint32_t>((x << shift_x) | (y << bits_z) | z);
-          const float f = static_cast<float>(d2);
-          uint32_t bits;
-          std::memcpy(&bits, &f, sizeof bits);
-          cand_d2[index] = d2;
-          heap[nc++] = (uint64_t{bits} << 32) | index;
-        }
-      }
-    auto visit = [&](uint32_t index) __attribute__((always_inline)) {
-      scanVoxel(keyAt(index >> shift_x, (index >> bits_z) & mask_y, index & mask_z));
-    };
-    if (nc <= kSortedCandidates) {
-      // a few candidates (the first stage's, usually): an insertion sort costs less than the heap
-      for (int64_t i = 1; i < nc; ++i) {
-        const uint64_t e = heap[i];
-        int64_t j = i;
-        for (; j > 0 && heap[j - 1] > e; --j) heap[j] = heap[j - 1];
-        heap[j] = e;
-      }
-      for (int64_t i = 0; i < nc; ++i) {
-        const uint32_t index = static_cast<uint32_t>(heap[i]);
-        if (cand_d2[index] > worst) break;  // this stage's others are farther still
-        visit(index);
-      }
-    } else {
-      const std::greater<uint64_t> farther;  // std::*_heap with greater: a min-heap
-      std::make_heap(heap, heap + nc, farther);
-      for (int64_t left = nc; left > 0; --left) {
-        const uint32_t index = static_cast<uint32_t>(heap[0]);
-        if (cand_d2[index] > worst) break;  // this stage's others are farther still
-        std::pop_heap(heap, heap + left, farther);
-        visit(index);
-      }
-    }
+    KnnStage stage;
+    stageCandidates(q, stage_r, inner, inner2, &stage);
+    visitNearestFirst(&stage, q, &best);
     // Settled when no unvisited voxel can hold a nearer point: those left are this stage's beyond
     // worst, and those beyond stage_r or outside the box (whose faces are about stage_r from q; the
     // exact distance guards rounding).
-    double unvisited2 = stage_r2;
+    double unvisited2 = stage.r2;
     for (int a = 0; a < 3; ++a) {
-      const double face = std::min(q[a] - box.lo[a] * vs, (box.hi[a] + 1) * vs - q[a]);
+      const double face = std::min(q[a] - stage.box.lo[a] * vs, (stage.box.hi[a] + 1) * vs - q[a]);
       unvisited2 = std::min(unvisited2, face * face);
     }
-    if (found == k && worst <= unvisited2) return found;
-    inner = box;
-    inner2 = stage_r2;
+    if (best.found == k && best.worst <= unvisited2) return best.found;
+    inner = stage.box;
+    inner2 = stage.r2;
   }
-  return found;
+  return best.found;
 }
 
 void VoxelMap::removePoint(int32_t v, int i) {
@@ -280,7 +319,7 @@ void VoxelMap::forEachVoxelNearBeams(const Vec3& origin, const std::vector<Vec3>
   // Any step gives the same result (the cubes below hold every voxel within the beam's radius of
   // the ray, and the points themselves are tested): one voxel walks the ray in half the samples of
   // half a voxel, for a few more voxels tested.
-  const double step = opts_.voxel_size;
+  const double step = options_.voxel_size;
   const size_t stride = static_cast<size_t>(std::max(1, o.ray_stride));
   for (size_t beam = first_beam; beam < end_beam; ++beam) {
     const Vec3 w = endpoints[beam * stride] - origin;
@@ -384,7 +423,7 @@ size_t VoxelMap::removeSeenThrough(const Vec3& origin, const std::vector<Vec3>& 
 
 size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   const double r2 = radius * radius;
-  const double vs = opts_.voxel_size;
+  const double vs = options_.voxel_size;
   size_t kept = 0;
   for (size_t v = 0; v < voxels_.size(); ++v) {
     const Voxel& vox = voxels_[v];
@@ -393,7 +432,7 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
     if (kept != v) {
       voxels_[kept] = vox;
       std::copy_n(&pool_[v * stride_], stride_, &pool_[kept * stride_]);
-      const size_t slots = static_cast<size_t>(opts_.max_points_per_voxel);
+      const size_t slots = static_cast<size_t>(options_.max_points_per_voxel);
       std::copy_n(&misses_[v * slots], slots, &misses_[kept * slots]);
       std::copy_n(&ranges_[v * slots], slots, &ranges_[kept * slots]);
     }
@@ -403,8 +442,8 @@ size_t VoxelMap::removeFarFrom(const Vec3& centre, double radius) {
   if (removed == 0) return 0;
   voxels_.resize(kept);
   pool_.resize(kept * stride_);
-  misses_.resize(kept * static_cast<size_t>(opts_.max_points_per_voxel));
-  ranges_.resize(kept * static_cast<size_t>(opts_.max_points_per_voxel));
+  misses_.resize(kept * static_cast<size_t>(options_.max_points_per_voxel));
+  ranges_.resize(kept * static_cast<size_t>(options_.max_points_per_voxel));
   voxels_.shrink_to_fit();
   pool_.shrink_to_fit();
   misses_.shrink_to_fit();

@@ -97,7 +97,7 @@ class LioEstimator {
   /// The sweep's start and end in the IMU clock (livo/sweep_timing.hpp, through the rig's LiDAR
   /// time offset); the end is the watermark the IMU must pass before addScan.
   SweepTiming sweepTiming(const LidarScan& scan) const {
-    return livo::sweepTiming(scan, opts_.extrinsics.time_offset_s);
+    return livo::sweepTiming(scan, options_.extrinsics.time_offset_s);
   }
   /// sweepTiming(scan).end_utime.
   int64_t scanEndUtime(const LidarScan& scan) const { return sweepTiming(scan).end_utime; }
@@ -118,12 +118,12 @@ class LioEstimator {
   Vec3 bodyRate() const { return prop_.angularVelocity(prop_.lastSample().gyro, prop_.state()); }
   /// The IMU's sensing-axis errors as estimated (ImuIntrinsics), when they are.
   bool modelsImuIntrinsics() const { return prop_.modelsIntrinsics(); }
-  bool estimatesImuAxes() const { return opts_.calibration.imu_axes == CalibrationEstimation::ImuAxes::kEstimate; }
+  bool estimatesImuAxes() const { return options_.calibration.imu_axes == CalibrationEstimation::ImuAxes::kEstimate; }
   const ImuIntrinsics& imuIntrinsics() const { return prop_.intrinsics(); }
   const ImuIntrinsics::Covariance& imuIntrinsicsCovariance() const { return prop_.intrinsicsCovariance(); }
   const VoxelMap& map() const { return map_; }
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
-  const LioOptions& options() const { return opts_; }
+  const LioOptions& options() const { return options_; }
   /// IMU samples waiting for a sweep and IMU steps kept for undistortion (bounded; diagnostics).
   size_t imuBacklog() const { return imu_.size(); }
   size_t undistortionSegments() const { return prop_.segments().size(); }
@@ -233,9 +233,9 @@ class LioEstimator {
   /// map points were removed.
   size_t insertIntoMap(const std::vector<Vec3>& body, const FilterState& x);
   void pruneMap(const Vec3& position);
-  const VoxelPlanes* planesForRegistration() const { return opts_.planes.enabled ? &planes_ : nullptr; }
+  const VoxelPlanes* planesForRegistration() const { return options_.planes.enabled ? &planes_ : nullptr; }
 
-  LioOptions opts_;
+  LioOptions options_;
   ImuPropagator prop_;
   VoxelMap map_;
   VoxelPlanes planes_;  // used by the registration when LioOptions::planes.enabled

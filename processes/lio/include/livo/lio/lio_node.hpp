@@ -93,7 +93,7 @@ class LioNode {
   void onImu(const imu_t& m);
   /// A plausible sample on a confirmed clock: into the buffer (or a reset on a clock step back).
   void acceptImu(const ImuSample& s);
-  /// Writes the epoch and the next keyframe id to opts_.numbering_file (if set).
+  /// Writes the epoch and the next keyframe id to options_.numbering_file (if set).
   void saveNumbering();
   void onLidar(const point_cloud_t& m);
   void onWheel(const wheel_odometry_t& m);
@@ -115,6 +115,15 @@ class LioNode {
   /// The promises in PROGRESS (progress_t.quiet_*): IMU samples, images and wheel readings that
   /// cannot make advance() act, even interleaved.
   std::vector<Node::QuietWindow> quietWindows() const;
+  /// What quietWindows() may promise beyond the IMU (the most channels whose floor the filter is not
+  /// past), and the lowest threshold of the next event the covered messages can bring about.
+  struct Promises {
+    bool images = false, sweeps = false, wheels = false;
+    int64_t threshold = 0;
+    int64_t period = 0;     // between images
+    int64_t image_due = 0;  // where the next image is due
+  };
+  Promises promises(const NextEvent& next) const;
   void process(const PendingScan& p);
   /// Propagates to an image time and publishes the prior (sets pending_).
   void handOff(int64_t utime);
@@ -126,7 +135,7 @@ class LioNode {
   bool estimatesCalibration() const;
   CalibrationEstimate calibrationEstimate() const;
 
-  LioNodeOptions opts_;
+  LioNodeOptions options_;
   Node node_;
   LioEstimator lio_;
   TimeBuffer<ImuSample> imu_;

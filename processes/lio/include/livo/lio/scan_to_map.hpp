@@ -87,20 +87,33 @@ class ScanToMap {
     double r;
     bool observes_normal;  // counts in the degeneracy test; only these are used in a degenerate sweep
   };
+  // The stages of evaluate(), in order.
+  /// The points' images at the LiDAR pose (R_WL, t_WL) into world_; returns those that moved enough
+  /// since their last search (all at the first iteration) to search their neighbours anew.
+  std::vector<uint32_t> placePoints(const Mat3& R_WL, const Vec3& t_WL, int iteration);
+  /// The neighbour searches and plane fits of those points (on the threads, if any) into matches_.
+  void fitPlanes(const std::vector<uint32_t>& to_search);
+  /// The gated point-to-plane residuals, in the points' order.
+  std::vector<Row> residualRows(const FilterState& x, const Pose3& sweep_end) const;
+  /// The Cauchy kernel's squared scale for these residuals (0: no kernel).
+  double robustScale2(const std::vector<Row>& rows) const;
+  /// G of the degeneracy test (degeneracy.hpp) from the rows that observe their plane's normal.
+  Mat6 degeneracyGeometry(const std::vector<Row>& rows) const;
+  /// H^T R^-1 H and H^T R^-1 z of the rows, robustly weighted (only the normal-observing rows in a
+  /// degenerate sweep).
+  void information(const std::vector<Row>& rows, double c2, bool degenerate, Mat13* S, Vec13* g) const;
+
   const VoxelMap& map_;
   const VoxelPlanes* planes_;
   std::vector<Vec3> points_;  // the points in the LiDAR frame (q above)
   Vec3 body_rate_;
   double undistorted_dt_;  // the time shift the points were undistorted with
-  ScanToMapOptions opts_;
+  ScanToMapOptions options_;
   WorkerThreads* threads_;
   std::vector<Match> matches_;
-  std::vector<double> gate_;         // per point: max |r|
-  std::vector<Vec3> world_;          // per point: its image at the current iterate
-  std::vector<uint32_t> to_search_;  // the points whose planes are fitted anew at this iterate
-  Mat13 floor_ = Mat13::Zero();      // the registration floor over the measured states
-  std::vector<Row> rows_;            // accepted residuals of the current iterate
-  std::vector<double> abs_r_;
+  std::vector<double> gate_;     // per point: max |r|
+  std::vector<Vec3> world_;      // per point: its image at the current iterate
+  Mat13 floor_ = Mat13::Zero();  // the registration floor over the measured states
   DegeneracyReport degeneracy_;
   double min_information_eigenvalue_ = 0.0;
   int last_count_ = 0;

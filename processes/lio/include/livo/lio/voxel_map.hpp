@@ -84,7 +84,7 @@ class VoxelMap {
   size_t numPoints() const;
   /// Every stored point (tests, rebuilds).
   std::vector<Vec3> points() const;
-  const VoxelMapOptions& options() const { return opts_; }
+  const VoxelMapOptions& options() const { return options_; }
 
  private:
   struct Voxel {
@@ -94,9 +94,20 @@ class VoxelMap {
   };
   const float* voxelPoints(int32_t v) const { return &pool_[static_cast<size_t>(v) * stride_]; }
   float* voxelPoints(int32_t v) { return &pool_[static_cast<size_t>(v) * stride_]; }
-  uint8_t* voxelMisses(int32_t v) { return &misses_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
-  float* voxelRanges(int32_t v) { return &ranges_[static_cast<size_t>(v) * opts_.max_points_per_voxel]; }
+  uint8_t* voxelMisses(int32_t v) { return &misses_[static_cast<size_t>(v) * options_.max_points_per_voxel]; }
+  float* voxelRanges(int32_t v) { return &ranges_[static_cast<size_t>(v) * options_.max_points_per_voxel]; }
   void removePoint(int32_t v, int i);
+  // knn's stages (voxel_map.cpp defines the structs)
+  struct KnnResult;
+  struct KnnBox;
+  struct KnnStage;
+  /// Offers voxel `key`'s points to the k nearest so far.
+  void scanVoxel(VoxelKey key, const Vec3& q, KnnResult* best) const;
+  /// The voxels within stage_r of q that may hold points, less those an earlier stage visited (in
+  /// `inner` within sqrt(inner2)), into the stage's order.
+  void stageCandidates(const Vec3& q, double stage_r, const KnnBox& inner, double inner2, KnnStage* stage) const;
+  /// Visits the stage's voxels nearest first until the rest are farther than the k-th nearest.
+  void visitNearestFirst(KnnStage* stage, const Vec3& q, KnnResult* best) const;
   /// False if no voxel with this key is stored; true if one may be (see occupied_).
   bool mayHold(VoxelKey key) const {
     const uint64_t bit = (key * 0x9e3779b97f4a7c15ULL) >> (64 - kOccupiedBits);
@@ -115,7 +126,7 @@ class VoxelMap {
   void forEachVoxelNearBeams(const Vec3& origin, const std::vector<Vec3>& endpoints, const SeenThroughOptions& o,
                              size_t first_beam, size_t end_beam, VisitVoxel visit) const;
 
-  VoxelMapOptions opts_;
+  VoxelMapOptions options_;
   double inv_size_;
   size_t stride_;  // floats per voxel: 3 * max_points_per_voxel
   std::vector<Voxel> voxels_;

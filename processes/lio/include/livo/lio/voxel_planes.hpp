@@ -57,7 +57,7 @@ class VoxelPlanes {
 
   size_t numCells() const { return cells_.size(); }
   size_t numPlanes() const;
-  const VoxelPlanesOptions& options() const { return opts_; }
+  const VoxelPlanesOptions& options() const { return options_; }
 
  private:
   /// The upper triangle of a sum of outer products v v^T: xx, xy, xz, yy, yz, zz.
@@ -81,11 +81,11 @@ class VoxelPlanes {
     SymmetricSum beams = SymmetricSum::Zero();  // of the unit beam directions' outer products
     Plane plane;
   };
-  Vec3 corner(const Cell& c) const { return Vec3(c.cx, c.cy, c.cz) * opts_.cell_size; }
+  Vec3 corner(const Cell& c) const { return Vec3(c.cx, c.cy, c.cz) * options_.cell_size; }
   void refit(Cell* c) const;
   void reindex();
 
-  VoxelPlanesOptions opts_;
+  VoxelPlanesOptions options_;
   double inv_size_;
   std::vector<Cell> cells_;
   FlatKeyIndex index_;
