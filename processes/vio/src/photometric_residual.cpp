@@ -38,56 +38,52 @@ Eigen::Matrix<double, 2, kMeasuredDim> currentPixelJacobian(const ShutterProject
   return J;
 }
 
-bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const FilterState& x,
-                   const TrackedPatch& patch, const PhotometricOptions& o, PatchResidual* out,
-                   const RollingShutter& shutter) {
-  const Pose3 T_I_C = x.camera.pose();
-  ShutterProjection s;
-  if (!projectThroughShutter(camera, T_I_C, advanced(x, shutter.omega_I, x.camera.dt), shutter, patch.p_W, &s))
-    return false;
-  // where the reference image sees the point through this calibration
-  Eigen::Vector2d u_ref;
-  Mat27 J_ref;
-  Eigen::Matrix<double, 2, 3> J_ref_point;
-  if (!projectIntoReference(camera, patch.view, x.camera, patch.p_W, &u_ref, &J_ref, &J_ref_point)) return false;
-  const double scale = 1.0 / static_cast<double>(1 << level);
-  const Eigen::Vector2d ds = (u_ref - patch.view.pixel - patch.shift0) * scale;  // from the sampled shift
-  if (ds.cwiseAbs().maxCoeff() > 1.0) return false;  // first order in the shift: re-select instead
-  out->pixel = s.pixel;
-  float w[kWindow * kWindow];
-  if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
+namespace {
+
+// The rows of the Jacobians of the two pixels: d [current; reference] / d [δθ δp δφ δρ δdt] (B) and
+// d [current; reference] / d p_W (Bp), in pixels of the level (`scale`).
+void pixelJacobians(const ShutterProjection& s, const RollingShutter& shutter, const FilterState& x, const Mat27& J_ref,
+                    const Eigen::Matrix<double, 2, 3>& J_ref_point, double scale, PatchResidual* out) {
   out->B.topRows<2>() = currentPixelJacobian(s, shutter, x) * scale;
   out->B.bottomRows<2>().leftCols<6>().setZero();
   out->B.bottomRows<2>().rightCols<FilterState::kCalibrationDim>() = J_ref * scale;
   // the map point moves both pixels: d u / d p_W = J_proj R_C_W of each view
   out->Bp.topRows<2>() = s.J_proj * (x.camera.rot.transpose() * s.R_W_I.transpose()) * scale;
   out->Bp.bottomRows<2>() = J_ref_point * scale;
-  {
-    // the reference body pose's right perturbation: p_I = R_ref^T (p_W - p_ref) as for the current view
-    const double dtr = x.camera.dt - patch.view.time_shift;
-    const Mat3 R_ref = dtr != 0.0 ? Mat3(patch.view.T_W_I.linear() * so3::Exp(patch.view.omega_I * dtr))
-                                  : Mat3(patch.view.T_W_I.linear());
-    const Vec3 p_ref = patch.view.T_W_I.translation() + patch.view.vel_W * dtr;
-    // d u / d p_W = J (R_C_I R_I_W): the position columns are -that, the rotation's J R_C_I [p_I]x
-    const Vec3 p_Iref = R_ref.transpose() * (patch.p_W - p_ref);
-    const Eigen::Matrix<double, 2, 3> J_proj_ref = J_ref_point * R_ref;  // d u / d p_I  R_I_C ... as J_proj R_C_I
-    out->Bref.leftCols<3>() = J_proj_ref * so3::hat(p_Iref) * scale;
-    out->Bref.rightCols<3>() = -J_ref_point * scale;
-    out->baseline = (s.R_W_I * x.camera.pos + s.p_W_I - (R_ref * x.camera.pos + p_ref)).norm();
-  }
+}
 
+// d reference pixel / d [δθ δp] of the reference's body pose (Bref, level pixels) and the baseline
+// between the two camera centres.
+void referencePoseJacobian(const TrackedPatch& patch, const FilterState& x, const ShutterProjection& s,
+                           const Eigen::Matrix<double, 2, 3>& J_ref_point, double scale, PatchResidual* out) {
+  // the reference body pose's right perturbation: p_I = R_ref^T (p_W - p_ref) as for the current view
+  const double dtr = x.camera.dt - patch.view.time_shift;
+  const Mat3 R_ref = dtr != 0.0 ? Mat3(patch.view.T_W_I.linear() * so3::Exp(patch.view.omega_I * dtr))
+                                : Mat3(patch.view.T_W_I.linear());
+  const Vec3 p_ref = patch.view.T_W_I.translation() + patch.view.vel_W * dtr;
+  // d u / d p_W = J (R_C_I R_I_W): the position columns are -that, the rotation's J R_C_I [p_I]x
+  const Vec3 p_Iref = R_ref.transpose() * (patch.p_W - p_ref);
+  const Eigen::Matrix<double, 2, 3> J_proj_ref = J_ref_point * R_ref;  // d u / d p_I  R_I_C ... as J_proj R_C_I
+  out->Bref.leftCols<3>() = J_proj_ref * so3::hat(p_Iref) * scale;
+  out->Bref.rightCols<3>() = -J_ref_point * scale;
+  out->baseline = (s.R_W_I * x.camera.pos + s.p_W_I - (R_ref * x.camera.pos + p_ref)).norm();
+}
+
+// The current intensities I and their gradients (G's first two columns) on the 8x8 interior of the
+// sampled 10x10 window w, the reference Q at the shift ds from the sampled one (to first order) and
+// d r / d s (G's last two columns).
+void sampleIntensities(const float* w, const TrackedPatch& patch, int level, const Eigen::Vector2d& ds, double* I,
+                       double* Q, Eigen::Matrix<double, kPatchArea, 4>* G) {
   const size_t at = static_cast<size_t>(level) * kPatchArea;
   const float* Q0 = patch.reference.data() + at;
   const float* Qx = patch.reference_dx.data() + at;
   const float* Qy = patch.reference_dy.data() + at;
-  // current intensities and gradients on the 8x8 interior of the 10x10 window: the per-pixel
-  // arithmetic in fixed-size rows the compiler vectorises, the sums after it in the original
-  // pixel order (a floating-point sum depends on its order)
-  double I[kPatchArea], Q[kPatchArea];
-  double* Gx = out->G.col(0).data();
-  double* Gy = out->G.col(1).data();
-  double* Rx = out->G.col(2).data();
-  double* Ry = out->G.col(3).data();
+  // the per-pixel arithmetic in fixed-size rows the compiler vectorises, the sums after it in the
+  // original pixel order (a floating-point sum depends on its order)
+  double* Gx = G->col(0).data();
+  double* Gy = G->col(1).data();
+  double* Rx = G->col(2).data();
+  double* Ry = G->col(3).data();
   for (int j = 0; j < kPatch; ++j) {
     const float* c = w + (j + 1) * kWindow + 1;
 #pragma GCC unroll 8
@@ -106,6 +102,12 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
     Rx[k] = -(Ainv_t(0, 0) * Gx[k] + Ainv_t(0, 1) * Gy[k]);
     Ry[k] = -(Ainv_t(1, 0) * Gx[k] + Ainv_t(1, 1) * Gy[k]);
   }
+}
+
+// The brightness fit of the reference Q to the current I (the gain free within bounds around g0,
+// a projection onto span{q, 1}; else the offset only): ncc, gain, offset and the residuals r, and
+// the fit projected out of every column of G.
+void fitBrightness(const double* I, const double* Q, double g0, const PhotometricOptions& o, PatchResidual* out) {
   double sum_i = 0.0, sum_q = 0.0;
   for (int k = 0; k < kPatchArea; ++k) {
     sum_i += I[k];
@@ -124,8 +126,7 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
     sqi += q[k] * di[k];
   }
   out->ncc = sqq > 1e-9 && sii > 1e-9 ? sqi / std::sqrt(sqq * sii) : 0.0;
-  // brightness fit: gain free within bounds (projection onto span{q, 1}), else offset only
-  const double g0 = patch.gain0, lo = o.min_gain * g0, hi = o.max_gain * g0;
+  const double lo = o.min_gain * g0, hi = o.max_gain * g0;
   bool gain_free = false;
   double a = g0;
   if (o.affine_brightness && sqq > 1e-6 * kPatchArea) {
@@ -144,6 +145,33 @@ bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjectio
     const Eigen::RowVector4d qG = qv.transpose() * out->G / sqq;
     out->G -= qv * qG;
   }
+}
+
+}  // namespace
+
+bool evaluatePatch(const ImagePyramid& pyramid, int level, const CameraProjection& camera, const FilterState& x,
+                   const TrackedPatch& patch, const PhotometricOptions& o, PatchResidual* out,
+                   const RollingShutter& shutter) {
+  const Pose3 T_I_C = x.camera.pose();
+  ShutterProjection s;
+  if (!projectThroughShutter(camera, T_I_C, advanced(x, shutter.omega_I, x.camera.dt), shutter, patch.p_W, &s))
+    return false;
+  // where the reference image sees the point through this calibration
+  Eigen::Vector2d u_ref;
+  Mat27 J_ref;
+  Eigen::Matrix<double, 2, 3> J_ref_point;
+  if (!projectIntoReference(camera, patch.view, x.camera, patch.p_W, &u_ref, &J_ref, &J_ref_point)) return false;
+  const double scale = 1.0 / static_cast<double>(1 << level);
+  const Eigen::Vector2d ds = (u_ref - patch.view.pixel - patch.shift0) * scale;  // from the sampled shift
+  if (ds.cwiseAbs().maxCoeff() > 1.0) return false;  // first order in the shift: re-select instead
+  out->pixel = s.pixel;
+  float w[kWindow * kWindow];
+  if (!pyramid.sampleGrid(level, ImagePyramid::toLevel(out->pixel, level), kWindow, w)) return false;
+  pixelJacobians(s, shutter, x, J_ref, J_ref_point, scale, out);
+  referencePoseJacobian(patch, x, s, J_ref_point, scale, out);
+  double I[kPatchArea], Q[kPatchArea];
+  sampleIntensities(w, patch, level, ds, I, Q, &out->G);
+  fitBrightness(I, Q, patch.gain0, o, out);
   return true;
 }
 

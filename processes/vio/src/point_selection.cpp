@@ -82,6 +82,9 @@ bool DepthGrid::depthEdge(const Eigen::Vector2d& pixel, double z, double radius_
   return false;
 }
 
+CellGrid::CellGrid(int width, int height, int cell_px)
+    : cell(std::max(8, cell_px)), cols((width + cell - 1) / cell), rows((height + cell - 1) / cell) {}
+
 int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const SelectionOptions& o) {
   const Vec3 ray = m.position - c_W;
   int best = -1;
@@ -100,64 +103,76 @@ int chooseReference(const MapPoint& m, const Vec3& c_W, int64_t utime, const Sel
   return best;
 }
 
-std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
-                                        const SensorCalibration& calibration, int64_t utime, float exposure_time,
-                                        const DepthGrid& depth, int levels, const SelectionOptions& o,
-                                        SelectionStats* stats) {
-  SelectionStats st;
-  const CameraRig& rig = camera.rig();
-  const int cell = std::max(8, o.grid_cell_px);
-  const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
-  struct Candidate {
-    int point = -1, observation = -1;
-    float gradient = -1.0f;
-    Eigen::Matrix2d A;
-    Eigen::Vector2d shift;  // level 0: the reference's projection through `calibration`, from the patch centre
-  };
-  std::vector<Candidate> grid(static_cast<size_t>(cols) * rows);
+namespace {
+
+// The point a grid cell tracks: the best textured of those whose reference fits.
+struct Candidate {
+  int point = -1, observation = -1;
+  float gradient = -1.0f;
+  Eigen::Matrix2d A;
+  Eigen::Vector2d shift;  // level 0: the reference's projection through the calibration, from the patch centre
+};
+
+// The warp A of point m's reference observation `ref` into the view T_W_C and the shift of the
+// reference's projection through `calibration` from the stored patch's centre; false if there is no
+// reference (ref < 0), it does not project, or the warped patch leaves the stored one.
+bool referenceWarp(const CameraProjection& camera, const Pose3& T_W_C, const SensorCalibration& calibration,
+                   const MapPoint& m, int ref, Eigen::Matrix2d* A, Eigen::Vector2d* shift) {
+  const double corner = 0.5 * (kPatch - 1), reach = 0.5 * (kStored - 1);
+  Eigen::Vector2d u_ref;
+  *shift = Eigen::Vector2d::Zero();
+  bool ok = ref >= 0;
+  if (ok) {
+    // the reference view through the calibration in the state (reference_view.hpp)
+    const ReferenceView& view = m.observations[static_cast<size_t>(ref)].view;
+    ok = projectIntoReference(camera, view, calibration, m.position, &u_ref) &&
+         affineWarp(camera, T_W_C, view.T_W_I * calibration.pose(), m.position, m.normal, A);
+    *shift = u_ref - view.pixel;
+  }
+  // the warped 8x8 patch (with a pixel's room for the update to move it) must stay inside the
+  // stored one at every level: check its corners
+  const double max_shift = shift->cwiseAbs().maxCoeff();
+  for (int k = 0; ok && k < 4; ++k) {
+    const Eigen::Vector2d d((k & 1) ? corner : -corner, (k & 2) ? corner : -corner);
+    ok = (*A * d).cwiseAbs().maxCoeff() + max_shift + 1.0 <= reach;
+  }
+  return ok;
+}
+
+// Per cell of `grid` the candidate among the map points in view, not occluded, off depth edges and
+// with a reference that fits (counted in `st`).
+std::vector<Candidate> candidatesPerCell(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
+                                         const SensorCalibration& calibration, int64_t utime, const DepthGrid& depth,
+                                         int levels, const SelectionOptions& o, const CellGrid& grid,
+                                         SelectionStats* st) {
+  std::vector<Candidate> cells(grid.size());
   const Pose3 T_C_W = T_W_C.inverse();
   const Vec3 c_W = T_W_C.translation();
   const double border = patchBorder(levels);
-  const double corner = 0.5 * (kPatch - 1), reach = 0.5 * (kStored - 1);
   for (size_t i = 0; i < map.size(); ++i) {
     const MapPoint& m = map.point(static_cast<int>(i));
     const Vec3 p_C = T_C_W * m.position;
     if (p_C.z() < o.min_depth || p_C.z() > o.max_depth) continue;
     Eigen::Vector2d px;
     if (!camera.project(p_C, &px, border)) continue;
-    ++st.in_view;
+    ++st->in_view;
     if (depth.occluded(px, p_C.z(), o.occlusion_tolerance, o.occlusion_tolerance_rel)) {
-      ++st.occluded;
+      ++st->occluded;
       continue;
     }
     if (depth.depthEdge(px, p_C.z(), o.depth_edge_radius_px, o.depth_edge_tolerance, o.depth_edge_tolerance_rel)) {
-      ++st.depth_edge;
+      ++st->depth_edge;
       continue;
     }
     const int ref = chooseReference(m, c_W, utime, o);
     Eigen::Matrix2d A;
-    Eigen::Vector2d u_ref, shift = Eigen::Vector2d::Zero();
-    bool ok = ref >= 0;
-    if (ok) {
-      // the reference view through the calibration in the state (reference_view.hpp)
-      const ReferenceView& view = m.observations[static_cast<size_t>(ref)].view;
-      ok = projectIntoReference(camera, view, calibration, m.position, &u_ref) &&
-           affineWarp(camera, T_W_C, view.T_W_I * calibration.pose(), m.position, m.normal, &A);
-      shift = u_ref - view.pixel;
-    }
-    // the warped 8x8 patch (with a pixel's room for the update to move it) must stay inside the
-    // stored one at every level: check its corners
-    const double max_shift = shift.cwiseAbs().maxCoeff();
-    for (int k = 0; ok && k < 4; ++k) {
-      const Eigen::Vector2d d((k & 1) ? corner : -corner, (k & 2) ? corner : -corner);
-      ok = (A * d).cwiseAbs().maxCoeff() + max_shift + 1.0 <= reach;
-    }
-    if (!ok) {
-      ++st.no_reference;
+    Eigen::Vector2d shift;
+    if (!referenceWarp(camera, T_W_C, calibration, m, ref, &A, &shift)) {
+      ++st->no_reference;
       continue;
     }
     const PatchObservation& obs = m.observations[static_cast<size_t>(ref)];
-    Candidate& c = grid[static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell)];
+    Candidate& c = cells[grid.of(px)];
     if (obs.gradient > c.gradient) {  // strict: the earlier (older) point of equal texture
       c.point = static_cast<int>(i);
       c.observation = ref;
@@ -166,30 +181,49 @@ std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraPr
       c.shift = shift;
     }
   }
+  return cells;
+}
+
+// The tracked patch of a candidate: its reference warped into this view at every level; false if the
+// warp leaves the stored patch.
+bool trackPatch(const PointPatchMap& map, const Candidate& c, float exposure_time, int levels, TrackedPatch* t) {
+  const MapPoint& m = map.point(c.point);
+  const PatchObservation& obs = m.observations[static_cast<size_t>(c.observation)];
+  t->point = c.point;
+  t->observation = c.observation;
+  t->p_W = m.position;
+  t->gradient = c.gradient;
+  t->view = obs.view;
+  t->reference_cov_W = obs.pose_cov_W.cast<double>();
+  t->gain0 = exposure_time > 0.0f && obs.exposure_time > 0.0f ? exposure_time / obs.exposure_time : 1.0f;
+  t->shift0 = c.shift;
+  t->warp = c.A;
+  bool ok = true;
+  for (int l = 0; l < levels && ok; ++l) {
+    const size_t at = static_cast<size_t>(l) * kPatchArea;
+    ok = warpReferencePatch(obs.level(l), c.A, c.shift / static_cast<double>(1 << l), t->reference.data() + at,
+                            t->reference_dx.data() + at, t->reference_dy.data() + at);
+  }
+  return ok;
+}
+
+}  // namespace
+
+std::vector<TrackedPatch> selectPatches(const PointPatchMap& map, const CameraProjection& camera, const Pose3& T_W_C,
+                                        const SensorCalibration& calibration, int64_t utime, float exposure_time,
+                                        const DepthGrid& depth, int levels, const SelectionOptions& o,
+                                        SelectionStats* stats) {
+  SelectionStats st;
+  const CellGrid grid(camera.rig().width, camera.rig().height, o.grid_cell_px);
+  const std::vector<Candidate> cells =
+      candidatesPerCell(map, camera, T_W_C, calibration, utime, depth, levels, o, grid, &st);
   std::vector<TrackedPatch> out;
   out.reserve(
-      static_cast<size_t>(std::count_if(grid.begin(), grid.end(), [](const Candidate& c) { return c.point >= 0; })));
-  for (const Candidate& c : grid) {
+      static_cast<size_t>(std::count_if(cells.begin(), cells.end(), [](const Candidate& c) { return c.point >= 0; })));
+  for (const Candidate& c : cells) {
     if (c.point < 0) continue;
-    const MapPoint& m = map.point(c.point);
-    const PatchObservation& obs = m.observations[static_cast<size_t>(c.observation)];
     TrackedPatch& t = out.emplace_back();  // filled in place: a TrackedPatch is over 1 kB
-    t.point = c.point;
-    t.observation = c.observation;
-    t.p_W = m.position;
-    t.gradient = c.gradient;
-    t.view = obs.view;
-    t.reference_cov_W = obs.pose_cov_W.cast<double>();
-    t.gain0 = exposure_time > 0.0f && obs.exposure_time > 0.0f ? exposure_time / obs.exposure_time : 1.0f;
-    t.shift0 = c.shift;
-    t.warp = c.A;
-    bool ok = true;
-    for (int l = 0; l < levels && ok; ++l) {
-      const size_t at = static_cast<size_t>(l) * kPatchArea;
-      ok = warpReferencePatch(obs.level(l), c.A, c.shift / static_cast<double>(1 << l), t.reference.data() + at,
-                              t.reference_dx.data() + at, t.reference_dy.data() + at);
-    }
-    if (!ok) {
+    if (!trackPatch(map, c, exposure_time, levels, &t)) {
       out.pop_back();
       ++st.no_reference;
     }

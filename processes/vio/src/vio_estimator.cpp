@@ -181,94 +181,130 @@ ImageResult VioEstimator::processImage(const GreyImage& image, const FilterState
   return r;
 }
 
-void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh,
-                            const std::vector<TrackedPatch>& tracked, ImageResult* r) {
-  const MaintenanceOptions& mo = options_.maintenance;
-  const SelectionOptions& so = options_.selection;
-  const CameraRig& rig = camera_.rig();
-  const int cell = std::max(8, mo.new_point_cell_px);
-  const int cols = (rig.width + cell - 1) / cell, rows = (rig.height + cell - 1) / cell;
-  std::vector<char> occupied(static_cast<size_t>(cols) * rows, 0);
-  const double border = patchBorder(pyramid_.levels());
-  // the body when the image was really taken (the camera's time shift) and the camera there
-  const FilterState at_image = advanced(x, shutter.omega_I, x.camera.dt);
-  const Pose3 T_I_C = x.camera.pose();
-  const Pose3 T_W_C = at_image.pose() * T_I_C;
-  const Pose3 T_C_W = T_W_C.inverse();
-  const Vec3 c_W = T_W_C.translation();
-  // where a point is seen (its row's pose under a rolling shutter) and the view a patch cut there
-  // is in: that row's body pose and motion, and the calibration in use
-  ShutterProjection sp;
-  auto seen = [&](const Vec3& p_W) {
-    return projectThroughShutter(camera_, T_I_C, at_image, shutter, p_W, &sp, border, /*with_jacobian=*/false);
-  };
-  auto viewAt = [&](double row_dt) {
+// The camera when the image was really taken (the stamp plus the camera's time shift) at the
+// posterior x: where it sees a point (its row's pose under a rolling shutter) and the view a patch
+// cut there is in (that row's body pose and motion, and the calibration in use).
+struct VioEstimator::ImageCamera {
+  ImageCamera(const FilterState& x, const RollingShutter& shutter_in, double border_in)
+      : at_image(advanced(x, shutter_in.omega_I, x.camera.dt)),
+        shutter(shutter_in),
+        T_I_C(x.camera.pose()),
+        T_W_C(at_image.pose() * T_I_C),
+        T_C_W(T_W_C.inverse()),
+        c_W(T_W_C.translation()),
+        vel_W(x.vel),
+        time_shift(x.camera.dt),
+        border(border_in) {}
+
+  bool sees(const CameraProjection& camera, const Vec3& p_W, ShutterProjection* sp) const {
+    return projectThroughShutter(camera, T_I_C, at_image, shutter, p_W, sp, border, /*with_jacobian=*/false);
+  }
+  ReferenceView viewAt(double row_dt) const {
     ReferenceView v;
     v.T_W_I = advanced(at_image, shutter.omega_I, row_dt).pose();
     v.omega_I = shutter.omega_I;
-    v.vel_W = x.vel;
+    v.vel_W = vel_W;
     v.T_I_C = T_I_C;
-    v.time_shift = x.camera.dt;
+    v.time_shift = time_shift;
     return v;
-  };
-  // the pose covariance the references cut now carry, rotation in the world frame
-  Mat6 J = Mat6::Identity();
-  J.topLeftCorner<3, 3>() = x.rot;
-  const Mat6 P_pose = r->covariance.topLeftCorner<6, 6>();
-  const Mat6 pose_cov_W = J * (0.5 * (P_pose + P_pose.transpose())) * J.transpose();
-  auto cellOf = [&](const Eigen::Vector2d& px) {
-    return static_cast<size_t>(static_cast<int>(px.y()) / cell * cols + static_cast<int>(px.x()) / cell);
-  };
+  }
 
-  // tracked points: seen now; a new patch when the view or the photometric error changed enough
-  Eigen::Vector2d px;
+  FilterState at_image;
+  RollingShutter shutter;
+  Pose3 T_I_C, T_W_C, T_C_W;
+  Vec3 c_W, vel_W;
+  double time_shift, border;
+};
+
+// The best-textured recent LiDAR point of a free cell.
+struct VioEstimator::NewPointCandidate {
+  float gradient = -1.0f;
+  int evaluated = 0;
+  Vec3 p = Vec3::Zero(), normal = Vec3::Zero();
+  Eigen::Vector2d px = Eigen::Vector2d::Zero();
+  double dt = 0.0;  // row time
+};
+
+namespace {
+
+// The pose covariance the references cut now carry, rotation in the world frame.
+Mat6 worldPoseCovariance(const Mat3& R_W_I, const StateCovariance& P) {
+  Mat6 J = Mat6::Identity();
+  J.topLeftCorner<3, 3>() = R_W_I;
+  const Mat6 P_pose = P.topLeftCorner<6, 6>();
+  return J * (0.5 * (P_pose + P_pose.transpose())) * J.transpose();
+}
+
+// Whether the view of a tracked point from c_W turned or moved far enough from all its patches' (or
+// its reference's residual RMS grew enough) for a new patch.
+bool viewChanged(const MapPoint& m, const Vec3& c_W, float rms, const MaintenanceOptions& mo) {
+  const Vec3 ray = m.position - c_W;
+  double min_angle = std::numeric_limits<double>::infinity(), ratio = 1.0;
+  for (const auto& obs : m.observations) {
+    const Vec3 ray_obs = m.position - obs.cameraCentre();
+    const double a = angleBetweenDeg(ray, ray_obs);
+    if (a < min_angle) {
+      min_angle = a;
+      ratio = ray.norm() / std::max(1e-9, ray_obs.norm());
+    }
+  }
+  ratio = std::max(ratio, 1.0 / ratio);
+  return min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || rms > mo.refresh_error;
+}
+
+}  // namespace
+
+void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh,
+                            const std::vector<TrackedPatch>& tracked, ImageResult* r) {
+  const ImageCamera cam(x, shutter, patchBorder(pyramid_.levels()));
+  const Mat6 pose_cov_W = worldPoseCovariance(x.rot, r->covariance);
+  const CellGrid grid(camera_.rig().width, camera_.rig().height, options_.maintenance.new_point_cell_px);
+  std::vector<char> occupied(grid.size(), 0);
+  r->new_patches += refreshTracked(image, cam, pose_cov_W, refresh, tracked, grid, &occupied);
+  const std::vector<NewPointCandidate> best = newPointCandidates(cam, grid, occupied, r);
+  addNewPoints(image, cam, pose_cov_W, best, r);
+}
+
+int VioEstimator::refreshTracked(const GreyImage& image, const ImageCamera& cam, const Mat6& pose_cov_W, bool refresh,
+                                 const std::vector<TrackedPatch>& tracked, const CellGrid& grid,
+                                 std::vector<char>* occupied) {
+  const MaintenanceOptions& mo = options_.maintenance;
+  int added = 0;
+  ShutterProjection sp;
   for (const TrackedPatch& t : tracked) {
     MapPoint& m = map_.point(t.point);
     m.last_seen = image.utime;
-    if (!seen(m.position)) continue;
-    px = sp.pixel;
-    occupied[cellOf(px)] = 1;
+    if (!cam.sees(camera_, m.position, &sp)) continue;
+    (*occupied)[grid.of(sp.pixel)] = 1;
     if (!refresh || !t.active) continue;
     m.observations[static_cast<size_t>(t.observation)].error = t.rms;
     if (t.ncc < mo.outlier_ncc) continue;  // occluded or changed: do not learn it
-    const Vec3 ray = m.position - c_W;
-    double min_angle = std::numeric_limits<double>::infinity(), ratio = 1.0;
-    for (const auto& obs : m.observations) {
-      const Vec3 ray_obs = m.position - obs.cameraCentre();
-      const double a = angleBetweenDeg(ray, ray_obs);
-      if (a < min_angle) {
-        min_angle = a;
-        ratio = ray.norm() / std::max(1e-9, ray_obs.norm());
-      }
-    }
-    ratio = std::max(ratio, 1.0 / ratio);
-    if (min_angle > mo.refresh_angle_deg || ratio > mo.refresh_distance_ratio || t.rms > mo.refresh_error) {
-      PatchObservation obs;
-      if (makeObservation(px, image, viewAt(sp.dt), pose_cov_W, &obs)) {
-        map_.addObservation(t.point, std::move(obs));
-        ++r->new_patches;
-      }
+    if (!viewChanged(m, cam.c_W, t.rms, mo)) continue;
+    PatchObservation obs;
+    if (makeObservation(sp.pixel, image, cam.viewAt(sp.dt), pose_cov_W, &obs)) {
+      map_.addObservation(t.point, std::move(obs));
+      ++added;
     }
   }
+  return added;
+}
 
-  // new points: per free cell the best-textured recent LiDAR point (newest scan first)
-  struct Best {
-    float gradient = -1.0f;
-    int evaluated = 0;
-    Vec3 p = Vec3::Zero(), normal = Vec3::Zero();
-    Eigen::Vector2d px = Eigen::Vector2d::Zero();
-    double dt = 0.0;  // row time
-  };
-  std::vector<Best> best(occupied.size());
+std::vector<VioEstimator::NewPointCandidate> VioEstimator::newPointCandidates(const ImageCamera& cam,
+                                                                              const CellGrid& grid,
+                                                                              const std::vector<char>& occupied,
+                                                                              ImageResult* r) const {
+  const SelectionOptions& so = options_.selection;
+  std::vector<NewPointCandidate> best(occupied.size());
   const int gl = std::min(1, pyramid_.levels() - 1);
+  ShutterProjection sp;
   for (auto s = scans_.rbegin(); s != scans_.rend(); ++s) {
     for (size_t k = 0; k < s->points.size(); ++k) {
       const Vec3& p = s->points[k];
-      const Vec3 p_C = T_C_W * p;
-      if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !seen(p)) continue;
-      px = sp.pixel;
-      const size_t c = cellOf(px);
-      Best& b = best[c];
+      const Vec3 p_C = cam.T_C_W * p;
+      if (p_C.z() < so.min_depth || p_C.z() > so.max_depth || !cam.sees(camera_, p, &sp)) continue;
+      const Eigen::Vector2d px = sp.pixel;
+      const size_t c = grid.of(px);
+      NewPointCandidate& b = best[c];
       if (occupied[c] || b.evaluated >= kMaxCandidatesPerCell || map_.find(p) >= 0) continue;
       ++r->candidates;
       if (depth_.occluded(px, p_C.z(), so.occlusion_tolerance, so.occlusion_tolerance_rel) ||
@@ -288,14 +324,19 @@ void VioEstimator::maintain(const GreyImage& image, const FilterState& x, const 
       }
     }
   }
-  for (const Best& b : best) {
-    if (r->new_points >= mo.max_new_points) break;
-    if (b.gradient < mo.min_gradient) {
+  return best;
+}
+
+void VioEstimator::addNewPoints(const GreyImage& image, const ImageCamera& cam, const Mat6& pose_cov_W,
+                                const std::vector<NewPointCandidate>& best, ImageResult* r) {
+  for (const NewPointCandidate& b : best) {
+    if (r->new_points >= options_.maintenance.max_new_points) break;
+    if (b.gradient < options_.maintenance.min_gradient) {
       r->candidates_weak += b.evaluated > 0;
       continue;
     }
     PatchObservation obs;
-    if (!makeObservation(b.px, image, viewAt(b.dt), pose_cov_W, &obs)) continue;
+    if (!makeObservation(b.px, image, cam.viewAt(b.dt), pose_cov_W, &obs)) continue;
     if (map_.add(b.p, image.utime, std::move(obs), b.normal) >= 0) ++r->new_points;
   }
 }

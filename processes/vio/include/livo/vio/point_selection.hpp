@@ -53,6 +53,17 @@ class DepthGrid {
   std::vector<int> filled_;  // cells with a point since the last clear()
 };
 
+/// Square cells of at least 8 px over the image, row-major (one tracked or new point per cell).
+struct CellGrid {
+  CellGrid(int width, int height, int cell_px);
+  size_t size() const { return static_cast<size_t>(cols) * rows; }
+  /// The cell of a pixel inside the image.
+  size_t of(const Eigen::Vector2d& pixel) const {
+    return static_cast<size_t>(static_cast<int>(pixel.y()) / cell * cols + static_cast<int>(pixel.x()) / cell);
+  }
+  int cell, cols, rows;
+};
+
 struct SelectionStats {
   int in_view = 0;  // project inside the image with the patch border, in the depth range
   int occluded = 0;

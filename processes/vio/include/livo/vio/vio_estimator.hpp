@@ -90,10 +90,23 @@ class VioEstimator {
     std::vector<Vec3> points;
     std::vector<Vec3> normals;  // per point, zero where its voxel is not a plane
   };
+  struct ImageCamera;        // the camera when the image was taken (vio_estimator.cpp)
+  struct NewPointCandidate;  // of a free cell
   void fillDepth(const Pose3& T_W_C);
-  /// `x`: the posterior at the image stamp.
+  /// Map maintenance after an image; `x`: the posterior at the image stamp.
   void maintain(const GreyImage& image, const FilterState& x, const RollingShutter& shutter, bool refresh,
                 const std::vector<TrackedPatch>& tracked, ImageResult* result);
+  /// The tracked points seen now (their cells marked `occupied`); with `refresh`, a new patch where
+  /// the view or the photometric error changed enough. Returns the patches added.
+  int refreshTracked(const GreyImage& image, const ImageCamera& cam, const Mat6& pose_cov_W, bool refresh,
+                     const std::vector<TrackedPatch>& tracked, const CellGrid& grid, std::vector<char>* occupied);
+  /// Per free cell the best-textured recent LiDAR point (newest scan first); counts the candidates
+  /// and the hidden ones in `result`.
+  std::vector<NewPointCandidate> newPointCandidates(const ImageCamera& cam, const CellGrid& grid,
+                                                    const std::vector<char>& occupied, ImageResult* result) const;
+  /// The candidates with texture enough as new map points (at most MaintenanceOptions::max_new_points).
+  void addNewPoints(const GreyImage& image, const ImageCamera& cam, const Mat6& pose_cov_W,
+                    const std::vector<NewPointCandidate>& best, ImageResult* result);
   bool makeObservation(const Eigen::Vector2d& pixel, const GreyImage& image, const ReferenceView& view,
                        const Mat6& pose_cov_W, PatchObservation* obs) const;
 
