@@ -22,6 +22,18 @@ bool priorFromMessage(const filter_state_t& m, FilterState* x, StateCovariance* 
   return true;
 }
 
+StatePrior decodePrior(const filter_state_t& m) {
+  StatePrior prior;
+  prior.utime = m.utime;
+  prior.request_id = m.request_id;
+  prior.epoch = m.epoch;
+  prior.correction_id = m.correction_id;
+  priorFromMessage(m, &prior.x, &prior.P, &prior.problem);  // false: `problem` says why
+  prior.body_rate = vec3From(m.angular_velocity);
+  prior.message = m;
+  return prior;
+}
+
 filter_state_t toPosterior(const filter_state_t& prior, const std::string& source, const FilterState& x,
                            const StateCovariance& P, bool valid, int iterations, int num_measurements) {
   filter_state_t m = toFilterState(prior.utime, x, P, prior.request_id, source);

@@ -26,22 +26,23 @@ NodeOptions nodeOptions(const VioNodeOptions& o, bool quiet) {
 }  // namespace
 
 VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
-    : opts_(std::move(options)),
-      node_(lcm, nodeOptions(opts_, quiet)),
-      vio_(opts_.vio, opts_.camera),
-      offset_us_(toUtime(opts_.camera_time_offset_s)),
-      tolerance_us_(toUtime(opts_.time_tolerance_s)) {
-  node_.declareOutput(opts_.state_posterior_channel);
-  node_.subscribe<image_t>(opts_.camera_channel, [this](const image_t& m) { onImage(m); });
-  node_.subscribe<filter_state_t>(opts_.state_prior_channel, [this](const filter_state_t& m) { onPrior(m); });
-  node_.subscribe<registered_scan_t>(opts_.registered_scan_channel, [this](const registered_scan_t& m) { onScan(m); });
-  node_.subscribe<loop_correction_t>(opts_.loop_correction_channel,
+    : options_(std::move(options)),
+      node_(lcm, nodeOptions(options_, quiet)),
+      vio_(options_.vio, options_.camera),
+      offset_us_(toUtime(options_.camera_time_offset_s)),
+      tolerance_us_(toUtime(options_.time_tolerance_s)) {
+  node_.declareOutput(options_.state_posterior_channel);
+  node_.subscribe<image_t>(options_.camera_channel, [this](const image_t& m) { onImage(m); });
+  node_.subscribe<filter_state_t>(options_.state_prior_channel, [this](const filter_state_t& m) { onPrior(m); });
+  node_.subscribe<registered_scan_t>(options_.registered_scan_channel,
+                                     [this](const registered_scan_t& m) { onScan(m); });
+  node_.subscribe<loop_correction_t>(options_.loop_correction_channel,
                                      [this](const loop_correction_t& m) { onCorrection(m); });
   // lockstep playback need not wait for what publishes nothing here: a scan only joins the map,
   // and an image is only buffered while no prior waits for one
   node_.setQuietWindows([this] {
-    std::vector<Node::QuietWindow> w{Node::QuietWindow::always(opts_.registered_scan_channel)};
-    if (pending_.empty()) w.push_back(Node::QuietWindow::always(opts_.camera_channel));
+    std::vector<Node::QuietWindow> w{Node::QuietWindow::always(options_.registered_scan_channel)};
+    if (pending_.empty()) w.push_back(Node::QuietWindow::always(options_.camera_channel));
     return w;
   });
 }
@@ -49,8 +50,9 @@ VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
 void VioNode::onImage(const image_t& m) {
   BufferedImage b;
   b.t = m.utime + offset_us_;
-  if (!readGreyImage(rawImage(m), opts_.camera.width, opts_.camera.height, opts_.image_check, &b.image, &b.problem)) {
-    node_.reject(opts_.camera_channel, b.problem);
+  if (!readGreyImage(rawImage(m), options_.camera.width, options_.camera.height, options_.image_check, &b.image,
+                     &b.problem)) {
+    node_.reject(options_.camera_channel, b.problem);
     b.image.pixels.release();
     ++counts_.bad_images;
   } else {
@@ -76,38 +78,39 @@ MapFrame::Placed VioNode::placeInMap(int32_t epoch, int64_t correction_id) {
 }
 
 void VioNode::onPrior(const filter_state_t& m) {
-  const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
+  const StatePrior prior = decodePrior(m);
+  const MapFrame::Placed placed = placeInMap(prior.epoch, prior.correction_id);
   if (placed.placement == MapFrame::Placement::kOldEpoch) {
     // lio was reset since: it ignores any answer, so none is sent
-    node_.reject(opts_.state_prior_channel, "prior " + std::to_string(m.request_id) + " " + placed.why);
+    node_.reject(options_.state_prior_channel, "prior " + std::to_string(prior.request_id) + " " + placed.why);
     return;
   }
   if (placed.placement == MapFrame::Placement::kUnknownFrame) {
-    keep(m, placed.why);
+    keep(prior, placed.why);
     return;
   }
-  if (std::find(answered_ids_.begin(), answered_ids_.end(), m.request_id) != answered_ids_.end() ||
+  if (std::find(answered_ids_.begin(), answered_ids_.end(), prior.request_id) != answered_ids_.end() ||
       std::any_of(pending_.begin(), pending_.end(),
-                  [&](const filter_state_t& p) { return p.request_id == m.request_id; })) {
-    node_.reject(opts_.state_prior_channel, "duplicate prior (request id already seen): not answered again");
+                  [&](const StatePrior& p) { return p.request_id == prior.request_id; })) {
+    node_.reject(options_.state_prior_channel, "duplicate prior (request id already seen): not answered again");
     return;
   }
-  const auto it = std::upper_bound(pending_.begin(), pending_.end(), m.utime,
-                                   [](int64_t t, const filter_state_t& p) { return t < p.utime; });
   if (placed.moved) {
     // the map and the prior are in different loop corrections (it was made before lio adopted the
     // newest one the map has): the image could only be matched after moving one onto the other
-    keep(m, "prior made in another loop correction than the map's (" + std::to_string(m.correction_id) + " vs " +
-                std::to_string(frame_.correctionId()) + ")");
+    keep(prior, "prior made in another loop correction than the map's (" + std::to_string(prior.correction_id) +
+                    " vs " + std::to_string(frame_.correctionId()) + ")");
     return;
   }
-  pending_.insert(it, m);
+  const auto it = std::upper_bound(pending_.begin(), pending_.end(), prior.utime,
+                                   [](int64_t t, const StatePrior& p) { return t < p.utime; });
+  pending_.insert(it, prior);
   resolve();
 }
 
 void VioNode::resolve() {
   while (!pending_.empty()) {
-    const filter_state_t prior = pending_.front();
+    const StatePrior prior = pending_.front();
     // the image at the prior's time (the nearest within the tolerance)
     auto best = images_.end();
     for (auto it = images_.begin(); it != images_.end(); ++it)
@@ -128,7 +131,7 @@ void VioNode::resolve() {
     }
     const bool newer_image = !images_.empty() && images_.back().t > prior.utime + tolerance_us_;
     const bool newer_prior = pending_.size() > 1;
-    if (newer_image || newer_prior || static_cast<int>(pending_.size()) > opts_.max_buffered_images) {
+    if (newer_image || newer_prior || static_cast<int>(pending_.size()) > options_.max_buffered_images) {
       pending_.pop_front();
       keep(prior, newer_image ? "no image at the prior's time (a newer image came)"
                               : "no image at the prior's time (a newer prior came)");
@@ -141,40 +144,37 @@ void VioNode::resolve() {
 
 void VioNode::trimImages() {
   if (images_.empty()) return;
-  const int64_t horizon = images_.back().t - toUtime(opts_.image_buffer_s);
+  const int64_t horizon = images_.back().t - toUtime(options_.image_buffer_s);
   while (!images_.empty() &&
-         (images_.front().t < horizon || static_cast<int>(images_.size()) > opts_.max_buffered_images)) {
+         (images_.front().t < horizon || static_cast<int>(images_.size()) > options_.max_buffered_images)) {
     if (images_.front().problem.empty()) ++counts_.unused_images;
     images_.pop_front();
   }
 }
 
-void VioNode::process(const filter_state_t& prior, const BufferedImage& image) {
-  FilterState x;
-  StateCovariance P;
-  std::string why;
-  if (!priorFromMessage(prior, &x, &P, &why)) {
-    node_.reject(opts_.state_prior_channel, why);
-    keep(prior, why);
+void VioNode::process(const StatePrior& prior, const BufferedImage& image) {
+  if (!prior.problem.empty()) {
+    node_.reject(options_.state_prior_channel, prior.problem);
+    keep(prior, prior.problem);
     return;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const ImageResult r = vio_.processImage(image.image, x, P, vec3From(prior.angular_velocity));
+  const ImageResult r = vio_.processImage(image.image, prior.x, prior.P, prior.body_rate);
   node_.recordWork("image", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   if (!r.valid) {
     keep(prior, r.why);
     return;
   }
-  node_.publish(opts_.state_posterior_channel,
-                toPosterior(prior, opts_.name, r.state, r.covariance, true, r.iterations, r.num_measurements));
+  node_.publish(options_.state_posterior_channel, toPosterior(prior.message, options_.name, r.state, r.covariance, true,
+                                                              r.iterations, r.num_measurements));
   answered_ids_.push_back(prior.request_id);
   if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
   ++counts_.priors;
   ++counts_.updated;
 }
 
-void VioNode::keep(const filter_state_t& prior, const std::string& why) {
-  node_.publish(opts_.state_posterior_channel, keptPrior(prior, opts_.name));
+void VioNode::keep(const StatePrior& prior, const std::string& why) {
+  node_.publish(options_.state_posterior_channel, keptPrior(prior.message, options_.name));
   answered_ids_.push_back(prior.request_id);
   if (answered_ids_.size() > kAnsweredIds) answered_ids_.pop_front();
   ++counts_.priors;
@@ -195,12 +195,12 @@ void VioNode::reportKeptReasons() {
 
 void VioNode::onScan(const registered_scan_t& m) {
   if (const std::string why = registeredScanProblem(m); !why.empty()) {
-    node_.reject(opts_.registered_scan_channel, why);
+    node_.reject(options_.registered_scan_channel, why);
     return;
   }
   const MapFrame::Placed placed = placeInMap(m.epoch, m.correction_id);
   if (placed.placement != MapFrame::Placement::kUse) {
-    node_.reject(opts_.registered_scan_channel, placed.why);
+    node_.reject(options_.registered_scan_channel, placed.why);
     return;
   }
   const point_cloud_t& c = m.cloud;
@@ -217,7 +217,7 @@ void VioNode::onScan(const registered_scan_t& m) {
 void VioNode::onCorrection(const loop_correction_t& m) {
   Pose3 T_Ck_O;
   if (const std::string why = correctionTransform(m, &T_Ck_O); !why.empty()) {
-    node_.reject(opts_.loop_correction_channel, "loop correction: " + why);
+    node_.reject(options_.loop_correction_channel, "loop correction: " + why);
     return;
   }
   const MapFrame::CorrectionStep step = frame_.addCorrection(m.correction_id, m.epoch, T_Ck_O);

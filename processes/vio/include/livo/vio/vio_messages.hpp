@@ -2,6 +2,7 @@
 // filter_state_t <-> FilterState conversion itself is common/filter_state_message.hpp).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "livo/filter_state.hpp"
@@ -9,6 +10,23 @@
 #include "livo/loop_correction_t.hpp"
 
 namespace livo::vio {
+
+/// A STATE_PRIOR as the node keeps it, decoded on arrival: what it refers to, the state and
+/// covariance the update starts from and the body rate there, or why it cannot be used.
+struct StatePrior {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  int32_t epoch = 0;
+  int64_t correction_id = 0;
+  FilterState x;
+  StateCovariance P = StateCovariance::Zero();
+  Vec3 body_rate = Vec3::Zero();  // bias-corrected angular rate (the rolling shutter's rows, the time shift)
+  std::string problem;            // non-empty: not usable (priorFromMessage's reason)
+  filter_state_t message;         // as received: an answer valid = 0 echoes its numbers
+};
+
+/// Decodes a STATE_PRIOR (the one place the node reads one).
+StatePrior decodePrior(const filter_state_t& m);
 
 /// The state and covariance (symmetrised) of a STATE_PRIOR; false with the reason if a number is
 /// not finite, the quaternion is degenerate or the pose covariance is not positive definite.

@@ -27,6 +27,7 @@
 #include "livo/registered_scan_t.hpp"
 #include "livo/vio/vio_config.hpp"
 #include "livo/vio/vio_estimator.hpp"
+#include "livo/vio/vio_messages.hpp"
 
 namespace livo::vio {
 
@@ -66,21 +67,21 @@ class VioNode {
   void onCorrection(const loop_correction_t& m);
   /// Answers every waiting prior that can be answered now, then trims the image buffer.
   void resolve();
-  void process(const filter_state_t& prior, const BufferedImage& image);
-  void keep(const filter_state_t& prior, const std::string& why);
+  void process(const StatePrior& prior, const BufferedImage& image);
+  void keep(const StatePrior& prior, const std::string& why);
   void trimImages();
   /// Where a pose of (epoch, correction) goes in the map; a newer epoch (a LIO reset) first drops
   /// the map, the waiting priors and the corrections of the old epoch.
   MapFrame::Placed placeInMap(int32_t epoch, int64_t correction_id);
 
-  VioNodeOptions opts_;
+  VioNodeOptions options_;
   Node node_;
   VioEstimator vio_;
   int64_t offset_us_ = 0;
   int64_t tolerance_us_ = 0;
-  std::deque<BufferedImage> images_;    // by t
-  std::deque<filter_state_t> pending_;  // priors waiting for their image, by utime
-  std::deque<int64_t> answered_ids_;    // recent request ids, to answer each only once
+  std::deque<BufferedImage> images_;  // by t
+  std::deque<StatePrior> pending_;    // priors waiting for their image, by utime
+  std::deque<int64_t> answered_ids_;  // recent request ids, to answer each only once
   Counts counts_;
   MapFrame frame_;  // the map's odometry epoch and loop correction
   ReasonCounts kept_reasons_;
