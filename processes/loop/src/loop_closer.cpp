@@ -29,6 +29,13 @@ Pose3 withUpInBody(const Pose3& T, const Vec3& up_in_body) {
       so3::normalize(Quat::FromTwoVectors(T.linear() * up_in_body, Vec3::UnitZ()).toRotationMatrix() * T.linear());
   return out;
 }
+// The cloud as float (as keyframe_t carries it): what later derivations see is what the first sees.
+std::vector<Eigen::Vector3f> floatCloud(const Points& cloud) {
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(cloud.size());
+  for (const Vec3& p : cloud) out.push_back(p.cast<float>());
+  return out;
+}
 Pose3 rotationOnly(const Mat3& R) {
   Pose3 T = Pose3::Identity();
   T.linear() = R;
@@ -292,13 +299,15 @@ LoopRegistrationResult LoopCloser::registerPair(int64_t from_id, const Features&
 
 Mat6 LoopCloser::chainOdometryCovariance(const Keyframe& to) const {
   if (options_.odometry_covariance_from_filter && chain_.filter_covariance) return chain_.odometry_covariance;
-  // the drift model: the increment's covariance from the absolute ones, floored by the drift
-  // model over the path
+  return chainDriftInformation(to).inverse();
+}
+
+Mat6 LoopCloser::chainDriftInformation(const Keyframe& to) const {
+  // the increment's covariance from the absolute ones, floored by the drift model over the path
   return relativeInformation(
-             chain_.start_keyframe.covariance, to.covariance,
-             std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
-             std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path))
-      .inverse();
+      chain_.start_keyframe.covariance, to.covariance,
+      std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
+      std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path));
 }
 
 std::optional<Mat6> LoopCloser::odometryBetween(const Keyframe& a, const Keyframe& b) const {
@@ -409,8 +418,7 @@ void LoopCloser::addNode(int64_t id, const Keyframe& kf, const Pose3& estimate, 
   placements_.push_back(Placement{id, kf.utime, kf.epoch, id, Pose3::Identity(), upInBody(kf)});
 }
 
-AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
-  if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
+LoopCloser::Keyframe LoopCloser::arrivingKeyframe(const KeyframeInput& input) const {
   Keyframe kf;
   kf.id = input.id;
   kf.utime = input.utime;
@@ -418,141 +426,157 @@ AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
   kf.odometry = published_.odometryToCorrected(input.epoch, input.correction_id)->inverse() * input.pose;
   kf.covariance = input.covariance.allFinite() ? input.covariance : Mat6::Zero();
   kf.G_R_I = rollPitch(input.pose.linear());
-  // the cloud as float (as keyframe_t carries it): what later derivations see is what this one sees
-  FloatCloud cloud_f;
-  cloud_f.reserve(input.cloud.size());
-  for (const Vec3& p : input.cloud) cloud_f.push_back(p.cast<float>());
-  // Its features are derived only when a registration with it might be tried (an older node is
-  // near), and only as far as needed; has_keypoints is found then, for kf and its node if it is one.
-  std::shared_ptr<const Features> cur_features;
-  const auto currentHasKeypoints = [&] {
-    if (!cur_features) cur_features = std::make_shared<const Features>(cloud_f, kf.G_R_I, options_);
-    kf.has_keypoints = cur_features->hasKeypoints();
-    if (const auto node = nodes_.find(input.id); node != nodes_.end()) node->second.has_keypoints = kf.has_keypoints;
-    return *kf.has_keypoints;
-  };
+  return kf;
+}
+
+LoopCloser::Chain LoopCloser::chainFrom(const Keyframe& node) {
+  return Chain{node.id, node.id, node, Pose3::Identity(), false, 0.0, Mat6::Zero()};
+}
+
+bool LoopCloser::hasKeypoints(Arrival& cur) {
+  if (!cur.features) cur.features = std::make_shared<const Features>(cur.cloud, cur.kf.G_R_I, options_);
+  cur.kf.has_keypoints = cur.features->hasKeypoints();
+  if (const auto node = nodes_.find(cur.kf.id); node != nodes_.end()) node->second.has_keypoints = cur.kf.has_keypoints;
+  return *cur.kf.has_keypoints;
+}
+
+void LoopCloser::extendChain(const Pose3& step, const std::optional<Mat6>& step_covariance) {
+  chain_.path += step.translation().norm();
+  if (step_covariance)
+    chain_.odometry_covariance = composedCovariance(chain_.odometry_covariance, step, *step_covariance);
+  else
+    chain_.filter_covariance = false;
+}
+
+std::optional<int64_t> LoopCloser::nodeToJoin(Arrival& cur, const Pose3& estimate) {
+  if (options_.merge_distance <= 0) return std::nullopt;
+  const std::vector<int64_t> reach = olderNodesNear(cur.kf.id, cur.kf, estimate.translation(), options_.merge_distance);
+  if (reach.empty() || !hasKeypoints(cur)) return std::nullopt;
+  const std::vector<int64_t> with = withKeypoints(reach, 1);
+  if (with.empty()) return std::nullopt;
+  return with.front();
+}
+
+std::optional<AcceptedLoop> LoopCloser::verifiedLoop(const Arrival& cur, int64_t to_id, bool merged,
+                                                     const Pose3& W_T_from, AddResult& result) {
+  const Keyframe& target = nodes_.at(to_id);
+  const std::shared_ptr<const Features> target_features = features(to_id);
+  const LoopRegistrationResult r = registerPair(cur.kf.id, *cur.features, cur.cloud, to_id, *target_features);
+  noteAttempt(r, result);
+  if (!r.accepted) return std::nullopt;
+  AcceptedLoop loop = acceptedLoop(cur.kf.id, cur.kf, to_id, target, r);
+  loop.merged = merged;
+  if (std::optional<RefusedLoop> refusal = inconsistency(loop, cur.kf, W_T_from)) {
+    refused_.push_back(*refusal);
+    result.refused.push_back(*refusal);
+    return std::nullopt;
+  }
+  return loop;
+}
+
+void LoopCloser::joinNode(const Arrival& cur, int64_t node, const Pose3& T_chain_kf, AcceptedLoop loop,
+                          AddResult& result) {
+  const Keyframe& kf = cur.kf;
+  placements_.push_back(Placement{kf.id, kf.utime, kf.epoch, node, loop.T_to_from, upInBody(kf)});
+  PoseEdge e;  // none if the chain's node is the joined one (no new relation)
+  e.from = chain_.node;
+  e.to = node;
+  e.T_from_to = T_chain_kf * loop.T_to_from.inverse();
+  e.is_loop = true;
+  const Mat6 cov = composedCovariance(chainCovariance(kf), loop.T_to_from.inverse(),
+                                      inverseCovariance(loop.T_to_from, loop.covariance));
+  e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
+  result.correction = addLoopEdge(node != chain_.node ? &e : nullptr, kf.id, kf, &loop);
+  accept(loop, kf, result);
+  chain_ = Chain{node, kf.id, kf, loop.T_to_from, true, 0.0, loop.covariance};
+}
+
+void LoopCloser::addChainNode(const Arrival& cur, const Pose3& T_node_kf, const Pose3& estimate) {
+  const Keyframe& kf = cur.kf;
+  PoseEdge e;
+  e.from = chain_.node;
+  e.to = kf.id;
+  e.T_from_to = T_node_kf;
+  e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
+  const bool from_filter = options_.odometry_covariance_from_filter && chain_.filter_covariance;
+  e.information = chain_.via_loop || from_filter
+                      ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
+                      : chainDriftInformation(kf);
+  addNode(kf.id, kf, estimate, cur.cloud);
+  graph_.addEdge(e);
+  chain_ = chainFrom(kf);
+}
+
+bool LoopCloser::placeOnChain(Arrival& cur, AddResult& result) {
+  const Keyframe& kf = cur.kf;
+  // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
+  const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
+  const Pose3 estimate = levelled(graph_.pose(chain_.node) * T_node_kf, upInBody(kf));
+  const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
+  const bool older_node = kf.utime - nodes_.at(chain_.node).utime >= recent;
+  if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
+    // passing again near the older node the odometry hangs from: the keyframe joins it (its
+    // cloud and features are not needed: the node represents it)
+    placements_.push_back(Placement{kf.id, kf.utime, kf.epoch, chain_.node, T_node_kf, upInBody(kf)});
+    return false;
+  }
+  if (const std::optional<int64_t> near = nodeToJoin(cur, estimate)) {
+    // the keyframe joins the older node if it registers to it (else it becomes a node of its own)
+    if (std::optional<AcceptedLoop> loop = verifiedLoop(cur, *near, true, estimate, result)) {
+      joinNode(cur, *near, T_node_kf, *loop, result);
+      return false;
+    }
+  }
+  addChainNode(cur, T_node_kf, estimate);
+  return result.attempts.empty();  // the nearest older node did not register: no second try
+}
+
+void LoopCloser::searchLoops(Arrival& cur, AddResult& result) {
+  // graph nodes only (a keyframe that joined one is represented by it), nearest first
+  std::vector<int64_t> candidates;
+  const std::vector<int64_t> near =
+      olderNodesNear(cur.kf.id, cur.kf, graph_.pose(cur.kf.id).translation(), options_.candidates.search_radius);
+  if (!near.empty() && options_.candidates.max_candidates > 0 && hasKeypoints(cur))
+    candidates = withKeypoints(near, options_.candidates.max_candidates);
+  if (cur.features) cacheFeatures(cur.kf.id, cur.features);
+  for (int64_t cand : candidates) {
+    std::optional<AcceptedLoop> loop = verifiedLoop(cur, cand, false, graph_.pose(cur.kf.id), result);
+    if (!loop) continue;
+    PoseEdge e;
+    e.from = cand;
+    e.to = cur.kf.id;
+    e.T_from_to = loop->T_to_from;
+    e.is_loop = true;
+    e.information = informationFromCovariance(edgeCovarianceFromRight(loop->T_to_from, loop->covariance));
+    result.correction = addLoopEdge(&e, cur.kf.id, cur.kf, &*loop);
+    accept(*loop, cur.kf, result);
+    break;
+  }
+}
+
+AddResult LoopCloser::addKeyframe(const KeyframeInput& input) {
+  if (const std::string why = problem(input); !why.empty()) throw std::invalid_argument(why);
+  Arrival cur{arrivingKeyframe(input), floatCloud(input.cloud), nullptr};
   const bool cooling = ++keyframes_since_loop_ <= options_.candidates.cooldown_keyframes;
   const bool first_of_epoch = placements_.empty() || newest_.epoch != input.epoch;
-  const Pose3 previous_odometry = newest_.odometry;
-  const Pose3 step = previous_odometry.inverse() * kf.odometry;  // the increment from the previous keyframe
-  kf.path = first_of_epoch ? 0.0 : newest_.path + step.translation().norm();
-  const std::optional<Mat6> step_covariance = first_of_epoch ? std::nullopt : accumulateIncrement(input, step, &kf);
-  newest_ = kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
+  const Pose3 step = newest_.odometry.inverse() * cur.kf.odometry;  // the increment from the previous keyframe
+  cur.kf.path = first_of_epoch ? 0.0 : newest_.path + step.translation().norm();
+  const std::optional<Mat6> step_covariance = first_of_epoch ? std::nullopt : accumulateIncrement(input, step, &cur.kf);
+  newest_ = cur.kf;  // what the next keyframe's odometry step starts from (has_keypoints is not used)
 
   AddResult result;
   if (first_of_epoch) {
     // the first keyframe, or the first of a new epoch: a segment of its own, in its raw pose
     // (0 = the raw frame for the graph's first node, which PoseGraph holds fixed anyway)
     const bool first = placements_.empty();
-    addNode(input.id, kf, kf.odometry, cloud_f);
+    addNode(input.id, cur.kf, cur.kf.odometry, cur.cloud);
     if (!first) graph_.holdFixed(input.id);
-    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
+    chain_ = chainFrom(cur.kf);
   } else {
-    chain_.path += step.translation().norm();
-    if (step_covariance)
-      chain_.odometry_covariance = composedCovariance(chain_.odometry_covariance, step, *step_covariance);
-    else
-      chain_.filter_covariance = false;
-    // the odometry's estimate: the chain's node, its loop part, the raw odometry since its start
-    const Pose3 T_node_kf = chain_.T_node_start * (chain_.start_keyframe.odometry.inverse() * kf.odometry);
-    const Pose3 estimate = levelled(graph_.pose(chain_.node) * T_node_kf, upInBody(kf));
-    const int64_t recent = static_cast<int64_t>(options_.candidates.exclude_recent_s * 1e6);
-    const bool older_node = kf.utime - nodes_.at(chain_.node).utime >= recent;
-    if (options_.merge_distance > 0 && older_node && T_node_kf.translation().norm() <= options_.merge_distance) {
-      // passing again near the older node the odometry hangs from: the keyframe joins it (its
-      // cloud and features are not needed: the node represents it)
-      placements_.push_back(Placement{input.id, kf.utime, kf.epoch, chain_.node, T_node_kf, upInBody(kf)});
-      return result;
-    }
-    // the nearest older node with keypoints within merge_distance, if the keyframe has keypoints
-    std::optional<int64_t> near;
-    if (options_.merge_distance > 0) {
-      const std::vector<int64_t> reach = olderNodesNear(input.id, kf, estimate.translation(), options_.merge_distance);
-      if (!reach.empty() && currentHasKeypoints())
-        if (const std::vector<int64_t> with = withKeypoints(reach, 1); !with.empty()) near = with.front();
-    }
-    if (near) {
-      const Keyframe& target = nodes_.at(*near);
-      const std::shared_ptr<const Features> target_features = features(*near);
-      LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, *near, *target_features);
-      noteAttempt(r, result);
-      std::optional<AcceptedLoop> loop;
-      if (r.accepted) {
-        loop = acceptedLoop(input.id, kf, *near, target, r);
-        loop->merged = true;
-        if (std::optional<RefusedLoop> refusal = inconsistency(*loop, kf, estimate)) {
-          refused_.push_back(*refusal);
-          result.refused.push_back(*refusal);
-          loop.reset();  // it becomes a node of its own (below)
-        }
-      }
-      if (loop) {
-        // the keyframe joins the older node; the graph gets the edge chain node -> that node
-        placements_.push_back(Placement{input.id, kf.utime, kf.epoch, *near, loop->T_to_from, upInBody(kf)});
-        PoseEdge e;  // none if the chain's node is the joined one (no new relation)
-        e.from = chain_.node;
-        e.to = *near;
-        e.T_from_to = T_node_kf * loop->T_to_from.inverse();
-        e.is_loop = true;
-        const Mat6 cov = composedCovariance(chainCovariance(kf), loop->T_to_from.inverse(),
-                                            inverseCovariance(loop->T_to_from, loop->covariance));
-        e.information = informationFromCovariance(edgeCovarianceFromRight(e.T_from_to, cov));
-        result.correction = addLoopEdge(*near != chain_.node ? &e : nullptr, input.id, kf, &*loop);
-        accept(*loop, kf, result);
-        chain_ = Chain{*near, input.id, kf, loop->T_to_from, true, 0.0, loop->covariance};
-        return result;
-      }
-    }
-    // a node of its own, with the chain's measurement from the node before
-    PoseEdge e;
-    e.from = chain_.node;
-    e.to = input.id;
-    e.T_from_to = T_node_kf;
-    e.is_loop = chain_.via_loop;  // with a loop part it is no raw odometry increment
-    const bool from_filter = options_.odometry_covariance_from_filter && chain_.filter_covariance;
-    e.information =
-        chain_.via_loop || from_filter
-            ? informationFromCovariance(edgeCovarianceFromRight(T_node_kf, chainCovariance(kf)))
-            : relativeInformation(
-                  chain_.start_keyframe.covariance, kf.covariance,
-                  std::hypot(options_.odometry_rotation_floor, options_.odometry_rotation_per_m * chain_.path),
-                  std::hypot(options_.odometry_translation_floor, options_.odometry_translation_per_m * chain_.path));
-    addNode(input.id, kf, estimate, cloud_f);
-    graph_.addEdge(e);
-    chain_ = Chain{input.id, input.id, kf, Pose3::Identity(), false, 0.0, Mat6::Zero()};
-    if (!result.attempts.empty()) return result;  // the nearest older node did not register: no second try
+    extendChain(step, step_covariance);
+    if (!placeOnChain(cur, result)) return result;
   }
-
-  if (cooling) return result;
-  // graph nodes only (a keyframe that joined one is represented by it), nearest first
-  std::vector<int64_t> candidates;
-  const std::vector<int64_t> near =
-      olderNodesNear(input.id, kf, graph_.pose(input.id).translation(), options_.candidates.search_radius);
-  if (!near.empty() && options_.candidates.max_candidates > 0 && currentHasKeypoints())
-    candidates = withKeypoints(near, options_.candidates.max_candidates);
-  if (cur_features) cacheFeatures(input.id, cur_features);
-  for (int64_t cand : candidates) {
-    const Keyframe& target = nodes_.at(cand);
-    const std::shared_ptr<const Features> target_features = features(cand);
-    LoopRegistrationResult r = registerPair(input.id, *cur_features, cloud_f, cand, *target_features);
-    noteAttempt(r, result);
-    if (!r.accepted) continue;
-    AcceptedLoop loop = acceptedLoop(input.id, kf, cand, target, r);
-    if (std::optional<RefusedLoop> refusal = inconsistency(loop, kf, graph_.pose(input.id))) {
-      refused_.push_back(*refusal);
-      result.refused.push_back(*refusal);
-      continue;
-    }
-    PoseEdge e;
-    e.from = cand;
-    e.to = input.id;
-    e.T_from_to = loop.T_to_from;
-    e.is_loop = true;
-    e.information = informationFromCovariance(edgeCovarianceFromRight(loop.T_to_from, loop.covariance));
-    result.correction = addLoopEdge(&e, input.id, kf, &loop);
-    accept(loop, kf, result);
-    break;
-  }
+  if (!cooling) searchLoops(cur, result);
   return result;
 }
 

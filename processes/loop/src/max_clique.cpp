@@ -115,24 +115,28 @@ std::vector<int> greedyClique(const Graph& graph, const std::vector<int>& order,
   return best;
 }
 
-}  // namespace
+// A degeneracy order (repeatedly removing a vertex of minimum remaining degree) and each vertex's
+// core number.
+struct Degeneracy {
+  std::vector<int> order;  // the vertices, in the order removed
+  std::vector<int> core;   // per vertex
+};
 
-std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& options, bool* exact) {
+Degeneracy degeneracyOrder(const Graph& graph) {
   const int n = graph.size();
-  if (exact) *exact = true;
-  if (n == 0) return {};
-  // Degeneracy order by repeatedly removing a vertex of minimum remaining degree (bucket queue).
-  std::vector<int> degree(n), core(n), position(n);
+  // bucket queue by remaining degree
+  std::vector<int> degree(n);
+  Degeneracy out;
+  out.core.resize(n);
   int max_degree = 0;
   for (int v = 0; v < n; ++v)
     max_degree = std::max(max_degree, degree[v] = static_cast<int>(graph.adjacency[v].size()));
   std::vector<std::vector<int>> buckets(max_degree + 1);
   for (int v = 0; v < n; ++v) buckets[degree[v]].push_back(v);
   std::vector<char> removed(n, 0);
-  std::vector<int> order;
-  order.reserve(n);
+  out.order.reserve(n);
   int current_core = 0;
-  for (int d = 0; static_cast<int>(order.size()) < n;) {
+  for (int d = 0; static_cast<int>(out.order.size()) < n;) {
     if (buckets[d].empty()) {
       ++d;
       continue;
@@ -142,39 +146,63 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
     if (removed[v] || degree[v] != d) continue;
     removed[v] = 1;
     current_core = std::max(current_core, d);
-    core[v] = current_core;
-    position[v] = static_cast<int>(order.size());
-    order.push_back(v);
+    out.core[v] = current_core;
+    out.order.push_back(v);
     for (int u : graph.adjacency[v]) {
       if (removed[u]) continue;
       buckets[--degree[u]].push_back(u);
       if (degree[u] < d) d = degree[u];
     }
   }
+  return out;
+}
 
-  std::vector<int> best = greedyClique(graph, order, core);
-  const size_t words = (n + 63) / 64;
-  std::vector<Bits> adj(n, Bits(words, 0));
+// The adjacency lists as one bitset per vertex.
+std::vector<Bits> adjacencyBits(const Graph& graph) {
+  const int n = graph.size();
+  std::vector<Bits> adj(n, Bits((n + 63) / 64, 0));
   for (int v = 0; v < n; ++v)
     for (int u : graph.adjacency[v]) set(adj[v], u);
+  return adj;
+}
+
+// The vertices whose core could still beat a clique of `size`.
+Bits eligibleVertices(const std::vector<int>& core, size_t size) {
+  Bits eligible((core.size() + 63) / 64, 0);
+  for (int u = 0; u < static_cast<int>(core.size()); ++u) {
+    if (core[u] + 1 > static_cast<int>(size))
+      set(eligible, u);
+    else
+      clear(eligible, u);
+  }
+  return eligible;
+}
+
+struct CliqueSearch {
+  std::vector<int> clique;
+  bool exact = true;  // false: the branch budget ran out
+};
+
+// The exact search, started from the clique `best`: from each vertex, the cliques among its
+// neighbours after it in degeneracy order (a clique is found from its vertex that comes first).
+CliqueSearch branchAndBound(const std::vector<Bits>& adj, const Degeneracy& degeneracy, std::vector<int> best,
+                            int64_t max_branches) {
+  const std::vector<int>& order = degeneracy.order;
+  const std::vector<int>& core = degeneracy.core;
+  const int n = static_cast<int>(order.size());
+  const size_t words = (n + 63) / 64;
   Bits later(words, 0);     // vertices after v in degeneracy order (visited before it below)
   Bits eligible(words, 0);  // vertices whose core could still beat the best
   size_t eligible_for = 0;
   SubSearch s(adj);
   int64_t branches = 0;
   // Vertices with the largest cores hold the largest cliques: visit them first to raise the bound.
-  // A clique is found from its vertex that comes first in degeneracy order.
   for (int oi = n - 1; oi >= 0; --oi) {
     const int v = order[oi];
     if (core[v] + 1 > static_cast<int>(best.size())) {
       if (eligible_for != best.size()) {
         eligible_for = best.size();
-        for (int u = 0; u < n; ++u) {
-          if (core[u] + 1 > static_cast<int>(best.size()))
-            set(eligible, u);
-          else
-            clear(eligible, u);
-        }
+        eligible = eligibleVertices(core, best.size());
       }
       Bits P(words);
       for (size_t w = 0; w < words; ++w) P[w] = adj[v][w] & later[w] & eligible[w];
@@ -182,7 +210,7 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
         s.current.clear();
         s.best.assign(best.size() - 1, -1);  // must beat best.size() including v
         s.branches = 0;
-        s.budget = options.max_branches - branches;
+        s.budget = max_branches - branches;
         s.expand(P);
         branches += s.branches;
         if (s.best.size() + 1 > best.size() && std::find(s.best.begin(), s.best.end(), -1) == s.best.end()) {
@@ -190,16 +218,25 @@ std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& optio
           best.push_back(v);
           best.insert(best.end(), s.best.begin(), s.best.end());
         }
-        if (s.out_of_budget) {
-          if (exact) *exact = false;
-          break;
-        }
+        if (s.out_of_budget) return {best, false};
       }
     }
     set(later, v);
   }
-  std::sort(best.begin(), best.end());
-  return best;
+  return {best, true};
+}
+
+}  // namespace
+
+std::vector<int> maximumClique(const Graph& graph, const MaxCliqueOptions& options, bool* exact) {
+  if (exact) *exact = true;
+  if (graph.size() == 0) return {};
+  const Degeneracy degeneracy = degeneracyOrder(graph);
+  CliqueSearch search = branchAndBound(adjacencyBits(graph), degeneracy,
+                                       greedyClique(graph, degeneracy.order, degeneracy.core), options.max_branches);
+  if (exact) *exact = search.exact;
+  std::sort(search.clique.begin(), search.clique.end());
+  return search.clique;
 }
 
 Graph consistencyGraph(const Points& source, const Points& target, const Correspondences& matches, double noise_bound) {

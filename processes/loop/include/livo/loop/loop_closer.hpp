@@ -339,6 +339,44 @@ class LoopCloser {
     mutable std::optional<CoarseFeatures> coarse_;
     mutable std::optional<GicpCloud> fine_;
   };
+  /// The keyframe being added: what the closer keeps of it, its cloud (float, as keyframe_t carries
+  /// it: what later derivations see is what this one sees) and its features once derived.
+  struct Arrival {
+    Keyframe kf;
+    FloatCloud cloud;
+    std::shared_ptr<const Features> features;  // derived only when a registration might be tried
+  };
+  /// The keyframe as the closer keeps it, its pose taken back to the raw odometry frame of its epoch.
+  Keyframe arrivingKeyframe(const KeyframeInput& input) const;
+  /// A chain that starts at graph node `node` (no loop part).
+  static Chain chainFrom(const Keyframe& node);
+  /// The odometry's step to the arriving keyframe (and its covariance, if the odometry gave one)
+  /// moves the chain on.
+  void extendChain(const Pose3& step, const std::optional<Mat6>& step_covariance);
+  /// Whether the arriving keyframe has keypoints: derives its features the first time, and notes the
+  /// answer in it and in its node if it is one.
+  bool hasKeypoints(Arrival& cur);
+  /// Places a keyframe that continues its epoch: it joins the chain's node or a near older node, or
+  /// becomes a node of its own. Returns whether to go on to the loop search (it became a node and
+  /// no registration was tried for it).
+  bool placeOnChain(Arrival& cur, AddResult& result);
+  /// The nearest older node with keypoints within merge_distance of the odometry's estimate of
+  /// the arriving keyframe, if the keyframe has keypoints.
+  std::optional<int64_t> nodeToJoin(Arrival& cur, const Pose3& estimate);
+  /// Registers the arriving keyframe (graph pose W_T_from) against node to_id: the loop if the
+  /// registration verifies it and the consistency check keeps it (the attempt and any refusal are
+  /// noted in result and the closer's counts). `merged`: the keyframe would join the node.
+  std::optional<AcceptedLoop> verifiedLoop(const Arrival& cur, int64_t to_id, bool merged, const Pose3& W_T_from,
+                                           AddResult& result);
+  /// The arriving keyframe joins graph node `node` through `loop`; the graph gets the edge from
+  /// the chain's node (T_chain_kf: the keyframe in its frame) to `node`, and the chain starts there.
+  void joinNode(const Arrival& cur, int64_t node, const Pose3& T_chain_kf, AcceptedLoop loop, AddResult& result);
+  /// The arriving keyframe as a node of its own at `estimate`, with the chain's measurement
+  /// T_node_kf from the chain's node; the chain starts at it.
+  void addChainNode(const Arrival& cur, const Pose3& T_node_kf, const Pose3& estimate);
+  /// The loop search of a new node: the older nodes near it with keypoints, nearest first,
+  /// registered until one gives a loop that enters the graph.
+  void searchLoops(Arrival& cur, AddResult& result);
   const Placement& placement(int64_t id) const;  // throws std::out_of_range for an unknown id
   /// Graph nodes of the keyframe's epoch older than exclude_recent_s within `radius` of p, nearest
   /// first, whether they have keypoints or not (that may take deriving their features).
@@ -353,6 +391,9 @@ class LoopCloser {
   /// The chain's raw odometry part (start to `to`): the composed increments' covariance if every
   /// increment had one (odometry_covariance_from_filter), else the drift model over the path.
   Mat6 chainOdometryCovariance(const Keyframe& to) const;
+  /// The drift model's information of the chain's raw odometry part (start to `to`): the
+  /// increment's from the absolute covariances, floored by the drift model over the path.
+  Mat6 chainDriftInformation(const Keyframe& to) const;
   /// The increment `step` from the newest keyframe to kf: kf's cumulative covariance from the
   /// newest one's, and the increment's covariance if the input gave a usable one (else nullopt;
   /// the drift model stands in for the cumulative sum).
