@@ -791,15 +791,69 @@ size_t OccupancyMap::leafCount() const {
   return n;
 }
 
-// The one octree the tiles make, in octomap's full (.ot) or binary (.bt) format, streamed: first
-// every tile's root and subtree size (the header needs the node count), then the levels above the
-// tiles, each tile's subtree in its place. A tile on disk is not decoded: what the file needs of it
-// was written beside it when it went there.
-bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_only) const {
-  refreshResident();
-  const int depth = kTreeDepth - tile_bits_;  // of the tiles' roots
+// The tiles' summaries in the tree's depth-first order, and the levels above them: node (d, range
+// of tiles), whose child i holds the tiles whose code at level d is i.
+struct OccupancyMap::TileLevels {
+  std::vector<TileSummary> tiles;  // by morton code
+  int depth = 0;                   // of the tiles' roots
+
+  unsigned childCode(size_t tile, int d) const { return unsigned(tiles[tile].morton >> (3 * (depth - 1 - d))) & 7u; }
+  // the ranges of tiles of the children of node (d, [lo, hi)); empty ranges for the absent ones
+  std::array<std::pair<size_t, size_t>, 8> children(size_t lo, size_t hi, int d) const {
+    std::array<std::pair<size_t, size_t>, 8> out;
+    out.fill({0, 0});
+    for (size_t a = lo; a < hi;) {
+      size_t b = a;
+      while (b < hi && childCode(b, d) == childCode(a, d)) ++b;
+      out[childCode(a, d)] = {a, b};
+      a = b;
+    }
+    return out;
+  }
+  // value and colour of a node above the tiles as octomap's updateInnerOccupancy makes them
+  // (maximum child log-odds; the integer mean of the children's colours that are set, else white),
+  // and the nodes of its subtree in the full format
+  struct Inner {
+    float log_odds = 0.f;
+    std::array<uint8_t, 3> rgb{{255, 255, 255}};
+    uint64_t nodes = 0;
+  };
+  Inner inner(size_t lo, size_t hi, int d) const {
+    if (d == depth) return Inner{tiles[lo].log_odds, tiles[lo].rgb, tiles[lo].nodes};
+    Inner me;
+    me.nodes = 1;
+    me.log_odds = -std::numeric_limits<float>::max();
+    int sum[3] = {0, 0, 0}, coloured = 0;
+    for (const auto& [a, b] : children(lo, hi, d)) {
+      if (a == b) continue;
+      const Inner c = inner(a, b, d + 1);
+      me.nodes += c.nodes;
+      me.log_odds = std::max(me.log_odds, c.log_odds);
+      if (!(c.rgb[0] == 255 && c.rgb[1] == 255 && c.rgb[2] == 255)) {
+        for (int k = 0; k < 3; ++k) sum[k] += c.rgb[k];
+        ++coloured;
+      }
+    }
+    if (coloured > 0)
+      for (int k = 0; k < 3; ++k) me.rgb[k] = static_cast<uint8_t>(sum[k] / coloured);
+    return me;
+  }
+  // the nodes of the subtree of node (d, [lo, hi)) in the binary format: the levels above the tiles
+  // are inner nodes (one per distinct prefix); tiles' roots that are leaves count one node each
+  // (their BinaryNode says so)
+  uint64_t binaryNodes(size_t lo, size_t hi, int d) const {
+    if (d == depth) return tiles[lo].nodes;
+    uint64_t n = 1;
+    for (const auto& [a, b] : children(lo, hi, d))
+      if (a != b) n += binaryNodes(a, b, d + 1);
+    return n;
+  }
+};
+
+OccupancyMap::TileLevels OccupancyMap::tileLevels(Format format, bool resident_only) const {
+  TileLevels levels;
+  levels.depth = kTreeDepth - tile_bits_;
   const bool binary = format == Format::kBinary;
-  std::vector<TileSummary> tiles;
   for (const auto& [index, tile] : tiles_) {
     if (resident_only && tile->spilled) continue;
     TileSummary s =
@@ -809,122 +863,82 @@ bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_onl
     // depth-first order: at every level the child index (x bit 1, y bit 2, z bit 4)
     const uint64_t x = index >> 32, y = (index >> 16) & 0xFFFF, z = index & 0xFFFF;
     s.morton = 0;
-    for (int d = depth - 1; d >= 0; --d)
+    for (int d = levels.depth - 1; d >= 0; --d)
       s.morton = (s.morton << 3) | (((x >> d) & 1) | (((y >> d) & 1) << 1) | (((z >> d) & 1) << 2));
-    tiles.push_back(s);
+    levels.tiles.push_back(s);
   }
-  std::sort(tiles.begin(), tiles.end(), [](const TileSummary& a, const TileSummary& b) { return a.morton < b.morton; });
+  std::sort(levels.tiles.begin(), levels.tiles.end(),
+            [](const TileSummary& a, const TileSummary& b) { return a.morton < b.morton; });
+  return levels;
+}
 
-  // the levels above the tiles: node (d, range of tiles); child i holds the tiles whose code at
-  // level d is i
-  auto childCode = [&](const TileSummary& t, int d) { return unsigned(t.morton >> (3 * (depth - 1 - d))) & 7u; };
-  struct Synth {
-    float log_odds = 0.f;
-    std::array<uint8_t, 3> rgb{{255, 255, 255}};
-    uint64_t nodes = 0;
-  };
-  // value and colour as octomap's updateInnerOccupancy makes them (maximum child log-odds; the
-  // integer mean of the children's colours that are set, else white)
-  std::function<Synth(size_t, size_t, int)> synth = [&](size_t lo, size_t hi, int d) -> Synth {
-    if (d == depth) return Synth{tiles[lo].log_odds, tiles[lo].rgb, tiles[lo].nodes};
-    Synth me;
-    me.nodes = 1;
-    me.log_odds = -std::numeric_limits<float>::max();
-    int sum[3] = {0, 0, 0}, coloured = 0;
-    for (size_t a = lo; a < hi;) {
-      size_t b = a;
-      while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
-      const Synth c = synth(a, b, d + 1);
-      me.nodes += c.nodes;
-      me.log_odds = std::max(me.log_odds, c.log_odds);
-      if (!(c.rgb[0] == 255 && c.rgb[1] == 255 && c.rgb[2] == 255)) {
-        for (int k = 0; k < 3; ++k) sum[k] += c.rgb[k];
-        ++coloured;
-      }
-      a = b;
-    }
-    if (coloured > 0)
-      for (int k = 0; k < 3; ++k) me.rgb[k] = static_cast<uint8_t>(sum[k] / coloured);
-    return me;
-  };
-  auto tilePayload = [&](const TileSummary& s) {
-    const Tile& tile = *tiles_.at(s.index);
-    if (tile.spilled) {  // as written when it went to disk
-      std::vector<uint8_t> bytes;
-      spill_->read(binary ? tile.binary : tile.record, &bytes);
-      const size_t skip = binary ? 0 : tile.full_offset;
-      out.write(reinterpret_cast<const char*>(bytes.data()) + skip, static_cast<std::streamsize>(bytes.size() - skip));
-      return;
-    }
-    std::string bytes;
-    summarize(*tile.tree, format, &bytes);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  };
-  std::function<void(size_t, size_t, int)> write = [&](size_t lo, size_t hi, int d) {
-    if (d == depth) {
-      tilePayload(tiles[lo]);
-      return;
-    }
-    std::vector<std::pair<size_t, size_t>> children(8, {0, 0});
-    for (size_t a = lo; a < hi;) {
-      size_t b = a;
-      while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
-      children[childCode(tiles[a], d)] = {a, b};
-      a = b;
-    }
-    if (binary) {
-      uint8_t codes[2] = {0, 0};
-      for (unsigned i = 0; i < 8; ++i) {
-        const auto [a, b] = children[i];
-        if (a == b) continue;
-        BinaryNode c;  // a level above the tiles is inner; a tile's root may be a leaf
-        if (d + 1 == depth) c.leaf = tiles[a].leaf, c.occupied = tiles[a].occupied;
-        putChildCode(codes, i, c);
-      }
-      out.write(reinterpret_cast<const char*>(codes), 2);
-      for (unsigned i = 0; i < 8; ++i) {
-        const auto [a, b] = children[i];
-        if (a == b || (d + 1 == depth && tiles[a].leaf)) continue;
-        write(a, b, d + 1);
-      }
-      return;
-    }
-    const Synth me = synth(lo, hi, d);
-    out.write(reinterpret_cast<const char*>(&me.log_odds), sizeof(float));
-    if (options_.colour) out.write(reinterpret_cast<const char*>(me.rgb.data()), 3);
-    uint8_t exists = 0;
-    for (unsigned i = 0; i < 8; ++i)
-      if (children[i].first != children[i].second) exists |= uint8_t(1u << i);
-    out.write(reinterpret_cast<const char*>(&exists), 1);
-    for (unsigned i = 0; i < 8; ++i)
-      if (children[i].first != children[i].second) write(children[i].first, children[i].second, d + 1);
-  };
+void OccupancyMap::writeTilePayload(std::ostream& out, const TileSummary& s, Format format) const {
+  const bool binary = format == Format::kBinary;
+  const Tile& tile = *tiles_.at(s.index);
+  if (tile.spilled) {  // as written when it went to disk
+    std::vector<uint8_t> bytes;
+    spill_->read(binary ? tile.binary : tile.record, &bytes);
+    const size_t skip = binary ? 0 : tile.full_offset;
+    out.write(reinterpret_cast<const char*>(bytes.data()) + skip, static_cast<std::streamsize>(bytes.size() - skip));
+    return;
+  }
+  std::string bytes;
+  summarize(*tile.tree, format, &bytes);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
 
-  if (tiles.empty()) {
+void OccupancyMap::writeLevel(std::ostream& out, const TileLevels& levels, size_t lo, size_t hi, int d,
+                              Format format) const {
+  if (d == levels.depth) {
+    writeTilePayload(out, levels.tiles[lo], format);
+    return;
+  }
+  const std::array<std::pair<size_t, size_t>, 8> children = levels.children(lo, hi, d);
+  if (format == Format::kBinary) {
+    uint8_t codes[2] = {0, 0};
+    for (unsigned i = 0; i < 8; ++i) {
+      const auto [a, b] = children[i];
+      if (a == b) continue;
+      BinaryNode c;  // a level above the tiles is inner; a tile's root may be a leaf
+      if (d + 1 == levels.depth) c.leaf = levels.tiles[a].leaf, c.occupied = levels.tiles[a].occupied;
+      putChildCode(codes, i, c);
+    }
+    out.write(reinterpret_cast<const char*>(codes), 2);
+    for (unsigned i = 0; i < 8; ++i) {
+      const auto [a, b] = children[i];
+      if (a == b || (d + 1 == levels.depth && levels.tiles[a].leaf)) continue;
+      writeLevel(out, levels, a, b, d + 1, format);
+    }
+    return;
+  }
+  const TileLevels::Inner me = levels.inner(lo, hi, d);
+  out.write(reinterpret_cast<const char*>(&me.log_odds), sizeof(float));
+  if (options_.colour) out.write(reinterpret_cast<const char*>(me.rgb.data()), 3);
+  uint8_t exists = 0;
+  for (unsigned i = 0; i < 8; ++i)
+    if (children[i].first != children[i].second) exists |= uint8_t(1u << i);
+  out.write(reinterpret_cast<const char*>(&exists), 1);
+  for (unsigned i = 0; i < 8; ++i)
+    if (children[i].first != children[i].second)
+      writeLevel(out, levels, children[i].first, children[i].second, d + 1, format);
+}
+
+// The one octree the tiles make, in octomap's full (.ot) or binary (.bt) format, streamed: first
+// every tile's root and subtree size (the header needs the node count), then the levels above the
+// tiles, each tile's subtree in its place. A tile on disk is not decoded: what the file needs of it
+// was written beside it when it went there.
+bool OccupancyMap::writeTree(std::ostream& out, Format format, bool resident_only) const {
+  refreshResident();
+  const bool binary = format == Format::kBinary;
+  const TileLevels levels = tileLevels(format, resident_only);
+  if (levels.tiles.empty()) {
     out << header(options_.colour, options_.resolution, binary, 0);
     return bool(out);
   }
-  uint64_t nodes = 0;
-  if (binary) {
-    // the levels above the tiles are inner nodes (one per distinct prefix); tiles' roots that are
-    // leaves count one node each (their BinaryNode says so)
-    std::function<uint64_t(size_t, size_t, int)> count = [&](size_t lo, size_t hi, int d) -> uint64_t {
-      if (d == depth) return tiles[lo].nodes;
-      uint64_t n = 1;
-      for (size_t a = lo; a < hi;) {
-        size_t b = a;
-        while (b < hi && childCode(tiles[b], d) == childCode(tiles[a], d)) ++b;
-        n += count(a, b, d + 1);
-        a = b;
-      }
-      return n;
-    };
-    nodes = count(0, tiles.size(), 0);
-  } else {
-    nodes = synth(0, tiles.size(), 0).nodes;
-  }
+  const size_t n = levels.tiles.size();
+  const uint64_t nodes = binary ? levels.binaryNodes(0, n, 0) : levels.inner(0, n, 0).nodes;
   out << header(options_.colour, options_.resolution, binary, nodes);
-  write(0, tiles.size(), 0);
+  writeLevel(out, levels, 0, n, 0, format);
   return bool(out);
 }
 

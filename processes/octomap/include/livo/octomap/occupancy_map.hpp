@@ -101,6 +101,13 @@ class OccupancyMap {
   /// What the file needs of a tile: its root's data and subtree size, and (payload) its part of
   /// the file in `format`.
   TileSummary summarize(const ::octomap::AbstractOccupancyOcTree& tree, Format format, std::string* payload) const;
+  /// The tiles to write (all, or the resident ones) summarized in `format`, in the tree's order.
+  struct TileLevels;
+  TileLevels tileLevels(Format format, bool resident_only) const;
+  /// A tile's part of the file in `format`.
+  void writeTilePayload(std::ostream& out, const TileSummary& s, Format format) const;
+  /// Node (d, tiles [lo, hi)) of the levels above the tiles and its subtree, the tiles' parts in place.
+  void writeLevel(std::ostream& out, const TileLevels& levels, size_t lo, size_t hi, int d, Format format) const;
   bool writeTree(std::ostream& out, Format format, bool resident_only) const;
 
   OctomapOptions options_;
