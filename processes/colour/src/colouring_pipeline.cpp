@@ -193,72 +193,90 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
   ++stats_.images;
   const Pose3 T_W_C = T_W_I * camera_.rig().T_I_C;
   const Pose3 T_C_W = T_W_C.inverse();
-  const int64_t t0 = image.utime - windowUs(), t1 = image.utime + windowUs();
-
-  // the map points measured within the window, each once (in the order first measured), then
-  // projected; positions are read ahead (a map point is some 40 bytes anywhere in the map: the
-  // read, not the arithmetic, is what a point costs)
-  window_ids_.clear();
-  // a bit per map point, cleared per image: a few kB, so the test stays in the first-level cache
-  // (a stamp per point, as before, is 4 bytes a point and missed it)
-  window_seen_.assign((map_.size() + 63) / 64, 0);
-  // without branches: whether a point is taken is as good as random (a window cuts through its
-  // scans, and most points were measured by the scans before too)
-  size_t taken = 0;
-  auto gather = [&](const ActiveScan& scan, auto in_window) {
-    for (const auto& [id, t] : scan.points) {
-      uint64_t& word = window_seen_[id >> 6];
-      const uint64_t bit = uint64_t{1} << (id & 63);
-      const bool take = in_window(t) & !(word & bit);
-      word |= take ? bit : 0;
-      window_ids_[taken] = id;
-      taken += take;
-    }
-  };
-  for (const ActiveScan& scan : active_) {
-    if (scan.t_max < t0 || scan.t_min > t1) continue;
-    window_ids_.resize(taken + scan.points.size());
-    // most of the window's scans lie in it whole: their points need no time test
-    if (scan.t_min >= t0 && scan.t_max <= t1)
-      gather(scan, [](int64_t) { return true; });
-    else
-      gather(scan, [t0, t1](int64_t t) { return (t >= t0) & (t <= t1); });
-  }
-  window_ids_.resize(taken);
-  candidates_.clear();
-  // each point's address is found once (a deque's indexing is no single add), for the read-ahead,
-  // and kept in a ring until its turn
-  const MapPoint* ahead[kReadAhead];
-  for (size_t i = 0; i < std::min(kReadAhead, window_ids_.size()); ++i) ahead[i] = &map_.point(window_ids_[i]);
-  for (size_t i = 0; i < window_ids_.size(); ++i) {
-    const MapPoint& mp = *ahead[i % kReadAhead];
-    if (i + kReadAhead < window_ids_.size()) {
-      ahead[i % kReadAhead] = &map_.point(window_ids_[i + kReadAhead]);
-      __builtin_prefetch(ahead[i % kReadAhead]);
-    }
-    const uint32_t id = window_ids_[i];
-    const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
-    if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
-    Eigen::Vector2d px;
-    if (!camera_.project(p_C, &px, 0.0)) continue;
-    candidates_.push_back({id, px, p_C.z()});
-  }
+  windowPoints(image.utime - windowUs(), image.utime + windowUs(), &window_seen_, &window_ids_);
+  projectedPoints(window_ids_, T_C_W, &candidates_);
   const std::vector<Candidate>& candidates = candidates_;
   stats_.projected += static_cast<int64_t>(candidates.size());
 
   depth_.clear();
   depth_.splatNearest(candidates, [](const Candidate& c) { return std::make_pair(c.pixel, c.z); });
 
-  double exposure_scale = 1.0;
-  if (options_.use_exposure_time && image.exposure_time > 0) {
-    if (reference_exposure_ <= 0.0) reference_exposure_ = image.exposure_time;
-    exposure_scale = reference_exposure_ / image.exposure_time;
+  const double exposure_scale = exposureScale(image);
+  visibleSamples(image, candidates, exposure_scale, &sampled_ids_, &observed_);
+  const double gain = options_.estimate_gain ? imageGain(sampled_ids_, observed_, &gain_observed_, &gain_mapped_) : 1.0;
+  stats_.last_gain = gain;
+  accumulateSamples(image, T_W_C, candidates, sampled_ids_, observed_, gain);
+  return true;
+}
+
+void ColouringPipeline::windowPoints(int64_t t0, int64_t t1, std::vector<uint64_t>* seen,
+                                     std::vector<uint32_t>* ids) const {
+  // the map points measured within the window, each once (in the order first measured)
+  std::vector<uint32_t>& window_ids = *ids;
+  window_ids.clear();
+  // a bit per map point, cleared per image: a few kB, so the test stays in the first-level cache
+  // (a stamp per point, as before, is 4 bytes a point and missed it)
+  seen->assign((map_.size() + 63) / 64, 0);
+  // without branches: whether a point is taken is as good as random (a window cuts through its
+  // scans, and most points were measured by the scans before too)
+  size_t taken = 0;
+  auto gather = [&](const ActiveScan& scan, auto in_window) {
+    for (const auto& [id, t] : scan.points) {
+      uint64_t& word = (*seen)[id >> 6];
+      const uint64_t bit = uint64_t{1} << (id & 63);
+      const bool take = in_window(t) & !(word & bit);
+      word |= take ? bit : 0;
+      window_ids[taken] = id;
+      taken += take;
+    }
+  };
+  for (const ActiveScan& scan : active_) {
+    if (scan.t_max < t0 || scan.t_min > t1) continue;
+    window_ids.resize(taken + scan.points.size());
+    // most of the window's scans lie in it whole: their points need no time test
+    if (scan.t_min >= t0 && scan.t_max <= t1)
+      gather(scan, [](int64_t) { return true; });
+    else
+      gather(scan, [t0, t1](int64_t t) { return (t >= t0) & (t <= t1); });
   }
+  window_ids.resize(taken);
+}
+
+void ColouringPipeline::projectedPoints(const std::vector<uint32_t>& ids, const Pose3& T_C_W,
+                                        std::vector<Candidate>* candidates) const {
+  // positions are read ahead (a map point is some 40 bytes anywhere in the map: the read, not the
+  // arithmetic, is what a point costs); each point's address is found once (a deque's indexing is
+  // no single add), for the read-ahead, and kept in a ring until its turn
+  candidates->clear();
+  const MapPoint* ahead[kReadAhead];
+  for (size_t i = 0; i < std::min(kReadAhead, ids.size()); ++i) ahead[i] = &map_.point(ids[i]);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    const MapPoint& mp = *ahead[i % kReadAhead];
+    if (i + kReadAhead < ids.size()) {
+      ahead[i % kReadAhead] = &map_.point(ids[i + kReadAhead]);
+      __builtin_prefetch(ahead[i % kReadAhead]);
+    }
+    const uint32_t id = ids[i];
+    const Eigen::Vector3d p_C = T_C_W * mp.position.cast<double>();
+    if (p_C.z() < options_.min_depth || p_C.z() > options_.max_depth) continue;
+    Eigen::Vector2d px;
+    if (!camera_.project(p_C, &px, 0.0)) continue;
+    candidates->push_back({id, px, p_C.z()});
+  }
+}
+
+double ColouringPipeline::exposureScale(const ColourImage& image) {
+  if (!(options_.use_exposure_time && image.exposure_time > 0)) return 1.0;
+  if (reference_exposure_ <= 0.0) reference_exposure_ = image.exposure_time;
+  return reference_exposure_ / image.exposure_time;
+}
+
+void ColouringPipeline::visibleSamples(const ColourImage& image, const std::vector<Candidate>& candidates,
+                                       double exposure_scale, std::vector<uint32_t>* ids,
+                                       std::vector<Eigen::Vector3f>* observed) {
   const double b = options_.border_px, w = camera_.rig().width - 1 - b, h = camera_.rig().height - 1 - b;
-  std::vector<uint32_t>& ids = sampled_ids_;
-  std::vector<Eigen::Vector3f>& observed = observed_;
-  ids.clear();
-  observed.clear();
+  ids->clear();
+  observed->clear();
   for (const Candidate& c : candidates) {
     if (c.pixel.x() < b || c.pixel.y() < b || c.pixel.x() > w || c.pixel.y() > h) continue;
     if (!depth_.visible(c.pixel, c.z)) {
@@ -266,29 +284,35 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
       continue;
     }
     const double scale = exposure_scale / camera_.vignette(c.pixel, options_.vignetting);
-    ids.push_back(c.id);
-    observed.push_back(image.sample(c.pixel) * static_cast<float>(scale));
+    ids->push_back(c.id);
+    observed->push_back(image.sample(c.pixel) * static_cast<float>(scale));
   }
-  double gain = 1.0;
-  if (options_.estimate_gain) {
-    gain_observed_.clear();
-    gain_mapped_.clear();
-    for (size_t i = 0; i < ids.size(); ++i) {
-      if (i + kReadAhead < ids.size()) __builtin_prefetch(&map_.point(ids[i + kReadAhead]));
-      const MapPoint& mp = map_.point(ids[i]);
-      if (mp.count >= 2) {
-        gain_observed_.push_back(observed[i]);
-        gain_mapped_.push_back(mp.colour);
-      }
-    }
-    const GainEstimate g =
-        estimateGain(gain_observed_, gain_mapped_, options_.gain_min_pairs, options_.gain_min, options_.gain_max);
-    if (g.valid) {
-      gain = g.gain;
-      ++stats_.gain_estimates;
+}
+
+double ColouringPipeline::imageGain(const std::vector<uint32_t>& ids, const std::vector<Eigen::Vector3f>& observed,
+                                    std::vector<Eigen::Vector3f>* gain_observed,
+                                    std::vector<Eigen::Vector3f>* gain_mapped) {
+  // the samples of points the map has coloured at least twice, against the map's colour
+  gain_observed->clear();
+  gain_mapped->clear();
+  for (size_t i = 0; i < ids.size(); ++i) {
+    if (i + kReadAhead < ids.size()) __builtin_prefetch(&map_.point(ids[i + kReadAhead]));
+    const MapPoint& mp = map_.point(ids[i]);
+    if (mp.count >= 2) {
+      gain_observed->push_back(observed[i]);
+      gain_mapped->push_back(mp.colour);
     }
   }
-  stats_.last_gain = gain;
+  const GainEstimate g =
+      estimateGain(*gain_observed, *gain_mapped, options_.gain_min_pairs, options_.gain_min, options_.gain_max);
+  if (!g.valid) return 1.0;
+  ++stats_.gain_estimates;
+  return g.gain;
+}
+
+void ColouringPipeline::accumulateSamples(const ColourImage& image, const Pose3& T_W_C,
+                                          const std::vector<Candidate>& candidates, const std::vector<uint32_t>& ids,
+                                          const std::vector<Eigen::Vector3f>& observed, double gain) {
   AccumulationOptions acc{options_.outlier_threshold, options_.outlier_min_count, options_.max_count};
   size_t k = 0;
   for (const Candidate& c : candidates) {
@@ -304,7 +328,6 @@ bool ColouringPipeline::processImage(const ColourImage& image) {
     markRecoloured(c.id);
     if (observer_) observer_({c.id, image.utime, c.pixel, T_W_C.translation(), col});
   }
-  return true;
 }
 
 void ColouringPipeline::pruneUncolourable() {

@@ -99,7 +99,27 @@ class ColouringPipeline {
   /// scan pose; see ColourOptions::view_margin_deg).
   ViewCone viewCone(const RegisteredScanView& scan);
   void processReady(bool flushing);
+  /// Colours the map points the image sees unoccluded (false: no pose at its time yet), in stages:
+  struct Candidate;
   bool processImage(const ColourImage& image);
+  /// The map points measured in [t0, t1], each once, in the order first measured (`seen`: a bit
+  /// per map point, working storage).
+  void windowPoints(int64_t t0, int64_t t1, std::vector<uint64_t>* seen, std::vector<uint32_t>* ids) const;
+  /// Those of `ids` in front of the camera within [min_depth, max_depth] that project into the image.
+  void projectedPoints(const std::vector<uint32_t>& ids, const Pose3& T_C_W, std::vector<Candidate>* candidates) const;
+  /// The factor that takes the image's brightness to the reference exposure (1 without exposure times).
+  double exposureScale(const ColourImage& image);
+  /// The candidates inside the border that the depth buffer shows unoccluded: their ids and colour
+  /// samples (exposure and vignetting taken out).
+  void visibleSamples(const ColourImage& image, const std::vector<Candidate>& candidates, double exposure_scale,
+                      std::vector<uint32_t>* ids, std::vector<Eigen::Vector3f>* observed);
+  /// The image's gain against the map's colours (1 where too few points have them); `gain_observed`
+  /// and `gain_mapped` are working storage.
+  double imageGain(const std::vector<uint32_t>& ids, const std::vector<Eigen::Vector3f>& observed,
+                   std::vector<Eigen::Vector3f>* gain_observed, std::vector<Eigen::Vector3f>* gain_mapped);
+  /// The samples, divided by the gain, into the map's colours (outliers refused).
+  void accumulateSamples(const ColourImage& image, const Pose3& T_W_C, const std::vector<Candidate>& candidates,
+                         const std::vector<uint32_t>& ids, const std::vector<Eigen::Vector3f>& observed, double gain);
   int64_t windowUs() const { return static_cast<int64_t>(options_.max_time_difference * 1e6); }
   /// Forgets ids the map freed (tiles written to disk) and adds the points that came back moved.
   void afterTileChanges(std::vector<uint32_t> freed);
@@ -134,7 +154,7 @@ class ColouringPipeline {
   std::vector<uint32_t> recoloured_;
   // per-image working sets, kept between images: sized ~10^5 points they would otherwise be
   // allocated (fresh pages, page faults) and returned to the system for every image
-  struct Candidate {
+  struct Candidate {  // a map point the image may see
     uint32_t id;
     Eigen::Vector2d pixel;
     double z;
