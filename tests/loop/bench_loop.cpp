@@ -58,16 +58,22 @@ const std::vector<Keyframe>& keyframes() {
   return kfs;
 }
 
+// Times `make` and reports the size of what it makes as counter `name`.
+template <class Make>
+void timeAndCount(benchmark::State& state, const char* name, const Make& make) {
+  size_t n = 0;
+  for (auto _ : state) {
+    const auto made = make();
+    n = made.size();
+    benchmark::DoNotOptimize(made);
+  }
+  state.counters[name] = static_cast<double>(n);
+}
+
 void BM_Features(benchmark::State& state) {
   const auto& kf = keyframes();
   const LoopCloserOptions defaults;
-  size_t n = 0;
-  for (auto _ : state) {
-    const CoarseFeatures f = computeCoarseFeatures(kf[1].levelled, defaults.coarse);
-    n = f.size();
-    benchmark::DoNotOptimize(f);
-  }
-  state.counters["keypoints"] = static_cast<double>(n);
+  timeAndCount(state, "keypoints", [&] { return computeCoarseFeatures(kf[1].levelled, defaults.coarse); });
   state.counters["raw_points"] = static_cast<double>(kf[1].levelled.size());
 }
 BENCHMARK(BM_Features)->Name("Features/Coarse")->Unit(benchmark::kMillisecond);
@@ -92,13 +98,7 @@ void BM_FeaturesDescribe(benchmark::State& state) {
   const auto& kf = keyframes();
   const LoopCloserOptions defaults;
   const CoarseKeypoints k = detectCoarseKeypoints(kf[1].levelled, defaults.coarse);
-  size_t n = 0;
-  for (auto _ : state) {
-    const CoarseFeatures f = describeCoarseKeypoints(k, defaults.coarse);
-    n = f.size();
-    benchmark::DoNotOptimize(f);
-  }
-  state.counters["keypoints"] = static_cast<double>(n);
+  timeAndCount(state, "keypoints", [&] { return describeCoarseKeypoints(k, defaults.coarse); });
 }
 BENCHMARK(BM_FeaturesDescribe)->Name("Features/Describe")->Unit(benchmark::kMillisecond);
 
@@ -129,13 +129,8 @@ BENCHMARK(BM_CoarseCached)->Name("Coarse/Cached")->Unit(benchmark::kMillisecond)
 void BM_Matching(benchmark::State& state) {
   const auto& kf = keyframes();
   const LoopRegistrationOptions opt;
-  size_t n = 0;
-  for (auto _ : state) {
-    const Correspondences m = matchDescriptors(kf[1].coarse.descriptors, kf[0].coarse.descriptors, opt.matching);
-    n = m.size();
-    benchmark::DoNotOptimize(m);
-  }
-  state.counters["matches"] = static_cast<double>(n);
+  timeAndCount(state, "matches",
+               [&] { return matchDescriptors(kf[1].coarse.descriptors, kf[0].coarse.descriptors, opt.matching); });
 }
 BENCHMARK(BM_Matching)->Name("Coarse/Matching")->Unit(benchmark::kMillisecond);
 
@@ -226,17 +221,32 @@ struct SquareDrive {
   }
 };
 
+// Times the solve of the graph `build` makes (untimed; it returns the number of loops it added),
+// reporting the loops and the solver's iterations.
+template <class Build>
+void timeSolve(benchmark::State& state, const Build& build) {
+  int iterations = 0, loops = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    PoseGraph g;
+    loops = build(g);
+    state.ResumeTiming();
+    const PoseGraphSummary s = g.optimize();
+    iterations = s.iterations;
+    benchmark::DoNotOptimize(s);
+  }
+  state.counters["loops"] = loops;
+  state.counters["solver_iterations"] = iterations;
+}
+
 // The node's schedule (the paper's): the graph is optimised whenever a loop is added, each solve
 // warm-started from the previous one. Timed: the solve after the loop at the 2,000th keyframe, on a
 // graph last optimised at the previous loop, 49 keyframes earlier.
 void BM_PoseGraphIncremental(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const SquareDrive drive(n);
-  int iterations = 0, loops = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    PoseGraph g;
-    loops = 0;
+  timeSolve(state, [&](PoseGraph& g) {
+    int loops = 0;
     for (int i = 0; i < n; ++i) {
       drive.addNode(g, i);
       if (SquareDrive::isLoop(i) || i == n - 1) {
@@ -245,13 +255,8 @@ void BM_PoseGraphIncremental(benchmark::State& state) {
         if (i < n - 1) g.optimize();
       }
     }
-    state.ResumeTiming();
-    const PoseGraphSummary s = g.optimize();
-    iterations = s.iterations;
-    benchmark::DoNotOptimize(s);
-  }
-  state.counters["loops"] = loops;
-  state.counters["solver_iterations"] = iterations;
+    return loops;
+  });
 }
 BENCHMARK(BM_PoseGraphIncremental)
     ->Name("PoseGraph/Incremental")
@@ -263,11 +268,8 @@ BENCHMARK(BM_PoseGraphIncremental)
 void BM_PoseGraphBatch(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const SquareDrive drive(n);
-  int iterations = 0, loops = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    PoseGraph g;
-    loops = 0;
+  timeSolve(state, [&](PoseGraph& g) {
+    int loops = 0;
     for (int i = 0; i < n; ++i) g.addNode(i, drive.odom[i]);
     for (int i = 1; i < n; ++i) g.addEdge({i - 1, i, drive.rel[i], drive.odometry_information, false});
     for (int i = 0; i < n; ++i)
@@ -275,13 +277,8 @@ void BM_PoseGraphBatch(benchmark::State& state) {
         drive.addLoop(g, i);
         ++loops;
       }
-    state.ResumeTiming();
-    const PoseGraphSummary s = g.optimize();
-    iterations = s.iterations;
-    benchmark::DoNotOptimize(s);
-  }
-  state.counters["loops"] = loops;
-  state.counters["solver_iterations"] = iterations;
+    return loops;
+  });
 }
 BENCHMARK(BM_PoseGraphBatch)->Name("PoseGraph/Batch")->Arg(2000)->Unit(benchmark::kMillisecond);
 

@@ -55,131 +55,167 @@ enum class Adoption {
                         // arrive after the correction, still in the previous frame)
 };
 
+// The node as the tests run it: quiet, no health messages.
+NodeOptions quietNode(const std::string& name) {
+  NodeOptions no;
+  no.name = name;
+  no.quiet = true;
+  no.health_period_s = 0;
+  return no;
+}
+
 // A loop of 36 keyframes with a yaw bias and a scale error in the odometry, run once more past
-// the start. An adopting odometry publishes its keyframe poses in the corrected frame and says
-// which correction they include (keyframe_t.correction_id).
+// the start.
+struct DriftedLoop {
+  static constexpr int kPerLap = 36, kTotal = kPerLap + 6;
+  std::vector<Pose3> truth, odo;
+};
+
+DriftedLoop driftedLoop() {
+  DriftedLoop d;
+  for (int i = 0; i < DriftedLoop::kTotal; ++i) {
+    const double a = 2 * M_PI * i / DriftedLoop::kPerLap;
+    d.truth.push_back(yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8)));
+  }
+  d.odo.push_back(d.truth[0]);
+  for (int i = 1; i < DriftedLoop::kTotal; ++i) {  // yaw bias and 2 % scale error per step
+    Pose3 rel = d.truth[i - 1].inverse() * d.truth[i];
+    rel.linear() = Eigen::AngleAxisd(0.006, Vec3::UnitZ()).toRotationMatrix() * rel.linear();
+    rel.translation() *= 1.02;
+    d.odo.push_back(d.odo.back() * rel);
+  }
+  return d;
+}
+
+// What the simulated odometry heard: the corrections, each with the keyframe index it arrived after.
+struct Heard {
+  std::optional<loop_correction_t> last;
+  int corrections = 0;
+  int64_t adopted_id = 0;  // the newest correction the odometry adopted
+  std::vector<std::pair<int, loop_correction_t>> arrivals;
+};
+
+// Publishes the drifted loop's keyframes as the odometry would (adopting the corrections it hears
+// as `adoption` says), with bad input on the way, and listens to the corrections.
+Heard publishDriftedLoop(lcm::LCM& lcm, const DriftedLoop& loop, Adoption adoption) {
+  const Points scene = makeScene(41, 0.15);
+  Heard heard;
+  Pose3 adopted = Pose3::Identity();  // the odometry's frame <- its raw frame
+  int index = 0;
+  NodeOptions listener_options = quietNode("listener");
+  listener_options.publish_progress = false;
+  Node listener(lcm, listener_options);
+  listener.subscribe<loop_correction_t>("LOOP_CORRECTION", [&](const loop_correction_t& m) {
+    heard.last = m;
+    ++heard.corrections;
+    heard.arrivals.push_back({index, m});
+  });
+  const int delay = adoption == Adoption::kTwoKeyframesLate ? 2 : 0;
+  std::vector<Pose3> published;
+  for (int i = 0; i < DriftedLoop::kTotal; ++i) {
+    index = i;
+    for (const auto& [after, m] : heard.arrivals)
+      if (adoption != Adoption::kIgnores && m.correction_id > heard.adopted_id && i - 1 - after >= delay) {
+        adopted = poseFrom(m.odometry_to_corrected_position, m.odometry_to_corrected_orientation);
+        heard.adopted_id = m.correction_id;
+      }
+    const Pose3& T = loop.truth[i];
+    const Points cloud =
+        viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
+    published.push_back(adopted * loop.odo[i]);
+    keyframe_t k = makeKeyframe(i, published.back(), cloud);
+    k.correction_id = heard.adopted_id;
+    lcm.publish("KEYFRAME", &k);
+    drain(lcm);
+    if (i == 10) {  // bad input on the way: a NaN pose and a repeated id are refused
+      keyframe_t bad = makeKeyframe(11, loop.odo[i], {});
+      bad.position[0] = std::numeric_limits<double>::quiet_NaN();
+      lcm.publish("KEYFRAME", &bad);
+      keyframe_t repeated = makeKeyframe(5, loop.odo[i], cloud);
+      lcm.publish("KEYFRAME", &repeated);
+      drain(lcm);
+    }
+  }
+  return heard;
+}
+
+// The last correction brings the keyframes back near the truth, and the closer's final poses too;
+// its odometry edges are the raw odometry increments whatever frame the poses came in.
+void expectCorrectedToTruth(const LoopCloser& closer, const DriftedLoop& loop, const Heard& heard) {
+  const std::vector<Pose3>& truth = loop.truth;
+  const std::vector<Pose3>& odo = loop.odo;
+  const int total = DriftedLoop::kTotal;
+  const loop_correction_t& last = *heard.last;
+  const double drift = translationError(odo[total - 1], truth[total - 1]);
+  // The graph's odometry edges are the raw odometry increments whatever frame the poses came in.
+  for (const PoseEdge& e : closer.graph().edges())
+    if (!e.is_loop) {
+      EXPECT_LT(translationError(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
+      EXPECT_LT(rotationErrorDeg(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
+    }
+  double worst = 0.0;
+  for (int i = 0; i < last.num_keyframes; ++i) {
+    const Pose3 corrected = poseFrom(last.position[i].data(), last.orientation[i].data());
+    worst = std::max(worst, translationError(corrected, truth[last.keyframe_id[i]]));
+  }
+  // One loop cannot undo a 2 % scale error exactly: the graph spreads it around the loop.
+  EXPECT_LT(worst, 0.2 * drift) << "drift " << drift;
+  const int n = last.num_keyframes;
+  const Pose3 newest = poseFrom(last.position[n - 1].data(), last.orientation[n - 1].data());
+  const double rotation_drift = rotationErrorDeg(odo[total - 1], truth[total - 1]);
+  EXPECT_LT(translationError(newest, truth[last.keyframe_id[n - 1]]), 0.1 * drift);
+  EXPECT_LT(rotationErrorDeg(newest, truth[last.keyframe_id[n - 1]]), 0.1 * rotation_drift);
+  // The final keyframe trajectory: every keyframe, also those after the last correction.
+  double worst_final = 0.0;
+  closer.forEachPose(
+      [&](int64_t id, const Pose3& pose) { worst_final = std::max(worst_final, translationError(pose, truth[id])); });
+  EXPECT_LT(worst_final, 0.2 * drift);
+  // odometry_to_corrected maps the raw pose of the keyframe that closed the loop onto its optimised one
+  const Pose3 T_Ck_O = poseFrom(last.odometry_to_corrected_position, last.odometry_to_corrected_orientation);
+  EXPECT_LT(translationError(T_Ck_O * odo[last.loop_from_id], closer.pose(last.loop_from_id)), 1e-9);
+  std::printf(
+      "[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
+      "%d corrections\n",
+      drift, worst, worst_final, translationError(newest, truth[last.keyframe_id[n - 1]]),
+      rotationErrorDeg(newest, truth[last.keyframe_id[n - 1]]), heard.corrections);
+}
+
+// An adopting odometry publishes its keyframe poses in the corrected frame and says which
+// correction they include (keyframe_t.correction_id).
 void runDriftedLoop(Adoption adoption) {
   SCOPED_TRACE(adoption == Adoption::kIgnores              ? "odometry ignores corrections"
                : adoption == Adoption::kBeforeNextKeyframe ? "odometry adopts corrections at once"
                                                            : "odometry adopts corrections two keyframes late");
-  const Points scene = makeScene(41, 0.15);
-  const int per_lap = 36, total = per_lap + 6;
-  std::vector<Pose3> truth, odo;
-  for (int i = 0; i < total; ++i) {
-    const double a = 2 * M_PI * i / per_lap;
-    truth.push_back(yawPose(a + M_PI / 2, Vec3(14 * std::cos(a), 14 * std::sin(a), 1.8)));
-  }
-  odo.push_back(truth[0]);
-  for (int i = 1; i < total; ++i) {  // yaw bias and 2 % scale error per step
-    Pose3 rel = truth[i - 1].inverse() * truth[i];
-    rel.linear() = Eigen::AngleAxisd(0.006, Vec3::UnitZ()).toRotationMatrix() * rel.linear();
-    rel.translation() *= 1.02;
-    odo.push_back(odo.back() * rel);
-  }
+  const DriftedLoop loop = driftedLoop();
+  const int total = DriftedLoop::kTotal;
   lcm::LCM lcm("memq://");
-  NodeOptions no;
-  no.name = "loop";
-  no.quiet = true;
-  no.health_period_s = 0;
   LoopNodeOptions lo;
   lo.output_dir = livo_test::tempPath("loop-out");
   // The graph's odometry noise model says how bad this odometry is (2 % of the distance, 0.006 rad
   // per 2.4 m step), else the graph would trust it over the loop.
   lo.core.odometry_translation_per_m = 0.02;
   lo.core.odometry_rotation_per_m = 2.5e-3;
-  LoopNode node(lcm, no, lo);
-  std::optional<loop_correction_t> last;
-  int corrections = 0;
-  Pose3 adopted = Pose3::Identity();  // the odometry's frame <- its raw frame
-  int64_t adopted_id = 0;
-  std::vector<std::pair<int, loop_correction_t>> heard;  // (keyframe index it arrived after, correction)
-  int index = 0;
-  NodeOptions listener_options = no;
-  listener_options.name = "listener";
-  listener_options.publish_progress = false;
-  Node listener(lcm, listener_options);
-  listener.subscribe<loop_correction_t>("LOOP_CORRECTION", [&](const loop_correction_t& m) {
-    last = m;
-    ++corrections;
-    heard.push_back({index, m});
-  });
-  const int delay = adoption == Adoption::kTwoKeyframesLate ? 2 : 0;
-
-  std::vector<Pose3> published;
-  for (int i = 0; i < total; ++i) {
-    index = i;
-    for (const auto& [after, m] : heard)
-      if (adoption != Adoption::kIgnores && m.correction_id > adopted_id && i - 1 - after >= delay) {
-        adopted = poseFrom(m.odometry_to_corrected_position, m.odometry_to_corrected_orientation);
-        adopted_id = m.correction_id;
-      }
-    const Pose3& T = truth[i];
-    const Points cloud =
-        viewFrom(scene, T.translation(), std::atan2(T.linear()(1, 0), T.linear()(0, 0)), 20.0, 0.02, 100 + i);
-    published.push_back(adopted * odo[i]);
-    keyframe_t k = makeKeyframe(i, published.back(), cloud);
-    k.correction_id = adopted_id;
-    lcm.publish("KEYFRAME", &k);
-    drain(lcm);
-    if (i == 10) {  // bad input on the way: a NaN pose and a repeated id are refused
-      keyframe_t bad = makeKeyframe(11, odo[i], {});
-      bad.position[0] = std::numeric_limits<double>::quiet_NaN();
-      lcm.publish("KEYFRAME", &bad);
-      keyframe_t repeated = makeKeyframe(5, odo[i], cloud);
-      lcm.publish("KEYFRAME", &repeated);
-      drain(lcm);
-    }
-  }
+  LoopNode node(lcm, quietNode("loop"), lo);
+  const Heard heard = publishDriftedLoop(lcm, loop, adoption);
   EXPECT_EQ(node.closer().size(), static_cast<size_t>(total));
   for (const AcceptedLoop& l : node.closer().loops())
     std::printf("[loop-node] loop %ld -> %ld: error vs truth %.3f m %.3f deg\n", long(l.from_id), long(l.to_id),
-                translationError(l.T_to_from, truth[l.to_id].inverse() * truth[l.from_id]),
-                rotationErrorDeg(l.T_to_from, truth[l.to_id].inverse() * truth[l.from_id]));
-  ASSERT_GE(corrections, 1);
-  ASSERT_TRUE(last.has_value());
-  ASSERT_GT(last->num_keyframes, per_lap);  // the loop closes on the way past the start
-  const double drift = translationError(odo[total - 1], truth[total - 1]);
-  EXPECT_GT(drift, 3.0);
+                translationError(l.T_to_from, loop.truth[l.to_id].inverse() * loop.truth[l.from_id]),
+                rotationErrorDeg(l.T_to_from, loop.truth[l.to_id].inverse() * loop.truth[l.from_id]));
+  ASSERT_GE(heard.corrections, 1);
+  ASSERT_TRUE(heard.last.has_value());
+  ASSERT_GT(heard.last->num_keyframes, DriftedLoop::kPerLap);  // the loop closes on the way past the start
+  EXPECT_GT(translationError(loop.odo[total - 1], loop.truth[total - 1]), 3.0);
   if (adoption != Adoption::kIgnores) {
-    ASSERT_GT(adopted_id, 0);
-    EXPECT_EQ(last->correction_id, corrections);  // 1, 2, ...
+    ASSERT_GT(heard.adopted_id, 0);
+    EXPECT_EQ(heard.last->correction_id, heard.corrections);  // 1, 2, ...
   }
   if (adoption == Adoption::kTwoKeyframesLate) {  // keyframes in the previous frame came after a correction
     bool stale_after_correction = false;
-    for (size_t c = 0; c < heard.size(); ++c) stale_after_correction |= heard[c].first + 1 < total;
+    for (const auto& [after, m] : heard.arrivals) stale_after_correction |= after + 1 < total;
     EXPECT_TRUE(stale_after_correction);
   }
-  // The graph's odometry edges are the raw odometry increments whatever frame the poses came in.
-  for (const PoseEdge& e : node.closer().graph().edges())
-    if (!e.is_loop) {
-      EXPECT_LT(translationError(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
-      EXPECT_LT(rotationErrorDeg(e.T_from_to, odo[e.from].inverse() * odo[e.to]), 1e-9) << e.from;
-    }
-  double worst = 0.0;
-  for (int i = 0; i < last->num_keyframes; ++i) {
-    const Pose3 corrected = poseFrom(last->position[i].data(), last->orientation[i].data());
-    worst = std::max(worst, translationError(corrected, truth[last->keyframe_id[i]]));
-  }
-  // One loop cannot undo a 2 % scale error exactly: the graph spreads it around the loop.
-  EXPECT_LT(worst, 0.2 * drift) << "drift " << drift;
-  const int n = last->num_keyframes;
-  const Pose3 newest = poseFrom(last->position[n - 1].data(), last->orientation[n - 1].data());
-  const double rotation_drift = rotationErrorDeg(odo[total - 1], truth[total - 1]);
-  EXPECT_LT(translationError(newest, truth[last->keyframe_id[n - 1]]), 0.1 * drift);
-  EXPECT_LT(rotationErrorDeg(newest, truth[last->keyframe_id[n - 1]]), 0.1 * rotation_drift);
-  // The final keyframe trajectory: every keyframe, also those after the last correction.
-  double worst_final = 0.0;
-  node.closer().forEachPose(
-      [&](int64_t id, const Pose3& pose) { worst_final = std::max(worst_final, translationError(pose, truth[id])); });
-  EXPECT_LT(worst_final, 0.2 * drift);
-  // odometry_to_corrected maps the raw pose of the keyframe that closed the loop onto its optimised one
-  const Pose3 T_Ck_O = poseFrom(last->odometry_to_corrected_position, last->odometry_to_corrected_orientation);
-  EXPECT_LT(translationError(T_Ck_O * odo[last->loop_from_id], node.closer().pose(last->loop_from_id)), 1e-9);
-  std::printf(
-      "[loop-node] drift %.2f m, worst corrected keyframe %.3f m (final graph %.3f m), newest %.3f m / %.3f deg, "
-      "%d corrections\n",
-      drift, worst, worst_final, translationError(newest, truth[last->keyframe_id[n - 1]]),
-      rotationErrorDeg(newest, truth[last->keyframe_id[n - 1]]), corrections);
+  expectCorrectedToTruth(node.closer(), loop, heard);
 
   node.writeOutputs();
   EXPECT_TRUE(std::filesystem::exists(lo.output_dir + "/loops.json"));
@@ -204,13 +240,9 @@ TEST(LoopNode, KeyframesPublishedBeforeAdoptionKeepRawOdometryEdges) { runDrifte
 TEST(LoopNode, OdometryResetStartsANewGraphSegment) {
   const Points scene = makeScene(41, 0.15);
   lcm::LCM lcm("memq://");
-  NodeOptions no;
-  no.name = "loop";
-  no.quiet = true;
-  no.health_period_s = 0;
   LoopNodeOptions lo;
   lo.output_dir = livo_test::tempPath("loop-epochs");
-  LoopNode node(lcm, no, lo);
+  LoopNode node(lcm, quietNode("loop"), lo);
   const int total = 30, reset_at = 20;
   std::vector<Pose3> raw;            // as published: each epoch in its own raw frame
   Pose3 origin = Pose3::Identity();  // of the current epoch
@@ -428,11 +460,7 @@ TEST(LoopCloser, KeyframesPassingAgainJoinTheOlderNodes) {
 
 TEST(LoopNode, EmptyAndInconsistentCloudsDoNotCrash) {
   lcm::LCM lcm("memq://");
-  NodeOptions no;
-  no.name = "loop";
-  no.quiet = true;
-  no.health_period_s = 0;
-  LoopNode node(lcm, no, {});
+  LoopNode node(lcm, quietNode("loop"), {});
   keyframe_t empty = makeKeyframe(0, Pose3::Identity(), {});
   lcm.publish("KEYFRAME", &empty);
   keyframe_t nan_points = makeKeyframe(1, Pose3::Identity(), {Vec3(std::nan(""), 0, 0), Vec3(1, 2, 3)});

@@ -675,6 +675,119 @@ TEST(OctomapBuilder, RebuildFromTheQuantisedStoreAgreesWithFullClouds) {
   EXPECT_GE(quantised, 0.95);
 }
 
+namespace {
+// Twelve sweeps into both maps (and colours, with `colour`), each of a quarter of the room,
+// turning, so tiles go idle and come back. Returns the most tiles `tiled` had on disk at once.
+size_t sweepQuartersOfTheRoom(OccupancyMap& tiled, OccupancyMap& single, bool colour) {
+  size_t most_spilled = 0;
+  for (int k = 0; k < 12; ++k) {
+    const Eigen::Vector3d origin(0.3 * std::cos(0.5 * k), 0.3 * std::sin(0.5 * k), 1.2);
+    std::vector<Eigen::Vector3f> sector;
+    for (const Eigen::Vector3f& p : boxRoomHits(origin)) {
+      const double az = std::atan2(p.y() - origin.y(), p.x() - origin.x()) + M_PI;  // 0 .. 2 pi
+      if (std::fmod(az - 1.1 * k + 8 * M_PI, 2 * M_PI) < 0.5 * M_PI) sector.push_back(p);
+    }
+    for (OccupancyMap* m : {&tiled, &single}) {
+      m->setTime(int64_t(k) * 1000000);
+      m->insertRays(sector, origin);
+      m->evictIdle();
+      if (colour) {
+        std::vector<std::array<uint8_t, 3>> rgb;
+        for (size_t i = 0; i < sector.size(); ++i) rgb.push_back({uint8_t(i % 200), uint8_t(k * 20), 7});
+        m->setColours(sector, rgb);
+      }
+    }
+    most_spilled = std::max(most_spilled, tiled.spilledTiles());
+  }
+  return most_spilled;
+}
+
+// Voxel centres in whole centimetres, sorted.
+std::vector<std::tuple<long, long, long>> sortedCentimetres(const std::vector<Eigen::Vector3d>& v) {
+  std::vector<std::tuple<long, long, long>> out;
+  for (const auto& p : v)
+    out.emplace_back(std::lround(p.x() * 100), std::lround(p.y() * 100), std::lround(p.z() * 100));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::unique_ptr<::octomap::AbstractOcTree> readFull(const std::string& bytes) {
+  std::istringstream in(bytes);
+  return std::unique_ptr<::octomap::AbstractOcTree>(::octomap::AbstractOcTree::read(in));
+}
+
+// .ot: read with octomap, written back by octomap byte for byte; every leaf of the single tree has
+// its value (and colour) in the tiled one
+void expectTheSameFullTree(const OccupancyMap& single, const OccupancyMap& tiled, bool colour) {
+  const std::string single_ot = single.fullBytes(), tiled_ot = tiled.fullBytes();
+  auto single_tree = readFull(single_ot), tiled_tree = readFull(tiled_ot);
+  ASSERT_TRUE(single_tree && tiled_tree);
+  for (const auto& [bytes, tree] :
+       {std::make_pair(&single_ot, single_tree.get()), std::make_pair(&tiled_ot, tiled_tree.get())}) {
+    std::ostringstream again;
+    tree->write(again);
+    EXPECT_TRUE(again.str() == *bytes) << "colour " << colour << ": octomap does not write back what it read";
+  }
+  size_t compared = 0;
+  if (colour) {
+    auto* a = dynamic_cast<::octomap::ColorOcTree*>(single_tree.get());
+    auto* b = dynamic_cast<::octomap::ColorOcTree*>(tiled_tree.get());
+    ASSERT_TRUE(a && b);
+    for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
+      const ::octomap::ColorOcTreeNode* n = b->search(it.getKey());
+      ASSERT_NE(n, nullptr);
+      ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
+      ASSERT_TRUE(n->getColor() == it->getColor());
+    }
+    EXPECT_EQ(b->getNumLeafNodes(), a->getNumLeafNodes());  // a colour tree is not pruned
+  } else {
+    auto* a = dynamic_cast<::octomap::OcTree*>(single_tree.get());
+    auto* b = dynamic_cast<::octomap::OcTree*>(tiled_tree.get());
+    ASSERT_TRUE(a && b);
+    for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
+      const ::octomap::OcTreeNode* n = b->search(it.getKey());
+      ASSERT_NE(n, nullptr);
+      ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
+    }
+    // both are pruned (at different times, and never across tiles): the leaves differ, the
+    // voxels they cover do not
+    for (auto it = b->begin_leafs(); it != b->end_leafs(); ++it) {
+      const ::octomap::OcTreeNode* n = a->search(it.getKey());
+      ASSERT_NE(n, nullptr);
+      ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
+    }
+  }
+  EXPECT_GT(compared, 10000u);
+}
+
+// .bt: octomap reads it and writes it back unchanged; the occupancy of every voxel agrees; the
+// message (the resident tiles only) is a valid tree of fewer nodes
+void expectTheSameBinaryTree(const OccupancyMap& single, const OccupancyMap& tiled, bool colour) {
+  const std::string single_bt = single.binaryBytes(), tiled_bt = tiled.binaryBytes();
+  ::octomap::OcTree single_bin(0.1), tiled_bin(0.1);
+  {
+    std::istringstream a(single_bt), b(tiled_bt);
+    ASSERT_TRUE(single_bin.readBinary(a));
+    ASSERT_TRUE(tiled_bin.readBinary(b));
+    std::ostringstream again;
+    tiled_bin.writeBinaryConst(again);
+    EXPECT_TRUE(again.str() == tiled_bt) << "colour " << colour;
+  }
+  for (auto it = single_bin.begin_leafs(); it != single_bin.end_leafs(); ++it) {
+    const ::octomap::OcTreeNode* n = tiled_bin.search(it.getCoordinate());
+    ASSERT_NE(n, nullptr);
+    ASSERT_EQ(tiled_bin.isNodeOccupied(n), single_bin.isNodeOccupied(*it));
+  }
+  EXPECT_EQ(tiled_bin.getNumLeafNodes(), single_bin.getNumLeafNodes()) << "colour " << colour;
+  ::octomap::OcTree resident(0.1);
+  std::istringstream r(tiled.binaryBytes(true));
+  ASSERT_TRUE(resident.readBinary(r));
+  EXPECT_GT(resident.size(), 0u);
+  EXPECT_LT(resident.size(), tiled_bin.size());
+}
+
+}  // namespace
+
 // A map kept as tiles that go to disk and come back is the one octree a map without tiles is:
 // the same occupied voxels, the same log-odds (and colours) in the .ot, the same occupancy in the
 // .bt, and both files are what octomap's own reader reads and its writer writes back byte for
@@ -686,109 +799,14 @@ TEST(OccupancyMap, TilesOnDiskMakeTheSameTree) {
     tiled_options.tile_idle_s = 1.5;
     single_options.tile_size = 0.0;
     OccupancyMap tiled(tiled_options), single(single_options);
-    size_t most_spilled = 0;
-    for (int k = 0; k < 12; ++k) {
-      const Eigen::Vector3d origin(0.3 * std::cos(0.5 * k), 0.3 * std::sin(0.5 * k), 1.2);
-      std::vector<Eigen::Vector3f> sector;
-      for (const Eigen::Vector3f& p : boxRoomHits(origin)) {
-        const double az = std::atan2(p.y() - origin.y(), p.x() - origin.x()) + M_PI;  // 0 .. 2 pi
-        if (std::fmod(az - 1.1 * k + 8 * M_PI, 2 * M_PI) < 0.5 * M_PI) sector.push_back(p);
-      }
-      for (OccupancyMap* m : {&tiled, &single}) {
-        m->setTime(int64_t(k) * 1000000);
-        m->insertRays(sector, origin);
-        m->evictIdle();
-        if (colour) {
-          std::vector<std::array<uint8_t, 3>> rgb;
-          for (size_t i = 0; i < sector.size(); ++i) rgb.push_back({uint8_t(i % 200), uint8_t(k * 20), 7});
-          m->setColours(sector, rgb);
-        }
-      }
-      most_spilled = std::max(most_spilled, tiled.spilledTiles());
-    }
+    const size_t most_spilled = sweepQuartersOfTheRoom(tiled, single, colour);
     EXPECT_GT(most_spilled, 10u) << "colour " << colour;
     EXPECT_GT(tiled.residentTiles(), 0u);
     EXPECT_EQ(single.spilledTiles(), 0u);
-
-    auto sorted = [](std::vector<Eigen::Vector3d> v) {
-      std::vector<std::tuple<long, long, long>> out;
-      for (const auto& p : v)
-        out.emplace_back(std::lround(p.x() * 100), std::lround(p.y() * 100), std::lround(p.z() * 100));
-      std::sort(out.begin(), out.end());
-      return out;
-    };
-    const auto occupied = sorted(single.occupiedVoxels());
+    const auto occupied = sortedCentimetres(single.occupiedVoxels());
     ASSERT_GT(occupied.size(), 1000u);
-    EXPECT_EQ(sorted(tiled.occupiedVoxels()), occupied);
-
-    // .ot: read with octomap, written back by octomap byte for byte; every leaf of the single
-    // tree has its value (and colour) in the tiled one
-    auto readFull = [](const std::string& bytes) {
-      std::istringstream in(bytes);
-      return std::unique_ptr<::octomap::AbstractOcTree>(::octomap::AbstractOcTree::read(in));
-    };
-    const std::string single_ot = single.fullBytes(), tiled_ot = tiled.fullBytes();
-    auto single_tree = readFull(single_ot), tiled_tree = readFull(tiled_ot);
-    ASSERT_TRUE(single_tree && tiled_tree);
-    for (const auto& [bytes, tree] :
-         {std::make_pair(&single_ot, single_tree.get()), std::make_pair(&tiled_ot, tiled_tree.get())}) {
-      std::ostringstream again;
-      tree->write(again);
-      EXPECT_TRUE(again.str() == *bytes) << "colour " << colour << ": octomap does not write back what it read";
-    }
-    size_t compared = 0;
-    if (colour) {
-      auto* a = dynamic_cast<::octomap::ColorOcTree*>(single_tree.get());
-      auto* b = dynamic_cast<::octomap::ColorOcTree*>(tiled_tree.get());
-      ASSERT_TRUE(a && b);
-      for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
-        const ::octomap::ColorOcTreeNode* n = b->search(it.getKey());
-        ASSERT_NE(n, nullptr);
-        ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
-        ASSERT_TRUE(n->getColor() == it->getColor());
-      }
-      EXPECT_EQ(b->getNumLeafNodes(), a->getNumLeafNodes());  // a colour tree is not pruned
-    } else {
-      auto* a = dynamic_cast<::octomap::OcTree*>(single_tree.get());
-      auto* b = dynamic_cast<::octomap::OcTree*>(tiled_tree.get());
-      ASSERT_TRUE(a && b);
-      for (auto it = a->begin_leafs(); it != a->end_leafs(); ++it, ++compared) {
-        const ::octomap::OcTreeNode* n = b->search(it.getKey());
-        ASSERT_NE(n, nullptr);
-        ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
-      }
-      // both are pruned (at different times, and never across tiles): the leaves differ, the
-      // voxels they cover do not
-      for (auto it = b->begin_leafs(); it != b->end_leafs(); ++it) {
-        const ::octomap::OcTreeNode* n = a->search(it.getKey());
-        ASSERT_NE(n, nullptr);
-        ASSERT_EQ(n->getLogOdds(), it->getLogOdds());
-      }
-    }
-    EXPECT_GT(compared, 10000u);
-
-    // .bt: octomap reads it and writes it back unchanged; the occupancy of every voxel agrees
-    const std::string single_bt = single.binaryBytes(), tiled_bt = tiled.binaryBytes();
-    ::octomap::OcTree single_bin(0.1), tiled_bin(0.1);
-    {
-      std::istringstream a(single_bt), b(tiled_bt);
-      ASSERT_TRUE(single_bin.readBinary(a));
-      ASSERT_TRUE(tiled_bin.readBinary(b));
-      std::ostringstream again;
-      tiled_bin.writeBinaryConst(again);
-      EXPECT_TRUE(again.str() == tiled_bt) << "colour " << colour;
-    }
-    for (auto it = single_bin.begin_leafs(); it != single_bin.end_leafs(); ++it) {
-      const ::octomap::OcTreeNode* n = tiled_bin.search(it.getCoordinate());
-      ASSERT_NE(n, nullptr);
-      ASSERT_EQ(tiled_bin.isNodeOccupied(n), single_bin.isNodeOccupied(*it));
-    }
-    EXPECT_EQ(tiled_bin.getNumLeafNodes(), single_bin.getNumLeafNodes()) << "colour " << colour;
-    // the message: the resident tiles only, a valid tree of fewer nodes
-    ::octomap::OcTree resident(0.1);
-    std::istringstream r(tiled.binaryBytes(true));
-    ASSERT_TRUE(resident.readBinary(r));
-    EXPECT_GT(resident.size(), 0u);
-    EXPECT_LT(resident.size(), tiled_bin.size());
+    EXPECT_EQ(sortedCentimetres(tiled.occupiedVoxels()), occupied);
+    ASSERT_NO_FATAL_FAILURE(expectTheSameFullTree(single, tiled, colour));
+    ASSERT_NO_FATAL_FAILURE(expectTheSameBinaryTree(single, tiled, colour));
   }
 }
