@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "livo/filter_state.hpp"
+#include "livo/imu_preintegration.hpp"
 #include "livo/lio/imu_intrinsics.hpp"
 #include "livo/lio/keyframe_clone.hpp"
 #include "livo/sensor_samples.hpp"
@@ -19,22 +20,12 @@ using Mat18x12 = Eigen::Matrix<double, 18, 12>;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 using IntrinsicsJacobian = Eigen::Matrix<double, FilterState::kNavDim, ImuIntrinsics::kDim>;
 
-/// Continuous-time noise densities of the IMU (the rig's imu section).
-struct ImuNoise {
-  double gyro_noise_density = 1.7e-4;   // rad/s/sqrt(Hz)
-  double accel_noise_density = 2.0e-3;  // m/s^2/sqrt(Hz)
-  double gyro_random_walk = 1.9e-5;     // rad/s^2/sqrt(Hz)
-  double accel_random_walk = 3.0e-3;    // m/s^3/sqrt(Hz)
-  // The gyro's scale-factor and axis-misalignment errors (1-sigma; 0: not modelled). Unlike white noise
-  // they are an error in proportion to the rate, the same sign through a whole turn: M w with M's
-  // diagonal of gyro_scale_std and its off-diagonal of gyro_misalignment_std. Between two updates that
-  // correct the attitude (the LiDAR sweeps, systematic_error_window_s apart) it adds up to M w T, so the
-  // propagation adds a rate noise of density^2 = var(M w) T: the attitude spread grows by the turn.
-  double gyro_scale_std = 0.0;             // relative
-  double gyro_misalignment_std = 0.0;      // rad
-  double systematic_error_window_s = 0.1;  // s, the LiDAR sweep period
-  // The accelerometer's (rig.imu.accel_scale_std, accel_misalignment_std): used only where the
-  // axes are modelled as states (ImuIntrinsics); the noise budget above is the gyro's alone.
+/// Continuous-time noise of the IMU (the rig's imu section): the densities and the gyro's scale and
+/// misalignment budget as the preintegration has them (livo/imu_preintegration.hpp; here the
+/// systematic_error_window_s is the LiDAR sweep period, the attitude being corrected once a sweep),
+/// plus the accelerometer's axis errors (rig.imu.accel_scale_std, accel_misalignment_std), used only
+/// where the axes are modelled as states (ImuIntrinsics); the noise budget is the gyro's alone.
+struct ImuNoise : ImuPreintegrationNoise {
   double accel_scale_std = 0.0;
   double accel_misalignment_std = 0.0;
 };
