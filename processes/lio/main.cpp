@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     if (!quiet) std::cerr << "[" << opts.name << "] " << node.sweepSummary() << "\n";
     if (const std::string c = node.calibrationSummary(); !quiet && !c.empty())
       std::cerr << "[" << opts.name << "] " << c << "\n";
-    if (!quiet && opts.lio.wheel.enabled) std::cerr << "[" << opts.name << "] " << node.wheelSummary() << "\n";
+    if (!quiet && opts.core.wheel.enabled) std::cerr << "[" << opts.name << "] " << node.wheelSummary() << "\n";
     if (!quiet && opts.camera_handoff) {
       const auto& h = node.handoffCounts();
       std::cerr << "[" << opts.name << "] camera hand-off: " << h.priors << " priors, " << h.adopted

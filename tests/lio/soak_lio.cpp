@@ -117,13 +117,13 @@ int main(int argc, char** argv) {
     std::cerr << "livo_lio_soak: " << config_file << ", " << setup.options.duration_s << " s, "
               << setup.trajectory_description << "\n";
     livo::lio::printOptions(options, std::cerr);
-    std::cerr << "  max stored keyframes " << options.lio.max_stored_keyframes << "\n";
+    std::cerr << "  max stored keyframes " << options.core.max_stored_keyframes << "\n";
 
     SimLioDriver::Options driver;
     driver.expected_sweeps = static_cast<size_t>(std::ceil(setup.options.duration_s * setup.rig.lidar->rate_hz)) + 16;
     driver.outage_begin_s = outage_begin;
     driver.outage_end_s = outage_end;
-    SimLioDriver feeder(setup, options.lio, driver);
+    SimLioDriver feeder(setup, options.core, driver);
     std::vector<Sample> samples;
     samples.reserve(static_cast<size_t>(setup.options.duration_s / cli.getDouble("--report-every")) + 4);
     printHeader();

@@ -129,11 +129,11 @@ std::vector<Message> syntheticRun() {
 TEST(LioNode, ReadsTheRigSchemaAndStrictLioSection) {
   const LioNodeOptions o = readLioNodeOptions(Config::fromString(kConfig));
   EXPECT_EQ(o.imu_channel, "IMU");
-  EXPECT_DOUBLE_EQ(o.lio.imu_noise.accel_random_walk, 3.0e-3);
-  EXPECT_NEAR(o.lio.extrinsics.T_I_L.translation().z(), 0.1, 1e-12);
-  EXPECT_NEAR(so3::Log(Mat3(o.lio.extrinsics.T_I_L.linear())).z(), M_PI / 2, 1e-12);
-  EXPECT_DOUBLE_EQ(o.lio.keyframe.min_distance, 0.5);
-  EXPECT_FALSE(o.lio.wheel.enabled);
+  EXPECT_DOUBLE_EQ(o.core.imu_noise.accel_random_walk, 3.0e-3);
+  EXPECT_NEAR(o.core.extrinsics.T_I_L.translation().z(), 0.1, 1e-12);
+  EXPECT_NEAR(so3::Log(Mat3(o.core.extrinsics.T_I_L.linear())).z(), M_PI / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(o.core.keyframe.min_distance, 0.5);
+  EXPECT_FALSE(o.core.wheel.enabled);
   std::string bad = std::string(kConfig) + "  map: {voxel_sise: 1.0}\n";
   EXPECT_THROW(readLioNodeOptions(Config::fromString(bad)), ConfigError);
   // a wheel section under rig enables the wheel update
@@ -142,8 +142,8 @@ TEST(LioNode, ReadsTheRigSchemaAndStrictLioSection) {
                "  wheel: {rate_hz: 50, track_width: 0.5, speed_noise_std: 0.02, "
                "T_I_B: {translation: [0, 0, -0.3], rpy_deg: [0, 0, 0]}}\n");
   const LioNodeOptions w = readLioNodeOptions(Config::fromString(wheel));
-  EXPECT_TRUE(w.lio.wheel.enabled);
-  EXPECT_NEAR(w.lio.wheel.T_I_B.translation().z(), -0.3, 1e-12);
+  EXPECT_TRUE(w.core.wheel.enabled);
+  EXPECT_NEAR(w.core.wheel.T_I_B.translation().z(), -0.3, 1e-12);
 }
 
 // A value out of range is refused naming its own key, not a neighbour checked in the same line.

@@ -5,8 +5,9 @@
 
 namespace livo {
 
-/// Appends `what` to `note`, after a "; " if the note already says something.
+/// Appends `what` to `note`, after a "; " if the note already says something (a null note: nothing).
 inline void appendNote(std::string* note, const std::string& what) {
+  if (!note) return;
   if (!note->empty()) *note += "; ";
   *note += what;
 }

@@ -12,7 +12,7 @@ namespace livo::lio {
 
 namespace {
 void readRig(const Config& rig, LioNodeOptions* o) {
-  LioOptions& l = o->lio;
+  LioOptions& l = o->core;
   // The rig is validated as every other process validates it (a model name, ranges and noise the
   // LIO itself does not read are still errors here); the LIO then reads what it uses.
   const SensorRig sensors = readSensorRig(rig);
@@ -270,7 +270,7 @@ void readWheel(const Config& w, LioOptions* l) {
 
 /// The ranges of lio.* once read; every check names the key it is about (c.where: lio.KEY, with its section).
 void checkRanges(const Config& c, const LioNodeOptions& o) {
-  const LioOptions& l = o.lio;
+  const LioOptions& l = o.core;
   auto check = [&](bool ok, const std::string& key, const char* what) {
     if (!ok) throw ConfigError(c.where(key) + ": " + what);
   };
@@ -309,7 +309,7 @@ void checkRanges(const Config& c, const LioNodeOptions& o) {
 }
 
 void readLio(const Config& c, LioNodeOptions* o) {
-  LioOptions& l = o->lio;
+  LioOptions& l = o->core;
   readNodeKeys(c, o);
   readOutputChannels(c.optionalSection("channels"), o);
   readInit(c.optionalSection("init"), &l.init);
@@ -358,7 +358,7 @@ std::string imuAxesModel(const LioOptions& l) {
 }  // namespace
 
 void printOptions(const LioNodeOptions& o, std::ostream& os) {
-  const LioOptions& l = o.lio;
+  const LioOptions& l = o.core;
   const Vec3 t = l.extrinsics.T_I_L.translation();
   os << "[" << o.name << "] inputs " << o.imu_channel << ", " << o.lidar_channel
      << (l.wheel.enabled ? ", " + o.wheel_channel : std::string()) << ", " << o.state_posterior_channel << ", "

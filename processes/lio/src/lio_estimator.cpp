@@ -9,17 +9,13 @@
 
 #include "livo/lio/scan_to_map.hpp"
 #include "livo/lio/undistorter.hpp"
+#include "livo/result_note.hpp"
 #include "livo/text_format.hpp"
 #include "livo/time.hpp"
 
 namespace livo::lio {
 
 namespace {
-void appendNote(std::string* note, const std::string& what) {
-  if (!note) return;
-  if (!note->empty()) *note += "; ";
-  *note += what;
-}
 
 /// The points registered against the map: every point_stride-th, then one per scan voxel.
 std::vector<Vec3> registrationSubset(const std::vector<Vec3>& body, int point_stride, double scan_voxel_size) {

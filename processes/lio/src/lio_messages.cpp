@@ -3,28 +3,25 @@
 #include <cmath>
 
 #include "livo/messages.hpp"
+#include "livo/odometry_message.hpp"
 #include "livo/output_messages.hpp"
 #include "livo/time.hpp"
 
 namespace livo::lio {
 
 odometry_t toOdometry(const ScanResult& r, const OdometryFrame& frame) {
-  odometry_t o;
+  OdometryOutput o;
   o.utime = r.utime;
-  o.parent_frame = "W";
-  o.child_frame = "I";
-  poseTo(r.state.pose(), o.position, o.orientation);
-  vec3To(r.state.vel, o.velocity);
-  vec3To(r.angular_velocity, o.angular_velocity);
-  matrixTo<6>(Mat6(r.covariance.topLeftCorner<6, 6>()), o.pose_covariance);
-  matrixTo<3>(Mat3(r.covariance.block<3, 3>(FilterState::kVel, FilterState::kVel)), o.velocity_covariance);
+  o.pose = r.state.pose();
+  o.velocity = r.state.vel;
+  o.angular_velocity = r.angular_velocity;
+  o.pose_covariance = r.covariance.topLeftCorner<6, 6>();
+  o.velocity_covariance = r.covariance.block<3, 3>(FilterState::kVel, FilterState::kVel);
   // a predicted sweep used none: its registration, if any, was not taken
   o.num_residuals = r.status == ScanResult::Status::kPredicted ? 0 : r.num_residuals;
-  o.degenerate = r.degeneracy.degenerate ? 1 : 0;
+  o.degenerate = r.degeneracy.degenerate;
   o.min_information_eigenvalue = r.min_information_eigenvalue;
-  o.epoch = frame.epoch;
-  o.correction_id = frame.correction_id;
-  return o;
+  return odometryMessage(o, OutputFrame{frame.epoch, frame.correction_id});
 }
 
 registered_scan_t toRegisteredScan(const ScanResult& r, const point_cloud_t& in, const OdometryFrame& frame) {

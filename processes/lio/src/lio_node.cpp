@@ -36,13 +36,13 @@ bool finiteOdometry(const odometry_t& o) {
 }  // namespace
 
 LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
-    : options_(std::move(options)), node_(lcm, nodeOptions(options_, quiet)), lio_(options_.lio) {
+    : options_(std::move(options)), node_(lcm, nodeOptions(options_, quiet)), lio_(options_.core) {
   node_.declareOutput(options_.odometry_channel);
   if (options_.publish_registered_scan) node_.declareOutput(options_.registered_scan_channel);
   node_.declareOutput(options_.keyframe_channel);
   node_.subscribe<imu_t>(options_.imu_channel, [this](const imu_t& m) { onImu(m); });
   node_.subscribe<point_cloud_t>(options_.lidar_channel, [this](const point_cloud_t& m) { onLidar(m); });
-  if (options_.lio.wheel.enabled)
+  if (options_.core.wheel.enabled)
     node_.subscribe<wheel_odometry_t>(options_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   if (options_.camera_handoff) {
     node_.declareOutput(options_.state_prior_channel);
@@ -248,7 +248,7 @@ void LioNode::advance() {
       continue;
     }
     const int64_t t_end = next.utime;
-    if (options_.lio.wheel.enabled) {
+    if (options_.core.wheel.enabled) {
       // wheel readings up to the first one past the end
       int64_t upto = t_end;
       for (const auto& e : wheel_.entries())
@@ -288,7 +288,7 @@ LioNode::NextEvent LioNode::nextEvent() const {
   if (scans_.empty()) return e;
   e.kind = NextEvent::kSweep;
   e.utime = e.imu_after = scans_.front().utime;
-  if (options_.lio.wheel.enabled) {
+  if (options_.core.wheel.enabled) {
     const bool wheel_past = !wheel_.empty() && wheel_.back().utime > e.utime;
     if (!wheel_past) e.wheel_wait = toUtime(options_.wheel_max_wait_s);
   }
@@ -323,7 +323,7 @@ LioNode::Promises LioNode::promises(const NextEvent& next) const {
   p.image_due = newest_image_ + p.period;
   const bool images_possible = options_.camera_handoff && newest_image_ >= 0 && newest_imu_ <= p.image_due + p.period;
   const bool sweeps_possible = newest_sweep_end_ >= 0;
-  const bool wheels_possible = options_.lio.wheel.enabled;
+  const bool wheels_possible = options_.core.wheel.enabled;
   const auto floor = [&](bool images, bool sweeps, bool wheels) {
     int64_t f = kNever;
     if (next.kind == NextEvent::kImage) f = sweeps ? next.utime : next.imu_after;
@@ -350,7 +350,7 @@ LioNode::Promises LioNode::promises(const NextEvent& next) const {
   if (pending_) {
     p.threshold = std::min(p.threshold, pending_->utime + toUtime(options_.posterior_max_wait_s));
     if (const int64_t queued = lio_.oldestQueuedImu(); queued != kNever)
-      p.threshold = std::min(p.threshold, queued + toUtime(options_.lio.max_imu_backlog_s));
+      p.threshold = std::min(p.threshold, queued + toUtime(options_.core.max_imu_backlog_s));
   }
   return p;
 }
@@ -382,12 +382,12 @@ std::vector<Node::QuietWindow> LioNode::quietWindows() const {
   }
   if (p.sweeps) {
     // a sweep ends at or after its stamp plus the LiDAR's time offset
-    const int64_t offset = toUtime(options_.lio.extrinsics.time_offset_s);
+    const int64_t offset = toUtime(options_.core.extrinsics.time_offset_s);
     out.push_back({options_.lidar_channel, newest_sweep_end_ - offset, kNever});
   }
   if (p.wheels) {
     out.push_back(Node::QuietWindow::always(options_.wheel_channel));
-  } else if (options_.lio.wheel.enabled) {
+  } else if (options_.core.wheel.enabled) {
     // the filter is past the sweep's end and it waits for the wheels: a reading past its end would
     // let it go; readings up to its end cannot
     const bool sweep_waits_for_wheels =
@@ -410,7 +410,7 @@ void LioNode::process(const PendingScan& p) {
   ++sweeps_;
   if (!r.message.empty() && r.status != ScanResult::Status::kInitializing)
     node_.warn("sweep at " + std::to_string(p.scan.utime) + " (" + toString(r.status) + "): " + r.message);
-  if (options_.lio.wheel.enabled && r.utime - last_wheel_log_ >= toUtime(kWheelLogPeriodS)) {
+  if (options_.core.wheel.enabled && r.utime - last_wheel_log_ >= toUtime(kWheelLogPeriodS)) {
     if (last_wheel_log_ != 0) node_.info(wheelSummary());
     last_wheel_log_ = r.utime;
   }
@@ -447,14 +447,14 @@ std::string LioNode::sweepSummary() const {
 
 bool LioNode::estimatesCalibration() const {
   CalibrationStd lidar, camera;
-  calibrationPrior(options_.lio.lidar_calibration_std, options_.lio.camera_calibration_std, options_.lio.calibration,
+  calibrationPrior(options_.core.lidar_calibration_std, options_.core.camera_calibration_std, options_.core.calibration,
                    &lidar, &camera);
   return lidar.any() || (options_.camera_handoff && camera.any());
 }
 
 CalibrationEstimate LioNode::calibrationEstimate() const {
-  return calibrationAgainstRig(lio_.state(), lio_.covariance(), options_.lio.extrinsics.T_I_L,
-                               options_.lio.camera_T_I_C);
+  return calibrationAgainstRig(lio_.state(), lio_.covariance(), options_.core.extrinsics.T_I_L,
+                               options_.core.camera_T_I_C);
 }
 
 std::string LioNode::calibrationSummary() const {
@@ -483,7 +483,7 @@ void LioNode::writeCalibrationFiles() {
   const std::string csv = options_.output_dir + "/calibration.csv", yaml = options_.output_dir + "/calibration.yaml";
   if (!writeFileAtomically(csv, {calibration_csv_.empty() ? calibrationCsvHeader() : calibration_csv_}, &error) ||
       !writeFileAtomically(yaml,
-                           {calibrationOverlay(lio_.state(), options_.lio.extrinsics.time_offset_s,
+                           {calibrationOverlay(lio_.state(), options_.core.extrinsics.time_offset_s,
                                                options_.camera_time_offset_s, options_.camera_handoff, e)},
                            &error))
     node_.error("calibration files: " + error);
@@ -496,7 +496,7 @@ std::string LioNode::wheelSummary() const {
   std::ostringstream os;
   os << "wheel updates: " << n.accepted << " accepted, " << n.rejected << " rejected (chi2 gate), " << n.no_reading
      << " without a reading; ";
-  if (!options_.lio.wheel_scale.enabled) {
+  if (!options_.core.wheel_scale.enabled) {
     os << "scale calibration off";
     return os.str();
   }

@@ -69,8 +69,8 @@ struct LioNodeOptions {
   // this far past the end. Only while a VIO listens and the camera is live (an image within 1 s).
   double image_max_wait_s = 0.1;
 
-  LioOptions lio = withSearchThreads(2);  // the process shares the registration's searches between
-                                          // two threads (lio.search_threads); the core's default is 1
+  LioOptions core = withSearchThreads(2);  // the process shares the registration's searches between
+                                           // two threads (lio.search_threads); the core's default is 1
 };
 
 /// Reads rig.* (the keys of the rig schema) and lio.* (all optional) into options.
