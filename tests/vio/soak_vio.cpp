@@ -65,10 +65,10 @@ class LivoDriver : public livo_soak::SimLioDriver {
  public:
   LivoDriver(const livo::sim::SimulationSetup& setup, const livo::lio::LioNodeOptions& lio_options,
              const livo::vio::VioNodeOptions& vio_options, const Options& o)
-      : SimLioDriver(setup, lio_options.lio, o),
+      : SimLioDriver(setup, lio_options.core, o),
         lio_name_(lio_options.name),
         vio_opts_(vio_options),
-        vio_(vio_options.vio, vio_options.camera),
+        vio_(vio_options.core, vio_options.camera),
         vio_offset_us_(livo::toUtime(vio_options.camera_time_offset_s)),
         tolerance_us_(livo::toUtime(vio_options.time_tolerance_s)) {}
 

@@ -175,40 +175,40 @@ TEST(VioNode, ReadsTheRigAndAStrictVioSection) {
   EXPECT_NEAR(d.camera.distortion[0], -0.05, 1e-12);
   EXPECT_EQ(d.camera_channel, "CAMERA");
   EXPECT_DOUBLE_EQ(d.camera_time_offset_s, 0.0);
-  EXPECT_EQ(d.vio.photometric.pyramid_levels, 3);
+  EXPECT_EQ(d.core.photometric.pyramid_levels, 3);
   const VioNodeOptions o = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  name: vio2\n  channels: {state_prior: PRIOR2}\n  map: {voxel_size: 0.25, max_points: 5000}\n"
       "  photometric: {noise_std: 8.0, affine_brightness: false}\n  update: {max_iterations: 3, covariance: full}\n"
       "  new_points: {min_gradient: 4.0}\n  refresh: {angle_deg: 12.0}\n  selection: {depth_edge_radius_px: 20}\n")));
   EXPECT_EQ(o.name, "vio2");
   EXPECT_EQ(o.state_prior_channel, "PRIOR2");
-  EXPECT_DOUBLE_EQ(o.vio.map.voxel_size, 0.25);
-  EXPECT_EQ(o.vio.map.max_points, 5000);
-  EXPECT_DOUBLE_EQ(o.vio.photometric.noise_std, 8.0);
-  EXPECT_FALSE(o.vio.photometric.affine_brightness);
-  EXPECT_EQ(o.vio.update.max_iterations, 3);
-  EXPECT_DOUBLE_EQ(o.vio.maintenance.min_gradient, 4.0);
-  EXPECT_DOUBLE_EQ(o.vio.maintenance.refresh_angle_deg, 12.0);
-  EXPECT_DOUBLE_EQ(o.vio.selection.depth_edge_radius_px, 20.0);
-  EXPECT_EQ(d.vio.update.covariance, CovarianceUpdate::kBeyondPrior);
-  EXPECT_EQ(o.vio.update.covariance, CovarianceUpdate::kFull);
-  EXPECT_DOUBLE_EQ(d.vio.map.plane_snap_max_rms, 0.0);  // off unless asked for
+  EXPECT_DOUBLE_EQ(o.core.map.voxel_size, 0.25);
+  EXPECT_EQ(o.core.map.max_points, 5000);
+  EXPECT_DOUBLE_EQ(o.core.photometric.noise_std, 8.0);
+  EXPECT_FALSE(o.core.photometric.affine_brightness);
+  EXPECT_EQ(o.core.update.max_iterations, 3);
+  EXPECT_DOUBLE_EQ(o.core.maintenance.min_gradient, 4.0);
+  EXPECT_DOUBLE_EQ(o.core.maintenance.refresh_angle_deg, 12.0);
+  EXPECT_DOUBLE_EQ(o.core.selection.depth_edge_radius_px, 20.0);
+  EXPECT_EQ(d.core.update.covariance, CovarianceUpdate::kBeyondPrior);
+  EXPECT_EQ(o.core.update.covariance, CovarianceUpdate::kFull);
+  EXPECT_DOUBLE_EQ(d.core.map.plane_snap_max_rms, 0.0);  // off unless asked for
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  update: {covariance: half}\n"))), ConfigError);
   EXPECT_THROW(readVioNodeOptions(Config::fromString(roomConfig("vio:\n  map: {voxel_sise: 0.3}\n"))), ConfigError);
   // the map points are LiDAR returns: known to the rig's range noise unless vio.photometric.point_std says
-  EXPECT_DOUBLE_EQ(d.vio.photometric.point_std, 0.01);  // rig.lidar.range_noise_std
+  EXPECT_DOUBLE_EQ(d.core.photometric.point_std, 0.01);  // rig.lidar.range_noise_std
   // the consistency gate and the calibration's share of an image's information
   const VioNodeOptions g = readVioNodeOptions(Config::fromString(roomConfig(
       "vio:\n  photometric: {point_std: 0.02, reference_rotation_std_deg: 0.05, reference_translation_std: 0.002,\n"
       "                reference_translation_per_m: 0.01}\n"
       "  update: {gate_probability: 0.99, calibration_information_scale: 0.1}\n")));
-  EXPECT_DOUBLE_EQ(g.vio.photometric.point_std, 0.02);
-  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_rotation_std_deg, 0.05);
-  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_translation_std, 0.002);
-  EXPECT_DOUBLE_EQ(g.vio.photometric.reference_translation_per_m, 0.01);
-  EXPECT_DOUBLE_EQ(g.vio.update.gate_probability, 0.99);
-  EXPECT_DOUBLE_EQ(g.vio.update.calibration_information_scale, 0.1);
-  EXPECT_DOUBLE_EQ(d.vio.update.gate_probability, 0.999);
+  EXPECT_DOUBLE_EQ(g.core.photometric.point_std, 0.02);
+  EXPECT_DOUBLE_EQ(g.core.photometric.reference_rotation_std_deg, 0.05);
+  EXPECT_DOUBLE_EQ(g.core.photometric.reference_translation_std, 0.002);
+  EXPECT_DOUBLE_EQ(g.core.photometric.reference_translation_per_m, 0.01);
+  EXPECT_DOUBLE_EQ(g.core.update.gate_probability, 0.99);
+  EXPECT_DOUBLE_EQ(g.core.update.calibration_information_scale, 0.1);
+  EXPECT_DOUBLE_EQ(d.core.update.gate_probability, 0.999);
   // the keys of what was removed (the camera's calibration is now the filter's state, the body rate
   // comes with the prior, the Mahalanobis test is the consistency gate) are unknown keys: refused
   for (const char* removed :

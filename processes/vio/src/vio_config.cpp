@@ -114,7 +114,7 @@ void checkNodeRanges(const Config& c, const VioNodeOptions& n) {
 }
 
 void readVio(const Config& c, VioNodeOptions* n) {
-  VioOptions& o = n->vio;
+  VioOptions& o = n->core;
   c.readOptional("name", n->name);
   readChannels(c.optionalSection("channels"), n);
   c.readOptional("time_tolerance_s", n->time_tolerance_s);
@@ -141,14 +141,14 @@ VioNodeOptions readVioNodeOptions(const Config& root) {
   n.camera_time_offset_s = n.camera.time_offset_s;
   n.camera_channel = sensor_rig.channels.camera;
   // the map points are LiDAR returns: known to the LiDAR's range noise
-  if (sensor_rig.lidar) n.vio.photometric.point_std = sensor_rig.lidar->range_noise_std;
+  if (sensor_rig.lidar) n.core.photometric.point_std = sensor_rig.lidar->range_noise_std;
   const Config vio = root.optionalSection("vio");
   if (!vio.isNull()) {
     readVio(vio, &n);
     vio.checkAllUsed();
   }
   try {
-    validate(n.vio);
+    validate(n.core);
   } catch (const std::invalid_argument& e) {
     throw ConfigError(root.file() + ": vio." + e.what());
   }
@@ -156,7 +156,7 @@ VioNodeOptions readVioNodeOptions(const Config& root) {
 }
 
 void printOptions(const VioNodeOptions& n, std::ostream& os) {
-  const VioOptions& o = n.vio;
+  const VioOptions& o = n.core;
   const CameraRig& c = n.camera;
   os << "[" << n.name << "] inputs " << n.camera_channel << ", " << n.state_prior_channel << ", "
      << n.registered_scan_channel << ", " << n.loop_correction_channel << "; output " << n.state_posterior_channel

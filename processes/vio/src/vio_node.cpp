@@ -28,7 +28,7 @@ NodeOptions nodeOptions(const VioNodeOptions& o, bool quiet) {
 VioNode::VioNode(lcm::LCM& lcm, VioNodeOptions options, bool quiet)
     : options_(std::move(options)),
       node_(lcm, nodeOptions(options_, quiet)),
-      vio_(options_.vio, options_.camera),
+      vio_(options_.core, options_.camera),
       offset_us_(toUtime(options_.camera_time_offset_s)),
       tolerance_us_(toUtime(options_.time_tolerance_s)) {
   node_.declareOutput(options_.state_posterior_channel);

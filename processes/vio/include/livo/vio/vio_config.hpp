@@ -29,7 +29,7 @@ struct VioNodeOptions {
   ImageCheckOptions image_check;
 
   CameraRig camera;
-  VioOptions vio;
+  VioOptions core;
 };
 
 /// Reads rig.* (through livo::readSensorRig; the rig must have a camera) and vio.*; throws
