@@ -84,29 +84,33 @@ class SimulationRun {
         rig_(setup.rig),
         mounted_(trueRig(setup.rig, setup.calibration_errors)),
         errors_(setup.calibration_errors),
-        o_(setup.options),
+        options_(setup.options),
         start_(setup.start_utime),
         end_(setup.endUtime()),
-        imu_noise_(rig_.imu, o_.initial_gyro_bias, o_.initial_accel_bias, Random(o_.seed, kImuStream)) {
-    stats_.sim_seconds = o_.duration_s;
+        imu_noise_(rig_.imu, options_.initial_gyro_bias, options_.initial_accel_bias,
+                   Random(options_.seed, kImuStream)) {
+    stats_.sim_seconds = options_.duration_s;
     for (const std::string& ch : {rig_.channels.imu, rig_.channels.ground_truth}) stats_.messages[ch] = 0;
     if (rig_.wheel) {
       stats_.messages[rig_.channels.wheel] = 0;
-      wheel_noise_.emplace(*rig_.wheel, o_.wheel_left_scale, o_.wheel_right_scale, Random(o_.seed, kWheelStream));
+      wheel_noise_.emplace(*rig_.wheel, options_.wheel_left_scale, options_.wheel_right_scale,
+                           Random(options_.seed, kWheelStream));
       // a stream of its own: with slip on, the readings outside its episodes are those without it
-      if (o_.wheel_slip.enabled()) wheel_slip_.emplace(o_.wheel_slip, Random(o_.seed, kWheelSlipStream));
+      if (options_.wheel_slip.enabled())
+        wheel_slip_.emplace(options_.wheel_slip, Random(options_.seed, kWheelSlipStream));
     }
     if (rig_.lidar) {
       stats_.messages[rig_.channels.lidar] = 0;
-      scanner_ = std::make_unique<LidarScanner>(*mounted_.lidar, o_.lidar, o_.lidar_effects);
+      scanner_ = std::make_unique<LidarScanner>(*mounted_.lidar, options_.lidar, options_.lidar_effects);
       sweep_us_ = static_cast<int64_t>(std::llround(scanner_->pattern().sweepDuration() * 1e6));
     }
-    if (rig_.camera && o_.images) {
+    if (rig_.camera && options_.images) {
       stats_.messages[rig_.channels.camera] = 0;
       if (rig_.camera->depth) stats_.messages[rig_.channels.depth] = 0;
-      renderer_ = std::make_unique<CameraRenderer>(*mounted_.camera, o_.camera);
+      renderer_ = std::make_unique<CameraRenderer>(*mounted_.camera, options_.camera);
       camera_offset_us_ = static_cast<int64_t>(std::llround(rig_.camera->time_offset_s * 1e6));
-      if (o_.camera.auto_exposure.enabled) auto_exposure_.emplace(o_.camera.auto_exposure, o_.camera.exposure_time);
+      if (options_.camera.auto_exposure.enabled)
+        auto_exposure_.emplace(options_.camera.auto_exposure, options_.camera.exposure_time);
     }
     if (s_.replaysRecordedImu()) {
       while (recorded_k_ < s_.recorded_imu.size() && s_.recorded_imu[recorded_k_].stamp_ns < start_ * 1000)
@@ -139,7 +143,7 @@ class SimulationRun {
   }
 
   void addGroundTruth(Chunk* c) {
-    for (int64_t u; (u = stampOf(start_, gt_k_, o_.ground_truth_rate_hz)) < c->end; ++gt_k_) {
+    for (int64_t u; (u = stampOf(start_, gt_k_, options_.ground_truth_rate_hz)) < c->end; ++gt_k_) {
       c->poses.push_back({u, s_.trajectory->at(s_.trajectoryTime(u)).T_W_I});
       c->pending.push_back({u, kGroundTruthRank, c->poses.size() - 1});
     }
@@ -178,7 +182,7 @@ class SimulationRun {
         // stamped u, swept from IMU time u + the LiDAR's time offset error
         const double t0 = s_.trajectoryTime(u) + errors_.lidar_time_offset_s;
         c->sweeps[slot] = scanner_->scan(*s_.scene, *s_.trajectory, t0, u, (u - start_) * 1e-6,
-                                         Random(o_.seed, kLidarStream, static_cast<uint64_t>(k)));
+                                         Random(options_.seed, kLidarStream, static_cast<uint64_t>(k)));
       });
     }
   }
@@ -201,7 +205,7 @@ class SimulationRun {
         // stamped on the camera's clock as the rig believes it (rig camera time_offset_s) and logged at
         // IMU time u; rendered at u + the camera's time offset error
         const double t = s_.trajectoryTime(u) + errors_.camera_time_offset_s;
-        const Random rng(o_.seed, kCameraStream, static_cast<uint64_t>(k));
+        const Random rng(options_.seed, kCameraStream, static_cast<uint64_t>(k));
         CameraImage& image = c->images[slot];
         const ExposureSetting setting =
             auto_exposure_ ? auto_exposure_->setting() : ExposureSetting{renderer_->exposureAt(t), 1.0};
@@ -217,8 +221,8 @@ class SimulationRun {
           depth.log_utime = u;
           depth.width = image.width;
           depth.height = image.height;
-          depth.millimetres = measureDepth(z_depth, image.width, image.height, o_.depth,
-                                           Random(o_.seed, kDepthStream, static_cast<uint64_t>(k)));
+          depth.millimetres = measureDepth(z_depth, image.width, image.height, options_.depth,
+                                           Random(options_.seed, kDepthStream, static_cast<uint64_t>(k)));
         }
       });
     }
@@ -269,7 +273,7 @@ class SimulationRun {
  private:
   /// Free-running: halfway between the clock's ticks; triggered: at the sweeps' starts or ends.
   int64_t frameStamp(int64_t k) const {
-    switch (o_.camera_trigger) {
+    switch (options_.camera_trigger) {
       case CameraTrigger::kSweepStart: return stampOf(start_, k, rig_.lidar->rate_hz);
       case CameraTrigger::kSweepEnd: return stampOf(start_, k, rig_.lidar->rate_hz) + sweep_us_;
       case CameraTrigger::kFree: break;
@@ -281,7 +285,7 @@ class SimulationRun {
   const SensorRig& rig_;     // the belief: stamps, channels, noise
   const SensorRig mounted_;  // the truth: what the sensors see
   const CalibrationErrors& errors_;
-  const SimOptions& o_;
+  const SimOptions& options_;
   const int64_t start_, end_;
   SimulationStats stats_;
   ImuNoise imu_noise_;

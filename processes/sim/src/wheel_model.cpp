@@ -21,8 +21,8 @@ WheelReading idealWheelReading(const BodyState& s, const WheelRig& rig, int64_t 
   return r;
 }
 
-WheelSlip::WheelSlip(const WheelSlipOptions& options, Random rng) : o_(options), rng_(rng) {
-  if (!o_.enabled()) throw std::invalid_argument("WheelSlip: rate_per_min must be > 0");
+WheelSlip::WheelSlip(const WheelSlipOptions& options, Random rng) : options_(options), rng_(rng) {
+  if (!options_.enabled()) throw std::invalid_argument("WheelSlip: rate_per_min must be > 0");
 }
 
 void WheelSlip::drawNext() {
@@ -36,15 +36,15 @@ void WheelSlip::drawNext() {
   const double u_side = rng_.uniform();
   WheelSlipEpisode e;
   const double after = episodes_.empty() ? 0.0 : episodes_.back().end_s;
-  e.start_s = after - std::log1p(-u_gap) * 60.0 / o_.rate_per_min;
-  e.end_s = e.start_s + o_.min_duration_s + (o_.max_duration_s - o_.min_duration_s) * u_duration;
-  if (u_wheels < o_.both_probability)
+  e.start_s = after - std::log1p(-u_gap) * 60.0 / options_.rate_per_min;
+  e.end_s = e.start_s + options_.min_duration_s + (options_.max_duration_s - options_.min_duration_s) * u_duration;
+  if (u_wheels < options_.both_probability)
     e.left = e.right = true;
   else
     (u_side < 0.5 ? e.left : e.right) = true;
-  e.lock = u_lock < o_.lock_probability;
-  const double spin_l = o_.min_spin + (o_.max_spin - o_.min_spin) * u_left;
-  const double spin_r = o_.min_spin + (o_.max_spin - o_.min_spin) * u_right;
+  e.lock = u_lock < options_.lock_probability;
+  const double spin_l = options_.min_spin + (options_.max_spin - options_.min_spin) * u_left;
+  const double spin_r = options_.min_spin + (options_.max_spin - options_.min_spin) * u_right;
   if (e.left) e.left_factor = e.lock ? 0.0 : 1.0 + spin_l;
   if (e.right) e.right_factor = e.lock ? 0.0 : 1.0 + spin_r;
   episodes_.push_back(e);

@@ -65,12 +65,12 @@ class WheelSlip {
   bool apply(double t, WheelReading* r);
   /// The episodes drawn so far: every one starting up to the latest time asked for, and the next.
   const std::vector<WheelSlipEpisode>& episodes() const { return episodes_; }
-  const WheelSlipOptions& options() const { return o_; }
+  const WheelSlipOptions& options() const { return options_; }
 
  private:
   void drawNext();
 
-  WheelSlipOptions o_;
+  WheelSlipOptions options_;
   Random rng_;
   std::vector<WheelSlipEpisode> episodes_;
 };
