@@ -17,6 +17,8 @@ PACKAGES=(
   # livo-import: Ouster metadata JSON; ROS 1 bags written by the real ROS library in its tests
   nlohmann-json3-dev python3-rosbag python3-roslz4 python3-rospy python3-std-msgs
   python3-sensor-msgs python3-geometry-msgs python3-nav-msgs python3-numpy
+  # livo-import rosbag2: MCAP chunks compressed with zstd (lz4: liblz4-dev above), SQLite bags (.db3)
+  libzstd-dev libsqlite3-dev
   # report.html: three.js inlined into the page; headless Chromium renders it in the report tests
   libjs-three chromium fonts-dejavu-core
   # private bus (network namespaces) and process tools
@@ -29,7 +31,27 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+# Test tooling on npm (livo-import's rosbag2 fixtures): Debian's npm (and nodejs) only when no npm is
+# on the PATH (a nodejs that bundles npm, e.g. nodesource's, conflicts with Debian's npm package).
+command -v npm >/dev/null 2>&1 || missing+=(npm)
+
+# The node modules of npm test tooling, from each package-lock.json (idempotent and quiet).
+npm_test_tooling() {
+  local root dir
+  root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+  for dir in "$root/tests/import/rosbag2_fixtures"; do
+    [ -f "$dir/package-lock.json" ] || continue
+    [ "$dir/node_modules/.package-lock.json" -nt "$dir/package-lock.json" ] && continue
+    npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error >/dev/null || {
+      echo "install_deps.sh: npm ci failed in $dir" >&2
+      exit 1
+    }
+  done
+}
+if [ ${#missing[@]} -eq 0 ]; then
+  npm_test_tooling
+  exit 0
+fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
@@ -45,3 +67,4 @@ if ! { $SUDO apt-get update -qq && $SUDO apt-get install -y -qq --no-install-rec
   exit 1
 fi
 rm -f "$log"
+npm_test_tooling
