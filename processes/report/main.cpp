@@ -97,7 +97,8 @@ int markdown(int argc, char** argv) {
       .option("--injected", "TEXT;...", "faults injected by playback, one entry per channel")
       .option("--sensor-use", "TEXT;...",
               "what the estimators did with each sensor, one entry per line of their summaries")
-      .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)");
+      .option("--restarts", "FILE", "a supervised run's restarts.tsv (scripts/run_pipeline.sh --respawn)")
+      .option("--sensor-gaps", "FILE", "a live run's sensor_gaps.tsv (livo-sensor-watch, scripts/run_live.sh)");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   const std::string dir = cli.get("--dir");
   livo::report::ReportInputs in;
@@ -134,6 +135,7 @@ int markdown(int argc, char** argv) {
     in.supervised = true;
     in.restarts = livo::report::readRestarts(cli.get("--restarts"));
   }
+  if (!cli.get("--sensor-gaps").empty()) in.sensor_gaps = livo::report::readSensorGaps(cli.get("--sensor-gaps"));
   if (std::ifstream r(dir + "/resets.json"); r) in.resets = nlohmann::json::parse(r);
   if (std::ifstream c(dir + "/calibration.csv"); c)
     in.calibration = livo::report::readCalibrationCsv(dir + "/calibration.csv");

@@ -197,6 +197,7 @@ std::string reportMarkdown(const ReportInputs& in) {
   md << listSection("Injected faults",
                     "Faults injected by `livo-playback --faults` (seeded), per channel:", in.injected_faults);
   if (in.supervised || !in.restarts.empty()) md << restartsMarkdown(in.restarts);
+  if (in.sensor_gaps) md << sensorGapsMarkdown(*in.sensor_gaps);
   md << warningsMarkdown(in.warnings);
   return md.str();
 }

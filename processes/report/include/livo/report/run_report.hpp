@@ -12,6 +12,7 @@
 #include "livo/report/calibration_course.hpp"
 #include "livo/report/picture_set.hpp"
 #include "livo/report/pipeline_outputs.hpp"
+#include "livo/report/sensor_gaps.hpp"
 #include "livo/report/weak_spots.hpp"
 
 namespace livo::report {
@@ -59,6 +60,7 @@ struct ReportInputs {
   nlohmann::json resets = nlohmann::json::array();  // resetsJson(): LIO resets (odometry epochs)
   std::optional<WeakSpots> weak_spots;              // weak_spots.json: the "Where the estimate was weak" section
   std::optional<PictureSet> pictures;               // pictures.json (livo-report pictures): the "Maps" section
+  std::optional<std::vector<SensorGapRow>> sensor_gaps;  // a live run's sensor_gaps.tsv: the "Sensor gaps" section
   std::vector<CalibrationRow> calibration;  // lio's calibration.csv: the "Calibration" section (none: no section)
   const PipelineOutputs* outputs = nullptr;
 };
