@@ -17,6 +17,11 @@ PACKAGES=(
   # livo-import: Ouster metadata JSON; ROS 1 bags written by the real ROS library in its tests
   nlohmann-json3-dev python3-rosbag python3-roslz4 python3-rospy python3-std-msgs
   python3-sensor-msgs python3-geometry-msgs python3-nav-msgs python3-numpy
+  # livo-ros-bridge (optional at build time: built when these are there): roscpp, raw subscriptions
+  # (topic_tools::ShapeShifter), tf2_ros, the output messages' headers; its test: roscore
+  # (roslaunch, rosmaster, rosout) and /tf read from Python
+  libroscpp-dev libtopic-tools-dev libtf2-ros-dev libnav-msgs-dev libsensor-msgs-dev libgeometry-msgs-dev
+  python3-roslaunch python3-rosmaster rosout python3-tf2-msgs
   # livo-import rosbag2: MCAP chunks compressed with zstd (lz4: liblz4-dev above), SQLite bags (.db3)
   libzstd-dev libsqlite3-dev
   # report.html: three.js inlined into the page; headless Chromium renders it in the report tests

@@ -9,9 +9,9 @@
 
 namespace livo {
 
-const std::vector<std::string> kConfigSections = {"rig",       "sim",      "bus",         "playback", "lio",
-                                                  "lio_graph", "vio",      "vio_feature", "loop",     "colour",
-                                                  "octomap",   "pipeline", "evaluate"};
+const std::vector<std::string> kConfigSections = {"rig",       "sim",      "bus",         "playback",  "lio",
+                                                  "lio_graph", "vio",      "vio_feature", "loop",      "colour",
+                                                  "octomap",   "pipeline", "evaluate",    "ros_bridge"};
 
 namespace {
 
