@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# A ROS 1 bag through the whole pipeline in one command, into --out:
-#   input.lcmlog (+ .meta.yaml)   the bag imported by livo-import rosbag, on the rig's channel names
+# A ROS 1 bag (or a ROS 2 bag: its directory, a .mcap or a .db3) through the whole pipeline in one
+# command, into --out:
+#   input.lcmlog (+ .meta.yaml)   the bag imported by livo-import rosbag (rosbag2), on the rig's channel names
 #   rig_from_bag.yaml             a starter rig from what the bag told (livo-import --rig-out): rates,
 #                                 LiDAR rings and model, camera size, colour and camera_info
 #                                 calibration; "REPLACE:" marks what the bag could not tell
@@ -52,7 +53,10 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ -n "$bag" ] && [ -n "$rig" ] && [ -n "$out" ] || usage
-[ -f "$bag" ] || die "no such bag: $bag"
+[ -f "$bag" ] || [ -d "$bag" ] || die "no such bag: $bag"
+format=rosbag
+case "$bag" in *.mcap|*.db3) format=rosbag2 ;; esac
+[ -d "$bag" ] && format=rosbag2
 [ -f "$rig" ] || die "no such rig: $rig (config/rigs/ has templates and dataset rigs; livo-import --rig-out writes a starter)"
 for tool in livo-import livo-loginfo; do
   [ -x "$bin/$tool" ] || die "$bin/$tool missing: run scripts/build.sh"
@@ -75,7 +79,7 @@ mkdir -p "$out/logs"
 log="$out/input.lcmlog"
 say "importing $bag -> $log (starter rig: $out/rig_from_bag.yaml; summary: $out/logs/import.txt)"
 rc=0
-"$bin/livo-import" rosbag "$bag" --out "$log" --rig-out "$out/rig_from_bag.yaml" --rig "$rig" \
+"$bin/livo-import" "$format" "$bag" --out "$log" --rig-out "$out/rig_from_bag.yaml" --rig "$rig" \
   ${import_args[@]+"${import_args[@]}"} >"$out/logs/import.txt" || rc=$?
 # the channel table for the person at the terminal (livo-import printed the rig check on stderr)
 sed -n '/^channel /,/^total /p' "$out/logs/import.txt" | sed 's/^/  /' >&2

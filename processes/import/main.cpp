@@ -13,7 +13,7 @@ livo::CommandLine importCommandLine() {
       "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
       "DEPTH, GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
   cli.positional("FORMAT",
-                 "rosbag (ROS 1 bag), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
+                 "rosbag (ROS 1 bag), rosbag2 (ROS 2 bag: directory with metadata.yaml, .mcap or .db3), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
                  "ouster (pcap + metadata JSON)");
   cli.positional("INPUT", "the bag, folder or pcap file");
   cli.option("--out", "LOG", "output LCM log (required unless --list-topics)")
@@ -33,7 +33,7 @@ livo::CommandLine importCommandLine() {
               "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
       .flag("--no-auto-topics",
             "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
-      .flag("--list-topics", "rosbag: print the bag's topics, types and counts, then exit")
+      .flag("--list-topics", "rosbag, rosbag2: print the bag's topics, types and counts, then exit")
       .flag("--list-presets", "print the presets, then exit")
       .option("--rig-out", "FILE",
               "also write a starter rig config (YAML) from what the input told: channels, measured rates, LiDAR "

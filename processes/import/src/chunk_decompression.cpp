@@ -2,6 +2,7 @@
 
 #include <bzlib.h>
 #include <lz4frame.h>
+#include <zstd.h>
 
 namespace livo::import {
 
@@ -70,6 +71,39 @@ DecompressedChunk lz4(const uint8_t* in, size_t size, size_t expected) {
 }
 
 }  // namespace
+
+DecompressedChunk decompressZstd(const uint8_t* in, size_t size, size_t expected) {
+  DecompressedChunk out;
+  out.data.resize(expected);
+  ZSTD_DStream* s = ZSTD_createDStream();
+  if (!s) {
+    out.data.clear();
+    out.error = "zstd: cannot initialise the decompressor";
+    return out;
+  }
+  ZSTD_inBuffer src{in, size, 0};
+  ZSTD_outBuffer dst{out.data.data(), expected, 0};
+  size_t rc = 1;
+  while (rc != 0 && src.pos < src.size && dst.pos < dst.size) {
+    const size_t before_in = src.pos, before_out = dst.pos;
+    rc = ZSTD_decompressStream(s, &dst, &src);
+    if (ZSTD_isError(rc)) {
+      out.error = std::string("zstd: ") + ZSTD_getErrorName(rc) + " after " + std::to_string(dst.pos) + " bytes";
+      break;
+    }
+    if (src.pos == before_in && dst.pos == before_out) break;
+  }
+  ZSTD_freeDStream(s);
+  out.data.resize(dst.pos);
+  if (out.error.empty()) {
+    if (dst.pos == expected)
+      out.complete = true;
+    else
+      out.error = "zstd: frame gave " + std::to_string(dst.pos) + " of " + std::to_string(expected) +
+                  " bytes (truncated chunk?)";
+  }
+  return out;
+}
 
 DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size,
                                   size_t expected_size) {

@@ -5,6 +5,7 @@
 
 #include "livo/config.hpp"
 #include "livo/import/file_utils.hpp"
+#include "livo/import/rosbag2_import.hpp"
 #include "livo/import/rosbag_presets.hpp"
 
 namespace livo::import {
@@ -50,7 +51,7 @@ RosbagImportOptions rosbagFlags(const CommandLine& cli, const std::string& forma
   r.camera_info_topic = cli.get("--camera-info");
   if (cli.has("--ground-truth")) {
     const std::string gt = cli.get("--ground-truth");
-    if (format == "rosbag" && !gt.empty() && gt[0] == '/' && !isFile(gt))
+    if ((format == "rosbag" || format == "rosbag2") && !gt.empty() && gt[0] == '/' && !isFile(gt))
       r.ground_truth_topic = gt;
     else
       r.ground_truth_file = gt;
@@ -129,8 +130,9 @@ void printRosbagPresets(std::ostream& out) {
 }
 
 void printBagTopics(const std::string& format, const std::string& bag, std::ostream& out) {
-  if (format != "rosbag") throw std::invalid_argument("--list-topics is for the rosbag format");
-  for (const BagTopic& t : listBagTopics(bag)) out << t.topic << "  " << t.type << "  " << t.messages << "\n";
+  if (format != "rosbag" && format != "rosbag2")
+    throw std::invalid_argument("--list-topics is for the rosbag and rosbag2 formats");
+  for (const BagTopic& t : format == "rosbag2" ? listRosbag2Topics(bag) : listBagTopics(bag)) out << t.topic << "  " << t.type << "  " << t.messages << "\n";
 }
 
 }  // namespace livo::import

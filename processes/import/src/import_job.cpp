@@ -6,6 +6,7 @@
 
 #include "livo/config.hpp"
 #include "livo/import/rig_survey.hpp"
+#include "livo/import/rosbag2_import.hpp"
 #include "livo/import/rosbag_presets.hpp"
 #include "livo/import/sorted_log_writer.hpp"
 #include "livo/import/starter_rig_config.hpp"
@@ -20,7 +21,8 @@ void applyPreset(ImportJob& job) {
     for (const RosbagPreset& q : rosbagPresets()) names += " " + q.name;
     throw std::invalid_argument("unknown preset '" + job.preset + "' (known:" + names + ")");
   }
-  if (job.format != "rosbag") throw std::invalid_argument("preset '" + job.preset + "' is for the rosbag format");
+  if (job.format != "rosbag" && job.format != "rosbag2")
+    throw std::invalid_argument("preset '" + job.preset + "' is for the rosbag and rosbag2 formats");
   RosbagImportOptions& r = job.rosbag;
   auto fill = [](std::string& topic, const std::string& value) {
     if (topic.empty()) topic = value;
@@ -97,6 +99,11 @@ void runImporter(const ImportJob& job, SortedLogWriter& writer, ImportReport& re
       o.channels = job.channels;
       o.progress = !job.quiet;
       importRosbag({job.input}, o, writer, report);
+    } else if (job.format == "rosbag2") {
+      RosbagImportOptions o = job.rosbag;
+      o.channels = job.channels;
+      o.progress = !job.quiet;
+      importRosbag2(job.input, o, writer, report);
     } else if (job.format == "kitti") {
       KittiImportOptions o = job.kitti;
       o.channels = job.channels;
@@ -113,7 +120,7 @@ void runImporter(const ImportJob& job, SortedLogWriter& writer, ImportReport& re
       o.progress = !job.quiet;
       importOuster(job.input, o, writer, report);
     } else {
-      report.error("unknown format '" + job.format + "' (rosbag, kitti, euroc, ouster)");
+      report.error("unknown format '" + job.format + "' (rosbag, rosbag2, kitti, euroc, ouster)");
     }
   } catch (const std::exception& e) {
     report.error(e.what());

@@ -11,7 +11,26 @@ RosHeader decodeRosHeader(ByteReader& r) {
   return h;
 }
 
-RosTypeInfo rosTypeInfo(const std::string& type) {
+RosHeader decodeCdrHeader(CdrReader& r) {
+  RosHeader h;
+  const int32_t sec = r.i32("header.stamp.sec");
+  if (sec < 0) r.fail("header.stamp.sec", "negative (" + std::to_string(sec) + ")");
+  h.sec = static_cast<uint32_t>(sec);
+  h.nsec = r.u32("header.stamp.nanosec");
+  h.frame_id = r.string("header.frame_id");
+  return h;
+}
+
+namespace {
+/// "sensor_msgs/msg/Imu" (ROS 2) -> "sensor_msgs/Imu".
+std::string ros1TypeName(const std::string& type) {
+  const size_t p = type.find("/msg/");
+  return p == std::string::npos ? type : type.substr(0, p) + "/" + type.substr(p + 5);
+}
+}  // namespace
+
+RosTypeInfo rosTypeInfo(const std::string& type_name) {
+  const std::string type = ros1TypeName(type_name);
   RosTypeInfo t;
   if (type == "sensor_msgs/Imu") t = {RosMessageKind::kImu, "6a62c6daae103f4ff57a132d6f95cec2", nullptr};
   if (type == "sensor_msgs/PointCloud2")
@@ -20,15 +39,15 @@ RosTypeInfo rosTypeInfo(const std::string& type) {
   if (type == "sensor_msgs/CompressedImage")
     t = {RosMessageKind::kCompressedImage, "8f7a12909da2c9d3332d540a0977563f", nullptr};
   if (type == "sensor_msgs/CameraInfo") t = {RosMessageKind::kCameraInfo, "c9a58c1b0b154e0e6da7578cb991d214", nullptr};
-  if (type == "nav_msgs/Odometry") t = {RosMessageKind::kPose, "cd5e73d190d741a2f92e81eda573aca7", decodeRosOdometry};
+  if (type == "nav_msgs/Odometry") t = {RosMessageKind::kPose, "cd5e73d190d741a2f92e81eda573aca7", decodeRosOdometry, decodeCdrOdometry};
   if (type == "geometry_msgs/PoseStamped")
-    t = {RosMessageKind::kPose, "d3812c3cbc69362b77dc0b19b345f8f5", decodeRosPoseStamped};
+    t = {RosMessageKind::kPose, "d3812c3cbc69362b77dc0b19b345f8f5", decodeRosPoseStamped, decodeCdrPoseStamped};
   if (type == "geometry_msgs/PoseWithCovarianceStamped")
-    t = {RosMessageKind::kPose, "953b798c0f514ff060a53a3498ce6246", decodeRosPoseWithCovarianceStamped};
+    t = {RosMessageKind::kPose, "953b798c0f514ff060a53a3498ce6246", decodeRosPoseWithCovarianceStamped, decodeCdrPoseWithCovarianceStamped};
   if (type == "geometry_msgs/TransformStamped")
-    t = {RosMessageKind::kPose, "b5764a33bfeb3588febc2682852579b0", decodeRosTransformStamped};
+    t = {RosMessageKind::kPose, "b5764a33bfeb3588febc2682852579b0", decodeRosTransformStamped, decodeCdrTransformStamped};
   if (type == "geometry_msgs/PointStamped")
-    t = {RosMessageKind::kPose, "c63aecb41bfdfd6b7e1fac37c7cbe7bf", decodeRosPointStamped};
+    t = {RosMessageKind::kPose, "c63aecb41bfdfd6b7e1fac37c7cbe7bf", decodeRosPointStamped, decodeCdrPointStamped};
   return t;
 }
 

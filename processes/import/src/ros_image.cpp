@@ -1,10 +1,13 @@
-#include "livo/import/ros_messages.hpp"
+#include "ros_decoding.hpp"
 
 namespace livo::import {
 
-RosImage decodeRosImage(ByteReader& r) {
+namespace {
+
+template <class Reader>
+RosImage decodeImage(Reader& r) {
   RosImage m;
-  m.header = decodeRosHeader(r);
+  m.header = detail::decodeHeader(r);
   m.height = r.u32("height");
   m.width = r.u32("width");
   m.encoding = r.string("encoding");
@@ -16,9 +19,10 @@ RosImage decodeRosImage(ByteReader& r) {
   return m;
 }
 
-RosCompressedImage decodeRosCompressedImage(ByteReader& r) {
+template <class Reader>
+RosCompressedImage decodeCompressedImage(Reader& r) {
   RosCompressedImage m;
-  m.header = decodeRosHeader(r);
+  m.header = detail::decodeHeader(r);
   m.format = r.string("format");
   const uint32_t size = r.u32("data");
   m.data = r.bytes(size, "data");
@@ -26,9 +30,10 @@ RosCompressedImage decodeRosCompressedImage(ByteReader& r) {
   return m;
 }
 
-RosCameraInfo decodeRosCameraInfo(ByteReader& r) {
+template <class Reader>
+RosCameraInfo decodeCameraInfo(Reader& r) {
   RosCameraInfo m;
-  m.header = decodeRosHeader(r);
+  m.header = detail::decodeHeader(r);
   m.height = r.u32("height");
   m.width = r.u32("width");
   m.distortion_model = r.string("distortion_model");
@@ -36,8 +41,8 @@ RosCameraInfo decodeRosCameraInfo(ByteReader& r) {
   m.D.resize(n);
   for (uint32_t i = 0; i < n; ++i) m.D[i] = r.f64("D");
   for (double& k : m.K) k = r.f64("K");
-  r.skip(9 * 8, "R");
-  r.skip(12 * 8, "P");
+  r.skipF64(9, "R");
+  r.skipF64(12, "P");
   m.binning_x = r.u32("binning_x");
   m.binning_y = r.u32("binning_y");
   m.roi_x_offset = r.u32("roi.x_offset");
@@ -47,5 +52,14 @@ RosCameraInfo decodeRosCameraInfo(ByteReader& r) {
   r.u8("roi.do_rectify");
   return m;
 }
+
+}  // namespace
+
+RosImage decodeRosImage(ByteReader& r) { return decodeImage(r); }
+RosImage decodeCdrImage(CdrReader& r) { return decodeImage(r); }
+RosCompressedImage decodeRosCompressedImage(ByteReader& r) { return decodeCompressedImage(r); }
+RosCompressedImage decodeCdrCompressedImage(CdrReader& r) { return decodeCompressedImage(r); }
+RosCameraInfo decodeRosCameraInfo(ByteReader& r) { return decodeCameraInfo(r); }
+RosCameraInfo decodeCdrCameraInfo(CdrReader& r) { return decodeCameraInfo(r); }
 
 }  // namespace livo::import

@@ -1,4 +1,4 @@
-#include "livo/import/ros_messages.hpp"
+#include "ros_decoding.hpp"
 
 namespace livo::import {
 
@@ -16,9 +16,11 @@ int pointFieldSize(uint8_t datatype) {
   }
 }
 
-RosPointCloud2 decodeRosPointCloud2(ByteReader& r) {
+namespace {
+template <class Reader>
+RosPointCloud2 decodePointCloud2(Reader& r) {
   RosPointCloud2 m;
-  m.header = decodeRosHeader(r);
+  m.header = detail::decodeHeader(r);
   m.height = r.u32("height");
   m.width = r.u32("width");
   const uint32_t n = r.arrayLength("fields", 13);
@@ -38,5 +40,9 @@ RosPointCloud2 decodeRosPointCloud2(ByteReader& r) {
   m.is_dense = r.u8("is_dense") != 0;
   return m;
 }
+}  // namespace
+
+RosPointCloud2 decodeRosPointCloud2(ByteReader& r) { return decodePointCloud2(r); }
+RosPointCloud2 decodeCdrPointCloud2(CdrReader& r) { return decodePointCloud2(r); }
 
 }  // namespace livo::import

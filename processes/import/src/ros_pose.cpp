@@ -1,50 +1,55 @@
-#include "livo/import/ros_messages.hpp"
+#include "ros_decoding.hpp"
 
 namespace livo::import {
 
 namespace {
-void readPoint(ByteReader& r, RosStampedPose& p, const char* const names[3]) {
+template <class Reader>
+void readPoint(Reader& r, RosStampedPose& p, const char* const names[3]) {
   for (int i = 0; i < 3; ++i) p.position[i] = r.f64(names[i]);
 }
-void readQuaternion(ByteReader& r, RosStampedPose& p, const char* const names[4]) {
+template <class Reader>
+void readQuaternion(Reader& r, RosStampedPose& p, const char* const names[4]) {
   for (int i = 0; i < 4; ++i) p.orientation_xyzw[i] = r.f64(names[i]);
 }
 const char* const kPosePosition[3] = {"pose.position.x", "pose.position.y", "pose.position.z"};
 const char* const kPoseOrientation[4] = {"pose.orientation.x", "pose.orientation.y", "pose.orientation.z",
                                          "pose.orientation.w"};
-}  // namespace
 
-RosStampedPose decodeRosOdometry(ByteReader& r) {
+template <class Reader>
+RosStampedPose decodeOdometry(Reader& r) {
   RosStampedPose p;
-  p.header = decodeRosHeader(r);
+  p.header = detail::decodeHeader(r);
   p.child_frame_id = r.string("child_frame_id");
   readPoint(r, p, kPosePosition);
   readQuaternion(r, p, kPoseOrientation);
-  r.skip(36 * 8, "pose.covariance");
-  r.skip(6 * 8 + 36 * 8, "twist");
+  r.skipF64(36, "pose.covariance");
+  r.skipF64(6 + 36, "twist");  // Twist (two Vector3) and its covariance, all float64
   return p;
 }
 
-RosStampedPose decodeRosPoseStamped(ByteReader& r) {
+template <class Reader>
+RosStampedPose decodePoseStamped(Reader& r) {
   RosStampedPose p;
-  p.header = decodeRosHeader(r);
+  p.header = detail::decodeHeader(r);
   readPoint(r, p, kPosePosition);
   readQuaternion(r, p, kPoseOrientation);
   return p;
 }
 
-RosStampedPose decodeRosPoseWithCovarianceStamped(ByteReader& r) {
+template <class Reader>
+RosStampedPose decodePoseWithCovarianceStamped(Reader& r) {
   RosStampedPose p;
-  p.header = decodeRosHeader(r);
+  p.header = detail::decodeHeader(r);
   readPoint(r, p, kPosePosition);
   readQuaternion(r, p, kPoseOrientation);
-  r.skip(36 * 8, "pose.covariance");
+  r.skipF64(36, "pose.covariance");
   return p;
 }
 
-RosStampedPose decodeRosTransformStamped(ByteReader& r) {
+template <class Reader>
+RosStampedPose decodeTransformStamped(Reader& r) {
   RosStampedPose p;
-  p.header = decodeRosHeader(r);
+  p.header = detail::decodeHeader(r);
   p.child_frame_id = r.string("child_frame_id");
   const char* const t[3] = {"transform.translation.x", "transform.translation.y", "transform.translation.z"};
   const char* const q[4] = {"transform.rotation.x", "transform.rotation.y", "transform.rotation.z",
@@ -54,13 +59,27 @@ RosStampedPose decodeRosTransformStamped(ByteReader& r) {
   return p;
 }
 
-RosStampedPose decodeRosPointStamped(ByteReader& r) {
+template <class Reader>
+RosStampedPose decodePointStamped(Reader& r) {
   RosStampedPose p;
-  p.header = decodeRosHeader(r);
+  p.header = detail::decodeHeader(r);
   const char* const names[3] = {"point.x", "point.y", "point.z"};
   readPoint(r, p, names);
   p.has_orientation = false;
   return p;
 }
+
+}  // namespace
+
+RosStampedPose decodeRosOdometry(ByteReader& r) { return decodeOdometry(r); }
+RosStampedPose decodeCdrOdometry(CdrReader& r) { return decodeOdometry(r); }
+RosStampedPose decodeRosPoseStamped(ByteReader& r) { return decodePoseStamped(r); }
+RosStampedPose decodeCdrPoseStamped(CdrReader& r) { return decodePoseStamped(r); }
+RosStampedPose decodeRosPoseWithCovarianceStamped(ByteReader& r) { return decodePoseWithCovarianceStamped(r); }
+RosStampedPose decodeCdrPoseWithCovarianceStamped(CdrReader& r) { return decodePoseWithCovarianceStamped(r); }
+RosStampedPose decodeRosTransformStamped(ByteReader& r) { return decodeTransformStamped(r); }
+RosStampedPose decodeCdrTransformStamped(CdrReader& r) { return decodeTransformStamped(r); }
+RosStampedPose decodeRosPointStamped(ByteReader& r) { return decodePointStamped(r); }
+RosStampedPose decodeCdrPointStamped(CdrReader& r) { return decodePointStamped(r); }
 
 }  // namespace livo::import

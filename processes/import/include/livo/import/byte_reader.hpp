@@ -50,6 +50,8 @@ class ByteReader {
     return n;
   }
   void skip(size_t n, const char* field) { bytes(n, field); }
+  /// A fixed array of n float64 (covariances).
+  void skipF64(size_t n, const char* field) { bytes(n * 8, field); }
 
   size_t position() const { return pos_; }
   size_t remaining() const { return size_ - pos_; }

@@ -1,5 +1,5 @@
 // Decompression of ROS bag chunks: "none", "bz2" (libbz2) and "lz4" (ROS writes LZ4 frames, read
-// with liblz4's frame API). A damaged or truncated chunk yields what could be decompressed.
+// with liblz4's frame API); and of MCAP chunks ("zstd" too). A damaged or truncated chunk yields what could be decompressed.
 #pragma once
 
 #include <cstdint>
@@ -16,5 +16,8 @@ struct DecompressedChunk {
 
 /// `expected_size` is the chunk record's uncompressed size.
 DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size, size_t expected_size);
+/// A zstd frame (MCAP chunks) of `expected_size` bytes uncompressed (libzstd's streaming API, so a
+/// cut frame yields what came out before the cut).
+DecompressedChunk decompressZstd(const uint8_t* in, size_t size, size_t expected_size);
 
 }  // namespace livo::import

@@ -1,6 +1,10 @@
-// ROS 1 messages read from their serialised form (the wire format of the message definitions:
-// little-endian primitives, uint32-length strings and arrays, fixed arrays inline). Only the
-// types the importer needs; each decoder throws DecodeError naming the field that does not fit.
+// ROS messages read from their serialised form into plain structs, which the converters
+// (rosbag_import, ros_message_conversion) turn into the project's types. Two wire formats, one
+// struct per message: ROS 1 serialisation (decodeRos*: little-endian primitives, uint32-length
+// strings and arrays, fixed arrays inline) and ROS 2's CDR (decodeCdr*: cdr_reader.hpp; the ROS 2
+// definitions of these types have the ROS 1 fields in the same order, less std_msgs/Header's seq).
+// Only the types the importer needs; each decoder throws DecodeError naming the field that does
+// not fit.
 #pragma once
 
 #include <array>
@@ -9,6 +13,7 @@
 #include <vector>
 
 #include "livo/import/byte_reader.hpp"
+#include "livo/import/cdr_reader.hpp"
 
 namespace livo::import {
 
@@ -20,6 +25,8 @@ struct RosHeader {
   int64_t stampNs() const { return static_cast<int64_t>(sec) * 1000000000LL + nsec; }
 };
 RosHeader decodeRosHeader(ByteReader& r);
+/// std_msgs/msg/Header (ROS 2): builtin_interfaces/Time (int32 sec, uint32 nanosec), frame_id; seq 0.
+RosHeader decodeCdrHeader(CdrReader& r);
 
 /// sensor_msgs/Imu.
 struct RosImu {
@@ -29,6 +36,7 @@ struct RosImu {
   std::array<double, 3> linear_acceleration{};
 };
 RosImu decodeRosImu(ByteReader& r);
+RosImu decodeCdrImu(CdrReader& r);
 
 /// sensor_msgs/PointField datatypes.
 enum class PointFieldType : uint8_t { kInt8 = 1, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
@@ -52,6 +60,7 @@ struct RosPointCloud2 {
   bool is_dense = false;
 };
 RosPointCloud2 decodeRosPointCloud2(ByteReader& r);
+RosPointCloud2 decodeCdrPointCloud2(CdrReader& r);
 
 /// sensor_msgs/Image.
 struct RosImage {
@@ -64,6 +73,7 @@ struct RosImage {
   size_t data_size = 0;
 };
 RosImage decodeRosImage(ByteReader& r);
+RosImage decodeCdrImage(CdrReader& r);
 
 /// sensor_msgs/CompressedImage.
 struct RosCompressedImage {
@@ -73,6 +83,7 @@ struct RosCompressedImage {
   size_t data_size = 0;
 };
 RosCompressedImage decodeRosCompressedImage(ByteReader& r);
+RosCompressedImage decodeCdrCompressedImage(CdrReader& r);
 
 /// sensor_msgs/CameraInfo (the calibration; R, P, binning and ROI are read but only binning and
 /// ROI are kept, to tell a calibration that does not describe the images as they are).
@@ -86,6 +97,7 @@ struct RosCameraInfo {
   uint32_t roi_x_offset = 0, roi_y_offset = 0, roi_height = 0, roi_width = 0;
 };
 RosCameraInfo decodeRosCameraInfo(ByteReader& r);
+RosCameraInfo decodeCdrCameraInfo(CdrReader& r);
 
 /// A stamped position with an optional orientation: nav_msgs/Odometry, geometry_msgs/PoseStamped,
 /// PoseWithCovarianceStamped, TransformStamped (orientation) and PointStamped (position only).
@@ -101,16 +113,24 @@ RosStampedPose decodeRosPoseStamped(ByteReader& r);
 RosStampedPose decodeRosPoseWithCovarianceStamped(ByteReader& r);
 RosStampedPose decodeRosTransformStamped(ByteReader& r);
 RosStampedPose decodeRosPointStamped(ByteReader& r);
+RosStampedPose decodeCdrOdometry(CdrReader& r);
+RosStampedPose decodeCdrPoseStamped(CdrReader& r);
+RosStampedPose decodeCdrPoseWithCovarianceStamped(CdrReader& r);
+RosStampedPose decodeCdrTransformStamped(CdrReader& r);
+RosStampedPose decodeCdrPointStamped(CdrReader& r);
 
-/// The message kinds the importer reads, chosen by type name and checked against the md5sum the
-/// connection record carries (a bag with a different definition under the same name is refused).
+/// The message kinds the importer reads, chosen by type name ("sensor_msgs/Imu", or ROS 2's
+/// "sensor_msgs/msg/Imu") and, in ROS 1 bags, checked against the md5sum the connection record
+/// carries (a bag with a different definition under the same name is refused).
 enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kCameraInfo, kPose };
 struct RosTypeInfo {
   RosMessageKind kind = RosMessageKind::kUnsupported;
   const char* md5 = "";
   RosStampedPose (*decode_pose)(ByteReader&) = nullptr;
+  RosStampedPose (*decode_pose_cdr)(CdrReader&) = nullptr;
 };
-/// Info for a type name, kind kUnsupported if the importer has no decoder for it.
+/// Info for a type name (ROS 1 or ROS 2 spelling), kind kUnsupported if the importer has no
+/// decoder for it.
 RosTypeInfo rosTypeInfo(const std::string& type);
 
 }  // namespace livo::import
