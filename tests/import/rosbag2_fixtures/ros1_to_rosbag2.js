@@ -1,5 +1,7 @@
 // Converts a ROS 1 bag into a ROS 2 bag with other implementations than livo-import: the ROS 1 bag
-// read and its messages parsed by @foxglove/rosbag, each message mapped field by field onto its
+// read by @foxglove/rosbag (chunk by chunk, each chunk's messages in file order from its index
+// records: messages with equal receive times keep the order the recorder wrote them in, as in a
+// real conversion), parsed by @foxglove/rosmsg-serialization, each message mapped field by field onto its
 // ROS 2 Humble definition (@foxglove/rosmsg-msgs-common: header without seq, time as sec /
 // nanosec, CameraInfo's D K R P as d k r p), serialised to CDR by @foxglove/rosmsg2-serialization
 // and written by @mcap/core's McapWriter (zstd chunks by @foxglove/wasm-zstd). Messages keep the
@@ -13,6 +15,9 @@
 const fs = require("fs");
 const { Bag } = require("@foxglove/rosbag");
 const { FileReader } = require("@foxglove/rosbag/node");
+const { MessageData } = require("@foxglove/rosbag/dist/cjs/record");
+const { MessageReader } = require("@foxglove/rosmsg-serialization");
+const { parse } = require("@foxglove/rosmsg");
 const { McapWriter, TempBuffer } = require("@mcap/core");
 const { MessageWriter } = require("@foxglove/rosmsg2-serialization");
 const { ros2humble } = require("@foxglove/rosmsg-msgs-common");
@@ -67,24 +72,33 @@ async function main() {
   const channels = new Map();
   const serializers = new Map();
   const rows = [];
-  const pending = [];
-  await bag.readMessages({}, (r) => pending.push(r));
+  const readers = new Map();
   let seq = 0;
-  for (const r of pending) {
-    const conn = [...bag.connections.values()].find((c) => c.topic === r.topic);
-    const type = conn.type;  // "sensor_msgs/Imu"
-    const ros2Type = type.replace("/", "/msg/");
-    if (!channels.has(r.topic)) {
-      const schemaId = await writer.registerSchema({ name: ros2Type, encoding: "ros2msg", data: new Uint8Array() });
-      channels.set(r.topic, await writer.registerChannel({ topic: r.topic, messageEncoding: "cdr", schemaId,
-                                                           metadata: new Map() }));
-      serializers.set(r.topic, new MessageWriter(definitionsOf(type)));
+  const chunks = [...bag.chunkInfos].sort((a, b) => a.chunkPosition - b.chunkPosition);
+  for (const chunkInfo of chunks) {
+    const { chunk, indices } = await bag.reader.readChunk(chunkInfo, {});
+    const offsets = indices.flatMap((ix) => ix.indices.map((e) => e.offset)).sort((a, b) => a - b);
+    for (const offset of offsets) {
+      const record = bag.reader.readRecordFromBuffer(chunk.data.subarray(offset), chunk.dataOffset, MessageData);
+      const conn = bag.connections.get(record.conn);
+      const type = conn.type;  // "sensor_msgs/Imu"
+      const ros2Type = type.replace("/", "/msg/");
+      if (!channels.has(conn.topic)) {
+        const schemaId = await writer.registerSchema({ name: ros2Type, encoding: "ros2msg", data: new Uint8Array() });
+        channels.set(conn.topic, await writer.registerChannel({ topic: conn.topic, messageEncoding: "cdr", schemaId,
+                                                                metadata: new Map() }));
+        serializers.set(conn.topic, new MessageWriter(definitionsOf(type)));
+        readers.set(conn.topic, new MessageReader(parse(conn.messageDefinition)));
+      }
+      const message = readers.get(conn.topic).readMessage(record.data);
+      const data = serializers.get(conn.topic).writeMessage(toRos2(message, type));
+      const logTime = BigInt(record.time.sec) * 1000000000n + BigInt(record.time.nsec);
+      await writer.addMessage({ channelId: channels.get(conn.topic), sequence: seq++, logTime, publishTime: logTime,
+                                data });
+      if (rowsPath)
+        rows.push({ topic: conn.topic, type: ros2Type, timestamp: logTime.toString(),
+                    data: Buffer.from(data).toString("base64") });
     }
-    const data = serializers.get(r.topic).writeMessage(toRos2(r.message, type));
-    const logTime = BigInt(r.timestamp.sec) * 1000000000n + BigInt(r.timestamp.nsec);
-    await writer.addMessage({ channelId: channels.get(r.topic), sequence: seq++, logTime, publishTime: logTime, data });
-    if (rowsPath)
-      rows.push({ topic: r.topic, type: ros2Type, timestamp: logTime.toString(), data: Buffer.from(data).toString("base64") });
   }
   await writer.end();
   fs.writeFileSync(output, buffer.get());
