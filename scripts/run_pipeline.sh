@@ -25,6 +25,7 @@
 #                           [--faults F,...] [--seed N]   (livo-playback fault injection)
 #                           [--respawn | --no-respawn] [--max-restarts N] [--kill P:SIG:AT_S,...]
 #                           [--stop-grace S] [--overlay FILE,...] [--max-lag N] [--serial] [--ground-map]
+#                           [--bus URL] [--remote P,...] [--no-playback]   (across hosts: README, Across machines)
 # Processes default to those of lio, vio, vio_feature, loop, colour, octomap that have a section in FILE.
 # --respawn (the default with --realtime): a process that exits is restarted (at most
 # --max-restarts times each, 3 by default, after 0.5, 1, 2, ... s); the rest go on; report.md lists
@@ -42,6 +43,10 @@
 # before the next goes out (no lag, no quiet promises): slower, and the outputs are the same.
 # --ground-map: records REGISTERED_SCAN whatever --record says, and evaluation_odometry.json gets the
 # ground-map thickness of those scans against GROUND_TRUTH (livo-evaluate --ground-map).
+# --bus URL: the LCM bus to run on (a LAN's, e.g. udpm://239.255.76.67:7667?ttl=1) instead of a
+# private one. --remote P,...: processes (and `record`, the recorder) that another host runs on that
+# bus: the replay waits for them as for its own, none is started here. --no-playback: another host
+# replays; the processes (and the recorder) run here until SIGTERM, then stop as at a replay's end.
 set -euo pipefail
 # One brace group: bash reads all of it before running any of it, so editing this file during a
 # long run (a 30 min soak) cannot break that run.
@@ -50,10 +55,10 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,44p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,49p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
-log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0 ground_map=0
+log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0 ground_map=0 bus="" remote="" no_playback=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
 declare -A swap=()
 while [ $# -gt 0 ]; do
@@ -76,6 +81,9 @@ while [ $# -gt 0 ]; do
     --max-lag) max_lag="$2"; shift 2 ;;
     --serial) serial=1; shift ;;
     --ground-map) ground_map=1; shift ;;
+    --bus) bus="$2"; shift 2 ;;
+    --remote) remote="$2"; shift 2 ;;
+    --no-playback) no_playback=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
             exe="${2#*=}"
             # a path relative to where the script was called from (the processes run inside --out)
@@ -139,11 +147,28 @@ if [ "$inside" = 0 ]; then
   [ "${free_mb:-0}" -ge $(( log_mb + 500 )) ] || \
     echo "run_pipeline.sh: warning: $free_mb MB free where $out is; the outputs may need about $log_mb MB and more" >&2
   rc=0
-  "$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
+  # on a given bus (another host's processes share it) rather than a private one
+  [ -z "$bus" ] || export LIVO_PRIVATE_BUS=1 LCM_DEFAULT_URL="$bus"
+  inner=("$root/scripts/private_bus.sh" "$0" --inside-bus --log "$log" --config "$config" --out "$out" \
     --processes "$(IFS=,; echo "${selected[*]}")" --record "$record" ${swaps[@]+"${swaps[@]}"} \
+    --remote "$remote" $([ "$no_playback" = 1 ] && echo --no-playback) \
     --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --max-lag "$max_lag" $([ "$serial" = 1 ] && echo --serial) --kill "$kills" --stop-grace "$stop_grace" \
     $([ "$respawn" = 1 ] && echo --respawn || echo --no-respawn) \
-    $([ "$realtime" = 1 ] && echo --realtime) || rc=$?
+    $([ "$realtime" = 1 ] && echo --realtime)) || true  # (an assignment fails as its last $(...))
+  if [ "$no_playback" = 1 ]; then  # SIGTERM ends the run: passed on to the processes' side
+    "${inner[@]}" &
+    inner_pid=$!
+    trap 'kill -TERM "$inner_pid" 2>/dev/null || true' TERM
+    wait "$inner_pid" || rc=$?
+    kill -0 "$inner_pid" 2>/dev/null && { rc=0; wait "$inner_pid" || rc=$?; }  # the signal ended the first wait
+    trap - TERM
+  else
+    "${inner[@]}" || rc=$?
+  fi
+  if [[ ",$remote," == *",record,"* ]]; then  # no outputs here: the recorder's host has them and the report
+    [ "$rc" = 0 ] || { echo "run_pipeline.sh: FAILED:" >&2; cat "$out/logs/run.txt" >&2 || true; }
+    exit "$rc"
+  fi
 
   # Files for the user, whatever happened above (outputs so far are kept).
   warnings=()
@@ -231,8 +256,10 @@ exec 3>"$out/logs/run.txt"
 sink_nice=()
 [ "$realtime" = 0 ] && [ "$serial" = 0 ] && [ "$max_lag" -gt 0 ] && sink_nice=(env LIVO_HANDLER_NICE=10)
 nice_of() { case "$1" in colour|octomap|record) echo "${sink_nice[@]}" ;; esac; }
-$(nice_of record) "$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
-logger=$!
+logger=""  # the recorder, unless another host runs it (--remote record)
+[[ ",$remote," == *",record,"* ]] ||
+  { $(nice_of record) "$bin/livo-record" --out "$out/outputs.lcmlog" --channels "$record" --name record 2>"$out/logs/record.log" &
+    logger=$!; }
 : > "$out/logs/restarts.tsv"
 declare -A pids=() restarts=() next_start=() died_at=() ended=()
 now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
@@ -270,12 +297,17 @@ lost_on_restart() {
 log_time() { cat "$out/logs/log_clock" 2>/dev/null || echo '?'; }
 
 start=$(date +%s%N)
+# the replay's consumers: these processes, those of other hosts (--remote) and the recorder
+consumers=("${selected[@]}")
+IFS=, read -ra remote_list <<<"$remote"
+for p in ${remote_list[@]+"${remote_list[@]}"}; do [ "$p" = record ] || consumers+=("$p"); done
+consumers+=(record)
 if [ "$realtime" = 1 ]; then
-  replay=(--speed 1 --consumers "$(IFS=,; echo "${selected[*]}"),record" --startup-timeout 60)
+  replay=(--speed 1 --consumers "$(IFS=,; echo "${consumers[*]}")" --startup-timeout 60)
 else
-  replay=(--lockstep --consumers "$(IFS=,; echo "${selected[*]}"),record" --stall-timeout 60 --startup-timeout 60)
+  replay=(--lockstep --consumers "$(IFS=,; echo "${consumers[*]}")" --stall-timeout 60 --startup-timeout 60)
   # the sinks (livo-playback checks from their PROGRESS that nothing but the recorder takes their outputs)
-  lag=(record); for p in "${selected[@]}"; do case "$p" in colour|octomap) lag+=("$p") ;; esac; done
+  lag=(record); for p in "${consumers[@]}"; do case "$p" in colour|octomap) lag+=("$p") ;; esac; done
   [ "$max_lag" -gt 0 ] && replay+=(--lag "$(IFS=,; echo "${lag[*]}")" --max-lag "$max_lag")
   [ "$serial" = 1 ] && replay+=(--serial)
   [ "$respawn" = 1 ] && replay+=(--respawn)
@@ -283,8 +315,15 @@ fi
 [ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")
 rc=0
 replay+=(--clock-file "$out/logs/log_clock")  # the log seconds replayed so far: --kill, the restart table
-"$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
-playback=$!
+if [ "$no_playback" = 1 ]; then  # another host replays: a stand-in that SIGTERM ends
+  echo "run_pipeline.sh: --no-playback: another host replays; this one runs until SIGTERM" >"$out/logs/playback.log"
+  sleep infinity &
+  playback=$!
+  trap 'kill "$playback" 2>/dev/null || true' INT TERM
+else
+  "$bin/livo-playback" "$log" "${replay[@]}" 2> >(tee "$out/logs/playback.log" >&2) &
+  playback=$!
+fi
 t0=$(now_ms)
 declare -a kill_plan=()
 IFS=, read -ra kill_plan <<<"$kills"
@@ -327,6 +366,7 @@ while kill -0 "$playback" 2>/dev/null; do
       tail -n 15 "$out/logs/$p.log" | sed 's/^/    /' >&3
       died=1
       kill -INT "$playback" 2>/dev/null || true
+      [ "$no_playback" = 0 ] || kill "$playback" 2>/dev/null || true  # the stand-in ignores SIGINT
       break 2
     fi
     echo "=== $p $how; $( [ "${restarts[$p]}" -lt "$max_restarts" ] && echo restarting || echo 'not restarted: restart limit reached' ) ===" >>"$out/logs/$p.log"
@@ -346,6 +386,7 @@ while kill -0 "$playback" 2>/dev/null; do
   if [ ${#kill_plan[@]} -gt 0 ]; then sleep 0.05; else sleep 0.2; fi
 done
 wait "$playback" || rc=$?
+[ "$no_playback" = 0 ] || rc=0
 for k in "${kill_plan[@]}"; do
   echo "--kill $k was never sent: the replay ended at $(cat "$out/logs/log_clock" 2>/dev/null || echo '?') s of log" >&3
 done
@@ -384,8 +425,10 @@ for p in "${!pids[@]}"; do
   fi
 done
 sleep 0.3
-kill -INT "$logger" 2>/dev/null || true
-wait "$logger" 2>/dev/null || true
+if [ -n "$logger" ]; then
+  kill -INT "$logger" 2>/dev/null || true
+  wait "$logger" 2>/dev/null || true
+fi
 [ "$rc" = 0 ] && [ "$failed" = 0 ] || exit 1
 exit 0
 }
