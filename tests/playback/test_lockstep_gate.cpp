@@ -3,10 +3,12 @@
 #include <limits>
 
 #include "livo/playback/lockstep_gate.hpp"
+#include "livo/playback/sender_clocks.hpp"
 
 using livo::progress_t;
 using livo::playback::LockstepGate;
 using livo::playback::LockstepGateOptions;
+using livo::playback::SenderClocks;
 
 namespace {
 progress_t progress(const std::string& node, int64_t seq, std::vector<std::pair<std::string, int64_t>> in,
@@ -149,6 +151,37 @@ TEST(LockstepGate, AnIdleReportCheckedBeforeThePublishIsNotALoss) {
   g.onProgress(progress("stage2", 3, {{"IMU", 0}}, {}, false, true), 7.1, 6.2);
   EXPECT_EQ(g.lostMessages(), 1);
   EXPECT_TRUE(g.idle());
+}
+
+// The same reports from a node on another host, whose clock reads 1000 s ahead of playback's
+// (another boot): its check times, brought onto playback's clock by SenderClocks, decide as above.
+// On playback's own host (offset 0) they come out at most the quickest delivery late.
+TEST(LockstepGate, AnIdleReportFromAnotherHostIsJudgedOnPlaybacksClock) {
+  for (const double offset : {1000.0, -1000.0, 0.0}) {
+    LockstepGateOptions o;
+    o.loss_grace_s = 1.0;
+    LockstepGate g({"stage2"}, o);
+    SenderClocks clocks;
+    // (sequence, checked on playback's clock, received)
+    auto report = [&](int64_t seq, double checked_s, double received_s) {
+      const double local = clocks.toLocal("stage2", 1, checked_s + offset, received_s);
+      EXPECT_GE(local, checked_s - 1e-9);
+      EXPECT_LE(local, received_s + 1e-9);
+      g.onProgress(progress("stage2", seq, {{"IMU", 0}}, {}, false, true), received_s, local);
+      return local;
+    };
+    EXPECT_NEAR(report(0, 0.0, 0.002), 0.002, 1e-9);  // the first report: no better bound than its receipt
+    g.onPublished("IMU", 5.0);
+    EXPECT_NEAR(report(1, 4.99, 7.0), 4.992, 1e-9);  // received 2 s late: checked before the publish
+    EXPECT_EQ(g.lostMessages(), 0);
+    EXPECT_FALSE(g.idle());
+    EXPECT_NEAR(report(2, 7.1, 7.1005), 7.1005, 1e-9);  // a quicker delivery tightens the bound
+    EXPECT_EQ(g.lostMessages(), 1);                     // checked idle 2.1 s after the publish: lost
+    EXPECT_TRUE(g.idle());
+    EXPECT_NEAR(clocks.toLocal("stage2", 1, 8.0 + offset, 9.0), 8.0005, 1e-9);  // the bound stays
+    // a new instance (restarted, maybe elsewhere) starts with no bound of its own
+    EXPECT_NEAR(clocks.toLocal("stage2", 2, 500.0, 9.5), 9.5, 1e-9);
+  }
 }
 
 TEST(LockstepGate, ToleratesRestartsWhenAsked) {

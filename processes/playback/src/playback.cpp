@@ -16,6 +16,7 @@
 #include "livo/message_registry.hpp"
 #include "livo/node.hpp"
 #include "livo/playback/lockstep_gate.hpp"
+#include "livo/playback/sender_clocks.hpp"
 
 namespace livo::playback {
 
@@ -109,7 +110,7 @@ class PlaybackRun {
         faults_(options.faults, options.seed),
         sink_(lcm, options.out_log),
         gate_(options.consumers, gateOptions(options)),
-        context_{&gate_, wall_start_, {}} {
+        context_{&gate_, wall_start_, {}, {}} {
     if (!sink_.toFile() && !lcm) throw std::invalid_argument("runPlayback: no bus and no output log");
     if (options.lockstep && options.consumers.empty())
       throw std::invalid_argument("--lockstep needs the consumer node names (--consumers a,b,...)");
@@ -208,6 +209,7 @@ class PlaybackRun {
     LockstepGate* gate;
     Clock::time_point start;
     std::string last_mover;  // the node whose PROGRESS last moved a count on
+    SenderClocks clocks;     // each node's clock against ours (it may run on another host)
   };
 
   static LockstepGateOptions gateOptions(const PlaybackOptions& options) {
@@ -229,12 +231,12 @@ class PlaybackRun {
         +[](const lcm::ReceiveBuffer* rbuf, const std::string&, ProgressContext* c) {
           progress_t p;
           if (p.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size)) return;
-          // the node's monotonic clock is this process's steady clock (one host)
+          // the node's monotonic clock: this host's or another's, with an offset bounded from its reports
+          const double received_s = std::chrono::duration<double>(Clock::now() - c->start).count();
           const double idle_checked_s =
-              p.idle_checked_us > 0
-                  ? p.idle_checked_us * 1e-6 - std::chrono::duration<double>(c->start.time_since_epoch()).count()
-                  : std::nan("");
-          if (c->gate->onProgress(p, std::chrono::duration<double>(Clock::now() - c->start).count(), idle_checked_s))
+              p.idle_checked_us > 0 ? c->clocks.toLocal(p.node, p.instance, p.idle_checked_us * 1e-6, received_s)
+                                    : std::nan("");
+          if (c->gate->onProgress(p, received_s, idle_checked_s))
             c->last_mover = p.node;
         },
         &context_);
