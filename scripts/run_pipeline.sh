@@ -174,7 +174,11 @@ if [ "$inside" = 0 ]; then
   warnings=()
   if [ -f "$out/outputs.lcmlog" ]; then
     extract_rc=0
-    "$bin/livo-report" extract "$out/outputs.lcmlog" --dir "$out" 2>"$out/logs/report_extract.log" || extract_rc=$?
+    # real time: each output's latency into timing.json (the arrival and trace files of the run)
+    latency=()
+    [ -s "$out/logs/arrivals.tsv" ] && latency=(--arrivals "$out/logs/arrivals.tsv" --traces "$out/logs")
+    "$bin/livo-report" extract "$out/outputs.lcmlog" --dir "$out" ${latency[@]+"${latency[@]}"} \
+      2>"$out/logs/report_extract.log" || extract_rc=$?
     cat "$out/logs/report_extract.log" >>"$out/logs/report.log"
     [ "$extract_rc" = 0 ] || warnings+=("no odometry was produced (see logs/)")
     # what extract found wrong in the outputs (a trajectory it could not correct, undecodable messages)
@@ -249,6 +253,12 @@ fi
 
 # ---- inside the private bus --------------------------------------------------------------------
 exec 3>"$out/logs/run.txt"
+# Real time: when each message arrived and went out, for report.md's "Latency" (processes/report/
+# README.md): the recorder times every message on the bus (livo-record --arrivals), each process
+# its publications (LIVO_LATENCY_TRACE, common/node.hpp). None in lockstep (nothing changes there).
+rm -f "$out/logs/arrivals.tsv" "$out/logs/"*.trace.tsv
+if [ "$realtime" = 1 ]; then export LIVO_RECORD_ARRIVALS="$out/logs/arrivals.tsv"; fi
+latency_trace() { if [ "$realtime" = 1 ]; then echo "$out/logs/$1.trace.tsv"; fi; }
 # Lockstep with lagging sinks: their handler threads run niced (LIVO_HANDLER_NICE), so that the
 # processes on the replay's critical path (playback, lio, vio, loop) get a core the moment they
 # have work (scheduling, not order: the outputs are the same). Not their LCM receive threads: those
@@ -268,10 +278,12 @@ start_process() {
   # a process may keep what must survive a restart in LIVO_STATE_DIR (lio: its epoch and keyframe
   # numbering), and LIVO_RESTARTS says how often it was restarted
   if [ "$respawn" = 1 ]; then
-    (cd "$out" && LIVO_STATE_DIR="$out/state" LIVO_RESTARTS="${restarts[$1]:-0}" exec $(nice_of "$1") "$(exe_of "$1")" \
+    (cd "$out" && LIVO_STATE_DIR="$out/state" LIVO_RESTARTS="${restarts[$1]:-0}" LIVO_LATENCY_TRACE="$(latency_trace "$1")" \
+      exec $(nice_of "$1") "$(exe_of "$1")" \
       --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
   else
-    (cd "$out" && exec $(nice_of "$1") "$(exe_of "$1")" --config "$config" --name "$1") >>"$out/logs/$1.log" 2>&1 &
+    (cd "$out" && LIVO_LATENCY_TRACE="$(latency_trace "$1")" exec $(nice_of "$1") "$(exe_of "$1")" --config "$config" \
+      --name "$1") >>"$out/logs/$1.log" 2>&1 &
   fi
   pids[$1]=$!
 }

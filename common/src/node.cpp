@@ -23,6 +23,7 @@
 #include "livo/health_t.hpp"
 #include "livo/image_t.hpp"
 #include "livo/imu_t.hpp"
+#include "livo/message_registry.hpp"
 #include "livo/point_cloud_t.hpp"
 #include "livo/pose_t.hpp"
 #include "livo/progress_t.hpp"
@@ -101,12 +102,18 @@ Node::Node(lcm::LCM& lcm, NodeOptions options) : lcm_(lcm), options_(std::move(o
     options_.drop_received = parseDropReceived(drop);
   // Unique per start: wall clock in ns mixed with the process id.
   instance_ = std::chrono::system_clock::now().time_since_epoch().count() ^ (static_cast<int64_t>(getpid()) << 40);
+  if (const char* trace = std::getenv("LIVO_LATENCY_TRACE"); trace && *trace) {
+    trace_ = std::fopen(trace, "a");  // a restarted process goes on in the same file
+    if (!trace_) throw std::runtime_error(std::string("LIVO_LATENCY_TRACE: cannot write ") + trace);
+    std::setvbuf(trace_, nullptr, _IOLBF, 0);  // whole lines, even if the process is killed
+  }
 }
 
 Node::~Node() {
   // Subscriptions point into subs_: unsubscribe before it goes away (the LCM may outlive us).
   for (auto* s : lcm_subs_) lcm_.unsubscribe(s);
   if (peer_sub_) lcm_.unsubscribe(peer_sub_);
+  if (trace_) std::fclose(trace_);
 }
 
 void Node::watchConsumers(const std::string& channel, double stale_s) {
@@ -145,6 +152,12 @@ void Node::subscribeRaw(const std::string& channel, std::function<void(const voi
 }
 
 namespace {
+// CLOCK_REALTIME in µs, the clock of LCM's recv_utime.
+int64_t wallMicros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
 // Whether an encoded message is raw sensor input (its leading 8-byte type fingerprint, big-endian).
 // The handler-delay test hook spares these: a node sleeping a mean N/2 ms per 200 Hz IMU message
 // could not keep up in real time, and the kernel would drop most of the stream.
@@ -176,6 +189,11 @@ void Node::dispatch(const lcm::ReceiveBuffer* rbuf, const std::string&, Subscrip
     std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms(node.handler_delay_rng_)));
   }
   node.current_ = sub;
+  if (node.trace_) {
+    node.current_recv_us_ = rbuf->recv_utime;
+    node.current_start_us_ = wallMicros();
+    if (!messageUtime(rbuf->data, static_cast<int>(rbuf->data_size), &node.current_utime_)) node.current_utime_ = -1;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   try {
     sub->handler(rbuf->data, static_cast<int>(rbuf->data_size));
@@ -197,9 +215,20 @@ void Node::flushProgress() {
 }
 
 void Node::publishRaw(const std::string& channel, const void* data, int size) {
+  if (trace_) tracePublish(channel, data, size);
   lcm_.publish(channel, data, static_cast<unsigned int>(size));
   ++published_[channel];
   published_bytes_[channel] += size;
+}
+
+void Node::tracePublish(const std::string& channel, const void* data, int size) {
+  int64_t utime = -1;
+  if (!messageUtime(data, size, &utime)) utime = -1;
+  // outside a handler (at shutdown): no input, "-"
+  std::fprintf(trace_, "%s\t%lld\t%s\t%lld\t%lld\t%lld\t%lld\n", channel.c_str(), static_cast<long long>(utime),
+               current_ ? current_->channel.c_str() : "-", static_cast<long long>(current_ ? current_utime_ : -1),
+               static_cast<long long>(current_ ? current_recv_us_ : 0),
+               static_cast<long long>(current_ ? current_start_us_ : 0), static_cast<long long>(wallMicros()));
 }
 
 Node::Subscription* Node::find(const std::string& channel) const {

@@ -1,9 +1,19 @@
 // livo-record --out LOG --channels A,B,...: records channels as a lockstep participant.
+#include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "livo/command_line.hpp"
 #include "livo/record/recorder.hpp"
+
+namespace {
+// LIVO_RECORD_ARRIVALS: --arrivals from the environment (scripts/run_pipeline.sh in real time)
+std::string arrivalsDefault() {
+  const char* v = std::getenv("LIVO_RECORD_ARRIVALS");
+  return v ? v : "";
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   livo::CommandLine cli(
@@ -12,7 +22,11 @@ int main(int argc, char** argv) {
   cli.option("--out", "LOG", "log to write")
       .option("--channels", "A,B,...", "channels to record (names, not patterns)")
       .option("--name", "NAME", "node name on the bus", "record")
-      .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)");
+      .option("--lcm-url", "URL", "LCM URL (default: $LCM_DEFAULT_URL)")
+      .option("--arrivals", "FILE",
+              "also write when each message on the bus (but PROGRESS) arrived, wall clock, to FILE: real-time "
+              "latency (livo-report extract --arrivals); the log is unchanged",
+              arrivalsDefault());
   if (!cli.parse(argc, argv)) return cli.exitCode();
   if (!cli.has("--out") || !cli.has("--channels")) {
     std::cerr << "livo-record: --out and --channels are required\n" << cli.usage();
@@ -29,7 +43,12 @@ int main(int argc, char** argv) {
     o.quiet = true;
     livo::Node node(*lcm, o);
     livo::record::Recorder recorder(node, cli.get("--out"), channels);
-    const int rc = livo::spin(*lcm, node, [&] { recorder.finish(o.health_channel); });
+    std::unique_ptr<livo::record::ArrivalLog> arrivals;
+    if (cli.has("--arrivals")) arrivals = std::make_unique<livo::record::ArrivalLog>(*lcm, cli.get("--arrivals"));
+    const int rc = livo::spin(*lcm, node, [&] {
+      recorder.finish(o.health_channel);
+      if (arrivals) arrivals->flush();
+    });
     std::cerr << "[" << o.name << "] wrote " << recorder.written() << " messages to " << cli.get("--out") << std::endl;
     return rc;
   } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include "livo/command_line.hpp"
 #include "livo/file_output.hpp"
 #include "livo/report/html_report.hpp"
+#include "livo/report/latency.hpp"
 #include "livo/report/memory_profile.hpp"
 #include "livo/report/pipeline_outputs.hpp"
 #include "livo/report/run_pictures.hpp"
@@ -50,7 +51,11 @@ int extract(int argc, char** argv) {
       .option("--health-channel", "CH", "node health", "HEALTH")
       .option("--prior-channel", "CH", "images handed to the VIO (STATE_PRIOR)", "STATE_PRIOR")
       .option("--posterior-channel", "CH", "the VIO's answers (STATE_POSTERIOR)", "STATE_POSTERIOR")
-      .option("--camera-channel", "CH", "images (named in the VIOs' HEALTH)", "CAMERA");
+      .option("--camera-channel", "CH", "images (named in the VIOs' HEALTH)", "CAMERA")
+      .option("--colored-cloud-channel", "CH", "the coloured map's updates (latency)", "COLORED_CLOUD")
+      .option("--arrivals", "FILE",
+              "real time: livo-record --arrivals of the run, for each output's latency in timing.json")
+      .option("--traces", "DIR", "with --arrivals: where the processes' LIVO_LATENCY_TRACE files (P.trace.tsv) are");
   if (!cli.parse(argc, argv)) return cli.exitCode();
   livo::report::PipelineChannels ch;
   ch.odometry = cli.get("--odometry-channel");
@@ -65,7 +70,20 @@ int extract(int argc, char** argv) {
   livo::writeTum(dir + "/odometry.tum", out.odometry);
   std::vector<std::string> trajectory_warnings;
   livo::writeTum(dir + "/trajectory.tum", livo::report::loopCorrectedTrajectory(out, &trajectory_warnings));
-  writeText(dir + "/timing.json", livo::report::timingJson(out.final_health).dump(2) + "\n");
+  nlohmann::json timing = livo::report::timingJson(out.final_health);
+  if (cli.has("--arrivals")) {
+    const auto traces = cli.has("--traces") ? livo::report::readPublishTraceDir(cli.get("--traces"))
+                                            : std::vector<livo::report::PublishTrace>{};
+    const auto latency = livo::report::computeLatency(
+        livo::report::readArrivals(cli.get("--arrivals")), traces,
+        livo::report::defaultLatencySpecs(ch.odometry, ch.state_posterior, cli.get("--colored-cloud-channel")));
+    livo::report::addLatency(latency, &timing);
+    for (const auto& c : latency)
+      std::cerr << "livo-report: latency of " << c.channel << ": " << c.messages << " messages, p50 "
+                << livo::formatFixed(c.p50_ms, 1) << " ms, p99 " << livo::formatFixed(c.p99_ms, 1) << " ms, max "
+                << livo::formatFixed(c.max_ms, 1) << " ms\n";
+  }
+  writeText(dir + "/timing.json", timing.dump(2) + "\n");
   writeText(dir + "/resets.json", livo::report::resetsJson(out.resets));
   const livo::report::WeakSpots weak = livo::report::findWeakSpots(out, ch.camera);
   writeText(dir + "/weak_spots.json", livo::report::weakSpotsJson(weak).dump(2) + "\n");

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <functional>
 #include <iosfwd>
@@ -220,6 +221,12 @@ class Node {
   std::map<std::string, Watch> watched_;  // channel -> its consumers
   lcm::Subscription* peer_sub_ = nullptr;
   std::mt19937 handler_delay_rng_;  // seeded by the node name (handler_delay_max_ms)
+  // LIVO_LATENCY_TRACE=FILE (real-time runs, livo-report's latency): a line per published message
+  // with its stamp, the input whose handler published it, when that input was received (LCM's
+  // recv_utime), when its handler started and when the message went out (wall clock, µs).
+  std::FILE* trace_ = nullptr;
+  int64_t current_recv_us_ = 0, current_start_us_ = 0, current_utime_ = -1;
+  void tracePublish(const std::string& channel, const void* data, int size);
 };
 
 /// Sets the shutdown flag on SIGINT/SIGTERM (idempotent).

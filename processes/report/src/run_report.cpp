@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "livo/report/latency.hpp"
 #include "livo/text_format.hpp"
 
 namespace livo::report {
@@ -191,6 +192,7 @@ std::string reportMarkdown(const ReportInputs& in) {
   if (in.weak_spots) md << weakSpotsMarkdown(*in.weak_spots);
   if (in.pictures) md << mapsMarkdown(*in.pictures);
   md << processingTimeMarkdown(in.timing);
+  md << latencyMarkdown(in.timing);
   if (!in.calibration.empty()) md << calibrationMarkdown(in.calibration);
   md << listSection("Sensor use",
                     "What the estimators did with their inputs, from their summaries at exit:", in.sensor_use);

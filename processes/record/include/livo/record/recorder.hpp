@@ -7,6 +7,7 @@
 // jumps by decades (its duration, and a real-time replay of it, would be absurd).
 #pragma once
 
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,6 +19,38 @@ class LogFile;
 }
 
 namespace livo::record {
+
+/// Arrival times for real-time latency (livo-report's "Latency"): a line per message received on
+/// any channel of the bus but `skip` (PROGRESS: every node's, after every message),
+/// `channel  type  utime  end_utime  arrival_us`, where arrival_us is LCM's recv_utime (wall clock,
+/// µs, taken by its receive thread: no wait behind the recorder's own writes), type the LCM type
+/// name ("-" if unknown), utime the message's stamp (-1 if it has none) and end_utime the end of a
+/// LiDAR sweep (utime + sweep_duration; utime for other types). The subscription goes past the
+/// node, so it adds nothing to PROGRESS: lockstep does not wait for it and the log is unchanged.
+class ArrivalLog {
+ public:
+  /// Throws std::runtime_error naming the file if it cannot be written. Appends (a restarted
+  /// recorder goes on in the same file).
+  ArrivalLog(lcm::LCM& lcm, const std::string& path, std::string skip = "PROGRESS");
+  ~ArrivalLog();
+  ArrivalLog(const ArrivalLog&) = delete;
+  ArrivalLog& operator=(const ArrivalLog&) = delete;
+  void flush();
+  int64_t written() const { return written_; }
+
+ private:
+  static void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, ArrivalLog* self);
+
+  lcm::LCM& lcm_;
+  std::string skip_;
+  std::FILE* file_ = nullptr;
+  lcm::Subscription* sub_ = nullptr;
+  int64_t written_ = 0;
+};
+
+/// The header and one line of an arrival log (ArrivalLog), for writers and readers of the format.
+std::string arrivalHeader();
+std::string arrivalLine(const std::string& channel, const void* data, int size, int64_t arrival_us);
 
 class Recorder {
  public:
