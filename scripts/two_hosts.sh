@@ -7,13 +7,14 @@
 #   scripts/two_hosts.sh [--mtu N] --base CMD [ARGS...] --robot CMD [ARGS...]
 #
 # BASE starts first, ROBOT once the link is up on both ends. When ROBOT exits, BASE gets SIGTERM
-# (scripts/run_pipeline.sh --no-playback stops its processes then) and is waited for. Exit status:
+# (scripts/run_pipeline.sh --no-playback stops its processes then) and is waited for; the link goes
+# with BASE's namespace, so BASE should last until then. Exit status:
 # ROBOT's if it failed, else BASE's. --mtu: the link's MTU (1500 by default, an Ethernet LAN's; LCM
 # messages over it travel as IP fragments, as they would between hosts). LIVO_LCM_URL overrides the
 # bus URL. Works as root or through an unprivileged user namespace, as scripts/private_bus.sh.
 set -euo pipefail
 
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "two_hosts.sh: $*" >&2; exit 1; }
 
 mtu=1500 base=() robot=() into=""
