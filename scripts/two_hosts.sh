@@ -8,10 +8,10 @@
 #
 # BASE starts first, ROBOT once the link is up on both ends. When ROBOT exits, BASE gets SIGTERM
 # (scripts/run_pipeline.sh --no-playback stops its processes then) and is waited for; the link goes
-# with BASE's namespace, so BASE should last until then. Exit status:
-# ROBOT's if it failed, else BASE's. --mtu: the link's MTU (1500 by default, an Ethernet LAN's; LCM
-# messages over it travel as IP fragments, as they would between hosts). LIVO_LCM_URL overrides the
-# bus URL. Works as root or through an unprivileged user namespace, as scripts/private_bus.sh.
+# with BASE's namespace, so BASE should last until then. Exit status: ROBOT's if it failed, else
+# BASE's. --mtu: the link's MTU (1500 by default, an Ethernet LAN's; LCM messages over it travel as
+# IP fragments, as they would between hosts). LIVO_LCM_URL overrides the bus URL. Works as root or
+# through an unprivileged user namespace, as scripts/private_bus.sh does.
 set -euo pipefail
 
 usage() { sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
