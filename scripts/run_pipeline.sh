@@ -265,6 +265,10 @@ latency_trace() { if [ "$realtime" = 1 ]; then echo "$out/logs/$1.trace.tsv"; fi
 # keep draining the sockets, or the bus would overflow them while the sinks wait for a core.
 sink_nice=()
 [ "$realtime" = 0 ] && [ "$serial" = 0 ] && [ "$max_lag" -gt 0 ] && sink_nice=(env LIVO_HANDLER_NICE=10)
+# Real time: the same, so that a pose or an image's answer never waits for a core behind the
+# colouring or the OctoMap (report.md's "Latency"); the recorder's arrival times come from its
+# receive thread, which keeps its priority.
+[ "$realtime" = 1 ] && sink_nice=(env LIVO_HANDLER_NICE=10)
 nice_of() { case "$1" in colour|octomap|record) echo "${sink_nice[@]}" ;; esac; }
 logger=""  # the recorder, unless another host runs it (--remote record)
 [[ ",$remote," == *",record,"* ]] ||
