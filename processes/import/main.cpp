@@ -13,7 +13,8 @@ livo::CommandLine importCommandLine() {
       "Turns a dataset into an LCM log of the project's types (IMU, LIDAR, CAMERA, CAMERA_RIGHT, "
       "DEPTH, GROUND_TRUTH), sorted by time, with a <log>.meta.yaml sidecar. See processes/import/README.md.");
   cli.positional("FORMAT",
-                 "rosbag (ROS 1 bag), rosbag2 (ROS 2 bag: directory with metadata.yaml, .mcap or .db3), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
+                 "rosbag (ROS 1 bag), rosbag2 (ROS 2 bag: directory with metadata.yaml, .mcap or .db3; the "
+                 "rosbag options apply), kitti (raw drive / odometry / scan folder), euroc (ASL folder), "
                  "ouster (pcap + metadata JSON)");
   cli.positional("INPUT", "the bag, folder or pcap file");
   cli.option("--out", "LOG", "output LCM log (required unless --list-topics)")
