@@ -4,6 +4,7 @@
 
 #include "livo/import/image_encoding.hpp"
 #include "livo/import/point_cloud2_conversion.hpp"
+#include "livo/import/ros_message_converter.hpp"
 #include "livo/import/ros_messages.hpp"
 #include "livo/import/stamp_conversion.hpp"
 
@@ -125,12 +126,7 @@ void RosInputConverter::imu(const import::RosImu& msg, const RosMessageBytes& m,
     if (!std::isfinite(v)) return report_.skip("non-finite angular_velocity", where);
   for (double v : msg.linear_acceleration)
     if (!std::isfinite(v)) return report_.skip("non-finite linear_acceleration", where);
-  imu_t s;
-  s.utime = stampOf(msg.header, m, where);
-  for (int i = 0; i < 3; ++i) {
-    s.angular_velocity[i] = msg.angular_velocity[i];
-    s.linear_acceleration[i] = msg.linear_acceleration[i];
-  }
+  const imu_t s = import::imuFromRos(msg, stampOf(msg.header, m, where));
   auto& units = imu_units_[m.topic];
   if (!units) {
     const std::string channel = options_.channels.imu;
@@ -163,16 +159,8 @@ void RosInputConverter::image(SensorRole role, image_t img) {
 }
 
 void RosInputConverter::pose(const import::RosStampedPose& p, const RosMessageBytes& m, const std::string& where) {
-  pose_t out;
-  out.utime = stampOf(p.header, m, where);
-  out.parent_frame = "W";
-  out.child_frame = options_.ground_truth_child_frame;
-  for (int i = 0; i < 3; ++i) out.position[i] = p.position[i];
-  out.orientation[0] = p.orientation_xyzw[3];
-  out.orientation[1] = p.orientation_xyzw[0];
-  out.orientation[2] = p.orientation_xyzw[1];
-  out.orientation[3] = p.orientation_xyzw[2];
-  sink_.observe(options_.channels.ground_truth, out);
+  sink_.observe(options_.channels.ground_truth,
+                import::poseFromRos(p, stampOf(p.header, m, where), options_.ground_truth_child_frame));
 }
 
 }  // namespace livo::ros_bridge

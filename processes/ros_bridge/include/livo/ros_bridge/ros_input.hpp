@@ -2,8 +2,10 @@
 // its serialised bytes (the ROS 1 wire format, which a bag stores too) with its type name and md5
 // sum; it is checked, decoded and converted by livo-import's own functions (rosTypeInfo and the
 // decoders of ros_messages.hpp, convertPointCloud2, convertRosImage / convertRosDepthImage /
-// convertRosCompressedImage, ImuUnitNormaliser), called as livo-import's bag converter calls
-// them, so a topic bridged live and the same topic imported from a bag give the same messages.
+// convertRosCompressedImage, imuFromRos, ImuUnitNormaliser, poseFromRos), called as livo-import's
+// RosMessageConverter calls them, so a topic bridged live and the same topic imported from a bag
+// give the same messages (RosBridge.BagThroughRosEqualsImport checks them byte for byte). What is
+// left here is that converter's dispatch, which it keeps private and ties to a log writer.
 // No ROS library here: the bytes may come from roscpp, a bag or a test.
 #pragma once
 
