@@ -27,6 +27,18 @@ livo::ros_bridge::RosBridgeFlags flagsOf(const livo::CommandLine& cli) {
   return f;
 }
 
+/// Waits for the ROS master (roscpp would retry inside its first advertise, deaf to SIGINT, since
+/// the signals are livo's); false if shutdown was requested first.
+bool waitForMaster() {
+  if (ros::master::check()) return true;
+  std::cerr << "livo-ros-bridge: waiting for the ROS master at " << ros::master::getURI() << std::endl;
+  while (!livo::shutdownRequested()) {
+    if (ros::master::check()) return true;
+    ros::WallDuration(0.2).sleep();
+  }
+  return false;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -64,8 +76,7 @@ int main(int argc, char** argv) {
     if (livo::configCheckDone(cli, std::cout)) return 0;
     livo::installSignalHandlers();
     auto lcm = livo::makeLcm(cli.has("--lcm-url") ? cli.get("--lcm-url") : "");
-    if (!ros::master::check())
-      std::cerr << "livo-ros-bridge: waiting for the ROS master at " << ros::master::getURI() << std::endl;
+    if (!waitForMaster()) return 0;  // SIGINT / SIGTERM before the master came
     ros::NodeHandle ros_node;
     livo::NodeOptions node_options;
     node_options.name = cli.get("--name");
