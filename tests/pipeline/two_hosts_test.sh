@@ -4,7 +4,8 @@
 # (scripts/two_hosts.sh), the bus a udpm URL with ttl=1 that crosses the link, lockstep across both,
 # gives what the one-host run gives: every recorded channel (livo-loginfo --digest; HEALTH and
 # PROGRESS carry wall-clock timings) and every map and trajectory file (md5), as
-# scripts/output_digests.sh compares them. Room with images, 10 s, seed 3.
+# scripts/output_digests.sh compares them. Room with images, 10 s, seed 3. Before that: the
+# namespaces and the link are what they should be, and a ttl=0 bus does not cross the link.
 set -uo pipefail
 root="$1"; bin="$2"
 dir=$(mktemp -d /tmp/livo-two-hosts-test.XXXXXX)
@@ -31,6 +32,15 @@ grep -q 'inet 10.76.67.2/24' "$dir/base.addr" || { cat "$dir/base.addr"; fail "t
 grep -q '^10.76.67.2 dev lan-robot ' "$dir/robot.route" || { cat "$dir/robot.route"; fail "the robot does not reach the base station over the link"; }
 grep -q '^224.0.0.0/4 dev lan-robot' "$dir/robot.mroute" || fail "multicast is not routed on the robot's end"
 grep -q '?ttl=1&' "$dir/robot.url" || fail "the bus URL does not cross one hop: $(cat "$dir/robot.url")"
+
+# ttl=0 (the private bus's) does not leave its host: none of the test publisher's 50 clouds reaches
+# the base station (its subscriber is stopped when the robot is done), so what crosses below crosses
+# by the ttl=1 URL.
+LIVO_LCM_URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608' "$root/scripts/two_hosts.sh" \
+  --base "$bin/test-bus-subscriber" "$dir/bus.ready" --robot "$bin/test-bus-publisher" "$dir/bus.ready" \
+  >"$dir/ttl0.out" 2>&1
+grep -q '^published 50 clouds' "$dir/ttl0.out" && grep -q '^received 0/50,' "$dir/ttl0.out" \
+  || { cat "$dir/ttl0.out"; fail "with ttl=0 the robot's messages reached the base station (or none was sent)"; }
 
 # One host: the five processes on a private bus (no report: the trajectories extracted alone).
 "$root/scripts/private_bus.sh" "$root/scripts/run_pipeline.sh" --inside-bus --log "$dir/room.lcmlog" --config "$config" \
