@@ -4,7 +4,8 @@
 #                    part in lockstep so nothing is missed (lcm-logger cannot say it is ready)
 #   odometry.tum     the online estimate (body pose at every scan)
 #   trajectory.tum   the final estimate (loop-corrected when loop closure ran)
-#   timing.json      per process: messages, median/p90/max ms, peak RSS
+#   timing.json      per process: messages, median/p90/max ms, peak RSS; in real time also the
+#                    latency of its outputs (from logs/arrivals.tsv and logs/<process>.trace.tsv)
 #   weak_spots.json  degenerate and predicted sweeps, images the VIO did not use, loop closures
 #   resets.json      odometry resets (new epochs; [] when there was none)
 #   evaluation_*.json, odometry.svg, trajectory.svg   accuracy against GROUND_TRUTH, if the log has
@@ -55,7 +56,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$(cd "${LIVO_BUILD_DIR:-$root/build}" 2>/dev/null && pwd)/bin" || bin="$root/build/bin"
 all_processes=(lio vio vio_feature loop colour octomap)
 
-usage() { sed -n '2,49p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
+usage() { sed -n '2,50p' "$0" | sed 's/^# \{0,1\}//'; exit "${1:-2}"; }
 die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0 ground_map=0 bus="" remote="" no_playback=0

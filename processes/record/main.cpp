@@ -43,11 +43,12 @@ int main(int argc, char** argv) {
     o.quiet = true;
     livo::Node node(*lcm, o);
     livo::record::Recorder recorder(node, cli.get("--out"), channels);
-    std::unique_ptr<livo::record::ArrivalLog> arrivals;
-    if (cli.has("--arrivals")) arrivals = std::make_unique<livo::record::ArrivalLog>(*lcm, cli.get("--arrivals"));
+    std::unique_ptr<livo::record::ArrivalThread> arrivals;
+    if (cli.has("--arrivals"))
+      arrivals = std::make_unique<livo::record::ArrivalThread>(cli.get("--lcm-url"), cli.get("--arrivals"));
     const int rc = livo::spin(*lcm, node, [&] {
       recorder.finish(o.health_channel);
-      if (arrivals) arrivals->flush();
+      arrivals.reset();
     });
     std::cerr << "[" << o.name << "] wrote " << recorder.written() << " messages to " << cli.get("--out") << std::endl;
     return rc;

@@ -10,6 +10,8 @@
 #  2. A sensor clock jump (IMU, LiDAR and camera stamps 5 s back from 20 s on, livo-playback
 #     --faults jump:...) resets lio once: epoch 1 downstream (ODOMETRY, KEYFRAME, REGISTERED_SCAN),
 #     the reset listed in report.md, no odometry edge across the epochs in loop's loops.json, no NaN.
+#  3. The real-time run's latency in timing.json and report.md (none in lockstep), the delay hook's
+#     wait counted where it happens (vio's queueing).
 # All traffic stays on the private bus (run_pipeline.sh runs scripts/private_bus.sh).
 set -uo pipefail
 root="$1"; bin="$2"
@@ -49,6 +51,27 @@ for run in ('realtime', 'jump'):
     assert lio['IMU']['messages'] >= 0.9 * 9001 and lio['LIDAR']['messages'] >= 0.9 * 450, \
         '%s: lio took %d IMU and %d LIDAR messages of 9001 / 450: it did not keep up' % (
             run, lio['IMU']['messages'], lio['LIDAR']['messages'])
+
+# Latency (processes/report/README.md, "Latency"): real-time runs have it in timing.json under the
+# publisher, with the process's own fields kept, and in report.md; lockstep has none. The handler
+# delay (uniform 0..40 ms before vio handles lio's STATE_PRIOR) shows up as vio's queueing.
+t = json.load(open('%s/realtime/timing.json' % d))
+for proc, channel, from_ in (('lio', 'ODOMETRY', 'sweep end'), ('vio', 'STATE_POSTERIOR', 'image stamp')):
+    assert all(k in t[proc] for k in ('messages', 'median_ms', 'p90_ms', 'max_ms', 'peak_rss_mb')), t[proc].keys()
+    l = t[proc]['latency'][channel]
+    assert l['from'] == from_ and l['messages'] >= 400 and l['unmatched'] <= 5, (channel, l)
+    assert 0 < l['p50_ms'] <= l['p99_ms'] <= l['max_ms'], (channel, l)
+    assert l['where_ms']['traced'] == l['messages'], (channel, l['where_ms'])
+mean = t['vio']['latency']['STATE_POSTERIOR']['where_ms']['mean']
+assert t['vio']['latency']['STATE_POSTERIOR']['handoffs'].get('STATE_PRIOR', 0) >= 400, t['vio']['latency']
+assert mean['queueing'] >= 15, ('the 0..40 ms delay before each STATE_PRIOR handler is vio queueing', mean)
+assert '## Latency' in open('%s/realtime/report.md' % d).read()
+assert not any('latency' in p for p in json.load(open('%s/lockstep/timing.json' % d)).values())
+assert '## Latency' not in open('%s/lockstep/report.md' % d).read()
+print('latency: ODOMETRY p50 %.1f p99 %.1f ms, STATE_POSTERIOR p50 %.1f p99 %.1f ms (vio queueing %.1f ms: the delay hook)'
+      % (t['lio']['latency']['ODOMETRY']['p50_ms'], t['lio']['latency']['ODOMETRY']['p99_ms'],
+         t['vio']['latency']['STATE_POSTERIOR']['p50_ms'], t['vio']['latency']['STATE_POSTERIOR']['p99_ms'],
+         mean['queueing']))
 
 lock, real = ate('lockstep'), ate('realtime')
 corrections = {}

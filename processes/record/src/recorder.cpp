@@ -69,6 +69,19 @@ void ArrivalLog::onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& ch
 
 void ArrivalLog::flush() { std::fflush(file_); }
 
+ArrivalThread::ArrivalThread(const std::string& lcm_url, const std::string& path)
+    : lcm_(makeLcm(lcm_url)), log_(std::make_unique<ArrivalLog>(*lcm_, path)) {
+  thread_ = std::thread([this] {
+    while (!stop_.load()) lcm_->handleTimeout(100);
+  });
+}
+
+ArrivalThread::~ArrivalThread() {
+  stop_.store(true);
+  thread_.join();
+  log_->flush();
+}
+
 Recorder::Recorder(Node& node, const std::string& out_path, const std::vector<std::string>& channels)
     : node_(node), path_(out_path), log_(std::make_unique<lcm::LogFile>(out_path, "w")) {
   if (!log_->good()) throw std::runtime_error(out_path + ": cannot write");
