@@ -4,7 +4,7 @@
 # (scripts/two_hosts.sh), the bus a udpm URL with ttl=1 that crosses the link, lockstep across both,
 # gives what the one-host run gives: every recorded channel (livo-loginfo --digest; HEALTH and
 # PROGRESS carry wall-clock timings) and every map and trajectory file (md5), as
-# scripts/output_digests.sh compares them. Room with images, 10 s, seed 3. Before that: the
+# scripts/output_digests.sh compares them. Room with images, 8 s, seed 3. Before that: the
 # namespaces and the link are what they should be, and a ttl=0 bus does not cross the link.
 set -uo pipefail
 root="$1"; bin="$2"
@@ -13,7 +13,7 @@ trap 'rm -rf "$dir"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 export LIVO_BUILD_DIR="$(dirname "$bin")"
 config="$root/config/sim/room.yaml"
-"$bin/livo-sim" --config "$config" --out "$dir/room.lcmlog" --duration 10 --seed 3 --quiet || fail "livo-sim failed"
+"$bin/livo-sim" --config "$config" --out "$dir/room.lcmlog" --duration 8 --seed 3 --quiet || fail "livo-sim failed"
 
 # The topology: two namespaces, neither the host's (two_hosts.sh checks that each has only lo and
 # its end of the link), the robot's end reaching the base station's address (the base station
