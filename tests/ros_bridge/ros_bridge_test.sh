@@ -96,7 +96,7 @@ for _ in $(seq 200); do [ -e "$dir/ros_ready" ] && break; sleep 0.1; done
 [ -e "$dir/ros_ready" ] || fail "the recorder never connected to the bridge's outputs"
 rosbag play -q --wait-for-subscribers "$dir/walk.bag" >"$dir/rosbag_play.log" 2>&1 || fail "rosbag play failed"
 # the last sweeps' odometry: wait until the ROS side has as many poses as the lockstep run made, or
-# until the count has not grown for 2 s
+# until the count has not grown for 2 s; then 0.5 s more for a pose too many and the last /tf
 last=-1; still=0
 while [ "$still" -lt 10 ]; do
   n=$(wc -l <"$dir/ros_odometry.tum")
@@ -105,6 +105,7 @@ while [ "$still" -lt 10 ]; do
   last=$n
   sleep 0.2
 done
+sleep 0.5
 kill -INT "$recorder"; wait "$recorder"
 kill -INT "$bridge"; wait "$bridge" || fail "livo-ros-bridge exited non-zero"
 kill -INT "$lio" "$logger"; wait "$lio" "$logger"
