@@ -36,6 +36,9 @@ namespace livo::ros_bridge {
 
 class RosBridgeNode : private import::MessageObserver {
  public:
+  /// The least time between two converted messages published on LCM.
+  static constexpr std::chrono::microseconds kPublishSpacing{1000};
+
   /// Subscribes and advertises on both sides; `ros_node` must be started (ros::init).
   RosBridgeNode(lcm::LCM& lcm, const NodeOptions& node_options, const RosBridgeNodeOptions& options,
                 ros::NodeHandle& ros_node);
@@ -43,7 +46,8 @@ class RosBridgeNode : private import::MessageObserver {
   /// Bridges until SIGINT / SIGTERM or ROS shuts down; then finish(). Returns 0, or 1 if the LCM
   /// provider failed.
   int run();
-  /// Emits what the IMU unit check still holds, ends the livo::Node and prints the summary. Idempotent.
+  /// Emits what the IMU unit check still holds, publishes what is queued, ends the livo::Node and
+  /// prints the summary. Idempotent.
   void finish();
 
   Node& node() { return node_; }
@@ -53,6 +57,11 @@ class RosBridgeNode : private import::MessageObserver {
   const std::map<std::string, int64_t>& sent() const { return sent_; }
 
  private:
+  struct Outgoing {  // a converted message, encoded
+    std::string channel;
+    std::vector<uint8_t> bytes;
+  };
+
   void subscribeInputs(ros::NodeHandle& ros_node);
   void advertiseOutputs(ros::NodeHandle& ros_node);
   void onRosMessage(SensorRole role, const std::string& topic, const topic_tools::ShapeShifter& message);
@@ -75,15 +84,6 @@ class RosBridgeNode : private import::MessageObserver {
   }
   /// Publishes the oldest queued message if kPublishSpacing has passed since the last one.
   void publishQueued();
-
- public:
-  static constexpr std::chrono::microseconds kPublishSpacing{1000};
-
- private:
-  struct Outgoing {
-    std::string channel;
-    std::vector<uint8_t> bytes;
-  };
 
   lcm::LCM& lcm_;
   Node node_;
