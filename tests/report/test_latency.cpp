@@ -84,12 +84,13 @@ TEST(Latency, KnownArrivalsGiveKnownPercentilesAndParts) {
   EXPECT_NEAR(odo.p50_ms, 19.0, 1e-9);  // 10..28 ms: the 10th
   EXPECT_NEAR(odo.p99_ms, 28.0, 1e-9);
   EXPECT_NEAR(odo.max_ms, 28.0, 1e-9);
-  EXPECT_NEAR(odo.mean.sensors_ms, 6.0, 1e-9);
+  EXPECT_NEAR(odo.mean.sensors_ms, 5.0, 1e-9);       // the IMU sample 5 ms past the end
+  EXPECT_NEAR(odo.mean.late_sensors_ms, 1.0, 1e-9);  // reached lio 1 ms after the recorder saw its time due
   EXPECT_NEAR(odo.mean.handoff_ms, 0.0, 1e-9);
   EXPECT_NEAR(odo.mean.queueing_ms, 1.0, 1e-9);
   EXPECT_NEAR(odo.mean.processing_ms, 11.0, 1e-9);  // 10 + k - 1 - 7 for k = 0..18: 11 on average
   EXPECT_NEAR(odo.mean.delivery_ms, 1.0, 1e-9);
-  EXPECT_NEAR(odo.slowest.processing_ms, 20.0, 1e-9);  // the slowest: 28 ms = 6 + 1 + 20 + 1
+  EXPECT_NEAR(odo.slowest.processing_ms, 20.0, 1e-9);  // the slowest: 28 ms = 5 + 1 + 1 + 20 + 1
   EXPECT_TRUE(odo.handoffs.empty());
 
   const ChannelLatency& post = out[1];

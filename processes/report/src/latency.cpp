@@ -5,6 +5,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -63,7 +64,10 @@ class SensorClock {
       if (a.type == "livo.imu_t") imu_.push_back(a);
       if (a.type == "livo.point_cloud_t") sweeps_.push_back(a);
       if (a.type == "livo.image_t") images_.push_back(a);
-      if (isSensorType(a.type)) sensor_channels_.push_back(a.channel);
+      if (isSensorType(a.type)) {
+        sensor_channels_.insert(a.channel);
+        sensor_ends_.emplace(std::make_pair(a.channel, a.utime), a.end_utime);
+      }
     }
     const auto by = [](auto key) { return [key](const Arrival& x, const Arrival& y) { return key(x) < key(y); }; };
     std::stable_sort(imu_.begin(), imu_.end(), by([](const Arrival& a) { return a.utime; }));
@@ -72,8 +76,13 @@ class SensorClock {
     image_tolerance_us_ = imageTolerance();
   }
 
-  bool isSensor(const std::string& channel) const {
-    return std::find(sensor_channels_.begin(), sensor_channels_.end(), channel) != sensor_channels_.end();
+  bool isSensor(const std::string& channel) const { return sensor_channels_.count(channel) > 0; }
+
+  // The sensor time a message on `channel` stamped `utime` covers up to (a sweep's end), if seen.
+  std::optional<int64_t> sensorEnd(const std::string& channel, int64_t utime) const {
+    auto it = sensor_ends_.find({channel, utime});
+    if (it == sensor_ends_.end()) return {};
+    return it->second;
   }
 
   // The wall time the sweep ending at `end` was complete: its message had arrived and so had the
@@ -124,7 +133,8 @@ class SensorClock {
   }
 
   std::vector<Arrival> imu_, sweeps_, images_;
-  std::vector<std::string> sensor_channels_;
+  std::set<std::string> sensor_channels_;
+  std::map<std::pair<std::string, int64_t>, int64_t> sensor_ends_;  // (channel, utime) -> end_utime
   int64_t image_tolerance_us_ = 25000;
 };
 
@@ -143,7 +153,16 @@ std::optional<int64_t> dueTime(const SensorClock& clock, LatencyReference refere
 LatencyParts partsOf(const PublishTrace& t, int64_t due, int64_t arrival, const SensorClock& clock) {
   LatencyParts p;
   const double waited = ms(t.trigger_recv_us - due);
-  (clock.isSensor(t.trigger_channel) ? p.sensors_ms : p.handoff_ms) = waited;
+  if (!clock.isSensor(t.trigger_channel)) {
+    p.handoff_ms = waited;
+  } else if (const auto end = clock.sensorEnd(t.trigger_channel, t.trigger_utime)) {
+    // the sensor time the output needed past its stamp (lio: the IMU sample past the sweep end),
+    // and how much later than that the data came (a driver's or the replay's delay)
+    p.sensors_ms = std::clamp(ms(*end - t.utime), 0.0, std::max(waited, 0.0));
+    p.late_sensors_ms = waited - p.sensors_ms;
+  } else {
+    p.sensors_ms = waited;
+  }
   p.queueing_ms = ms(t.start_us - t.trigger_recv_us);
   p.processing_ms = ms(t.publish_us - t.start_us);
   p.delivery_ms = ms(arrival - t.publish_us);
@@ -152,6 +171,7 @@ LatencyParts partsOf(const PublishTrace& t, int64_t due, int64_t arrival, const 
 
 void accumulate(const LatencyParts& p, double weight, LatencyParts* sum) {
   sum->sensors_ms += weight * p.sensors_ms;
+  sum->late_sensors_ms += weight * p.late_sensors_ms;
   sum->handoff_ms += weight * p.handoff_ms;
   sum->queueing_ms += weight * p.queueing_ms;
   sum->processing_ms += weight * p.processing_ms;
@@ -229,11 +249,9 @@ const char* referenceName(LatencyReference r) {
 }
 
 nlohmann::json partsJson(const LatencyParts& p) {
-  return {{"waiting_for_sensors", p.sensors_ms},
-          {"waiting_for_handoff", p.handoff_ms},
-          {"queueing", p.queueing_ms},
-          {"processing", p.processing_ms},
-          {"delivery", p.delivery_ms}};
+  return {{"waiting_for_sensors", p.sensors_ms}, {"sensor_data_late", p.late_sensors_ms},
+          {"waiting_for_handoff", p.handoff_ms}, {"queueing", p.queueing_ms},
+          {"processing", p.processing_ms},       {"delivery", p.delivery_ms}};
 }
 
 std::string fixed(double v) { return std::isfinite(v) ? formatFixed(v, 1) : "n/a"; }
@@ -345,9 +363,9 @@ std::string latencyMarkdown(const nlohmann::json& timing) {
       for (const auto& [h, n] : handoffs.items())
         names += (names.empty() ? "" : ", ") + h + " " + std::to_string(n.get<int64_t>()) + "x";
       if (!names.empty()) handoff += " (" + names + ")";
-      parts << "| " << channel << " | " << meanAndSlowest(w, "waiting_for_sensors") << " | " << handoff << " | "
-            << meanAndSlowest(w, "queueing") << " | " << meanAndSlowest(w, "processing") << " | "
-            << meanAndSlowest(w, "delivery") << " |\n";
+      parts << "| " << channel << " | " << meanAndSlowest(w, "waiting_for_sensors") << " | "
+            << meanAndSlowest(w, "sensor_data_late") << " | " << handoff << " | " << meanAndSlowest(w, "queueing")
+            << " | " << meanAndSlowest(w, "processing") << " | " << meanAndSlowest(w, "delivery") << " |\n";
     }
   }
   if (rows.str().empty()) return "";
@@ -359,8 +377,9 @@ std::string latencyMarkdown(const nlohmann::json& timing) {
      << "| --- | --- | --- | --- | --- | --- | --- |\n"
      << rows.str() << "\n"
      << "Where the time goes, ms (mean over all messages / over the slowest 1 %):\n\n"
-     << "| output | waiting for sensor data | waiting for a hand-off | queueing | processing | delivery |\n"
-     << "| --- | --- | --- | --- | --- | --- |\n"
+     << "| output | waiting for sensor data | sensor data late | waiting for a hand-off | queueing | processing | "
+        "delivery |\n"
+     << "| --- | --- | --- | --- | --- | --- | --- |\n"
      << parts.str() << "\n";
   return md.str();
 }

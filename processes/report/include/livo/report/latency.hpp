@@ -67,11 +67,13 @@ std::vector<LatencySpec> defaultLatencySpecs(const std::string& odometry = "ODOM
 
 /// Where one message's latency went, ms; the parts add up to its latency.
 struct LatencyParts {
-  double sensors_ms = 0.0;     // waiting for sensor data: the stamp's data to the input that set the handler off
-  double handoff_ms = 0.0;     // ... when that input was another process's message (a hand-off)
-  double queueing_ms = 0.0;    // that input waited in the process's queue before its handler started
-  double processing_ms = 0.0;  // the handler, until this message went out
-  double delivery_ms = 0.0;    // from its publication to its arrival at the recorder
+  double sensors_ms = 0.0;       // waiting for sensor data: the sensor time the output needed past its
+                                 // stamp (the input that set the handler off: its end less the stamp)
+  double late_sensors_ms = 0.0;  // that input came later than its sensor time says (driver, replay)
+  double handoff_ms = 0.0;       // ... when that input was another process's message (a hand-off)
+  double queueing_ms = 0.0;      // that input waited in the process's queue before its handler started
+  double processing_ms = 0.0;    // the handler, until this message went out
+  double delivery_ms = 0.0;      // from its publication to its arrival at the recorder
 };
 
 struct ChannelLatency {
