@@ -31,7 +31,9 @@ livo::CommandLine importCommandLine() {
           "read for --rig-out, --rig and the sidecar")
       .option("--ground-truth", "TOPIC|FILE",
               "rosbag: ground-truth topic (Odometry, PoseStamped, PoseWithCovarianceStamped, TransformStamped, "
-              "PointStamped) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
+              "PointStamped, TFMessage) or a TUM / EuRoC csv file; euroc: a TUM / csv file")
+      .option("--ground-truth-frame", "CHILD",
+              "rosbag: a tf2_msgs/TFMessage ground-truth topic's child frame to take (default: its first)")
       .flag("--no-auto-topics",
             "rosbag: do not pick the only IMU / PointCloud2 / image / depth image topic when none is given")
       .flag("--list-topics", "rosbag, rosbag2: print the bag's topics, types and counts, then exit")

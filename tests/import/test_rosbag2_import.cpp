@@ -157,7 +157,7 @@ TEST_P(Rosbag2Storages, EveryTypeMatchesWhatTheForeignWriterWrote) {
 
 INSTANTIATE_TEST_SUITE_P(Files, Rosbag2Storages,
                          ::testing::Values("unchunked.mcap", "unchunked_nosummary.mcap", "chunked_none.mcap",
-                                           "chunked_zstd.mcap", "chunked_lz4.mcap", "bag_mcap", "bag_db3",
+                                           "chunked_zstd.mcap", "chunked_lz4.mcap", "bag_mcap", "bag_split", "bag_db3",
                                            "single.db3"),
                          [](const auto& info) {
                            std::string n = info.param;
@@ -192,12 +192,36 @@ TEST(Rosbag2Import, PoseStampedAndTransformStampedGroundTruth) {
   }
 }
 
+TEST(Rosbag2Import, TfMessageGroundTruthIsOneChildFramesTransforms) {
+  const json exp = expected();
+  for (const std::string input : {"chunked_zstd.mcap", "single.db3"}) {
+    for (const std::string frame : {"base_link", ""}) {
+      SCOPED_TRACE(input + " frame '" + frame + "'");
+      const std::string dir = test::freshTempDir("rosbag2_tf");
+      ImportJob job = rosbag2Job(input, dir + "/tf.lcmlog");
+      job.rosbag.ground_truth_topic = "/tf";
+      job.rosbag.ground_truth_tf_frame = frame;
+      const ImportOutcome r = runImport(job, nullptr);
+      EXPECT_TRUE(r.ok());
+      // Without --ground-truth-frame: the first child frame on /tf (odom), said in a note.
+      const std::string taken = frame.empty() ? "odom" : frame;
+      expectPoses(test::messagesOn<pose_t>(test::readLog(job.out), "GROUND_TRUTH"), exp["tf_" + taken]);
+      EXPECT_EQ(r.report.skipped().at("transforms on /tf to another frame than " + taken + " (--ground-truth-frame)").count,
+                3);
+      EXPECT_EQ(r.report.metadataValue("ground_truth_tf_frame"), "\"" + taken + "\"");
+      bool noted = false;
+      for (const std::string& n : r.report.notes()) noted |= n.find("--ground-truth-frame not given") != std::string::npos;
+      EXPECT_EQ(noted, frame.empty());
+    }
+  }
+}
+
 TEST(Rosbag2Import, TopicsFromMetadataSummaryOrScanAgree) {
   for (const std::string input : {"bag_mcap", "chunked_lz4.mcap", "unchunked_nosummary.mcap", "single.db3"}) {
     SCOPED_TRACE(input);
     std::map<std::string, std::pair<std::string, int64_t>> topics;
     for (const BagTopic& t : listRosbag2Topics(kFixtures + "/" + input)) topics[t.topic] = {t.type, t.messages};
-    EXPECT_EQ(topics.size(), 10u);
+    EXPECT_EQ(topics.size(), 11u);
     EXPECT_EQ(topics["/imu"], (std::pair<std::string, int64_t>{"sensor_msgs/msg/Imu", 6}));
     EXPECT_EQ(topics["/points"], (std::pair<std::string, int64_t>{"sensor_msgs/msg/PointCloud2", 2}));
     EXPECT_EQ(topics["/tf_gt"], (std::pair<std::string, int64_t>{"geometry_msgs/msg/TransformStamped", 3}));

@@ -56,6 +56,7 @@ RosbagImportOptions rosbagFlags(const CommandLine& cli, const std::string& forma
     else
       r.ground_truth_file = gt;
   }
+  r.ground_truth_tf_frame = cli.get("--ground-truth-frame");
   r.auto_map = !cli.has("--no-auto-topics");
   r.use_bag_time = cli.has("--use-bag-time");
   r.imu_units.accel = cli.get("--imu-accel-unit");

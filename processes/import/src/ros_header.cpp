@@ -48,6 +48,7 @@ RosTypeInfo rosTypeInfo(const std::string& type_name) {
     t = {RosMessageKind::kPose, "b5764a33bfeb3588febc2682852579b0", decodeRosTransformStamped, decodeCdrTransformStamped};
   if (type == "geometry_msgs/PointStamped")
     t = {RosMessageKind::kPose, "c63aecb41bfdfd6b7e1fac37c7cbe7bf", decodeRosPointStamped, decodeCdrPointStamped};
+  if (type == "tf2_msgs/TFMessage") t = {RosMessageKind::kTfMessage, "94810edda583a504dfda3829e70d7eec", nullptr};
   return t;
 }
 

@@ -79,7 +79,7 @@ bool fits(Role role, RosMessageKind kind) {
     case Role::kCameraRight: return kind == RosMessageKind::kImage || kind == RosMessageKind::kCompressedImage;
     case Role::kDepth: return kind == RosMessageKind::kImage;
     case Role::kCameraInfo: return kind == RosMessageKind::kCameraInfo;
-    case Role::kGroundTruth: return kind == RosMessageKind::kPose;
+    case Role::kGroundTruth: return kind == RosMessageKind::kPose || kind == RosMessageKind::kTfMessage;
     default: return false;
   }
 }
@@ -217,6 +217,8 @@ RosCameraInfo decodeCameraInfo(ByteReader& r) { return decodeRosCameraInfo(r); }
 RosCameraInfo decodeCameraInfo(CdrReader& r) { return decodeCdrCameraInfo(r); }
 RosStampedPose decodePose(const RosTypeInfo& info, ByteReader& r) { return info.decode_pose(r); }
 RosStampedPose decodePose(const RosTypeInfo& info, CdrReader& r) { return info.decode_pose_cdr(r); }
+std::vector<RosStampedPose> decodeTf(ByteReader& r) { return decodeRosTfMessage(r); }
+std::vector<RosStampedPose> decodeTf(CdrReader& r) { return decodeCdrTfMessage(r); }
 }  // namespace
 
 template <class Reader>
@@ -235,6 +237,7 @@ void RosMessageConverter::decodeAndConvert(Reader& r, const RosTypeInfo& info, R
       return image(role, convertRosCompressedImage(decodeCompressed(r), frameOf(role), m.where), m);
     case RosMessageKind::kCameraInfo: return cameraInfo(decodeCameraInfo(r), *m.topic);
     case RosMessageKind::kPose: return pose(decodePose(info, r), m);
+    case RosMessageKind::kTfMessage: return transforms(decodeTf(r), m);
     default: return;
   }
 }
@@ -331,6 +334,25 @@ void RosMessageConverter::pose(const RosStampedPose& p, const RosWireMessage& m)
   if (!p.has_orientation && report_.metadataValue("ground_truth_orientation").empty())
     report_.metadataString("ground_truth_orientation", "none (position only; identity written)");
   writer_.add(options_.channels.ground_truth, out);
+}
+
+/// The transforms to the ground-truth frame (--ground-truth-frame, else the first child frame on
+/// the topic) become poses; transforms to other frames are counted.
+void RosMessageConverter::transforms(const std::vector<RosStampedPose>& tfs, const RosWireMessage& m) {
+  for (const RosStampedPose& t : tfs) {
+    if (tf_frame_.empty()) {
+      tf_frame_ = options_.ground_truth_tf_frame.empty() ? t.child_frame_id : options_.ground_truth_tf_frame;
+      if (options_.ground_truth_tf_frame.empty())
+        report_.note("--ground-truth-frame not given: the ground truth is " + *m.topic + "'s transforms to " +
+                     tf_frame_ + " (the first child frame on it)");
+      report_.metadataString("ground_truth_tf_frame", tf_frame_);
+    }
+    if (t.child_frame_id == tf_frame_)
+      pose(t, m);
+    else
+      report_.skip("transforms on " + *m.topic + " to another frame than " + tf_frame_ + " (--ground-truth-frame)",
+                   m.where, 1, false);
+  }
 }
 
 }  // namespace livo::import

@@ -69,8 +69,19 @@ RosStampedPose decodePointStamped(Reader& r) {
   return p;
 }
 
+template <class Reader>
+std::vector<RosStampedPose> decodeTfMessage(Reader& r) {
+  const uint32_t n = r.arrayLength("transforms", 4 + 4 + 4 + 4 + 7 * 8);
+  std::vector<RosStampedPose> out;
+  out.reserve(n);
+  for (uint32_t i = 0; i < n; ++i) out.push_back(decodeTransformStamped(r));
+  return out;
+}
+
 }  // namespace
 
+std::vector<RosStampedPose> decodeRosTfMessage(ByteReader& r) { return decodeTfMessage(r); }
+std::vector<RosStampedPose> decodeCdrTfMessage(CdrReader& r) { return decodeTfMessage(r); }
 RosStampedPose decodeRosOdometry(ByteReader& r) { return decodeOdometry(r); }
 RosStampedPose decodeCdrOdometry(CdrReader& r) { return decodeOdometry(r); }
 RosStampedPose decodeRosPoseStamped(ByteReader& r) { return decodePoseStamped(r); }

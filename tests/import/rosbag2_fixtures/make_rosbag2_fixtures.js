@@ -6,8 +6,8 @@
 //   node make_rosbag2_fixtures.js OUT_DIR JPEG
 //
 // OUT_DIR gets: unchunked.mcap (with a summary), unchunked_nosummary.mcap (no summary, no index),
-// chunked_{none,zstd,lz4}.mcap, bag_mcap/ (metadata.yaml + a zstd-chunked file), truncated.mcap (a
-// chunked file cut inside its last chunk), rows.json (the same messages for make_rosbag2_db3.py)
+// chunked_{none,zstd,lz4}.mcap, bag_mcap/ (metadata.yaml + a zstd-chunked file), bag_split/ (two
+// files), truncated.mcap (a chunked file cut inside its data section), rows.json (the same messages for make_rosbag2_db3.py)
 // and expected.json (every value written, for the tests to compare field by field).
 "use strict";
 
@@ -70,7 +70,8 @@ const header = (sec, nanosec, frame_id) => ({ stamp: stamp(sec, nanosec), frame_
 
 // ---- the messages -------------------------------------------------------------------------
 const messages = []; // {topic, type, logTime (ns, BigInt), data (Uint8Array)}
-const expected = { imu: [], imu_be: [], points: [], image: [], compressed: [], camera_info: null, odom: [], pose: [], tf: [] };
+const expected = { imu: [], imu_be: [], points: [], image: [], compressed: [], camera_info: null, odom: [], pose: [], tf: [],
+                   tf_odom: [], tf_base_link: [] };
 const add = (topic, type, sec, nanosec, data) =>
   messages.push({ topic, type, logTime: BigInt(sec) * 1000000000n + BigInt(nanosec) + 1000n, data });
 
@@ -173,7 +174,7 @@ for (let k = 0; k < 2; ++k) {
   expected.compressed.push({ sec, nanosec, size: jpeg.length });
 }
 
-// Ground truth: Odometry (with covariances), PoseStamped, TransformStamped.
+// Ground truth: Odometry (with covariances), PoseStamped, TransformStamped, TFMessage.
 for (let k = 0; k < 3; ++k) {
   const sec = T0 + 1, nanosec = k * 200000000;
   const p = { x: 1.5 + k, y: -0.5 * k, z: 0.25 }, q = { x: 0.1, y: 0.2 - 0.05 * k, z: -0.3, w: 0.927 };
@@ -193,18 +194,27 @@ for (let k = 0; k < 3; ++k) {
     header: header(sec, nanosec + 2000, "map"), child_frame_id: "body",
     transform: { translation: t, rotation: q } }));
   expected.tf.push({ sec, nanosec: nanosec + 2000, p: [t.x, t.y, t.z], q: [q.w, q.x, q.y, q.z] });
+  // tf2_msgs/TFMessage on /tf: map -> odom (fixed) and odom -> base_link (moving) in each message.
+  const b = { x: 0.5 * k, y: 1 - 0.25 * k, z: 0.125 }, identity = { x: 0, y: 0, z: 0, w: 1 };
+  add("/tf", "tf2_msgs/TFMessage", sec, nanosec + 3000, cdr("tf2_msgs/TFMessage", { transforms: [
+    { header: header(sec, nanosec + 3000, "map"), child_frame_id: "odom",
+      transform: { translation: { x: 0, y: 0, z: 0 }, rotation: identity } },
+    { header: header(sec, nanosec + 3000, "odom"), child_frame_id: "base_link",
+      transform: { translation: b, rotation: q } }] }));
+  expected.tf_odom.push({ sec, nanosec: nanosec + 3000, p: [0, 0, 0], q: [1, 0, 0, 0] });
+  expected.tf_base_link.push({ sec, nanosec: nanosec + 3000, p: [b.x, b.y, b.z], q: [q.w, q.x, q.y, q.z] });
 }
 
 // A topic nobody maps.
 add("/chatter", "std_msgs/String", T0, 140000000, cdr("std_msgs/String", { data: "hello" }));
 
 // ---- the files ----------------------------------------------------------------------------
-async function writeMcap(file, options) {
+async function writeMcap(file, options, part = messages) {
   const buffer = new TempBuffer();
   const writer = new McapWriter({ writable: buffer, ...options });
   await writer.start({ profile: "ros2", library: "livo-lcm test fixture (@mcap/core)" });
   const channels = new Map();
-  for (const m of messages) {
+  for (const m of part) {
     if (!channels.has(m.topic)) {
       const schemaId = await writer.registerSchema({
         name: ros2Name(m.type), encoding: "ros2msg", data: new TextEncoder().encode(schemaText(m.type)) });
@@ -213,7 +223,7 @@ async function writeMcap(file, options) {
     }
   }
   let seq = 0;
-  for (const m of messages)
+  for (const m of part)
     await writer.addMessage({ channelId: channels.get(m.topic), sequence: seq++, logTime: m.logTime,
                               publishTime: m.logTime, data: m.data });
   await writer.end();
@@ -243,7 +253,16 @@ async function main() {
   fs.mkdirSync(bagDir, { recursive: true });
   await writeMcap(path.join(bagDir, "bag_mcap_0.mcap"), {
     chunkSize: small, compressChunk: (d) => ({ compression: "zstd", compressedData: zstd.compress(d, 3) }) });
-  fs.writeFileSync(path.join(bagDir, "metadata.yaml"), metadataYaml("mcap", "bag_mcap_0.mcap"));
+  fs.writeFileSync(path.join(bagDir, "metadata.yaml"), metadataYaml("mcap", ["bag_mcap_0.mcap"]));
+
+  // A bag split in two files (rosbag2's --max-bag-size): the first half of the messages, then the rest.
+  const splitDir = path.join(outDir, "bag_split");
+  fs.mkdirSync(splitDir, { recursive: true });
+  const half = Math.floor(messages.length / 2);
+  await writeMcap(path.join(splitDir, "bag_split_0.mcap"), { chunkSize: small }, messages.slice(0, half));
+  await writeMcap(path.join(splitDir, "bag_split_1.mcap"), { useChunks: false }, messages.slice(half));
+  fs.writeFileSync(path.join(splitDir, "metadata.yaml"),
+                   metadataYaml("mcap", ["bag_split_0.mcap", "bag_split_1.mcap"]));
 
   const rows = messages.map((m) => ({ topic: m.topic, type: ros2Name(m.type), timestamp: m.logTime.toString(),
                                       data: Buffer.from(m.data).toString("base64") }));
@@ -252,7 +271,7 @@ async function main() {
 }
 
 /// rosbag2's metadata.yaml (version 5 layout) for the messages above.
-function metadataYaml(storage, file) {
+function metadataYaml(storage, files) {
   const counts = new Map();
   for (const m of messages) counts.set(m.topic, { type: ros2Name(m.type), n: (counts.get(m.topic)?.n ?? 0) + 1 });
   const t0 = messages.reduce((a, m) => (m.logTime < a ? m.logTime : a), messages[0].logTime);
@@ -263,7 +282,8 @@ function metadataYaml(storage, file) {
   for (const [topic, { type, n }] of counts)
     y += `    - topic_metadata:\n        name: ${topic}\n        type: ${type}\n        serialization_format: cdr\n` +
          `        offered_qos_profiles: ""\n      message_count: ${n}\n`;
-  y += `  compression_format: ""\n  compression_mode: ""\n  relative_file_paths:\n    - ${file}\n`;
+  y += `  compression_format: ""\n  compression_mode: ""\n  relative_file_paths:\n`;
+  for (const f of files) y += `    - ${f}\n`;
   return y;
 }
 

@@ -90,6 +90,7 @@ class RosMessageConverter {
   void image(Role role, image_t img, const RosWireMessage& m);
   void cameraInfo(const RosCameraInfo& msg, const std::string& topic);
   void pose(const RosStampedPose& p, const RosWireMessage& m);
+  void transforms(const std::vector<RosStampedPose>& tfs, const RosWireMessage& m);
 
   const RosbagImportOptions& options_;
   SortedLogWriter& writer_;
@@ -99,6 +100,7 @@ class RosMessageConverter {
   int64_t camera_infos_ = 0;
   RosCameraInfo first_camera_info_;
   bool camera_info_changed_ = false;
+  std::string tf_frame_;  // the ground truth's child frame on a TFMessage topic
 };
 
 }  // namespace livo::import

@@ -119,10 +119,14 @@ RosStampedPose decodeCdrPoseWithCovarianceStamped(CdrReader& r);
 RosStampedPose decodeCdrTransformStamped(CdrReader& r);
 RosStampedPose decodeCdrPointStamped(CdrReader& r);
 
+/// tf2_msgs/TFMessage: its geometry_msgs/TransformStamped, in order.
+std::vector<RosStampedPose> decodeRosTfMessage(ByteReader& r);
+std::vector<RosStampedPose> decodeCdrTfMessage(CdrReader& r);
+
 /// The message kinds the importer reads, chosen by type name ("sensor_msgs/Imu", or ROS 2's
 /// "sensor_msgs/msg/Imu") and, in ROS 1 bags, checked against the md5sum the connection record
 /// carries (a bag with a different definition under the same name is refused).
-enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kCameraInfo, kPose };
+enum class RosMessageKind { kUnsupported, kImu, kPointCloud2, kImage, kCompressedImage, kCameraInfo, kPose, kTfMessage };
 struct RosTypeInfo {
   RosMessageKind kind = RosMessageKind::kUnsupported;
   const char* md5 = "";

@@ -1,7 +1,8 @@
 // ROS 1 bag -> LCM log: each mapped topic's messages converted to the project's types
 // (sensor_msgs/Imu -> imu_t, PointCloud2 -> point_cloud_t, Image / CompressedImage -> image_t,
 // depth Image (16UC1 mm, 32FC1 m) -> image_t DEPTH16 / DEPTH32F,
-// Odometry / PoseStamped / PoseWithCovarianceStamped / TransformStamped / PointStamped -> pose_t),
+// Odometry / PoseStamped / PoseWithCovarianceStamped / TransformStamped / PointStamped, and one
+// child frame's transforms of a tf2_msgs/TFMessage topic -> pose_t),
 // stamped by their header stamps. The camera's sensor_msgs/CameraInfo is read into the report's
 // calibration (no message type carries it). Other topics are counted, never decoded.
 #pragma once
@@ -28,6 +29,9 @@ struct RosbagImportOptions {
   bool auto_map = true;
   std::string ground_truth_file;  // TUM / EuRoC csv instead of a topic
   std::string ground_truth_child_frame = "I";
+  // A tf2_msgs/TFMessage ground-truth topic (/tf): the child frame whose transforms are the ground
+  // truth; empty: the child frame of the topic's first transform (said in a note).
+  std::string ground_truth_tf_frame;
   ChannelNames channels;
   PointCloudConversionOptions lidar;
   ImuUnitOptions imu_units;
