@@ -61,6 +61,7 @@ die() { echo "run_pipeline.sh: $*" >&2; exit 1; }
 
 log="" config="" out="" realtime=0 without="" processes="" inside=0 faults="" seed=1 respawn="" max_restarts=3 kills="" stop_grace=60 overlays="" max_lag=16 serial=0 ground_map=0 bus="" remote="" no_playback=0
 record='ODOMETRY,REGISTERED_SCAN,KEYFRAME,LOOP_CORRECTION,COLORED_CLOUD,OCTOMAP,STATE_PRIOR,STATE_POSTERIOR,VISUAL_STATE,VISUAL_ODOMETRY,HEALTH,GROUND_TRUTH'
+live=0
 declare -A swap=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -85,6 +86,9 @@ while [ $# -gt 0 ]; do
     --bus) bus="$2"; shift 2 ;;
     --remote) remote="$2"; shift 2 ;;
     --no-playback) no_playback=1; shift ;;
+    # scripts/run_live.sh: --no-playback with no log, livo-sensor-watch as the stand-in (logs/sensor_gaps.tsv),
+    # SIGINT as SIGTERM, the run in a session of its own (a Ctrl-C reaches this script alone, which stops it in order)
+    --live) live=1; no_playback=1; realtime=1; shift ;;
     --swap) [[ "$2" == *=* ]] || die "--swap takes PROCESS=EXECUTABLE"
             exe="${2#*=}"
             # a path relative to where the script was called from (the processes run inside --out)
@@ -95,19 +99,19 @@ while [ $# -gt 0 ]; do
     *) echo "run_pipeline.sh: unknown argument '$1'" >&2; usage ;;
   esac
 done
-[ -n "$log" ] && [ -n "$config" ] && [ -n "$out" ] || usage
+{ [ -n "$log" ] || [ "$live" = 1 ]; } && [ -n "$config" ] && [ -n "$out" ] || usage
 [ -n "$respawn" ] || respawn=$realtime
 [[ "$max_restarts" =~ ^[0-9]+$ ]] || die "--max-restarts takes a whole number"
 [[ "$stop_grace" =~ ^[0-9]+$ ]] || die "--stop-grace takes whole seconds"
 [[ "$max_lag" =~ ^[0-9]+$ ]] || die "--max-lag takes a whole number"
 [ "$ground_map" = 0 ] || [[ ",$record," == *",REGISTERED_SCAN,"* ]] || record+=",REGISTERED_SCAN"
-[ -f "$log" ] || die "no such log: $log"
+[ "$live" = 1 ] || [ -f "$log" ] || die "no such log: $log"
 [ -f "$config" ] || die "no such config: $config"
-log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
+[ "$live" = 1 ] || log="$(cd "$(dirname "$log")" && pwd)/$(basename "$log")"
 config="$(cd "$(dirname "$config")" && pwd)/$(basename "$config")"
 mkdir -p "$out/logs"
 out="$(cd "$out" && pwd)"
-for tool in livo-playback livo-record livo-report; do
+for tool in "$([ "$live" = 1 ] && echo livo-sensor-watch || echo livo-playback)" livo-record livo-report; do
   [ -x "$bin/$tool" ] || die "$bin/$tool missing: run scripts/build.sh"
 done
 
@@ -141,10 +145,10 @@ done
 if [ "$inside" = 0 ]; then
   swaps=()
   for p in "${!swap[@]}"; do swaps+=(--swap "$p=${swap[$p]}"); done
-  echo "run_pipeline.sh: ${selected[*]} on $(basename "$log") -> $out" >&2
+  echo "run_pipeline.sh: ${selected[*]} on $([ "$live" = 1 ] && echo "the live bus ${bus:-${LCM_DEFAULT_URL:-}}" || basename "$log") -> $out" >&2
   # outputs.lcmlog records clouds: about as large as the input log (a full disk fails every process)
   free_mb=$(df -Pm "$out" | awk 'NR == 2 { print $4 }')
-  log_mb=$(( $(stat -c %s "$log") / 1048576 ))
+  log_mb=$(( $([ "$live" = 1 ] && echo 0 || stat -c %s "$log") / 1048576 ))
   [ "${free_mb:-0}" -ge $(( log_mb + 500 )) ] || \
     echo "run_pipeline.sh: warning: $free_mb MB free where $out is; the outputs may need about $log_mb MB and more" >&2
   rc=0
@@ -155,11 +159,11 @@ if [ "$inside" = 0 ]; then
     --remote "$remote" $([ "$no_playback" = 1 ] && echo --no-playback) \
     --faults "$faults" --seed "$seed" --max-restarts "$max_restarts" --max-lag "$max_lag" $([ "$serial" = 1 ] && echo --serial) --kill "$kills" --stop-grace "$stop_grace" \
     $([ "$respawn" = 1 ] && echo --respawn || echo --no-respawn) \
-    $([ "$realtime" = 1 ] && echo --realtime)) || true  # (an assignment fails as its last $(...))
+    $([ "$realtime" = 1 ] && echo --realtime) $([ "$live" = 1 ] && echo --live)) || true  # (an assignment fails as its last $(...))
   if [ "$no_playback" = 1 ]; then  # SIGTERM ends the run: passed on to the processes' side
-    "${inner[@]}" &
+    $([ "$live" = 1 ] && echo setsid -w) "${inner[@]}" &
     inner_pid=$!
-    trap 'kill -TERM "$inner_pid" 2>/dev/null || true' TERM
+    trap 'kill -TERM "$inner_pid" 2>/dev/null || true' TERM $([ "$live" = 1 ] && echo INT)
     wait "$inner_pid" || rc=$?
     kill -0 "$inner_pid" 2>/dev/null && { rc=0; wait "$inner_pid" || rc=$?; }  # the signal ended the first wait
     trap - TERM
@@ -191,7 +195,7 @@ if [ "$inside" = 0 ]; then
   fi
   evaluations="" figures=""
   if [ -x "$bin/livo-evaluate" ] && [ -s "$out/odometry.tum" ] && \
-     "$bin/livo-loginfo" "$log" | grep -q '^GROUND_TRUTH '; then
+     "$bin/livo-loginfo" "$([ "$live" = 1 ] && echo "$out/outputs.lcmlog" || echo "$log")" | grep -q '^GROUND_TRUTH '; then
     # the ground truth as replayed (recorded beside the outputs) when there is one: with --faults
     # that shift time (jump) it carries the same stamps the estimators saw
     gt="$log:GROUND_TRUTH"
@@ -230,15 +234,18 @@ if [ "$inside" = 0 ]; then
   while IFS= read -r line; do warnings+=("playback: ${line#*lockstep: }"); done \
     < <(grep -E '^\[playback\] lockstep: ' "$out/logs/playback.log" 2>/dev/null | grep -v 'restarted\|exited;\|silent for\|heard again\|may lag\|in step' || true)
   read -r log_s wall_s < "$out/logs/replay_times.txt" 2>/dev/null || { log_s=0; wall_s=0; }
+  # live: the sensor time the odometry spans
+  [ "$live" = 1 ] && log_s=$(awk '!/^#/ { if (!n++) a = $1; b = $1 } END { printf "%.3f", n ? b - a : 0 }' "$out/odometry.tum" 2>/dev/null || echo 0)
   joined_warnings=$(IFS=';'; echo "${warnings[*]:-}")
   injected=$(sed -n 's/^\[playback\] faults on \(.*\)$/\1/p' "$out/logs/playback.log" 2>/dev/null | paste -sd';' -)
   # the LIO's last word on its wheel updates (accepted, rejected, learned scales)
   sensor_use=$(grep -ho 'wheel updates: .*' "$out/logs/lio.log" 2>/dev/null | tail -n 1 | sed 's/^/lio: /; s/;/,/g' || true)
-  "$bin/livo-report" markdown --dir "$out" --log "$log" --config "$config" --processes "$(IFS=,; echo "${selected[*]}")" \
-    --mode "$([ "$realtime" = 1 ] && echo 'real time' || echo lockstep)" --log-seconds "$log_s" --wall-seconds "$wall_s" \
+  "$bin/livo-report" markdown --dir "$out" --log "${log:-live bus ${bus:-${LCM_DEFAULT_URL:-}}}" --config "$config" --processes "$(IFS=,; echo "${selected[*]}")" \
+    --mode "$([ "$live" = 1 ] && echo live || { [ "$realtime" = 1 ] && echo 'real time' || echo lockstep; })" --log-seconds "$log_s" --wall-seconds "$wall_s" \
     --evaluation "$evaluations" --figure "$figures" --warning "$joined_warnings" --injected "$injected" \
     --sensor-use "$sensor_use" \
-    $([ "$respawn" = 1 ] && echo --restarts "$out/logs/restarts.tsv") >/dev/null
+    $([ "$respawn" = 1 ] && echo --restarts "$out/logs/restarts.tsv") \
+    $([ "$live" = 1 ] && echo --sensor-gaps "$out/logs/sensor_gaps.tsv") >/dev/null
   # The same report as one page with the map in 3D; without it the run still has report.md.
   rm -f "$out/report.html"
   "$bin/livo-report" html --dir "$out" >/dev/null 2>>"$out/logs/report.log" \
@@ -332,7 +339,12 @@ fi
 [ -n "$faults" ] && replay+=(--faults "$faults" --seed "$seed")
 rc=0
 replay+=(--clock-file "$out/logs/log_clock")  # the log seconds replayed so far: --kill, the restart table
-if [ "$no_playback" = 1 ]; then  # another host replays: a stand-in that SIGTERM ends
+if [ "$live" = 1 ]; then  # the stand-in watches the sensors (warnings on stderr and logs/sensor_watch.log)
+  echo "run_pipeline.sh: --live: no replay; the sensors' drivers publish on the bus" >"$out/logs/playback.log"
+  "$bin/livo-sensor-watch" --config "$config" --out "$out/logs/sensor_gaps.tsv" 2> >(tee "$out/logs/sensor_watch.log" >&2) &
+  playback=$!
+  trap 'kill "$playback" 2>/dev/null || true' INT TERM
+elif [ "$no_playback" = 1 ]; then  # another host replays: a stand-in that SIGTERM ends
   echo "run_pipeline.sh: --no-playback: another host replays; this one runs until SIGTERM" >"$out/logs/playback.log"
   sleep infinity &
   playback=$!
