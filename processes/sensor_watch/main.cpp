@@ -101,7 +101,9 @@ int main(int argc, char** argv) {
     std::cerr << "livo-sensor-watch: watching " << joined << " (a gap: " << cli.get("--gap") << " s without a message)"
               << std::endl;
     while (!livo::shutdownRequested()) {
-      if (lcm->handleTimeout(100) < 0) throw std::runtime_error("the LCM provider failed");
+      // a signal interrupts the wait (-1): the loop ends on the flag it set
+      if (lcm->handleTimeout(100) < 0 && !livo::shutdownRequested())
+        throw std::runtime_error("the LCM provider failed");
       watcher.checkSilence();
     }
     watcher.finish();
