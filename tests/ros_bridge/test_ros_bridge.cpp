@@ -8,6 +8,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <ros/serialization.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
 
@@ -161,6 +162,42 @@ TEST(RosInput, CloudWithPerPointTimesAndTheEndStampConvention) {
   EXPECT_EQ(c.ring[3], 3);
   EXPECT_NEAR(c.time_offset[3], 0.003f, 1e-6);
   EXPECT_EQ(out.clouds[1].second.utime, 1700000001000000LL - 100000);  // stamp - sweep_duration
+}
+
+sensor_msgs::Image image(const std::string& encoding, uint32_t bytes_per_pixel) {
+  sensor_msgs::Image m;
+  m.header.stamp = ros::Time(1700000002, 500000000);
+  m.width = 4;
+  m.height = 3;
+  m.encoding = encoding;
+  m.step = m.width * bytes_per_pixel;
+  m.data.assign(static_cast<size_t>(m.step) * m.height, 7);
+  return m;
+}
+
+TEST(RosInput, ImagesByRoleAsTheImporterWritesThem) {
+  Collected out;
+  import::ImportReport report;
+  report.setQuiet(true);
+  RosInputConverter converter(exactUnits(), out, report);
+  const auto grey = serialise(image("mono8", 1)), depth = serialise(image("16UC1", 2));
+  ASSERT_TRUE(converter.convert(SensorRole::kCamera, wire<sensor_msgs::Image>("/cam/left", grey)));
+  ASSERT_TRUE(converter.convert(SensorRole::kCameraRight, wire<sensor_msgs::Image>("/cam/right", grey)));
+  ASSERT_TRUE(converter.convert(SensorRole::kDepth, wire<sensor_msgs::Image>("/cam/depth", depth)));
+  ASSERT_EQ(out.images.size(), 3u);
+  EXPECT_EQ(out.images[0].first, "CAMERA");
+  EXPECT_EQ(out.images[0].second.frame, "C");
+  EXPECT_EQ(out.images[0].second.encoding, int8_t{image_t::ENCODING_GRAY8});
+  EXPECT_EQ(out.images[0].second.utime, 1700000002500000LL);
+  EXPECT_EQ(out.images[1].first, "CAMERA_RIGHT");
+  EXPECT_EQ(out.images[1].second.frame, "C1");
+  EXPECT_EQ(out.images[2].first, "DEPTH");
+  EXPECT_EQ(out.images[2].second.encoding, int8_t{image_t::ENCODING_DEPTH16});
+  EXPECT_EQ(out.images[2].second.width, 4);
+  // a colour camera's encoding the importer does not know is refused, as in a bag
+  const auto yuv = serialise(image("yuv422", 2));
+  EXPECT_FALSE(converter.convert(SensorRole::kCamera, wire<sensor_msgs::Image>("/cam/left", yuv)));
+  EXPECT_EQ(out.images.size(), 3u);
 }
 
 TEST(RosInput, GroundTruthPoseAndZeroStamps) {
