@@ -70,7 +70,9 @@ void RosBridgeNode::onRosMessage(SensorRole role, const std::string& topic, cons
   m.data = bytes_.data();
   m.size = bytes_.size();
   m.receive_ns = nowNs();
+  const auto start = std::chrono::steady_clock::now();
   if (input_.convert(role, m)) ++converted_[topic];
+  node_.recordWork(topic, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   printNewNotes();
 }
 

@@ -5,6 +5,7 @@
 //   LCM -> ROS: ODOMETRY -> nav_msgs/Odometry (+ /tf world -> body), REGISTERED_SCAN and
 //               COLORED_CLOUD -> sensor_msgs/PointCloud2 (ros_output_messages.hpp); the clouds are
 //               converted only while a ROS node subscribes to them.
+// Each input message's conversion time is recorded as the work "work:<topic>" (HEALTH, the summary).
 // run() alternates between the two (ROS's callback queue, then LCM with a 1 ms wait), so neither
 // side waits more than about a millisecond for the other and the livo::Node is used from one thread.
 // The converted sensor messages go out in order, at most one per kPublishSpacing: an LCM
