@@ -54,13 +54,14 @@ class Watcher {
   }
   void finish() {
     for (const auto& gap : watch_.finish(now())) {
-      std::cerr << "livo-sensor-watch: warning: " << gap.channel << " still silent at the end, for "
-                << livo::formatFixed(gap.length(), 2) << " s" << std::endl;
+      if (gap.never)
+        std::cerr << "livo-sensor-watch: warning: no message on " << gap.channel << " in "
+                  << livo::formatFixed(gap.length(), 1) << " s" << std::endl;
+      else
+        std::cerr << "livo-sensor-watch: warning: " << gap.channel << " still silent at the end, for "
+                  << livo::formatFixed(gap.length(), 2) << " s" << std::endl;
       livo::sensor_watch::writeGapLine(out_, gap);
     }
-    for (const auto& c : watch_.neverHeard())
-      std::cerr << "livo-sensor-watch: warning: no message on " << c << " in " << livo::formatFixed(now(), 1) << " s"
-                << std::endl;
     out_.flush();
   }
 

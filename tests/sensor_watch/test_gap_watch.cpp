@@ -1,5 +1,6 @@
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -56,11 +57,18 @@ TEST(GapWatch, OnlyWatchedChannelsAfterTheirFirstMessageAndOpenGapsAtTheEnd) {
   EXPECT_FALSE(watch.arrived("IMU", 31.0, 0));
   EXPECT_FALSE(watch.arrived("CAMERA", 40.0, 0));  // not watched
   const auto open = watch.finish(40.0);
-  ASSERT_EQ(open.size(), 1u);
+  ASSERT_EQ(open.size(), 2u);
   EXPECT_EQ(open[0].channel, "IMU");
   EXPECT_TRUE(open[0].open);
+  EXPECT_FALSE(open[0].never);
   EXPECT_DOUBLE_EQ(open[0].length(), 9.0);
-  EXPECT_EQ(watch.neverHeard(), std::vector<std::string>{"LIDAR"});
+  EXPECT_EQ(open[1].channel, "LIDAR");  // never heard: from the start of the watch
+  EXPECT_TRUE(open[1].never);
+  EXPECT_DOUBLE_EQ(open[1].from_s, 0.0);
+  EXPECT_DOUBLE_EQ(open[1].length(), 40.0);
+  std::ostringstream line;
+  livo::sensor_watch::writeGapLine(line, open[1]);
+  EXPECT_EQ(line.str(), "LIDAR\t0.000\t40.000\t40.000\tnever\t-\t-\n");
   EXPECT_THROW(GapWatch({}, 1.0), std::invalid_argument);
   EXPECT_THROW(GapWatch({"IMU"}, 0.0), std::invalid_argument);
 }
@@ -89,6 +97,15 @@ TEST(GapWatch, GapsFileReadByTheReport) {
   EXPECT_NE(md.find("| IMU | 1.995 | 3.500 | 1.505 | 101.995000 .. 103.500000 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| LIDAR | 3.900 | the stop (still silent) | 2.100 |"), std::string::npos) << md;
   EXPECT_NE(livo::report::sensorGapsMarkdown({}).find("None"), std::string::npos);
+  {
+    std::ofstream out(path);
+    livo::sensor_watch::writeGapLine(out, livo::sensor_watch::SensorGap{"IMU", 0.0, 12.5, true, true, 0, 0});
+  }
+  const auto never = livo::report::readSensorGaps(path);
+  ASSERT_EQ(never.size(), 1u);
+  EXPECT_TRUE(never[0].never && never[0].open);
+  EXPECT_NE(livo::report::sensorGapsMarkdown(never).find("| IMU | 0.000 | the stop (never heard) | 12.500 |"),
+            std::string::npos);
 
   std::ofstream(path) << "IMU\t1.0\t2.0\n";
   EXPECT_THROW(livo::report::readSensorGaps(path), std::runtime_error);

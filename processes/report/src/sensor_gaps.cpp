@@ -16,10 +16,12 @@ std::vector<SensorGapRow> readSensorGaps(const std::string& path) {
     std::vector<std::string> fields;
     std::stringstream ss(line);
     for (std::string field; std::getline(ss, field, '\t');) fields.push_back(field);
-    if (fields.size() != 7 || (fields[4] != "back" && fields[4] != "open"))
-      throw std::runtime_error(path + ":" + std::to_string(number) +
-                               ": expected channel, from_s, to_s, length_s, back|open and two stamps, tab-separated");
-    out.push_back({fields[0], fields[1], fields[2], fields[3], fields[4] == "open", fields[5], fields[6]});
+    if (fields.size() != 7 || (fields[4] != "back" && fields[4] != "open" && fields[4] != "never"))
+      throw std::runtime_error(
+          path + ":" + std::to_string(number) +
+          ": expected channel, from_s, to_s, length_s, back|open|never and two stamps, tab-separated");
+    out.push_back(
+        {fields[0], fields[1], fields[2], fields[3], fields[4] != "back", fields[4] == "never", fields[5], fields[6]});
   }
   return out;
 }
@@ -33,8 +35,11 @@ std::string sensorGapsMarkdown(const std::vector<SensorGapRow>& gaps) {
         "are the sensor's own, of the messages either side.\n\n";
   md << "| channel | from s | to s | length s | sensor stamps s |\n| --- | --- | --- | --- | --- |\n";
   for (const auto& g : gaps)
-    md << "| " << g.channel << " | " << g.from_s << " | " << (g.open ? "the stop (still silent)" : g.to_s) << " | "
-       << g.length_s << " | " << g.stamp_before << " .. " << (g.open ? "-" : g.stamp_after) << " |\n";
+    md << "| " << g.channel << " | " << g.from_s << " | "
+       << (g.never  ? "the stop (never heard)"
+           : g.open ? "the stop (still silent)"
+                    : g.to_s)
+       << " | " << g.length_s << " | " << g.stamp_before << " .. " << (g.open ? "-" : g.stamp_after) << " |\n";
   md << "\n";
   return md.str();
 }

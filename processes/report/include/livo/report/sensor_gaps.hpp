@@ -15,6 +15,7 @@ struct SensorGapRow {
   std::string to_s;    // the first message after it, or the stop when `open`
   std::string length_s;
   bool open = false;         // still silent when the run stopped
+  bool never = false;        // never heard in the run (open, from its start)
   std::string stamp_before;  // sensor stamps (s) bounding the gap, "-" when unknown
   std::string stamp_after;
 };

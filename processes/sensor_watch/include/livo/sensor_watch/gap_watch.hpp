@@ -19,6 +19,7 @@ struct SensorGap {
   double from_s = 0.0;       // wall seconds after the watch started: the last message before the gap
   double to_s = 0.0;         // the first message after it, or the end of the watch when `open`
   bool open = false;         // still silent when the watch ended
+  bool never = false;        // never heard at all (open, from the watch's start)
   int64_t stamp_before = 0;  // sensor utime of the last message before the gap (0: none in its type)
   int64_t stamp_after = 0;   // of the first message after it (0: none, or open)
   double length() const { return to_s - from_s; }
@@ -35,10 +36,9 @@ class GapWatch {
   /// The channels that have been silent for gap_s or longer at `now_s` and were not returned yet
   /// for this silence (each gap once), as gaps open at now_s.
   std::vector<SensorGap> newlySilent(double now_s);
-  /// The gaps still open at `now_s` (the end of the run), with to_s = now_s and open set.
+  /// The gaps still open at `now_s` (the end of the run), with to_s = now_s and open set; a channel
+  /// never heard is one from 0 with `never` set too.
   std::vector<SensorGap> finish(double now_s) const;
-  /// Watched channels that never carried a message.
-  std::vector<std::string> neverHeard() const;
   double gapSeconds() const { return gap_s_; }
 
  private:
@@ -53,8 +53,8 @@ class GapWatch {
 };
 
 /// The file livo-report reads (processes/report/src/sensor_gaps.cpp): one line per gap,
-/// tab-separated: channel, from_s, to_s, length_s, `back` or `open`, sensor stamp before and after
-/// in seconds (`-` when unknown); lines starting with '#' are comments.
+/// tab-separated: channel, from_s, to_s, length_s, `back`, `open` or `never` (never heard), sensor stamp before and
+/// after in seconds (`-` when unknown); lines starting with '#' are comments.
 void writeGapLine(std::ostream& os, const SensorGap& gap);
 
 }  // namespace livo::sensor_watch
