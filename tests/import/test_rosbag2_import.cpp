@@ -157,7 +157,8 @@ TEST_P(Rosbag2Storages, EveryTypeMatchesWhatTheForeignWriterWrote) {
 
 INSTANTIATE_TEST_SUITE_P(Files, Rosbag2Storages,
                          ::testing::Values("unchunked.mcap", "unchunked_nosummary.mcap", "chunked_none.mcap",
-                                           "chunked_zstd.mcap", "chunked_lz4.mcap", "bag_mcap", "bag_split", "bag_db3",
+                                           "chunked_zstd.mcap", "chunked_lz4.mcap", "bag_mcap", "bag_split", "bag_zstd_file",
+                                           "bag_zstd_message", "bag_db3",
                                            "single.db3"),
                          [](const auto& info) {
                            std::string n = info.param;

@@ -4,6 +4,9 @@
 #include <lz4frame.h>
 #include <zstd.h>
 
+#include <algorithm>
+#include <cstdio>
+
 namespace livo::import {
 
 namespace {
@@ -103,6 +106,74 @@ DecompressedChunk decompressZstd(const uint8_t* in, size_t size, size_t expected
                   " bytes (truncated chunk?)";
   }
   return out;
+}
+
+DecompressedChunk decompressZstdFrame(const uint8_t* in, size_t size) {
+  DecompressedChunk out;
+  ZSTD_DStream* s = ZSTD_createDStream();
+  if (!s) {
+    out.error = "zstd: cannot initialise the decompressor";
+    return out;
+  }
+  ZSTD_inBuffer src{in, size, 0};
+  out.data.resize(std::max<size_t>(size * 4, 256));
+  size_t rc = 1, produced = 0;
+  while (rc != 0) {
+    if (produced == out.data.size()) out.data.resize(out.data.size() * 2);
+    ZSTD_outBuffer dst{out.data.data(), out.data.size(), produced};
+    const size_t before_in = src.pos;
+    rc = ZSTD_decompressStream(s, &dst, &src);
+    const bool progressed = dst.pos != produced || src.pos != before_in;
+    produced = dst.pos;
+    if (ZSTD_isError(rc)) {
+      out.error = std::string("zstd: ") + ZSTD_getErrorName(rc) + " after " + std::to_string(produced) + " bytes";
+      break;
+    }
+    if (rc != 0 && !progressed && src.pos == src.size) {
+      out.error = "zstd: the frame ends early after " + std::to_string(produced) + " bytes (truncated?)";
+      break;
+    }
+  }
+  ZSTD_freeDStream(s);
+  out.data.resize(produced);
+  out.complete = out.error.empty();
+  return out;
+}
+
+std::string decompressZstdFile(const std::string& in_path, const std::string& out_path) {
+  std::FILE* in = std::fopen(in_path.c_str(), "rb");
+  if (!in) return in_path + ": cannot open";
+  std::FILE* out = std::fopen(out_path.c_str(), "wb");
+  if (!out) {
+    std::fclose(in);
+    return out_path + ": cannot write";
+  }
+  ZSTD_DStream* s = ZSTD_createDStream();
+  std::vector<uint8_t> ibuf(ZSTD_DStreamInSize()), obuf(ZSTD_DStreamOutSize());
+  std::string error;
+  size_t rc = 1, got = 0, total = 0;
+  while (error.empty() && (got = std::fread(ibuf.data(), 1, ibuf.size(), in)) > 0) {
+    ZSTD_inBuffer src{ibuf.data(), got, 0};
+    while (src.pos < src.size) {
+      ZSTD_outBuffer dst{obuf.data(), obuf.size(), 0};
+      rc = ZSTD_decompressStream(s, &dst, &src);
+      if (ZSTD_isError(rc)) {
+        error = in_path + ": zstd: " + ZSTD_getErrorName(rc) + " after " + std::to_string(total) + " bytes";
+        break;
+      }
+      if (std::fwrite(obuf.data(), 1, dst.pos, out) != dst.pos) {
+        error = out_path + ": write error";
+        break;
+      }
+      total += dst.pos;
+    }
+  }
+  if (error.empty() && rc != 0)
+    error = in_path + ": zstd: the file ends inside a frame after " + std::to_string(total) + " bytes (truncated?)";
+  ZSTD_freeDStream(s);
+  std::fclose(in);
+  if (std::fclose(out) != 0 && error.empty()) error = out_path + ": write error";
+  return error;
 }
 
 DecompressedChunk decompressChunk(const std::string& compression, const uint8_t* in, size_t size,

@@ -35,7 +35,7 @@ std::map<std::string, std::string> firstImageEncodings(Rosbag2Reader& reader, co
   struct AllSeen {};
   try {
     reader.readFile(0, [&](const Rosbag2Message& m) {
-      if (m.topic->serialization_format == "cdr") first.offer(wireMessage(m));
+      if (m.topic->serialization_format == "cdr" && m.error.empty()) first.offer(wireMessage(m));
       if (first.done()) throw AllSeen{};
     });
   } catch (const AllSeen&) {
@@ -73,6 +73,10 @@ void importRosbag2(const std::string& input, const RosbagImportOptions& o, Sorte
       reader->readFile(
           i,
           [&](const Rosbag2Message& m) {
+            if (!m.error.empty()) {
+              report.skip("message on " + m.topic->topic + " does not decompress: " + m.error, m.where);
+              return;
+            }
             if (m.topic->serialization_format != "cdr") {
               report.skip("serialization format '" + m.topic->serialization_format + "' of " + m.topic->topic +
                               " is not cdr",

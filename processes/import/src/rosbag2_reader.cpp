@@ -3,9 +3,15 @@
 #include <sqlite3.h>
 #include <yaml-cpp/yaml.h>
 
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
+#include "livo/import/chunk_decompression.hpp"
 #include "livo/import/file_utils.hpp"
 #include "livo/import/mcap_reader.hpp"
 
@@ -29,6 +35,7 @@ std::string storageOfFile(const std::string& file) {
 /// topics with their counts.
 struct BagMetadata {
   std::string storage;
+  std::string compression_mode;  // "", FILE or MESSAGE
   std::vector<std::string> files;
   std::vector<Rosbag2Topic> topics;
 };
@@ -41,11 +48,13 @@ BagMetadata readMetadata(const std::string& dir) {
     if (!info) throw Rosbag2Error(path + ": no rosbag2_bagfile_information (not a rosbag2 metadata.yaml)");
     m.storage = info["storage_identifier"].as<std::string>("");
     const std::string compression = info["compression_format"].as<std::string>("");
-    if (!compression.empty())
-      throw Rosbag2Error(path + ": compression_format " + compression + " (mode " +
-                         info["compression_mode"].as<std::string>("") +
-                         "): compressed rosbag2 files are not supported; decompress the bag first "
-                         "(ros2 bag convert), or record MCAP with chunk compression instead");
+    if (!compression.empty()) {
+      m.compression_mode = info["compression_mode"].as<std::string>("");
+      for (char& c : m.compression_mode) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      if (compression != "zstd" || (m.compression_mode != "FILE" && m.compression_mode != "MESSAGE"))
+        throw Rosbag2Error(path + ": compression_format " + compression + ", compression_mode " + m.compression_mode +
+                           ": not supported (zstd, FILE or MESSAGE)");
+    }
     for (const YAML::Node& f : info["relative_file_paths"]) m.files.push_back((fs::path(dir) / f.as<std::string>()).string());
     for (const YAML::Node& t : info["topics_with_message_count"]) {
       const YAML::Node tm = t["topic_metadata"];
@@ -59,7 +68,11 @@ BagMetadata readMetadata(const std::string& dir) {
   } catch (const YAML::Exception& e) {
     throw Rosbag2Error(path + ": " + e.what());
   }
-  if (m.storage.empty() && !m.files.empty()) m.storage = storageOfFile(m.files.front());
+  if (m.storage.empty() && !m.files.empty()) {
+    std::string first = m.files.front();
+    if (endsWith(first, ".zstd")) first.resize(first.size() - 5);
+    m.storage = storageOfFile(first);
+  }
   if (m.files.empty()) throw Rosbag2Error(path + ": relative_file_paths lists no file");
   return m;
 }
@@ -140,6 +153,7 @@ Rosbag2Reader::Rosbag2Reader(const std::string& input) {
       throw Rosbag2Error(input + ": a directory without metadata.yaml (not a rosbag2 bag directory)");
     BagMetadata m = readMetadata(input);
     storage_ = m.storage;
+    compression_mode_ = m.compression_mode;
     files_ = m.files;
     metadata_topics_ = m.topics;
   } else if (isFile(input)) {
@@ -186,14 +200,65 @@ const Rosbag2Topic& Rosbag2Reader::topicFor(const std::string& name, const std::
   return t;
 }
 
+namespace {
+/// A temporary file beside nothing of the user's, removed on destruction.
+struct TempFile {
+  std::string path;
+  explicit TempFile(const std::string& suffix) {
+    std::string t = (fs::temp_directory_path() / ("livo-import-XXXXXX" + suffix)).string();
+    const int fd = mkstemps(t.data(), static_cast<int>(suffix.size()));
+    if (fd < 0) throw Rosbag2Error(t + ": cannot create a temporary file");
+    close(fd);
+    path = t;
+  }
+  ~TempFile() { std::remove(path.c_str()); }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+};
+}  // namespace
+
 void Rosbag2Reader::readFile(size_t i, const std::function<void(const Rosbag2Message&)>& fn,
                              const std::function<void(double, double)>& progress) {
   const std::string& file = files_.at(i);
   if (!isFile(file)) throw Rosbag2Error(file + ": listed in metadata.yaml but missing");
-  if (storage_ == "mcap")
-    readMcap(file, fn, progress);
-  else
-    readSqlite(file, fn, progress);
+  std::unique_ptr<TempFile> plain;
+  std::string path = file, decompression_error;
+  if (compression_mode_ == "FILE") {
+    plain = std::make_unique<TempFile>(storage_ == "mcap" ? ".mcap" : ".db3");
+    decompression_error = decompressZstdFile(file, plain->path);  // what came out before damage is read
+    path = plain->path;
+  }
+  auto named = [&](const Rosbag2Message& m) {
+    if (!plain) return fn(m);
+    Rosbag2Message renamed = m;  // errors name the bag's file, not the temporary one
+    renamed.where = file + renamed.where.substr(path.size());
+    fn(renamed);
+  };
+  try {
+    if (storage_ == "mcap")
+      readMcap(path, named, progress);
+    else
+      readSqlite(path, named, progress);
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    if (plain && what.rfind(path, 0) == 0) what = file + " (decompressed)" + what.substr(path.size());
+    throw Rosbag2Error(decompression_error.empty() ? what : decompression_error + "; then " + what);
+  }
+  if (!decompression_error.empty()) throw Rosbag2Error(decompression_error);
+}
+
+void Rosbag2Reader::deliver(Rosbag2Message& m, const std::function<void(const Rosbag2Message&)>& fn) {
+  if (compression_mode_ != "MESSAGE") return fn(m);
+  DecompressedChunk plain = decompressZstdFrame(m.data, m.size);
+  if (!plain.complete) {
+    m.error = plain.error;
+    m.data = nullptr;
+    m.size = 0;
+    return fn(m);
+  }
+  m.data = plain.data.data();
+  m.size = plain.data.size();
+  fn(m);
 }
 
 void Rosbag2Reader::readMcap(const std::string& file, const std::function<void(const Rosbag2Message&)>& fn,
@@ -207,7 +272,7 @@ void Rosbag2Reader::readMcap(const std::string& file, const std::function<void(c
       out.data = m.data;
       out.size = m.size;
       out.where = m.where;
-      fn(out);
+      deliver(out, fn);
       if (progress) progress(static_cast<double>(reader.position()), static_cast<double>(reader.fileSize()));
     });
   } catch (const McapError& e) {
@@ -242,7 +307,7 @@ void Rosbag2Reader::readSqlite(const std::string& file, const std::function<void
     m.data = static_cast<const uint8_t*>(sqlite3_column_blob(st.s, 3));
     m.size = static_cast<size_t>(sqlite3_column_bytes(st.s, 3));
     m.where = file + ": messages row id " + std::to_string(id) + " (topic " + it->second.topic + ")";
-    fn(m);
+    deliver(m, fn);
     if (progress) progress(++done, total);
   }
   if (rc != SQLITE_DONE)

@@ -7,7 +7,8 @@
 //
 // OUT_DIR gets: unchunked.mcap (with a summary), unchunked_nosummary.mcap (no summary, no index),
 // chunked_{none,zstd,lz4}.mcap, bag_mcap/ (metadata.yaml + a zstd-chunked file), bag_split/ (two
-// files), truncated.mcap (a chunked file cut inside its data section), rows.json (the same messages for make_rosbag2_db3.py)
+// files), bag_zstd_file/ and bag_zstd_message/ (rosbag2's zstd compression, per file and per
+// message), truncated.mcap (a chunked file cut inside its data section), rows.json (the same messages for make_rosbag2_db3.py)
 // and expected.json (every value written, for the tests to compare field by field).
 "use strict";
 
@@ -209,7 +210,7 @@ for (let k = 0; k < 3; ++k) {
 add("/chatter", "std_msgs/String", T0, 140000000, cdr("std_msgs/String", { data: "hello" }));
 
 // ---- the files ----------------------------------------------------------------------------
-async function writeMcap(file, options, part = messages) {
+async function writeMcap(file, options, part = messages, compressMessage = (d) => d) {
   const buffer = new TempBuffer();
   const writer = new McapWriter({ writable: buffer, ...options });
   await writer.start({ profile: "ros2", library: "livo-lcm test fixture (@mcap/core)" });
@@ -225,7 +226,7 @@ async function writeMcap(file, options, part = messages) {
   let seq = 0;
   for (const m of part)
     await writer.addMessage({ channelId: channels.get(m.topic), sequence: seq++, logTime: m.logTime,
-                              publishTime: m.logTime, data: m.data });
+                              publishTime: m.logTime, data: compressMessage(m.data) });
   await writer.end();
   const bytes = buffer.get();
   fs.writeFileSync(file, bytes);
@@ -264,6 +265,20 @@ async function main() {
   fs.writeFileSync(path.join(splitDir, "metadata.yaml"),
                    metadataYaml("mcap", ["bag_split_0.mcap", "bag_split_1.mcap"]));
 
+  // rosbag2's own compression (zstd): each file (mode FILE), each message's payload (mode MESSAGE).
+  const fileDir = path.join(outDir, "bag_zstd_file");
+  fs.mkdirSync(fileDir, { recursive: true });
+  const plainBytes = await writeMcap(path.join(fileDir, "plain.tmp"), { chunkSize: small });
+  fs.unlinkSync(path.join(fileDir, "plain.tmp"));
+  fs.writeFileSync(path.join(fileDir, "bag_zstd_file_0.mcap.zstd"), zstd.compress(plainBytes, 3));
+  fs.writeFileSync(path.join(fileDir, "metadata.yaml"), metadataYaml("mcap", ["bag_zstd_file_0.mcap.zstd"], "FILE"));
+  const messageDir = path.join(outDir, "bag_zstd_message");
+  fs.mkdirSync(messageDir, { recursive: true });
+  await writeMcap(path.join(messageDir, "bag_zstd_message_0.mcap"), { chunkSize: small }, messages,
+                  (d) => zstd.compress(d, 3));
+  fs.writeFileSync(path.join(messageDir, "metadata.yaml"),
+                   metadataYaml("mcap", ["bag_zstd_message_0.mcap"], "MESSAGE"));
+
   const rows = messages.map((m) => ({ topic: m.topic, type: ros2Name(m.type), timestamp: m.logTime.toString(),
                                       data: Buffer.from(m.data).toString("base64") }));
   fs.writeFileSync(path.join(outDir, "rows.json"), JSON.stringify(rows));
@@ -271,7 +286,7 @@ async function main() {
 }
 
 /// rosbag2's metadata.yaml (version 5 layout) for the messages above.
-function metadataYaml(storage, files) {
+function metadataYaml(storage, files, compressionMode = "") {
   const counts = new Map();
   for (const m of messages) counts.set(m.topic, { type: ros2Name(m.type), n: (counts.get(m.topic)?.n ?? 0) + 1 });
   const t0 = messages.reduce((a, m) => (m.logTime < a ? m.logTime : a), messages[0].logTime);
@@ -282,7 +297,9 @@ function metadataYaml(storage, files) {
   for (const [topic, { type, n }] of counts)
     y += `    - topic_metadata:\n        name: ${topic}\n        type: ${type}\n        serialization_format: cdr\n` +
          `        offered_qos_profiles: ""\n      message_count: ${n}\n`;
-  y += `  compression_format: ""\n  compression_mode: ""\n  relative_file_paths:\n`;
+  y += compressionMode ? `  compression_format: zstd\n  compression_mode: ${compressionMode}\n`
+                      : `  compression_format: ""\n  compression_mode: ""\n`;
+  y += "  relative_file_paths:\n";
   for (const f of files) y += `    - ${f}\n`;
   return y;
 }

@@ -19,5 +19,10 @@ DecompressedChunk decompressChunk(const std::string& compression, const uint8_t*
 /// A zstd frame (MCAP chunks) of `expected_size` bytes uncompressed (libzstd's streaming API, so a
 /// cut frame yields what came out before the cut).
 DecompressedChunk decompressZstd(const uint8_t* in, size_t size, size_t expected_size);
+/// A zstd frame of unknown uncompressed size (rosbag2's per-message compression); `error` says why
+/// when it is not complete.
+DecompressedChunk decompressZstdFrame(const uint8_t* in, size_t size);
+/// A zstd-compressed file (rosbag2's per-file compression) into `out_path`; "" or the reason it failed.
+std::string decompressZstdFile(const std::string& in_path, const std::string& out_path);
 
 }  // namespace livo::import

@@ -3,6 +3,8 @@
 // rosbag2's SQLite 3 (tables topics(id, name, type, serialization_format, ...) and
 // messages(id, topic_id, timestamp, data)). Messages come out in each file's order (MCAP: file
 // order; SQLite: row id), files in metadata.yaml's order; their payloads are left serialised.
+// rosbag2's own compression (metadata.yaml compression_format zstd) is undone: mode FILE (each
+// file decompressed to a temporary file, removed after reading) and MESSAGE (each payload).
 #pragma once
 
 #include <cstdint>
@@ -32,12 +34,13 @@ struct Rosbag2Message {
   const uint8_t* data = nullptr;
   size_t size = 0;
   std::string where;  // "<file>: message at offset 120 (topic /imu)", "<file>: messages row id 7 (topic /imu)"
+  std::string error;  // a message compressed by rosbag2 that does not decompress: why (data is then empty)
 };
 
 class Rosbag2Reader {
  public:
   /// A bag directory, or one .mcap / .db3 file. Throws Rosbag2Error for anything else, a
-  /// metadata.yaml that cannot be read, an unknown storage or compressed files.
+  /// metadata.yaml that cannot be read, an unknown storage or compression.
   explicit Rosbag2Reader(const std::string& input);
 
   /// "mcap" or "sqlite3".
@@ -61,7 +64,10 @@ class Rosbag2Reader {
                   const std::function<void(double, double)>& progress);
   const Rosbag2Topic& topicFor(const std::string& name, const std::string& type, const std::string& format);
 
+  void deliver(Rosbag2Message& m, const std::function<void(const Rosbag2Message&)>& fn);
+
   std::string storage_;
+  std::string compression_mode_;  // "", "FILE" or "MESSAGE" (zstd)
   std::vector<std::string> files_;
   std::vector<Rosbag2Topic> metadata_topics_;  // from metadata.yaml
   std::map<std::string, Rosbag2Topic> known_;  // topics seen while reading, by name
