@@ -19,6 +19,7 @@ livo::ros_bridge::RosBridgeFlags flagsOf(const livo::CommandLine& cli) {
   f.camera_right = cli.get("--camera-right");
   f.depth = cli.get("--depth");
   f.ground_truth = cli.get("--ground-truth");
+  f.ground_truth_frame = cli.get("--ground-truth-frame");
   f.world_frame = cli.get("--world-frame");
   f.body_frame = cli.get("--body-frame");
   f.lidar_stamp = cli.get("--lidar-stamp");
@@ -56,7 +57,8 @@ int main(int argc, char** argv) {
       .option("--camera", "TOPIC", "sensor_msgs/Image or CompressedImage")
       .option("--camera-right", "TOPIC", "second camera")
       .option("--depth", "TOPIC", "depth sensor_msgs/Image (16UC1 mm, 32FC1 m)")
-      .option("--ground-truth", "TOPIC", "nav_msgs/Odometry, geometry_msgs/PoseStamped, ...")
+      .option("--ground-truth", "TOPIC", "nav_msgs/Odometry, geometry_msgs/PoseStamped, ..., tf2_msgs/TFMessage")
+      .option("--ground-truth-frame", "FRAME", "on a TFMessage topic: the child frame that is the ground truth")
       .option("--lidar-stamp", "start|end", "what the cloud's header.stamp marks")
       .option("--sweep-duration", "S", "seconds per sweep")
       .option("--lidar-rings", "N", "beams (0: from the cloud)")

@@ -11,6 +11,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "livo/import/byte_reader.hpp"
 #include "livo/import/point_cloud2_conversion.hpp"
@@ -221,6 +222,29 @@ TEST(RosInput, GroundTruthPoseAndZeroStamps) {
   EXPECT_DOUBLE_EQ(q.position[0], 1.5);
   EXPECT_DOUBLE_EQ(q.orientation[0], 0.5);  // w first
   EXPECT_EQ(report.skipped().count("header.stamp is zero: stamped with the arrival time instead"), 1u);
+}
+
+TEST(RosInput, GroundTruthFromTfOneChildFrame) {
+  Collected out;
+  import::ImportReport report;
+  report.setQuiet(true);
+  import::RosbagImportOptions options = exactUnits();
+  options.ground_truth_tf_frame = "vicon/body";  // --ground-truth-frame
+  RosInputConverter converter(options, out, report);
+  tf2_msgs::TFMessage tf;
+  tf.transforms.resize(2);
+  tf.transforms[0].header.stamp = ros::Time(1700000004, 0);
+  tf.transforms[0].child_frame_id = "base_link";
+  tf.transforms[1].header.stamp = ros::Time(1700000004, 10000);
+  tf.transforms[1].child_frame_id = "vicon/body";
+  tf.transforms[1].transform.translation.y = 2.5;
+  tf.transforms[1].transform.rotation.w = 1.0;
+  const auto bytes = serialise(tf);
+  ASSERT_TRUE(converter.convert(SensorRole::kGroundTruth, wire<tf2_msgs::TFMessage>("/tf", bytes)));
+  ASSERT_EQ(out.poses.size(), 1u);
+  EXPECT_EQ(out.poses[0].second.utime, 1700000004000010LL);
+  EXPECT_DOUBLE_EQ(out.poses[0].second.position[1], 2.5);
+  EXPECT_EQ(report.skippedTotal(), 1);  // the transform to base_link
 }
 
 TEST(RosInput, RefusesWhatTheImporterRefuses) {

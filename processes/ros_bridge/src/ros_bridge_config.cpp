@@ -18,6 +18,7 @@ void readTopics(const Config& c, import::RosbagImportOptions& in) {
   t.readOptional("camera_right", in.camera_right_topic);
   t.readOptional("depth", in.depth_topic);
   t.readOptional("ground_truth", in.ground_truth_topic);
+  t.readOptional("ground_truth_frame", in.ground_truth_tf_frame);
 }
 
 void flagTopics(const RosBridgeFlags& f, import::RosbagImportOptions& in) {
@@ -30,6 +31,7 @@ void flagTopics(const RosBridgeFlags& f, import::RosbagImportOptions& in) {
   over(in.camera_right_topic, f.camera_right);
   over(in.depth_topic, f.depth);
   over(in.ground_truth_topic, f.ground_truth);
+  over(in.ground_truth_tf_frame, f.ground_truth_frame);
 }
 
 /// livo-import's preset: fills the empty topics and sets the LiDAR's stamp convention and sweep.

@@ -48,7 +48,7 @@ bool fits(SensorRole role, RosMessageKind kind) {
     case SensorRole::kCamera:
     case SensorRole::kCameraRight: return kind == RosMessageKind::kImage || kind == RosMessageKind::kCompressedImage;
     case SensorRole::kDepth: return kind == RosMessageKind::kImage;
-    case SensorRole::kGroundTruth: return kind == RosMessageKind::kPose;
+    case SensorRole::kGroundTruth: return kind == RosMessageKind::kPose || kind == RosMessageKind::kTfMessage;
   }
   return false;
 }
@@ -98,6 +98,7 @@ bool RosInputConverter::convert(SensorRole role, const RosMessageBytes& m) {
         image(role, import::convertRosCompressedImage(import::decodeRosCompressedImage(r), frameOf(role), where));
         break;
       case RosMessageKind::kPose: pose(info.decode_pose(r), m, where); break;
+      case RosMessageKind::kTfMessage: transforms(import::decodeRosTfMessage(r), m, where); break;
       default: return false;
     }
   } catch (const import::DecodeError& e) {
@@ -161,6 +162,23 @@ void RosInputConverter::image(SensorRole role, image_t img) {
 void RosInputConverter::pose(const import::RosStampedPose& p, const RosMessageBytes& m, const std::string& where) {
   sink_.observe(options_.channels.ground_truth,
                 import::poseFromRos(p, stampOf(p.header, m, where), options_.ground_truth_child_frame));
+}
+
+void RosInputConverter::transforms(const std::vector<import::RosStampedPose>& tfs, const RosMessageBytes& m,
+                                   const std::string& where) {
+  for (const import::RosStampedPose& t : tfs) {
+    if (tf_frame_.empty()) {
+      tf_frame_ = options_.ground_truth_tf_frame.empty() ? t.child_frame_id : options_.ground_truth_tf_frame;
+      if (options_.ground_truth_tf_frame.empty())
+        report_.note("ground_truth_frame not given: the ground truth is " + m.topic + "'s transforms to " + tf_frame_ +
+                     " (the first child frame on it)");
+    }
+    if (t.child_frame_id == tf_frame_)
+      pose(t, m, where);
+    else
+      report_.skip("transforms on " + m.topic + " to another frame than " + tf_frame_ + " (ground_truth_frame)", where,
+                   1, false);
+  }
 }
 
 }  // namespace livo::ros_bridge

@@ -45,7 +45,7 @@ struct RosBridgeNodeOptions {
 /// The command line's values; empty / unset ones leave the config's.
 struct RosBridgeFlags {
   std::string preset;
-  std::string imu, lidar, camera, camera_right, depth, ground_truth;
+  std::string imu, lidar, camera, camera_right, depth, ground_truth, ground_truth_frame;
   std::string world_frame, body_frame;
   std::string lidar_stamp;  // start, end
   std::optional<double> sweep_duration;

@@ -14,6 +14,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "livo/import/import_report.hpp"
 #include "livo/import/imu_units.hpp"
@@ -59,12 +60,16 @@ class RosInputConverter {
   void cloud(import::RosPointCloud2 msg, const RosMessageBytes& m, const std::string& where);
   void image(SensorRole role, image_t img);
   void pose(const import::RosStampedPose& p, const RosMessageBytes& m, const std::string& where);
+  /// tf2_msgs/TFMessage ground truth: the transforms to one child frame (options.ground_truth_tf_frame,
+  /// else the first one seen), as the importer takes them.
+  void transforms(const std::vector<import::RosStampedPose>& tfs, const RosMessageBytes& m, const std::string& where);
   int64_t stampOf(const import::RosHeader& h, const RosMessageBytes& m, const std::string& where);
 
   import::RosbagImportOptions options_;
   import::MessageObserver& sink_;
   import::ImportReport& report_;
   std::map<std::string, std::unique_ptr<import::ImuUnitNormaliser>> imu_units_;  // per IMU topic
+  std::string tf_frame_;  // the ground truth's child frame on a TFMessage topic, once known
 };
 
 }  // namespace livo::ros_bridge
