@@ -180,6 +180,15 @@ TEST(Rosbag2Import, BigEndianCdrReadsTheSameValues) {
   }
 }
 
+TEST(Rosbag2Import, Ros1SerialisationInMcapReadsTheSameValues) {
+  const std::string dir = test::freshTempDir("rosbag2_ros1_encoded");
+  ImportJob job = rosbag2Job("ros1_encoded.mcap", dir + "/ros1.lcmlog");
+  const ImportOutcome r = runImport(job, nullptr);
+  EXPECT_TRUE(r.ok());
+  EXPECT_TRUE(r.report.skipped().empty());
+  expectImu(test::messagesOn<imu_t>(test::readLog(job.out), "IMU"), expected()["imu"]);
+}
+
 TEST(Rosbag2Import, PoseStampedAndTransformStampedGroundTruth) {
   const json exp = expected();
   for (const auto& [topic, key] : {std::pair{"/pose", "pose"}, {"/tf_gt", "tf"}}) {

@@ -9,11 +9,14 @@ namespace livo::import {
 
 namespace {
 
+/// CDR, or ROS 1 serialisation (MCAP files converted from ROS 1 bags: message encoding "ros1").
+bool readable(const Rosbag2Topic& t) { return t.serialization_format == "cdr" || t.serialization_format == "ros1"; }
+
 RosWireMessage wireMessage(const Rosbag2Message& m) {
   RosWireMessage w;
   w.topic = &m.topic->topic;
   w.type = &m.topic->type;
-  w.format = RosWireFormat::kCdr;
+  w.format = m.topic->serialization_format == "ros1" ? RosWireFormat::kRos1 : RosWireFormat::kCdr;
   w.receive_time_ns = m.receive_time_ns;
   w.data = m.data;
   w.size = m.size;
@@ -35,7 +38,7 @@ std::map<std::string, std::string> firstImageEncodings(Rosbag2Reader& reader, co
   struct AllSeen {};
   try {
     reader.readFile(0, [&](const Rosbag2Message& m) {
-      if (m.topic->serialization_format == "cdr" && m.error.empty()) first.offer(wireMessage(m));
+      if (readable(*m.topic) && m.error.empty()) first.offer(wireMessage(m));
       if (first.done()) throw AllSeen{};
     });
   } catch (const AllSeen&) {
@@ -77,9 +80,9 @@ void importRosbag2(const std::string& input, const RosbagImportOptions& o, Sorte
               report.skip("message on " + m.topic->topic + " does not decompress: " + m.error, m.where);
               return;
             }
-            if (m.topic->serialization_format != "cdr") {
+            if (!readable(*m.topic)) {
               report.skip("serialization format '" + m.topic->serialization_format + "' of " + m.topic->topic +
-                              " is not cdr",
+                              " is neither cdr nor ros1",
                           m.where);
               return;
             }

@@ -8,7 +8,7 @@
 // OUT_DIR gets: unchunked.mcap (with a summary), unchunked_nosummary.mcap (no summary, no index),
 // chunked_{none,zstd,lz4}.mcap, bag_mcap/ (metadata.yaml + a zstd-chunked file), bag_split/ (two
 // files), bag_zstd_file/ and bag_zstd_message/ (rosbag2's zstd compression, per file and per
-// message), truncated.mcap (a chunked file cut inside its data section), rows.json (the same messages for make_rosbag2_db3.py)
+// message), ros1_encoded.mcap (the IMU in ROS 1 serialisation), truncated.mcap (a chunked file cut inside its data section), rows.json (the same messages for make_rosbag2_db3.py)
 // and expected.json (every value written, for the tests to compare field by field).
 "use strict";
 
@@ -17,7 +17,8 @@ const path = require("path");
 const { McapWriter, TempBuffer } = require("@mcap/core");
 const { MessageWriter } = require("@foxglove/rosmsg2-serialization");
 const { CdrWriter, EncapsulationKind } = require("@foxglove/cdr");
-const { ros2humble } = require("@foxglove/rosmsg-msgs-common");
+const { ros1, ros2humble } = require("@foxglove/rosmsg-msgs-common");
+const { MessageWriter: Ros1MessageWriter } = require("@foxglove/rosmsg-serialization");
 const zstd = require("@foxglove/wasm-zstd");
 const lz4 = require("lz4js");
 
@@ -76,6 +77,7 @@ const expected = { imu: [], imu_be: [], points: [], image: [], compressed: [], c
 const add = (topic, type, sec, nanosec, data) =>
   messages.push({ topic, type, logTime: BigInt(sec) * 1000000000n + BigInt(nanosec) + 1000n, data });
 
+const ros1Imu = [];
 for (let k = 0; k < 6; ++k) {
   const sec = T0, nanosec = 100000000 + k * 5000000;
   const m = {
@@ -90,6 +92,12 @@ for (let k = 0; k < 6; ++k) {
   let data = cdr("sensor_msgs/Imu", m);
   if (k === 3) data = data.slice(0, 150); // cut inside angular_velocity: undecodable
   add("/imu", "sensor_msgs/Imu", sec, nanosec, data);
+  if (k !== 3) {
+    // The same sample in ROS 1 serialisation (an MCAP file converted from a ROS 1 bag).
+    ros1Imu.push({ logTime: BigInt(sec) * 1000000000n + BigInt(nanosec), data: new Ros1MessageWriter(
+      [ros1["sensor_msgs/Imu"], ros1["std_msgs/Header"], ros1["geometry_msgs/Quaternion"], ros1["geometry_msgs/Vector3"]])
+      .writeMessage({ ...m, header: { seq: k, stamp: { sec, nsec: nanosec }, frame_id: "imu_link" } }) });
+  }
   if (k !== 3)
     expected.imu.push({ sec, nanosec, w: [m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z],
                         a: [m.linear_acceleration.x, m.linear_acceleration.y, m.linear_acceleration.z] });
@@ -278,6 +286,20 @@ async function main() {
                   (d) => zstd.compress(d, 3));
   fs.writeFileSync(path.join(messageDir, "metadata.yaml"),
                    metadataYaml("mcap", ["bag_zstd_message_0.mcap"], "MESSAGE"));
+
+  // ROS 1 serialisation in MCAP (message encoding ros1, schema encoding ros1msg).
+  {
+    const buffer = new TempBuffer();
+    const writer = new McapWriter({ writable: buffer, chunkSize: small });
+    await writer.start({ profile: "ros1", library: "livo-lcm test fixture (@mcap/core)" });
+    const schemaId = await writer.registerSchema({ name: "sensor_msgs/Imu", encoding: "ros1msg", data: new Uint8Array() });
+    const channelId = await writer.registerChannel({ topic: "/imu", messageEncoding: "ros1", schemaId, metadata: new Map() });
+    let seq = 0;
+    for (const m of ros1Imu)
+      await writer.addMessage({ channelId, sequence: seq++, logTime: m.logTime, publishTime: m.logTime, data: m.data });
+    await writer.end();
+    fs.writeFileSync(path.join(outDir, "ros1_encoded.mcap"), buffer.get());
+  }
 
   const rows = messages.map((m) => ({ topic: m.topic, type: ros2Name(m.type), timestamp: m.logTime.toString(),
                                       data: Buffer.from(m.data).toString("base64") }));

@@ -1,6 +1,7 @@
 // ROS 2 bag (rosbag2 directory, .mcap or .db3) -> LCM log: the same topics, presets, conversions
 // and report as the ROS 1 importer (rosbag_import.hpp; both go through ros_message_converter.hpp),
-// the messages decoded from CDR. A message whose serialization format is not CDR is skipped.
+// the messages decoded from CDR (or from ROS 1 serialisation: MCAP files converted from ROS 1
+// bags, message encoding "ros1", read without an md5 check). Other serialization formats are skipped.
 #pragma once
 
 #include <string>
