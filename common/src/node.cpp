@@ -116,8 +116,9 @@ Node::~Node() {
   if (trace_) std::fclose(trace_);
 }
 
-void Node::watchConsumers(const std::string& channel, double stale_s) {
+void Node::watchConsumers(const std::string& channel, double stale_s, const std::string& answer_channel) {
   watched_[channel].stale_s = stale_s;
+  watched_[channel].answer_channel = answer_channel;
   if (!peer_sub_) peer_sub_ = lcm_.subscribeFunction(options_.progress_channel, &Node::onPeerProgress, this);
 }
 
@@ -128,7 +129,10 @@ void Node::onPeerProgress(const lcm::ReceiveBuffer* rbuf, const std::string&, No
   const auto now = std::chrono::steady_clock::now();
   for (auto& [channel, watch] : node->watched_) {
     const bool consumes = std::find(p.input_channel.begin(), p.input_channel.end(), channel) != p.input_channel.end();
-    if (consumes && !p.finished) {
+    const bool answers = watch.answer_channel.empty() ||
+                         std::find(p.output_channel.begin(), p.output_channel.end(), watch.answer_channel) !=
+                             p.output_channel.end();
+    if (consumes && answers && !p.finished) {
       watch.consumers[p.node] = now;
     } else {
       watch.consumers.erase(p.node);

@@ -428,6 +428,7 @@ TEST(LioNode, CameraHandOffPublishesPriorsAndAdoptsPosteriors) {
       priors.push_back(prior);
       vio.publish("STATE_POSTERIOR", posteriorFromTruth(prior, T_lio_truth * seq.truth(prior.utime)));
     });
+    vio.declareOutput("STATE_POSTERIOR");  // lio counts a node that answers, not any subscriber
     vio.announce();  // lio hands off only while a STATE_PRIOR subscriber is alive
   };
   const Outputs out = runNode(in, nullptr, setup);
@@ -492,6 +493,7 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
     setup.handoff = &counts;
     setup.attach = [](Node& vio) {
       vio.subscribe<filter_state_t>("STATE_PRIOR", [](const filter_state_t&) {});
+      vio.declareOutput("STATE_POSTERIOR");
       vio.announce();
     };
     const Outputs out = runNode(in, nullptr, setup);
@@ -521,6 +523,7 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
           vio.publish("STATE_POSTERIOR", foreign);
         }
       });
+      vio.declareOutput("STATE_POSTERIOR");
       vio.announce();
     };
     const Outputs out = runNode(in, nullptr, setup);
@@ -531,6 +534,32 @@ TEST(LioNode, CameraHandOffGoesOnWithoutVio) {
     ASSERT_EQ(out.odometry.size(), lidar_only.odometry.size());
     EXPECT_LT(alignedError(out, seq), 0.002);
   }
+}
+
+// A recorder of STATE_PRIOR (livo-record in run_pipeline.sh) subscribes to it but publishes no
+// STATE_POSTERIOR: lio does not take it for a VIO, hands nothing off, never waits, and its odometry is
+// byte for byte LiDAR-only.
+TEST(LioNode, ARecorderOfStatePriorIsNoVio) {
+  int64_t first_image = 0, last_image = 0;
+  const std::vector<Message> in = withImages(syntheticRun(), &first_image, &last_image);
+  const Outputs lidar_only = runNode(syntheticRun());
+  RunSetup setup;
+  setup.config = handoffConfig();
+  LioNode::HandoffCounts counts;
+  setup.handoff = &counts;
+  int64_t recorded_priors = 0;
+  setup.attach = [&](Node& recorder) {
+    recorder.subscribeRaw("STATE_PRIOR", [&](const void*, int) { ++recorded_priors; });
+    recorder.subscribeRaw("ODOMETRY", [](const void*, int) {});
+    recorder.declareOutput("HEALTH");
+    recorder.announce();
+  };
+  const Outputs out = runNode(in, nullptr, setup);
+  EXPECT_EQ(counts.priors, 0);
+  EXPECT_EQ(recorded_priors, 0);
+  EXPECT_EQ(counts.missing, 0);
+  EXPECT_GE(counts.no_vio, 40);
+  EXPECT_EQ(out.odometry_bytes, lidar_only.odometry_bytes);
 }
 
 // A camera triggered by the LiDAR: every image stamped exactly at a sweep end (the next sweep's
@@ -559,6 +588,7 @@ TEST(LioNode, ImagesAtTheSweepEndsCostNoSweep) {
       post.valid = 0;
       vio.publish("STATE_POSTERIOR", post);
     });
+    vio.declareOutput("STATE_POSTERIOR");
     vio.announce();
   };
   int64_t rejected = 0;
@@ -706,6 +736,7 @@ TEST(LioNode, QuietPromisesHoldAndCoverMostImuSamplesImagesAndWheelReadings) {
         keep.source = "fake_vio";
         vio.publish("STATE_POSTERIOR", keep);
       });
+      vio.declareOutput("STATE_POSTERIOR");
       vio.announce();
     };
     setup.before_each = [&](const Message& m) {
@@ -875,6 +906,7 @@ TEST(LioNode, AnAnswerArrivingAmongTheQuietSamplesChangesNothing) {
       });
       // on the bus itself: a node's input would make the fake VIO report progress on each PROGRESS
       vio.lcm().subscribe("PROGRESS", &LioProgress::onProgress, &lio_progress);
+      vio.declareOutput("STATE_POSTERIOR");
       vio.announce();
     };
     setup.before_each = [&](const Message& m) {

@@ -109,9 +109,12 @@ class Node {
   /// Watches the other nodes' PROGRESS for subscribers of `channel` (e.g. is a VIO there to answer
   /// STATE_PRIOR?). A node counts from its first PROGRESS (spin() announces at start) until it
   /// finishes or has not been heard for stale_s of wall time (a dead process). Watching does not
-  /// count as an input: it adds nothing to this node's PROGRESS.
-  void watchConsumers(const std::string& channel, double stale_s = 3.0);
-  /// Whether a live node other than this one subscribes to a watched channel.
+  /// count as an input: it adds nothing to this node's PROGRESS. With `answer_channel`, only a node
+  /// that also lists it among its outputs counts (lio: a VIO publishes STATE_POSTERIOR, declared at
+  /// start; a recorder of STATE_PRIOR answers nothing).
+  void watchConsumers(const std::string& channel, double stale_s = 3.0, const std::string& answer_channel = "");
+  /// Whether a live node other than this one subscribes to a watched channel (and publishes its
+  /// answer channel, if one was given).
   bool hasConsumers(const std::string& channel) const;
 
   /// A node's promise to lockstep playback (progress_t.quiet_*): messages on `channel` stamped in
@@ -216,6 +219,7 @@ class Node {
   Subscription* current_ = nullptr;  // subscription whose handler is running
   struct Watch {
     double stale_s;
+    std::string answer_channel;  // empty: any subscriber counts
     std::map<std::string, std::chrono::steady_clock::time_point> consumers;  // node -> last heard
   };
   std::map<std::string, Watch> watched_;  // channel -> its consumers

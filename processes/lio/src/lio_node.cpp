@@ -46,7 +46,8 @@ LioNode::LioNode(lcm::LCM& lcm, LioNodeOptions options, bool quiet)
     node_.subscribe<wheel_odometry_t>(options_.wheel_channel, [this](const wheel_odometry_t& m) { onWheel(m); });
   if (options_.camera_handoff) {
     node_.declareOutput(options_.state_prior_channel);
-    node_.watchConsumers(options_.state_prior_channel);
+    // a VIO: it takes STATE_PRIOR and publishes STATE_POSTERIOR (a recorder of STATE_PRIOR does not)
+    node_.watchConsumers(options_.state_prior_channel, 3.0, options_.state_posterior_channel);
     node_.subscribeRaw(options_.camera_channel, [this](const void* data, int size) { onCamera(data, size); });
   }
   node_.setQuietWindows([this] { return quietWindows(); });

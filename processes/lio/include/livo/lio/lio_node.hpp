@@ -56,7 +56,7 @@ class LioNode {
     int64_t kept_prior = 0;      // answered valid = 0 (or unusable): the prior was kept
     int64_t missing = 0;         // no answer within posterior_max_wait_s: went on LiDAR-only
     int64_t images_skipped = 0;  // image times not handed off (filter not tracking yet, or already past them)
-    int64_t no_vio = 0;          // image times not handed off because no node subscribes to STATE_PRIOR
+    int64_t no_vio = 0;          // image times not handed off because no node answers STATE_PRIOR
   };
   const HandoffCounts& handoffCounts() const { return handoff_; }
   /// What became of the sweeps whose odometry was published.
