@@ -82,6 +82,18 @@ struct VectorPriorCost {
   }
 };
 
+struct FullVectorPriorCost {
+  Vec3 mean;
+  Mat3 sqrt_info;  // S with S^T S = covariance^-1
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    const Eigen::Matrix<T, 3, 1> e = Eigen::Map<const Eigen::Matrix<T, 3, 1>>(x) - mean.cast<T>();
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> out(r);
+    out = sqrt_info.cast<T>() * e;
+    return true;
+  }
+};
+
 struct WheelCost {
   WheelPreintegration pre;
   Mat6 sqrt_info;
@@ -175,6 +187,11 @@ ceres::CostFunction* makeScalarPriorFactor(double mean, double sigma) {
 
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma) {
   return new ceres::AutoDiffCostFunction<VectorPriorCost<3>, 3, 3>(new VectorPriorCost<3>{mean, sigma.cwiseInverse()});
+}
+
+ceres::CostFunction* makeCorrelatedVectorPriorFactor(const Vec3& mean, const Mat3& covariance) {
+  return new ceres::AutoDiffCostFunction<FullVectorPriorCost, 3, 3>(
+      new FullVectorPriorCost{mean, Mat3(sqrtInformation(covariance.inverse()))});
 }
 
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma) {

@@ -447,3 +447,36 @@ TEST(Marginalization, PriorMovesWithARigidCorrectionOfTheWorld) {
   EXPECT_THROW(movedPrior(*prior, wrong, T), std::invalid_argument);
   EXPECT_THROW(movedPrior(*prior, {WorldMotion::kNone}, T), std::invalid_argument);
 }
+
+// The correlated vector prior (the first state's accelerometer bias: tight along "up", loose across):
+// its squared residual is the Mahalanobis distance and its Jacobian's J^T J the information.
+TEST(GraphFactors, CorrelatedVectorPriorIsTheMahalanobisDistance) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  for (int trial = 0; trial < 5; ++trial) {
+    Mat3 A;
+    for (int i = 0; i < 9; ++i) A(i) = g(rng);
+    const Mat3 covariance = A * A.transpose() + 1e-3 * Mat3::Identity();
+    const Vec3 mean(g(rng), g(rng), g(rng)), x(g(rng), g(rng), g(rng));
+    std::unique_ptr<ceres::CostFunction> cost(makeCorrelatedVectorPriorFactor(mean, covariance));
+    const double* params[] = {x.data()};
+    Vec3 r;
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> J;
+    double* jacobians[] = {J.data()};
+    ASSERT_TRUE(cost->Evaluate(params, r.data(), jacobians));
+    const Mat3 information = covariance.inverse();
+    EXPECT_NEAR(r.squaredNorm(), (x - mean).dot(information * (x - mean)), 1e-9 * (1.0 + r.squaredNorm()));
+    EXPECT_LT((Mat3(J.transpose() * J) - information).norm(), 1e-8 * information.norm());
+  }
+  // The start at rest: 2 mm/s^2 along up, 0.05 across; a bias error along up costs 625x one across.
+  const Vec3 up(0.0, 0.0, 1.0);
+  const Mat3 at_rest = 0.05 * 0.05 * Mat3::Identity() + (0.002 * 0.002 - 0.05 * 0.05) * up * up.transpose();
+  std::unique_ptr<ceres::CostFunction> prior(makeCorrelatedVectorPriorFactor(Vec3::Zero(), at_rest));
+  auto cost2 = [&](const Vec3& b) {
+    const double* params[] = {b.data()};
+    Vec3 r;
+    prior->Evaluate(params, r.data(), nullptr);
+    return r.squaredNorm();
+  };
+  EXPECT_NEAR(cost2(Vec3(0, 0, 0.01)) / cost2(Vec3(0.01, 0, 0)), 625.0, 1e-6);
+}

@@ -47,6 +47,9 @@ ceres::CostFunction* makeScaledRelativePoseFactor(const Pose3& T_i_j, const Mat6
 
 /// A Gaussian prior on a 3-vector block (velocity, a bias): per-axis sigmas.
 ceres::CostFunction* makeVectorPriorFactor(const Vec3& mean, const Vec3& sigma);
+/// The same with a full covariance (symmetric positive definite), e.g. an accelerometer bias known
+/// along "up" from gravity's magnitude at rest and only loosely across it.
+ceres::CostFunction* makeCorrelatedVectorPriorFactor(const Vec3& mean, const Mat3& covariance);
 /// The wheel scales' prior (2 residuals; block s).
 ceres::CostFunction* makeWheelScalePrior(const Vec2& mean, double sigma);
 /// The wheel mounting correction's prior (3 residuals; block δ): isotropic, sigma in radians.

@@ -84,6 +84,7 @@ struct LioGraphEstimator::Node {
     Mat6 information = Mat6::Zero();
     // kVelocity (world frame), kBias, kWheelMounting (body frame); kWheelScale: head<2>, sigma(0); kVisualScale: (0)
     Vec3 mean = Vec3::Zero(), sigma = Vec3::Ones();
+    std::optional<Mat3> covariance;  // kBias: a full covariance in place of the per-axis sigmas
     std::unique_ptr<ceres::CostFunction> cost;
     void remake() {
       switch (kind) {
@@ -91,7 +92,7 @@ struct LioGraphEstimator::Node {
         case Kind::kWheelScale: cost.reset(makeWheelScalePrior(mean.head<2>(), sigma(0))); break;
         case Kind::kWheelMounting: cost.reset(makeWheelMountingPrior(mean, sigma(0))); break;
         case Kind::kVisualScale: cost.reset(makeScalarPriorFactor(mean(0), sigma(0))); break;
-        default: cost.reset(makeVectorPriorFactor(mean, sigma));
+        default: cost.reset(covariance ? makeCorrelatedVectorPriorFactor(mean, *covariance) : makeVectorPriorFactor(mean, sigma));
       }
     }
   };
@@ -191,14 +192,16 @@ bool LioGraphEstimator::initialize(int64_t t_end, std::string* note) {
     return false;
   }
   const StartStateSigmas sigma = r.static_start ? restStartSigmas(init) : movingStartSigmas(init);
-  window_.push_back(startNode(t_end, r.state, window.back().gyro, sigma));
+  const Mat3 accel_bias_covariance = r.covariance.block<3, 3>(FilterState::kAccelBias, FilterState::kAccelBias);
+  window_.push_back(startNode(t_end, r.state, window.back().gyro, sigma, accel_bias_covariance));
   *note = r.static_start ? "initialised at rest" : "initialised in motion";
   return true;
 }
 
 std::unique_ptr<LioGraphEstimator::Node> LioGraphEstimator::startNode(int64_t t_end, const FilterState& state,
                                                                       const Vec3& last_gyro,
-                                                                      const StartStateSigmas& sigma) {
+                                                                      const StartStateSigmas& sigma,
+                                                                      const Mat3& accel_bias_covariance) {
   auto n = std::make_unique<Node>();
   n->utime = t_end;
   n->setPose(se3::fromRotationTranslation(state.rot, Vec3::Zero()));
@@ -224,7 +227,7 @@ std::unique_ptr<LioGraphEstimator::Node> LioGraphEstimator::startNode(int64_t t_
   n->priors[3].kind = Unary::Kind::kBias;
   n->priors[3].blocks = {n->ba};
   n->priors[3].mean = state.accel_bias;
-  n->priors[3].sigma = Vec3::Constant(sigma.accel_bias);
+  n->priors[3].covariance = accel_bias_covariance;
   addCalibrationPriors(n.get());
   for (Unary& u : n->priors) u.remake();
   return n;

@@ -146,9 +146,11 @@ class LioGraphEstimator {
   /// The first state from the IMU's start-up window ending at t_end; false (with the reason) while it
   /// cannot start.
   bool initialize(int64_t t_end, std::string* note);
-  /// The first state (at rest at the origin, or as the initialisation found it) and its priors.
+  /// The first state (at rest at the origin, or as the initialisation found it) and its priors; the
+  /// accelerometer bias's covariance as the initialisation found it (at rest: tight along "up", where
+  /// gravity's magnitude tells the bias, loose across it).
   std::unique_ptr<Node> startNode(int64_t t_end, const FilterState& state, const Vec3& last_gyro,
-                                  const StartStateSigmas& sigma);
+                                  const StartStateSigmas& sigma, const Mat3& accel_bias_covariance);
   /// The priors of the calibration blocks the window estimates (tyre scales, wheel mounting, visual
   /// scale), around what an earlier epoch learned, added to the first state's.
   void addCalibrationPriors(Node* n);
