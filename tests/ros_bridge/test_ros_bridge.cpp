@@ -1,8 +1,10 @@
 // livo-ros-bridge without a network: ROS 1 messages serialised by roscpp's own serialisation go
-// through RosInputConverter (livo-import's conversions), and the outputs' ROS messages are read back
+// through livo-import's RosMessageConverter as the bridge runs it, and the outputs' ROS messages are read back
 // with livo-import's decoders (a reader this code did not write); the config and its precedence.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include <geometry_msgs/PoseStamped.h>
@@ -15,9 +17,9 @@
 
 #include "livo/import/byte_reader.hpp"
 #include "livo/import/point_cloud2_conversion.hpp"
+#include "livo/import/ros_message_converter.hpp"
 #include "livo/import/ros_messages.hpp"
 #include "livo/ros_bridge/ros_bridge_config.hpp"
-#include "livo/ros_bridge/ros_input.hpp"
 #include "livo/ros_bridge/ros_output_messages.hpp"
 
 namespace {
@@ -46,16 +48,26 @@ std::vector<uint8_t> serialise(const M& m) {
   return bytes;
 }
 
+/// A serialised message as the bridge's subscription hands it to the converter.
+struct Wire {
+  std::string topic, type, md5;
+  std::vector<uint8_t> bytes;
+  import::RosWireMessage message() const {import::RosWireMessage m;
+  m.topic = &topic;
+  m.type = &type;
+  m.md5sum = &md5;
+  m.format = import::RosWireFormat::kRos1;
+  m.receive_time_ns = 1700000123456789000LL;  // the arrival time
+  m.data = bytes.data();
+  m.size = bytes.size();
+  m.where = "topic " + topic;
+  return m;
+}
+};  // namespace
+
 template <class M>
-RosMessageBytes wire(const std::string& topic, const std::vector<uint8_t>& bytes) {
-  RosMessageBytes b;
-  b.topic = topic;
-  b.type = ros::message_traits::datatype<M>();
-  b.md5 = ros::message_traits::md5sum<M>();
-  b.data = bytes.data();
-  b.size = bytes.size();
-  b.receive_ns = 1700000123456789000LL;
-  return b;
+Wire wire(const std::string& topic, const M& msg) {
+  return {topic, ros::message_traits::datatype<M>(), ros::message_traits::md5sum<M>(), serialise(msg)};
 }
 
 sensor_msgs::Imu imuMessage(uint32_t sec, uint32_t nsec) {
@@ -103,18 +115,33 @@ sensor_msgs::PointCloud2 velodyneCloud(uint32_t sec, uint32_t nsec, int points) 
   return m;
 }
 
-import::RosbagImportOptions exactUnits(){import::RosbagImportOptions o;
-o.imu_units.accel = "m/s2";  // decided at once: nothing held back
+/// The inputs as readRosBridgeNodeOptions leaves them (topics named, none chosen automatically),
+/// with the IMU's units given (decided at once: nothing held back).
+import::RosbagImportOptions bridgeInput(){import::RosbagImportOptions o;
+o.auto_map = false;
+o.progress = false;
+o.imu_units.accel = "m/s2";
+o.imu_topic = "/imu";
+o.lidar_topic = "/velodyne_points";
+o.camera_topic = "/cam/left";
+o.camera_right_topic = "/cam/right";
+o.depth_topic = "/cam/depth";
+o.ground_truth_topic = "/gt";
 return o;
-}  // namespace
+}
+
+/// livo-import's converter as the bridge constructs it.
+import::RosMessageConverter bridgeConverter(const import::RosbagImportOptions& o, Collected& out,
+                                            import::ImportReport& report){report.setQuiet(true);
+return import::RosMessageConverter(o, out, report, "the arrival time");
+}
 
 TEST(RosInput, ImuSampleAsLivoImportWritesIt) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  RosInputConverter converter(exactUnits(), out, report);
-  const auto bytes = serialise(imuMessage(1700000000, 5000));
-  ASSERT_TRUE(converter.convert(SensorRole::kImu, wire<sensor_msgs::Imu>("/imu/data", bytes)));
+  const import::RosbagImportOptions options = bridgeInput();
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
+  ASSERT_TRUE(converter.handle(wire("/imu", imuMessage(1700000000, 5000)).message()));
   ASSERT_EQ(out.imu.size(), 1u);
   EXPECT_EQ(out.imu[0].first, "IMU");
   const imu_t& s = out.imu[0].second;
@@ -126,17 +153,16 @@ TEST(RosInput, ImuSampleAsLivoImportWritesIt) {
 TEST(RosInput, ImuUnitsDecidedAsTheImporterDecides) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  import::RosbagImportOptions options;  // accel "auto": the first samples are held until decided
-  RosInputConverter converter(options, out, report);
+  import::RosbagImportOptions options = bridgeInput();
+  options.imu_units.accel = "auto";  // the first samples are held until decided
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
   for (uint32_t i = 0; i < 3; ++i) {
     sensor_msgs::Imu m = imuMessage(1700000000, i * 5000000);
     m.linear_acceleration.z = 1.0;  // in g, as a Livox IMU reports it
-    const auto bytes = serialise(m);
-    converter.convert(SensorRole::kImu, wire<sensor_msgs::Imu>("/livox/imu", bytes));
+    EXPECT_TRUE(converter.handle(wire("/imu", m).message()));
   }
   EXPECT_EQ(out.imu.size(), 0u);
-  converter.flush();
+  converter.finish();
   ASSERT_EQ(out.imu.size(), 3u);
   EXPECT_NEAR(out.imu[2].second.linear_acceleration[2], import::kStandardGravity, 1e-12);
   EXPECT_FALSE(report.notes().empty());
@@ -145,14 +171,14 @@ TEST(RosInput, ImuUnitsDecidedAsTheImporterDecides) {
 TEST(RosInput, CloudWithPerPointTimesAndTheEndStampConvention) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  import::RosbagImportOptions options = exactUnits();
-  const auto bytes = serialise(velodyneCloud(1700000001, 0, 50));
-  RosInputConverter start(options, out, report);
-  ASSERT_TRUE(start.convert(SensorRole::kLidar, wire<sensor_msgs::PointCloud2>("/velodyne_points", bytes)));
-  options.lidar.stamp = import::LidarStampConvention::kEnd;  // as --lidar-stamp end / the ntu_viral preset
-  RosInputConverter end(options, out, report);
-  ASSERT_TRUE(end.convert(SensorRole::kLidar, wire<sensor_msgs::PointCloud2>("/velodyne_points", bytes)));
+  const Wire cloud = wire("/velodyne_points", velodyneCloud(1700000001, 0, 50));
+  const import::RosbagImportOptions start_options = bridgeInput();
+  import::RosMessageConverter start = bridgeConverter(start_options, out, report);
+  ASSERT_TRUE(start.handle(cloud.message()));
+  import::RosbagImportOptions end_options = bridgeInput();
+  end_options.lidar.stamp = import::LidarStampConvention::kEnd;  // as --lidar-stamp end / the ntu_viral preset
+  import::RosMessageConverter end = bridgeConverter(end_options, out, report);
+  ASSERT_TRUE(end.handle(cloud.message()));
   ASSERT_EQ(out.clouds.size(), 2u);
   const point_cloud_t& c = out.clouds[0].second;
   EXPECT_EQ(out.clouds[0].first, "LIDAR");
@@ -179,12 +205,12 @@ sensor_msgs::Image image(const std::string& encoding, uint32_t bytes_per_pixel) 
 TEST(RosInput, ImagesByRoleAsTheImporterWritesThem) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  RosInputConverter converter(exactUnits(), out, report);
-  const auto grey = serialise(image("mono8", 1)), depth = serialise(image("16UC1", 2));
-  ASSERT_TRUE(converter.convert(SensorRole::kCamera, wire<sensor_msgs::Image>("/cam/left", grey)));
-  ASSERT_TRUE(converter.convert(SensorRole::kCameraRight, wire<sensor_msgs::Image>("/cam/right", grey)));
-  ASSERT_TRUE(converter.convert(SensorRole::kDepth, wire<sensor_msgs::Image>("/cam/depth", depth)));
+  const import::RosbagImportOptions options = bridgeInput();
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
+  const sensor_msgs::Image grey = image("mono8", 1), depth = image("16UC1", 2);
+  ASSERT_TRUE(converter.handle(wire("/cam/left", grey).message()));
+  ASSERT_TRUE(converter.handle(wire("/cam/right", grey).message()));
+  ASSERT_TRUE(converter.handle(wire("/cam/depth", depth).message()));
   ASSERT_EQ(out.images.size(), 3u);
   EXPECT_EQ(out.images[0].first, "CAMERA");
   EXPECT_EQ(out.images[0].second.frame, "C");
@@ -196,16 +222,15 @@ TEST(RosInput, ImagesByRoleAsTheImporterWritesThem) {
   EXPECT_EQ(out.images[2].second.encoding, int8_t{image_t::ENCODING_DEPTH16});
   EXPECT_EQ(out.images[2].second.width, 4);
   // a colour camera's encoding the importer does not know is refused, as in a bag
-  const auto yuv = serialise(image("yuv422", 2));
-  EXPECT_FALSE(converter.convert(SensorRole::kCamera, wire<sensor_msgs::Image>("/cam/left", yuv)));
+  EXPECT_FALSE(converter.handle(wire("/cam/left", image("yuv422", 2)).message()));
   EXPECT_EQ(out.images.size(), 3u);
 }
 
 TEST(RosInput, GroundTruthPoseAndZeroStamps) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  RosInputConverter converter(exactUnits(), out, report);
+  const import::RosbagImportOptions options = bridgeInput();
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
   geometry_msgs::PoseStamped p;
   p.header.stamp = ros::Time(0, 0);  // no stamp: the arrival time is used, as the importer uses the bag's
   p.pose.position.x = 1.5;
@@ -213,8 +238,7 @@ TEST(RosInput, GroundTruthPoseAndZeroStamps) {
   p.pose.orientation.y = 0.5;
   p.pose.orientation.z = 0.5;
   p.pose.orientation.w = 0.5;
-  const auto bytes = serialise(p);
-  ASSERT_TRUE(converter.convert(SensorRole::kGroundTruth, wire<geometry_msgs::PoseStamped>("/gt", bytes)));
+  ASSERT_TRUE(converter.handle(wire("/gt", p).message()));
   ASSERT_EQ(out.poses.size(), 1u);
   const pose_t& q = out.poses[0].second;
   EXPECT_EQ(q.utime, 1700000123456789LL);
@@ -227,10 +251,10 @@ TEST(RosInput, GroundTruthPoseAndZeroStamps) {
 TEST(RosInput, GroundTruthFromTfOneChildFrame) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  import::RosbagImportOptions options = exactUnits();
+  import::RosbagImportOptions options = bridgeInput();
+  options.ground_truth_topic = "/tf";
   options.ground_truth_tf_frame = "vicon/body";  // --ground-truth-frame
-  RosInputConverter converter(options, out, report);
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
   tf2_msgs::TFMessage tf;
   tf.transforms.resize(2);
   tf.transforms[0].header.stamp = ros::Time(1700000004, 0);
@@ -239,8 +263,7 @@ TEST(RosInput, GroundTruthFromTfOneChildFrame) {
   tf.transforms[1].child_frame_id = "vicon/body";
   tf.transforms[1].transform.translation.y = 2.5;
   tf.transforms[1].transform.rotation.w = 1.0;
-  const auto bytes = serialise(tf);
-  ASSERT_TRUE(converter.convert(SensorRole::kGroundTruth, wire<tf2_msgs::TFMessage>("/tf", bytes)));
+  ASSERT_TRUE(converter.handle(wire("/tf", tf).message()));
   ASSERT_EQ(out.poses.size(), 1u);
   EXPECT_EQ(out.poses[0].second.utime, 1700000004000010LL);
   EXPECT_DOUBLE_EQ(out.poses[0].second.position[1], 2.5);
@@ -250,19 +273,19 @@ TEST(RosInput, GroundTruthFromTfOneChildFrame) {
 TEST(RosInput, RefusesWhatTheImporterRefuses) {
   Collected out;
   import::ImportReport report;
-  report.setQuiet(true);
-  RosInputConverter converter(exactUnits(), out, report);
-  const auto bytes = serialise(imuMessage(1700000000, 0));
-  RosMessageBytes other_md5 = wire<sensor_msgs::Imu>("/imu", bytes);
+  const import::RosbagImportOptions options = bridgeInput();
+  import::RosMessageConverter converter = bridgeConverter(options, out, report);
+  const sensor_msgs::Imu imu = imuMessage(1700000000, 0);
+  Wire other_md5 = wire("/imu", imu);
   other_md5.md5 = "0123456789abcdef0123456789abcdef";
-  EXPECT_FALSE(converter.convert(SensorRole::kImu, other_md5));
-  EXPECT_FALSE(converter.convert(SensorRole::kLidar, wire<sensor_msgs::Imu>("/imu", bytes)));
-  RosMessageBytes cut = wire<sensor_msgs::Imu>("/imu", bytes);
-  cut.size -= 10;
-  EXPECT_FALSE(converter.convert(SensorRole::kImu, cut));
-  RosMessageBytes unknown = wire<sensor_msgs::Imu>("/imu", bytes);
+  EXPECT_FALSE(converter.handle(other_md5.message()));
+  EXPECT_FALSE(converter.handle(wire("/velodyne_points", imu).message()));  // an Imu cannot be the LiDAR
+  Wire cut = wire("/imu", imu);
+  cut.bytes.resize(cut.bytes.size() - 10);
+  EXPECT_FALSE(converter.handle(cut.message()));
+  Wire unknown = wire("/imu", imu);
   unknown.type = "std_msgs/String";
-  EXPECT_FALSE(converter.convert(SensorRole::kImu, unknown));
+  EXPECT_FALSE(converter.handle(unknown.message()));
   EXPECT_EQ(out.total(), 0u);
   EXPECT_EQ(report.skippedTotal(), 4);
   bool named_field = false;
@@ -407,7 +430,13 @@ TEST(RosBridgeConfig, PresetFlagsAndConfigInLivoImportsOrder) {
   EXPECT_EQ(o.input.channels.imu, "IMU0");               // the rig's channels
   EXPECT_EQ(o.frames.world, "map");
   EXPECT_EQ(o.frames.body, "body");
-  EXPECT_EQ(topicRoles(o.input).at("/cam"), SensorRole::kCamera);
+  // the roles the bridge subscribes to, as its converter maps them
+  Collected out;
+  import::ImportReport report;
+  const import::RosMessageConverter converter = bridgeConverter(o.input, out, report);
+  const auto roles = converter.roleTopics();
+  EXPECT_NE(std::find(roles.begin(), roles.end(), std::make_pair(std::string("camera"), std::string("/cam"))),
+            roles.end());
 }
 
 TEST(RosBridgeConfig, ErrorsNameTheKey) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "livo/import/image_encoding.hpp"
 #include "livo/import/point_cloud2_conversion.hpp"
@@ -86,8 +87,9 @@ bool fits(Role role, RosMessageKind kind) {
 
 }  // namespace
 
-RosMessageConverter::RosMessageConverter(const RosbagImportOptions& o, SortedLogWriter& w, ImportReport& r)
-    : options_(o), writer_(w), report_(r) {
+RosMessageConverter::RosMessageConverter(const RosbagImportOptions& o, MessageObserver& sink, ImportReport& r,
+                                         std::string receive_time)
+    : options_(o), sink_(sink), report_(r), receive_time_(std::move(receive_time)) {
   topics_[Role::kImu] = o.imu_topic;
   topics_[Role::kLidar] = o.lidar_topic;
   topics_[Role::kCamera] = o.camera_topic;
@@ -164,28 +166,28 @@ std::vector<std::pair<std::string, std::string>> RosMessageConverter::roleTopics
   return out;
 }
 
-void RosMessageConverter::handle(const RosWireMessage& m) {
+bool RosMessageConverter::handle(const RosWireMessage& m) {
   const std::string& topic = *m.topic;
   const std::string& type = *m.type;
   const Role role = roleOf(topic);
   if (role == Role::kIgnored) {
     report_.skip("topic not mapped: " + topic + " (" + type + ")", m.where, 1, false);
-    return;
+    return false;
   }
   const RosTypeInfo info = rosTypeInfo(type);
   if (info.kind == RosMessageKind::kUnsupported) {
     report_.skip("unsupported message type " + type + " on " + topic, m.where);
-    return;
+    return false;
   }
   if (m.md5sum && *m.md5sum != info.md5 && *m.md5sum != "*") {
     report_.skip(
         "md5sum " + *m.md5sum + " of " + type + " on " + topic + " differs from the known definition " + info.md5,
         m.where);
-    return;
+    return false;
   }
   if (!fits(role, info.kind)) {
     report_.skip(std::string("topic ") + topic + " is " + type + ", which cannot be the " + roleName(role), m.where);
-    return;
+    return false;
   }
   try {
     if (m.format == RosWireFormat::kCdr) {
@@ -200,7 +202,9 @@ void RosMessageConverter::handle(const RosWireMessage& m) {
     std::string what = e.what();
     if (what.rfind(m.where + ": ", 0) == 0) what = what.substr(m.where.size() + 2);
     report_.skip(std::string("undecodable ") + type + " on " + topic + ": " + what, e.what());
+    return false;
   }
+  return true;
 }
 
 namespace {
@@ -256,7 +260,7 @@ RosMessageConverter::Role RosMessageConverter::roleOf(const std::string& topic) 
 int64_t RosMessageConverter::stampOf(const RosHeader& h, const RosWireMessage& m) {
   if (options_.use_bag_time) return nsToUtime(m.receive_time_ns);
   if (h.sec == 0 && h.nsec == 0) {
-    report_.skip("header.stamp is zero: stamped with the bag's receive time instead", m.where, 1, false);
+    report_.skip("header.stamp is zero: stamped with " + receive_time_ + " instead", m.where, 1, false);
     return nsToUtime(m.receive_time_ns);
   }
   return nsToUtime(h.stampNs());
@@ -272,7 +276,7 @@ void RosMessageConverter::imu(const RosImu& msg, const RosWireMessage& m) {
   if (!norm) {
     const std::string channel = options_.channels.imu;
     norm = std::make_unique<ImuUnitNormaliser>(options_.imu_units, *m.topic, report_,
-                                               [this, channel](const imu_t& x) { writer_.add(channel, x); });
+                                               [this, channel](const imu_t& x) { sink_.observe(channel, x); });
   }
   norm->add(s);
 }
@@ -282,7 +286,7 @@ void RosMessageConverter::cloud(RosPointCloud2 msg, const RosWireMessage& m) {
     msg.header.sec = static_cast<uint32_t>(m.receive_time_ns / 1000000000LL);
     msg.header.nsec = static_cast<uint32_t>(m.receive_time_ns % 1000000000LL);
   } else if (msg.header.sec == 0 && msg.header.nsec == 0) {
-    report_.skip("header.stamp is zero: stamped with the bag's receive time instead", m.where, 1, false);
+    report_.skip("header.stamp is zero: stamped with " + receive_time_ + " instead", m.where, 1, false);
     msg.header.sec = static_cast<uint32_t>(m.receive_time_ns / 1000000000LL);
     msg.header.nsec = static_cast<uint32_t>(m.receive_time_ns % 1000000000LL);
   }
@@ -293,15 +297,15 @@ void RosMessageConverter::cloud(RosPointCloud2 msg, const RosWireMessage& m) {
     report_.metadataString("lidar_point_layout", c.layout);
     report_.metadataString("lidar_topic", *m.topic);
   }
-  writer_.add(options_.channels.lidar, c.cloud);
+  sink_.observe(options_.channels.lidar, c.cloud);
 }
 
 void RosMessageConverter::image(Role role, image_t img, const RosWireMessage& m) {
   if (options_.use_bag_time) img.utime = nsToUtime(m.receive_time_ns);
-  writer_.add(role == Role::kCameraRight ? options_.channels.camera_right
-              : role == Role::kDepth     ? options_.channels.depth
-                                         : options_.channels.camera,
-              img);
+  sink_.observe(role == Role::kCameraRight ? options_.channels.camera_right
+                : role == Role::kDepth     ? options_.channels.depth
+                                           : options_.channels.camera,
+                img);
 }
 
 /// The first calibrated CameraInfo becomes the report's camera calibration (and metadata
@@ -333,7 +337,7 @@ void RosMessageConverter::pose(const RosStampedPose& p, const RosWireMessage& m)
   const pose_t out = poseFromRos(p, stampOf(p.header, m), options_.ground_truth_child_frame);
   if (!p.has_orientation && report_.metadataValue("ground_truth_orientation").empty())
     report_.metadataString("ground_truth_orientation", "none (position only; identity written)");
-  writer_.add(options_.channels.ground_truth, out);
+  sink_.observe(options_.channels.ground_truth, out);
 }
 
 /// The transforms to the ground-truth frame (--ground-truth-frame, else the first child frame on

@@ -52,7 +52,8 @@ std::map<std::string, std::string> firstImageEncodings(Rosbag2Reader& reader, co
 
 void importRosbag2(const std::string& input, const RosbagImportOptions& o, SortedLogWriter& writer,
                    ImportReport& report) {
-  RosMessageConverter conv(o, writer, report);
+  LogWriterSink sink(writer);
+  RosMessageConverter conv(o, sink, report);
   std::unique_ptr<Rosbag2Reader> reader;
   try {
     reader = std::make_unique<Rosbag2Reader>(input);

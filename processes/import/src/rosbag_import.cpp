@@ -71,7 +71,8 @@ std::map<uint32_t, BagConnection> bagConnections(const std::string& bag) {
 
 void importRosbag(const std::vector<std::string>& bags, const RosbagImportOptions& o, SortedLogWriter& writer,
                   ImportReport& report) {
-  RosMessageConverter conv(o, writer, report);
+  LogWriterSink sink(writer);
+  RosMessageConverter conv(o, sink, report);
   const bool need_auto = o.auto_map && (o.imu_topic.empty() || o.lidar_topic.empty() || o.camera_topic.empty() ||
                                         o.depth_topic.empty() || o.camera_info_topic.empty());
   if (need_auto && !bags.empty()) {
@@ -79,7 +80,7 @@ void importRosbag(const std::vector<std::string>& bags, const RosbagImportOption
       const std::map<uint32_t, BagConnection> connections = bagConnections(bags.front());
       const bool images_to_map = o.camera_topic.empty() || o.depth_topic.empty();
       conv.autoMap(topicsOf(connections), images_to_map ? firstImageEncodings(bags.front(), connections)
-                                              : std::map<std::string, std::string>{});
+                                                        : std::map<std::string, std::string>{});
     } catch (const std::exception& e) {
       report.error(e.what());
       return;

@@ -1,6 +1,7 @@
 #include "livo/ros_bridge/ros_bridge_node.hpp"
 
 #include <iostream>
+#include <set>
 #include <thread>
 
 #include <ros/callback_queue.h>
@@ -20,18 +21,24 @@ int64_t nowNs() {
 
 RosBridgeNode::RosBridgeNode(lcm::LCM& lcm, const NodeOptions& node_options, const RosBridgeNodeOptions& options,
                              ros::NodeHandle& ros_node)
-    : lcm_(lcm), node_(lcm, node_options), options_(options), input_(options_.input, *this, report_) {
+    : lcm_(lcm),
+      node_(lcm, node_options),
+      options_(options),
+      input_(options_.input, *this, report_, "the arrival time") {
   subscribeInputs(ros_node);
   advertiseOutputs(ros_node);
 }
 
 void RosBridgeNode::subscribeInputs(ros::NodeHandle& ros_node) {
   const import::ChannelNames& ch = options_.input.channels;
-  for (const auto& [topic, role] : topicRoles(options_.input)) {
-    const uint32_t queue = static_cast<uint32_t>(role == SensorRole::kImu ? options_.imu_queue : options_.sensor_queue);
+  std::set<std::string> subscribed;
+  for (const auto& [role, topic] : input_.roleTopics()) {
+    if (!subscribed.insert(topic).second) continue;  // a topic named for two roles has the first (as the converter)
+    const uint32_t queue =
+        static_cast<uint32_t>(role == std::string("imu") ? options_.imu_queue : options_.sensor_queue);
     boost::function<void(const topic_tools::ShapeShifter::ConstPtr&)> callback =
-        [this, role = role, topic = topic](const topic_tools::ShapeShifter::ConstPtr& m) {
-          onRosMessage(role, topic, *m);
+        [this, topic = topic, where = "topic " + topic](const topic_tools::ShapeShifter::ConstPtr& m) {
+          onRosMessage(topic, where, *m);
         };
     subscribers_.push_back(ros_node.subscribe<topic_tools::ShapeShifter>(topic, queue, callback, ros::VoidConstPtr(),
                                                                          ros::TransportHints().tcpNoDelay()));
@@ -59,19 +66,22 @@ void RosBridgeNode::advertiseOutputs(ros::NodeHandle& ros_node) {
   }
 }
 
-void RosBridgeNode::onRosMessage(SensorRole role, const std::string& topic, const topic_tools::ShapeShifter& message) {
+void RosBridgeNode::onRosMessage(const std::string& topic, const std::string& where,
+                                 const topic_tools::ShapeShifter& message) {
   bytes_.resize(message.size());
   ros::serialization::OStream stream(bytes_.data(), static_cast<uint32_t>(bytes_.size()));
   message.write(stream);
-  RosMessageBytes m;
-  m.topic = topic;
-  m.type = message.getDataType();
-  m.md5 = message.getMD5Sum();
+  import::RosWireMessage m;
+  m.topic = &topic;
+  m.type = &message.getDataType();
+  m.md5sum = &message.getMD5Sum();
+  m.format = import::RosWireFormat::kRos1;
+  m.receive_time_ns = nowNs();
   m.data = bytes_.data();
   m.size = bytes_.size();
-  m.receive_ns = nowNs();
+  m.where = where;
   const auto start = std::chrono::steady_clock::now();
-  if (input_.convert(role, m)) ++converted_[topic];
+  if (input_.handle(m)) ++converted_[topic];
   node_.recordWork(topic, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   printNewNotes();
 }
@@ -152,7 +162,7 @@ int RosBridgeNode::run() {
 void RosBridgeNode::finish() {
   if (finished_) return;
   finished_ = true;
-  input_.flush();
+  input_.finish();
   while (!outgoing_.empty()) {  // what was converted still goes out, at the same pace
     publishQueued();
     std::this_thread::sleep_for(std::chrono::microseconds(100));

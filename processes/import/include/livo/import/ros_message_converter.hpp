@@ -1,9 +1,10 @@
-// One conversion path for the messages of every ROS bag format: a serialised message (ROS 1
-// serialisation from a ROS 1 bag, CDR from a ROS 2 bag) is decoded into the plain structs of
-// ros_messages.hpp, then converted to the project's types by the same code whatever the format:
-// topic roles (--imu, --lidar, ... and their automatic choice), stamps (header or receive time),
-// IMU units, PointCloud2 / Image / CompressedImage / depth conversion, CameraInfo calibration,
-// ground-truth poses, and the report's skips.
+// One conversion path for ROS messages, from a bag or live: a serialised message (ROS 1
+// serialisation from a ROS 1 bag or a ROS 1 subscription, CDR from a ROS 2 bag) is decoded into
+// the plain structs of ros_messages.hpp, then converted to the project's types by the same code
+// whatever the format: topic roles (--imu, --lidar, ... and their automatic choice), stamps (header
+// or receive time), IMU units, PointCloud2 / Image / CompressedImage / depth conversion, CameraInfo
+// calibration, ground-truth poses, and the report's skips. The converted messages go to a
+// MessageObserver: livo-import's SortedLogWriter (through LogWriterSink), livo-ros-bridge's LCM queue.
 #pragma once
 
 #include <cstdint>
@@ -26,13 +27,14 @@ namespace livo::import {
 
 enum class RosWireFormat { kRos1, kCdr };
 
-/// A serialised message as a bag holds it. The strings are the bag reader's (not copied).
+/// A serialised message as a bag holds it (or a subscription delivers it). The strings are the
+/// caller's (not copied).
 struct RosWireMessage {
   const std::string* topic = nullptr;
   const std::string* type = nullptr;    // "sensor_msgs/Imu" or "sensor_msgs/msg/Imu"
   const std::string* md5sum = nullptr;  // ROS 1 only (nullptr: not checked)
   RosWireFormat format = RosWireFormat::kRos1;
-  int64_t receive_time_ns = 0;  // the bag's receive (log) time
+  int64_t receive_time_ns = 0;  // the bag's receive (log) time, or the arrival time
   const uint8_t* data = nullptr;
   size_t size = 0;
   std::string where;  // "<file>: message record 12 (topic /imu)", for errors
@@ -64,13 +66,20 @@ class FirstImageEncodings {
 
 class RosMessageConverter {
  public:
-  RosMessageConverter(const RosbagImportOptions& o, SortedLogWriter& w, ImportReport& r);
+  /// `sink` gets each converted message with its LCM channel (o.channels), in conversion order;
+  /// `r` gets the notes, metadata and skips. Neither is owned. `receive_time` names
+  /// RosWireMessage::receive_time_ns in the report ("the arrival time" for a live input).
+  RosMessageConverter(const RosbagImportOptions& o, MessageObserver& sink, ImportReport& r,
+                      std::string receive_time = "the bag's receive time");
 
   /// Fills empty roles from the bag's topics when exactly one topic fits. `image_encodings`
   /// (FirstImageEncodings) tells depth Image topics, which fit only the depth role, from cameras.
   void autoMap(const std::vector<RosTopic>& topics, const std::map<std::string, std::string>& image_encodings);
-  /// Decodes and converts one message (or counts it as skipped, with the reason).
-  void handle(const RosWireMessage& m);
+  /// Decodes and converts one message. Returns false, with the reason in the report's skips, if
+  /// it was refused: topic not mapped, unknown type, other md5sum, a type that cannot fill the
+  /// topic's role, undecodable bytes. (A decoded message may still be skipped, e.g. a non-finite
+  /// IMU sample, or held back, e.g. IMU samples until their units are decided.)
+  bool handle(const RosWireMessage& m);
   /// Flushes what is held back (IMU samples waiting for the unit decision).
   void finish();
   /// (role name, topic) of each role with a topic: imu, lidar, camera, ...
@@ -93,8 +102,9 @@ class RosMessageConverter {
   void transforms(const std::vector<RosStampedPose>& tfs, const RosWireMessage& m);
 
   const RosbagImportOptions& options_;
-  SortedLogWriter& writer_;
+  MessageObserver& sink_;
   ImportReport& report_;
+  std::string receive_time_;
   std::map<Role, std::string> topics_;
   std::map<std::string, std::unique_ptr<ImuUnitNormaliser>> imu_units_;
   int64_t camera_infos_ = 0;

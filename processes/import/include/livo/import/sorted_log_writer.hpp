@@ -16,8 +16,9 @@
 
 namespace livo::import {
 
-/// Sees each message a SortedLogWriter is given, in the order the importer adds them (not time
-/// order), e.g. RigSurvey measuring rates and sensor facts while the log is written.
+/// Sees each converted message with its channel, in the order it was produced (not time order):
+/// a SortedLogWriter's observer (RigSurvey measuring rates and sensor facts while the log is
+/// written), or where a converter's output goes (LogWriterSink below, livo-ros-bridge's LCM queue).
 class MessageObserver {
  public:
   virtual ~MessageObserver() = default;
@@ -74,6 +75,19 @@ class SortedLogWriter {
   std::map<std::string, int64_t> counts_;
   bool finished_ = false;
   MessageObserver* observer_ = nullptr;
+};
+
+/// A MessageObserver that adds each message to a SortedLogWriter (a converter's output into the log).
+class LogWriterSink : public MessageObserver {
+ public:
+  explicit LogWriterSink(SortedLogWriter& writer) : writer_(writer) {}
+  void observe(const std::string& channel, const imu_t& msg) override { writer_.add(channel, msg); }
+  void observe(const std::string& channel, const point_cloud_t& msg) override { writer_.add(channel, msg); }
+  void observe(const std::string& channel, const image_t& msg) override { writer_.add(channel, msg); }
+  void observe(const std::string& channel, const pose_t& msg) override { writer_.add(channel, msg); }
+
+ private:
+  SortedLogWriter& writer_;
 };
 
 }  // namespace livo::import

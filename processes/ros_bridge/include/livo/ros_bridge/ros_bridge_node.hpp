@@ -1,7 +1,8 @@
 // livo-ros-bridge's node: a ROS 1 node and an LCM node in one thread.
 //   ROS -> LCM: each configured topic is subscribed as raw serialised messages
-//               (topic_tools::ShapeShifter, any type) and converted by RosInputConverter, i.e. by
-//               livo-import rosbag's decoders and conversions; published on the sensor channels.
+//               (topic_tools::ShapeShifter, any type) and converted by livo-import's own
+//               RosMessageConverter, as livo-import rosbag converts a bag's; published on the
+//               sensor channels.
 //   LCM -> ROS: ODOMETRY -> nav_msgs/Odometry (+ /tf world -> body), REGISTERED_SCAN and
 //               COLORED_CLOUD -> sensor_msgs/PointCloud2 (ros_output_messages.hpp); the clouds are
 //               converted only while a ROS node subscribes to them.
@@ -27,11 +28,12 @@
 #include <topic_tools/shape_shifter.h>
 
 #include "livo/colored_cloud_t.hpp"
+#include "livo/import/import_report.hpp"
+#include "livo/import/ros_message_converter.hpp"
 #include "livo/node.hpp"
 #include "livo/odometry_t.hpp"
 #include "livo/registered_scan_t.hpp"
 #include "livo/ros_bridge/ros_bridge_config.hpp"
-#include "livo/ros_bridge/ros_input.hpp"
 
 namespace livo::ros_bridge {
 
@@ -65,7 +67,8 @@ class RosBridgeNode : private import::MessageObserver {
 
   void subscribeInputs(ros::NodeHandle& ros_node);
   void advertiseOutputs(ros::NodeHandle& ros_node);
-  void onRosMessage(SensorRole role, const std::string& topic, const topic_tools::ShapeShifter& message);
+  /// `where` names the topic in the report's skip examples ("topic /imu").
+  void onRosMessage(const std::string& topic, const std::string& where, const topic_tools::ShapeShifter& message);
   void onOdometry(const odometry_t& odometry);
   void onRegisteredScan(const registered_scan_t& scan);
   void onColouredCloud(const colored_cloud_t& cloud);
@@ -90,7 +93,7 @@ class RosBridgeNode : private import::MessageObserver {
   Node node_;
   RosBridgeNodeOptions options_;
   import::ImportReport report_;
-  RosInputConverter input_;
+  import::RosMessageConverter input_;  // to this node's MessageObserver: the LCM queue
   std::vector<ros::Subscriber> subscribers_;
   ros::Publisher odometry_publisher_, scan_publisher_, cloud_publisher_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_;
