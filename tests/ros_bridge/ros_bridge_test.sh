@@ -6,15 +6,17 @@
 #                recorded by livo-record
 #   ROS path     roscore; livo-lio; livo-ros-bridge; a rospy recorder of the bridge's nav_msgs/Odometry,
 #                /tf and registered scans (ros_outputs_recorder.py); `rosbag play` of the bag in real
-#                time; lcm-logger records the sensor channels the bridge publishes
+#                time; livo_ros_bridge_bus_recorder (bus_recorder.cpp: a subscription without LCM's
+#                30-message queue limit, which lost IMU samples in lcm-logger under load) records
+#                the sensor channels the bridge publishes
 # Checks: the bridge's IMU, LIDAR and GROUND_TRUTH streams are byte-identical to the import's (one
 # code path: livo-import rosbag's conversions); the ROS side received as many odometry poses as the
 # import path made, each with its /tf, in the configured frames, and registered scans as PointCloud2;
 # the ATE of both against the bag's ground truth agrees within the real-time tolerance below.
 #
-#   tests/ros_bridge/ros_bridge_test.sh REPO_ROOT BIN_DIR
+#   tests/ros_bridge/ros_bridge_test.sh REPO_ROOT BIN_DIR BUS_RECORDER
 set -uo pipefail
-root="$1"; bin="$2"
+root="$1"; bin="$2"; bus_recorder="$3"
 if [ "${LIVO_PRIVATE_BUS:-}" != 1 ]; then exec "$root/scripts/private_bus.sh" "$0" "$@"; fi
 dir=$(mktemp -d /tmp/livo-ros-bridge.XXXXXX)
 pids=()
@@ -79,7 +81,10 @@ echo "import path: $(( $(date +%s) - start )) s so far"
 
 # ---- ROS path: roscore, livo-lio, livo-ros-bridge, a rospy recorder, rosbag play --------------------
 pids+=("$roscore")
-lcm-logger -q -c 'IMU|LIDAR|GROUND_TRUTH|ODOMETRY' "$dir/bridge.lcmlog" >"$dir/lcm_logger.log" 2>&1 &
+# the kernel's UDP receive-buffer drops on this private bus, before and after (should stay 0)
+rcvbuf_errors() { awk '$1 == "Udp:" && $2 ~ /^[0-9]/ { print $6 }' /proc/net/snmp; }
+rcvbuf_before=$(rcvbuf_errors)
+"$bus_recorder" 'IMU|LIDAR|GROUND_TRUTH|ODOMETRY' "$dir/bridge.lcmlog" >"$dir/bus_recorder.log" 2>&1 &
 logger=$!
 "$bin/livo-lio" --config "$config" --name lio >"$dir/lio_realtime.log" 2>&1 &
 lio=$!
@@ -108,8 +113,9 @@ done
 sleep 0.5
 kill -INT "$recorder"; wait "$recorder"
 kill -INT "$bridge"; wait "$bridge" || fail "livo-ros-bridge exited non-zero"
-kill -INT "$lio" "$logger"; wait "$lio" "$logger"
+kill -INT "$lio" "$logger"; wait "$lio"; wait "$logger" || fail "the bus recorder failed"
 echo "bridge: $(grep 'ROS messages converted' "$dir/bridge.log")"
+echo "bus recorder: $(cat "$dir/bus_recorder.log"); UDP receive-buffer drops: $(( $(rcvbuf_errors) - rcvbuf_before ))"
 echo "whole run: $(( $(date +%s) - start )) s"
 
 # ---- checks ------------------------------------------------------------------------------------------
