@@ -19,6 +19,7 @@ set -uo pipefail
 root="$1"; bin="$2"; bus_recorder="$3"
 if [ "${LIVO_PRIVATE_BUS:-}" != 1 ]; then exec "$root/scripts/private_bus.sh" "$0" "$@"; fi
 dir=$(mktemp -d /tmp/livo-ros-bridge.XXXXXX)
+cd "$dir"  # livo-lio writes calibration.csv/.yaml into its working directory
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null; done
